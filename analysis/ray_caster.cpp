@@ -1,0 +1,81 @@
+#include "analysis/ray_caster.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace pandora {
+
+void RayCaster::OccludedBatch(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const {
+  occluded->assign(rays.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        (*occluded)[i] = Occluded(rays[i]) ? 1 : 0;
+                    });
+}
+
+namespace {
+
+class BruteForceRayCaster final : public RayCaster {
+ public:
+  explicit BruteForceRayCaster(const TriangleMesh& mesh) : mesh_(mesh) {}
+
+  bool Occluded(const Ray& ray) const override {
+    for (std::size_t i = 0; i < mesh_.triangles.size(); ++i)
+      if (HitTriangle(ray, static_cast<int>(i), ray.t_far)) return true;
+    return false;
+  }
+
+  std::optional<RayHit> Intersect(const Ray& ray) const override {
+    std::optional<RayHit> best;
+    double t_max = ray.t_far;
+    for (std::size_t i = 0; i < mesh_.triangles.size(); ++i) {
+      if (auto t = HitTriangle(ray, static_cast<int>(i), t_max)) {
+        t_max = *t;
+        const Eigen::Vector3i& tri = mesh_.triangles[i];
+        const Vec3 n = (mesh_.vertices[tri[1]] - mesh_.vertices[tri[0]])
+                           .cross(mesh_.vertices[tri[2]] - mesh_.vertices[tri[0]]);
+        best = RayHit{*t, static_cast<int>(i), n.normalized()};
+      }
+    }
+    return best;
+  }
+
+  const char* name() const override { return "brute-force"; }
+  std::size_t triangle_count() const override { return mesh_.triangles.size(); }
+
+ private:
+  // Moller-Trumbore in double precision. Returns t when the ray hits triangle `index` (closed
+  // triangle, either side) with t_near < t < t_max.
+  std::optional<double> HitTriangle(const Ray& ray, int index, double t_max) const {
+    const Eigen::Vector3i& tri = mesh_.triangles[index];
+    const Vec3& a = mesh_.vertices[tri[0]];
+    const Vec3 e1 = mesh_.vertices[tri[1]] - a;
+    const Vec3 e2 = mesh_.vertices[tri[2]] - a;
+    const Vec3 p = ray.direction.cross(e2);
+    const double det = e1.dot(p);
+    if (det == 0.0 || !std::isfinite(det)) return std::nullopt;
+    const double inv = 1.0 / det;
+    const Vec3 s = ray.origin - a;
+    const double u = s.dot(p) * inv;
+    if (u < 0.0 || u > 1.0) return std::nullopt;
+    const Vec3 q = s.cross(e1);
+    const double v = ray.direction.dot(q) * inv;
+    if (v < 0.0 || u + v > 1.0) return std::nullopt;
+    const double t = e2.dot(q) * inv;
+    if (t > ray.t_near && t < t_max) return t;
+    return std::nullopt;
+  }
+
+  TriangleMesh mesh_;
+};
+
+}  // namespace
+
+std::unique_ptr<RayCaster> MakeBruteForceRayCaster(const TriangleMesh& mesh) {
+  return std::make_unique<BruteForceRayCaster>(mesh);
+}
+
+}  // namespace pandora

@@ -1,0 +1,70 @@
+#pragma once
+/// \file ray_caster.h
+/// Ray casting against the scene's triangles behind a small interface: Embree (fast, single
+/// precision, used everywhere) and a brute-force double-precision implementation (tests, references).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "analysis/geometry.h"
+
+namespace pandora {
+
+/// A ray segment: points origin + t * direction for t in (t_near, t_far). `direction` is unit length,
+/// so t is in metres.
+struct Ray {
+  Vec3 origin;
+  Vec3 direction;
+  double t_near = 0;
+  double t_far = 0;
+};
+
+/// The first hit along a ray.
+struct RayHit {
+  double t = 0;       ///< Metres along the ray.
+  int triangle = -1;  ///< Index into the mesh the caster was built from.
+  Vec3 normal;        ///< Geometric unit normal of the hit triangle (counter-clockwise front).
+};
+
+/// Answers occlusion and first-hit queries against a fixed triangle mesh. Implementations are
+/// immutable after construction and safe for concurrent const use from many threads.
+class RayCaster {
+ public:
+  virtual ~RayCaster() = default;
+
+  /// True when the segment hits any triangle (either side).
+  virtual bool Occluded(const Ray& ray) const = 0;
+  /// The nearest hit in (t_near, t_far), or nullopt.
+  virtual std::optional<RayHit> Intersect(const Ray& ray) const = 0;
+  /// Occluded() for every ray, in parallel (TBB); `occluded` is resized to rays.size().
+  virtual void OccludedBatch(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const;
+
+  /// "embree" or "brute-force".
+  virtual const char* name() const = 0;
+  /// Number of triangles.
+  virtual std::size_t triangle_count() const = 0;
+};
+
+/// Embree 3 BVH over `mesh` (single precision, robust mode, high build quality). The mesh is recentred
+/// on its bounding-box centre before conversion to float, so precision is relative to the scene's
+/// size rather than its distance from the world origin. Throws std::runtime_error when Embree fails.
+std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh);
+
+/// Double-precision brute force (Moller-Trumbore over every triangle). O(triangles) per ray.
+std::unique_ptr<RayCaster> MakeBruteForceRayCaster(const TriangleMesh& mesh);
+
+/// Result of RawEmbreeOcclusion.
+struct RawOcclusionResult {
+  double seconds = 0;
+  std::size_t rays = 0;
+  std::size_t occluded = 0;
+};
+
+/// The benchmark baseline: a bare loop of rtcOccluded1 over `rays` split across TBB threads, with no
+/// work besides filling RTCRay. `caster` must come from MakeEmbreeRayCaster (throws
+/// std::invalid_argument otherwise).
+RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays);
+
+}  // namespace pandora

@@ -1,0 +1,113 @@
+#pragma once
+/// \file scene.h
+/// The scene file: geometry (meshes and primitives), rigs of cameras, and the study (region, voxel
+/// size, fields). The full format reference is docs/scene-format.md.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "analysis/camera.h"
+#include "analysis/geometry.h"
+
+namespace pandora {
+
+/// Surface appearance, kept for rendering.
+struct Material {
+  std::string name;
+  Vec3 color{0.7, 0.7, 0.7};  ///< Linear RGB diffuse colour in [0, 1].
+  std::string texture;        ///< Path of a diffuse texture, empty when none.
+};
+
+/// One object of the scene after its instance transform: world coordinates, metres.
+struct SceneObject {
+  std::string name;
+  std::string source;   ///< "box", "sphere", ..., or the mesh file path as written in the scene.
+  TriangleMesh mesh;    ///< World coordinates.
+  int material = -1;    ///< Index into Scene::materials, -1 for the default.
+  bool solid = false;   ///< Closed (checked on load); its inside is filled: voxels there stay inactive.
+};
+
+/// A named set of cameras.
+struct Rig {
+  std::string name;
+  std::vector<Camera> cameras;
+
+  int enabled_count() const {
+    int n = 0;
+    for (const Camera& c : cameras) n += c.enabled ? 1 : 0;
+    return n;
+  }
+};
+
+/// The region of interest: a box, or a closed mesh (voxels whose centre is inside it).
+struct Region {
+  enum class Kind { kBox, kMesh };
+  Kind kind = Kind::kBox;
+  Aabb box;           ///< The box, or the bounds of the mesh.
+  TriangleMesh mesh;  ///< Closed mesh when kind == kMesh.
+};
+
+/// What to compute and where.
+struct Study {
+  Region region;
+  double voxel_size = 0.05;  ///< Metres.
+  std::vector<std::string> fields{"coverage", "cameras", "resolution"};
+  double pixel_sigma = 0.5;             ///< Pixel noise 1-sigma, pixels (uncertainty fields).
+  /// Refuse regions whose grids would exceed this. The file gives it in MiB ("memory_budget_mb",
+  /// default 4096); stored in bytes.
+  double memory_budget_bytes = 4096.0 * 1024.0 * 1024.0;
+};
+
+/// A named viewpoint for rendering ("views" in the scene file). World frame, metres.
+struct View {
+  Vec3 from = Vec3::Zero();  ///< Eye position.
+  Vec3 at = Vec3::UnitX();   ///< Point looked at (differs from `from`).
+  Vec3 up = Vec3::UnitZ();   ///< Up direction (not parallel to at - from).
+  /// Horizontal field of view in degrees, in (0, 180); unset means the renderer's default.
+  std::optional<double> fov_deg;
+};
+
+/// A loaded, validated scene file.
+struct Scene {
+  std::string path;         ///< As given on the command line.
+  std::string sha256;       ///< Hex SHA-256 of the file's bytes.
+  std::vector<Material> materials;
+  std::vector<SceneObject> objects;
+  std::vector<Rig> rigs;    ///< In file order; at least one.
+  Study study;
+  std::map<std::string, View> views;  ///< Named viewpoints, by name.
+
+  /// All triangles of all objects, for ray casting. Also returns, per triangle, its object index.
+  TriangleMesh AllTriangles(std::vector<int>* triangle_object = nullptr) const;
+  /// Bounds of geometry, cameras of every rig, and the region.
+  Aabb Bounds() const;
+  /// The rig called `name`, or the first rig when `name` is empty. Throws InputError (path
+  /// "$.rigs") naming the available rigs when there is none of that name.
+  const Rig& FindRig(const std::string& name) const;
+};
+
+/// Options for LoadScene.
+struct LoadOptions {
+  /// When false, mesh files are not read (objects keep empty meshes); used by tools that only need
+  /// the cameras.
+  bool load_meshes = true;
+};
+
+/// Reads and validates a scene file. Throws InputError naming the file, the JSON path of the first bad
+/// field, the reason and a hint. Mesh paths are relative to the scene file's folder.
+Scene LoadScene(const std::string& path, const LoadOptions& options = {});
+
+/// Parses a scene from JSON text; `path` is used for messages and to resolve relative mesh paths.
+Scene ParseScene(const std::string& json_text, const std::string& path,
+                 const LoadOptions& options = {});
+
+/// Serializes a rig back to the scene file's JSON form (position + quaternion pose, focal lengths in
+/// pixels, distortion by OpenCV names). Used as metadata in outputs and by `pandora accept`.
+nlohmann::json RigToJson(const Rig& rig);
+
+}  // namespace pandora

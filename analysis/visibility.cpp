@@ -1,0 +1,81 @@
+#include "analysis/visibility.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace pandora {
+
+const char* ViewResultName(ViewResult result) {
+  switch (result) {
+    case ViewResult::kSeen: return "seen";
+    case ViewResult::kDisabled: return "disabled";
+    case ViewResult::kOutOfRange: return "out of range";
+    case ViewResult::kNotProjectable: return "not projectable";
+    case ViewResult::kOutsideImage: return "outside image";
+    case ViewResult::kBackFacing: return "back facing";
+    case ViewResult::kOccluded: return "occluded";
+  }
+  return "unknown";
+}
+
+double PixelDensity(const Mat23& J) {
+  const Eigen::Matrix2d jjt = J * J.transpose();
+  const double det = jjt.determinant();
+  if (!(det > 0.0) || !std::isfinite(det)) return 0.0;
+  return std::sqrt(std::sqrt(det));
+}
+
+VisibilityTester::VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster,
+                                   double scene_scale)
+    : cameras_(cameras), caster_(caster), epsilon_(kRelativeEpsilon * scene_scale) {
+  camera_from_world_.reserve(cameras_.size());
+  for (const Camera& c : cameras_) camera_from_world_.push_back(c.camera_from_world());
+}
+
+ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3* normal, Ray* segment,
+                                          Mat23* d_pixel_d_world) const {
+  const Camera& cam = cameras_[camera];
+  if (!cam.enabled) return ViewResult::kDisabled;
+  const Vec3 to_point = X - cam.center();
+  const double distance = to_point.norm();
+  if (distance < cam.near || distance > cam.far) return ViewResult::kOutOfRange;
+  const Eigen::Isometry3d& cfw = camera_from_world_[camera];
+  const Vec3 p_camera = cfw.linear() * X + cfw.translation();
+  Mat23 d_pixel_d_camera;
+  const std::optional<Vec2> pixel =
+      cam.model.Project(p_camera, d_pixel_d_world ? &d_pixel_d_camera : nullptr);
+  if (!pixel) return ViewResult::kNotProjectable;
+  if (!cam.model.InImage(*pixel)) return ViewResult::kOutsideImage;
+  if (normal && normal->dot(-to_point) <= 0.0) return ViewResult::kBackFacing;
+  if (d_pixel_d_world) *d_pixel_d_world = d_pixel_d_camera * cfw.linear();
+  if (segment) {
+    segment->origin = cam.center();
+    segment->direction = to_point / distance;
+    segment->t_near = epsilon_;
+    segment->t_far = std::max(epsilon_, distance - epsilon_);
+  }
+  return ViewResult::kSeen;
+}
+
+ViewResult VisibilityTester::Test(int camera, const Vec3& X, const Vec3* normal,
+                                  Mat23* d_pixel_d_world) const {
+  Ray segment;
+  const ViewResult r = TestGeometry(camera, X, normal, &segment, d_pixel_d_world);
+  if (r != ViewResult::kSeen) return r;
+  if (segment.t_far <= segment.t_near) return ViewResult::kSeen;  // X within epsilon of the centre
+  return caster_.Occluded(segment) ? ViewResult::kOccluded : ViewResult::kSeen;
+}
+
+void VisibilityTester::TestBatch(int camera, const std::vector<Vec3>& points,
+                                 std::vector<ViewResult>* results) const {
+  results->assign(points.size(), ViewResult::kSeen);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        (*results)[i] = Test(camera, points[i]);
+                    });
+}
+
+}  // namespace pandora

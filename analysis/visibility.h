@@ -1,0 +1,72 @@
+#pragma once
+/// \file visibility.h
+/// Whether camera c sees point X: X projects inside c's image (distortion included, within the lens's
+/// monotonic domain), lies within c's working range, faces c when it is a surface point, and the
+/// segment from c's centre to X hits no triangle. Expected outcomes are values, never exceptions.
+
+#include <cstdint>
+#include <vector>
+
+#include "analysis/camera.h"
+#include "analysis/ray_caster.h"
+
+namespace pandora {
+
+/// Why a point is or is not seen, in the order the tests run (cheapest first).
+enum class ViewResult : uint8_t {
+  kSeen = 0,
+  kDisabled,        ///< The camera is disabled.
+  kOutOfRange,      ///< Distance from the centre outside [near, far].
+  kNotProjectable,  ///< Behind the camera or beyond the lens's monotonic domain.
+  kOutsideImage,    ///< Projects outside [-0.5, w-0.5] x [-0.5, h-0.5].
+  kBackFacing,      ///< Surface point whose normal faces away from the camera.
+  kOccluded,        ///< The segment to the camera hits geometry.
+};
+
+/// Returns a short lowercase name ("seen", "occluded", ...).
+const char* ViewResultName(ViewResult result);
+
+/// The local pixel density (pixels per metre) of a projection Jacobian: the geometric mean of the two
+/// non-zero singular values of the 2x3 Jacobian d(pixel)/d(X), i.e. det(J J^T)^(1/4). For an ideal
+/// pinhole on its axis this is f/Z. It measures displacements perpendicular to the viewing ray, so
+/// lens distortion and obliquity count. Returns 0 for a degenerate Jacobian.
+double PixelDensity(const Mat23& d_pixel_d_world);
+
+/// Per-camera visibility tests against one ray caster. Immutable; safe for concurrent const use.
+class VisibilityTester {
+ public:
+  /// Relative epsilon for occlusion segments (times the scene scale); see epsilon().
+  static constexpr double kRelativeEpsilon = 1e-5;
+
+  /// `scene_scale` is a length that bounds the scene (e.g. the diagonal of Scene::Bounds()); the
+  /// occlusion segment stops epsilon() = kRelativeEpsilon * scene_scale short of both ends, so a
+  /// point lying on a surface is not occluded by that surface and float round-off in the ray caster
+  /// (relative ~1e-7 of the scene size) cannot flip the answer.
+  VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster, double scene_scale);
+
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  double epsilon() const { return epsilon_; }
+
+  /// Every test but occlusion. On kSeen, `segment` (if given) receives the occlusion segment from the
+  /// camera centre to X, and `d_pixel_d_world` (if given) the 2x3 projection Jacobian at X.
+  /// `normal` (world, any length) makes X a surface point that must face the camera.
+  ViewResult TestGeometry(int camera, const Vec3& X, const Vec3* normal = nullptr,
+                          Ray* segment = nullptr, Mat23* d_pixel_d_world = nullptr) const;
+
+  /// The full test: TestGeometry, then the occlusion segment against the ray caster.
+  ViewResult Test(int camera, const Vec3& X, const Vec3* normal = nullptr,
+                  Mat23* d_pixel_d_world = nullptr) const;
+
+  /// Test() for many points against one camera, in parallel. `results` is resized to points.size().
+  void TestBatch(int camera, const std::vector<Vec3>& points, std::vector<ViewResult>* results) const;
+
+  const RayCaster& caster() const { return caster_; }
+
+ private:
+  std::vector<Camera> cameras_;
+  std::vector<Eigen::Isometry3d> camera_from_world_;
+  const RayCaster& caster_;
+  double epsilon_;
+};
+
+}  // namespace pandora

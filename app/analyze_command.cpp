@@ -1,0 +1,99 @@
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "analysis/error.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+#include "app/commands.h"
+#include "app/output.h"
+#include "volume/fields.h"
+#include "volume/summary.h"
+#include "volume/vdb_io.h"
+
+#ifndef PANDORA_VERSION
+#define PANDORA_VERSION "dev"
+#endif
+
+namespace pandora::app {
+namespace {
+
+std::vector<std::string> SplitFields(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void PrintTable(const nlohmann::json& s) {
+  std::printf("rig %s: %d cameras, voxel %.4g m, %lld region voxels (%lld inside solids)\n",
+              s["rig"].get<std::string>().c_str(), s["cameras"].get<int>(),
+              s["voxel_size_m"].get<double>(), s["region_voxels"].get<long long>(),
+              s["solid_voxels"].get<long long>());
+  std::printf("coverage  >=1 %5.1f%%   >=2 %5.1f%%   >=3 %5.1f%%\n",
+              100 * s["coverage"]["ge1"].get<double>(), 100 * s["coverage"]["ge2"].get<double>(),
+              100 * s["coverage"]["ge3"].get<double>());
+  std::printf("%-12s %-20s %8s\n", "camera", "name", "sees");
+  for (const auto& c : s["per_camera"])
+    std::printf("%-12s %-20s %7.1f%%%s\n", c["id"].get<std::string>().c_str(),
+                c["name"].get<std::string>().c_str(), 100 * c["visible_fraction"].get<double>(),
+                c["enabled"].get<bool>() ? "" : "  (disabled)");
+  const auto& t = s["timing"];
+  std::printf("%.3f s, %.3g rays (%.3g rays/s), %.3g point-camera tests\n",
+              t["seconds"].get<double>(), t["rays"].get<double>(),
+              t["rays_per_second"].get<double>(), t["point_camera_tests"].get<double>());
+}
+
+}  // namespace
+
+int RunAnalyze(const AnalyzeArgs& args) {
+  Scene scene = LoadScene(args.scene);
+  const Rig& rig = scene.FindRig(args.rig);
+  if (args.voxel_size != 0) {
+    if (!(args.voxel_size > 0) || !std::isfinite(args.voxel_size))
+      throw InputError("--voxel-size", "", "must be a positive number of metres");
+    scene.study.voxel_size = args.voxel_size;
+  }
+  FieldOptions options;
+  options.scene_path = scene.path;
+  options.fields = args.fields.empty() ? scene.study.fields : SplitFields(args.fields);
+  options.memory_budget_bytes =
+      args.memory_budget_mb > 0 ? args.memory_budget_mb * 1e6 : scene.study.memory_budget_bytes;
+  PrepareOutputDir(args.out);
+
+  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  ProgressBar bar("analyze " + rig.name, !args.quiet);
+  options.progress = [&bar](double f) { bar.Update(f); };
+  const Fields fields = EvaluateFields(scene, rig, *caster, options);
+  bar.Finish();
+
+  const int threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  const nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, threads);
+  const std::filesystem::path out(args.out);
+  std::map<std::string, std::string> meta{
+      {"units", "m"},
+      {"tool", "pandora"},
+      {"tool_version", PANDORA_VERSION},
+      {"scene_file", scene.path},
+      {"scene_sha256", scene.sha256},
+      {"rig_name", rig.name},
+      {"rig", RigToJson(rig).dump()},
+      {"voxel_size_m", std::to_string(scene.study.voxel_size)},
+  };
+  WriteFieldsVdb(fields, (out / "fields.vdb").string(), meta);
+  WriteFileAtomically((out / "summary.json").string(), summary.dump(2) + "\n");
+  if (!args.quiet) {
+    PrintTable(summary);
+    std::printf("wrote %s and %s\n", (out / "fields.vdb").c_str(), (out / "summary.json").c_str());
+  }
+  return 0;
+}
+
+}  // namespace pandora::app

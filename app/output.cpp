@@ -1,0 +1,78 @@
+#include "app/output.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "analysis/error.h"
+
+namespace pandora::app {
+
+void PrepareOutputDir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    throw InputError(dir, "", "cannot create the output folder: " + ec.message(),
+                     "choose another --out folder");
+  if (!std::filesystem::is_directory(dir))
+    throw InputError(dir, "", "the output path exists and is not a folder",
+                     "choose another --out folder");
+  const std::string probe = (std::filesystem::path(dir) / ".pandora-write-test.tmp").string();
+  std::ofstream f(probe);
+  if (!f)
+    throw InputError(dir, "", "the output folder is not writable", "choose another --out folder");
+  f.close();
+  std::remove(probe.c_str());
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    f.flush();
+    if (!f) {
+      std::remove(tmp.c_str());
+      throw InputError(path, "", "cannot write the file", "check the output folder");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", "cannot rename the temporary file: " + ec.message(),
+                     "check the output folder");
+  }
+}
+
+ProgressBar::ProgressBar(std::string label, bool enabled)
+    : label_(std::move(label)), active_(enabled && isatty(STDERR_FILENO)) {}
+
+ProgressBar::~ProgressBar() { Finish(); }
+
+void ProgressBar::Update(double fraction) {
+  if (!active_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (finished_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(100)) return;
+  last_ = now;
+  const int width = 30;
+  const int filled = static_cast<int>(fraction * width + 0.5);
+  std::fprintf(stderr, "\r%s [%s%s] %3d%%", label_.c_str(), std::string(filled, '#').c_str(),
+               std::string(width - filled, ' ').c_str(), static_cast<int>(fraction * 100 + 0.5));
+  std::fflush(stderr);
+}
+
+void ProgressBar::Finish() {
+  if (!active_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (finished_) return;
+  finished_ = true;
+  std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 40, "");
+  std::fflush(stderr);
+}
+
+}  // namespace pandora::app

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs Pandora's build and test dependencies from Debian 12 packages.
+# Non-interactive and idempotent: does nothing when every package is already installed.
+# Runs as root, or through sudo when not root.
+set -euo pipefail
+
+PACKAGES=(
+  cmake ninja-build ccache g++ pkg-config git
+  libopenvdb-dev libopenvdb-tools libembree-dev libcgal-dev libceres-dev libglm-dev
+  libopenexr-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
+  libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: not root and sudo is missing; run as root" >&2; exit 1; }
+  SUDO="sudo"
+fi
+
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO -E apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,187 @@
+#include "volume/active_set.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "analysis/error.h"
+
+namespace pandora {
+
+VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path) {
+  VoxelLattice lattice;
+  lattice.voxel_size = voxel_size;
+  lattice.origin = region.min + Vec3::Constant(0.5 * voxel_size);
+  const Vec3 extent = region.size();
+  for (int a = 0; a < 3; ++a) {
+    const double n = std::max(1.0, std::ceil(extent[a] / voxel_size - 1e-9));
+    if (!(n <= double(1 << 30)))
+      throw InputError(scene_path, "$.study.voxel_size",
+                       "the region needs more than 2^30 voxels along one axis",
+                       "use a larger voxel_size or a smaller region");
+    lattice.dims[a] = static_cast<int>(n);
+  }
+  return lattice;
+}
+
+FrustumCuller::FrustumCuller(const std::vector<Camera>& cameras) {
+  cams_.resize(cameras.size());
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    const Camera& cam = cameras[c];
+    Planes& p = cams_[c];
+    p.enabled = cam.enabled;
+    p.camera_from_world = cam.camera_from_world();
+    p.axis = cam.world_from_camera.linear().col(2).normalized();
+    p.center = cam.center();
+    p.near = cam.near;
+    p.far = cam.far;
+    p.max_angle = cam.model.max_field_angle();
+    p.use_planes = p.max_angle < 0.5 * M_PI - 1e-9;
+    if (p.use_planes) {
+      const Eigen::Vector4d& b = cam.model.normalized_bounds();  // x_min, x_max, y_min, y_max
+      p.normals[0] = Vec3(1, 0, -b[0]);
+      p.normals[1] = Vec3(-1, 0, b[1]);
+      p.normals[2] = Vec3(0, 1, -b[2]);
+      p.normals[3] = Vec3(0, -1, b[3]);
+    }
+  }
+}
+
+bool FrustumCuller::MayIntersect(int camera, const Aabb& box) const {
+  const Planes& p = cams_[camera];
+  if (!p.enabled) return false;
+  // Working range: nearest and farthest points of the box from the centre.
+  const Vec3 nearest = p.center.cwiseMax(box.min).cwiseMin(box.max);
+  const double d_min = (nearest - p.center).norm();
+  if (d_min > p.far) return false;
+  const Vec3 far_corner((p.center.x() < box.center().x()) ? box.max.x() : box.min.x(),
+                        (p.center.y() < box.center().y()) ? box.max.y() : box.min.y(),
+                        (p.center.z() < box.center().z()) ? box.max.z() : box.min.z());
+  if ((far_corner - p.center).norm() < p.near) return false;
+  // Bounding cone around the optical axis, against the box's bounding sphere.
+  const Vec3 m = box.center() - p.center;
+  const double dist = m.norm();
+  const double radius = 0.5 * box.diagonal();
+  if (dist > radius) {
+    const double angle = std::acos(std::clamp(m.dot(p.axis) / dist, -1.0, 1.0));
+    if (angle - std::asin(radius / dist) > p.max_angle) return false;
+  }
+  if (!p.use_planes) return true;
+  // The pyramid through the centre that bounds the image: outside when all corners are outside one
+  // plane.
+  std::array<Vec3, 8> corners;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 w((i & 1) ? box.max.x() : box.min.x(), (i & 2) ? box.max.y() : box.min.y(),
+                 (i & 4) ? box.max.z() : box.min.z());
+    corners[i] = p.camera_from_world * w;
+  }
+  for (const Vec3& n : p.normals) {
+    bool all_outside = true;
+    for (const Vec3& q : corners)
+      if (n.dot(q) >= 0.0) {
+        all_outside = false;
+        break;
+      }
+    if (all_outside) return false;
+  }
+  return true;
+}
+
+std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& region,
+                                  const std::vector<const InsideMesh*>& solids,
+                                  const InsideMesh* region_mesh, const FrustumCuller& culler,
+                                  int camera_count, ActiveSetStats* stats) {
+  const Eigen::Vector3i nb = (lattice.dims + Eigen::Vector3i::Constant(7)) / 8;
+  const std::int64_t block_count = std::int64_t(nb.x()) * nb.y() * nb.z();
+  std::vector<Block> all(static_cast<std::size_t>(block_count));
+  std::vector<std::uint8_t> keep(all.size(), 0);
+  const double h = lattice.voxel_size;
+
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_count, 4), [&](const auto& range) {
+    for (std::int64_t b = range.begin(); b != range.end(); ++b) {
+      Block& block = all[b];
+      const int bx = static_cast<int>(b / (std::int64_t(nb.y()) * nb.z()));
+      const int by = static_cast<int>((b / nb.z()) % nb.y());
+      const int bz = static_cast<int>(b % nb.z());
+      block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
+      const Eigen::Vector3i last =
+          (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
+      // Box of the voxel centres of this block (only centres are evaluated).
+      Aabb box;
+      box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
+      box.Extend(lattice.Center(last.x(), last.y(), last.z()));
+
+      // Region.
+      InsideMesh::BoxClass region_class = InsideMesh::BoxClass::kInside;
+      if (region.kind == Region::Kind::kMesh) region_class = region_mesh->Classify(box);
+      if (region_class == InsideMesh::BoxClass::kOutside) continue;
+      // Solids.
+      bool all_solid = false;
+      std::vector<const InsideMesh*> crossing;
+      for (const InsideMesh* s : solids) {
+        const InsideMesh::BoxClass c = s->Classify(box);
+        if (c == InsideMesh::BoxClass::kInside) {
+          all_solid = true;
+          break;
+        }
+        if (c == InsideMesh::BoxClass::kCrossing) crossing.push_back(s);
+      }
+
+      block.extent = last - block.origin + Eigen::Vector3i::Ones();
+      const std::int64_t n_vox = std::int64_t(block.extent.x()) * block.extent.y() * block.extent.z();
+      if (region_class == InsideMesh::BoxClass::kInside && crossing.empty()) {
+        // Fast path: the whole block is one thing, no per-voxel test.
+        (all_solid ? block.solid_voxels : block.free_voxels) = n_vox;
+      } else {
+        block.mask.assign(512, 0);
+        for (int x = block.origin.x(); x <= last.x(); ++x)
+          for (int y = block.origin.y(); y <= last.y(); ++y)
+            for (int z = block.origin.z(); z <= last.z(); ++z) {
+              const Vec3 p = lattice.Center(x, y, z);
+              if (region_class == InsideMesh::BoxClass::kCrossing && !region_mesh->Inside(p))
+                continue;
+              bool inside_solid = all_solid;
+              for (std::size_t s = 0; !inside_solid && s < crossing.size(); ++s)
+                inside_solid = crossing[s]->Inside(p);
+              if (inside_solid) {
+                ++block.solid_voxels;
+              } else {
+                block.mask[Block::Offset(x - block.origin.x(), y - block.origin.y(),
+                                         z - block.origin.z())] = 1;
+                ++block.free_voxels;
+              }
+            }
+        if (block.free_voxels == n_vox) std::vector<std::uint8_t>().swap(block.mask);
+      }
+      if (block.free_voxels == 0 && block.solid_voxels == 0) continue;
+      keep[b] = 1;
+      block.full = block.mask.empty() && n_vox == 512;
+      if (block.free_voxels == 0) continue;
+      // Cameras: pad the box by half a voxel diagonal's worth of round-off only.
+      Aabb padded = box;
+      padded.min -= Vec3::Constant(1e-9 * h);
+      padded.max += Vec3::Constant(1e-9 * h);
+      for (int c = 0; c < camera_count; ++c)
+        if (culler.MayIntersect(c, padded)) block.cameras |= (std::uint64_t{1} << c);
+    }
+  });
+
+  std::vector<Block> blocks;
+  ActiveSetStats s;
+  for (std::size_t b = 0; b < all.size(); ++b) {
+    if (!keep[b]) continue;
+    s.region_voxels += all[b].free_voxels;
+    s.solid_voxels += all[b].solid_voxels;
+    if (all[b].free_voxels == 0) continue;
+    ++s.blocks;
+    if (all[b].cameras == 0) ++s.culled_blocks;
+    blocks.push_back(std::move(all[b]));
+  }
+  if (stats) *stats = s;
+  return blocks;
+}
+
+}  // namespace pandora

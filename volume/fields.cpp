@@ -1,0 +1,257 @@
+#include "volume/fields.h"
+
+#include <openvdb/openvdb.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "analysis/error.h"
+#include "analysis/inside_mesh.h"
+#include "analysis/visibility.h"
+#include "volume/fields_vdb.h"
+
+namespace pandora {
+
+const std::vector<std::string>& KnownFields() {
+  static const std::vector<std::string> fields{"coverage", "cameras", "resolution"};
+  return fields;
+}
+
+Fields::Fields() : impl_(std::make_unique<Impl>()) {}
+Fields::~Fields() = default;
+Fields::Fields(Fields&&) noexcept = default;
+Fields& Fields::operator=(Fields&&) noexcept = default;
+
+namespace {
+
+bool Wants(const std::vector<std::string>& fields, const char* name) {
+  return std::find(fields.begin(), fields.end(), name) != fields.end();
+}
+
+// Bytes per voxel of each grid at full density, leaf masks and node overhead included (an OpenVDB
+// leaf of 512 voxels carries ~100 bytes of masks and header).
+double BytesPerVoxel(const std::string& field) {
+  const double overhead = 0.25;
+  if (field == "coverage") return 4 + overhead;
+  if (field == "cameras") return 8 + overhead;
+  if (field == "resolution") return 4 + overhead;
+  return 8 + overhead;  // Reserved fields (later issues): float or double storage.
+}
+
+// Results of one block, before they become OpenVDB leaves.
+struct BlockResult {
+  openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
+  openvdb::Int64Tree::LeafNodeType* cameras = nullptr;
+  openvdb::FloatTree::LeafNodeType* resolution = nullptr;
+  bool coverage_tile = false;  // A whole leaf of zeros: stored as a tile.
+  std::vector<Ray> rays;
+  std::array<std::int64_t, 65> histogram{};
+  std::vector<std::int64_t> per_camera;
+  std::int64_t tests = 0, ray_count = 0, seen = 0;
+};
+
+}  // namespace
+
+double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
+                          int camera_count) {
+  const double voxels = static_cast<double>(lattice.voxel_count());
+  const double blocks = voxels / 512.0 + 1.0;
+  // Active-set pass: one Block record per 8^3 block, a 512-byte mask where a block is partial.
+  double bytes = blocks * (sizeof(Block) + 512.0 + sizeof(BlockResult));
+  for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
+  return bytes + 64.0 * camera_count;
+}
+
+Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                      const FieldOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
+  for (std::size_t i = 0; i < options.fields.size(); ++i)
+    if (!Wants(KnownFields(), options.fields[i].c_str()))
+      throw InputError(file, "$.study.fields[" + std::to_string(i) + "]",
+                       "unknown or not yet available field '" + options.fields[i] + "'",
+                       "available: coverage, cameras, resolution");
+  if (options.fields.empty())
+    throw InputError(file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
+  const int camera_count = static_cast<int>(rig.cameras.size());
+  if (camera_count > 64)
+    throw InputError(file, "$.rigs", "rig '" + rig.name + "' has " + std::to_string(camera_count) +
+                                         " cameras; fields support at most 64",
+                     "split the rig or disable cameras in a copy of it");
+
+  Fields out;
+  const Study& study = scene.study;
+  out.lattice = MakeLattice(study.region.box, study.voxel_size, file);
+  const double estimate = EstimateFieldBytes(out.lattice, options.fields, camera_count);
+  out.stats.estimated_bytes = estimate;
+  if (estimate > options.memory_budget_bytes) {
+    // Memory scales with 1/h^3: the smallest voxel size that fits.
+    const double h_min =
+        study.voxel_size * std::cbrt(estimate / options.memory_budget_bytes) * 1.01;
+    std::ostringstream reason, hint;
+    reason << "the region needs about " << std::llround(estimate / 1e6) << " MB at voxel size "
+           << study.voxel_size << " m, over the budget of "
+           << std::llround(options.memory_budget_bytes / 1e6) << " MB";
+    hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
+         << "(--memory-budget or study.memory_budget_mb)";
+    throw InputError(file, "$.study.voxel_size", reason.str(), hint.str());
+  }
+
+  // Solids and the region mesh.
+  std::vector<std::unique_ptr<InsideMesh>> solid_meshes;
+  std::vector<const InsideMesh*> solids;
+  for (const SceneObject& o : scene.objects)
+    if (o.solid && !o.mesh.triangles.empty()) {
+      solid_meshes.push_back(std::make_unique<InsideMesh>(o.mesh));
+      solids.push_back(solid_meshes.back().get());
+    }
+  std::unique_ptr<InsideMesh> region_mesh;
+  if (study.region.kind == Region::Kind::kMesh)
+    region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
+
+  const FrustumCuller culler(rig.cameras);
+  const std::vector<Block> blocks = BuildActiveSet(out.lattice, study.region, solids,
+                                                   region_mesh.get(), culler, camera_count,
+                                                   &out.stats.active_set);
+  out.stats.active_set_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const bool want_coverage = Wants(options.fields, "coverage");
+  const bool want_cameras = Wants(options.fields, "cameras");
+  const bool want_resolution = Wants(options.fields, "resolution");
+  const int enabled = rig.enabled_count();
+  const VisibilityTester tester(rig.cameras, caster, scene.Bounds().diagonal());
+
+  std::vector<BlockResult> results(blocks.size());
+  std::atomic<std::size_t> done{0};
+  const std::size_t report_every = std::max<std::size_t>(1, blocks.size() / 200);
+
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const auto& range) {
+    for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
+      const Block& block = blocks[bi];
+      BlockResult& res = results[bi];
+      res.per_camera.assign(camera_count, 0);
+      res.tests = block.free_voxels * enabled;
+      const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+
+      std::array<std::int32_t, 512> coverage{};
+      std::array<std::uint64_t, 512> seen_by{};
+      std::array<float, 512> density{};
+      if (block.cameras != 0) {
+        for (int c = 0; c < camera_count; ++c) {
+          if (!(block.cameras >> c & 1)) continue;
+          const Camera& cam = rig.cameras[c];
+          for (int x = 0; x < block.extent.x(); ++x)
+            for (int y = 0; y < block.extent.y(); ++y)
+              for (int z = 0; z < block.extent.z(); ++z) {
+                if (!block.IsFree(x, y, z)) continue;
+                const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
+                                                  block.origin.z() + z);
+                Ray segment;
+                if (tester.TestGeometry(c, p, nullptr, &segment) != ViewResult::kSeen) continue;
+                if (segment.t_far > segment.t_near) {
+                  ++res.ray_count;
+                  if (options.record_rays) res.rays.push_back(segment);
+                  if (caster.Occluded(segment)) continue;
+                }
+                const int o = Block::Offset(x, y, z);
+                ++coverage[o];
+                seen_by[o] |= std::uint64_t{1} << c;
+                ++res.per_camera[c];
+                if (want_resolution) {
+                  Mat23 J;
+                  if (cam.Project(p, &J))
+                    density[o] = std::max(density[o], static_cast<float>(PixelDensity(J)));
+                }
+              }
+        }
+      }
+
+      // Statistics and leaves.
+      const bool any_seen = block.cameras != 0;
+      if (want_coverage && !any_seen && block.full) res.coverage_tile = true;
+      if (want_coverage && !res.coverage_tile)
+        res.coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, false);
+      if (any_seen && want_cameras)
+        res.cameras = new openvdb::Int64Tree::LeafNodeType(origin, 0, false);
+      if (any_seen && want_resolution)
+        res.resolution = new openvdb::FloatTree::LeafNodeType(origin, 0.0f, false);
+      for (int x = 0; x < block.extent.x(); ++x)
+        for (int y = 0; y < block.extent.y(); ++y)
+          for (int z = 0; z < block.extent.z(); ++z) {
+            if (!block.IsFree(x, y, z)) continue;
+            const int o = Block::Offset(x, y, z);
+            ++res.histogram[coverage[o]];
+            if (res.coverage) res.coverage->setValueOn(o, coverage[o]);
+            if (coverage[o] == 0) continue;
+            ++res.seen;
+            if (res.cameras) res.cameras->setValueOn(o, static_cast<std::int64_t>(seen_by[o]));
+            if (res.resolution) res.resolution->setValueOn(o, density[o]);
+          }
+      if (res.cameras && res.cameras->isEmpty()) {
+        delete res.cameras;
+        res.cameras = nullptr;
+      }
+      if (res.resolution && res.resolution->isEmpty()) {
+        delete res.resolution;
+        res.resolution = nullptr;
+      }
+      const std::size_t n = done.fetch_add(1) + 1;
+      if (options.progress && (n % report_every == 0 || n == blocks.size()))
+        options.progress(double(n) / double(blocks.size()));
+    }
+  });
+
+  // Assemble the grids serially (adding leaves is cheap; building them was the work).
+  Fields::Impl& g = out.impl();
+  g.transform = openvdb::math::Transform::createLinearTransform(study.voxel_size);
+  g.transform->postTranslate(openvdb::Vec3d(out.lattice.origin.x(), out.lattice.origin.y(),
+                                            out.lattice.origin.z()));
+  if (want_coverage) {
+    g.coverage = openvdb::Int32Grid::create(0);
+    g.coverage->setName(kCoverageGrid);
+    g.coverage->setTransform(g.transform);
+  }
+  if (want_cameras) {
+    g.cameras = openvdb::Int64Grid::create(0);
+    g.cameras->setName(kCamerasGrid);
+    g.cameras->setTransform(g.transform);
+  }
+  if (want_resolution) {
+    g.resolution = openvdb::FloatGrid::create(0.0f);
+    g.resolution->setName(kResolutionGrid);
+    g.resolution->setTransform(g.transform);
+  }
+  FieldStats& st = out.stats;
+  st.coverage_histogram.assign(camera_count + 1, 0);
+  st.per_camera_seen.assign(camera_count, 0);
+  std::size_t total_rays = 0;
+  for (const BlockResult& r : results) total_rays += r.rays.size();
+  if (options.record_rays) out.recorded_rays.reserve(total_rays);
+  for (std::size_t bi = 0; bi < results.size(); ++bi) {
+    BlockResult& r = results[bi];
+    const openvdb::Coord origin(blocks[bi].origin.x(), blocks[bi].origin.y(), blocks[bi].origin.z());
+    if (r.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
+    if (r.coverage) g.coverage->tree().addLeaf(r.coverage);
+    if (r.cameras) g.cameras->tree().addLeaf(r.cameras);
+    if (r.resolution) g.resolution->tree().addLeaf(r.resolution);
+    for (int k = 0; k <= camera_count; ++k) st.coverage_histogram[k] += r.histogram[k];
+    for (int c = 0; c < camera_count; ++c) st.per_camera_seen[c] += r.per_camera[c];
+    st.point_camera_tests += r.tests;
+    st.rays += r.ray_count;
+    st.seen_voxels += r.seen;
+    if (options.record_rays)
+      out.recorded_rays.insert(out.recorded_rays.end(), r.rays.begin(), r.rays.end());
+  }
+  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace pandora
