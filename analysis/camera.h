@@ -92,12 +92,15 @@ class CameraModel {
 
   /// Largest angle (radians) between the optical axis and the ray through any pixel of the image
   /// (corners included, distortion included). Used for conservative culling. May exceed pi/2 for
-  /// fisheye lenses.
+  /// fisheye lenses. Computed from a dense sampling of the image border (refined at local extrema)
+  /// and padded by 1e-6 relative; where part of the image lies beyond the image of the valid domain,
+  /// the domain edge bounds it (atan(max_radius()) for Brown-Conrady, max_radius() for fisheye).
   double max_field_angle() const { return max_field_angle_; }
 
   /// Bounds of the normalized image-plane coordinates (x, y) = (X/Z, Y/Z) of all rays through the
-  /// image, distortion included: [x_min, x_max] x [y_min, y_max]. Only meaningful when
-  /// max_field_angle() < pi/2; otherwise all four are infinite.
+  /// image, distortion included: [x_min, x_max] x [y_min, y_max], padded by 1e-6 relative (and
+  /// widened to the domain's square [-r, r]^2 when part of the image lies beyond the domain). Only
+  /// meaningful when max_field_angle() < pi/2; otherwise -inf, +inf, -inf, +inf.
   const Eigen::Vector4d& normalized_bounds() const { return normalized_bounds_; }
 
  private:
