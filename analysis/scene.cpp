@@ -1,1 +1,1123 @@
-// placeholder, replaced in this change
+#include "analysis/scene.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "analysis/error.h"
+#include "analysis/mesh_io.h"
+#include "analysis/primitives.h"
+#include "analysis/sha256.h"
+
+namespace pandora {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegree = kPi / 180.0;
+constexpr int kMaxResolution = 65536;
+constexpr int kMinSegments = 3;
+constexpr int kMaxSegments = 4096;
+constexpr int kDefaultSegments = 32;
+
+// Distinct camera colours (linear RGB), by camera index in its rig.
+const Vec3 kCameraPalette[8] = {
+    {0.90, 0.10, 0.10},  // red
+    {0.10, 0.60, 0.15},  // green
+    {0.10, 0.25, 0.90},  // blue
+    {0.95, 0.75, 0.05},  // yellow
+    {0.70, 0.15, 0.80},  // purple
+    {0.05, 0.75, 0.80},  // cyan
+    {0.95, 0.45, 0.05},  // orange
+    {0.95, 0.40, 0.65},  // pink
+};
+
+// The study fields this version accepts (the last four are reserved for later versions).
+std::vector<std::string> KnownFields() {
+  return {"coverage", "cameras", "resolution", "sigma_max", "sigma_mean", "triangulation_angle",
+          "condition"};
+}
+
+// -------------------------------------------------------------------------------------------------
+// Small string helpers.
+
+std::string FormatNumber(double v) {
+  std::ostringstream s;
+  s.precision(12);
+  s << v;
+  return s.str();
+}
+
+std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+std::string JoinQuoted(const std::vector<std::string>& items) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + Quoted(items[i]);
+  return out;
+}
+
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// "did you mean 'X'? " when a candidate is close to `word` (by edit distance, or as a prefix), then
+// the list of candidates.
+std::string SuggestionHint(const std::string& word, const std::vector<std::string>& candidates,
+                           const std::string& what) {
+  std::string best;
+  size_t best_distance = std::string::npos;
+  for (const std::string& c : candidates) {
+    size_t d = EditDistance(word, c);
+    const bool prefix = word.size() >= 3 && (c.rfind(word, 0) == 0 || word.rfind(c, 0) == 0);
+    const size_t limit = std::max<size_t>(2, c.size() / 3);
+    if (d > limit && !prefix) continue;
+    if (prefix) d = std::min(d, limit);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  std::string hint;
+  if (!best.empty()) hint = "did you mean " + Quoted(best) + "? ";
+  return hint + what + ": " + JoinQuoted(candidates);
+}
+
+bool IsIdentifier(const std::string& key) {
+  if (key.empty() || std::isdigit(static_cast<unsigned char>(key[0]))) return false;
+  return std::all_of(key.begin(), key.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+}
+
+// JSON path of member `key` of the value at `path`: $.a.b, or $.a["odd key"].
+std::string MemberPath(const std::string& path, const std::string& key) {
+  return IsIdentifier(key) ? path + "." + key : path + "[" + json(key).dump() + "]";
+}
+
+std::string ElementPath(const std::string& path, size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+
+// -------------------------------------------------------------------------------------------------
+// Reading JSON with paths.
+
+// What every reader needs: the file for messages, its folder for relative paths, the length unit.
+struct Context {
+  std::string file;
+  fs::path folder;
+  double metres_per_unit = 1.0;
+  LoadOptions options;
+};
+
+// A JSON value with its path. Every accessor validates and throws an InputError naming the path.
+class Node {
+ public:
+  Node(const json* value, std::string path, const Context* context)
+      : value_(value), path_(std::move(path)), context_(context) {}
+
+  const json& value() const { return *value_; }
+  const std::string& path() const { return path_; }
+  const Context& context() const { return *context_; }
+
+  [[noreturn]] void Fail(const std::string& reason, const std::string& hint = {}) const {
+    throw InputError(context_->file, path_, reason, hint);
+  }
+
+  // Objects.
+
+  void ExpectObject(const char* what = "an object") const {
+    if (!value_->is_object()) Fail(std::string("expected ") + what + ", got " + TypeName());
+  }
+
+  // Fails on the first key not in `allowed`, suggesting the closest allowed one.
+  void CheckKeys(const std::vector<std::string>& allowed) const {
+    ExpectObject();
+    for (const auto& item : value_->items()) {
+      if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
+      throw InputError(context_->file, MemberPath(path_, item.key()),
+                       "unknown key " + Quoted(item.key()),
+                       SuggestionHint(item.key(), allowed, "allowed keys here"));
+    }
+  }
+
+  bool Has(const std::string& key) const { return value_->contains(key); }
+
+  std::optional<Node> Find(const std::string& key) const {
+    const auto it = value_->find(key);
+    if (it == value_->end()) return std::nullopt;
+    return Node(&*it, MemberPath(path_, key), context_);
+  }
+
+  Node Get(const std::string& key) const {
+    std::optional<Node> child = Find(key);
+    if (!child) Fail("missing required key " + Quoted(key));
+    return *child;
+  }
+
+  // The one key of `keys` present; fails when none or several are.
+  std::string OneOf(const std::vector<std::string>& keys, const std::string& what) const {
+    std::string found;
+    for (const std::string& key : keys) {
+      if (!Has(key)) continue;
+      if (!found.empty()) {
+        throw InputError(context_->file, MemberPath(path_, key),
+                         "both " + Quoted(found) + " and " + Quoted(key) + " are given",
+                         "give exactly one " + what + ": " + JoinQuoted(keys));
+      }
+      found = key;
+    }
+    if (found.empty()) Fail("missing " + what, "give exactly one of " + JoinQuoted(keys));
+    return found;
+  }
+
+  // Arrays.
+
+  size_t ArraySize(const char* what = "an array") const {
+    if (!value_->is_array()) Fail(std::string("expected ") + what + ", got " + TypeName());
+    return value_->size();
+  }
+
+  Node At(size_t i) const { return Node(&(*value_)[i], ElementPath(path_, i), context_); }
+
+  // Scalars.
+
+  double Number() const {
+    if (!value_->is_number()) Fail("expected a number, got " + TypeName());
+    const double v = value_->get<double>();
+    if (!std::isfinite(v)) Fail("number is not finite");
+    return v;
+  }
+
+  double Positive() const {
+    const double v = Number();
+    if (!(v > 0)) Fail("must be positive, got " + FormatNumber(v));
+    return v;
+  }
+
+  double NonNegative() const {
+    const double v = Number();
+    if (!(v >= 0)) Fail("must be zero or positive, got " + FormatNumber(v));
+    return v;
+  }
+
+  // A length in the file's unit, returned in metres.
+  double Length() const { return Number() * context_->metres_per_unit; }
+  double PositiveLength() const { return Positive() * context_->metres_per_unit; }
+  double NonNegativeLength() const { return NonNegative() * context_->metres_per_unit; }
+
+  int Integer(int min, int max) const {
+    const double v = Number();
+    if (v != std::floor(v)) Fail("expected an integer, got " + FormatNumber(v));
+    if (v < min || v > max) {
+      Fail("must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got " +
+           FormatNumber(v));
+    }
+    return static_cast<int>(v);
+  }
+
+  std::string String() const {
+    if (!value_->is_string()) Fail("expected a string, got " + TypeName());
+    return value_->get<std::string>();
+  }
+
+  std::string NonEmptyString() const {
+    std::string s = String();
+    if (s.empty()) Fail("must not be empty");
+    return s;
+  }
+
+  bool Bool() const {
+    if (!value_->is_boolean()) Fail("expected true or false, got " + TypeName());
+    return value_->get<bool>();
+  }
+
+  // An array of exactly `n` numbers.
+  Eigen::VectorXd Numbers(size_t n) const {
+    const std::string expected = "expected an array of " + std::to_string(n) + " numbers";
+    if (!value_->is_array()) Fail(expected + ", got " + TypeName());
+    if (value_->size() != n) {
+      Fail(expected + ", got an array of " + std::to_string(value_->size()));
+    }
+    Eigen::VectorXd v(n);
+    for (size_t i = 0; i < n; ++i) v[i] = At(i).Number();
+    return v;
+  }
+
+  Vec3 Vector3() const { return Numbers(3); }
+  Vec2 Vector2() const { return Numbers(2); }
+  Vec3 Point() const { return Vector3() * context_->metres_per_unit; }
+
+  Vec3 PositiveVector3() const {
+    Vec3 v = Vector3();
+    for (int i = 0; i < 3; ++i) {
+      if (!(v[i] > 0)) At(i).Fail("must be positive, got " + FormatNumber(v[i]));
+    }
+    return v;
+  }
+
+  // [r, g, b] linear in [0, 1], or "#rrggbb" in sRGB (converted to linear).
+  Vec3 Color() const {
+    if (value_->is_string()) {
+      const std::string s = value_->get<std::string>();
+      const bool ok =
+          s.size() == 7 && s[0] == '#' && std::all_of(s.begin() + 1, s.end(), [](char c) {
+            return std::isxdigit(static_cast<unsigned char>(c));
+          });
+      if (!ok) Fail("expected a colour \"#rrggbb\", got " + json(s).dump());
+      Vec3 color;
+      for (int i = 0; i < 3; ++i) {
+        const double srgb = std::stoi(s.substr(1 + 2 * i, 2), nullptr, 16) / 255.0;
+        color[i] = srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4);
+      }
+      return color;
+    }
+    if (!value_->is_array()) {
+      Fail("expected a colour: [r, g, b] with components in 0..1 or \"#rrggbb\", got " +
+           TypeName());
+    }
+    const Vec3 color = Vector3();
+    for (int i = 0; i < 3; ++i) {
+      if (color[i] < 0 || color[i] > 1) {
+        At(i).Fail("colour components must be in 0..1, got " + FormatNumber(color[i]));
+      }
+    }
+    return color;
+  }
+
+ private:
+  std::string TypeName() const {
+    if (value_->is_number()) return "a number";
+    if (value_->is_string()) return "a string";
+    if (value_->is_boolean()) return "a boolean";
+    if (value_->is_array()) return "an array";
+    if (value_->is_object()) return "an object";
+    return "null";
+  }
+
+  const json* value_;
+  std::string path_;
+  const Context* context_;
+};
+
+// -------------------------------------------------------------------------------------------------
+// Parsing the text, with the path of the value being read kept for error messages.
+
+// Follows the parser's position as a JSON path, and rejects duplicate keys.
+class PathTracker {
+ public:
+  explicit PathTracker(const std::string& file) : file_(file) {}
+
+  // The path of the value the parser is reading now.
+  std::string CurrentPath() const {
+    if (stack_.empty()) return "$";
+    const Frame& top = stack_.back();
+    if (top.is_array) return ElementPath(top.path, top.count);
+    return top.key.empty() && top.keys.empty() ? top.path : MemberPath(top.path, top.key);
+  }
+
+  bool OnEvent(json::parse_event_t event, const json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start: {
+        Frame frame;
+        frame.is_array = event == json::parse_event_t::array_start;
+        frame.path = CurrentPath();
+        stack_.push_back(std::move(frame));
+        break;
+      }
+      case json::parse_event_t::key: {
+        Frame& top = stack_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second) {
+          throw InputError(file_, MemberPath(top.path, top.key), "duplicate key " + Quoted(top.key),
+                           "a key may appear once per object; the later value would replace the "
+                           "earlier one");
+        }
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        stack_.pop_back();
+        EndValue();
+        break;
+      case json::parse_event_t::value:
+        EndValue();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array = false;
+    size_t count = 0;  // Elements read so far (arrays).
+    std::string key;   // The current key (objects).
+    std::set<std::string> keys;
+    std::string path;
+  };
+
+  void EndValue() {
+    if (!stack_.empty() && stack_.back().is_array) ++stack_.back().count;
+  }
+
+  std::string file_;
+  std::vector<Frame> stack_;
+};
+
+json ParseJson(const std::string& text, const std::string& file) {
+  PathTracker tracker(file);
+  try {
+    return json::parse(text, [&tracker](int, json::parse_event_t event, json& parsed) {
+      return tracker.OnEvent(event, parsed);
+    });
+  } catch (const json::parse_error& e) {
+    std::string message = e.what();
+    const size_t bracket = message.find("] ");
+    if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) {
+      message = message.substr(bracket + 2);
+    }
+    const std::string where = tracker.CurrentPath();
+    throw InputError(file, "$", "malformed JSON: " + message,
+                     where == "$" ? "check the brackets, commas and quotes there"
+                                  : "the error is inside " + where +
+                                        "; check the brackets, commas and quotes there");
+  } catch (const json::exception& e) {
+    // Numbers too large for a double (1e400) end up here.
+    std::string message = e.what();
+    const size_t bracket = message.find("] ");
+    if (bracket != std::string::npos) message = message.substr(bracket + 2);
+    throw InputError(file, tracker.CurrentPath(), message,
+                     "numbers must be finite and within the range of a double");
+  }
+}
+
+// -------------------------------------------------------------------------------------------------
+// Scene parts.
+
+Mat3 RotationXyzDegrees(const Vec3& degrees) {
+  return (Eigen::AngleAxisd(degrees.z() * kDegree, Vec3::UnitZ()) *
+          Eigen::AngleAxisd(degrees.y() * kDegree, Vec3::UnitY()) *
+          Eigen::AngleAxisd(degrees.x() * kDegree, Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+// [w, x, y, z], normalized.
+Mat3 ReadQuaternion(const Node& node) {
+  const Eigen::VectorXd q = node.Numbers(4);
+  const double norm = q.norm();
+  if (!(norm > 1e-9)) node.Fail("quaternion is zero (its length must not be close to 0)");
+  return Eigen::Quaterniond(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm).toRotationMatrix();
+}
+
+// Rotation that turns a Y-up model into this Z-up world: (x, y, z) -> (x, -z, y).
+Mat3 YUpToZUp() {
+  Mat3 m;
+  m << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  return m;
+}
+
+std::string Extension(const std::string& file) {
+  std::string ext = fs::path(file).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string ResolvePath(const Context& context, const std::string& file) {
+  const fs::path p(file);
+  return p.is_absolute() ? p.string() : (context.folder / p).lexically_normal().string();
+}
+
+// A "mesh" block ({"file", "unit_scale", "up_axis"}), read but not loaded.
+struct MeshReference {
+  std::string file;                // As written.
+  std::string resolved;            // Against the scene's folder.
+  Node file_node;                  // For errors.
+  Eigen::Affine3d file_to_object;  // Unit scale and up-axis conversion, to metres.
+};
+
+MeshReference ReadMeshReference(const Node& node) {
+  node.CheckKeys({"file", "unit_scale", "up_axis"});
+  const Node file_node = node.Get("file");
+  const std::string file = file_node.NonEmptyString();
+  double unit_scale = 1.0;
+  if (auto n = node.Find("unit_scale")) unit_scale = n->Positive();
+  const std::string ext = Extension(file);
+  // glTF is Y-up by definition; assimp converts COLLADA to Y-up whatever the file declares.
+  std::string up_axis = (ext == ".gltf" || ext == ".glb" || ext == ".dae") ? "y" : "z";
+  if (auto n = node.Find("up_axis")) {
+    up_axis = n->String();
+    if (up_axis != "y" && up_axis != "z") {
+      n->Fail("unknown up axis " + json(up_axis).dump(), "use \"z\" or \"y\"");
+    }
+  }
+  Eigen::Affine3d transform = Eigen::Affine3d::Identity();
+  if (up_axis == "y") transform.linear() = YUpToZUp();
+  transform.linear() *= unit_scale * node.context().metres_per_unit;
+  return MeshReference{file, ResolvePath(node.context(), file), file_node, transform};
+}
+
+// Loads the parts of a mesh file, rethrowing its errors at the "file" field.
+std::vector<MeshPart> LoadMeshParts(const MeshReference& reference) {
+  try {
+    return LoadMeshFile(reference.resolved);
+  } catch (const InputError& e) {
+    reference.file_node.Fail(e.reason() + " (" + reference.resolved + ")", e.hint());
+  }
+}
+
+TriangleMesh Transformed(const TriangleMesh& mesh, const Eigen::Affine3d& transform) {
+  TriangleMesh out = mesh;
+  for (Vec3& v : out.vertices) v = transform * v;
+  return out;
+}
+
+// Fails unless `mesh` is closed and oriented outward. `subject` names it in messages.
+void CheckSolid(const TriangleMesh& mesh, const Node& node, const std::string& subject,
+                const std::string& fix) {
+  const TriangleMesh welded = WeldVertices(mesh);
+  const ClosedCheck check = CheckClosed(welded);
+  if (!check.closed) {
+    std::ostringstream reason;
+    reason << subject << " must be closed, but " << check.description << "; " << check.bad_edges
+           << " bad edge(s), e.g. from (" << check.example_a.transpose() << ") to ("
+           << check.example_b.transpose() << ")";
+    node.Fail(reason.str(),
+              "a closed mesh shares every edge between exactly two triangles of opposite "
+              "orientation; " +
+                  fix);
+  }
+  const double volume = SignedVolume(welded);
+  if (!(volume > 0)) {
+    node.Fail(subject + " must face outward, but its triangles face inward (signed volume " +
+                  FormatNumber(volume) + " m^3)",
+              "flip the normals of the mesh in a modelling tool");
+  }
+}
+
+// Adds a material, returning its index.
+int AddMaterial(Scene* scene, Material material) {
+  scene->materials.push_back(std::move(material));
+  return static_cast<int>(scene->materials.size()) - 1;
+}
+
+Material ReadMaterial(const Node& node, const std::string& name) {
+  node.CheckKeys({"color", "texture"});
+  Material material;
+  material.name = name;
+  if (auto n = node.Find("color")) material.color = n->Color();
+  if (auto n = node.Find("texture")) {
+    material.texture = ResolvePath(node.context(), n->NonEmptyString());
+  }
+  return material;
+}
+
+void ReadObject(const Node& node, const std::map<std::string, int>& material_index,
+                std::set<std::string>* names, Scene* scene) {
+  const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
+                                                  "capsule", "plane",  "mesh"};
+  std::vector<std::string> allowed = {"name",  "position", "rotation_deg", "quaternion",
+                                      "scale", "material", "color",        "solid"};
+  allowed.insert(allowed.end(), geometry_keys.begin(), geometry_keys.end());
+  node.CheckKeys(allowed);
+
+  const Node name_node = node.Get("name");
+  const std::string name = name_node.NonEmptyString();
+  if (!names->insert(name).second) {
+    name_node.Fail("duplicate object name " + Quoted(name), "object names must be unique");
+  }
+  const std::string kind = node.OneOf(geometry_keys, "geometry key");
+  const Node geometry = node.Get(kind);
+
+  // Instance transform: translate * rotate * scale, in metres.
+  Vec3 position = Vec3::Zero();
+  if (auto n = node.Find("position")) position = n->Point();
+  Mat3 rotation = Mat3::Identity();
+  if (node.Has("rotation_deg") && node.Has("quaternion")) {
+    node.Get("quaternion")
+        .Fail("both 'rotation_deg' and 'quaternion' are given", "give one rotation form");
+  }
+  if (auto n = node.Find("rotation_deg")) rotation = RotationXyzDegrees(n->Vector3());
+  if (auto n = node.Find("quaternion")) rotation = ReadQuaternion(*n);
+  Vec3 scale = Vec3::Ones();
+  if (auto n = node.Find("scale")) {
+    scale = n->value().is_number() ? Vec3::Constant(n->Positive()) : n->PositiveVector3();
+  }
+  Eigen::Affine3d world_from_object = Eigen::Affine3d::Identity();
+  world_from_object.translation() = position;
+  world_from_object.linear() = rotation * scale.asDiagonal();
+
+  bool solid = false;
+  if (auto n = node.Find("solid")) {
+    solid = n->Bool();
+    if (solid && kind == "plane") n->Fail("a plane is an open sheet and cannot be solid");
+  }
+
+  // Material: a named one, a colour shortcut, or (meshes) the file's own.
+  int material = -1;
+  if (node.Has("material") && node.Has("color")) {
+    node.Get("color").Fail("both 'material' and 'color' are given", "give one of them");
+  }
+  if (auto n = node.Find("material")) {
+    const std::string material_name = n->NonEmptyString();
+    const auto it = material_index.find(material_name);
+    if (it == material_index.end()) {
+      std::vector<std::string> known;
+      for (const auto& [k, v] : material_index) known.push_back(k);
+      n->Fail("unknown material " + Quoted(material_name),
+              known.empty() ? "define it under \"materials\""
+                            : SuggestionHint(material_name, known, "defined materials"));
+    }
+    material = it->second;
+  }
+  if (auto n = node.Find("color")) {
+    Material m;
+    m.name = name;
+    m.color = n->Color();
+    material = AddMaterial(scene, m);
+  }
+
+  const Context& context = node.context();
+  const double unit = context.metres_per_unit;
+  auto segments = [&geometry]() {
+    auto n = geometry.Find("segments");
+    return n ? n->Integer(kMinSegments, kMaxSegments) : kDefaultSegments;
+  };
+
+  if (kind == "mesh") {
+    const MeshReference reference = ReadMeshReference(geometry);
+    const Eigen::Affine3d transform = world_from_object * reference.file_to_object;
+    if (!context.options.load_meshes) {
+      scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid});
+      return;
+    }
+    std::vector<MeshPart> parts = LoadMeshParts(reference);
+    TriangleMesh all;
+    std::set<std::string> part_names;
+    for (MeshPart& part : parts) {
+      SceneObject object;
+      object.name = name;
+      if (parts.size() > 1) {
+        object.name = name + "/" + part.material_name;
+        for (int k = 2; !part_names.insert(object.name).second; ++k) {
+          object.name = name + "/" + part.material_name + "#" + std::to_string(k);
+        }
+      }
+      object.source = reference.file;
+      object.mesh = Transformed(part.mesh, transform);
+      object.solid = solid;
+      object.material = material;
+      if (material < 0 && part.has_material) {
+        object.material =
+            AddMaterial(scene, Material{name + "/" + part.material_name, part.color, part.texture});
+      }
+      if (solid) all.Append(object.mesh);
+      scene->objects.push_back(std::move(object));
+    }
+    if (solid) {
+      CheckSolid(all, node, "solid object " + Quoted(name),
+                 "repair the mesh, or set \"solid\": false");
+    }
+    return;
+  }
+
+  TriangleMesh mesh;
+  if (kind == "box") {
+    geometry.CheckKeys({"size"});
+    mesh = MakeBox(geometry.Get("size").PositiveVector3() * unit);
+  } else if (kind == "sphere") {
+    geometry.CheckKeys({"radius", "segments"});
+    mesh = MakeSphere(geometry.Get("radius").PositiveLength(), segments());
+  } else if (kind == "cylinder") {
+    geometry.CheckKeys({"radius", "height", "segments"});
+    mesh = MakeCylinder(geometry.Get("radius").PositiveLength(),
+                        geometry.Get("height").PositiveLength(), segments());
+  } else if (kind == "capsule") {
+    geometry.CheckKeys({"radius", "length", "segments"});
+    mesh = MakeCapsule(geometry.Get("radius").PositiveLength(),
+                       geometry.Get("length").NonNegativeLength(), segments());
+  } else {  // plane
+    geometry.CheckKeys({"size"});
+    const Node size_node = geometry.Get("size");
+    const Vec2 size = size_node.Vector2();
+    for (int i = 0; i < 2; ++i) {
+      if (!(size[i] > 0)) size_node.At(i).Fail("must be positive, got " + FormatNumber(size[i]));
+    }
+    mesh = MakePlane(size * unit);
+  }
+  scene->objects.push_back({name, kind, Transformed(mesh, world_from_object), material, solid});
+  // Primitives are closed by construction; the check guards against degenerate transforms.
+  if (solid) {
+    CheckSolid(scene->objects.back().mesh, node, "solid object " + Quoted(name),
+               "set \"solid\": false");
+  }
+}
+
+// Pose: "position" plus one of "look_at" (+ "up"), "quaternion", "euler_deg".
+Eigen::Isometry3d ReadPose(const Node& node) {
+  const Vec3 position = node.Get("position").Point();
+  const std::string form = node.OneOf({"look_at", "quaternion", "euler_deg"}, "orientation");
+  if (form != "look_at" && node.Has("up")) {
+    node.Get("up").Fail("'up' only applies with 'look_at'");
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = position;
+  if (form == "look_at") {
+    const Node target_node = node.Get("look_at");
+    const Vec3 target = target_node.Point();
+    Vec3 up = Vec3::UnitZ();
+    if (auto n = node.Find("up")) {
+      up = n->Vector3();
+      if (!(up.norm() > 0)) n->Fail("'up' must not be the zero vector");
+    }
+    const std::optional<Eigen::Isometry3d> look = LookAt(position, target, up);
+    if (!look) {
+      target_node.Fail(
+          "cannot aim the camera: the target is the camera position, or 'up' is "
+          "parallel to the viewing direction",
+          "move the target, or give an 'up' that is not along the viewing direction");
+    }
+    return *look;
+  }
+  if (form == "quaternion") {
+    pose.linear() = ReadQuaternion(node.Get("quaternion"));
+    return pose;
+  }
+  const Node euler = node.Get("euler_deg");
+  euler.CheckKeys({"yaw", "pitch", "roll"});
+  double yaw = 0, pitch = 0, roll = 0;
+  if (auto n = euler.Find("yaw")) yaw = n->Number() * kDegree;
+  if (auto n = euler.Find("pitch")) pitch = n->Number() * kDegree;
+  if (auto n = euler.Find("roll")) roll = n->Number() * kDegree;
+  Mat3 base;  // Columns: camera x, y, z in the world. Looks along +X, image right = -Y, down = -Z.
+  base << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  pose.linear() =
+      (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3::UnitY()) *
+       Eigen::AngleAxisd(roll, Vec3::UnitX()))
+          .toRotationMatrix() *
+      base;
+  return pose;
+}
+
+Intrinsics ReadIntrinsics(const Node& node) {
+  Intrinsics k;
+  const Node resolution = node.Get("resolution");
+  if (resolution.ArraySize("an array of 2 positive integers [width, height]") != 2) {
+    resolution.Fail("expected an array of 2 positive integers [width, height], got an array of " +
+                    std::to_string(resolution.value().size()));
+  }
+  k.width = resolution.At(0).Integer(1, kMaxResolution);
+  k.height = resolution.At(1).Integer(1, kMaxResolution);
+
+  // Lens model first: the allowed field of view depends on it.
+  if (auto d = node.Find("distortion")) {
+    // Typos first (against every coefficient name), then the model's own coefficients.
+    d->CheckKeys({"model", "k1", "k2", "p1", "p2", "k3", "k4"});
+    const Node model_node = d->Get("model");
+    const std::string model = model_node.String();
+    if (model == "brown_conrady") {
+      k.model = LensModel::kBrownConrady;
+      d->CheckKeys({"model", "k1", "k2", "p1", "p2", "k3"});
+    } else if (model == "fisheye") {
+      k.model = LensModel::kFisheye;
+      d->CheckKeys({"model", "k1", "k2", "k3", "k4"});
+    } else {
+      model_node.Fail("unknown distortion model " + json(model).dump(),
+                      SuggestionHint(model, {"brown_conrady", "fisheye"}, "models"));
+    }
+    auto coefficient = [&d](const char* key, double* value) {
+      if (auto n = d->Find(key)) *value = n->Number();
+    };
+    coefficient("k1", &k.k1);
+    coefficient("k2", &k.k2);
+    coefficient("p1", &k.p1);
+    coefficient("p2", &k.p2);
+    coefficient("k3", &k.k3);
+    coefficient("k4", &k.k4);
+  }
+
+  const std::string form = node.OneOf({"hfov_deg", "focal_px", "lens"}, "focal length");
+  if (form == "hfov_deg") {
+    const Node n = node.Get("hfov_deg");
+    const double hfov = n.Number();
+    const double max = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+    if (!(hfov > 0 && hfov < max)) {
+      n.Fail("horizontal field of view must be in (0, " + FormatNumber(max) + ") degrees for a " +
+                 LensModelName(k.model) + " lens, got " + FormatNumber(hfov),
+             k.model == LensModel::kFisheye
+                 ? ""
+                 : "for wider lenses use \"distortion\": {\"model\": \"fisheye\"}");
+    }
+    k.fx = k.fy = FocalFromHfov(hfov * kDegree, k.width, k.model);
+  } else if (form == "focal_px") {
+    const Node n = node.Get("focal_px");
+    if (n.value().is_number()) {
+      k.fx = k.fy = n.Positive();
+    } else {
+      const Vec2 f = n.Vector2();
+      for (int i = 0; i < 2; ++i) {
+        if (!(f[i] > 0)) n.At(i).Fail("must be positive, got " + FormatNumber(f[i]));
+      }
+      k.fx = f.x();
+      k.fy = f.y();
+    }
+  } else {
+    const Node lens = node.Get("lens");
+    lens.CheckKeys({"focal_mm", "sensor_width_mm", "pixel_aspect"});
+    k.fx = FocalFromLens(lens.Get("focal_mm").Positive(), lens.Get("sensor_width_mm").Positive(),
+                         k.width);
+    k.fy = k.fx;
+    if (auto n = lens.Find("pixel_aspect")) k.fy = k.fx * n->Positive();
+  }
+  if (!std::isfinite(k.fx) || !std::isfinite(k.fy) || !(k.fx > 0) || !(k.fy > 0)) {
+    node.Get(form).Fail("focal length is not a positive finite number of pixels");
+  }
+
+  k.cx = 0.5 * (k.width - 1);
+  k.cy = 0.5 * (k.height - 1);
+  if (auto n = node.Find("principal_point")) {
+    const Vec2 c = n->Vector2();
+    k.cx = c.x();
+    k.cy = c.y();
+  }
+  return k;
+}
+
+Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
+  node.CheckKeys({"id", "name", "color", "enabled", "position", "look_at", "up", "quaternion",
+                  "euler_deg", "resolution", "hfov_deg", "focal_px", "lens", "principal_point",
+                  "distortion", "range"});
+  Camera camera;
+  const Node id = node.Get("id");
+  if (id.value().is_number_integer()) {
+    camera.id = std::to_string(id.value().get<int64_t>());
+  } else if (id.value().is_number()) {
+    id.Number();  // Finite.
+    camera.id = id.value().dump();
+  } else if (id.value().is_string()) {
+    camera.id = id.NonEmptyString();
+  } else {
+    id.Fail("expected a string or a number");
+  }
+  if (!ids->insert(camera.id).second) {
+    id.Fail("duplicate camera id " + Quoted(camera.id), "camera ids must be unique within a rig");
+  }
+  camera.name = camera.id;
+  if (auto n = node.Find("name")) camera.name = n->NonEmptyString();
+  camera.color = kCameraPalette[index % 8];
+  if (auto n = node.Find("color")) camera.color = n->Color();
+  if (auto n = node.Find("enabled")) camera.enabled = n->Bool();
+
+  camera.world_from_camera = ReadPose(node);
+  camera.model = CameraModel(ReadIntrinsics(node));
+
+  if (auto range = node.Find("range")) {
+    range->CheckKeys({"near", "far"});
+    if (auto n = range->Find("near")) camera.near = n->NonNegativeLength();
+    if (auto n = range->Find("far")) {
+      camera.far = n->Length();
+      if (!(camera.far > camera.near)) {
+        n->Fail("far (" + FormatNumber(camera.far) + " m) must be greater than near (" +
+                FormatNumber(camera.near) + " m)");
+      }
+    }
+  }
+  return camera;
+}
+
+Rig ReadRig(const Node& node, std::set<std::string>* names) {
+  node.CheckKeys({"name", "cameras"});
+  Rig rig;
+  const Node name = node.Get("name");
+  rig.name = name.NonEmptyString();
+  if (!names->insert(rig.name).second) {
+    name.Fail("duplicate rig name " + Quoted(rig.name), "rig names must be unique");
+  }
+  const Node cameras = node.Get("cameras");
+  const size_t n = cameras.ArraySize("an array of cameras");
+  if (n == 0) cameras.Fail("a rig needs at least one camera");
+  std::set<std::string> ids;
+  for (size_t i = 0; i < n; ++i) rig.cameras.push_back(ReadCamera(cameras.At(i), i, &ids));
+  return rig;
+}
+
+Study ReadStudy(const Node& node) {
+  node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb"});
+  Study study;
+  const Node region = node.Get("region");
+  region.CheckKeys({"box", "mesh"});
+  const std::string kind = region.OneOf({"box", "mesh"}, "region shape");
+  if (kind == "box") {
+    const Node box = region.Get("box");
+    box.CheckKeys({"min", "max", "center", "size"});
+    study.region.kind = Region::Kind::kBox;
+    if (box.Has("min") || box.Has("max")) {
+      for (const char* key : {"center", "size"}) {
+        if (box.Has(key)) {
+          box.Get(key).Fail("give either 'min' and 'max' or 'center' and 'size', not both");
+        }
+      }
+      const Vec3 min = box.Get("min").Point();
+      const Node max_node = box.Get("max");
+      const Vec3 max = max_node.Point();
+      for (int i = 0; i < 3; ++i) {
+        if (!(max[i] > min[i])) {
+          max_node.At(i).Fail("max must be greater than min on every axis (axis " +
+                              std::string(1, "xyz"[i]) + ")");
+        }
+      }
+      study.region.box.min = min;
+      study.region.box.max = max;
+    } else {
+      const Vec3 center = box.Get("center").Point();
+      const Vec3 size = box.Get("size").PositiveVector3() * node.context().metres_per_unit;
+      study.region.box.min = center - 0.5 * size;
+      study.region.box.max = center + 0.5 * size;
+    }
+  } else {
+    study.region.kind = Region::Kind::kMesh;
+    const MeshReference reference = ReadMeshReference(region.Get("mesh"));
+    if (node.context().options.load_meshes) {
+      TriangleMesh mesh;
+      for (const MeshPart& part : LoadMeshParts(reference)) mesh.Append(part.mesh);
+      mesh = WeldVertices(Transformed(mesh, reference.file_to_object));
+      CheckSolid(mesh, reference.file_node, "the region mesh", "repair the mesh");
+      study.region.box = mesh.Bounds();
+      study.region.mesh = std::move(mesh);
+    }
+  }
+
+  if (auto n = node.Find("voxel_size")) study.voxel_size = n->PositiveLength();
+  if (auto n = node.Find("fields")) {
+    const size_t count = n->ArraySize("an array of field names");
+    const std::vector<std::string> known = KnownFields();
+    if (count == 0) n->Fail("at least one field is needed", "known fields: " + JoinQuoted(known));
+    study.fields.clear();
+    for (size_t i = 0; i < count; ++i) {
+      const Node field = n->At(i);
+      const std::string name = field.String();
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        field.Fail("unknown field " + Quoted(name), SuggestionHint(name, known, "known fields"));
+      }
+      if (std::find(study.fields.begin(), study.fields.end(), name) != study.fields.end()) {
+        field.Fail("field " + Quoted(name) + " is listed twice");
+      }
+      study.fields.push_back(name);
+    }
+  }
+  if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->Positive();
+  if (auto n = node.Find("memory_budget_mb")) {
+    study.memory_budget_bytes = n->Positive() * 1024.0 * 1024.0;
+  }
+  return study;
+}
+
+View ReadView(const Node& node) {
+  node.CheckKeys({"from", "at", "up", "fov_deg"});
+  View view;
+  view.from = node.Get("from").Point();
+  const Node at = node.Get("at");
+  view.at = at.Point();
+  if (auto n = node.Find("up")) view.up = n->Vector3();
+  if (!LookAt(view.from, view.at, view.up)) {
+    at.Fail("'at' equals 'from', or 'up' is parallel to the viewing direction");
+  }
+  if (auto n = node.Find("fov_deg")) {
+    const double fov = n->Number();
+    if (!(fov > 0 && fov < 180)) n->Fail("must be in (0, 180) degrees, got " + FormatNumber(fov));
+    view.fov_deg = fov;
+  }
+  return view;
+}
+
+double ReadUnit(const Node& node) {
+  const std::string unit = node.String();
+  struct UnitScale {
+    const char* name;
+    double metres;
+  };
+  constexpr UnitScale kUnits[] = {
+      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
+  for (const UnitScale& u : kUnits) {
+    if (unit == u.name) return u.metres;
+  }
+  node.Fail("unknown unit " + json(unit).dump(), "use one of 'm', 'cm', 'mm', 'in', 'ft'");
+}
+
+}  // namespace
+
+// -------------------------------------------------------------------------------------------------
+
+TriangleMesh Scene::AllTriangles(std::vector<int>* triangle_object) const {
+  TriangleMesh all;
+  size_t vertices = 0, triangles = 0;
+  for (const SceneObject& o : objects) {
+    vertices += o.mesh.vertices.size();
+    triangles += o.mesh.triangles.size();
+  }
+  all.vertices.reserve(vertices);
+  all.triangles.reserve(triangles);
+  if (triangle_object) {
+    triangle_object->clear();
+    triangle_object->reserve(triangles);
+  }
+  for (size_t i = 0; i < objects.size(); ++i) {
+    all.Append(objects[i].mesh);
+    if (triangle_object) {
+      triangle_object->insert(triangle_object->end(), objects[i].mesh.triangles.size(),
+                              static_cast<int>(i));
+    }
+  }
+  return all;
+}
+
+Aabb Scene::Bounds() const {
+  Aabb bounds;
+  for (const SceneObject& o : objects) bounds.Extend(o.mesh.Bounds());
+  for (const Rig& rig : rigs) {
+    for (const Camera& camera : rig.cameras) bounds.Extend(camera.center());
+  }
+  bounds.Extend(study.region.box);
+  return bounds;
+}
+
+const Rig& Scene::FindRig(const std::string& name) const {
+  if (name.empty() && !rigs.empty()) return rigs.front();
+  for (const Rig& rig : rigs) {
+    if (rig.name == name) return rig;
+  }
+  std::vector<std::string> names;
+  for (const Rig& rig : rigs) names.push_back(rig.name);
+  if (names.empty()) throw InputError(path, "$.rigs", "the scene has no rigs");
+  throw InputError(path, "$.rigs", "no rig named " + Quoted(name),
+                   SuggestionHint(name, names, "rigs in this scene"));
+}
+
+Scene ParseScene(const std::string& json_text, const std::string& path,
+                 const LoadOptions& options) {
+  Context context;
+  context.file = path;
+  context.folder = fs::path(path).parent_path();
+  context.options = options;
+  const json root_value = ParseJson(json_text, path);
+  const Node root(&root_value, "$", &context);
+  root.CheckKeys({"pandora", "units", "materials", "objects", "rigs", "study", "views"});
+
+  Scene scene;
+  scene.path = path;
+  scene.sha256 = Sha256Hex(json_text);
+
+  if (auto n = root.Find("pandora")) {
+    if (!n->value().is_number() || n->Number() != 1) {
+      n->Fail("unsupported format version " + n->value().dump(), "this build reads version 1");
+    }
+  }
+  if (auto n = root.Find("units")) context.metres_per_unit = ReadUnit(*n);
+
+  std::map<std::string, int> material_index;
+  if (auto materials = root.Find("materials")) {
+    materials->ExpectObject("an object of named materials");
+    for (const auto& item : materials->value().items()) {
+      const Node m(&item.value(), MemberPath(materials->path(), item.key()), &context);
+      if (item.key().empty()) m.Fail("material names must not be empty");
+      material_index[item.key()] = AddMaterial(&scene, ReadMaterial(m, item.key()));
+    }
+  }
+
+  if (auto objects = root.Find("objects")) {
+    const size_t n = objects->ArraySize("an array of objects");
+    std::set<std::string> names;
+    for (size_t i = 0; i < n; ++i) ReadObject(objects->At(i), material_index, &names, &scene);
+  }
+
+  const Node rigs = root.Get("rigs");
+  const size_t rig_count = rigs.ArraySize("an array of rigs");
+  if (rig_count == 0) rigs.Fail("at least one rig is needed");
+  std::set<std::string> rig_names;
+  for (size_t i = 0; i < rig_count; ++i) scene.rigs.push_back(ReadRig(rigs.At(i), &rig_names));
+
+  scene.study = ReadStudy(root.Get("study"));
+
+  if (auto views = root.Find("views")) {
+    views->ExpectObject("an object of named views");
+    for (const auto& item : views->value().items()) {
+      const Node v(&item.value(), MemberPath(views->path(), item.key()), &context);
+      if (item.key().empty()) v.Fail("view names must not be empty");
+      scene.views[item.key()] = ReadView(v);
+    }
+  }
+  return scene;
+}
+
+Scene LoadScene(const std::string& path, const LoadOptions& options) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(path, "", "cannot open file: it is a folder");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(
+        path, "", "cannot open file",
+        fs::exists(path, ec) ? "check the file's permissions" : "no such file; check the path");
+  }
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path, "", "cannot read file");
+  return ParseScene(text, path, options);
+}
+
+json RigToJson(const Rig& rig) {
+  json cameras = json::array();
+  for (const Camera& camera : rig.cameras) {
+    const Intrinsics& k = camera.model.intrinsics();
+    const Eigen::Quaterniond q(camera.world_from_camera.rotation());
+    const Vec3 p = camera.center();
+    json c = {
+        {"id", camera.id},
+        {"name", camera.name},
+        {"color", {camera.color.x(), camera.color.y(), camera.color.z()}},
+        {"enabled", camera.enabled},
+        {"position", {p.x(), p.y(), p.z()}},
+        {"quaternion", {q.w(), q.x(), q.y(), q.z()}},
+        {"resolution", {k.width, k.height}},
+        {"focal_px", {k.fx, k.fy}},
+        {"principal_point", {k.cx, k.cy}},
+    };
+    if (k.model == LensModel::kBrownConrady) {
+      c["distortion"] = {{"model", "brown_conrady"},
+                         {"k1", k.k1},
+                         {"k2", k.k2},
+                         {"p1", k.p1},
+                         {"p2", k.p2},
+                         {"k3", k.k3}};
+    } else if (k.model == LensModel::kFisheye) {
+      c["distortion"] = {
+          {"model", "fisheye"}, {"k1", k.k1}, {"k2", k.k2}, {"k3", k.k3}, {"k4", k.k4}};
+    }
+    json range = {{"near", camera.near}};
+    if (std::isfinite(camera.far)) range["far"] = camera.far;
+    c["range"] = range;
+    cameras.push_back(std::move(c));
+  }
+  return json{{"name", rig.name}, {"cameras", std::move(cameras)}};
+}
+
+}  // namespace pandora

@@ -20,11 +20,14 @@ namespace pandora {
 struct Material {
   std::string name;
   Vec3 color{0.7, 0.7, 0.7};  ///< Linear RGB diffuse colour in [0, 1].
-  std::string texture;        ///< Path of a diffuse texture, empty when none.
+  /// Path of a diffuse texture (resolved against the scene file's folder, or the mesh file's folder
+  /// for materials read from mesh files), empty when none.
+  std::string texture;
 };
 
 /// One object of the scene after its instance transform: world coordinates, metres.
 struct SceneObject {
+  /// The object's name; "object/material" for each part of a mesh file with several materials.
   std::string name;
   std::string source;   ///< "box", "sphere", ..., or the mesh file path as written in the scene.
   TriangleMesh mesh;    ///< World coordinates.
@@ -93,8 +96,8 @@ struct Scene {
 
 /// Options for LoadScene.
 struct LoadOptions {
-  /// When false, mesh files are not read (objects keep empty meshes); used by tools that only need
-  /// the cameras.
+  /// When false, mesh files are not read (objects keep empty meshes, one object per mesh entry; a
+  /// mesh region keeps an empty mesh and box); used by tools that only need the cameras.
   bool load_meshes = true;
 };
 
