@@ -16,6 +16,10 @@ void RayCaster::OccludedBatch(const std::vector<Ray>& rays, std::vector<uint8_t>
                     });
 }
 
+void RayCaster::OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const {
+  for (std::size_t i = 0; i < count; ++i) occluded[i] = Occluded(rays[i]) ? 1 : 0;
+}
+
 namespace {
 
 class BruteForceRayCaster final : public RayCaster {

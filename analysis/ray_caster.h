@@ -40,6 +40,10 @@ class RayCaster {
   virtual std::optional<RayHit> Intersect(const Ray& ray) const = 0;
   /// Occluded() for every ray, in parallel (TBB); `occluded` is resized to rays.size().
   virtual void OccludedBatch(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const;
+  /// Occluded() for `count` rays on the calling thread; occluded[i] is 1 or 0. Rays that are close
+  /// to each other in the array should be coherent (for example, from one camera to neighbouring
+  /// voxels): Embree traces them as SIMD packets (16, 8 or 4 wide, whichever the CPU runs natively).
+  virtual void OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const;
 
   /// "embree" or "brute-force".
   virtual const char* name() const = 0;
@@ -55,6 +59,12 @@ std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh);
 /// Double-precision brute force (Moller-Trumbore over every triangle). O(triangles) per ray.
 std::unique_ptr<RayCaster> MakeBruteForceRayCaster(const TriangleMesh& mesh);
 
+/// How RawEmbreeOcclusion traces the rays.
+enum class RawMode {
+  kSingle,  ///< rtcOccluded1, one ray at a time (the usual baseline).
+  kPacket,  ///< Consecutive rays as native-width packets (rtcOccluded16/8/4), as OccludedPacket does.
+};
+
 /// Result of RawEmbreeOcclusion.
 struct RawOcclusionResult {
   double seconds = 0;
@@ -62,9 +72,13 @@ struct RawOcclusionResult {
   std::size_t occluded = 0;
 };
 
-/// The benchmark baseline: a bare loop of rtcOccluded1 over `rays` split across TBB threads, with no
-/// work besides filling RTCRay. `caster` must come from MakeEmbreeRayCaster (throws
-/// std::invalid_argument otherwise).
-RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays);
+/// The benchmark baseline: a bare loop of Embree occlusion queries over `rays` split across TBB
+/// threads, with the rays converted to Embree's layout before the clock starts. `caster` must come
+/// from MakeEmbreeRayCaster (throws std::invalid_argument otherwise).
+RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays,
+                                      RawMode mode = RawMode::kSingle);
+
+/// The packet width OccludedPacket uses on this CPU (16, 8, 4, or 1).
+int EmbreePacketWidth(const RayCaster& caster);
 
 }  // namespace pandora

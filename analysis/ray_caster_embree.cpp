@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <stdexcept>
@@ -13,6 +14,48 @@
 
 namespace pandora {
 namespace {
+
+// Embree's SoA packet types and entry points by width.
+template <int W>
+struct Packet;
+template <>
+struct Packet<4> {
+  using Type = RTCRay4;
+  static void Occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcOccluded4(valid, s, c, r);
+  }
+};
+template <>
+struct Packet<8> {
+  using Type = RTCRay8;
+  static void Occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcOccluded8(valid, s, c, r);
+  }
+};
+template <>
+struct Packet<16> {
+  using Type = RTCRay16;
+  static void Occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcOccluded16(valid, s, c, r);
+  }
+};
+
+// Copies lane `lane` of a packet from a single RTCRay.
+template <typename P>
+void SetLane(P* p, int lane, const RTCRay& r) {
+  p->org_x[lane] = r.org_x;
+  p->org_y[lane] = r.org_y;
+  p->org_z[lane] = r.org_z;
+  p->tnear[lane] = r.tnear;
+  p->dir_x[lane] = r.dir_x;
+  p->dir_y[lane] = r.dir_y;
+  p->dir_z[lane] = r.dir_z;
+  p->time[lane] = 0.0f;
+  p->tfar[lane] = r.tfar;
+  p->mask[lane] = r.mask;
+  p->id[lane] = 0;
+  p->flags[lane] = 0;
+}
 
 class EmbreeRayCaster final : public RayCaster {
  public:
@@ -48,6 +91,14 @@ class EmbreeRayCaster final : public RayCaster {
     rtcCommitScene(scene_);
     if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
       throw std::runtime_error("Embree: scene build failed");
+    if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED))
+      packet_width_ = 16;
+    else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED))
+      packet_width_ = 8;
+    else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED))
+      packet_width_ = 4;
+    else
+      packet_width_ = 1;
   }
 
   ~EmbreeRayCaster() override {
@@ -80,10 +131,50 @@ class EmbreeRayCaster final : public RayCaster {
     return hit;
   }
 
+  void OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const override {
+    switch (packet_width_) {
+      case 16: return TracePackets<16>(rays, count, occluded);
+      case 8: return TracePackets<8>(rays, count, occluded);
+      case 4: return TracePackets<4>(rays, count, occluded);
+      default: RayCaster::OccludedPacket(rays, count, occluded);
+    }
+  }
+
+  // Traces already converted rays in packets of W (the last one partly valid).
+  template <int W>
+  void TraceConverted(const RTCRay* rays, std::size_t count, uint8_t* occluded) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(64) typename Packet<W>::Type packet;
+    alignas(64) int valid[W];
+    for (std::size_t start = 0; start < count; start += W) {
+      const int n = static_cast<int>(std::min<std::size_t>(W, count - start));
+      for (int lane = 0; lane < W; ++lane) {
+        valid[lane] = lane < n ? -1 : 0;
+        SetLane(&packet, lane, rays[start + std::min(lane, n - 1)]);
+      }
+      Packet<W>::Occluded(valid, scene_, &context, &packet);
+      for (int lane = 0; lane < n; ++lane) occluded[start + lane] = packet.tfar[lane] < 0.0f;
+    }
+  }
+
+  int packet_width() const { return packet_width_; }
   const char* name() const override { return "embree"; }
   std::size_t triangle_count() const override { return triangles_; }
 
   RTCScene scene() const { return scene_; }
+
+  template <int W>
+  void TracePackets(const Ray* rays, std::size_t count, uint8_t* occluded) const {
+    constexpr std::size_t kChunk = 256;
+    RTCRay converted[kChunk];
+    for (std::size_t start = 0; start < count; start += kChunk) {
+      const std::size_t n = std::min(kChunk, count - start);
+      for (std::size_t i = 0; i < n; ++i) Fill(rays[start + i], &converted[i]);
+      TraceConverted<W>(converted, n, occluded + start);
+    }
+  }
   const Vec3& offset() const { return offset_; }
 
   // Converts to Embree's single-precision ray in the recentred frame.
@@ -107,6 +198,7 @@ class EmbreeRayCaster final : public RayCaster {
 
  private:
   std::size_t triangles_ = 0;
+  int packet_width_ = 1;
   Vec3 offset_ = Vec3::Zero();
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
@@ -118,24 +210,49 @@ std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh) {
   return std::make_unique<EmbreeRayCaster>(mesh);
 }
 
-RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays) {
+int EmbreePacketWidth(const RayCaster& caster) {
+  const auto* embree = dynamic_cast<const EmbreeRayCaster*>(&caster);
+  return embree ? embree->packet_width() : 1;
+}
+
+RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays,
+                                      RawMode mode) {
   const auto* embree = dynamic_cast<const EmbreeRayCaster*>(&caster);
   if (!embree) throw std::invalid_argument("RawEmbreeOcclusion needs an Embree ray caster");
   // Convert first so the timed loop is Embree alone.
   std::vector<RTCRay> converted(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) embree->Fill(rays[i], &converted[i]);
   const RTCScene scene = embree->scene();
+  const int width = mode == RawMode::kPacket ? embree->packet_width() : 1;
+  // Packets are formed from consecutive rays within each chunk, as the field evaluation forms them
+  // from consecutive voxels of one block and camera.
+  const std::size_t grain = 1024;
 
   const auto start = std::chrono::steady_clock::now();
   const std::size_t occluded = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, converted.size(), 1024), std::size_t{0},
+      tbb::blocked_range<std::size_t>(0, converted.size(), grain), std::size_t{0},
       [&](const tbb::blocked_range<std::size_t>& r, std::size_t count) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          RTCRay ray = converted[i];
-          rtcOccluded1(scene, &context, &ray);
-          count += ray.tfar < 0.0f ? 1 : 0;
+        if (width == 1) {
+          RTCIntersectContext context;
+          rtcInitIntersectContext(&context);
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            RTCRay ray = converted[i];
+            rtcOccluded1(scene, &context, &ray);
+            count += ray.tfar < 0.0f ? 1 : 0;
+          }
+          return count;
+        }
+        uint8_t hits[grain];
+        const std::size_t n = r.size();
+        for (std::size_t done = 0; done < n; done += grain) {
+          const std::size_t m = std::min(grain, n - done);
+          const RTCRay* first = converted.data() + r.begin() + done;
+          switch (width) {
+            case 16: embree->TraceConverted<16>(first, m, hits); break;
+            case 8: embree->TraceConverted<8>(first, m, hits); break;
+            default: embree->TraceConverted<4>(first, m, hits); break;
+          }
+          for (std::size_t i = 0; i < m; ++i) count += hits[i];
         }
         return count;
       },

@@ -107,11 +107,18 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
   // Solids and the region mesh.
   std::vector<std::unique_ptr<InsideMesh>> solid_meshes;
   std::vector<const InsideMesh*> solids;
-  for (const SceneObject& o : scene.objects)
-    if (o.solid && !o.mesh.triangles.empty()) {
+  for (const SceneObject& o : scene.objects) {
+    if (!o.solid || o.mesh.triangles.empty()) continue;
+    // Solids that cannot contain a region voxel cost nothing.
+    const Aabb b = o.mesh.Bounds();
+    if ((b.max.array() < study.region.box.min.array()).any() ||
+        (b.min.array() > study.region.box.max.array()).any())
+      continue;
+    {
       solid_meshes.push_back(std::make_unique<InsideMesh>(o.mesh));
       solids.push_back(solid_meshes.back().get());
     }
+  }
   std::unique_ptr<InsideMesh> region_mesh;
   if (study.region.kind == Region::Kind::kMesh)
     region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
@@ -145,32 +152,40 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       std::array<std::uint64_t, 512> seen_by{};
       std::array<float, 512> density{};
       if (block.cameras != 0) {
+        // Per camera: the geometric tests first, then the surviving segments traced together as
+        // coherent packets (one origin, neighbouring directions).
+        std::array<Ray, 512> segments;
+        std::array<std::int16_t, 512> where;
+        std::array<float, 512> segment_density;
+        std::array<std::uint8_t, 512> occluded;
         for (int c = 0; c < camera_count; ++c) {
           if (!(block.cameras >> c & 1)) continue;
-          const Camera& cam = rig.cameras[c];
+          std::size_t n = 0;
           for (int x = 0; x < block.extent.x(); ++x)
             for (int y = 0; y < block.extent.y(); ++y)
               for (int z = 0; z < block.extent.z(); ++z) {
                 if (!block.IsFree(x, y, z)) continue;
                 const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
                                                   block.origin.z() + z);
-                Ray segment;
-                if (tester.TestGeometry(c, p, nullptr, &segment) != ViewResult::kSeen) continue;
-                if (segment.t_far > segment.t_near) {
-                  ++res.ray_count;
-                  if (options.record_rays) res.rays.push_back(segment);
-                  if (caster.Occluded(segment)) continue;
-                }
-                const int o = Block::Offset(x, y, z);
-                ++coverage[o];
-                seen_by[o] |= std::uint64_t{1} << c;
-                ++res.per_camera[c];
-                if (want_resolution) {
-                  Mat23 J;
-                  if (cam.Project(p, &J))
-                    density[o] = std::max(density[o], static_cast<float>(PixelDensity(J)));
-                }
+                Mat23 J;
+                if (tester.TestGeometry(c, p, nullptr, &segments[n], want_resolution ? &J : nullptr) !=
+                    ViewResult::kSeen)
+                  continue;
+                where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
+                if (want_resolution) segment_density[n] = static_cast<float>(PixelDensity(J));
+                ++n;
               }
+          caster.OccludedPacket(segments.data(), n, occluded.data());
+          res.ray_count += static_cast<std::int64_t>(n);
+          if (options.record_rays) res.rays.insert(res.rays.end(), segments.begin(), segments.begin() + n);
+          for (std::size_t i = 0; i < n; ++i) {
+            if (occluded[i]) continue;
+            const int o = where[i];
+            ++coverage[o];
+            seen_by[o] |= std::uint64_t{1} << c;
+            ++res.per_camera[c];
+            if (want_resolution) density[o] = std::max(density[o], segment_density[i]);
+          }
         }
       }
 
