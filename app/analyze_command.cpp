@@ -31,6 +31,12 @@ std::vector<std::string> SplitFields(const std::string& list) {
   return out;
 }
 
+std::string FormatNumber(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
 void PrintTable(const nlohmann::json& s) {
   std::printf("rig %s: %d cameras, voxel %.4g m, %lld region voxels (%lld inside solids)\n",
               s["rig"].get<std::string>().c_str(), s["cameras"].get<int>(),
@@ -85,7 +91,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
       {"scene_sha256", scene.sha256},
       {"rig_name", rig.name},
       {"rig", RigToJson(rig).dump()},
-      {"voxel_size_m", std::to_string(scene.study.voxel_size)},
+      {"voxel_size_m", FormatNumber(scene.study.voxel_size)},
   };
   WriteFieldsVdb(fields, (out / "fields.vdb").string(), meta);
   WriteFileAtomically((out / "summary.json").string(), summary.dump(2) + "\n");

@@ -254,8 +254,9 @@ TEST(Fields, VdbRoundTrip) {
   auto cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(by_name["cameras"]);
   auto resolution = openvdb::gridPtrCast<openvdb::FloatGrid>(by_name["resolution"]);
   ASSERT_TRUE(coverage && cameras && resolution);
-  EXPECT_EQ(coverage->metaValue<std::string>("units"), "cameras");
-  EXPECT_EQ(resolution->metaValue<std::string>("units"), "px/m");
+  EXPECT_EQ(coverage->metaValue<std::string>("value_units"), "cameras");
+  EXPECT_EQ(coverage->metaValue<std::string>("units"), "m");
+  EXPECT_EQ(resolution->metaValue<std::string>("value_units"), "px/m");
   EXPECT_EQ(coverage->metaValue<std::string>("scene_sha256"), "abc");
   EXPECT_EQ(coverage->activeVoxelCount(), fields.impl().coverage->activeVoxelCount());
   EXPECT_NEAR(coverage->voxelSize().x(), 0.05, 1e-15);

@@ -33,7 +33,7 @@ void Describe(openvdb::GridBase& grid) {
     units = "px/m";
     meaning = "best pixel density among the cameras that see the voxel (det(J J^T)^(1/4))";
   }
-  grid.insertMeta("units", openvdb::StringMetadata(units));
+  grid.insertMeta("value_units", openvdb::StringMetadata(units));
   grid.insertMeta("description", openvdb::StringMetadata(meaning));
 }
 
