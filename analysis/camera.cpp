@@ -418,11 +418,17 @@ std::optional<Vec2> CameraModel::Project(const Vec3& p, Mat23* d_pixel_d_point) 
     if (!(dd_dn.determinant() > 0)) return std::nullopt;
   }
   if (d_pixel_d_point != nullptr) {
-    Mat23 dn_dp = Mat23::Zero();
-    dn_dp(0, 0) = dn_dp(1, 1) = 1 / Z;
-    dn_dp(0, 2) = -n.x() / Z;
-    dn_dp(1, 2) = -n.y() / Z;
-    *d_pixel_d_point = Eigen::Vector2d(k_.fx, k_.fy).asDiagonal() * dd_dn * dn_dp;
+    // diag(fx, fy) * dd_dn * dn_dp with dn_dp = [1/Z 0 -x/Z; 0 1/Z -y/Z], written out (the
+    // generic Eigen product showed up in profiles of the field evaluation).
+    const double iz = 1 / Z;
+    Mat23& J = *d_pixel_d_point;
+    for (int r = 0; r < 2; ++r) {
+      const double f = r == 0 ? k_.fx : k_.fy;
+      const double a = f * dd_dn(r, 0) * iz, b = f * dd_dn(r, 1) * iz;
+      J(r, 0) = a;
+      J(r, 1) = b;
+      J(r, 2) = -(a * n.x() + b * n.y());
+    }
   }
   return Vec2(k_.fx * d.x() + k_.cx, k_.fy * d.y() + k_.cy);
 }
