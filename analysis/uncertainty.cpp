@@ -1,0 +1,174 @@
+#include "analysis/uncertainty.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pandora {
+
+void InformationBuilder::Add(const Mat23& A, double sigma_px) {
+  J_.noalias() += A.transpose() * A / (sigma_px * sigma_px);
+  ++cameras_;
+}
+
+Information InformationBuilder::Decompose() const {
+  Information info;
+  info.J = 0.5 * (J_ + J_.transpose());
+  const Eigen::SelfAdjointEigenSolver<Mat3> solver(info.J);
+  info.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
+  info.eigenvectors = solver.eigenvectors();
+  const double largest = info.eigenvalues[2];
+  info.observable = largest > 0 && std::isfinite(largest) &&
+                    info.eigenvalues[0] > kRelativeObservability * largest;
+  return info;
+}
+
+StaticUncertainty StaticFromInformation(const Information& info, int cameras) {
+  StaticUncertainty out;
+  if (cameras < 2 || !info.observable) return out;
+  const Vec3 variances = info.eigenvalues.cwiseInverse();  // ascending lambda -> descending var
+  out.triangulable = true;
+  out.covariance = info.eigenvectors * variances.asDiagonal() * info.eigenvectors.transpose();
+  out.sigma_max = std::sqrt(variances[0]);
+  out.sigma_mean = std::sqrt(variances.sum() / 3.0);
+  out.condition = info.eigenvalues[2] / info.eigenvalues[0];
+  return out;
+}
+
+Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior) {
+  Eigen::Matrix2d P;
+  if (!(r < std::numeric_limits<double>::infinity())) {
+    P.setConstant(std::numeric_limits<double>::infinity());
+    return P;
+  }
+  // Tracking index Lambda = sqrt(q T^3 / r). The steady-state gains alpha = 1 - u^2, beta = Lambda u
+  // follow from u + 1/u = w = (Lambda + R) / 2, R = sqrt(Lambda^2 / 3 + 16), with u in (0, 1].
+  const double lambda = std::sqrt(q * T * T * T / r);
+  const double R = std::sqrt(lambda * lambda / 3.0 + 16.0);
+  const double w_minus_2 = 0.5 * (lambda + (lambda * lambda / 3.0) / (R + 4.0));  // w - 2, exact
+  const double w = 2.0 + w_minus_2;
+  const double s = std::sqrt(w_minus_2 * (w + 2.0));  // 1/u - u = sqrt(w^2 - 4)
+  const double u = 2.0 / (w + s);                     // the root below 1, no cancellation
+  // Posterior: p11 = alpha r = u s r, p12 = beta r / T, p22 = (r Lambda / T^2) (s - Lambda / 2),
+  // with s - Lambda/2 = Lambda (2R + Lambda/3) / (4 (s + Lambda/2)) (all terms positive).
+  const double p11 = u * s * r;
+  const double p12 = lambda * u * r / T;
+  const double s_minus = lambda > 0 ? lambda * (2.0 * R + lambda / 3.0) / (4.0 * (s + 0.5 * lambda)) : 0.0;
+  const double p22 = r * lambda * s_minus / (T * T);
+  P << p11, p12, p12, p22;
+  if (!prior) return P;
+  // Prior M = F P F^T + Q.
+  Eigen::Matrix2d F, Q;
+  F << 1, T, 0, 1;
+  Q << T * T * T / 3.0, T * T / 2.0, T * T / 2.0, T;
+  return F * P * F.transpose() + q * Q;
+}
+
+SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,
+                                        const MotionModel& motion, bool prior) {
+  SteadyUncertainty out;
+  if (cameras < 2 || !info.observable) return out;
+  const double T = 1.0 / motion.rate_hz;
+  Vec3 variances;
+  for (int k = 0; k < 3; ++k)
+    variances[k] = ScalarSteadyState(motion.q, T, 1.0 / info.eigenvalues[k], prior)(0, 0);
+  out.converged = variances.allFinite();
+  out.covariance = info.eigenvectors * variances.asDiagonal() * info.eigenvectors.transpose();
+  out.sigma_max = std::sqrt(variances.maxCoeff());
+  out.sigma_mean = std::sqrt(variances.sum() / 3.0);
+  return out;
+}
+
+namespace {
+
+double RelativeChange(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  const double scale = std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+  if (scale == 0) return 0;
+  return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+}  // namespace
+
+std::optional<Eigen::MatrixXd> SolveDareDoubling(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G,
+                                                 const Eigen::MatrixXd& Q, double tolerance,
+                                                 int max_iterations, int* iterations) {
+  // Dual (filtering) form: A_0 = F^T, G_0 = G, H_0 = Q. Each step squares the horizon:
+  //   W = I + G_k H_k,  A_{k+1} = A_k W^-1 A_k,  G_{k+1} = G_k + A_k W^-1 G_k A_k^T,
+  //   H_{k+1} = H_k + A_k^T H_k W^-1 A_k;  H_k -> M.
+  const Eigen::Index n = F.rows();
+  Eigen::MatrixXd A = F.transpose(), Gk = G, H = Q;
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
+  for (int k = 1; k <= max_iterations; ++k) {
+    const Eigen::PartialPivLU<Eigen::MatrixXd> W(I + Gk * H);
+    const Eigen::MatrixXd WinvA = W.solve(A);
+    const Eigen::MatrixXd WinvG = W.solve(Gk);
+    const Eigen::MatrixXd H_next = H + A.transpose() * H * WinvA;
+    const Eigen::MatrixXd G_next = Gk + A * WinvG * A.transpose();
+    const Eigen::MatrixXd A_next = A * WinvA;
+    const double change = RelativeChange(H_next, H);
+    H = 0.5 * (H_next + H_next.transpose());
+    Gk = 0.5 * (G_next + G_next.transpose());
+    A = A_next;
+    if (iterations) *iterations = k;
+    if (!H.allFinite()) return std::nullopt;
+    if (change <= tolerance) return H;
+  }
+  return std::nullopt;
+}
+
+Eigen::MatrixXd SolveDareIteration(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G,
+                                   const Eigen::MatrixXd& Q, double tolerance, int max_iterations,
+                                   bool* converged, int* iterations) {
+  Eigen::MatrixXd M = Q;
+  if (converged) *converged = false;
+  for (int k = 1; k <= max_iterations; ++k) {
+    const Eigen::MatrixXd P = PosteriorFromPrior(M, G);
+    Eigen::MatrixXd next = F * P * F.transpose() + Q;
+    next = 0.5 * (next + next.transpose());
+    const double change = RelativeChange(next, M);
+    M = next;
+    if (iterations) *iterations = k;
+    if (change <= tolerance) {
+      if (converged) *converged = true;
+      break;
+    }
+  }
+  return M;
+}
+
+ConstantVelocity6 MakeConstantVelocity6(const Mat3& J, const MotionModel& motion) {
+  const double T = 1.0 / motion.rate_hz;
+  ConstantVelocity6 m;
+  const Mat3 I = Mat3::Identity();
+  m.F.setIdentity();
+  m.F.block<3, 3>(0, 3) = T * I;
+  m.Q << T * T * T / 3.0 * I, T * T / 2.0 * I, T * T / 2.0 * I, T * I;
+  m.Q *= motion.q;
+  m.G.setZero();
+  m.G.block<3, 3>(0, 0) = J;
+  return m;
+}
+
+Eigen::MatrixXd PosteriorFromPrior(const Eigen::MatrixXd& M, const Eigen::MatrixXd& G) {
+  const Eigen::Index n = M.rows();
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
+  Eigen::MatrixXd P = (I + M * G).partialPivLu().solve(M);
+  return 0.5 * (P + P.transpose());
+}
+
+double MaxTriangulationAngle(const std::vector<Vec3>& d) {
+  double best = 0;
+  for (std::size_t i = 0; i < d.size(); ++i)
+    for (std::size_t j = i + 1; j < d.size(); ++j) {
+      // atan2 of |cross| and dot is accurate at tiny and near-pi angles, unlike acos.
+      const double angle = std::atan2(d[i].cross(d[j]).norm(), d[i].dot(d[j]));
+      best = std::max(best, angle);
+    }
+  return best;
+}
+
+}  // namespace pandora

@@ -1,0 +1,125 @@
+#pragma once
+/// \file uncertainty.h
+/// Triangulation uncertainty of a point from the cameras that see it: the static (single-frame)
+/// covariance and the steady-state covariance of a constant-velocity Kalman filter
+/// (Artemis-style). Double precision; metres, seconds; covariances in m^2.
+///
+/// Measurement model. Camera i observes X through its distorted projection with isotropic pixel
+/// noise sigma_i (pixels); linearised at X with the 2x3 Jacobian A_i (pixels per metre), the
+/// information (Fisher) matrix of one synchronous frame is
+///     J = sum_i A_i^T A_i / sigma_i^2            [1/m^2]
+/// and the static covariance is Cov = J^-1. J is symmetric positive semi-definite; each camera adds
+/// rank 2 (nothing along its viewing ray), so two cameras with distinct centres make it full rank.
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "analysis/geometry.h"
+
+namespace pandora {
+
+/// Eigen-decomposition of an information matrix, with the observability decision.
+struct Information {
+  Mat3 J = Mat3::Zero();            ///< sum_i A_i^T A_i / sigma_i^2, 1/m^2.
+  Vec3 eigenvalues = Vec3::Zero();  ///< Ascending, clipped at 0 (round-off).
+  Mat3 eigenvectors = Mat3::Identity();  ///< Columns, orthonormal, matching eigenvalues.
+  /// True when every eigenvalue exceeds kRelativeObservability times the largest: the point can be
+  /// located in all three directions.
+  bool observable = false;
+};
+
+/// A direction whose information is below this fraction of the largest is unobservable: it lies
+/// beyond double precision's reach (the covariance would be dominated by round-off in J).
+inline constexpr double kRelativeObservability = 1e-12;
+
+/// Accumulates J from per-camera Jacobians and pixel sigmas, then decomposes it.
+class InformationBuilder {
+ public:
+  /// Adds a camera's 2x3 Jacobian (pixels per metre) with its pixel noise sigma (pixels, > 0).
+  void Add(const Mat23& d_pixel_d_world, double sigma_px);
+  int cameras() const { return cameras_; }
+  /// Symmetric eigen-decomposition (Eigen's SelfAdjointEigenSolver, closed-form 3x3 not used: it
+  /// loses relative accuracy on the small eigenvalues of stiff configurations).
+  Information Decompose() const;
+
+ private:
+  Mat3 J_ = Mat3::Zero();
+  int cameras_ = 0;
+};
+
+/// Static (single-frame) position uncertainty.
+struct StaticUncertainty {
+  bool triangulable = false;  ///< >= 2 cameras and J observable in all directions.
+  Mat3 covariance = Mat3::Zero();  ///< J^-1 from the eigen-decomposition, m^2 (when triangulable).
+  double sigma_max = 0;   ///< sqrt(largest eigenvalue of Cov): worst-direction 1-sigma, m.
+  double sigma_mean = 0;  ///< sqrt(trace(Cov) / 3), m.
+  double condition = 0;   ///< Largest over smallest eigenvalue of J (>= 1).
+};
+
+/// Cov = J^-1 computed as V diag(1/lambda) V^T. Not triangulable (all values 0) when fewer than two
+/// cameras contributed or a direction is unobservable; never a pseudo-inverse (that would report
+/// zero variance along the unobserved direction, the opposite of the truth).
+StaticUncertainty StaticFromInformation(const Information& info, int cameras);
+
+/// Constant-velocity motion model: white acceleration of spectral density q (m^2/s^3) per axis,
+/// isotropic, and all cameras sampling together at `rate_hz`.
+struct MotionModel {
+  double q = 1.0;         ///< m^2/s^3, >= 0.
+  double rate_hz = 60.0;  ///< > 0.
+};
+
+/// Steady-state position covariance of the Kalman filter for one scalar axis with per-frame
+/// position measurement variance r (m^2): F = [1 T; 0 1], Q = q [T^3/3 T^2/2; T^2/2 T], H = [1 0].
+/// Returns the 2x2 posterior (after the update; `prior` = false) or prior (before it) covariance of
+/// (position, velocity). Closed form: with Lambda^2 = q T^3 / r the gains are alpha = 1 - u^2,
+/// beta = Lambda u, where u + 1/u = (Lambda + sqrt(Lambda^2 / 3 + 16)) / 2 (docs/uncertainty.md
+/// derives it); evaluated without cancellation for every q >= 0 and rate > 0. r = +inf (no
+/// measurement) gives an infinite covariance (no steady state).
+Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior = false);
+
+/// Steady-state uncertainty: per eigen-direction of J the scalar problem above, recombined.
+struct SteadyUncertainty {
+  bool converged = false;        ///< False when not triangulable.
+  Mat3 covariance = Mat3::Zero();  ///< Position block, m^2.
+  double sigma_max = 0, sigma_mean = 0;
+};
+
+/// The steady-state position covariance for a point with information `info` under `motion`.
+/// With isotropic process noise and synchronous cameras the 6x6 problem decouples along the
+/// eigenvectors of J into three scalar position-velocity problems (measurement variance 1/lambda_k).
+SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,
+                                        const MotionModel& motion, bool prior = false);
+
+/// The general discrete algebraic Riccati equation of filtering, solved by the structure-preserving
+/// doubling algorithm (Chu, Fan and Lin 2005): the steady prior covariance M of
+///   M = F (M - M H^T (H M H^T + R)^-1 H M) F^T + Q,
+/// given G = H^T R^-1 H (information per step, n x n) instead of H and R. Converges quadratically
+/// when the closed loop is stable. Returns nullopt when it has not converged within `max_iterations`
+/// (relative change below `tolerance`).
+std::optional<Eigen::MatrixXd> SolveDareDoubling(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G,
+                                                 const Eigen::MatrixXd& Q, double tolerance = 1e-15,
+                                                 int max_iterations = 100, int* iterations = nullptr);
+
+/// Plain Riccati iteration from M = Q (the reference where it converges; slow when stiff).
+/// Returns the last iterate and, in `converged`, whether the relative change fell below `tolerance`.
+Eigen::MatrixXd SolveDareIteration(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G,
+                                   const Eigen::MatrixXd& Q, double tolerance, int max_iterations,
+                                   bool* converged = nullptr, int* iterations = nullptr);
+
+/// The full 6x6 constant-velocity model for a 3D point (state: position, velocity), for the general
+/// solvers and tests: F = [I T I; 0 I], Q = q [T^3/3 I, T^2/2 I; T^2/2 I, T I], G = [J 0; 0 0].
+struct ConstantVelocity6 {
+  Eigen::Matrix<double, 6, 6> F, Q, G;
+};
+ConstantVelocity6 MakeConstantVelocity6(const Mat3& J, const MotionModel& motion);
+
+/// Posterior from prior for the 6x6 model: P = (M^-1 + G)^-1, computed as M - M H^T(...)H M stably
+/// via (I + M G)^-1 M.
+Eigen::MatrixXd PosteriorFromPrior(const Eigen::MatrixXd& M, const Eigen::MatrixXd& G);
+
+/// Largest angle (radians) between two of the given viewing directions (unit vectors from the
+/// cameras to the point); 0 with fewer than two.
+double MaxTriangulationAngle(const std::vector<Vec3>& directions);
+
+}  // namespace pandora
