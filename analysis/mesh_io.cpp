@@ -6,9 +6,20 @@
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <limits>
 #include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <unordered_set>
 #include <utility>
 
 #include "analysis/error.h"
@@ -44,6 +55,730 @@ std::string MaterialTexture(const aiMaterial& material, const fs::path& folder) 
   return path.is_absolute() ? path.string() : (folder / path).lexically_normal().string();
 }
 
+// -------------------------------------------------------------------------------------------------
+// Checks before assimp reads a file. Assimp 5.2 trusts some files blindly: its PLY reader hangs or
+// crashes when the header has no end_header line or declares more records than the file holds, and
+// allocates a list before reading it, whatever count the file gives; its COLLADA reader loops
+// forever, growing memory, on a <p> index list holding anything but integers, and reads past the
+// end of an array when an accessor asks for more values than the array holds. These checks reject
+// such files with a reason; a file that passes them is not necessarily valid. (Its post-processing
+// steps trust the imported faces: see CheckImportedScene.)
+
+constexpr uint64_t kMaxUint64 = std::numeric_limits<uint64_t>::max();
+// A PLY header longer than this is taken as corrupt (real headers are a few hundred bytes).
+constexpr uint64_t kMaxPlyHeaderBytes = uint64_t{16} << 20;
+
+[[noreturn]] void ThrowCorrupt(const std::string& path, const std::string& format,
+                               const std::string& detail) {
+  throw InputError(path, "", "cannot read mesh file: corrupt " + format + ": " + detail,
+                   "the file is damaged or was cut short; export it again");
+}
+
+uint64_t SaturatingMul(uint64_t a, uint64_t b) {
+  return (a != 0 && b > kMaxUint64 / a) ? kMaxUint64 : a * b;
+}
+uint64_t SaturatingAdd(uint64_t a, uint64_t b) { return b > kMaxUint64 - a ? kMaxUint64 : a + b; }
+
+// "37 bytes", "1.2 GB".
+std::string ByteSize(uint64_t bytes) {
+  if (bytes < 1000) return std::to_string(bytes) + (bytes == 1 ? " byte" : " bytes");
+  static const char* const kUnits[] = {"kB", "MB", "GB", "TB", "PB", "EB"};
+  double value = static_cast<double>(bytes) / 1000;
+  int unit = 0;
+  while (value >= 999.95 && unit < 5) {
+    value /= 1000;
+    ++unit;
+  }
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f %s", value, kUnits[unit]);
+  return text;
+}
+
+// `text` for a message: at most 60 characters, anything but printable ASCII as '?'.
+std::string Printable(const std::string& text) {
+  std::string out = text.substr(0, 60);
+  for (char& c : out) {
+    if (c < 0x20 || c > 0x7E) c = '?';
+  }
+  return text.size() > 60 ? out + "..." : out;
+}
+
+// Up to `max_bytes` bytes from the start of the file.
+std::string ReadStart(const std::string& path, uint64_t max_bytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(static_cast<size_t>(max_bytes), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::vector<std::string> SplitWords(const std::string& line) {
+  std::vector<std::string> words;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && IsBlank(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !IsBlank(line[i])) ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+  return words;
+}
+
+// Sequential reads of the bytes of a file from its current position, `size` bytes in all.
+class ByteReader {
+ public:
+  ByteReader(std::istream& in, uint64_t size) : in_(in), unbuffered_(size), buffer_(1 << 16) {}
+
+  uint64_t left() const { return unbuffered_ + (end_ - pos_); }
+
+  // Skips `n` bytes; false (reading nothing) when fewer are left.
+  bool Skip(uint64_t n) {
+    if (n > left()) return false;
+    if (n <= end_ - pos_) {
+      pos_ += static_cast<size_t>(n);
+      return true;
+    }
+    n -= end_ - pos_;
+    pos_ = end_ = 0;
+    in_.seekg(static_cast<std::streamoff>(n), std::ios::cur);
+    unbuffered_ -= n;
+    return static_cast<bool>(in_);
+  }
+
+  // Reads `n` bytes; false when fewer are left.
+  bool Read(unsigned char* out, size_t n) {
+    if (n > left()) return false;
+    for (size_t i = 0; i < n; ++i) {
+      if (pos_ == end_ && !Fill()) return false;
+      out[i] = static_cast<unsigned char>(buffer_[pos_++]);
+    }
+    return true;
+  }
+
+  // The next line without its line end ("\n", "\r\n" or "\r"); false at the end.
+  bool ReadLine(std::string* line) {
+    line->clear();
+    if (pos_ == end_ && !Fill()) return false;
+    while (pos_ < end_ || Fill()) {
+      const char* begin = buffer_.data() + pos_;
+      const char* limit = buffer_.data() + end_;
+      const char* stop = begin;
+      while (stop < limit && *stop != '\n' && *stop != '\r') ++stop;
+      line->append(begin, stop);
+      pos_ += static_cast<size_t>(stop - begin);
+      if (stop == limit) continue;
+      if (buffer_[pos_++] == '\r' && (pos_ < end_ || Fill()) && buffer_[pos_] == '\n') ++pos_;
+      return true;
+    }
+    return true;  // The last line, without a line end.
+  }
+
+ private:
+  bool Fill() {
+    pos_ = end_ = 0;
+    if (unbuffered_ == 0) return false;
+    const size_t want = static_cast<size_t>(std::min<uint64_t>(buffer_.size(), unbuffered_));
+    in_.read(buffer_.data(), static_cast<std::streamsize>(want));
+    end_ = static_cast<size_t>(std::max<std::streamsize>(in_.gcount(), 0));
+    // A file that shrank while being read ends here.
+    unbuffered_ = end_ < want ? 0 : unbuffered_ - want;
+    return end_ > 0;
+  }
+
+  std::istream& in_;
+  uint64_t unbuffered_;
+  std::vector<char> buffer_;
+  size_t pos_ = 0, end_ = 0;
+};
+
+// --- PLY.
+
+enum class PlyEncoding { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+
+struct PlyProperty {
+  std::string name;
+  std::string type;        // The value's type; for a list, the entries' type.
+  std::string count_type;  // A list's count type; empty for a scalar.
+  int size = 0;            // Bytes of `type`; 0 when unknown.
+  int count_size = 0;      // Bytes of `count_type`.
+  bool list() const { return !count_type.empty(); }
+};
+
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+  bool HasList() const {
+    return std::any_of(properties.begin(), properties.end(),
+                       [](const PlyProperty& p) { return p.list(); });
+  }
+};
+
+struct PlyHeader {
+  PlyEncoding encoding = PlyEncoding::kAscii;
+  std::vector<PlyElement> elements;
+  uint64_t data_offset = 0;  // Where the data starts: after the end_header line.
+};
+
+// Bytes of a PLY value type (the spec's names and their sized aliases); 0 when unknown.
+int PlyTypeSize(const std::string& type) {
+  static const std::map<std::string, int> kSizes = {
+      {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
+      {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
+      {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
+  const auto it = kSizes.find(type);
+  return it == kSizes.end() ? 0 : it->second;
+}
+
+bool IsPlySigned(const std::string& type) {
+  return type == "char" || type == "int8" || type == "short" || type == "int16" || type == "int" ||
+         type == "int32";
+}
+bool IsPlyFloat(const std::string& type) {
+  return type == "float" || type == "float32" || type == "double" || type == "float64";
+}
+
+// "99999999 vertices", "1 face", "3 'edge' records".
+std::string PlyRecords(uint64_t n, const std::string& element) {
+  const std::string count = std::to_string(n);
+  if (element == "vertex") return count + (n == 1 ? " vertex" : " vertices");
+  if (element == "face") return count + (n == 1 ? " face" : " faces");
+  return count + " '" + Printable(element) + "' record" + (n == 1 ? "" : "s");
+}
+
+// "face 8 of 12".
+std::string PlyRecord(uint64_t index, const PlyElement& element) {
+  const std::string what = element.name == "vertex" || element.name == "face"
+                               ? element.name
+                               : "'" + Printable(element.name) + "' record";
+  return what + " " + std::to_string(index + 1) + " of " + std::to_string(element.count);
+}
+
+// Whether assimp reads the file as PLY by its content: "ply" (any case) starts the first line.
+bool HasPlyMagic(const std::string& start) {
+  return start.size() >= 3 && std::tolower(static_cast<unsigned char>(start[0])) == 'p' &&
+         std::tolower(static_cast<unsigned char>(start[1])) == 'l' &&
+         std::tolower(static_cast<unsigned char>(start[2])) == 'y';
+}
+
+// Parses the header at the start of `head` (the first bytes of a file of `file_size` bytes).
+// Returns nothing when the format line is one assimp rejects by itself.
+std::optional<PlyHeader> ParsePlyHeader(const std::string& head, uint64_t file_size,
+                                        const std::string& path) {
+  size_t pos = 0;
+  int line_number = 0;
+  std::string line;
+  // The next line without its line end ("\n", "\r\n" or "\r"); false at the end of `head`.
+  auto next_line = [&]() {
+    if (pos >= head.size()) return false;
+    size_t end = head.find_first_of("\r\n", pos);
+    if (end == std::string::npos) end = head.size();
+    line = head.substr(pos, end - pos);
+    pos = end;
+    if (pos < head.size() && head[pos] == '\r') ++pos;
+    if (pos < head.size() && head[pos] == '\n' && (pos == end || head[end] == '\r')) ++pos;
+    ++line_number;
+    return true;
+  };
+  next_line();  // "ply".
+  PlyHeader header;
+  // Assimp takes the second line as the format line and rejects the file unless it is one.
+  if (!next_line()) return std::nullopt;
+  const std::vector<std::string> format = SplitWords(line);
+  if (format.size() < 2 || format[0] != "format") return std::nullopt;
+  if (format[1] == "ascii") {
+    header.encoding = PlyEncoding::kAscii;
+  } else if (format[1].rfind("binary_", 0) == 0) {
+    // Assimp reads any "binary_b..." as big endian, any other "binary_..." as little endian.
+    const bool big = format[1].size() > 7 && (format[1][7] == 'b' || format[1][7] == 'B');
+    header.encoding = big ? PlyEncoding::kBinaryBigEndian : PlyEncoding::kBinaryLittleEndian;
+  } else {
+    return std::nullopt;
+  }
+
+  while (next_line()) {
+    const std::vector<std::string> words = SplitWords(line);
+    if (words.empty()) continue;
+    const std::string where =
+        "header line " + std::to_string(line_number) + " (\"" + Printable(line) + "\")";
+    if (words[0] == "end_header") {
+      header.data_offset = pos;
+      return header;
+    }
+    if (words[0] == "element") {
+      if (words.size() < 3) ThrowCorrupt(path, "PLY", where + " has no count");
+      PlyElement element;
+      element.name = words[1];
+      for (char c : words[2]) {
+        if (c < '0' || c > '9')
+          ThrowCorrupt(path, "PLY", where + " has a count that is not a number");
+        element.count = SaturatingAdd(SaturatingMul(element.count, 10), uint64_t(c - '0'));
+      }
+      header.elements.push_back(element);
+    } else if (words[0] == "property" && !header.elements.empty()) {
+      PlyProperty property;
+      if (words.size() >= 2 && words[1] == "list") {
+        if (words.size() < 5) ThrowCorrupt(path, "PLY", where + " is incomplete");
+        property.count_type = words[2];
+        property.type = words[3];
+        property.name = words[4];
+        property.count_size = PlyTypeSize(property.count_type);
+      } else {
+        if (words.size() < 3) ThrowCorrupt(path, "PLY", where + " is incomplete");
+        property.type = words[1];
+        property.name = words[2];
+      }
+      property.size = PlyTypeSize(property.type);
+      header.elements.back().properties.push_back(property);
+    }
+    // Comments, obj_info and unknown lines carry no data.
+  }
+  if (head.size() < file_size) {
+    ThrowCorrupt(path, "PLY", "no end_header line in the first " + ByteSize(head.size()));
+  }
+  ThrowCorrupt(path, "PLY", "the header has no end_header line");
+}
+
+// What assimp makes of a list count read as `type` from the bits `raw` (little endian, `size`
+// bytes): it converts the value to a 32-bit unsigned integer, negative ones wrapping around.
+uint64_t PlyBinaryCount(uint64_t raw, const std::string& type, int size) {
+  if (type == "float" || type == "float32") {
+    float f;
+    const uint32_t bits = static_cast<uint32_t>(raw);
+    std::memcpy(&f, &bits, sizeof(f));
+    return (f >= 0 && f < 4294967296.0f) ? static_cast<uint64_t>(f) : kMaxUint64;
+  }
+  if (type == "double" || type == "float64") {
+    double d;
+    std::memcpy(&d, &raw, sizeof(d));
+    return (d >= 0 && d < 4294967296.0) ? static_cast<uint64_t>(d) : kMaxUint64;
+  }
+  if (IsPlySigned(type) && size < 8 && ((raw >> (8 * size - 1)) & 1)) {
+    raw |= ~uint64_t{0} << (8 * size);  // Sign-extend.
+  }
+  return static_cast<uint32_t>(raw);
+}
+
+// The same for a list count written as text: assimp reads the leading digits (after a sign for
+// signed types) into a 32-bit unsigned integer, or a number for floating-point types.
+uint64_t PlyTextCount(std::string_view word, const std::string& type) {
+  if (IsPlyFloat(type)) {
+    const double d = std::strtod(std::string(word).c_str(), nullptr);
+    return (d >= 0 && d < 4294967296.0) ? static_cast<uint64_t>(d) : kMaxUint64;
+  }
+  size_t i = 0;
+  bool negative = false;
+  if (IsPlySigned(type) && i < word.size() && (word[i] == '-' || word[i] == '+')) {
+    negative = word[i] == '-';
+    ++i;
+  }
+  uint32_t value = 0;
+  for (; i < word.size() && word[i] >= '0' && word[i] <= '9'; ++i) {
+    value = value * 10 + static_cast<uint32_t>(word[i] - '0');
+  }
+  return negative ? static_cast<uint32_t>(0u - value) : value;
+}
+
+// Walks the records of a binary PLY file, checking that each fits in the file.
+void CheckPlyBinaryRecords(const PlyHeader& header, ByteReader& reader, const std::string& path) {
+  const bool big_endian = header.encoding == PlyEncoding::kBinaryBigEndian;
+  for (const PlyElement& element : header.elements) {
+    if (!element.HasList()) {
+      uint64_t record = 0;
+      for (const PlyProperty& p : element.properties) record += p.size;
+      if (!reader.Skip(SaturatingMul(element.count, record))) {
+        ThrowCorrupt(path, "PLY",
+                     "the file ends inside the " + PlyRecords(element.count, element.name) + " (" +
+                         ByteSize(reader.left()) + " left for them)");
+      }
+      continue;
+    }
+    for (uint64_t i = 0; i < element.count; ++i) {
+      for (const PlyProperty& p : element.properties) {
+        if (!p.list()) {
+          if (!reader.Skip(p.size)) {
+            ThrowCorrupt(path, "PLY", "the file ends inside " + PlyRecord(i, element));
+          }
+          continue;
+        }
+        unsigned char bytes[8] = {};
+        if (!reader.Read(bytes, p.count_size)) {
+          ThrowCorrupt(path, "PLY", "the file ends inside " + PlyRecord(i, element));
+        }
+        if (big_endian) std::reverse(bytes, bytes + p.count_size);
+        uint64_t raw = 0;
+        for (int b = 0; b < p.count_size; ++b) raw |= uint64_t{bytes[b]} << (8 * b);
+        const uint64_t count = PlyBinaryCount(raw, p.count_type, p.count_size);
+        const uint64_t size = SaturatingMul(count, p.size);
+        if (!reader.Skip(size)) {
+          const std::string entries = count == kMaxUint64 ? "an invalid number of entries"
+                                                          : std::to_string(count) + " entries";
+          ThrowCorrupt(path, "PLY",
+                       PlyRecord(i, element) + " has a list of " + entries +
+                           " but the file has only " + ByteSize(reader.left()) + " left");
+        }
+      }
+    }
+  }
+}
+
+// Walks the lines of an ASCII PLY file (one record a line, as assimp reads them), checking that
+// no list count exceeds what the file could hold: assimp allocates the list before reading it.
+void CheckPlyTextLists(const PlyHeader& header, ByteReader& reader, uint64_t data_bytes,
+                       const std::string& path) {
+  std::string line;
+  for (const PlyElement& element : header.elements) {
+    for (uint64_t i = 0; i < element.count; ++i) {
+      do {
+        // Missing lines are no danger: assimp gives their values as zeros.
+        if (!reader.ReadLine(&line)) return;
+      } while (line.find_first_not_of(" \t\r\f\v") == std::string::npos);
+      if (!element.HasList()) continue;
+      size_t at = 0;
+      // The next word of the line; false at its end.
+      auto next_word = [&](std::string_view* word) {
+        while (at < line.size() && IsBlank(line[at])) ++at;
+        if (at == line.size()) return false;
+        const size_t begin = at;
+        while (at < line.size() && !IsBlank(line[at])) ++at;
+        *word = std::string_view(line).substr(begin, at - begin);
+        return true;
+      };
+      std::string_view word;
+      for (const PlyProperty& p : element.properties) {
+        if (!next_word(&word)) break;
+        if (!p.list()) continue;
+        const uint64_t count = PlyTextCount(word, p.count_type);
+        // Each entry takes at least a digit and a separator.
+        if (SaturatingMul(count, 2) > data_bytes + 1) {
+          const std::string entries = count == kMaxUint64 ? "an invalid number of entries"
+                                                          : std::to_string(count) + " entries";
+          ThrowCorrupt(path, "PLY",
+                       PlyRecord(i, element) + " has a list of " + entries +
+                           " but the file has only " + ByteSize(data_bytes) + " after the header");
+        }
+        for (uint64_t k = 0; k < count && next_word(&word); ++k) {
+        }
+      }
+    }
+  }
+}
+
+void CheckPly(const std::string& path, uint64_t file_size) {
+  const std::string head = ReadStart(path, std::min(file_size, kMaxPlyHeaderBytes));
+  const std::optional<PlyHeader> header = ParsePlyHeader(head, file_size, path);
+  if (!header) return;
+  const bool binary = header->encoding != PlyEncoding::kAscii;
+  const uint64_t data_bytes = file_size - std::min(file_size, header->data_offset);
+
+  // The least the declared records take: in binary, every value at its size and lists empty; as
+  // text, a digit and a separator per value (the last line may lack its line end). A record
+  // without properties is counted as a byte (a line as text), so that a huge count cannot pass.
+  uint64_t least = 0;
+  std::string declared;
+  for (const PlyElement& element : header->elements) {
+    uint64_t record = 0;
+    for (const PlyProperty& p : element.properties) {
+      if (binary && (p.size == 0 || (p.list() && p.count_size == 0))) {
+        throw InputError(path, "",
+                         "cannot read mesh file: PLY property '" + Printable(p.name) +
+                             "' of element '" + Printable(element.name) +
+                             "' has an unknown type ('" +
+                             Printable(p.list() ? p.count_type + " " + p.type : p.type) + "')",
+                         "binary PLY values must be char, uchar, short, ushort, int, uint, "
+                         "float or double");
+      }
+      record += binary ? (p.list() ? p.count_size : p.size) : 2;
+    }
+    least = SaturatingAdd(least, SaturatingMul(element.count, std::max<uint64_t>(record, 1)));
+    if (element.count > 0) {
+      declared += (declared.empty() ? "" : ", ") + PlyRecords(element.count, element.name);
+    }
+  }
+  const uint64_t slack = binary ? 0 : 1;
+  if (least > SaturatingAdd(data_bytes, slack)) {
+    ThrowCorrupt(path, "PLY",
+                 "the header declares " + declared + " (at least " + ByteSize(least) +
+                     (binary ? "" : " as text") + ") but the file has " + ByteSize(data_bytes) +
+                     " after the header");
+  }
+
+  const bool has_lists = std::any_of(header->elements.begin(), header->elements.end(),
+                                     [](const PlyElement& element) { return element.HasList(); });
+  if (!has_lists) return;  // Without lists the size check above is exact for binary files.
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(header->data_offset));
+  if (!in) return;
+  ByteReader reader(in, data_bytes);
+  if (binary) {
+    CheckPlyBinaryRecords(*header, reader, path);
+  } else {
+    CheckPlyTextLists(*header, reader, data_bytes, path);
+  }
+}
+
+// --- STL.
+
+// A binary STL file: an 80-byte header, a 32-bit triangle count, 50 bytes a triangle. Assimp reads
+// a file as binary only when its size is exactly that, and as ASCII when it starts with "solid";
+// anything else it rejects with a vague message. This gives the reason for a binary one.
+void CheckBinaryStl(const std::string& path, uint64_t file_size) {
+  const std::string head = ReadStart(path, 84);
+  const size_t text = head.find_first_not_of(" \t\r\n");
+  if (text != std::string::npos && head.compare(text, 5, "solid") == 0) return;  // ASCII.
+  if (file_size < 84) {
+    ThrowCorrupt(
+        path, "STL",
+        "a binary STL file starts with an 84-byte header, but the file has " + ByteSize(file_size));
+  }
+  uint64_t count = 0;
+  for (int b = 0; b < 4; ++b) {
+    count |= uint64_t{static_cast<unsigned char>(head[80 + b])} << (8 * b);
+  }
+  const uint64_t size = 84 + 50 * count;
+  if (file_size < size) {
+    ThrowCorrupt(path, "STL",
+                 "the header declares " + std::to_string(count) + " triangles (" + ByteSize(size) +
+                     ") but the file has " + ByteSize(file_size));
+  }
+}
+
+// --- COLLADA.
+
+// A start tag of an XML document: its name, attributes and where its text begins.
+struct XmlTag {
+  std::string name;
+  std::map<std::string, std::string> attributes;
+  size_t content = 0;         // Just past the '>'.
+  bool self_closing = false;  // <name/>
+};
+
+// The next start tag from `pos` in `text`, skipping comments, CDATA, declarations and end tags;
+// false when there is none. Leaves `pos` just past the tag.
+bool NextXmlTag(const std::string& text, size_t* pos, XmlTag* tag) {
+  while ((*pos = text.find('<', *pos)) != std::string::npos) {
+    const size_t at = *pos;
+    const char* close = nullptr;
+    if (text.compare(at, 4, "<!--") == 0)
+      close = "-->";
+    else if (text.compare(at, 9, "<![CDATA[") == 0)
+      close = "]]>";
+    else if (at + 1 < text.size() &&
+             (text[at + 1] == '?' || text[at + 1] == '!' || text[at + 1] == '/'))
+      close = ">";
+    if (close != nullptr) {
+      const size_t end = text.find(close, at + 1);
+      if (end == std::string::npos) return false;
+      *pos = end + std::strlen(close);
+      continue;
+    }
+    size_t i = at + 1;
+    auto is_space = [](char c) { return IsBlank(c) || c == '\n'; };
+    while (i < text.size() && !is_space(text[i]) && text[i] != '>' && text[i] != '/') ++i;
+    tag->name = text.substr(at + 1, i - at - 1);
+    tag->attributes.clear();
+    // Attributes: name="value" or name='value' ('>' may stand in a value).
+    while (true) {
+      while (i < text.size() && is_space(text[i])) ++i;
+      if (i >= text.size()) return false;
+      if (text[i] == '>' || text[i] == '/') break;
+      const size_t name_begin = i;
+      while (i < text.size() && !is_space(text[i]) && text[i] != '=' && text[i] != '>') ++i;
+      const std::string name = text.substr(name_begin, i - name_begin);
+      while (i < text.size() && is_space(text[i])) ++i;
+      if (i >= text.size() || text[i] != '=') continue;
+      ++i;
+      while (i < text.size() && is_space(text[i])) ++i;
+      if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) continue;
+      const size_t value_end = text.find(text[i], i + 1);
+      if (value_end == std::string::npos) return false;
+      tag->attributes[name] = text.substr(i + 1, value_end - i - 1);
+      i = value_end + 1;
+    }
+    const size_t end = text.find('>', i);
+    if (end == std::string::npos) return false;
+    tag->self_closing = text[end - 1] == '/';
+    tag->content = end + 1;
+    *pos = end + 1;
+    return true;
+  }
+  return false;
+}
+
+// An unsigned attribute as assimp reads it (through pugixml): its leading digits, or `otherwise`
+// when it is missing.
+uint64_t XmlUnsigned(const XmlTag& tag, const std::string& name, uint64_t otherwise) {
+  const auto it = tag.attributes.find(name);
+  if (it == tag.attributes.end()) return otherwise;
+  const std::string& value = it->second;
+  size_t i = value.find_first_not_of(" \t\r\n");
+  uint64_t n = 0;
+  for (; i < value.size() && value[i] >= '0' && value[i] <= '9'; ++i) {
+    n = SaturatingAdd(SaturatingMul(n, 10), uint64_t(value[i] - '0'));
+  }
+  return n;
+}
+
+long LineAt(const std::string& text, size_t pos) {
+  return 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n');
+}
+
+// Two things assimp takes on trust in COLLADA files:
+// - A <p> index list: assimp reads integers until the end of its text; on any other character it
+//   stops advancing and appends zeros forever. The schema allows only integers there.
+// - An <accessor>: assimp reads `count` units of `stride` values from the array it names, without
+//   checking that the array (as many values as its own count says) holds them.
+void CheckCollada(const std::string& path, uint64_t file_size) {
+  const std::string text = ReadStart(path, file_size);
+  struct Accessor {
+    std::string array;
+    uint64_t last_value;  // Index of the last value read (offset + (count - 1) * stride).
+    size_t at;
+  };
+  std::map<std::string, uint64_t> array_sizes;
+  std::vector<Accessor> accessors;
+  size_t pos = 0;
+  XmlTag tag;
+  while (NextXmlTag(text, &pos, &tag)) {
+    const bool is_array =
+        tag.name.size() > 6 && tag.name.compare(tag.name.size() - 6, 6, "_array") == 0;
+    if (is_array && tag.attributes.count("id")) {
+      array_sizes[tag.attributes["id"]] = XmlUnsigned(tag, "count", 0);
+    } else if (tag.name == "accessor") {
+      const uint64_t count = XmlUnsigned(tag, "count", 0);
+      std::string source = tag.attributes.count("source") ? tag.attributes["source"] : "";
+      if (!source.empty() && source[0] == '#') source.erase(0, 1);
+      if (count > 0) {
+        const uint64_t last = SaturatingAdd(
+            XmlUnsigned(tag, "offset", 0), SaturatingMul(count - 1, XmlUnsigned(tag, "stride", 1)));
+        accessors.push_back({source, last, pos});
+      }
+    } else if (tag.name == "p" && !tag.self_closing) {
+      size_t begin = tag.content, end;
+      if (text.compare(begin, 9, "<![CDATA[") == 0) {
+        begin += 9;
+        end = text.find("]]>", begin);
+      } else {
+        end = text.find('<', begin);
+      }
+      if (end == std::string::npos) end = text.size();
+      for (size_t i = begin; i < end; ++i) {
+        const char c = text[i];
+        if ((c >= '0' && c <= '9') || c == '-' || c == '+' || c == ' ' || c == '\t' || c == '\r' ||
+            c == '\n') {
+          continue;
+        }
+        const unsigned char u = static_cast<unsigned char>(c);
+        char shown[16];
+        if (u >= 0x21 && u <= 0x7E) {
+          std::snprintf(shown, sizeof(shown), "'%c'", c);
+        } else {
+          std::snprintf(shown, sizeof(shown), "byte 0x%02X", u);
+        }
+        ThrowCorrupt(path, "COLLADA",
+                     "the <p> index list on line " + std::to_string(LineAt(text, i)) + " holds " +
+                         shown + "; it may hold only whole numbers");
+      }
+      pos = end;
+    }
+  }
+  for (const Accessor& accessor : accessors) {
+    const auto array = array_sizes.find(accessor.array);
+    if (array == array_sizes.end()) continue;  // Assimp reports a missing source itself.
+    if (accessor.last_value >= array->second) {
+      ThrowCorrupt(path, "COLLADA",
+                   "the accessor on line " + std::to_string(LineAt(text, accessor.at)) +
+                       " reads value " + std::to_string(accessor.last_value + 1) + " of '" +
+                       Printable(accessor.array) + "', which holds " +
+                       std::to_string(array->second));
+    }
+  }
+}
+
+// Rejects an empty file, and the damage assimp does not survive in the formats it reads blindly.
+// The format is the one assimp will pick: by the extension, or by the content when assimp does not
+// know the extension.
+void CheckBeforeAssimp(const std::string& path, const Assimp::Importer& importer) {
+  std::error_code ec;
+  const uint64_t file_size = fs::file_size(path, ec);
+  if (ec) return;  // Assimp reports it.
+  if (file_size == 0) {
+    throw InputError(path, "", "cannot read mesh file: the file is empty (0 bytes)",
+                     "the file was cut short; export it again");
+  }
+  std::string extension = fs::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool known = !extension.empty() && importer.IsExtensionSupported(extension);
+  const std::string start = ReadStart(path, 4096);
+  if (HasPlyMagic(start) && (extension == ".ply" || !known)) {
+    CheckPly(path, file_size);
+  } else if (extension == ".stl") {
+    CheckBinaryStl(path, file_size);
+  } else if (extension == ".dae" ||
+             ((extension == ".xml" || !known) && start.find("<COLLADA") != std::string::npos)) {
+    CheckCollada(path, file_size);
+  }
+}
+
+// Checks what assimp's post-processing steps (triangulation, welding, pre-transforming) take on
+// trust: faces with vertices, vertex indices within their mesh, node mesh indices within the
+// scene. A corrupt file can break each, and the steps then crash or abort.
+void CheckImportedScene(const aiScene& scene, const std::string& path) {
+  auto fail = [&](const std::string& detail) {
+    throw InputError(path, "", "cannot read mesh file: corrupt mesh data: " + detail,
+                     "the file is damaged; export it again");
+  };
+  if (scene.mNumMeshes > 0 && scene.mMeshes == nullptr) fail("the meshes are missing");
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    std::string name = "mesh " + std::to_string(m);
+    if (mesh == nullptr) fail(name + " is missing");
+    if (mesh->mName.length > 0) name += " ('" + Printable(mesh->mName.C_Str()) + "')";
+    if (mesh->mNumVertices > 0 && mesh->mVertices == nullptr) fail(name + " has no positions");
+    if (mesh->mNumFaces > 0 && mesh->mFaces == nullptr) fail(name + " has no faces");
+    if (scene.mNumMaterials > 0 && mesh->mMaterialIndex >= scene.mNumMaterials) {
+      fail(name + " uses material " + std::to_string(mesh->mMaterialIndex) + " of " +
+           std::to_string(scene.mNumMaterials));
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 0 || face.mIndices == nullptr) {
+        fail(name + ": face " + std::to_string(f) + " has no vertices");
+      }
+      for (unsigned k = 0; k < face.mNumIndices; ++k) {
+        if (face.mIndices[k] >= mesh->mNumVertices) {
+          fail(name + ": face " + std::to_string(f) + " refers to vertex " +
+               std::to_string(face.mIndices[k]) + " but the mesh has " +
+               std::to_string(mesh->mNumVertices) + " vertices");
+        }
+      }
+    }
+  }
+  std::vector<const aiNode*> stack;
+  std::unordered_set<const aiNode*> seen;
+  if (scene.mRootNode != nullptr) stack.push_back(scene.mRootNode);
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    if (!seen.insert(node).second) fail("the node tree has a cycle");
+    const std::string name = "node '" + Printable(node->mName.C_Str()) + "'";
+    if (node->mNumMeshes > 0 && node->mMeshes == nullptr) fail(name + " has no mesh list");
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      if (node->mMeshes[i] >= scene.mNumMeshes) {
+        fail(name + " refers to mesh " + std::to_string(node->mMeshes[i]) + " but the file has " +
+             std::to_string(scene.mNumMeshes) + " meshes");
+      }
+    }
+    if (node->mNumChildren > 0 && node->mChildren == nullptr) fail(name + " has no child list");
+    for (unsigned i = 0; i < node->mNumChildren; ++i) {
+      if (node->mChildren[i] == nullptr) fail(name + " has a missing child");
+      stack.push_back(node->mChildren[i]);
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<MeshPart> LoadMeshFile(const std::string& path) {
@@ -53,14 +788,22 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
                      "mesh paths are relative to the folder of the scene file");
   }
   if (fs::is_directory(path, ec)) throw InputError(path, "", "is a folder, not a mesh file");
+  // Only formats whose readers survived our damage tests (scene_test, MeshFileRobustnessTest and
+  // the fuzzing recorded in docs/scene-format.md). Assimp reads more, but some of its readers
+  // (X3D, for one) crash on damaged files, and a scene loader must never crash.
+  static const std::set<std::string> kSupported{".obj", ".gltf", ".glb", ".ply", ".stl",
+                                                ".dae", ".fbx", ".3ds", ".x"};
+  std::string extension = fs::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!kSupported.count(extension)) {
+    throw InputError(path, "", "unsupported mesh format '" + extension + "'",
+                     "use OBJ, glTF/GLB, PLY, STL, COLLADA (.dae), FBX, 3DS or DirectX .x");
+  }
 
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_PreTransformVertices | aiProcess_SortByPType);
-  if (scene == nullptr) {
+  auto fail = [&]() {
     std::string message = importer.GetErrorString();
     if (message.empty()) message = "unknown error";
     // What assimp says when removing points and lines (aiProcess_SortByPType) leaves nothing.
@@ -70,7 +813,16 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
     }
     throw InputError(path, "", "cannot read mesh file: " + message,
                      "check that the file is a valid OBJ, glTF/GLB, PLY, STL, COLLADA or FBX file");
-  }
+  };
+  CheckBeforeAssimp(path, importer);
+  // Read first, check what the post-processing steps trust, then run them.
+  const aiScene* raw = importer.ReadFile(path, 0);
+  if (raw == nullptr) fail();
+  CheckImportedScene(*raw, path);
+  const aiScene* scene =
+      importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                   aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  if (scene == nullptr) fail();
   // A scene left without meshes (AI_SCENE_FLAGS_INCOMPLETE) is reported below as having no
   // triangles.
   const fs::path folder = fs::path(path).parent_path();
@@ -92,6 +844,11 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
       if (face.mNumIndices != 3) continue;  // Points and lines, if any are left.
+      if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices) {
+        throw InputError(path, "",
+                         "cannot read mesh file: corrupt mesh data: a triangle refers "
+                         "to a vertex past the end of its mesh");
+      }
       out.triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]),
                                  offset + static_cast<int>(face.mIndices[1]),
                                  offset + static_cast<int>(face.mIndices[2]));

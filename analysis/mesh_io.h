@@ -26,8 +26,12 @@ struct MeshPart {
 /// grouped into one part per material (parts in material order, empty materials left out).
 /// COLLADA files are converted to Y up as assimp does (their declared up axis is honoured); other
 /// formats keep their file coordinates.
-/// Throws InputError (file `path`, empty JSON path) when the file is missing or unreadable (the
-/// reason carries assimp's message), holds non-finite coordinates, or has no triangles.
+/// Throws InputError (file `path`, empty JSON path) when the file is missing, empty or unreadable
+/// (the reason carries assimp's message), holds non-finite coordinates, or has no triangles. Damage
+/// that assimp 5.2 does not survive (it hangs, aborts or crashes) is caught before assimp reads the
+/// file (PLY headers that promise more than the file holds, COLLADA index lists and accessors) or
+/// before its post-processing runs (faces without vertices or with indices past the end), and
+/// reported as "corrupt ...".
 std::vector<MeshPart> LoadMeshFile(const std::string& path);
 
 }  // namespace pandora

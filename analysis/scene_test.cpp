@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <assimp/Exporter.hpp>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -991,19 +994,30 @@ struct ExportFormat {
   bool export_may_be_corrupt = false;
 };
 
-TEST(MeshFileTest, EveryExportableFormatLoadsWithBoundsAndMaterials) {
-  const std::vector<ExportFormat> formats = {
+// The formats the exporter round trips use.
+std::vector<ExportFormat> ExportFormats() {
+  return {
       {"obj", "obj", false, true},   {"gltf2", "gltf", true, true},
       {"glb2", "glb", true, true},   {"ply", "ply", false, false},
       {"plyb", "ply", false, false}, {"stl", "stl", false, false},
       {"stlb", "stl", false, false}, {"collada", "dae", true, true},
       {"fbxa", "fbx", false, true},  {"fbx", "fbx", false, true, true},
   };
-  Assimp::Exporter exporter;
+}
+
+// The ids of the formats `exporter` can write.
+std::set<std::string> AvailableExportFormats(const Assimp::Exporter& exporter) {
   std::set<std::string> available;
   for (size_t i = 0; i < exporter.GetExportFormatCount(); ++i) {
     available.insert(exporter.GetExportFormatDescription(i)->id);
   }
+  return available;
+}
+
+TEST(MeshFileTest, EveryExportableFormatLoadsWithBoundsAndMaterials) {
+  const std::vector<ExportFormat> formats = ExportFormats();
+  Assimp::Exporter exporter;
+  const std::set<std::string> available = AvailableExportFormats(exporter);
   const std::unique_ptr<aiScene> cube = MakeTwoMaterialCube();
   TempDir dir;
   int tested = 0;
@@ -1311,5 +1325,286 @@ TEST(SceneErrorTest, OtherInvalidValues) {
   EXPECT_INPUT_ERROR(ErrorFor(scene), "$.materials[\"dark wood\"].colour", "unknown key");
 }
 
+// -------------------------------------------------------------------------------------------------
+// Damaged mesh files: each must load or be reported as an InputError at the "file" field; none may
+// crash the loader.
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Loads `file` (relative to `dir`) as the only object of a scene. Returns "" when it loads, else
+// the reason of the InputError, after checking that the error names the field and the file.
+std::string LoadOrReason(const TempDir& dir, const std::string& file) {
+  json scene = BaseScene();
+  scene["objects"] = {{{"name", "m"}, {"mesh", {{"file", file}}}}};
+  try {
+    Parse(scene, dir.File("scene.json"));
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.json_path(), "$.objects[0].mesh.file") << e.what();
+    EXPECT_CONTAINS(e.reason(), fs::path(file).filename().string());
+    return e.reason();
+  }
+  return "";
+}
+
+// Damaged copies of `bytes`: cut to 0, 10, 50 and 90 % of the size, the last byte flipped, and 16
+// bytes overwritten with 0xFF at each eighth of the size.
+std::vector<std::pair<std::string, std::string>> DamagedCopies(const std::string& bytes) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (int percent : {0, 10, 50, 90}) {
+    out.emplace_back("cut to " + std::to_string(percent) + "%",
+                     bytes.substr(0, bytes.size() * percent / 100));
+  }
+  if (!bytes.empty()) {
+    std::string flipped = bytes;
+    flipped.back() = static_cast<char>(~flipped.back());
+    out.emplace_back("last byte flipped", flipped);
+  }
+  for (int eighth = 1; eighth < 8; ++eighth) {
+    std::string overwritten = bytes;
+    const size_t at = bytes.size() * eighth / 8;
+    for (size_t i = at; i < std::min(bytes.size(), at + 16); ++i) overwritten[i] = '\xFF';
+    out.emplace_back("0xFF run at " + std::to_string(eighth) + "/8", overwritten);
+  }
+  return out;
+}
+
+TEST(MeshFileRobustnessTest, DamagedExportsLoadOrFailWithAnInputError) {
+  Assimp::Exporter exporter;
+  const std::set<std::string> available = AvailableExportFormats(exporter);
+  const std::unique_ptr<aiScene> cube = MakeTwoMaterialCube();
+  TempDir dir;
+  int cases = 0;
+  for (const ExportFormat& format : ExportFormats()) {
+    if (!available.count(format.id)) continue;
+    // Each format in its own folder, so that its companion files (OBJ's .mtl, glTF's .bin) are
+    // damaged too, one at a time, with the main file intact.
+    const fs::path folder = dir.path() / format.id;
+    fs::create_directories(folder);
+    const std::string main = std::string(format.id) + "/cube." + format.extension;
+    ASSERT_EQ(exporter.Export(cube.get(), format.id, dir.File(main)), AI_SUCCESS)
+        << exporter.GetErrorString();
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+      const std::string original = ReadBytes(entry.path());
+      for (const auto& [damage, bytes] : DamagedCopies(original)) {
+        SCOPED_TRACE(entry.path().filename().string() + " (" + format.id + ") " + damage);
+        {
+          std::ofstream out(entry.path(), std::ios::binary | std::ios::trunc);
+          out << bytes;
+        }
+        const std::string reason = LoadOrReason(dir, main);
+        ++cases;
+        if (entry.path().filename() == fs::path(main).filename() && bytes.empty()) {
+          EXPECT_CONTAINS(reason, "empty");
+        }
+      }
+      std::ofstream(entry.path(), std::ios::binary | std::ios::trunc) << original;
+    }
+  }
+  EXPECT_GE(cases, 100);
+}
+
+TEST(MeshFileRobustnessTest, EmptyFileOfEveryFormatIsAnError) {
+  TempDir dir;
+  for (const char* name :
+       {"e.obj", "e.ply", "e.stl", "e.glb", "e.gltf", "e.dae", "e.fbx", "e.3ds", "e.x"}) {
+    SCOPED_TRACE(name);
+    dir.Write(name, "");
+    EXPECT_CONTAINS(LoadOrReason(dir, name), "the file is empty");
+  }
+}
+
+TEST(MeshFileRobustnessTest, UntestedFormatsAreRefused) {
+  TempDir dir;
+  for (const char* name : {"m.x3d", "m.blend", "m.unknown", "m"}) {
+    SCOPED_TRACE(name);
+    dir.Write(name, "solid nothing\n");
+    EXPECT_CONTAINS(LoadOrReason(dir, name), "unsupported mesh format");
+  }
+}
+
+// The bytes of `value` in the machine's order (little endian), or reversed.
+template <typename T>
+std::string Binary(T value, bool reversed = false) {
+  std::string bytes(sizeof(T), '\0');
+  std::memcpy(bytes.data(), &value, sizeof(T));
+  if (reversed) std::reverse(bytes.begin(), bytes.end());
+  return bytes;
+}
+
+// A PLY header: `format`, then the vertices (float x, y, z) and faces (`face_list` list).
+std::string PlyHeaderText(const std::string& format, uint64_t vertices, uint64_t faces,
+                          const std::string& face_list = "uchar int") {
+  return "ply\nformat " + format + " 1.0\ncomment made by scene_test\nelement vertex " +
+         std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+         std::to_string(faces) + "\nproperty list " + face_list + " vertex_indices\nend_header\n";
+}
+
+// The binary data of the triangle (0,0,0) (1,0,0) (0,1,0), without the face.
+std::string PlyTriangleVertices(bool big_endian) {
+  std::string data;
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) data += Binary(v, big_endian);
+  return data;
+}
+
+TEST(MeshFileRobustnessTest, PlyDataMustMatchItsHeader) {
+  TempDir dir;
+  const std::string le = "binary_little_endian", be = "binary_big_endian";
+  const std::string vertices = PlyTriangleVertices(false);
+  const std::string face = Binary<uint8_t>(3) + Binary(0) + Binary(1) + Binary(2);
+  std::string garbage = std::string("\x00\x01", 2) + "garbage";
+  while (garbage.size() < 37) garbage += '\xFF';
+
+  // Valid files, to check that the checks reject nothing good.
+  struct Good {
+    const char* name;
+    std::string bytes;
+  };
+  const std::vector<Good> good = {
+      {"little.ply", PlyHeaderText(le, 3, 1) + vertices + face},
+      {"big.ply", PlyHeaderText(be, 3, 1, "ushort uint") + PlyTriangleVertices(true) +
+                      Binary<uint16_t>(3, true) + Binary(0, true) + Binary(1, true) +
+                      Binary(2, true)},
+      {"trailing_bytes.ply", PlyHeaderText(le, 3, 1) + vertices + face + "extra"},
+      {"text.ply", PlyHeaderText("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+      {"text_crlf.ply",
+       "ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\n"
+       "property float y\r\nproperty float z\r\nelement face 1\r\n"
+       "property list uchar int vertex_indices\r\nend_header\r\n"
+       "0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2"},
+  };
+  for (const Good& g : good) {
+    SCOPED_TRACE(g.name);
+    dir.Write(g.name, g.bytes);
+    EXPECT_EQ(LoadOrReason(dir, g.name), "");
+  }
+
+  struct Bad {
+    const char* name;
+    std::string bytes;
+    std::vector<std::string> reason_parts;
+  };
+  const std::vector<Bad> bad = {
+      {"count_lie.ply",
+       PlyHeaderText(le, 99999999, 1) + garbage,
+       {"corrupt PLY: the header declares 99999999 vertices, 1 face (at least 1.2 GB) but the "
+        "file has 37 bytes after the header"}},
+      {"count_lie_big.ply",
+       PlyHeaderText(be, 5, 1) + PlyTriangleVertices(true),
+       {"5 vertices, 1 face (at least 61 bytes)", "36 bytes after the header"}},
+      {"count_lie_text.ply",
+       PlyHeaderText("ascii", 99999999, 1) + "0 0 0\n1 0 0\n0 1 0\n",
+       {"99999999 vertices", "as text", "18 bytes after the header"}},
+      {"no_end_header.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 99999999\n" + garbage,
+       {"corrupt PLY: the header has no end_header line"}},
+      {"cut_in_header.ply", PlyHeaderText(le, 3, 1).substr(0, 60), {"no end_header"}},
+      {"count_not_a_number.ply",
+       "ply\nformat ascii 1.0\nelement vertex many\nend_header\n",
+       {"header line 3", "not a number"}},
+      {"unknown_type.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty int64 id\nend_header\n" +
+           std::string(8, '\0'),
+       {"unknown type ('int64')"}},
+      {"cut_in_faces.ply",
+       PlyHeaderText(le, 3, 2) + vertices + face,
+       {"the file ends inside face 2 of 2"}},
+      {"cut_in_a_list.ply",
+       PlyHeaderText(le, 3, 2) + vertices + face + Binary<uint8_t>(3) + Binary(0),
+       {"face 2 of 2 has a list of 3 entries but the file has only 4 bytes left"}},
+      {"huge_list.ply",
+       PlyHeaderText(le, 3, 1, "int int") + vertices + Binary(0x7FFFFFFF) + Binary(0) + Binary(1) +
+           Binary(2),
+       {"face 1 of 1 has a list of 2147483647 entries but the file has only 12 bytes left"}},
+      {"negative_list.ply",
+       PlyHeaderText(le, 3, 1, "char int") + vertices + Binary<int8_t>(-1) + Binary(0) + Binary(1) +
+           Binary(2),
+       {"a list of 4294967295 entries"}},
+      {"huge_list_text.ply",
+       PlyHeaderText("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n",
+       {"face 1 of 1 has a list of 4000000000 entries"}},
+      {"index_past_end.ply",
+       PlyHeaderText("ascii", 3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 99\n",
+       {"corrupt mesh data", "refers to vertex 99 but the mesh has 3 vertices"}},
+      {"negative_index.ply",
+       PlyHeaderText(le, 3, 1) + vertices + Binary<uint8_t>(3) + Binary(0) + Binary(1) + Binary(-1),
+       {"refers to vertex 4294967295"}},
+      {"empty_face.ply",
+       PlyHeaderText("ascii", 3, 2) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n",
+       {"corrupt mesh data", "face 1 has no vertices"}},
+  };
+  for (const Bad& b : bad) {
+    SCOPED_TRACE(b.name);
+    dir.Write(b.name, b.bytes);
+    const std::string reason = LoadOrReason(dir, b.name);
+    for (const std::string& part : b.reason_parts) EXPECT_CONTAINS(reason, part);
+  }
+
+  // The command line's example of a corrupt mesh, at its JSON path.
+  const fs::path scene_file = TestData("bad/corrupt_mesh.json");
+  const InputError e = ErrorForText(ReadBytes(scene_file), scene_file.string());
+  EXPECT_INPUT_ERROR(e, "$.objects[1].mesh.file", "corrupt PLY: the header has no end_header line");
+  EXPECT_CONTAINS(e.reason(), "corrupt.ply");
+}
+
+TEST(MeshFileRobustnessTest, BinaryStlSizeMustMatchItsTriangleCount) {
+  TempDir dir;
+  std::string triangle;  // Normal, three corners, attribute bytes.
+  for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) {
+    triangle += Binary(v);
+  }
+  triangle += Binary<uint16_t>(0);
+  const std::string header(80, ' ');
+  dir.Write("one.stl", header + Binary<uint32_t>(1) + triangle);
+  EXPECT_EQ(LoadOrReason(dir, "one.stl"), "");
+  dir.Write("lie.stl", header + Binary<uint32_t>(12) + triangle);
+  EXPECT_CONTAINS(LoadOrReason(dir, "lie.stl"),
+                  "corrupt STL: the header declares 12 triangles (684 bytes) but the file has "
+                  "134 bytes");
+  dir.Write("short.stl", header.substr(0, 40));
+  EXPECT_CONTAINS(LoadOrReason(dir, "short.stl"), "84-byte header, but the file has 40 bytes");
+}
+
+TEST(MeshFileRobustnessTest, ColladaIndexListMustHoldOnlyIntegers) {
+  Assimp::Exporter exporter;
+  if (!AvailableExportFormats(exporter).count("collada")) GTEST_SKIP() << "no COLLADA exporter";
+  const std::unique_ptr<aiScene> cube = MakeTwoMaterialCube();
+  TempDir dir;
+  ASSERT_EQ(exporter.Export(cube.get(), "collada", dir.File("cube.dae")), AI_SUCCESS);
+  std::string text = ReadBytes(dir.File("cube.dae"));
+  EXPECT_EQ(LoadOrReason(dir, "cube.dae"), "");
+  // Assimp 5.2 would append zeros forever on the '.'.
+  const size_t list = text.find("<p>");
+  ASSERT_NE(list, std::string::npos);
+  text.insert(list + 3, "1.5 ");
+  dir.Write("cube.dae", text);
+  const std::string reason = LoadOrReason(dir, "cube.dae");
+  EXPECT_CONTAINS(reason, "corrupt COLLADA: the <p> index list on line");
+  EXPECT_CONTAINS(reason, "holds '.'");
+  text.erase(list + 3, 4);
+  dir.Write("cube.dae", text);
+  EXPECT_EQ(LoadOrReason(dir, "cube.dae"), "");
+}
+
+TEST(MeshFileRobustnessTest, ColladaAccessorMustStayInsideItsArray) {
+  Assimp::Exporter exporter;
+  if (!AvailableExportFormats(exporter).count("collada")) GTEST_SKIP() << "no COLLADA exporter";
+  const std::unique_ptr<aiScene> cube = MakeTwoMaterialCube();
+  TempDir dir;
+  ASSERT_EQ(exporter.Export(cube.get(), "collada", dir.File("cube.dae")), AI_SUCCESS);
+  std::string text = ReadBytes(dir.File("cube.dae"));
+  // Assimp 5.2 reads as many values as the array's count says, then as many as the accessor
+  // says, past the end of what it read: a crash when the count is damaged or missing.
+  const size_t count = text.find("count=\"", text.find("<float_array"));
+  ASSERT_NE(count, std::string::npos);
+  text.replace(count, text.find('"', count + 7) + 1 - count, "cou4t=\"8\"");
+  dir.Write("cube.dae", text);
+  const std::string reason = LoadOrReason(dir, "cube.dae");
+  EXPECT_CONTAINS(reason, "corrupt COLLADA: the accessor on line");
+  EXPECT_CONTAINS(reason, "which holds 0");
+}
 }  // namespace
 }  // namespace pandora
