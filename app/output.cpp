@@ -27,26 +27,6 @@ void PrepareOutputDir(const std::string& dir) {
   std::remove(probe.c_str());
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    f.flush();
-    if (!f) {
-      std::remove(tmp.c_str());
-      throw InputError(path, "", "cannot write the file", "check the output folder");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw InputError(path, "", "cannot rename the temporary file: " + ec.message(),
-                     "check the output folder");
-  }
-}
-
 ProgressBar::ProgressBar(std::string label, bool enabled)
     : label_(std::move(label)), active_(enabled && isatty(STDERR_FILENO)) {}
 

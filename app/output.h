@@ -1,19 +1,19 @@
 #pragma once
 /// \file output.h
-/// Output helpers for the command-line tool: atomic file writes, output folders, progress bar.
+/// Output helpers for the command-line tool: output folders, progress bar (atomic writes live in
+/// analysis/atomic_file.h).
 
 #include <chrono>
 #include <mutex>
 #include <string>
+
+#include "analysis/atomic_file.h"
 
 namespace pandora::app {
 
 /// Creates `dir` (and parents) if needed and checks that a file can be created in it. Throws
 /// InputError (file = dir) otherwise.
 void PrepareOutputDir(const std::string& dir);
-
-/// Writes `text` to `path` + ".tmp", then renames it to `path`. Throws InputError on failure.
-void WriteFileAtomically(const std::string& path, const std::string& text);
 
 /// A one-line progress bar on stderr, drawn only when stderr is a terminal. Thread-safe; redraws at
 /// most ten times a second.

@@ -4,9 +4,9 @@
 #include <openvdb/openvdb.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <mutex>
 
+#include "analysis/atomic_file.h"
 #include "analysis/error.h"
 #include "volume/fields_vdb.h"
 
@@ -49,7 +49,7 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
     for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
     Describe(*grid);
   }
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = TemporaryPath(path);
   try {
     openvdb::io::File file(tmp);
     file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
@@ -60,13 +60,7 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
     throw InputError(path, "", std::string("cannot write the VDB file: ") + e.what(),
                      "check that the output folder exists and is writable");
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw InputError(path, "", "cannot rename the temporary file: " + ec.message(),
-                     "check that the output folder is writable");
-  }
+  CommitTemporary(path);
 }
 
 }  // namespace pandora
