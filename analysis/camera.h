@@ -120,6 +120,7 @@ struct Camera {
   CameraModel model;
   double near = 0.0;        ///< Working range, Euclidean distance from the centre, metres.
   double far = std::numeric_limits<double>::infinity();
+  double pixel_sigma = 0.0;  ///< Pixel noise 1-sigma (pixels) for uncertainty; 0: the study's.
 
   Vec3 center() const { return world_from_camera.translation(); }
   Eigen::Isometry3d camera_from_world() const { return world_from_camera.inverse(); }

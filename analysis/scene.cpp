@@ -42,11 +42,6 @@ const Vec3 kCameraPalette[8] = {
     {0.95, 0.40, 0.65},  // pink
 };
 
-// The study fields this version accepts (the last four are reserved for later versions).
-std::vector<std::string> KnownFields() {
-  return {"coverage", "cameras", "resolution", "sigma_max", "sigma_mean", "triangulation_angle",
-          "condition"};
-}
 
 // -------------------------------------------------------------------------------------------------
 // Small string helpers.
@@ -807,7 +802,7 @@ Intrinsics ReadIntrinsics(const Node& node) {
 Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
   node.CheckKeys({"id", "name", "color", "enabled", "position", "look_at", "up", "quaternion",
                   "euler_deg", "resolution", "hfov_deg", "focal_px", "lens", "principal_point",
-                  "distortion", "range"});
+                  "distortion", "range", "pixel_sigma"});
   Camera camera;
   const Node id = node.Get("id");
   if (id.value().is_number_integer()) {
@@ -831,6 +826,7 @@ Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
 
   camera.world_from_camera = ReadPose(node);
   camera.model = CameraModel(ReadIntrinsics(node));
+  if (auto n = node.Find("pixel_sigma")) camera.pixel_sigma = n->Positive();
 
   if (auto range = node.Find("range")) {
     range->CheckKeys({"near", "far"});
@@ -863,7 +859,8 @@ Rig ReadRig(const Node& node, std::set<std::string>* names) {
 }
 
 Study ReadStudy(const Node& node) {
-  node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb"});
+  node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
+                  "max_sigma_mm"});
   Study study;
   const Node region = node.Get("region");
   region.CheckKeys({"box", "mesh"});
@@ -911,7 +908,7 @@ Study ReadStudy(const Node& node) {
   if (auto n = node.Find("voxel_size")) study.voxel_size = n->PositiveLength();
   if (auto n = node.Find("fields")) {
     const size_t count = n->ArraySize("an array of field names");
-    const std::vector<std::string> known = KnownFields();
+    const std::vector<std::string>& known = FieldNames();
     if (count == 0) n->Fail("at least one field is needed", "known fields: " + JoinQuoted(known));
     study.fields.clear();
     for (size_t i = 0; i < count; ++i) {
@@ -929,6 +926,30 @@ Study ReadStudy(const Node& node) {
   if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->Positive();
   if (auto n = node.Find("memory_budget_mb")) {
     study.memory_budget_bytes = n->Positive() * 1024.0 * 1024.0;
+  }
+  if (auto n = node.Find("max_sigma_mm")) study.max_sigma_mm = n->Positive();
+  if (auto motion = node.Find("motion")) {
+    motion->CheckKeys({"q", "rate_hz", "covariance"});
+    MotionModel m;
+    // q is a spectral density of acceleration, m^2/s^3: it scales with the file's length unit squared.
+    const double metres = node.context().metres_per_unit;
+    m.q = motion->Get("q").NonNegative() * metres * metres;
+    m.rate_hz = motion->Get("rate_hz").Positive();
+    study.motion = m;
+    if (auto c = motion->Find("covariance")) {
+      const std::string which = c->String();
+      if (which != "posterior" && which != "prior")
+        c->Fail("expected \"posterior\" or \"prior\", got " + Quoted(which),
+                "posterior is after each frame's update (the usual report), prior before it");
+      study.steady_prior = which == "prior";
+    }
+  }
+  if (auto n = node.Find("fields")) {
+    for (size_t i = 0; i < study.fields.size(); ++i)
+      if (study.fields[i].size() > 7 &&
+          study.fields[i].compare(study.fields[i].size() - 7, 7, "_steady") == 0 && !study.motion)
+        n->At(i).Fail("field " + Quoted(study.fields[i]) + " needs a motion model",
+                      "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the study");
   }
   return study;
 }
@@ -1070,6 +1091,18 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   return scene;
 }
 
+const std::vector<std::string>& FieldNames() {
+  static const std::vector<std::string> names{
+      "coverage",  "cameras",   "resolution",       "sigma_max",        "sigma_mean",
+      "triangulation_angle",    "condition",        "sigma_max_steady", "sigma_mean_steady"};
+  return names;
+}
+
+bool IsUncertaintyField(const std::string& name) {
+  const std::vector<std::string>& all = FieldNames();
+  return std::find(all.begin() + 3, all.end(), name) != all.end();
+}
+
 Scene LoadScene(const std::string& path, const LoadOptions& options) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InputError(path, "", "cannot open file: it is a folder");
@@ -1115,6 +1148,7 @@ json RigToJson(const Rig& rig) {
     json range = {{"near", camera.near}};
     if (std::isfinite(camera.far)) range["far"] = camera.far;
     c["range"] = range;
+    if (camera.pixel_sigma > 0) c["pixel_sigma"] = camera.pixel_sigma;
     cameras.push_back(std::move(c));
   }
   return json{{"name", rig.name}, {"cameras", std::move(cameras)}};

@@ -13,6 +13,7 @@
 
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
+#include "analysis/uncertainty.h"
 
 namespace pandora {
 
@@ -60,11 +61,26 @@ struct Study {
   Region region;
   double voxel_size = 0.05;  ///< Metres.
   std::vector<std::string> fields{"coverage", "cameras", "resolution"};
-  double pixel_sigma = 0.5;             ///< Pixel noise 1-sigma, pixels (uncertainty fields).
+  double pixel_sigma = 0.5;  ///< Pixel noise 1-sigma, pixels, for cameras that do not set their own.
+  /// Motion model for the steady-state fields ("*_steady"); none when the file has no "motion".
+  std::optional<MotionModel> motion;
+  /// Steady-state fields report the prior (predicted, before a frame's update) covariance instead
+  /// of the posterior (after it); "covariance": "prior" in the file.
+  bool steady_prior = false;
+  /// Target worst-direction 1-sigma (mm); summary.json reports the share of the region meeting it.
+  std::optional<double> max_sigma_mm;
   /// Refuse regions whose grids would exceed this. The file gives it in MiB ("memory_budget_mb",
   /// default 4096); stored in bytes.
   double memory_budget_bytes = 4096.0 * 1024.0 * 1024.0;
 };
+
+/// Every field name a study may ask for, in output order:
+/// coverage, cameras, resolution, sigma_max, sigma_mean, triangulation_angle, condition,
+/// sigma_max_steady, sigma_mean_steady. docs/fields.md defines each.
+const std::vector<std::string>& FieldNames();
+
+/// True for the fields that need the triangulation uncertainty (all but the first three).
+bool IsUncertaintyField(const std::string& name);
 
 /// A named viewpoint for rendering ("views" in the scene file). World frame, metres.
 struct View {

@@ -15,12 +15,19 @@ void InformationBuilder::Add(const Mat23& A, double sigma_px) {
   ++cameras_;
 }
 
-Information InformationBuilder::Decompose() const {
+Information DecomposeInformation(const Mat3& J, bool eigenvectors) {
   Information info;
-  info.J = 0.5 * (J_ + J_.transpose());
-  const Eigen::SelfAdjointEigenSolver<Mat3> solver(info.J);
-  info.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
-  info.eigenvectors = solver.eigenvectors();
+  info.J = 0.5 * (J + J.transpose());
+  const int options = eigenvectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly;
+  Eigen::SelfAdjointEigenSolver<Mat3> solver;
+  solver.computeDirect(info.J, options);
+  Vec3 values = solver.eigenvalues();
+  if (!(values[0] > 1e-8 * values[2])) {
+    solver.compute(info.J, options);  // stiff or singular: the iterative solver
+    values = solver.eigenvalues();
+  }
+  info.eigenvalues = values.cwiseMax(0.0);
+  if (eigenvectors) info.eigenvectors = solver.eigenvectors();
   const double largest = info.eigenvalues[2];
   info.observable = largest > 0 && std::isfinite(largest) &&
                     info.eigenvalues[0] > kRelativeObservability * largest;

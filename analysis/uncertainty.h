@@ -33,15 +33,19 @@ struct Information {
 /// beyond double precision's reach (the covariance would be dominated by round-off in J).
 inline constexpr double kRelativeObservability = 1e-12;
 
+/// Decomposes a symmetric information matrix J (1/m^2). Uses the closed-form 3x3 solver and, when J
+/// is stiff (smallest over largest eigenvalue below 1e-8), the iterative QL solver, whose small
+/// eigenvalues are more accurate there. With `eigenvectors` false only eigenvalues are computed.
+Information DecomposeInformation(const Mat3& J, bool eigenvectors = true);
+
 /// Accumulates J from per-camera Jacobians and pixel sigmas, then decomposes it.
 class InformationBuilder {
  public:
   /// Adds a camera's 2x3 Jacobian (pixels per metre) with its pixel noise sigma (pixels, > 0).
   void Add(const Mat23& d_pixel_d_world, double sigma_px);
   int cameras() const { return cameras_; }
-  /// Symmetric eigen-decomposition (Eigen's SelfAdjointEigenSolver, closed-form 3x3 not used: it
-  /// loses relative accuracy on the small eigenvalues of stiff configurations).
-  Information Decompose() const;
+  /// DecomposeInformation of the accumulated J.
+  Information Decompose() const { return DecomposeInformation(J_); }
 
  private:
   Mat3 J_ = Mat3::Zero();

@@ -14,15 +14,11 @@
 
 #include "analysis/error.h"
 #include "analysis/inside_mesh.h"
+#include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
-
-const std::vector<std::string>& KnownFields() {
-  static const std::vector<std::string> fields{"coverage", "cameras", "resolution"};
-  return fields;
-}
 
 Fields::Fields() : impl_(std::make_unique<Impl>()) {}
 Fields::~Fields() = default;
@@ -31,9 +27,26 @@ Fields& Fields::operator=(Fields&&) noexcept = default;
 
 namespace {
 
-bool Wants(const std::vector<std::string>& fields, const char* name) {
+bool Wants(const std::vector<std::string>& fields, const std::string& name) {
   return std::find(fields.begin(), fields.end(), name) != fields.end();
 }
+
+// The float fields in a fixed order; index into BlockResult::floats.
+enum FloatField {
+  kResolution,
+  kSigmaMax,
+  kSigmaMean,
+  kAngle,
+  kCondition,
+  kSigmaMaxSteady,
+  kSigmaMeanSteady,
+  kFloatFieldCount
+};
+const char* const kFloatFieldNames[kFloatFieldCount] = {
+    "resolution", "sigma_max",        "sigma_mean",       "triangulation_angle",
+    "condition",  "sigma_max_steady", "sigma_mean_steady"};
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 
 // Bytes per voxel of each grid at full density, leaf masks and node overhead included (an OpenVDB
 // leaf of 512 voxels carries ~100 bytes of masks and header).
@@ -41,20 +54,20 @@ double BytesPerVoxel(const std::string& field) {
   const double overhead = 0.25;
   if (field == "coverage") return 4 + overhead;
   if (field == "cameras") return 8 + overhead;
-  if (field == "resolution") return 4 + overhead;
-  return 8 + overhead;  // Reserved fields (later issues): float or double storage.
+  return 4 + overhead;  // float fields
 }
 
 // Results of one block, before they become OpenVDB leaves.
 struct BlockResult {
   openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
   openvdb::Int64Tree::LeafNodeType* cameras = nullptr;
-  openvdb::FloatTree::LeafNodeType* resolution = nullptr;
+  std::array<FloatLeaf*, kFloatFieldCount> floats{};
   bool coverage_tile = false;  // A whole leaf of zeros: stored as a tile.
   std::vector<Ray> rays;
   std::array<std::int64_t, 65> histogram{};
   std::vector<std::int64_t> per_camera;
-  std::int64_t tests = 0, ray_count = 0, seen = 0;
+  std::int64_t tests = 0, ray_count = 0, seen = 0, triangulable = 0, unobservable = 0;
+  std::vector<float> sigma_max, sigma_max_steady;
 };
 
 }  // namespace
@@ -73,11 +86,16 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                       const FieldOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
-  for (std::size_t i = 0; i < options.fields.size(); ++i)
-    if (!Wants(KnownFields(), options.fields[i].c_str()))
-      throw InputError(file, "$.study.fields[" + std::to_string(i) + "]",
-                       "unknown or not yet available field '" + options.fields[i] + "'",
-                       "available: coverage, cameras, resolution");
+  for (std::size_t i = 0; i < options.fields.size(); ++i) {
+    const std::string path = "$.study.fields[" + std::to_string(i) + "]";
+    if (!Wants(FieldNames(), options.fields[i]))
+      throw InputError(file, path, "unknown field '" + options.fields[i] + "'",
+                       "available: coverage, cameras, resolution, sigma_max, sigma_mean, "
+                       "triangulation_angle, condition, sigma_max_steady, sigma_mean_steady");
+    if (options.fields[i].find("_steady") != std::string::npos && !scene.study.motion)
+      throw InputError(file, path, "field '" + options.fields[i] + "' needs a motion model",
+                       "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the study");
+  }
   if (options.fields.empty())
     throw InputError(file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
   const int camera_count = static_cast<int>(rig.cameras.size());
@@ -132,15 +150,38 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
 
   const bool want_coverage = Wants(options.fields, "coverage");
   const bool want_cameras = Wants(options.fields, "cameras");
-  const bool want_resolution = Wants(options.fields, "resolution");
+  std::array<bool, kFloatFieldCount> want_float{};
+  for (int f = 0; f < kFloatFieldCount; ++f) want_float[f] = Wants(options.fields, kFloatFieldNames[f]);
+  const bool want_resolution = want_float[kResolution];
+  const bool want_static = want_float[kSigmaMax] || want_float[kSigmaMean] || want_float[kCondition];
+  const bool want_steady = want_float[kSigmaMaxSteady] || want_float[kSigmaMeanSteady];
+  const bool want_angle = want_float[kAngle];
+  // Any uncertainty field needs the triangulability decision, so J is built for all of them.
+  const bool want_information = want_static || want_steady || want_angle;
+  const bool want_jacobian = want_resolution || want_information;
   const int enabled = rig.enabled_count();
   const VisibilityTester tester(rig.cameras, caster, scene.Bounds().diagonal());
+  std::vector<double> inverse_variance(camera_count);  // 1 / sigma_c^2, pixels^-2
+  for (int c = 0; c < camera_count; ++c) {
+    const double sigma =
+        rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
+    inverse_variance[c] = 1.0 / (sigma * sigma);
+  }
+  const MotionModel motion = study.motion.value_or(MotionModel{});
+  const double frame_period = 1.0 / motion.rate_hz;
 
   std::vector<BlockResult> results(blocks.size());
   std::atomic<std::size_t> done{0};
   const std::size_t report_every = std::max<std::size_t>(1, blocks.size() / 200);
 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const auto& range) {
+    // Per-thread scratch, reused across blocks (the information accumulators are 24 KB).
+    std::array<Ray, 512> segments;
+    std::array<std::int16_t, 512> where;
+    std::array<float, 512> segment_density;
+    std::array<Mat23, 512> segment_jacobian;
+    std::array<std::uint8_t, 512> occluded;
+    std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2
     for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
       const Block& block = blocks[bi];
       BlockResult& res = results[bi];
@@ -151,13 +192,11 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       std::array<std::int32_t, 512> coverage{};
       std::array<std::uint64_t, 512> seen_by{};
       std::array<float, 512> density{};
+      if (want_information)
+        for (auto& row : information) row.fill(0.0);
       if (block.cameras != 0) {
         // Per camera: the geometric tests first, then the surviving segments traced together as
         // coherent packets (one origin, neighbouring directions).
-        std::array<Ray, 512> segments;
-        std::array<std::int16_t, 512> where;
-        std::array<float, 512> segment_density;
-        std::array<std::uint8_t, 512> occluded;
         for (int c = 0; c < camera_count; ++c) {
           if (!(block.cameras >> c & 1)) continue;
           std::size_t n = 0;
@@ -167,9 +206,9 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                 if (!block.IsFree(x, y, z)) continue;
                 const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
                                                   block.origin.z() + z);
-                Mat23 J;
-                if (tester.TestGeometry(c, p, nullptr, &segments[n], want_resolution ? &J : nullptr) !=
-                    ViewResult::kSeen)
+                Mat23& J = segment_jacobian[n];
+                if (tester.TestGeometry(c, p, nullptr, &segments[n],
+                                        want_jacobian ? &J : nullptr) != ViewResult::kSeen)
                   continue;
                 where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
                 if (want_resolution) segment_density[n] = static_cast<float>(PixelDensity(J));
@@ -185,6 +224,18 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             seen_by[o] |= std::uint64_t{1} << c;
             ++res.per_camera[c];
             if (want_resolution) density[o] = std::max(density[o], segment_density[i]);
+            if (want_information) {
+              // J += A^T A / sigma^2, upper triangle only.
+              const Mat23& A = segment_jacobian[i];
+              const double w = inverse_variance[c];
+              std::array<double, 6>& I = information[o];
+              I[0] += w * A.col(0).squaredNorm();
+              I[1] += w * A.col(0).dot(A.col(1));
+              I[2] += w * A.col(0).dot(A.col(2));
+              I[3] += w * A.col(1).squaredNorm();
+              I[4] += w * A.col(1).dot(A.col(2));
+              I[5] += w * A.col(2).squaredNorm();
+            }
           }
         }
       }
@@ -196,8 +247,9 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         res.coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, false);
       if (any_seen && want_cameras)
         res.cameras = new openvdb::Int64Tree::LeafNodeType(origin, 0, false);
-      if (any_seen && want_resolution)
-        res.resolution = new openvdb::FloatTree::LeafNodeType(origin, 0.0f, false);
+      if (any_seen)
+        for (int f = 0; f < kFloatFieldCount; ++f)
+          if (want_float[f]) res.floats[f] = new FloatLeaf(origin, 0.0f, false);
       for (int x = 0; x < block.extent.x(); ++x)
         for (int y = 0; y < block.extent.y(); ++y)
           for (int z = 0; z < block.extent.z(); ++z) {
@@ -208,16 +260,59 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (coverage[o] == 0) continue;
             ++res.seen;
             if (res.cameras) res.cameras->setValueOn(o, static_cast<std::int64_t>(seen_by[o]));
-            if (res.resolution) res.resolution->setValueOn(o, density[o]);
+            if (res.floats[kResolution]) res.floats[kResolution]->setValueOn(o, density[o]);
+            if (coverage[o] < 2) continue;  // not triangulable: no uncertainty work at all
+            const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
+                                              block.origin.z() + z);
+            if (want_angle) {
+              std::vector<Vec3> directions;
+              for (int c = 0; c < camera_count; ++c)
+                if (seen_by[o] >> c & 1) directions.push_back((p - rig.cameras[c].center()).normalized());
+              res.floats[kAngle]->setValueOn(
+                  o, static_cast<float>(MaxTriangulationAngle(directions) * 180.0 / M_PI));
+            }
+            if (!want_information) continue;
+            const std::array<double, 6>& I = information[o];
+            Mat3 J;
+            J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+            const Information info = DecomposeInformation(J, /*eigenvectors=*/false);
+            if (!info.observable) {
+              ++res.unobservable;
+              continue;
+            }
+            ++res.triangulable;
+            const Vec3 variance = info.eigenvalues.cwiseInverse();  // m^2, descending
+            const float sigma_max_mm = static_cast<float>(1e3 * std::sqrt(variance[0]));
+            res.sigma_max.push_back(sigma_max_mm);
+            if (want_float[kSigmaMax]) res.floats[kSigmaMax]->setValueOn(o, sigma_max_mm);
+            if (want_float[kSigmaMean])
+              res.floats[kSigmaMean]->setValueOn(
+                  o, static_cast<float>(1e3 * std::sqrt(variance.sum() / 3.0)));
+            if (want_float[kCondition])
+              res.floats[kCondition]->setValueOn(
+                  o, static_cast<float>(info.eigenvalues[2] / info.eigenvalues[0]));
+            if (want_steady) {
+              Vec3 steady;
+              for (int k = 0; k < 3; ++k)
+                steady[k] = ScalarSteadyState(motion.q, frame_period, variance[k],
+                                              study.steady_prior)(0, 0);
+              const float steady_max = static_cast<float>(1e3 * std::sqrt(steady.maxCoeff()));
+              res.sigma_max_steady.push_back(steady_max);
+              if (want_float[kSigmaMaxSteady]) res.floats[kSigmaMaxSteady]->setValueOn(o, steady_max);
+              if (want_float[kSigmaMeanSteady])
+                res.floats[kSigmaMeanSteady]->setValueOn(
+                    o, static_cast<float>(1e3 * std::sqrt(steady.sum() / 3.0)));
+            }
           }
       if (res.cameras && res.cameras->isEmpty()) {
         delete res.cameras;
         res.cameras = nullptr;
       }
-      if (res.resolution && res.resolution->isEmpty()) {
-        delete res.resolution;
-        res.resolution = nullptr;
-      }
+      for (FloatLeaf*& leaf : res.floats)
+        if (leaf && leaf->isEmpty()) {
+          delete leaf;
+          leaf = nullptr;
+        }
       const std::size_t n = done.fetch_add(1) + 1;
       if (options.progress && (n % report_every == 0 || n == blocks.size()))
         options.progress(double(n) / double(blocks.size()));
@@ -239,10 +334,12 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     g.cameras->setName(kCamerasGrid);
     g.cameras->setTransform(g.transform);
   }
-  if (want_resolution) {
-    g.resolution = openvdb::FloatGrid::create(0.0f);
-    g.resolution->setName(kResolutionGrid);
-    g.resolution->setTransform(g.transform);
+  for (int f = 0; f < kFloatFieldCount; ++f) {
+    if (!want_float[f]) continue;
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName(kFloatFieldNames[f]);
+    grid->setTransform(g.transform);
+    g.floats[kFloatFieldNames[f]] = grid;
   }
   FieldStats& st = out.stats;
   st.coverage_histogram.assign(camera_count + 1, 0);
@@ -256,7 +353,13 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     if (r.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
     if (r.coverage) g.coverage->tree().addLeaf(r.coverage);
     if (r.cameras) g.cameras->tree().addLeaf(r.cameras);
-    if (r.resolution) g.resolution->tree().addLeaf(r.resolution);
+    for (int f = 0; f < kFloatFieldCount; ++f)
+      if (r.floats[f]) g.floats[kFloatFieldNames[f]]->tree().addLeaf(r.floats[f]);
+    st.triangulable_voxels += r.triangulable;
+    st.unobservable_voxels += r.unobservable;
+    st.sigma_max_mm.insert(st.sigma_max_mm.end(), r.sigma_max.begin(), r.sigma_max.end());
+    st.sigma_max_steady_mm.insert(st.sigma_max_steady_mm.end(), r.sigma_max_steady.begin(),
+                                  r.sigma_max_steady.end());
     for (int k = 0; k <= camera_count; ++k) st.coverage_histogram[k] += r.histogram[k];
     for (int c = 0; c < camera_count; ++c) st.per_camera_seen[c] += r.per_camera[c];
     st.point_camera_tests += r.tests;

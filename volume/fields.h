@@ -15,15 +15,19 @@
 
 namespace pandora {
 
-/// The fields Pandora can compute now.
+/// The fields (names from FieldNames(), analysis/scene.h):
 ///  - "coverage"   Int32: number of cameras that see the voxel centre. Active on every free region
 ///                 voxel (0 where none sees it); culled blocks are stored as constant tiles.
 ///  - "cameras"    Int64: bit c set when camera c (index in the rig) sees the voxel. Active where at
 ///                 least one camera sees it. Up to 64 cameras.
 ///  - "resolution" Float, px/m: the best pixel density (PixelDensity of the projection Jacobian) among
 ///                 the cameras that see the voxel. Active where at least one camera sees it.
-const std::vector<std::string>& KnownFields();
-
+///  - "sigma_max", "sigma_mean" Float, mm: worst-direction and RMS 1-sigma of the static
+///                 triangulation covariance (analysis/uncertainty.h); "triangulation_angle" Float,
+///                 degrees: largest angle between two rays that see the voxel; "condition" Float:
+///                 cond(J). Active where the voxel is triangulable (>= 2 cameras, observable).
+///  - "sigma_max_steady", "sigma_mean_steady" Float, mm: the same for the steady-state Kalman
+///                 covariance under study.motion.
 /// Options of EvaluateFields.
 struct FieldOptions {
   std::vector<std::string> fields{"coverage", "cameras", "resolution"};
@@ -40,6 +44,11 @@ struct FieldOptions {
 struct FieldStats {
   ActiveSetStats active_set;
   std::int64_t seen_voxels = 0;                ///< Voxels seen by at least one camera.
+  std::int64_t triangulable_voxels = 0;        ///< >= 2 cameras and observable (when computed).
+  std::int64_t unobservable_voxels = 0;        ///< >= 2 cameras but a direction unobservable.
+  /// sigma_max (mm) of every triangulable voxel, unsorted; filled when an uncertainty field is
+  /// computed (for percentiles). Likewise sigma_max_steady when a motion model is set.
+  std::vector<float> sigma_max_mm, sigma_max_steady_mm;
   std::vector<std::int64_t> coverage_histogram;  ///< [k] = voxels seen by exactly k cameras.
   std::vector<std::int64_t> per_camera_seen;     ///< [c] = voxels camera c sees.
   std::int64_t point_camera_tests = 0;  ///< (voxel, camera) pairs decided, culled blocks included.
@@ -76,8 +85,8 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
 
 /// Evaluates the requested fields for the enabled cameras of `rig` over `scene.study.region`.
 /// Throws InputError when the memory estimate exceeds the budget (path "$.study.voxel_size", with the
-/// smallest voxel size that fits in the hint), when a field name is unknown ("$.study.fields"), or
-/// when the rig has more than 64 cameras. Runs in parallel with TBB (limit threads with
+/// smallest voxel size that fits in the hint), when a field name is unknown ("$.study.fields"), when
+/// a steady-state field is asked for without study.motion, or when the rig has more than 64 cameras. Runs in parallel with TBB (limit threads with
 /// tbb::global_control).
 Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
                       const FieldOptions& options);

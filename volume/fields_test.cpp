@@ -124,11 +124,11 @@ TEST(Fields, MatchBruteForceVoxelByVoxel) {
   EXPECT_LT(st.rays, st.point_camera_tests);  // culling and projection save rays
 
   const Fields::Impl& g = fields.impl();
-  ASSERT_TRUE(g.coverage && g.cameras && g.resolution);
+  ASSERT_TRUE(g.coverage && g.cameras && g.Float("resolution"));
   EXPECT_EQ(static_cast<std::int64_t>(g.coverage->activeVoxelCount()), ref.region);
   EXPECT_EQ(static_cast<std::int64_t>(g.cameras->activeVoxelCount()),
             static_cast<std::int64_t>(ref.seen.size()));
-  EXPECT_EQ(g.resolution->activeVoxelCount(), g.cameras->activeVoxelCount());
+  EXPECT_EQ(g.Float("resolution")->activeVoxelCount(), g.cameras->activeVoxelCount());
   auto cov = g.coverage->getConstAccessor();
   auto cams = g.cameras->getConstAccessor();
   for (const auto& [ijk, value] : ref.seen) {
@@ -187,7 +187,7 @@ TEST(Fields, SinglePinholeClosedForm) {
       }
   EXPECT_EQ(wide.stats.seen_voxels, expected);
   const double f = rig.cameras[0].model.intrinsics().fx;
-  auto res = fields.impl().resolution->getConstAccessor();
+  auto res = fields.impl().Float("resolution")->getConstAccessor();
   for (const auto& ijk : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(10, 3, 19), Eigen::Vector3i(19, 19, 7)}) {
     const Vec3 p = fields.lattice.Center(ijk.x(), ijk.y(), ijk.z());
     const double Z = 2.0 - p.z();
@@ -205,7 +205,7 @@ TEST(Fields, OnlyRequestedFieldsAreBuilt) {
   const Fields fields = EvaluateFields(scene, scene.rigs[0], *caster, options);
   EXPECT_TRUE(fields.impl().coverage);
   EXPECT_FALSE(fields.impl().cameras);
-  EXPECT_FALSE(fields.impl().resolution);
+  EXPECT_FALSE(fields.impl().Float("resolution"));
   options.fields = {"coverage", "bogus"};
   try {
     EvaluateFields(scene, scene.rigs[0], *caster, options);
@@ -261,7 +261,7 @@ TEST(Fields, VdbRoundTrip) {
   EXPECT_EQ(coverage->activeVoxelCount(), fields.impl().coverage->activeVoxelCount());
   EXPECT_NEAR(coverage->voxelSize().x(), 0.05, 1e-15);
   // Values survive the trip.
-  auto a = fields.impl().resolution->getConstAccessor();
+  auto a = fields.impl().Float("resolution")->getConstAccessor();
   for (auto it = resolution->cbeginValueOn(); it; ++it)
     ASSERT_EQ(*it, a.getValue(it.getCoord()));
   auto b = fields.impl().cameras->getConstAccessor();

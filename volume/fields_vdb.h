@@ -5,27 +5,37 @@
 
 #include <openvdb/openvdb.h>
 
+#include <map>
+#include <string>
+
 #include "volume/fields.h"
 
 namespace pandora {
 
-/// Grid names as written to fields.vdb.
+/// Grid names as written to fields.vdb (the float fields are named as in FieldNames()).
 inline constexpr const char* kCoverageGrid = "coverage";
 inline constexpr const char* kCamerasGrid = "cameras";
-inline constexpr const char* kResolutionGrid = "resolution";
 
 struct Fields::Impl {
   openvdb::math::Transform::Ptr transform;
-  openvdb::Int32Grid::Ptr coverage;    ///< Null unless requested.
-  openvdb::Int64Grid::Ptr cameras;     ///< Null unless requested.
-  openvdb::FloatGrid::Ptr resolution;  ///< Null unless requested.
+  openvdb::Int32Grid::Ptr coverage;  ///< Null unless requested.
+  openvdb::Int64Grid::Ptr cameras;   ///< Null unless requested.
+  /// resolution, sigma_max, ...: the requested float fields by name.
+  std::map<std::string, openvdb::FloatGrid::Ptr> floats;
 
-  /// The non-null grids, in a fixed order.
+  /// The float grid `name`, or null when it was not requested.
+  openvdb::FloatGrid::Ptr Float(const std::string& name) const {
+    auto it = floats.find(name);
+    return it == floats.end() ? nullptr : it->second;
+  }
+
+  /// The non-null grids, in FieldNames() order.
   openvdb::GridPtrVec Grids() const {
     openvdb::GridPtrVec grids;
     if (coverage) grids.push_back(coverage);
     if (cameras) grids.push_back(cameras);
-    if (resolution) grids.push_back(resolution);
+    for (const std::string& name : FieldNames())
+      if (auto g = Float(name)) grids.push_back(g);
     return grids;
   }
 };

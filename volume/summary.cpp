@@ -1,10 +1,32 @@
 #include "volume/summary.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace pandora {
 namespace {
 
 double Fraction(std::int64_t part, std::int64_t whole) {
   return whole > 0 ? static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+}
+
+// Percentile p in [0, 100] by the nearest-rank method (a value that occurs in the data), or null
+// when there is none.
+nlohmann::json Percentile(std::vector<float> values, double p) {
+  if (values.empty()) return nullptr;
+  const std::size_t rank = static_cast<std::size_t>(
+      std::clamp(std::ceil(p / 100.0 * values.size()), 1.0, double(values.size())));
+  std::nth_element(values.begin(), values.begin() + (rank - 1), values.end());
+  return values[rank - 1];
+}
+
+nlohmann::json Percentiles(const std::vector<float>& values) {
+  return {{"p50", Percentile(values, 50)}, {"p90", Percentile(values, 90)},
+          {"p99", Percentile(values, 99)}};
+}
+
+std::int64_t CountAtMost(const std::vector<float>& values, double limit) {
+  return std::count_if(values.begin(), values.end(), [&](float v) { return v <= limit; });
 }
 
 }  // namespace
@@ -49,6 +71,30 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
                           {"visible_fraction", Fraction(seen, region)}});
   }
   j["per_camera"] = per_camera;
+
+  const bool uncertainty = std::any_of(field_names.begin(), field_names.end(), IsUncertaintyField);
+  if (uncertainty) {
+    // Fractions of the free region voxels; sigma in mm over the triangulable voxels.
+    nlohmann::json u{{"triangulable", Fraction(st.triangulable_voxels, region)},
+                     {"triangulable_voxels", st.triangulable_voxels},
+                     {"unobservable_voxels", st.unobservable_voxels},
+                     {"pixel_sigma", scene.study.pixel_sigma},
+                     {"sigma_max_mm", Percentiles(st.sigma_max_mm)}};
+    if (scene.study.max_sigma_mm) {
+      u["max_sigma_mm"] = *scene.study.max_sigma_mm;
+      u["meets_max_sigma"] = Fraction(CountAtMost(st.sigma_max_mm, *scene.study.max_sigma_mm), region);
+    }
+    if (scene.study.motion && !st.sigma_max_steady_mm.empty()) {
+      u["motion"] = {{"q", scene.study.motion->q},
+                     {"rate_hz", scene.study.motion->rate_hz},
+                     {"covariance", scene.study.steady_prior ? "prior" : "posterior"}};
+      u["sigma_max_steady_mm"] = Percentiles(st.sigma_max_steady_mm);
+      if (scene.study.max_sigma_mm)
+        u["meets_max_sigma_steady"] =
+            Fraction(CountAtMost(st.sigma_max_steady_mm, *scene.study.max_sigma_mm), region);
+    }
+    j["uncertainty"] = u;
+  }
 
   const double secs = st.seconds;
   j["timing"] = {{"seconds", secs},

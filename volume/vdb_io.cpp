@@ -4,6 +4,7 @@
 #include <openvdb/openvdb.h>
 
 #include <cstdio>
+#include <map>
 #include <mutex>
 
 #include "analysis/atomic_file.h"
@@ -21,20 +22,21 @@ namespace {
 
 // Per-grid description: units and meaning, for people reading `vdb_print -l`.
 void Describe(openvdb::GridBase& grid) {
-  const std::string name = grid.getName();
-  std::string units, meaning;
-  if (name == kCoverageGrid) {
-    units = "cameras";
-    meaning = "number of cameras that see the voxel centre";
-  } else if (name == kCamerasGrid) {
-    units = "bitmask";
-    meaning = "bit c set when camera c (rig order, see rig metadata) sees the voxel centre";
-  } else if (name == kResolutionGrid) {
-    units = "px/m";
-    meaning = "best pixel density among the cameras that see the voxel (det(J J^T)^(1/4))";
-  }
-  grid.insertMeta("value_units", openvdb::StringMetadata(units));
-  grid.insertMeta("description", openvdb::StringMetadata(meaning));
+  static const std::map<std::string, std::pair<const char*, const char*>> kDescriptions{
+      {"coverage", {"cameras", "number of cameras that see the voxel centre"}},
+      {"cameras", {"bitmask", "bit c set when camera c (rig order, see rig metadata) sees the voxel centre"}},
+      {"resolution", {"px/m", "best pixel density among the cameras that see the voxel (det(J J^T)^(1/4))"}},
+      {"sigma_max", {"mm", "worst-direction 1-sigma of the static triangulation covariance"}},
+      {"sigma_mean", {"mm", "sqrt(trace/3) of the static triangulation covariance"}},
+      {"triangulation_angle", {"deg", "largest angle between two rays that see the voxel"}},
+      {"condition", {"1", "condition number of the information matrix J"}},
+      {"sigma_max_steady", {"mm", "worst-direction 1-sigma of the steady-state Kalman covariance"}},
+      {"sigma_mean_steady", {"mm", "sqrt(trace/3) of the steady-state Kalman covariance"}},
+  };
+  auto it = kDescriptions.find(grid.getName());
+  if (it == kDescriptions.end()) return;
+  grid.insertMeta("value_units", openvdb::StringMetadata(it->second.first));
+  grid.insertMeta("description", openvdb::StringMetadata(it->second.second));
 }
 
 }  // namespace
