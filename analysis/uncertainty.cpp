@@ -18,16 +18,26 @@ void InformationBuilder::Add(const Mat23& A, double sigma_px) {
 Information DecomposeInformation(const Mat3& J, bool eigenvectors) {
   Information info;
   info.J = 0.5 * (J + J.transpose());
-  const int options = eigenvectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly;
-  Eigen::SelfAdjointEigenSolver<Mat3> solver;
-  solver.computeDirect(info.J, options);
-  Vec3 values = solver.eigenvalues();
-  if (!(values[0] > 1e-8 * values[2])) {
-    solver.compute(info.J, options);  // stiff or singular: the iterative solver
+  Vec3 values;
+  if (eigenvectors) {
+    Eigen::SelfAdjointEigenSolver<Mat3> solver;
+    solver.computeDirect(info.J, Eigen::ComputeEigenvectors);
     values = solver.eigenvalues();
+    if (!(values[0] > 1e-8 * values[2])) {
+      solver.compute(info.J, Eigen::ComputeEigenvectors);  // stiff or singular: iterative QL
+      values = solver.eigenvalues();
+    }
+    info.eigenvectors = solver.eigenvectors();
+  } else {
+    Eigen::SelfAdjointEigenSolver<Mat3> solver;
+    solver.computeDirect(info.J, Eigen::EigenvaluesOnly);
+    values = solver.eigenvalues();
+    if (!(values[0] > 1e-8 * values[2])) {
+      solver.compute(info.J, Eigen::EigenvaluesOnly);  // stiff or singular: iterative QL
+      values = solver.eigenvalues();
+    }
   }
   info.eigenvalues = values.cwiseMax(0.0);
-  if (eigenvectors) info.eigenvectors = solver.eigenvectors();
   const double largest = info.eigenvalues[2];
   info.observable = largest > 0 && std::isfinite(largest) &&
                     info.eigenvalues[0] > kRelativeObservability * largest;

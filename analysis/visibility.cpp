@@ -52,7 +52,15 @@ ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3*
   if (!pixel) return ViewResult::kNotProjectable;
   if (!cam.model.InImage(*pixel)) return ViewResult::kOutsideImage;
   if (normal && normal->dot(-to_point) <= 0.0) return ViewResult::kBackFacing;
-  if (d_pixel_d_world) *d_pixel_d_world = d_pixel_d_camera * cfw.linear();
+  if (d_pixel_d_world) {
+    // d(pixel)/d(world) = d(pixel)/d(camera) R_camera_from_world, written out (hot path).
+    const Mat3& R = cfw.linear();
+    Mat23& out = *d_pixel_d_world;
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 3; ++c)
+        out(r, c) = d_pixel_d_camera(r, 0) * R(0, c) + d_pixel_d_camera(r, 1) * R(1, c) +
+                    d_pixel_d_camera(r, 2) * R(2, c);
+  }
   if (segment) {
     segment->origin = cam.center();
     segment->direction = to_point / distance;

@@ -167,6 +167,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
     inverse_variance[c] = 1.0 / (sigma * sigma);
   }
+  std::vector<Vec3> camera_centers(camera_count);
+  for (int c = 0; c < camera_count; ++c) camera_centers[c] = rig.cameras[c].center();
   const MotionModel motion = study.motion.value_or(MotionModel{});
   const double frame_period = 1.0 / motion.rate_hz;
 
@@ -265,11 +267,22 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
                                               block.origin.z() + z);
             if (want_angle) {
-              std::vector<Vec3> directions;
-              for (int c = 0; c < camera_count; ++c)
-                if (seen_by[o] >> c & 1) directions.push_back((p - rig.cameras[c].center()).normalized());
-              res.floats[kAngle]->setValueOn(
-                  o, static_cast<float>(MaxTriangulationAngle(directions) * 180.0 / M_PI));
+              // The largest angle is between the pair with the smallest dot product; only that
+              // pair gets the accurate (atan2) angle.
+              std::array<Vec3, 64> d;
+              int k = 0;
+              for (std::uint64_t bits = seen_by[o]; bits; bits &= bits - 1)
+                d[k++] = (p - camera_centers[__builtin_ctzll(bits)]).normalized();
+              double min_dot = 2.0;
+              int best_i = 0, best_j = 1;
+              for (int i = 0; i < k; ++i)
+                for (int j = i + 1; j < k; ++j) {
+                  const double dot = d[i].dot(d[j]);
+                  if (dot < min_dot) min_dot = dot, best_i = i, best_j = j;
+                }
+              const double angle =
+                  std::atan2(d[best_i].cross(d[best_j]).norm(), d[best_i].dot(d[best_j]));
+              res.floats[kAngle]->setValueOn(o, static_cast<float>(angle * 180.0 / M_PI));
             }
             if (!want_information) continue;
             const std::array<double, 6>& I = information[o];
