@@ -9,9 +9,11 @@
 #include "analysis/error.h"
 #include "analysis/inside_mesh.h"
 #include "analysis/primitives.h"
+#include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "tests/random_scene.h"
 #include "volume/fields_vdb.h"
+#include "volume/summary.h"
 #include "volume/vdb_io.h"
 
 namespace pandora {
@@ -142,6 +144,98 @@ TEST(Fields, MatchBruteForceVoxelByVoxel) {
   EXPECT_NEAR(w.x(), c.x(), 1e-12);
   EXPECT_NEAR(w.y(), c.y(), 1e-12);
   EXPECT_NEAR(w.z(), c.z(), 1e-12);
+}
+
+TEST(Fields, UncertaintyMatchesPerPointComputation) {
+  Scene scene = TestScene();
+  scene.study.motion = MotionModel{0.5, 30.0};
+  scene.study.max_sigma_mm = 5.0;
+  scene.rigs[0].cameras[1].pixel_sigma = 1.5;  // one camera noisier than the study's 0.5 px
+  const Rig& rig = scene.rigs[0];
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage",  "cameras",          "sigma_max",        "sigma_mean",
+                    "condition", "triangulation_angle", "sigma_max_steady", "sigma_mean_steady"};
+  const Fields fields = EvaluateFields(scene, rig, *caster, options);
+  const Fields::Impl& g = fields.impl();
+  for (const char* name : {"sigma_max", "sigma_mean", "condition", "triangulation_angle",
+                           "sigma_max_steady", "sigma_mean_steady"})
+    ASSERT_TRUE(g.Float(name)) << name;
+  EXPECT_FALSE(g.Float("resolution"));
+
+  // Every voxel seen by >= 2 cameras is triangulable here; the uncertainty grids hold exactly those.
+  const std::int64_t two_or_more = fields.stats.seen_voxels - fields.stats.coverage_histogram[1];
+  EXPECT_EQ(fields.stats.triangulable_voxels + fields.stats.unobservable_voxels, two_or_more);
+  EXPECT_EQ(static_cast<std::int64_t>(g.Float("sigma_max")->activeVoxelCount()),
+            fields.stats.triangulable_voxels);
+  EXPECT_GT(fields.stats.triangulable_voxels, 1000);
+
+  auto cams = g.cameras->getConstAccessor();
+  auto smax = g.Float("sigma_max")->getConstAccessor();
+  auto smean = g.Float("sigma_mean")->getConstAccessor();
+  auto cond = g.Float("condition")->getConstAccessor();
+  auto angle = g.Float("triangulation_angle")->getConstAccessor();
+  auto steady_max = g.Float("sigma_max_steady")->getConstAccessor();
+  auto steady_mean = g.Float("sigma_mean_steady")->getConstAccessor();
+  int checked = 0;
+  for (auto it = g.Float("sigma_max")->cbeginValueOn(); it; ++it) {
+    if (++checked % 7 != 0) continue;  // a sample
+    const openvdb::Coord xyz = it.getCoord();
+    const Vec3 X = fields.lattice.Center(xyz.x(), xyz.y(), xyz.z());
+    const auto mask = static_cast<std::uint64_t>(cams.getValue(xyz));
+    InformationBuilder builder;
+    std::vector<Vec3> directions;
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      if (!(mask >> c & 1)) continue;
+      Mat23 J;
+      ASSERT_TRUE(rig.cameras[c].Project(X, &J).has_value());
+      builder.Add(J, c == 1 ? 1.5 : 0.5);
+      directions.push_back((X - rig.cameras[c].center()).normalized());
+    }
+    const Information info = builder.Decompose();
+    const StaticUncertainty s = StaticFromInformation(info, builder.cameras());
+    ASSERT_TRUE(s.triangulable);
+    EXPECT_NEAR(*it, 1e3 * s.sigma_max, 1e-6 * 1e3 * s.sigma_max);
+    EXPECT_NEAR(smean.getValue(xyz), 1e3 * s.sigma_mean, 1e-6 * 1e3 * s.sigma_mean);
+    EXPECT_NEAR(cond.getValue(xyz), s.condition, 1e-6 * s.condition);
+    EXPECT_NEAR(angle.getValue(xyz), MaxTriangulationAngle(directions) * 180 / M_PI, 1e-4);
+    const SteadyUncertainty st = SteadyFromInformation(info, builder.cameras(), *scene.study.motion);
+    EXPECT_NEAR(steady_max.getValue(xyz), 1e3 * st.sigma_max, 1e-6 * 1e3 * st.sigma_max);
+    EXPECT_NEAR(steady_mean.getValue(xyz), 1e3 * st.sigma_mean, 1e-6 * 1e3 * st.sigma_mean);
+    EXPECT_LT(st.sigma_max, s.sigma_max);  // filtering over frames helps
+  }
+  EXPECT_GT(checked, 1000);
+
+  // The summary's percentiles are ranks of the grid's values.
+  std::vector<float> values;
+  for (auto it = g.Float("sigma_max")->cbeginValueOn(); it; ++it) values.push_back(*it);
+  std::sort(values.begin(), values.end());
+  const nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, 1);
+  const auto& u = summary["uncertainty"];
+  EXPECT_DOUBLE_EQ(u["sigma_max_mm"]["p50"].get<double>(),
+                   values[static_cast<std::size_t>(std::ceil(0.5 * values.size())) - 1]);
+  EXPECT_DOUBLE_EQ(u["sigma_max_mm"]["p99"].get<double>(),
+                   values[static_cast<std::size_t>(std::ceil(0.99 * values.size())) - 1]);
+  const double meets = double(std::count_if(values.begin(), values.end(),
+                                             [](float v) { return v <= 5.0f; })) /
+                       double(fields.stats.active_set.region_voxels);
+  EXPECT_DOUBLE_EQ(u["meets_max_sigma"].get<double>(), meets);
+  EXPECT_DOUBLE_EQ(u["triangulable"].get<double>(),
+                   double(fields.stats.triangulable_voxels) / fields.stats.active_set.region_voxels);
+  EXPECT_TRUE(u.contains("sigma_max_steady_mm"));
+}
+
+TEST(Fields, SteadyFieldsNeedAMotionModel) {
+  const Scene scene = TestScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage", "sigma_max_steady"};
+  try {
+    EvaluateFields(scene, scene.rigs[0], *caster, options);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.json_path(), "$.study.fields[1]");
+  }
 }
 
 TEST(Fields, SinglePinholeClosedForm) {
