@@ -196,8 +196,12 @@ def scene(with_medics):
         "study": {
             "region": {"box": {"min": REGION_MIN, "max": REGION_MAX}},
             "voxel_size": 0.004,
-            "fields": ["coverage", "cameras", "resolution"],
+            "fields": ["coverage", "cameras", "resolution", "sigma_max", "sigma_mean",
+                       "triangulation_angle", "condition", "sigma_max_steady", "sigma_mean_steady"],
             "pixel_sigma": 0.5,
+            # Hands and instruments at the neck: white acceleration of 1 m^2/s^3, 30 Hz video.
+            "motion": {"q": 1.0, "rate_hz": 30},
+            "max_sigma_mm": 2.0,
         },
         "views": {
             "overview": {"from": [-2.2, -2.4, 2.6], "at": [0.3, 0.0, 1.0], "fov_deg": 50},
