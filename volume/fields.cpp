@@ -167,8 +167,6 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
     inverse_variance[c] = 1.0 / (sigma * sigma);
   }
-  std::vector<Vec3> camera_centers(camera_count);
-  for (int c = 0; c < camera_count; ++c) camera_centers[c] = rig.cameras[c].center();
   const MotionModel motion = study.motion.value_or(MotionModel{});
   const double frame_period = 1.0 / motion.rate_hz;
 
@@ -184,6 +182,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::array<Mat23, 512> segment_jacobian;
     std::array<std::uint8_t, 512> occluded;
     std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2
+    // Unit directions of the rays that see each voxel, [voxel * cameras + k] (triangulation angle).
+    std::vector<Vec3> seen_directions(want_angle ? 512 * camera_count : 0);
     for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
       const Block& block = blocks[bi];
       BlockResult& res = results[bi];
@@ -222,6 +222,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
           for (std::size_t i = 0; i < n; ++i) {
             if (occluded[i]) continue;
             const int o = where[i];
+            if (want_angle) seen_directions[o * camera_count + coverage[o]] = segments[i].direction;
             ++coverage[o];
             seen_by[o] |= std::uint64_t{1} << c;
             ++res.per_camera[c];
@@ -264,15 +265,11 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (res.cameras) res.cameras->setValueOn(o, static_cast<std::int64_t>(seen_by[o]));
             if (res.floats[kResolution]) res.floats[kResolution]->setValueOn(o, density[o]);
             if (coverage[o] < 2) continue;  // not triangulable: no uncertainty work at all
-            const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
-                                              block.origin.z() + z);
             if (want_angle) {
               // The largest angle is between the pair with the smallest dot product; only that
               // pair gets the accurate (atan2) angle.
-              std::array<Vec3, 64> d;
-              int k = 0;
-              for (std::uint64_t bits = seen_by[o]; bits; bits &= bits - 1)
-                d[k++] = (p - camera_centers[__builtin_ctzll(bits)]).normalized();
+              const Vec3* d = &seen_directions[o * camera_count];
+              const int k = coverage[o];
               double min_dot = 2.0;
               int best_i = 0, best_j = 1;
               for (int i = 0; i < k; ++i)
