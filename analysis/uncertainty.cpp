@@ -18,25 +18,14 @@ void InformationBuilder::Add(const Mat23& A, double sigma_px) {
 Information DecomposeInformation(const Mat3& J, bool eigenvectors) {
   Information info;
   info.J = 0.5 * (J + J.transpose());
-  Vec3 values;
-  if (eigenvectors) {
-    Eigen::SelfAdjointEigenSolver<Mat3> solver;
-    solver.computeDirect(info.J, Eigen::ComputeEigenvectors);
-    values = solver.eigenvalues();
-    if (!(values[0] > 1e-8 * values[2])) {
-      solver.compute(info.J, Eigen::ComputeEigenvectors);  // stiff or singular: iterative QL
-      values = solver.eigenvalues();
-    }
-    info.eigenvectors = solver.eigenvectors();
-  } else {
-    Eigen::SelfAdjointEigenSolver<Mat3> solver;
-    solver.computeDirect(info.J, Eigen::EigenvaluesOnly);
-    values = solver.eigenvalues();
-    if (!(values[0] > 1e-8 * values[2])) {
-      solver.compute(info.J, Eigen::EigenvaluesOnly);  // stiff or singular: iterative QL
-      values = solver.eigenvalues();
-    }
-  }
+  // The closed-form 3x3 solver, or the iterative QL solver when J is stiff or singular (there the
+  // closed form loses relative accuracy on the small eigenvalue).
+  const int options = eigenvectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly;
+  Eigen::SelfAdjointEigenSolver<Mat3> solver;
+  solver.computeDirect(info.J, options);
+  if (!(solver.eigenvalues()[0] > 1e-8 * solver.eigenvalues()[2])) solver.compute(info.J, options);
+  const Vec3 values = solver.eigenvalues();
+  if (eigenvectors) info.eigenvectors = solver.eigenvectors();
   info.eigenvalues = values.cwiseMax(0.0);
   const double largest = info.eigenvalues[2];
   info.observable = largest > 0 && std::isfinite(largest) &&
