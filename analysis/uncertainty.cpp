@@ -91,10 +91,18 @@ SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,
 
 namespace {
 
+// Largest change of an entry relative to its own scale, |dM_ij| / sqrt(M_ii M_jj): blocks of very
+// different units (m^2 against m^2/s^2 at 1 MHz) are each judged on their own scale.
 double RelativeChange(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  const double scale = std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
-  if (scale == 0) return 0;
-  return (a - b).cwiseAbs().maxCoeff() / scale;
+  double worst = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i)
+    for (Eigen::Index j = 0; j < a.cols(); ++j) {
+      const double scale = std::sqrt(std::max(std::abs(a(i, i) * a(j, j)), std::abs(b(i, i) * b(j, j))));
+      const double change = std::abs(a(i, j) - b(i, j));
+      if (change == 0) continue;
+      worst = std::max(worst, scale > 0 ? change / scale : std::numeric_limits<double>::infinity());
+    }
+  return worst;
 }
 
 }  // namespace
@@ -131,6 +139,8 @@ Eigen::MatrixXd SolveDareIteration(const Eigen::MatrixXd& F, const Eigen::Matrix
                                    bool* converged, int* iterations) {
   Eigen::MatrixXd M = Q;
   if (converged) *converged = false;
+  // The approach can oscillate when stiff: stop only after three steps in a row below tolerance.
+  int calm_steps = 0;
   for (int k = 1; k <= max_iterations; ++k) {
     const Eigen::MatrixXd P = PosteriorFromPrior(M, G);
     Eigen::MatrixXd next = F * P * F.transpose() + Q;
@@ -138,7 +148,8 @@ Eigen::MatrixXd SolveDareIteration(const Eigen::MatrixXd& F, const Eigen::Matrix
     const double change = RelativeChange(next, M);
     M = next;
     if (iterations) *iterations = k;
-    if (change <= tolerance) {
+    calm_steps = change <= tolerance ? calm_steps + 1 : 0;
+    if (calm_steps >= 3) {
       if (converged) *converged = true;
       break;
     }

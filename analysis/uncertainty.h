@@ -106,7 +106,8 @@ std::optional<Eigen::MatrixXd> SolveDareDoubling(const Eigen::MatrixXd& F, const
                                                  int max_iterations = 100, int* iterations = nullptr);
 
 /// Plain Riccati iteration from M = Q (the reference where it converges; slow when stiff).
-/// Returns the last iterate and, in `converged`, whether the relative change fell below `tolerance`.
+/// Returns the last iterate and, in `converged`, whether the change of every entry relative to its
+/// own scale (|dM_ij| / sqrt(M_ii M_jj)) stayed below `tolerance` for three steps in a row.
 Eigen::MatrixXd SolveDareIteration(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G,
                                    const Eigen::MatrixXd& Q, double tolerance, int max_iterations,
                                    bool* converged = nullptr, int* iterations = nullptr);

@@ -27,4 +27,16 @@ struct BenchArgs {
 };
 int RunBench(const BenchArgs& args);
 
+/// `pandora accuracy`: error against run time (issue 3, point 6) for (a) voxel size against the
+/// coverage and uncertainty summaries of the finest size, (b) Monte Carlo trials against the
+/// closed-form triangulation covariance, (c) the steady-state Riccati solvers against a long-double
+/// reference. Writes accuracy_{voxel,montecarlo,steady}.{csv,svg} and accuracy_tables.md to `out`.
+struct AccuracyArgs {
+  std::string scene;
+  std::string rig;
+  std::string out = "out/accuracy";
+  bool quick = false;  ///< Fewer voxel sizes, trials and sample points (tests).
+};
+int RunAccuracy(const AccuracyArgs& args);
+
 }  // namespace pandora::app

@@ -1,4 +1,5 @@
-// The `pandora` command: analyze a camera rig in a scene, benchmark the field evaluation.
+// The `pandora` command: analyze a camera rig in a scene, benchmark the field evaluation, tabulate
+// error against run time.
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
@@ -41,6 +42,15 @@ int main(int argc, char** argv) {
   b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
   b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
+  AccuracyArgs accuracy;
+  CLI::App* acc = app.add_subcommand(
+      "accuracy", "Error against run time: voxel size, Monte Carlo trials, steady-state solvers");
+  acc->add_option("scene", accuracy.scene, "Scene file (JSON)")->required();
+  acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
+  acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
+  acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
+  acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -55,6 +65,7 @@ int main(int argc, char** argv) {
   try {
     if (*a) return RunAnalyze(analyze);
     if (*b) return RunBench(bench);
+    if (*acc) return RunAccuracy(accuracy);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;
