@@ -45,26 +45,42 @@ StaticUncertainty StaticFromInformation(const Information& info, int cameras) {
   return out;
 }
 
+namespace {
+
+// The closed form's common part: Lambda, R, s and u (see ScalarSteadyState).
+struct SteadyTerms {
+  double lambda, R, s, u;
+};
+
+SteadyTerms Terms(double q, double T, double r) {
+  // Tracking index Lambda = sqrt(q T^3 / r). The steady-state gains alpha = 1 - u^2, beta = Lambda u
+  // follow from u + 1/u = w = (Lambda + R) / 2, R = sqrt(Lambda^2 / 3 + 16), with u in (0, 1].
+  SteadyTerms t;
+  t.lambda = std::sqrt(q * T * T * T / r);
+  t.R = std::sqrt(t.lambda * t.lambda / 3.0 + 16.0);
+  const double w_minus_2 = 0.5 * (t.lambda + (t.lambda * t.lambda / 3.0) / (t.R + 4.0));  // exact
+  const double w = 2.0 + w_minus_2;
+  t.s = std::sqrt(w_minus_2 * (w + 2.0));  // 1/u - u = sqrt(w^2 - 4)
+  t.u = 2.0 / (w + t.s);                   // the root below 1, no cancellation
+  return t;
+}
+
+}  // namespace
+
 Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior) {
   Eigen::Matrix2d P;
   if (!(r < std::numeric_limits<double>::infinity())) {
     P.setConstant(std::numeric_limits<double>::infinity());
     return P;
   }
-  // Tracking index Lambda = sqrt(q T^3 / r). The steady-state gains alpha = 1 - u^2, beta = Lambda u
-  // follow from u + 1/u = w = (Lambda + R) / 2, R = sqrt(Lambda^2 / 3 + 16), with u in (0, 1].
-  const double lambda = std::sqrt(q * T * T * T / r);
-  const double R = std::sqrt(lambda * lambda / 3.0 + 16.0);
-  const double w_minus_2 = 0.5 * (lambda + (lambda * lambda / 3.0) / (R + 4.0));  // w - 2, exact
-  const double w = 2.0 + w_minus_2;
-  const double s = std::sqrt(w_minus_2 * (w + 2.0));  // 1/u - u = sqrt(w^2 - 4)
-  const double u = 2.0 / (w + s);                     // the root below 1, no cancellation
+  const SteadyTerms t = Terms(q, T, r);
   // Posterior: p11 = alpha r = u s r, p12 = beta r / T, p22 = (r Lambda / T^2) (s - Lambda / 2),
   // with s - Lambda/2 = Lambda (2R + Lambda/3) / (4 (s + Lambda/2)) (all terms positive).
-  const double p11 = u * s * r;
-  const double p12 = lambda * u * r / T;
-  const double s_minus = lambda > 0 ? lambda * (2.0 * R + lambda / 3.0) / (4.0 * (s + 0.5 * lambda)) : 0.0;
-  const double p22 = r * lambda * s_minus / (T * T);
+  const double p11 = t.u * t.s * r;
+  const double p12 = t.lambda * t.u * r / T;
+  const double s_minus =
+      t.lambda > 0 ? t.lambda * (2.0 * t.R + t.lambda / 3.0) / (4.0 * (t.s + 0.5 * t.lambda)) : 0.0;
+  const double p22 = r * t.lambda * s_minus / (T * T);
   P << p11, p12, p12, p22;
   if (!prior) return P;
   // Prior M = F P F^T + Q.
@@ -74,6 +90,12 @@ Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior) {
   return F * P * F.transpose() + q * Q;
 }
 
+double SteadyPositionVariance(double q, double T, double r, bool prior) {
+  if (prior || !(r < std::numeric_limits<double>::infinity())) return ScalarSteadyState(q, T, r, prior)(0, 0);
+  const SteadyTerms t = Terms(q, T, r);
+  return t.u * t.s * r;
+}
+
 SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,
                                         const MotionModel& motion, bool prior) {
   SteadyUncertainty out;
@@ -81,7 +103,7 @@ SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,
   const double T = 1.0 / motion.rate_hz;
   Vec3 variances;
   for (int k = 0; k < 3; ++k)
-    variances[k] = ScalarSteadyState(motion.q, T, 1.0 / info.eigenvalues[k], prior)(0, 0);
+    variances[k] = SteadyPositionVariance(motion.q, T, 1.0 / info.eigenvalues[k], prior);
   out.converged = variances.allFinite();
   out.covariance = info.eigenvectors * variances.asDiagonal() * info.eigenvectors.transpose();
   out.sigma_max = std::sqrt(variances.maxCoeff());

@@ -82,6 +82,10 @@ struct MotionModel {
 /// measurement) gives an infinite covariance (no steady state).
 Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior = false);
 
+/// ScalarSteadyState(q, T, r, prior)(0, 0), the position variance alone (m^2); the posterior costs
+/// three square roots and no matrix.
+double SteadyPositionVariance(double q, double T, double r, bool prior = false);
+
 /// Steady-state uncertainty: per eigen-direction of J the scalar problem above, recombined.
 struct SteadyUncertainty {
   bool converged = false;        ///< False when not triangulable.

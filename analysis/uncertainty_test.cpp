@@ -254,6 +254,7 @@ TEST(SteadyState, ClosedFormMatchesDoublingAndRiccati) {
       for (bool prior : {false, true}) {
         const Eigen::Matrix2d closed = ScalarSteadyState(q, T, r, prior);
         ASSERT_TRUE(closed.allFinite());
+        EXPECT_EQ(SteadyPositionVariance(q, T, r, prior), closed(0, 0));
         const Eigen::Matrix2d doubling = ScalarViaDoubling(q, T, r, prior);
         // The reference's posterior is (I + M G)^-1 M, which loses about cond(I + M G) * eps
         // relative accuracy when stiff (the closed form does not); the prior is exact to 1e-9.

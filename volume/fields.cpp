@@ -304,8 +304,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (want_steady) {
               Vec3 steady;
               for (int k = 0; k < 3; ++k)
-                steady[k] = ScalarSteadyState(motion.q, frame_period, variance[k],
-                                              study.steady_prior)(0, 0);
+                steady[k] = SteadyPositionVariance(motion.q, frame_period, variance[k],
+                                                   study.steady_prior);
               const float steady_max = static_cast<float>(1e3 * std::sqrt(steady.maxCoeff()));
               res.sigma_max_steady.push_back(steady_max);
               if (want_float[kSigmaMaxSteady]) res.floats[kSigmaMaxSteady]->setValueOn(o, steady_max);
