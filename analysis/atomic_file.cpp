@@ -1,5 +1,7 @@
 #include "analysis/atomic_file.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -8,7 +10,11 @@
 
 namespace pandora {
 
-std::string TemporaryPath(const std::string& path) { return path + ".tmp"; }
+std::string TemporaryPath(const std::string& path) {
+  // Unique to this process, so two runs writing the same output never interleave and a user's own
+  // "NAME.tmp" is never touched.
+  return path + ".tmp-" + std::to_string(static_cast<long>(getpid()));
+}
 
 void CommitTemporary(const std::string& path) {
   const std::string tmp = TemporaryPath(path);

@@ -7,7 +7,7 @@
 
 namespace pandora {
 
-/// The temporary name used while `path` is being written: `path` + ".tmp".
+/// The temporary name used while `path` is being written: `path` + ".tmp-" + the process id.
 std::string TemporaryPath(const std::string& path);
 
 /// Renames TemporaryPath(path) to `path` (atomic on one file system). On failure removes the

@@ -210,6 +210,15 @@ class Node {
     return v;
   }
 
+  // A pixel noise sigma: positive and within [1e-6, 1e6] pixels, so 1 / sigma^2 stays a normal
+  // double in any information matrix.
+  double PixelSigma() const {
+    const double v = Positive();
+    if (v < 1e-6 || v > 1e6)
+      Fail("pixel noise must be between 1e-6 and 1e6 pixels, got " + FormatNumber(v));
+    return v;
+  }
+
   double NonNegative() const {
     const double v = Number();
     if (!(v >= 0)) Fail("must be zero or positive, got " + FormatNumber(v));
@@ -826,7 +835,7 @@ Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
 
   camera.world_from_camera = ReadPose(node);
   camera.model = CameraModel(ReadIntrinsics(node));
-  if (auto n = node.Find("pixel_sigma")) camera.pixel_sigma = n->Positive();
+  if (auto n = node.Find("pixel_sigma")) camera.pixel_sigma = n->PixelSigma();
 
   if (auto range = node.Find("range")) {
     range->CheckKeys({"near", "far"});
@@ -923,7 +932,7 @@ Study ReadStudy(const Node& node) {
       study.fields.push_back(name);
     }
   }
-  if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->Positive();
+  if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->PixelSigma();
   if (auto n = node.Find("memory_budget_mb")) {
     study.memory_budget_bytes = n->Positive() * 1024.0 * 1024.0;
   }

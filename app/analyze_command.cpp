@@ -37,6 +37,27 @@ std::string FormatNumber(double v) {
   return buffer;
 }
 
+// The --fields option: known names, each once, steady-state ones only with a motion model.
+std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& fields,
+                                           const Study& study) {
+  if (fields.empty()) throw InputError("--fields", "", "no field given", "e.g. --fields coverage,sigma_max");
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string& f = fields[i];
+    const auto& known = FieldNames();
+    if (std::find(known.begin(), known.end(), f) == known.end()) {
+      std::string all;
+      for (const std::string& k : known) all += (all.empty() ? "" : ", ") + k;
+      throw InputError("--fields", "", "unknown field '" + f + "'", "available: " + all);
+    }
+    if (std::find(fields.begin(), fields.begin() + i, f) != fields.begin() + i)
+      throw InputError("--fields", "", "field '" + f + "' is listed twice");
+    if (f.find("_steady") != std::string::npos && !study.motion)
+      throw InputError("--fields", "", "field '" + f + "' needs a motion model",
+                       "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the scene's study");
+  }
+  return fields;
+}
+
 void PrintTable(const nlohmann::json& s) {
   std::printf("rig %s: %d cameras, voxel %.4g m, %lld region voxels (%lld inside solids)\n",
               s["rig"].get<std::string>().c_str(), s["cameras"].get<int>(),
@@ -58,19 +79,27 @@ void PrintTable(const nlohmann::json& s) {
 
 }  // namespace
 
+double CheckPositiveOption(const char* option, double value, const char* unit) {
+  if (!(value > 0) || !std::isfinite(value))
+    throw InputError(option, "", std::string("must be a positive number of ") + unit);
+  return value;
+}
+
 int RunAnalyze(const AnalyzeArgs& args) {
   Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
-  if (args.voxel_size != 0) {
-    if (!(args.voxel_size > 0) || !std::isfinite(args.voxel_size))
-      throw InputError("--voxel-size", "", "must be a positive number of metres");
-    scene.study.voxel_size = args.voxel_size;
-  }
   FieldOptions options;
   options.scene_path = scene.path;
-  options.fields = args.fields.empty() ? scene.study.fields : SplitFields(args.fields);
-  options.memory_budget_bytes =
-      args.memory_budget_mb > 0 ? args.memory_budget_mb * 1e6 : scene.study.memory_budget_bytes;
+  if (!std::isnan(args.voxel_size)) {
+    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+    options.voxel_size_option = "--voxel-size";
+  }
+  options.fields = scene.study.fields;
+  if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
+  options.memory_budget_bytes = scene.study.memory_budget_bytes;
+  if (!std::isnan(args.memory_budget_mb))
+    options.memory_budget_bytes =
+        CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
   PrepareOutputDir(args.out);
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());

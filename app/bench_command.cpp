@@ -3,6 +3,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <limits>
 
@@ -20,13 +22,21 @@ namespace pandora::app {
 int RunBench(const BenchArgs& args) {
   Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
-  if (args.voxel_size > 0) scene.study.voxel_size = args.voxel_size;
+  if (!std::isnan(args.voxel_size))
+    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  if (!args.json_out.empty()) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(args.json_out, args.scene, ec))
+      throw InputError(args.json_out, "", "--json would overwrite the scene file",
+                       "write the results to another file");
+  }
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
   FieldOptions options;
   options.scene_path = scene.path;
+  if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
   options.fields = {"coverage", "cameras", "resolution"};
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
 

@@ -3,17 +3,25 @@
 /// The `pandora` subcommands. Each returns the process exit code; bad input throws InputError, which
 /// main() prints as one line and turns into exit code 2.
 
+#include <limits>
 #include <string>
 
 namespace pandora::app {
+
+/// A numeric option the user did not give.
+inline const double kUnset = std::numeric_limits<double>::quiet_NaN();
+
+/// Checks the value of a numeric command-line option: positive and finite, else InputError naming
+/// the option. Returns `value`.
+double CheckPositiveOption(const char* option, double value, const char* unit);
 
 struct AnalyzeArgs {
   std::string scene;
   std::string rig;
   std::string out = "out";
-  double voxel_size = 0;  ///< 0: the scene's study.voxel_size.
+  double voxel_size = kUnset;  ///< kUnset: the scene's study.voxel_size.
   std::string fields;     ///< Comma-separated; empty: the scene's study.fields.
-  double memory_budget_mb = 0;  ///< 0: the scene's study.memory_budget_mb.
+  double memory_budget_mb = kUnset;  ///< MiB; kUnset: the scene's study.memory_budget_mb.
   bool quiet = false;
 };
 int RunAnalyze(const AnalyzeArgs& args);
@@ -21,7 +29,7 @@ int RunAnalyze(const AnalyzeArgs& args);
 struct BenchArgs {
   std::string scene;
   std::string rig;
-  double voxel_size = 0;
+  double voxel_size = kUnset;
   int repeat = 3;
   std::string json_out;
 };

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   a->add_option("--out", analyze.out, "Output folder")->capture_default_str();
   a->add_option("--voxel-size", analyze.voxel_size, "Voxel size in metres (default: study.voxel_size)");
   a->add_option("--fields", analyze.fields, "Comma-separated fields (default: study.fields)");
-  a->add_option("--memory-budget", analyze.memory_budget_mb, "Memory budget in MB (default: study.memory_budget_mb)");
+  a->add_option("--memory-budget", analyze.memory_budget_mb, "Memory budget in MiB (default: study.memory_budget_mb)");
   a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
 

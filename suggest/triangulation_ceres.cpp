@@ -176,7 +176,7 @@ MonteCarloResult MonteCarloCovariance(const std::vector<Camera>& cameras, const 
   result.trials = trials;
   result.predicted_covariance = predicted.covariance;
   result.sigma_max_predicted = predicted.sigma_max;
-  // Two passes on offsets from X (millimetres, not metres: no cancellation against |X|).
+  // Two passes on offsets from X (small numbers, in metres: no cancellation against |X|).
   int good = 0;
   Vec3 sum = Vec3::Zero();
   for (int k = 0; k < trials; ++k) {

@@ -4,25 +4,38 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "analysis/error.h"
 
 namespace pandora {
 
-VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path) {
+VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path,
+                         const std::string& json_path) {
   VoxelLattice lattice;
   lattice.voxel_size = voxel_size;
   lattice.origin = region.min + Vec3::Constant(0.5 * voxel_size);
   const Vec3 extent = region.size();
+  double total = 1;
   for (int a = 0; a < 3; ++a) {
     const double n = std::max(1.0, std::ceil(extent[a] / voxel_size - 1e-9));
     if (!(n <= double(1 << 30)))
-      throw InputError(scene_path, "$.study.voxel_size",
+      throw InputError(scene_path, json_path,
                        "the region needs more than 2^30 voxels along one axis",
                        "use a larger voxel_size or a smaller region");
     lattice.dims[a] = static_cast<int>(n);
+    total *= n;
+  }
+  // Far beyond any memory budget, and beyond what 64-bit voxel and block counts may hold safely.
+  if (!(total <= std::ldexp(1.0, 50))) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.3g", total);
+    throw InputError(scene_path, json_path,
+                     std::string("the region needs about ") + count + " voxels (more than 2^50)",
+                     "use a larger voxel_size or a smaller region");
   }
   return lattice;
 }
@@ -114,9 +127,18 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
       box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
       box.Extend(lattice.Center(last.x(), last.y(), last.z()));
 
-      // Region.
+      // Region. A box region's last voxel centres can lie up to half a voxel beyond its max (the
+      // lattice rounds the extent up): such blocks test each centre against the box.
       InsideMesh::BoxClass region_class = InsideMesh::BoxClass::kInside;
-      if (region.kind == Region::Kind::kMesh) region_class = region_mesh->Classify(box);
+      const double slack = 1e-9 * h;
+      Aabb region_box = region.box;
+      region_box.min -= Vec3::Constant(slack);
+      region_box.max += Vec3::Constant(slack);
+      if (region.kind == Region::Kind::kMesh) {
+        region_class = region_mesh->Classify(box);
+      } else if (!region_box.Contains(box.max)) {
+        region_class = InsideMesh::BoxClass::kCrossing;
+      }
       if (region_class == InsideMesh::BoxClass::kOutside) continue;
       // Solids.
       bool all_solid = false;
@@ -141,7 +163,9 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
           for (int y = block.origin.y(); y <= last.y(); ++y)
             for (int z = block.origin.z(); z <= last.z(); ++z) {
               const Vec3 p = lattice.Center(x, y, z);
-              if (region_class == InsideMesh::BoxClass::kCrossing && !region_mesh->Inside(p))
+              if (region_class == InsideMesh::BoxClass::kCrossing &&
+                  !(region.kind == Region::Kind::kMesh ? region_mesh->Inside(p)
+                                                       : region_box.Contains(p)))
                 continue;
               bool inside_solid = all_solid;
               for (std::size_t s = 0; !inside_solid && s < crossing.size(); ++s)
@@ -160,7 +184,7 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
       keep[b] = 1;
       block.full = block.mask.empty() && n_vox == 512;
       if (block.free_voxels == 0) continue;
-      // Cameras: pad the box by half a voxel diagonal's worth of round-off only.
+      // Cameras: pad the box by round-off only (1e-9 of a voxel).
       Aabb padded = box;
       padded.min -= Vec3::Constant(1e-9 * h);
       padded.max += Vec3::Constant(1e-9 * h);

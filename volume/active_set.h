@@ -23,13 +23,16 @@ struct VoxelLattice {
   Eigen::Vector3i dims = Eigen::Vector3i::Zero();
 
   Vec3 Center(int i, int j, int k) const { return origin + voxel_size * Vec3(i, j, k); }
+  /// Lattice points (MakeLattice bounds it by 2^50, so this cannot overflow).
   std::int64_t voxel_count() const { return std::int64_t(dims.x()) * dims.y() * dims.z(); }
 };
 
 /// Builds the lattice for `region` at `voxel_size` (the count per axis is ceil(extent / voxel_size),
-/// at least 1). Throws InputError (path "$.study.voxel_size") when an axis would need more than 2^30
-/// voxels.
-VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path);
+/// at least 1; centres beyond the region's max are excluded by BuildActiveSet). Throws InputError
+/// (path "$.study.voxel_size") when an axis would need more than 2^30 voxels or the whole lattice
+/// more than 2^50.
+VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path,
+                         const std::string& json_path = "$.study.voxel_size");
 
 /// Conservative frustum test of a box against a camera: its working range (distance), its bounding
 /// cone (max field angle) and, for fields of view under 180 degrees, the four planes through the

@@ -106,7 +106,10 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
 
   Fields out;
   const Study& study = scene.study;
-  out.lattice = MakeLattice(study.region.box, study.voxel_size, file);
+  // Errors about the voxel size name where it came from: the scene file or a command-line option.
+  const std::string size_file = options.voxel_size_option.empty() ? file : options.voxel_size_option;
+  const std::string size_path = options.voxel_size_option.empty() ? "$.study.voxel_size" : "";
+  out.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
   const double estimate = EstimateFieldBytes(out.lattice, options.fields, camera_count);
   out.stats.estimated_bytes = estimate;
   if (estimate > options.memory_budget_bytes) {
@@ -114,12 +117,12 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     const double h_min =
         study.voxel_size * std::cbrt(estimate / options.memory_budget_bytes) * 1.01;
     std::ostringstream reason, hint;
-    reason << "the region needs about " << std::llround(estimate / 1e6) << " MB at voxel size "
+    reason << "the region needs about " << std::llround(estimate / 1048576.0) << " MiB at voxel size "
            << study.voxel_size << " m, over the budget of "
-           << std::llround(options.memory_budget_bytes / 1e6) << " MB";
+           << std::llround(options.memory_budget_bytes / 1048576.0) << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
          << "(--memory-budget or study.memory_budget_mb)";
-    throw InputError(file, "$.study.voxel_size", reason.str(), hint.str());
+    throw InputError(size_file, size_path, reason.str(), hint.str());
   }
 
   // Solids and the region mesh.
@@ -175,7 +178,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
   const std::size_t report_every = std::max<std::size_t>(1, blocks.size() / 200);
 
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const auto& range) {
-    // Per-thread scratch, reused across blocks (the information accumulators are 24 KB).
+    // Scratch for the blocks of this TBB range (the information accumulators are 24 KB).
     std::array<Ray, 512> segments;
     std::array<std::int16_t, 512> where;
     std::array<float, 512> segment_density;
@@ -265,6 +268,16 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (res.cameras) res.cameras->setValueOn(o, static_cast<std::int64_t>(seen_by[o]));
             if (res.floats[kResolution]) res.floats[kResolution]->setValueOn(o, density[o]);
             if (coverage[o] < 2) continue;  // not triangulable: no uncertainty work at all
+            if (!want_information) continue;
+            const std::array<double, 6>& I = information[o];
+            Mat3 J;
+            J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+            const Information info = DecomposeInformation(J, /*eigenvectors=*/false);
+            if (!info.observable) {
+              ++res.unobservable;
+              continue;
+            }
+            ++res.triangulable;
             if (want_angle) {
               // The largest angle is between the pair with the smallest dot product; only that
               // pair gets the accurate (atan2) angle.
@@ -281,16 +294,6 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                   std::atan2(d[best_i].cross(d[best_j]).norm(), d[best_i].dot(d[best_j]));
               res.floats[kAngle]->setValueOn(o, static_cast<float>(angle * 180.0 / M_PI));
             }
-            if (!want_information) continue;
-            const std::array<double, 6>& I = information[o];
-            Mat3 J;
-            J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-            const Information info = DecomposeInformation(J, /*eigenvectors=*/false);
-            if (!info.observable) {
-              ++res.unobservable;
-              continue;
-            }
-            ++res.triangulable;
             const Vec3 variance = info.eigenvalues.cwiseInverse();  // m^2, descending
             const float sigma_max_mm = static_cast<float>(1e3 * std::sqrt(variance[0]));
             res.sigma_max.push_back(sigma_max_mm);

@@ -38,6 +38,9 @@ struct FieldOptions {
   bool record_rays = false;
   /// Used in error messages.
   std::string scene_path;
+  /// Where the voxel size came from, for error messages: empty for the scene file's
+  /// $.study.voxel_size, else the command-line option (e.g. "--voxel-size").
+  std::string voxel_size_option;
 };
 
 /// Counts and timing of one evaluation.

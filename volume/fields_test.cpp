@@ -291,6 +291,27 @@ TEST(Fields, SinglePinholeClosedForm) {
   }
 }
 
+TEST(Fields, VoxelCentresBeyondTheRegionBoxAreLeftOut) {
+  // Extent 1.0 at voxel 0.3: the lattice has 4 voxels per axis (centres 0.15 .. 1.05), but only 3
+  // centres per axis lie inside the box; a solid lid just above the box is never counted.
+  Scene scene = TestScene();
+  scene.objects.clear();
+  scene.objects.push_back(Object("lid", MakeBox(Vec3(2, 2, 0.2)), Vec3(0.5, 0.5, 1.12), true));
+  scene.study.region.box.min = Vec3(0, 0, 0);
+  scene.study.region.box.max = Vec3(1.0, 1.0, 1.0);
+  scene.study.voxel_size = 0.3;
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const Fields f = EvaluateFields(scene, scene.rigs[0], *caster, FieldOptions{});
+  EXPECT_EQ(f.lattice.dims, Eigen::Vector3i(4, 4, 4));
+  EXPECT_EQ(f.stats.active_set.region_voxels, 27);
+  EXPECT_EQ(f.stats.active_set.solid_voxels, 0);
+  EXPECT_EQ(static_cast<std::int64_t>(f.impl().coverage->activeVoxelCount()), 27);
+  // An extent that is a whole number of voxels keeps its last layer (centre within round-off).
+  scene.study.region.box.max = Vec3(0.9, 0.9, 0.9);
+  const Fields g = EvaluateFields(scene, scene.rigs[0], *caster, FieldOptions{});
+  EXPECT_EQ(g.stats.active_set.region_voxels, 27);
+}
+
 TEST(Fields, OnlyRequestedFieldsAreBuilt) {
   const Scene scene = TestScene();
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
