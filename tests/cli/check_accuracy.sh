@@ -13,7 +13,7 @@ fail() { echo "FAIL: $*"; exit 1; }
 for f in accuracy_voxel.csv accuracy_montecarlo.csv accuracy_steady.csv \
          accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg accuracy_tables.md; do
   [ -s "$out/$f" ] || fail "$f missing or empty"
-  [ ! -e "$out/$f.tmp" ] || fail "$f.tmp left behind"
+  [ -z "$(ls "$out" | grep -F "$f.tmp")" ] || fail "$f.tmp* left behind"
 done
 for f in accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg; do
   head -c 200 "$out/$f" | grep -q '<svg ' || fail "$f does not start an SVG document"

@@ -18,5 +18,5 @@ for key in '"rig"' '"cameras"' '"voxel_size_m"' '"region_voxels"' '"active_voxel
            '"rays"' '"rays_per_second"'; do
   grep -q "$key" "$out/summary.json" || { echo "FAIL: summary.json lacks $key"; exit 1; }
 done
-[ ! -e "$out/fields.vdb.tmp" ] && [ ! -e "$out/summary.json.tmp" ] || { echo "FAIL: temporary files left"; exit 1; }
+[ -z "$(ls "$out" | grep -F .tmp)" ] || { echo "FAIL: temporary files left: $(ls "$out")"; exit 1; }
 echo "ok: vdb_print lists grids and metadata; summary.json has the keys"
