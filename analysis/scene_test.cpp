@@ -640,7 +640,8 @@ TEST(SceneCameraTest, RigToJsonRoundTrip) {
   scene["rigs"] = json::parse(R"([
     {"name": "main", "cameras": [
       {"id": "a", "position": [1.1, 2.2, 3.3], "look_at": [0.3, -0.7, 0.1], "up": [0.1, 0.2, 1],
-       "resolution": [1920, 1080], "hfov_deg": 73.3, "range": {"near": 0.25, "far": 9.5}},
+       "resolution": [1920, 1080], "hfov_deg": 73.3, "range": {"near": 0.25, "far": 9.5},
+       "pixel_sigma": 0.8},
       {"id": 7, "name": "fish", "position": [-1, 0.5, 2],
        "euler_deg": {"yaw": 33, "pitch": -21, "roll": 4},
        "resolution": [1280, 1280], "hfov_deg": 190, "color": "#336699", "enabled": false,
@@ -658,6 +659,8 @@ TEST(SceneCameraTest, RigToJsonRoundTrip) {
   ])");
   const Scene original = Parse(scene);
   const Rig& rig = original.FindRig("main");
+  EXPECT_EQ(rig.cameras[0].pixel_sigma, 0.8);
+  EXPECT_EQ(rig.cameras[1].pixel_sigma, 0.0);  // the study's
 
   json again = BaseScene();
   again["rigs"] = json::array({RigToJson(rig)});
@@ -691,7 +694,8 @@ TEST(SceneCameraTest, RigToJsonRoundTrip) {
                         {ka.k3, kb.k3},
                         {ka.k4, kb.k4},
                         {a.near, b.near},
-                        {a.far, b.far}}) {
+                        {a.far, b.far},
+                        {a.pixel_sigma, b.pixel_sigma}}) {
       if (std::isinf(x)) {
         EXPECT_EQ(x, y);
       } else {
@@ -1608,5 +1612,50 @@ TEST(MeshFileRobustnessTest, ColladaAccessorMustStayInsideItsArray) {
   EXPECT_CONTAINS(reason, "corrupt COLLADA: the accessor on line");
   EXPECT_CONTAINS(reason, "which holds 0");
 }
+}  // namespace
+}  // namespace pandora
+
+namespace pandora {
+namespace {
+
+TEST(SceneStudyTest, MotionModelAndPrecisionTarget) {
+  json scene = BaseScene();
+  scene["units"] = "mm";
+  scene["study"]["region"]["box"] = {{"min", {-1000, -1000, 0}}, {"max", {1000, 1000, 2000}}};
+  scene["study"]["motion"] = {{"q", 2e6}, {"rate_hz", 120}, {"covariance", "prior"}};
+  scene["study"]["max_sigma_mm"] = 1.5;
+  scene["study"]["fields"] = {"coverage", "sigma_max", "sigma_max_steady"};
+  FirstCamera(scene)["pixel_sigma"] = 0.25;
+  const Scene s = Parse(scene);
+  ASSERT_TRUE(s.study.motion.has_value());
+  EXPECT_NEAR(s.study.motion->q, 2.0, 1e-12);  // mm^2/s^3 -> m^2/s^3 scales by 1e-6
+  EXPECT_EQ(s.study.motion->rate_hz, 120.0);
+  EXPECT_TRUE(s.study.steady_prior);
+  ASSERT_TRUE(s.study.max_sigma_mm.has_value());
+  EXPECT_EQ(*s.study.max_sigma_mm, 1.5);  // millimetres whatever the file's unit
+  EXPECT_EQ(s.rigs[0].cameras[0].pixel_sigma, 0.25);
+  EXPECT_TRUE(IsUncertaintyField("sigma_max_steady"));
+  EXPECT_FALSE(IsUncertaintyField("resolution"));
+}
+
+TEST(SceneStudyTest, BadMotionAndSigmas) {
+  json scene = BaseScene();
+  scene["study"]["fields"] = {"coverage", "sigma_mean_steady"};
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.study.fields[1]", "needs a motion model");
+  scene = BaseScene();
+  scene["study"]["motion"] = {{"q", -1}, {"rate_hz", 30}};
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.study.motion.q", "must be zero or positive");
+  scene["study"]["motion"] = {{"q", 1}, {"rate_hz", 0}};
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.study.motion.rate_hz", "must be positive");
+  scene["study"]["motion"] = {{"q", 1}, {"rate_hz", 30}, {"covariance", "both"}};
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.study.motion.covariance", "expected \"posterior\" or \"prior\"");
+  scene = BaseScene();
+  FirstCamera(scene)["pixel_sigma"] = 1e9;
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.rigs[0].cameras[0].pixel_sigma", "between 1e-6 and 1e6");
+  scene = BaseScene();
+  scene["study"]["max_sigma_mm"] = 0;
+  EXPECT_INPUT_ERROR(ErrorFor(scene), "$.study.max_sigma_mm", "must be positive");
+}
+
 }  // namespace
 }  // namespace pandora
