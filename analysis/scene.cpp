@@ -920,17 +920,7 @@ Study ReadStudy(const Node& node) {
     const std::vector<std::string>& known = FieldNames();
     if (count == 0) n->Fail("at least one field is needed", "known fields: " + JoinQuoted(known));
     study.fields.clear();
-    for (size_t i = 0; i < count; ++i) {
-      const Node field = n->At(i);
-      const std::string name = field.String();
-      if (std::find(known.begin(), known.end(), name) == known.end()) {
-        field.Fail("unknown field " + Quoted(name), SuggestionHint(name, known, "known fields"));
-      }
-      if (std::find(study.fields.begin(), study.fields.end(), name) != study.fields.end()) {
-        field.Fail("field " + Quoted(name) + " is listed twice");
-      }
-      study.fields.push_back(name);
-    }
+    for (size_t i = 0; i < count; ++i) study.fields.push_back(n->At(i).String());
   }
   if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->PixelSigma();
   if (auto n = node.Find("memory_budget_mb")) {
@@ -953,12 +943,11 @@ Study ReadStudy(const Node& node) {
       study.steady_prior = which == "prior";
     }
   }
-  if (auto n = node.Find("fields")) {
-    for (size_t i = 0; i < study.fields.size(); ++i)
-      if (study.fields[i].size() > 7 &&
-          study.fields[i].compare(study.fields[i].size() - 7, 7, "_steady") == 0 && !study.motion)
-        n->At(i).Fail("field " + Quoted(study.fields[i]) + " needs a motion model",
-                      "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the study");
+  // Checked after the motion model is known: steady-state fields need one.
+  if (auto problem = CheckFieldList(study.fields, study.motion.has_value())) {
+    const auto n = node.Find("fields");
+    if (n) n->At(problem->index).Fail(problem->reason, problem->hint);
+    node.Fail(problem->reason, problem->hint);  // the default list: not reachable in practice
   }
   return study;
 }
@@ -1110,6 +1099,23 @@ const std::vector<std::string>& FieldNames() {
 bool IsUncertaintyField(const std::string& name) {
   const std::vector<std::string>& all = FieldNames();
   return std::find(all.begin() + 3, all.end(), name) != all.end();
+}
+
+std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& fields,
+                                               bool has_motion) {
+  const std::vector<std::string>& known = FieldNames();
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string& name = fields[i];
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      return FieldListProblem{i, "unknown field " + Quoted(name),
+                              SuggestionHint(name, known, "known fields")};
+    if (std::find(fields.begin(), fields.begin() + i, name) != fields.begin() + i)
+      return FieldListProblem{i, "field " + Quoted(name) + " is listed twice", ""};
+    if (!has_motion && name.size() > 7 && name.compare(name.size() - 7, 7, "_steady") == 0)
+      return FieldListProblem{i, "field " + Quoted(name) + " needs a motion model",
+                              "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the study"};
+  }
+  return std::nullopt;
 }
 
 Scene LoadScene(const std::string& path, const LoadOptions& options) {

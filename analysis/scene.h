@@ -82,6 +82,16 @@ const std::vector<std::string>& FieldNames();
 /// True for the fields that need the triangulation uncertainty (all but the first three).
 bool IsUncertaintyField(const std::string& name);
 
+/// The first problem with a list of field names, wherever it came from (scene file, command line,
+/// library caller): an unknown name (the hint suggests the closest), a name listed twice, or a
+/// steady-state field without a motion model. `index` is the offending entry.
+struct FieldListProblem {
+  std::size_t index = 0;
+  std::string reason, hint;
+};
+std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& fields,
+                                               bool has_motion);
+
 /// A named viewpoint for rendering ("views" in the scene file). World frame, metres.
 struct View {
   Vec3 from = Vec3::Zero();  ///< Eye position.

@@ -41,20 +41,8 @@ std::string FormatNumber(double v) {
 std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& fields,
                                            const Study& study) {
   if (fields.empty()) throw InputError("--fields", "", "no field given", "e.g. --fields coverage,sigma_max");
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    const std::string& f = fields[i];
-    const auto& known = FieldNames();
-    if (std::find(known.begin(), known.end(), f) == known.end()) {
-      std::string all;
-      for (const std::string& k : known) all += (all.empty() ? "" : ", ") + k;
-      throw InputError("--fields", "", "unknown field '" + f + "'", "available: " + all);
-    }
-    if (std::find(fields.begin(), fields.begin() + i, f) != fields.begin() + i)
-      throw InputError("--fields", "", "field '" + f + "' is listed twice");
-    if (f.find("_steady") != std::string::npos && !study.motion)
-      throw InputError("--fields", "", "field '" + f + "' needs a motion model",
-                       "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the scene's study");
-  }
+  if (auto problem = CheckFieldList(fields, study.motion.has_value()))
+    throw InputError("--fields", "", problem->reason, problem->hint);
   return fields;
 }
 

@@ -86,16 +86,9 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                       const FieldOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
-  for (std::size_t i = 0; i < options.fields.size(); ++i) {
-    const std::string path = "$.study.fields[" + std::to_string(i) + "]";
-    if (!Wants(FieldNames(), options.fields[i]))
-      throw InputError(file, path, "unknown field '" + options.fields[i] + "'",
-                       "available: coverage, cameras, resolution, sigma_max, sigma_mean, "
-                       "triangulation_angle, condition, sigma_max_steady, sigma_mean_steady");
-    if (options.fields[i].find("_steady") != std::string::npos && !scene.study.motion)
-      throw InputError(file, path, "field '" + options.fields[i] + "' needs a motion model",
-                       "add \"motion\": {\"q\": ..., \"rate_hz\": ...} to the study");
-  }
+  if (auto problem = CheckFieldList(options.fields, scene.study.motion.has_value()))
+    throw InputError(file, "$.study.fields[" + std::to_string(problem->index) + "]", problem->reason,
+                     problem->hint);
   if (options.fields.empty())
     throw InputError(file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
   const int camera_count = static_cast<int>(rig.cameras.size());
