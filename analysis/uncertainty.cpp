@@ -61,7 +61,7 @@ __attribute__((target_clones("avx512f", "avx2", "default")))
 void JacobiLoop(const double* __restrict xx, const double* __restrict xy, const double* __restrict xz,
                 const double* __restrict yy, const double* __restrict yz, const double* __restrict zz,
                 double* __restrict v0, double* __restrict v1, double* __restrict v2,
-                unsigned char* __restrict converged, std::size_t n) {
+                double* __restrict residual, std::size_t n) {
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
     // Scale by the largest diagonal entry (J is positive semi-definite: that bounds every entry),
@@ -81,7 +81,7 @@ void JacobiLoop(const double* __restrict xx, const double* __restrict xy, const 
     }
     const double off = a01 * a01 + a02 * a02 + a12 * a12;
     const double diag = a00 * a00 + a11 * a11 + a22 * a22;
-    converged[i] = static_cast<unsigned char>(off <= 1e-30 * diag);
+    residual[i] = off / (diag + 1e-300);
     // Sort: smallest, largest, and the median of three.
     const double lo = Min(Min(a00, a11), a22);
     const double hi = Max(Max(a00, a11), a22);
@@ -96,8 +96,16 @@ void JacobiLoop(const double* __restrict xx, const double* __restrict xy, const 
 
 void SymmetricEigenvalues3(const double* const upper[6], double* const values[3],
                            unsigned char* converged, std::size_t n) {
-  JacobiLoop(upper[0], upper[1], upper[2], upper[3], upper[4], upper[5], values[0], values[1],
-             values[2], converged, n);
+  // The residual goes through a double array: a byte store in the loop kept some clones scalar.
+  constexpr std::size_t kChunk = 512;
+  double residual[kChunk];
+  for (std::size_t start = 0; start < n; start += kChunk) {
+    const std::size_t m = std::min(kChunk, n - start);
+    JacobiLoop(upper[0] + start, upper[1] + start, upper[2] + start, upper[3] + start,
+               upper[4] + start, upper[5] + start, values[0] + start, values[1] + start,
+               values[2] + start, residual, m);
+    for (std::size_t i = 0; i < m; ++i) converged[start + i] = residual[i] <= 1e-30;
+  }
 }
 
 StaticUncertainty StaticFromInformation(const Information& info, int cameras) {

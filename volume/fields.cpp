@@ -10,6 +10,7 @@
 #include <chrono>
 #include <ctime>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -70,6 +71,90 @@ struct BlockResult {
   std::int64_t tests = 0, ray_count = 0, seen = 0, triangulable = 0, unobservable = 0;
   std::vector<float> sigma_max, sigma_max_steady;
 };
+
+// atan(t) for t >= 0 (+inf allowed) to 2.1e-8 relative (measured against std::atan over
+// 1e-12..1e12), branch-free so that it vectorises:
+// Cephes' single-precision reduction (t > tan(3 pi/8): pi/2 - atan(1/t); t > tan(pi/8):
+// pi/4 + atan((t-1)/(t+1))) and its degree-9 odd minimax polynomial. The angle grid is float.
+inline double AtanNonNegative(double t) {
+  const bool big = t > 2.414213562373095;
+  const bool mid = t > 0.4142135623730950;
+  const double x = big ? -1.0 / t : (mid ? (t - 1.0) / (t + 1.0) : t);
+  const double base = big ? M_PI_2 : (mid ? M_PI_4 : 0.0);
+  const double z = x * x;
+  return base +
+         (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z -
+          3.33329491539e-1) * z * x +
+         x;
+}
+
+// The triangulation angle of `count` voxels at (x, y, z) seen by the cameras in mask[m]: the
+// largest angle in degrees between two rays from camera centres that see the voxel. Vectorised
+// over voxels, in tiles of 64 that keep every camera's directions in L1: per camera the unit
+// directions (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so every
+// comparison with it fails), per camera pair the dot product, keeping the pair with the smallest,
+// then the angle as atan2(|cross|, dot) (both keep their relative
+// accuracy, so tiny and near-180 degree angles are as exact as at 90). No per-ray storage.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void TriangulationAngles(int count, const double* x, const double* y, const double* z,
+                         const std::uint64_t* mask, const std::vector<Vec3>& centres,
+                         std::uint64_t cameras, double* dirs, float* degrees) {
+  constexpr int kTile = 64;
+  const int camera_count = static_cast<int>(centres.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int start = 0; start < count; start += kTile) {
+    const int n = std::min(kTile, count - start);
+    const double *tx = x + start, *ty = y + start, *tz = z + start;
+    const std::uint64_t* tmask = mask + start;
+    for (int c = 0; c < camera_count; ++c) {
+      if (!(cameras >> c & 1)) continue;
+      const double cx = centres[c].x(), cy = centres[c].y(), cz = centres[c].z();
+      double* d = dirs + 3 * kTile * c;
+#pragma omp simd
+      for (int m = 0; m < n; ++m) {
+        const double vx = tx[m] - cx, vy = ty[m] - cy, vz = tz[m] - cz;
+        const double inv =
+            (tmask[m] >> c & 1) != 0 ? 1.0 / std::sqrt(vx * vx + vy * vy + vz * vz) : nan;
+        d[m] = vx * inv;
+        d[m + kTile] = vy * inv;
+        d[m + 2 * kTile] = vz * inv;
+      }
+    }
+    double best_dot[kTile];
+    std::int64_t best_a[kTile], best_b[kTile];  // camera indices of the best pair
+    for (int m = 0; m < kTile; ++m) best_dot[m] = 2.0, best_a[m] = 0, best_b[m] = 0;
+    for (int a = 0; a < camera_count; ++a) {
+      if (!(cameras >> a & 1)) continue;
+      const double* ad = dirs + 3 * kTile * a;
+      for (int b = a + 1; b < camera_count; ++b) {
+        if (!(cameras >> b & 1)) continue;
+        const double* bd = dirs + 3 * kTile * b;
+#pragma omp simd
+        for (int m = 0; m < n; ++m) {
+          const double dot =
+              ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] + ad[m + 2 * kTile] * bd[m + 2 * kTile];
+          const bool take = dot < best_dot[m];  // false for NaN: a camera that does not see it
+          best_dot[m] = take ? dot : best_dot[m];
+          best_a[m] = take ? a : best_a[m];
+          best_b[m] = take ? b : best_b[m];
+        }
+      }
+    }
+#pragma omp simd
+    for (int m = 0; m < n; ++m) {
+      const double* ad = dirs + 3 * kTile * best_a[m] + m;
+      const double* bd = dirs + 3 * kTile * best_b[m] + m;
+      const double ax = ad[0], ay = ad[kTile], az = ad[2 * kTile];
+      const double bx = bd[0], by = bd[kTile], bz = bd[2 * kTile];
+      const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+      const double dot = best_dot[m];
+      const double angle = AtanNonNegative(std::sqrt(cx * cx + cy * cy + cz * cz) / std::abs(dot));
+      degrees[start + m] = static_cast<float>((dot < 0 ? M_PI - angle : angle) * (180.0 / M_PI));
+    }
+  }
+}
 
 }  // namespace
 
@@ -165,6 +250,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
     inverse_variance[c] = 1.0 / (sigma * sigma);
   }
+  std::vector<Vec3> centres;
+  for (const Camera& cam : rig.cameras) centres.push_back(cam.center());
   const MotionModel motion = study.motion.value_or(MotionModel{});
   const double frame_period = 1.0 / motion.rate_hz;
 
@@ -179,8 +266,11 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::array<Mat23, 512> segment_jacobian;  // camera frame
     std::array<std::uint8_t, 512> occluded;
     std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2; set by a voxel's first ray
-    // Unit directions of the rays that see each voxel, [voxel * cameras + k] (triangulation angle).
-    std::vector<Vec3> seen_directions(want_angle ? 512 * camera_count : 0);
+    // Triangulation angle scratch: candidate positions and camera masks, per-camera directions.
+    std::array<double, 512> cand_x, cand_y, cand_z;
+    std::array<std::uint64_t, 512> cand_mask;
+    std::array<float, 512> angle_deg;
+    std::vector<double> directions(want_angle ? 3 * 64 * camera_count : 0);  // one tile
     // Measurement variances (m^2, three per triangulable voxel) and their offsets, for the
     // block's steady-state pass.
     std::array<double, 3 * 512> steady_variance;
@@ -236,7 +326,6 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
           for (std::size_t i = 0; i < n; ++i) {
             if (occluded[i]) continue;
             const int o = where[i];
-            if (want_angle) seen_directions[o * camera_count + coverage[o]] = segments[i].direction;
             ++coverage[o];
             seen_by[o] |= std::uint64_t{1} << c;
             ++res.per_camera[c];
@@ -246,7 +335,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
               density[o] = std::max(density[o], static_cast<float>(PixelDensity(Jc)));
             if (want_information) {
               // A = Jc R (world frame), then J += A^T A / sigma^2, upper triangle only; written
-              // out in scalars (Eigen's small products were the largest part of this loop).
+              // out in scalars (Eigen's small products were the largest part of this loop; a
+              // vectorised pass over all of a block's segments was slower, occluded ones included).
               const double a00 = Jc(0, 0) * R[0] + Jc(0, 1) * R[3] + Jc(0, 2) * R[6];
               const double a01 = Jc(0, 0) * R[1] + Jc(0, 1) * R[4] + Jc(0, 2) * R[7];
               const double a02 = Jc(0, 0) * R[2] + Jc(0, 1) * R[5] + Jc(0, 2) * R[8];
@@ -277,6 +367,15 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       if (any_seen)
         for (int f = 0; f < kFloatFieldCount; ++f)
           if (want_float[f]) res.floats[f] = new FloatLeaf(origin, 0.0f, false);
+      // Float values straight into the leaf buffers (setValueOn re-checks out-of-core loading on
+      // every call).
+      std::array<float*, kFloatFieldCount> float_data{};
+      for (int f = 0; f < kFloatFieldCount; ++f)
+        if (res.floats[f]) float_data[f] = res.floats[f]->buffer().data();
+      const auto put = [&](int field, int offset, float value) {
+        float_data[field][offset] = value;
+        res.floats[field]->getValueMask().setOn(offset);
+      };
       int steady_count = 0, candidate_count = 0;
       for (int x = 0; x < block.extent.x(); ++x)
         for (int y = 0; y < block.extent.y(); ++y)
@@ -293,10 +392,25 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (!want_information) continue;
             // Gathered for the block's batched eigenvalue pass.
             for (int k = 0; k < 6; ++k) upper[k][candidate_count] = information[o][k];
+            if (want_angle) {
+              const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
+                                                block.origin.z() + z);
+              cand_x[candidate_count] = p.x();
+              cand_y[candidate_count] = p.y();
+              cand_z[candidate_count] = p.z();
+              cand_mask[candidate_count] = seen_by[o];
+            }
             candidate[candidate_count++] = static_cast<std::int16_t>(o);
           }
-      if (candidate_count > 0)
+      if (candidate_count > 0) {
+        res.sigma_max.reserve(candidate_count);
+        if (want_steady) res.sigma_max_steady.reserve(candidate_count);
         SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
+        if (want_angle)
+          TriangulationAngles(candidate_count, cand_x.data(), cand_y.data(), cand_z.data(),
+                              cand_mask.data(), centres, block.cameras, directions.data(),
+                              angle_deg.data());
+      }
       for (int m = 0; m < candidate_count; ++m) {
             const int o = candidate[m];
             Vec3 eigenvalues(eigenvalue[0][m], eigenvalue[1][m], eigenvalue[2][m]);
@@ -314,33 +428,16 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
               continue;
             }
             ++res.triangulable;
-            if (want_angle) {
-              // The largest angle is between the pair with the smallest dot product; only that
-              // pair gets the accurate (atan2) angle.
-              const Vec3* d = &seen_directions[o * camera_count];
-              const int k = coverage[o];
-              double min_dot = 2.0;
-              int best_i = 0, best_j = 1;
-              for (int i = 0; i < k; ++i)
-                for (int j = i + 1; j < k; ++j) {
-                  const double dot = d[i].dot(d[j]);
-                  if (dot < min_dot) min_dot = dot, best_i = i, best_j = j;
-                }
-              // Single precision suffices for a float grid: |cross| and dot keep their relative
-              // accuracy in float, and atan2f's error (< 1 ulp) is below the grid's rounding.
-              const float angle = std::atan2(static_cast<float>(d[best_i].cross(d[best_j]).norm()),
-                                             static_cast<float>(d[best_i].dot(d[best_j])));
-              res.floats[kAngle]->setValueOn(o, angle * static_cast<float>(180.0 / M_PI));
-            }
+            if (want_angle) put(kAngle, o, angle_deg[m]);
             const Vec3 variance = eigenvalues.cwiseInverse();  // m^2, descending
             const float sigma_max_mm = static_cast<float>(1e3 * std::sqrt(variance[0]));
             res.sigma_max.push_back(sigma_max_mm);
-            if (want_float[kSigmaMax]) res.floats[kSigmaMax]->setValueOn(o, sigma_max_mm);
+            if (want_float[kSigmaMax]) put(kSigmaMax, o, sigma_max_mm);
             if (want_float[kSigmaMean])
-              res.floats[kSigmaMean]->setValueOn(
+              put(kSigmaMean, 
                   o, static_cast<float>(1e3 * std::sqrt(variance.sum() / 3.0)));
             if (want_float[kCondition])
-              res.floats[kCondition]->setValueOn(
+              put(kCondition, 
                   o, static_cast<float>(eigenvalues[2] / eigenvalues[0]));
             if (want_steady) {
               // Gathered for one vectorised closed-form pass over the block (below).
@@ -358,9 +455,9 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
           const float steady_max =
               static_cast<float>(1e3 * std::sqrt(std::max(v[0], std::max(v[1], v[2]))));
           res.sigma_max_steady.push_back(steady_max);
-          if (want_float[kSigmaMaxSteady]) res.floats[kSigmaMaxSteady]->setValueOn(o, steady_max);
+          if (want_float[kSigmaMaxSteady]) put(kSigmaMaxSteady, o, steady_max);
           if (want_float[kSigmaMeanSteady])
-            res.floats[kSigmaMeanSteady]->setValueOn(
+            put(kSigmaMeanSteady, 
                 o, static_cast<float>(1e3 * std::sqrt((v[0] + v[1] + v[2]) / 3.0)));
         }
       }
