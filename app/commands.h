@@ -47,4 +47,17 @@ struct AccuracyArgs {
 };
 int RunAccuracy(const AccuracyArgs& args);
 
+/// `pandora export-surface`: the scene's surfaces sampled every `spacing` metres (area-weighted,
+/// deterministic), each sample with coverage, resolution and sigma_max for `rig`, written as a binary
+/// PLY point cloud (volume/surface.h, docs/report.md).
+struct ExportSurfaceArgs {
+  std::string scene;
+  std::string rig;
+  double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
+  std::string out;        ///< The .ply file.
+  unsigned long long seed = 1;
+  bool quiet = false;
+};
+int RunExportSurface(const ExportSurfaceArgs& args);
+
 }  // namespace pandora::app

@@ -51,6 +51,17 @@ int main(int argc, char** argv) {
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
   acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
+  ExportSurfaceArgs surface;
+  CLI::App* es = app.add_subcommand(
+      "export-surface", "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
+  es->add_option("scene", surface.scene, "Scene file (JSON)")->required();
+  es->add_option("--rig", surface.rig, "Rig name (default: the first rig)");
+  es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
+  es->add_option("--out", surface.out, "Output PLY file")->required();
+  es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
+  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -66,6 +77,7 @@ int main(int argc, char** argv) {
     if (*a) return RunAnalyze(analyze);
     if (*b) return RunBench(bench);
     if (*acc) return RunAccuracy(accuracy);
+    if (*es) return RunExportSurface(surface);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;
