@@ -7,7 +7,7 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build ccache g++ pkg-config git
   libopenvdb-dev libopenvdb-tools libembree-dev libcgal-dev libceres-dev libglm-dev
-  libopenexr-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
+  libopenexr-dev openexr libpng-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
   chromium
 )
@@ -27,10 +27,10 @@ fi
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo >/dev/null || { echo "setup: not root and sudo is missing; run as root" >&2; exit 1; }
-  SUDO="sudo -E"
+  SUDO="sudo"
 fi
 
 echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+${SUDO:+$SUDO -E} apt-get install -y -qq --no-install-recommends "${missing[@]}"
