@@ -5,6 +5,7 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace pandora::app {
 
@@ -59,5 +60,17 @@ struct ExportSurfaceArgs {
   bool quiet = false;
 };
 int RunExportSurface(const ExportSurfaceArgs& args);
+
+/// `pandora report`: one self-contained HTML file (DIR/report.html) with renders, field slices,
+/// histograms, the camera table and the summary numbers, the rigs side by side (docs/report.md).
+struct ReportArgs {
+  std::string scene;
+  std::vector<std::string> rigs;  ///< Names (each may be comma-separated); empty: every rig.
+  std::string out = "report";
+  double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
+  double width = 640;             ///< Pixels across the renders from the named views.
+  bool quiet = false;
+};
+int RunReport(const ReportArgs& args);
 
 }  // namespace pandora::app

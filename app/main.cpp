@@ -62,6 +62,17 @@ int main(int argc, char** argv) {
   es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 
+  ReportArgs report;
+  CLI::App* rep = app.add_subcommand(
+      "report", "One self-contained HTML report: renders, field slices, histograms, cameras, rigs side by side");
+  rep->add_option("scene", report.scene, "Scene file (JSON)")->required();
+  rep->add_option("--rig", report.rigs, "Rig name(s), repeatable or comma-separated (default: every rig)");
+  rep->add_option("--out", report.out, "Output folder (report.html is written there)")->capture_default_str();
+  rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)");
+  rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")->capture_default_str();
+  rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -78,6 +89,7 @@ int main(int argc, char** argv) {
     if (*b) return RunBench(bench);
     if (*acc) return RunAccuracy(accuracy);
     if (*es) return RunExportSurface(surface);
+    if (*rep) return RunReport(report);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;
