@@ -48,6 +48,33 @@ struct AccuracyArgs {
 };
 int RunAccuracy(const AccuracyArgs& args);
 
+/// `pandora render`: the scene lit by the rig's cameras as projectors (render/render.h). One
+/// viewpoint: a named view, --from/--at, or a camera's own eye (--camera ID).
+struct RenderArgs {
+  std::string scene;
+  std::string rig;
+  std::string view;            ///< Name in the scene's "views".
+  std::string from, at, up;    ///< "X,Y,Z" each.
+  std::string camera;          ///< Camera id: render what that camera images.
+  double fov = kUnset;         ///< Horizontal field of view, degrees.
+  std::string size;            ///< "WxH"; empty: 1280x720, or the camera's resolution with --camera.
+  std::string out = "render.png";
+  std::string pattern = "uniform";   ///< uniform | grid
+  std::string surface = "material";  ///< material | black | hidden-line | contours
+  double brightness = kUnset;
+  int grid = 32;
+  int samples = 1;
+  bool no_cameras = false;
+  std::string fields;          ///< fields.vdb for the overlays.
+  std::string slice;           ///< Field shown on a slice plane.
+  std::string slice_axis = "z";
+  double slice_at = kUnset;
+  std::string iso;             ///< Field whose isosurface is drawn.
+  double iso_value = kUnset;
+  bool quiet = false;
+};
+int RunRender(const RenderArgs& args);
+
 /// `pandora export-surface`: the scene's surfaces sampled every `spacing` metres (area-weighted,
 /// deterministic), each sample with coverage, resolution and sigma_max for `rig`, written as a binary
 /// PLY point cloud (volume/surface.h, docs/report.md).

@@ -51,6 +51,34 @@ int main(int argc, char** argv) {
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
   acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
+  RenderArgs render;
+  CLI::App* rn = app.add_subcommand(
+      "render", "Render the scene lit by every enabled camera as a projector of its own colour (PNG or EXR)");
+  rn->add_option("scene", render.scene, "Scene file (JSON)")->required();
+  rn->add_option("--rig", render.rig, "Rig name (default: the first rig)");
+  rn->add_option("--view", render.view, "Named view from the scene's \"views\"");
+  rn->add_option("--from", render.from, "Eye position X,Y,Z (with --at)");
+  rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
+  rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");
+  rn->add_option("--camera", render.camera, "Render what this camera (id) images, distortion included");
+  rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)");
+  rn->add_option("--size", render.size, "Image size WxH (default 1280x720; the camera's with --camera)");
+  rn->add_option("--out", render.out, "Output image: FILE.png or FILE.exr")->capture_default_str();
+  rn->add_option("--pattern", render.pattern, "uniform | grid (each camera's pixel grid)")->capture_default_str();
+  rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")->capture_default_str();
+  rn->add_option("--surface", render.surface, "material | black | hidden-line | contours")->capture_default_str();
+  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default 1)");
+  rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")->capture_default_str();
+  rn->add_flag("--no-cameras", render.no_cameras, "Do not draw the camera bodies and frusta");
+  rn->add_option("--fields", render.fields, "fields.vdb from `pandora analyze`, for --slice and --iso");
+  rn->add_option("--slice", render.slice, "Show this field on a slice plane (viridis, with a legend)");
+  rn->add_option("--slice-axis", render.slice_axis, "x | y | z: the slice plane's normal")->capture_default_str();
+  rn->add_option("--slice-at", render.slice_at, "Slice position along its axis in metres (default: the middle)");
+  rn->add_option("--iso", render.iso, "Draw the isosurface of this field");
+  rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)");
+  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
+
   ExportSurfaceArgs surface;
   CLI::App* es = app.add_subcommand(
       "export-surface", "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
@@ -88,6 +116,7 @@ int main(int argc, char** argv) {
     if (*a) return RunAnalyze(analyze);
     if (*b) return RunBench(bench);
     if (*acc) return RunAccuracy(accuracy);
+    if (*rn) return RunRender(render);
     if (*es) return RunExportSurface(surface);
     if (*rep) return RunReport(report);
   } catch (const pandora::InputError& e) {

@@ -87,7 +87,9 @@ struct RenderOptions {
   /// Dim ambient light in kMaterial mode (fraction of the material colour shown unlit).
   double ambient = 0.15;
   int grid_pixels = 32;        ///< kGrid: a line every this many camera pixels.
+  double grid_fill = 0.15;     ///< kGrid: light between the lines, as a fraction of the lines'.
   double line_width_px = 1.2;  ///< Grid lines, mesh edges and contours, in output pixels.
+  double line_grey = 0.25;     ///< Linear grey of mesh edges and contours.
   int samples = 1;             ///< Samples per pixel per axis (samples^2 per pixel, stratified).
   Vec3 background{0.02, 0.02, 0.03};  ///< Linear RGB where no surface is hit.
   OverlayOptions overlays;
