@@ -95,7 +95,9 @@ struct ReportArgs {
   std::vector<std::string> rigs;  ///< Names (each may be comma-separated); empty: every rig.
   std::string out = "report";
   double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
-  double width = 640;             ///< Pixels across the renders from the named views.
+  int width = 640;                ///< Pixels across the renders from the named views.
+  int camera_width = 320;         ///< Pixels across each camera's own view.
+  double brightness = 1.0;        ///< Scale of every camera's light in the renders.
   bool quiet = false;
 };
 int RunReport(const ReportArgs& args);

@@ -97,7 +97,11 @@ int main(int argc, char** argv) {
   rep->add_option("--rig", report.rigs, "Rig name(s), repeatable or comma-separated (default: every rig)");
   rep->add_option("--out", report.out, "Output folder (report.html is written there)")->capture_default_str();
   rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)");
-  rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")->capture_default_str();
+  rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")
+      ->capture_default_str();
+  rep->add_option("--camera-width", report.camera_width, "Width in pixels of each camera's own view")
+      ->capture_default_str();
+  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders")->capture_default_str();
   rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
 

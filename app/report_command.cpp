@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -19,6 +20,7 @@
 #include "app/output.h"
 #include "app/plot.h"
 #include "app/report_images.h"
+#include "render/render.h"
 #include "volume/fields.h"
 #include "volume/slice.h"
 #include "volume/summary.h"
@@ -99,9 +101,9 @@ std::string RigRow(const std::vector<std::string>& cells) {
   return s + "</div>\n";
 }
 
-double JsonNumber(const nlohmann::json& j, std::initializer_list<const char*> path) {
+double JsonNumber(const nlohmann::json& j, const std::vector<std::string>& path) {
   const nlohmann::json* p = &j;
-  for (const char* key : path) {
+  for (const std::string& key : path) {
     if (!p->is_object() || !p->contains(key)) return std::nan("");
     p = &(*p)[key];
   }
@@ -111,7 +113,7 @@ double JsonNumber(const nlohmann::json& j, std::initializer_list<const char*> pa
 // The headline numbers, as in summary.json.
 struct Headline {
   std::string label;
-  std::initializer_list<const char*> path;
+  std::vector<std::string> path;
   bool percent;        // a fraction shown as %
   bool higher_better;  // for highlighting the best rig
 };
@@ -232,7 +234,12 @@ int RunReport(const ReportArgs& args) {
   for (const std::string& n : names) rigs.push_back(&scene.FindRig(n));
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  const int view_width = static_cast<int>(CheckPositiveOption("--width", args.width, "pixels"));
+  for (auto [option, value] : {std::pair<const char*, int>{"--width", args.width},
+                               std::pair<const char*, int>{"--camera-width", args.camera_width}})
+    if (value < 16 || value > 8192)
+      throw InputError(option, "", "must be 16 to 8192 pixels, not " + std::to_string(value));
+  CheckPositiveOption("--brightness", args.brightness, "");
+  const int view_width = args.width;
   PrepareOutputDir(args.out);
 
   // Fields: the study's, plus what the figures need.
@@ -297,6 +304,75 @@ int RunReport(const ReportArgs& args) {
     heads.push_back("<h3 class=\"rig\">" + Html(r.rig->name) + " &mdash; " +
                     std::to_string(r.rig->enabled_count()) + " cameras</h3>");
 
+  // Renders: the named views, then each camera's own view, per rig.
+  if (!scene.views.empty()) {
+    body << "<h2 id=\"views\">Views</h2>\n<p class=\"note\">Each enabled camera projects light of "
+            "its own colour; where several see a surface their colours add, and surfaces no camera "
+            "sees stay dark (visibility rules: range, image, facing, occlusion). Camera bodies and "
+            "frusta are drawn in their colours.</p>\n"
+         << RigRow(heads);
+    const Scale sigma_scale = FieldScale("sigma_max", reports);
+    const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
+    auto render_views = [&](const std::string& name, const View& view, bool overlay) {
+      std::vector<std::string> cells;
+      for (const RigReport& r : reports) {
+        RenderOptions options;
+        options.pixel_sigma = study.pixel_sigma;
+        options.brightness = args.brightness;
+        if (overlay) {
+          options.overlays.slice_field = "sigma_max";
+          options.overlays.slice_axis = 2;
+          options.overlays.slice_position = study.region.box.center().z();
+          options.overlays.slice_min = sigma_scale.min;
+          options.overlays.slice_max = sigma_scale.max;
+        }
+        const Image image = Render(scene, *r.rig, *caster, ViewFromScene(view, view_width, height),
+                                   options, overlay ? &r.fields : nullptr);
+        const std::string alt = r.rig->name + " view " + name + (overlay ? " with sigma_max slice" : "");
+        cells.push_back("<figure>" + fig.Img("image/png", PngBytes(image), alt, "render") +
+                        "<figcaption>view <b>" + Html(name) + "</b>" +
+                        (overlay ? " with the sigma_max slice at z = " +
+                                       Fmt("%.3f", study.region.box.center().z()) + " m (viridis 0&ndash;" +
+                                       Fmt("%g", sigma_scale.max) + " mm)"
+                                 : "") +
+                        "</figcaption></figure>");
+      }
+      body << RigRow(cells);
+    };
+    // Each view plain, then with the sigma_max slice through the region centre (where geometry
+    // does not hide it).
+    for (const auto& [name, view] : scene.views) render_views(name, view, false);
+    for (const auto& [name, view] : scene.views) render_views(name, view, true);
+  }
+  body << "<h2 id=\"camera-views\">What each camera sees</h2>\n<p class=\"note\">Each camera's "
+          "own image (its lens model, distortion included), lit by every camera of its rig.</p>\n"
+       << RigRow(heads);
+  {
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) {
+      std::string cell = "<div class=\"thumbs\">";
+      for (std::size_t c = 0; c < r.rig->cameras.size(); ++c) {
+        const Camera& cam = r.rig->cameras[c];
+        if (!cam.enabled) continue;
+        RenderView view;
+        view.camera = static_cast<int>(c);
+        view.width = args.camera_width;
+        view.height = std::max(1, static_cast<int>(std::lround(double(args.camera_width) *
+                                                              cam.model.height() / cam.model.width())));
+        RenderOptions options;
+        options.pixel_sigma = study.pixel_sigma;
+        options.brightness = args.brightness;
+        options.overlays.cameras = false;
+        const Image image = Render(scene, *r.rig, *caster, view, options);
+        cell += "<figure>" + fig.Img("image/png", PngBytes(image), r.rig->name + " camera " + cam.id, "thumb") +
+                "<figcaption>" + Html(cam.id) + (cam.name != cam.id ? " (" + Html(cam.name) + ")" : "") +
+                "</figcaption></figure>";
+      }
+      cells.push_back(cell + "</div>");
+    }
+    body << RigRow(cells);
+  }
+
   // Field slices on shared scales.
   body << "<h2 id=\"slices\">Field slices</h2>\n<p class=\"note\">Voxel planes through the centre of "
           "the region, one pixel block per voxel. Light grey: not a free region voxel (inside a "
@@ -324,29 +400,31 @@ int RunReport(const ReportArgs& args) {
     bar.max = scale.max;
     bar.discrete = scale.discrete;
     bar.max_is_open = scale.open;
-    bar.swatches = {{HexColor(kNoValueColor).data(), field == "sigma_max" ? "not triangulable" : "unseen"},
-                    {HexColor(kOutsideRegionColor).data(), "outside region"}};
+    if (field != "coverage")
+      bar.swatches.push_back({HexColor(kNoValueColor).data(), field == "sigma_max" ? "not triangulable" : "unseen"});
+    bar.swatches.push_back({HexColor(kOutsideRegionColor).data(), "outside region"});
     body << "<h3>" << Html(field) << "</h3>\n";
     const std::string legend = fig.Svg(RenderColorbarSvg(bar), field + " colour scale");
     body << "<div class=\"legend\">" << legend << "</div>\n";
-    for (int axis : {2, 1}) {
-      std::vector<std::string> cells;
-      for (const RigReport& r : reports) {
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) {
+      std::string cell = "<div class=\"pair\">";
+      for (int axis : {2, 1}) {
         const FieldSlice s = SliceField(r.fields, field, axis, centre[axis]);
-        const int scale_px = std::max(1, 300 / std::max(s.width, s.height));
-        const char* u = "x";
+        const int scale_px = std::max(1, 320 / std::max(s.width, s.height));
         const char* v = axis == 2 ? "y" : "z";
         const std::string caption =
-            std::string(axis == 2 ? "z" : "y") + " = " + Fmt("%.3f", s.coordinate) + " m; " + u +
-            " " + Fmt("%.3f", s.u_min) + "&rarr;" + Fmt("%.3f", s.u_max) + " m left to right, " + v +
-            " " + Fmt("%.3f", s.v_min) + "&rarr;" + Fmt("%.3f", s.v_max) + " m bottom to top";
-        cells.push_back("<figure>" +
-                        fig.Png(SliceRaster(s, scale.min, scale.max, scale_px),
-                                r.rig->name + " " + field + " slice " + (axis == 2 ? "z" : "y"), "slice") +
-                        "<figcaption>" + caption + "</figcaption></figure>");
+            std::string(axis == 2 ? "z" : "y") + " = " + Fmt("%.3f", s.coordinate) + " m; x " +
+            Fmt("%.3f", s.u_min) + "&rarr;" + Fmt("%.3f", s.u_max) + " m left to right, " + v + " " +
+            Fmt("%.3f", s.v_min) + "&rarr;" + Fmt("%.3f", s.v_max) + " m bottom to top";
+        cell += "<figure>" +
+                fig.Png(SliceRaster(s, scale.min, scale.max, scale_px),
+                        r.rig->name + " " + field + " slice " + (axis == 2 ? "z" : "y"), "slice") +
+                "<figcaption>" + caption + "</figcaption></figure>";
       }
-      body << RigRow(cells);
+      cells.push_back(cell + "</div>");
     }
+    body << RigRow(cells);
   }
 
   // Histograms on shared axes.
@@ -444,6 +522,8 @@ int RunReport(const ReportArgs& args) {
           ".rigs{display:grid;gap:16px;align-items:start}.cell{min-width:0}\n"
           "figure{margin:0 0 10px}figcaption{font-size:11px;color:#555}\n"
           "img{max-width:100%;height:auto;display:block}img.slice{image-rendering:pixelated;width:100%}\n"
+          ".pair{display:grid;grid-template-columns:1fr 1fr;gap:8px}\n"
+          ".thumbs{display:grid;grid-template-columns:repeat(auto-fill,minmax(160px,1fr));gap:6px}\n"
           "img.render{width:100%}.legend img{max-width:440px}\n"
           "table{border-collapse:collapse;font-size:13px;margin:6px 0}td,th{border:1px solid #ccc;"
           "padding:3px 8px;text-align:right}th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}\n"
@@ -474,7 +554,6 @@ int RunReport(const ReportArgs& args) {
   if (!args.quiet)
     std::printf("wrote %s (%d images, %.1f MiB)\n", path.c_str(), fig.count(),
                 page.str().size() / 1048576.0);
-  (void)view_width;
   return 0;
 }
 

@@ -1,9 +1,14 @@
 #include "app/report_images.h"
 
-#include <png.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace pandora::app {
@@ -26,33 +31,46 @@ Raster SliceRaster(const FieldSlice& slice, double min, double max, int scale) {
   return r;
 }
 
+std::string PngBytes(const Image& image) {
+  // A private temporary name (process id and a counter), removed whatever happens.
+  static std::atomic<int> counter{0};
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("pandora-report-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".png");
+  struct Remove {
+    std::filesystem::path p;
+    ~Remove() {
+      std::error_code ec;
+      std::filesystem::remove(p, ec);
+    }
+  } remove{path};
+  WritePng(image, path.string());
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (!in) throw std::runtime_error("cannot read back " + path.string());
+  return bytes.str();
+}
+
 std::string EncodePng(const Raster& raster) {
   if (raster.width <= 0 || raster.height <= 0 ||
       raster.rgb.size() != 3 * static_cast<std::size_t>(raster.width) * raster.height)
     throw std::invalid_argument("EncodePng: empty raster or wrong buffer size");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  if (!png) throw std::runtime_error("libpng: cannot create a write struct");
-  png_infop info = png_create_info_struct(png);
-  std::string out;
-  if (!info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, info ? &info : nullptr);
-    throw std::runtime_error("libpng: encoding failed");
-  }
-  png_set_write_fn(
-      png, &out,
-      [](png_structp p, png_bytep data, png_size_t size) {
-        static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<const char*>(data), size);
-      },
-      [](png_structp) {});
-  png_set_IHDR(png, info, raster.width, raster.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-  png_write_info(png, info);
-  for (int y = 0; y < raster.height; ++y)
-    png_write_row(png, const_cast<png_bytep>(raster.rgb.data() + 3 * static_cast<std::size_t>(y) * raster.width));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return out;
+  // Inverse sRGB transfer curve per 8-bit value.
+  static const std::array<float, 256> linear = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double v = i / 255.0;
+      t[i] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+    }
+    return t;
+  }();
+  Image image;
+  image.width = raster.width;
+  image.height = raster.height;
+  image.rgb.resize(raster.rgb.size());
+  for (std::size_t i = 0; i < raster.rgb.size(); ++i) image.rgb[i] = linear[raster.rgb[i]];
+  return PngBytes(image);
 }
 
 std::string Base64(const std::string& bytes) {

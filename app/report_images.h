@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "render/render.h"
 #include "volume/colormap.h"
 #include "volume/slice.h"
 
@@ -33,7 +34,12 @@ inline constexpr Rgb8 kNoValueColor{64, 64, 64};           ///< Unseen, or not t
 /// kNoValueColor inside the region without a value, kOutsideRegionColor outside.
 Raster SliceRaster(const FieldSlice& slice, double min, double max, int scale);
 
-/// PNG bytes of `raster` (8-bit RGB).
+/// PNG bytes of a rendered image, through the renderer's WritePng (render/render.h) into a
+/// temporary file that is read back and removed.
+std::string PngBytes(const Image& image);
+
+/// PNG bytes of `raster` (8-bit sRGB): converted to linear RGB (the inverse sRGB curve, so WritePng's
+/// encoding gives the same 8-bit values back) and written by PngBytes.
 std::string EncodePng(const Raster& raster);
 
 /// Standard base64 (RFC 4648, with padding).
