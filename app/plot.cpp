@@ -362,7 +362,8 @@ std::string RenderBarChartSvg(const BarChart& chart) {
         std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil((longest * 7.0 + 6) / bin)));
     o << "<g text-anchor=\"middle\" fill=\"#333\">\n";
     for (std::size_t i = 0; i < n; i += every)
-      o << "<text x=\"" << Num(left + (i + 0.5) * bin) << "\" y=\"" << Num(bottom + 16) << "\">"
+      o << "<text x=\"" << Num(left + (i + (chart.edge_labels ? 0.0 : 0.5)) * bin) << "\" y=\""
+        << Num(bottom + 16) << "\">"
         << Escape(chart.categories[i]) << "</text>\n";
     o << "</g>\n";
     if (std::isfinite(chart.marker)) {

@@ -65,6 +65,9 @@ struct BarChart {
   std::vector<BarSeries> series;
   double y_max = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data.
   bool percent = false;                 ///< Tick labels as percentages of 1 (0.25 -> "25%").
+  /// Category labels at the left edge of their bar (bins of a continuous value, labelled by their
+  /// lower bound) instead of under its centre.
+  bool edge_labels = false;
   /// A vertical dashed line at a position in category units (0 = left edge of the first bin,
   /// categories.size() = right edge of the last); NaN: none.
   double marker = std::numeric_limits<double>::quiet_NaN();

@@ -121,6 +121,15 @@ TEST(BarChart, GroupedSeriesLegendAndMarker) {
   EXPECT_EQ(Count(svg, "stroke-dasharray"), 1);
   EXPECT_EQ(Count(svg, ">2 mm<"), 1);
   EXPECT_NE(svg.find("%<"), std::string::npos);
+  // Edge labels sit one half bin left of centred ones.
+  auto label_x = [](const std::string& text, const std::string& label) {
+    const std::size_t p = text.rfind("<text x=\"", text.find(">" + label + "<"));
+    return std::stod(text.substr(p + 9));
+  };
+  const double centred = label_x(svg, "b");
+  chart.edge_labels = true;
+  const std::string edges = RenderBarChartSvg(chart);
+  EXPECT_NEAR(centred - label_x(edges, "b"), (label_x(svg, "c") - label_x(svg, "b")) / 2, 0.02);
 }
 
 TEST(Colorbar, DiscreteBoxesAndSwatches) {

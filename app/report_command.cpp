@@ -482,7 +482,9 @@ int RunReport(const ReportArgs& args) {
       chart.title = "sigma_max: " + reports[i].rig->name;
       chart.x_label = "sigma_max (mm), bins of " + Fmt("%g", width) + " mm";
       chart.y_label = "share of region voxels";
-      chart.note = "triangulable voxels only; the last bar: sigma_max >= " + Fmt("%g", scale.max) + " mm";
+      chart.note = "triangulable voxels only; bins labelled by their lower edge; the last bar: sigma_max >= " +
+                   Fmt("%g", scale.max) + " mm";
+      chart.edge_labels = true;
       chart.percent = true;
       chart.y_max = y_max;
       for (int b = 0; b < bins; ++b) chart.categories.push_back(Fmt("%g", b * width));
