@@ -311,38 +311,23 @@ int RunReport(const ReportArgs& args) {
             "sees stay dark (visibility rules: range, image, facing, occlusion). Camera bodies and "
             "frusta are drawn in their colours.</p>\n"
          << RigRow(heads);
-    const Scale sigma_scale = FieldScale("sigma_max", reports);
     const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
-    auto render_views = [&](const std::string& name, const View& view, bool overlay) {
+    auto render_views = [&](const std::string& name, const View& view) {
       std::vector<std::string> cells;
       for (const RigReport& r : reports) {
         RenderOptions options;
         options.pixel_sigma = study.pixel_sigma;
         options.brightness = args.brightness;
-        if (overlay) {
-          options.overlays.slice_field = "sigma_max";
-          options.overlays.slice_axis = 2;
-          options.overlays.slice_position = study.region.box.center().z();
-          options.overlays.slice_min = sigma_scale.min;
-          options.overlays.slice_max = sigma_scale.max;
-        }
-        const Image image = Render(scene, *r.rig, *caster, ViewFromScene(view, view_width, height),
-                                   options, overlay ? &r.fields : nullptr);
-        const std::string alt = r.rig->name + " view " + name + (overlay ? " with sigma_max slice" : "");
-        cells.push_back("<figure>" + fig.Img("image/png", PngBytes(image), alt, "render") +
-                        "<figcaption>view <b>" + Html(name) + "</b>" +
-                        (overlay ? " with the sigma_max slice at z = " +
-                                       Fmt("%.3f", study.region.box.center().z()) + " m (viridis 0&ndash;" +
-                                       Fmt("%g", sigma_scale.max) + " mm)"
-                                 : "") +
-                        "</figcaption></figure>");
+        const Image image = Render(scene, *r.rig, *caster, ViewFromScene(view, view_width, height), options);
+        cells.push_back("<figure>" +
+                        fig.Img("image/png", PngBytes(image), r.rig->name + " view " + name, "render") +
+                        "<figcaption>view <b>" + Html(name) + "</b></figcaption></figure>");
       }
       body << RigRow(cells);
     };
-    // Each view plain, then with the sigma_max slice through the region centre (where geometry
-    // does not hide it).
-    for (const auto& [name, view] : scene.views) render_views(name, view, false);
-    for (const auto& [name, view] : scene.views) render_views(name, view, true);
+    // The field slices come as images below: an overlay in these views is often hidden by the
+    // very occluders the report is about (the medics in the trauma room), so the views stay plain.
+    for (const auto& [name, view] : scene.views) render_views(name, view);
   }
   body << "<h2 id=\"camera-views\">What each camera sees</h2>\n<p class=\"note\">Each camera's "
           "own image (its lens model, distortion included), lit by every camera of its rig.</p>\n"
