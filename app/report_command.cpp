@@ -231,7 +231,11 @@ int RunReport(const ReportArgs& args) {
   const std::vector<std::string> names = SplitList(args.rigs);
   if (names.empty())
     for (const Rig& r : scene.rigs) rigs.push_back(&r);
-  for (const std::string& n : names) rigs.push_back(&scene.FindRig(n));
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (std::find(names.begin(), names.begin() + i, names[i]) != names.begin() + i)
+      throw InputError("--rig", "", "rig '" + names[i] + "' listed twice");
+    rigs.push_back(&scene.FindRig(names[i]));
+  }
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
   for (auto [option, value] : {std::pair<const char*, int>{"--width", args.width},
@@ -495,6 +499,15 @@ int RunReport(const ReportArgs& args) {
     body << RigRow(cells);
   }
 
+  // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.
+  std::string summaries;
+  for (const RigReport& r : reports) {
+    std::string json = r.summary.dump();
+    for (std::size_t p = json.find("</"); p != std::string::npos; p = json.find("</", p + 2))
+      json.replace(p, 2, "<\\/");
+    summaries += "<script type=\"application/json\" class=\"summary\" data-rig=\"" + Html(r.rig->name) +
+                 "\">" + json + "</script>\n";
+  }
   std::ostringstream page;
   page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
        << "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; "
@@ -518,7 +531,7 @@ int RunReport(const ReportArgs& args) {
           ".meta,.note{color:#555}#image-check{font-size:12px}#image-check.bad{color:#b00;font-weight:bold}\n"
           "#image-check.ok{color:#070}\n</style>\n</head>\n<body data-expected-images=\""
        << fig.count() << "\">\n"
-       << body.str()
+       << body.str() << summaries
        << "<script>\n"
           "// Marks the page when an image failed to decode (also used by the test suite).\n"
           "window.addEventListener('load', function () {\n"

@@ -5,6 +5,10 @@
 #       Runs `pandora report SCENE --out OUT_DIR ARGS...`, then checks OUT_DIR/report.html with both
 #       checkers below and that it has one column per rig in RIGS (comma-separated) with each rig's
 #       name in the column headers.
+#   check_report.sh numbers PANDORA SCENE HTML RIGS WORK_DIR
+#       Runs `pandora analyze` for each rig and requires the summary embedded in the report for that
+#       rig to equal analyze's summary.json (coverage, uncertainty, region and per-camera numbers;
+#       jq -S), and the numbers table to show analyze's coverage >= 2 and sigma_max p50 values.
 #   check_report.sh negative HTML WORK_DIR
 #       Proves the checkers can fail: makes copies of HTML with one PNG corrupted, one SVG truncated,
 #       and one external image added, and requires each checker to reject each copy it covers.
@@ -103,6 +107,27 @@ case "$mode" in
       grep -q "<th>$r</th>" "$html" || { fail "rig '$r' missing from the numbers table"; exit 1; }
     done
     echo "ok: report with ${#names[@]} rig column(s), $(stat -c %s "$html") bytes"
+    ;;
+  numbers)
+    pandora=$1 scene=$2 html=$3 rigs=$4 work=$5
+    rm -rf "$work"; mkdir -p "$work"
+    IFS=, read -ra names <<<"$rigs"
+    keys='{coverage, uncertainty, region_voxels, solid_voxels, active_voxels, per_camera, voxel_size_m, rig, cameras}'
+    for r in "${names[@]}"; do
+      "$pandora" analyze "$scene" --rig "$r" --out "$work/$r" --quiet || { fail "analyze $r"; exit 1; }
+      jq -S "$keys" "$work/$r/summary.json" >"$work/$r/analyze.json"
+      grep -o "<script type=\"application/json\" class=\"summary\" data-rig=\"$r\">.*</script>" "$html" |
+        sed 's/^<script[^>]*>//; s#</script>$##' | jq -S "$keys" >"$work/$r/report.json" ||
+        { fail "no embedded summary for rig $r"; exit 1; }
+      diff -u "$work/$r/analyze.json" "$work/$r/report.json" || { fail "rig $r: the report's numbers differ from analyze"; exit 1; }
+      ge2=$(jq -r '.coverage.ge2 * 1000 | round / 10' "$work/$r/summary.json")
+      p50=$(jq -r '.uncertainty.sigma_max_mm.p50' "$work/$r/summary.json")
+      ge2_text=$(printf '%.1f%%' "$ge2"); p50_text=$(printf '%.3f' "$p50")
+      grep "Coverage &ge; 2 cameras" "$html" | grep -q "$ge2_text" || { fail "rig $r: table lacks coverage >= 2 of $ge2_text"; exit 1; }
+      grep "p50 (mm)" "$html" | head -1 | grep -q "$p50_text" || { fail "rig $r: table lacks sigma_max p50 $p50_text"; exit 1; }
+      echo "rig $r: report numbers equal analyze's (coverage >= 2 $ge2_text, sigma_max p50 $p50_text mm)"
+    done
+    echo "ok: numbers match for ${#names[@]} rig(s)"
     ;;
   negative)
     html=$1 work=$2
