@@ -46,26 +46,26 @@ class ViewRays {
       R_ = cam_->world_from_camera.linear();
       sx_ = double(cam_->model.width()) / width_;
       sy_ = double(cam_->model.height()) / height_;
-      // Centre rays and their pixel differentials (central differences over one output pixel).
+      // Centre rays (one unprojection per pixel) and their exact per-pixel differentials: the
+      // projection's Jacobian J at the unit direction has the ray in its null space, so
+      // M = J^T (J J^T)^-1 is d(direction)/d(pixel), perpendicular to the direction.
       const std::size_t n = std::size_t(width_) * height_;
       table_.resize(n);
       tbb::parallel_for(0, height_, [&](int y) {
         for (int x = 0; x < width_; ++x) {
           Entry& e = table_[std::size_t(y) * width_ + x];
-          e.ok = Direction(x, y, &e.d);
-          if (!e.ok) continue;
-          Vec3 xp, xm, yp, ym;
-          const bool bx = Direction(x + 0.5, y, &xp) && Direction(x - 0.5, y, &xm);
-          const bool by = Direction(x, y + 0.5, &yp) && Direction(x, y - 0.5, &ym);
-          // At the edge of the lens domain fall back to one-sided differences.
-          if (bx) e.dx = xp - xm;
-          else if (Direction(x + 0.5, y, &xp)) e.dx = 2.0 * (xp - e.d);
-          else if (Direction(x - 0.5, y, &xm)) e.dx = 2.0 * (e.d - xm);
-          else e.dx = Vec3::Zero();
-          if (by) e.dy = yp - ym;
-          else if (Direction(x, y + 0.5, &yp)) e.dy = 2.0 * (yp - e.d);
-          else if (Direction(x, y - 0.5, &ym)) e.dy = 2.0 * (e.d - ym);
-          else e.dy = Vec3::Zero();
+          const Vec2 pixel((x + 0.5) * sx_ - 0.5, (y + 0.5) * sy_ - 0.5);
+          const auto dir = cam_->model.Unproject(pixel);
+          if (!dir) continue;
+          Mat23 J;
+          if (!cam_->model.Project(*dir, &J)) continue;
+          const Eigen::Matrix2d JJt = J * J.transpose();
+          if (!(std::abs(JJt.determinant()) > 0)) continue;
+          const Eigen::Matrix<double, 3, 2> M = J.transpose() * JJt.inverse();
+          e.ok = true;
+          e.d = R_ * *dir;
+          e.dx = R_ * M.col(0) * sx_;
+          e.dy = R_ * M.col(1) * sy_;
         }
       });
     } else {
