@@ -702,7 +702,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   }
 
   if (ov.cameras && rays.perspective()) DrawCameraOverlays(rig, rays.pinhole(), ov, options, &image);
-  if (have_slice) DrawLegend(ov.slice_field, slice.min, slice.max, &image);
+  if (have_slice && ov.legend) DrawLegend(ov.slice_field, slice.min, slice.max, &image);
 
   if (stats) {
     stats->primary_rays = 0;

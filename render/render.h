@@ -70,6 +70,7 @@ struct OverlayOptions {
   double slice_min = std::numeric_limits<double>::quiet_NaN();
   double slice_max = std::numeric_limits<double>::quiet_NaN();
   double slice_opacity = 0.75;
+  bool legend = true;              ///< Draw the slice's colour bar with its range and field name.
   /// Isosurface (needs `fields`): empty = none, else a field name and an iso value; e.g.
   /// "coverage" at 1.5 is the boundary of coverage >= 2, "sigma_max" at 2.0 the 2 mm boundary.
   /// Extracted with OpenVDB's volumeToMesh, ray traced with the scene, alpha-composited.
