@@ -78,6 +78,11 @@ struct RawOcclusionResult {
 RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays,
                                       RawMode mode = RawMode::kSingle);
 
+/// The same baseline for first-hit queries: a bare TBB loop of rtcIntersect1 over `rays` (converted
+/// before the clock starts). In the result, `occluded` counts the rays that hit something. `caster`
+/// must come from MakeEmbreeRayCaster (throws std::invalid_argument otherwise).
+RawOcclusionResult RawEmbreeIntersection(const RayCaster& caster, const std::vector<Ray>& rays);
+
 /// The packet width OccludedPacket uses on this CPU (16, 8, 4, or 1).
 int EmbreePacketWidth(const RayCaster& caster);
 

@@ -262,4 +262,32 @@ RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector
   return RawOcclusionResult{seconds, rays.size(), occluded};
 }
 
+RawOcclusionResult RawEmbreeIntersection(const RayCaster& caster, const std::vector<Ray>& rays) {
+  const auto* embree = dynamic_cast<const EmbreeRayCaster*>(&caster);
+  if (!embree) throw std::invalid_argument("RawEmbreeIntersection needs an Embree ray caster");
+  std::vector<RTCRay> converted(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) embree->Fill(rays[i], &converted[i]);
+  const RTCScene scene = embree->scene();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t hits = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, converted.size(), 1024), std::size_t{0},
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t count) {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRayHit rh;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          rh.ray = converted[i];
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scene, &context, &rh);
+          count += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        return count;
+      },
+      [](std::size_t a, std::size_t b) { return a + b; });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return RawOcclusionResult{seconds, rays.size(), hits};
+}
+
 }  // namespace pandora

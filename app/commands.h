@@ -33,7 +33,14 @@ struct BenchArgs {
   double voxel_size = kUnset;
   int repeat = 3;
   std::string json_out;
+  /// `--render`: time the renderer instead of the fields (bench_render.cpp).
+  bool render = false;
+  std::string view;               ///< Named view; empty: the scene's first view.
+  std::string size = "1280x720";  ///< Image size.
 };
+/// `pandora bench --render`: Render() against raw Embree loops over the very same primary rays
+/// (rtcIntersect1) and occlusion segments (rtcOccluded packets and single rays), same run.
+int RunRenderBench(const BenchArgs& args);
 int RunBench(const BenchArgs& args);
 
 /// `pandora accuracy`: error against run time (issue 3, point 6) for (a) voxel size against the

@@ -40,6 +40,10 @@ int main(int argc, char** argv) {
   b->add_option("--voxel-size", bench.voxel_size, "Voxel size in metres (default: study.voxel_size)");
   b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")->check(CLI::PositiveNumber);
   b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
+  b->add_flag("--render", bench.render,
+              "Time `pandora render` (1280x720) against raw Embree loops over the same primary and shadow rays");
+  b->add_option("--view", bench.view, "With --render: the named view (default: the scene's first view)");
+  b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
   b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
   AccuracyArgs accuracy;

@@ -155,6 +155,7 @@ int RunRender(const RenderArgs& args) {
   if (!args.fields.empty()) fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  options.layers = ext == ".exr";  // the PNG has no room for them
   RenderStats stats;
   const Image image = RenderWithStats(scene, rig, *caster, view, options, fields.get(), &stats);
   if (ext == ".png") WritePng(image, args.out);

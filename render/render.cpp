@@ -17,6 +17,7 @@
 #include "analysis/visibility.h"
 #include "render/colormap.h"
 #include "render/overlay_fields.h"
+#include "volume/active_set.h"
 
 namespace pandora {
 
@@ -46,26 +47,26 @@ class ViewRays {
       R_ = cam_->world_from_camera.linear();
       sx_ = double(cam_->model.width()) / width_;
       sy_ = double(cam_->model.height()) / height_;
-      // Centre rays and their pixel differentials (central differences over one output pixel).
+      // Centre rays (one unprojection per pixel) and their exact per-pixel differentials: the
+      // projection's Jacobian J at the unit direction has the ray in its null space, so
+      // M = J^T (J J^T)^-1 is d(direction)/d(pixel), perpendicular to the direction.
       const std::size_t n = std::size_t(width_) * height_;
       table_.resize(n);
       tbb::parallel_for(0, height_, [&](int y) {
         for (int x = 0; x < width_; ++x) {
           Entry& e = table_[std::size_t(y) * width_ + x];
-          e.ok = Direction(x, y, &e.d);
-          if (!e.ok) continue;
-          Vec3 xp, xm, yp, ym;
-          const bool bx = Direction(x + 0.5, y, &xp) && Direction(x - 0.5, y, &xm);
-          const bool by = Direction(x, y + 0.5, &yp) && Direction(x, y - 0.5, &ym);
-          // At the edge of the lens domain fall back to one-sided differences.
-          if (bx) e.dx = xp - xm;
-          else if (Direction(x + 0.5, y, &xp)) e.dx = 2.0 * (xp - e.d);
-          else if (Direction(x - 0.5, y, &xm)) e.dx = 2.0 * (e.d - xm);
-          else e.dx = Vec3::Zero();
-          if (by) e.dy = yp - ym;
-          else if (Direction(x, y + 0.5, &yp)) e.dy = 2.0 * (yp - e.d);
-          else if (Direction(x, y - 0.5, &ym)) e.dy = 2.0 * (e.d - ym);
-          else e.dy = Vec3::Zero();
+          const Vec2 pixel((x + 0.5) * sx_ - 0.5, (y + 0.5) * sy_ - 0.5);
+          const auto dir = cam_->model.Unproject(pixel);
+          if (!dir) continue;
+          Mat23 J;
+          if (!cam_->model.Project(*dir, &J)) continue;
+          const Eigen::Matrix2d JJt = J * J.transpose();
+          if (!(std::abs(JJt.determinant()) > 0)) continue;
+          const Eigen::Matrix<double, 3, 2> M = J.transpose() * JJt.inverse();
+          e.ok = true;
+          e.d = R_ * *dir;
+          e.dx = R_ * M.col(0) * sx_;
+          e.dy = R_ * M.col(1) * sy_;
         }
       });
     } else {
@@ -106,7 +107,7 @@ class ViewRays {
   // The centre ray of pixel (x, y) and the derivatives of its unit direction per output pixel.
   bool Center(int x, int y, Vec3* d, Vec3* ddx, Vec3* ddy) const {
     if (!cam_) {
-      const Vec3 D = R_ * Vec3((x - cx_) / f_, (y - cy_) / f_, 1.0);
+      const Vec3 D = R_.col(2) + ((x - cx_) / f_) * R_.col(0) + ((y - cy_) / f_) * R_.col(1);
       const double len = D.norm();
       *d = D / len;
       const Vec3 Dx = R_.col(0) / f_, Dy = R_.col(1) / f_;
@@ -225,9 +226,16 @@ class LineOverlay {
   LineOverlay(const Camera& view, const Image& image)
       : view_(view), cfw_(view.camera_from_world()), image_(image),
         alpha_(std::size_t(image.width) * image.height, 0.0f),
-        color_(std::size_t(image.width) * image.height, Vec3::Zero()) {}
+        color_(std::size_t(image.width) * image.height, 0) {}
 
-  void Segment(const Vec3& A, const Vec3& B, const Vec3& color, double width) {
+  // Segments drawn after this call use `color` (up to 255 colours per overlay).
+  std::size_t colors() const { return palette_.size(); }
+  void SetColor(const Vec3& color) {
+    palette_.push_back(color);
+    current_ = uint8_t(palette_.size() - 1);
+  }
+
+  void Segment(const Vec3& A, const Vec3& B, double width) {
     Vec3 a = cfw_ * A, b = cfw_ * B;
     constexpr double kNear = 1e-3;
     if (a.z() < kNear && b.z() < kNear) return;
@@ -246,31 +254,48 @@ class LineOverlay {
     const int ymin = std::max(0, int(std::floor(std::min(pa.y(), pb.y()) - reach)));
     const int ymax = std::min(H - 1, int(std::ceil(std::max(pa.y(), pb.y()) + reach)));
     if (xmin > xmax || ymin > ymax) return;
-    // Walk along the segment in half-pixel steps, touching the pixels within reach.
-    const double len = std::sqrt(len2);
-    const int steps = std::max(1, int(std::ceil(2.0 * len)));
-    for (int i = 0; i <= steps; ++i) {
-      const Vec2 q = pa + (double(i) / steps) * ab;
-      const int qx = int(std::lround(q.x())), qy = int(std::lround(q.y()));
-      const int r = int(std::ceil(reach));
-      for (int y = std::max(ymin, qy - r); y <= std::min(ymax, qy + r); ++y)
-        for (int x = std::max(xmin, qx - r); x <= std::min(xmax, qx + r); ++x) {
-          const Vec2 c(x, y);
-          const double sigma = len2 > 0 ? std::clamp((c - pa).dot(ab) / len2, 0.0, 1.0) : 0.0;
-          const double dist = (pa + sigma * ab - c).norm();
-          double cover = LineCoverage(dist, width);
-          if (cover <= 0) continue;
-          // Perspective-correct point on the 3D segment, and its distance from the eye.
-          const double s = (sigma / b.z()) / ((1.0 - sigma) / a.z() + sigma / b.z());
-          const double depth = (a + s * (b - a)).norm();
-          const std::size_t p = std::size_t(y) * W + x;
-          const double surface = image_.depth[p];
-          if (depth > surface * (1.0 + 1e-3)) cover *= 0.3;  // hidden behind the surface: dimmed
-          if (cover > alpha_[p]) {
-            alpha_[p] = float(cover);
-            color_[p] = color;
-          }
+    // Clip the screen segment to the image grown by `reach` (Liang-Barsky), so segments that run
+    // far outside the image (an end near the eye plane) cost only their visible part.
+    double s0 = 0, s1 = 1;
+    auto clip = [&](double p, double q) {  // keep p * s <= q
+      if (p == 0) return q >= 0;
+      const double r = q / p;
+      if (p < 0) s0 = std::max(s0, r);
+      else s1 = std::min(s1, r);
+      return s0 <= s1;
+    };
+    if (!clip(-ab.x(), pa.x() + reach) || !clip(ab.x(), W - 1 + reach - pa.x()) ||
+        !clip(-ab.y(), pa.y() + reach) || !clip(ab.y(), H - 1 + reach - pa.y()))
+      return;
+    const Vec2 qa = pa + s0 * ab, qb = pa + s1 * ab;
+    // Walk the major axis one pixel at a time; cover the pixels within reach across it.
+    const bool x_major = std::abs(ab.x()) >= std::abs(ab.y());
+    const int major = x_major ? 0 : 1, minor = 1 - major;
+    const int r = int(std::ceil(reach));
+    const int m0 = int(std::floor(std::min(qa[major], qb[major]))) - r;
+    const int m1 = int(std::ceil(std::max(qa[major], qb[major]))) + r;
+    const int major_max = x_major ? W - 1 : H - 1, minor_max = x_major ? H - 1 : W - 1;
+    for (int m = std::max(0, m0); m <= std::min(major_max, m1); ++m) {
+      // Minor coordinate of the line at this major coordinate (clamped to the segment's span).
+      const double t = ab[major] != 0 ? std::clamp((m - pa[major]) / ab[major], s0, s1) : s0;
+      const int centre = int(std::lround(pa[minor] + t * ab[minor]));
+      for (int n = std::max(0, centre - r); n <= std::min(minor_max, centre + r); ++n) {
+        const int x = x_major ? m : n, y = x_major ? n : m;
+        const Vec2 c(x, y);
+        const double sigma = len2 > 0 ? std::clamp((c - pa).dot(ab) / len2, 0.0, 1.0) : 0.0;
+        const double dist = (pa + sigma * ab - c).norm();
+        double cover = LineCoverage(dist, width);
+        if (cover <= 0) continue;
+        // Perspective-correct point on the 3D segment, and its distance from the eye.
+        const double s = (sigma / b.z()) / ((1.0 - sigma) / a.z() + sigma / b.z());
+        const double depth = (a + s * (b - a)).norm();
+        const std::size_t p = std::size_t(y) * W + x;
+        if (depth > image_.depth[p] * (1.0 + 1e-3)) cover *= 0.3;  // hidden behind the surface: dimmed
+        if (cover > alpha_[p]) {
+          alpha_[p] = float(cover);
+          color_[p] = current_;
         }
+      }
     }
   }
 
@@ -279,7 +304,8 @@ class LineOverlay {
       const double a = alpha_[p];
       if (a <= 0) continue;
       for (int k = 0; k < 3; ++k)
-        image->rgb[3 * p + k] = float((1.0 - a) * image->rgb[3 * p + k] + a * color_[p][k]);
+        image->rgb[3 * p + k] =
+            float((1.0 - a) * image->rgb[3 * p + k] + a * palette_[color_[p]][k]);
     }
   }
 
@@ -288,7 +314,9 @@ class LineOverlay {
   Eigen::Isometry3d cfw_;
   const Image& image_;
   std::vector<float> alpha_;
-  std::vector<Vec3> color_;
+  std::vector<uint8_t> color_;
+  std::vector<Vec3> palette_;
+  uint8_t current_ = 0;
 };
 
 // Each enabled camera: a small box body behind its centre and its frustum (the distorted image
@@ -299,7 +327,8 @@ void DrawCameraOverlays(const Rig& rig, const Camera& view, const OverlayOptions
   const double width = std::max(1.0, options.line_width_px);
   for (const Camera& cam : rig.cameras) {
     if (!cam.enabled) continue;
-    const Vec3 color = cam.color.cwiseMax(Vec3::Constant(0.15));
+    if (lines.colors() >= 255) break;  // more than 255 cameras: the rest are not drawn
+    lines.SetColor(cam.color.cwiseMax(Vec3::Constant(0.15)));
     const Eigen::Isometry3d& T = cam.world_from_camera;
     const double len = std::min(ov.frustum_length, cam.far);
     // Body: a box 8 x 6 x 10 cm behind the centre (camera frame: x right, y down, z forward).
@@ -309,7 +338,7 @@ void DrawCameraOverlays(const Rig& rig, const Camera& view, const OverlayOptions
       corners[i] = T * Vec3((i & 1) ? bx : -bx, (i & 2) ? by : -by, (i & 4) ? 0.0 : -bz);
     static const int kEdges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
                                       {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-    for (const auto& e : kEdges) lines.Segment(corners[e[0]], corners[e[1]], color, width);
+    for (const auto& e : kEdges) lines.Segment(corners[e[0]], corners[e[1]], width);
     // Frustum: the image border, 16 points per side, unprojected to distance `len`.
     const double w = cam.model.width() - 0.5, h = cam.model.height() - 0.5;
     std::vector<Vec3> border;
@@ -324,8 +353,8 @@ void DrawCameraOverlays(const Rig& rig, const Camera& view, const OverlayOptions
         corner.push_back(i == 0);
       }
     for (std::size_t i = 0; i < border.size(); ++i) {
-      lines.Segment(border[i], border[(i + 1) % border.size()], color, width);
-      if (corner[i]) lines.Segment(cam.center(), border[i], color, width);
+      lines.Segment(border[i], border[(i + 1) % border.size()], width);
+      if (corner[i]) lines.Segment(cam.center(), border[i], width);
     }
   }
   lines.CompositeInto(image);
@@ -362,6 +391,33 @@ void DrawLegend(const std::string& field, double vmin, double vmax, Image* image
   DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by, top, white, scale);
   DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by + bar_h - 5 * scale, bottom, white, scale);
 }
+
+// Cheap necessary conditions of VisibilityTester::TestGeometry's kSeen, tested first: the point
+// faces the camera, lies within its working range, and (for lenses under 180 degrees) in front of
+// it within the normalized-coordinate bounds of the whole (distorted) image. A point failing any of
+// them would fail TestGeometry too, so skipping it changes no result, only the time.
+struct Cull {
+  explicit Cull(const Camera& cam)
+      : center(cam.center()), cfw(cam.camera_from_world()), near2(cam.near * cam.near),
+        far2(cam.far * cam.far), bounds(cam.model.normalized_bounds()),
+        use_bounds(cam.model.max_field_angle() < 0.5 * M_PI) {}
+  bool MaySee(const Vec3& X, const Vec3& n) const {
+    const Vec3 v = center - X;
+    if (n.dot(v) <= 0.0) return false;
+    const double d2 = v.squaredNorm();
+    if (d2 < near2 * (1 - 1e-12) || d2 > far2 * (1 + 1e-12)) return false;
+    if (!use_bounds) return true;
+    const Vec3 p = cfw.linear() * X + cfw.translation();
+    if (p.z() <= 0.0) return false;
+    const double x = p.x() / p.z(), y = p.y() / p.z();
+    return x >= bounds[0] && x <= bounds[1] && y >= bounds[2] && y <= bounds[3];
+  }
+  Vec3 center;
+  Eigen::Isometry3d cfw;
+  double near2, far2;
+  Eigen::Vector4d bounds;
+  bool use_bounds;
+};
 
 struct Buffers {
   std::vector<Vec3> normal;  // centre ray's facing normal (contours)
@@ -438,7 +494,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   image.depth.assign(pixels, std::numeric_limits<float>::infinity());
   image.object.assign(pixels, -1);
   Buffers buffers;
-  buffers.normal.assign(pixels, Vec3::Zero());
+  if (options.surface == Surface::kContours) buffers.normal.assign(pixels, Vec3::Zero());
 
   const int tiles_x = (W + kTile - 1) / kTile, tiles_y = (H + kTile - 1) / kTile;
   const int tiles = tiles_x * tiles_y;
@@ -450,6 +506,10 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   for (int c = 0; c < camera_count; ++c)
     sigma_px[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : options.pixel_sigma;
 
+  const bool need_jacobian = options.layers || options.pattern == Pattern::kGrid;
+  const FrustumCuller culler(rig.cameras);
+  std::vector<Cull> culls;
+  for (const Camera& cam : rig.cameras) culls.emplace_back(cam);
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
     std::vector<Sample> s;
     std::vector<Ray> segments;
@@ -501,18 +561,31 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
         smp.n = hit->normal.dot(smp.d) > 0 ? Vec3(-hit->normal) : hit->normal;
         smp.X = rays.eye() + hit->t * smp.d;
       }
+      // Whole tiles outside a camera's frustum or range skip it (FrustumCuller is conservative).
+      Aabb tile_box;
+      for (const Sample& smp : s)
+        if (smp.hit) tile_box.Extend(smp.X);
+      if (!tile_box.empty()) {
+        tile_box.min.array() -= 2 * lift;
+        tile_box.max.array() += 2 * lift;
+      }
       // Per camera: the geometric tests, then the occlusion segments of the whole tile as packets.
       for (int c = 0; c < camera_count; ++c) {
-        if (!rig.cameras[c].enabled) continue;
+        if (!rig.cameras[c].enabled || tile_box.empty()) continue;
+        if (!culler.MayIntersect(c, tile_box)) continue;
+        const Cull& cull = culls[c];
         segments.clear();
         owner.clear();
         jacobians.clear();
         for (int i = 0; i < int(s.size()); ++i) {
           if (!s[i].hit) continue;
+          const Vec3 X = s[i].X + lift * s[i].n;
+          if (!cull.MaySee(X, s[i].n)) continue;
           Ray seg;
           Mat23 J;
-          const Vec3 X = s[i].X + lift * s[i].n;
-          if (tester.TestGeometry(c, X, &s[i].n, &seg, &J) != ViewResult::kSeen) continue;
+          if (tester.TestGeometry(c, X, &s[i].n, &seg, need_jacobian ? &J : nullptr) !=
+              ViewResult::kSeen)
+            continue;
           if (seg.t_far <= seg.t_near) seg.t_far = seg.t_near;  // at the centre: nothing between
           segments.push_back(seg);
           owner.push_back(i);
@@ -531,8 +604,10 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           const Mat23& J = jacobians[k];
           if (smp.layers) {
             smp.seen |= uint64_t(1) << c;
-            smp.resolution = std::max(smp.resolution, PixelDensity(J));
-            smp.info.Add(J, sigma_px[c]);
+            if (options.layers) {
+              smp.resolution = std::max(smp.resolution, PixelDensity(J));
+              smp.info.Add(J, sigma_px[c]);
+            }
           }
           if (smp.weight == 0) continue;
           double w = 1.0;
@@ -639,7 +714,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
                 StaticFromInformation(smp.info.Decompose(), smp.info.cameras());
             if (u.triangulable) image.sigma_max[p] = float(1e3 * u.sigma_max);
           }
-          buffers.normal[p] = smp.n;
+          if (!buffers.normal.empty()) buffers.normal[p] = smp.n;
         }
       }
     }
@@ -702,7 +777,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   }
 
   if (ov.cameras && rays.perspective()) DrawCameraOverlays(rig, rays.pinhole(), ov, options, &image);
-  if (have_slice) DrawLegend(ov.slice_field, slice.min, slice.max, &image);
+  if (have_slice && ov.legend) DrawLegend(ov.slice_field, slice.min, slice.max, &image);
 
   if (stats) {
     stats->primary_rays = 0;

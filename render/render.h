@@ -70,6 +70,7 @@ struct OverlayOptions {
   double slice_min = std::numeric_limits<double>::quiet_NaN();
   double slice_max = std::numeric_limits<double>::quiet_NaN();
   double slice_opacity = 0.75;
+  bool legend = true;              ///< Draw the slice's colour bar with its range and field name.
   /// Isosurface (needs `fields`): empty = none, else a field name and an iso value; e.g.
   /// "coverage" at 1.5 is the boundary of coverage >= 2, "sigma_max" at 2.0 the 2 mm boundary.
   /// Extracted with OpenVDB's volumeToMesh, ray traced with the scene, alpha-composited.
@@ -93,6 +94,10 @@ struct RenderOptions {
   int samples = 1;             ///< Samples per pixel per axis (samples^2 per pixel, stratified).
   Vec3 background{0.02, 0.02, 0.03};  ///< Linear RGB where no surface is hit.
   OverlayOptions overlays;
+  /// Compute the resolution and sigma_max layers (projection Jacobians and a 3x3 decomposition per
+  /// pixel); when false they stay 0 and +inf. `pandora render` computes them for EXR output only.
+  /// coverage, cameras, depth and object are always filled.
+  bool layers = true;
   /// Study pixel sigma for the sigma_max layer, for cameras without their own (Study::pixel_sigma).
   double pixel_sigma = 0.5;
 };

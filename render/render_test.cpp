@@ -273,8 +273,7 @@ TEST(Render, GridPatternDrawsTheCamerasPixelGridInItsOwnEyeView) {
   options.line_width_px = 1.2;
   options.grid_fill = 0.15;
   const Image img = Render(scene, rig, *caster, view, options);
-  // Tolerance 1e-4: the hit point carries Embree's float round-off and the ray differentials come
-  // from central differences of the unprojection.
+  // Tolerance 1e-4: the hit point carries Embree's float round-off.
   // Output pixel = camera pixel; lines lie on the pixel borders u = 8k - 0.5: the pixels on either
   // side are 0.5 px from a line and get the box-filtered coverage 0.6 + 0.5 - 0.5 = 0.6.
   auto line = [](int u) { return (u % 8 == 0 || u % 8 == 7) ? 0.6 : 0.0; };
