@@ -2,8 +2,9 @@
 /// \file colormap.h
 /// The viridis colour map (perceptually uniform, readable in greyscale and by colour-blind readers)
 /// for field images, surface-sample colours and legends. Piecewise linear in sRGB through nine
-/// evenly spaced stops of matplotlib's viridis table (#440154 ... #fde725); the largest deviation
-/// from the full 256-entry table is a few 8-bit steps, invisible in a figure.
+/// evenly spaced stops of matplotlib's viridis table (#440154 ... #fde725). Against the table's
+/// samples at k/9 (R's viridis(10)) it is within 5 8-bit steps per channel (report_images_test),
+/// invisible in a figure.
 
 #include <algorithm>
 #include <array>
