@@ -88,6 +88,10 @@ browser_check() {
   esac
 }
 
+for tool in chromium xmllint jq base64 od; do
+  command -v "$tool" >/dev/null || { echo "FAIL: $tool is not installed (bash scripts/setup.sh installs it)"; exit 1; }
+done
+
 mode=$1; shift
 case "$mode" in
   run)
