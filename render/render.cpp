@@ -105,21 +105,26 @@ class ViewRays {
   }
 
   // The centre ray of pixel (x, y) and the derivatives of its unit direction per output pixel.
+  // `ddx` and `ddy` may be null when the differentials are not needed.
   bool Center(int x, int y, Vec3* d, Vec3* ddx, Vec3* ddy) const {
     if (!cam_) {
       const Vec3 D = R_.col(2) + ((x - cx_) / f_) * R_.col(0) + ((y - cy_) / f_) * R_.col(1);
       const double len = D.norm();
       *d = D / len;
-      const Vec3 Dx = R_.col(0) / f_, Dy = R_.col(1) / f_;
-      *ddx = (Dx - *d * d->dot(Dx)) / len;
-      *ddy = (Dy - *d * d->dot(Dy)) / len;
+      if (ddx) {
+        const Vec3 Dx = R_.col(0) / f_, Dy = R_.col(1) / f_;
+        *ddx = (Dx - *d * d->dot(Dx)) / len;
+        *ddy = (Dy - *d * d->dot(Dy)) / len;
+      }
       return true;
     }
     const Entry& e = table_[std::size_t(y) * width_ + x];
     if (!e.ok) return false;
     *d = e.d;
-    *ddx = e.dx;
-    *ddy = e.dy;
+    if (ddx) {
+      *ddx = e.dx;
+      *ddy = e.dy;
+    }
     return true;
   }
 
@@ -215,8 +220,6 @@ struct Sample {
   Vec3 X, n;              // hit point and geometric normal facing the eye
   Vec3 light = Vec3::Zero();
   uint64_t seen = 0;
-  double resolution = 0;
-  InformationBuilder info;
 };
 
 // Antialiased 3D line segments with hidden parts dimmed, into an overlay (alpha, colour) buffer that
@@ -507,6 +510,8 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     sigma_px[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : options.pixel_sigma;
 
   const bool need_jacobian = options.layers || options.pattern == Pattern::kGrid;
+  const bool need_differentials =
+      options.pattern == Pattern::kGrid || options.surface == Surface::kHiddenLine;
   const FrustumCuller culler(rig.cameras);
   std::vector<Cull> culls;
   for (const Camera& cam : rig.cameras) culls.emplace_back(cam);
@@ -516,11 +521,17 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::vector<int> owner;
     std::vector<Mat23> jacobians;
     std::vector<uint8_t> occluded;
+    std::vector<double> resolution;        // per pixel of the tile (layers)
+    std::vector<InformationBuilder> info;  // per pixel of the tile (layers)
     for (int tile = r.begin(); tile != r.end(); ++tile) {
       const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
       const int x1 = std::min(W, x0 + kTile), y1 = std::min(H, y0 + kTile);
       const int tw = x1 - x0;
       s.clear();
+      if (options.layers) {
+        resolution.assign(std::size_t(tw) * (y1 - y0), 0.0);
+        info.assign(std::size_t(tw) * (y1 - y0), InformationBuilder());
+      }
       // Samples: the centre ray of each pixel (layers; colour too when samples == 1), then the
       // stratified colour samples.
       for (int y = y0; y < y1; ++y)
@@ -531,9 +542,9 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           c.py = y;
           c.layers = true;
           c.weight = samples == 1 ? 1.0 : 0.0;
-          if (!rays.Center(x, y, &c.d, &c.ddx, &c.ddy)) {
+          if (!rays.Center(x, y, &c.d, need_differentials ? &c.ddx : nullptr,
+                           need_differentials ? &c.ddy : nullptr))
             c.d = Vec3::Zero();
-          }
           s.push_back(c);
           if (samples > 1)
             for (int j = 0; j < samples; ++j)
@@ -605,8 +616,8 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           if (smp.layers) {
             smp.seen |= uint64_t(1) << c;
             if (options.layers) {
-              smp.resolution = std::max(smp.resolution, PixelDensity(J));
-              smp.info.Add(J, sigma_px[c]);
+              resolution[smp.pixel] = std::max(resolution[smp.pixel], PixelDensity(J));
+              info[smp.pixel].Add(J, sigma_px[c]);
             }
           }
           if (smp.weight == 0) continue;
@@ -708,10 +719,10 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           image.object[p] = triangle_object[smp.triangle];
           image.cameras[p] = smp.seen;
           image.coverage[p] = float(__builtin_popcountll(smp.seen));
-          image.resolution[p] = float(smp.resolution);
-          if (smp.info.cameras() >= 2) {
-            const StaticUncertainty u =
-                StaticFromInformation(smp.info.Decompose(), smp.info.cameras());
+          if (options.layers) image.resolution[p] = float(resolution[smp.pixel]);
+          if (options.layers && info[smp.pixel].cameras() >= 2) {
+            const InformationBuilder& b = info[smp.pixel];
+            const StaticUncertainty u = StaticFromInformation(b.Decompose(), b.cameras());
             if (u.triangulable) image.sigma_max[p] = float(1e3 * u.sigma_max);
           }
           if (!buffers.normal.empty()) buffers.normal[p] = smp.n;
@@ -741,7 +752,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           Vec3 dp;
           const int xp = int(p % W), yp = int(p / W);
           Vec3 ddx, ddy;
-          rays.Center(xp, yp, &dp, &ddx, &ddy);
+          rays.Center(xp, yp, &dp, nullptr, nullptr);
           const double predicted = image.depth[p] * n.dot(dp) / denom;
           jump = !(predicted > 0) || std::abs(predicted - image.depth[q]) > 0.05 * image.depth[p];
         } else {
@@ -761,14 +772,14 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
       for (int x = 0; x < W; ++x) {
         const std::size_t p = std::size_t(y) * W + x;
         Vec3 d, ddx, ddy;
-        if (x + 1 < W && rays.Center(x + 1, y, &d, &ddx, &ddy)) edge(p, p + 1, d);
+        if (x + 1 < W && rays.Center(x + 1, y, &d, nullptr, nullptr)) edge(p, p + 1, d);
       }
     });
     tbb::parallel_for(0, H - 1, [&](int y) {
       for (int x = 0; x < W; ++x) {
         const std::size_t p = std::size_t(y) * W + x;
         Vec3 d, ddx, ddy;
-        if (rays.Center(x, y + 1, &d, &ddx, &ddy)) edge(p, p + W, d);
+        if (rays.Center(x, y + 1, &d, nullptr, nullptr)) edge(p, p + W, d);
       }
     });
     for (std::size_t p = 0; p < pixels; ++p)
