@@ -33,6 +33,73 @@ Information DecomposeInformation(const Mat3& J, bool eigenvectors) {
   return info;
 }
 
+namespace {
+
+// One Jacobi rotation zeroing a_pq; r is the third index. Branch-free: a_pq = 0 with a_pp = a_qq
+// gives t = 0 (the denominator's tiny term), no rotation.
+// By value, unlike std::min/max: references to temporaries stop GCC's vectoriser.
+inline double Min(double a, double b) { return a < b ? a : b; }
+inline double Max(double a, double b) { return a > b ? a : b; }
+
+inline void JacobiRotate(double& app, double& aqq, double& apq, double& arp, double& arq) {
+  const double d = aqq - app;
+  const double sign = std::copysign(1.0, d);
+  const double t = sign * 2.0 * apq / (std::abs(d) + std::sqrt(d * d + 4.0 * apq * apq) + 1e-300);
+  const double c = 1.0 / std::sqrt(1.0 + t * t);
+  const double s = t * c;
+  app -= t * apq;
+  aqq += t * apq;
+  apq = 0.0;
+  const double rp = arp, rq = arq;
+  arp = c * rp - s * rq;
+  arq = s * rp + c * rq;
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void JacobiLoop(const double* __restrict xx, const double* __restrict xy, const double* __restrict xz,
+                const double* __restrict yy, const double* __restrict yz, const double* __restrict zz,
+                double* __restrict v0, double* __restrict v1, double* __restrict v2,
+                unsigned char* __restrict converged, std::size_t n) {
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    // Scale by the largest diagonal entry (J is positive semi-definite: that bounds every entry),
+    // so squares neither overflow nor underflow at any scene scale.
+    const double scale = Max(Max(xx[i], yy[i]), Max(zz[i], 1e-300));
+    const double inv = 1.0 / scale;
+    double a00 = xx[i] * inv, a01 = xy[i] * inv, a02 = xz[i] * inv;
+    double a11 = yy[i] * inv, a12 = yz[i] * inv, a22 = zz[i] * inv;
+    // Convergence is quadratic once the rotations are small; five sweeps take any 3x3 from O(1)
+    // off-diagonal entries to round-off, and the check below catches the rest.
+    // (Unrolled so that the outer loop is a single basic block the vectoriser accepts.)
+#pragma GCC unroll 5
+    for (int sweep = 0; sweep < 5; ++sweep) {
+      JacobiRotate(a00, a11, a01, a02, a12);  // (0,1), r = 2
+      JacobiRotate(a00, a22, a02, a01, a12);  // (0,2), r = 1: a_10 -> a01, a_12 -> a12
+      JacobiRotate(a11, a22, a12, a01, a02);  // (1,2), r = 0: a_01 -> a01, a_02 -> a02
+    }
+    const double off = a01 * a01 + a02 * a02 + a12 * a12;
+    const double diag = a00 * a00 + a11 * a11 + a22 * a22;
+    converged[i] = static_cast<unsigned char>(off <= 1e-30 * diag);
+    // Sort: smallest, largest, and the median of three.
+    const double lo = Min(Min(a00, a11), a22);
+    const double hi = Max(Max(a00, a11), a22);
+    const double mid = Max(Min(a00, a11), Min(Max(a00, a11), a22));
+    v0[i] = lo * scale;
+    v1[i] = mid * scale;
+    v2[i] = hi * scale;
+  }
+}
+
+}  // namespace
+
+void SymmetricEigenvalues3(const double* const upper[6], double* const values[3],
+                           unsigned char* converged, std::size_t n) {
+  JacobiLoop(upper[0], upper[1], upper[2], upper[3], upper[4], upper[5], values[0], values[1],
+             values[2], converged, n);
+}
+
 StaticUncertainty StaticFromInformation(const Information& info, int cameras) {
   StaticUncertainty out;
   if (cameras < 2 || !info.observable) return out;
@@ -94,6 +161,39 @@ double SteadyPositionVariance(double q, double T, double r, bool prior) {
   if (prior || !(r < std::numeric_limits<double>::infinity())) return ScalarSteadyState(q, T, r, prior)(0, 0);
   const SteadyTerms t = Terms(q, T, r);
   return t.u * t.s * r;
+}
+
+namespace {
+
+// One function body, compiled for AVX-512, AVX2 and baseline x86-64; the loader picks the best the
+// CPU has. The loop has no branches, so each clone vectorises at its own width.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void SteadyPosteriorLoop(double qT3, const double* r, double* out, std::size_t n) {
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    // Terms() inlined: Lambda, R, w - 2, s, u; then the posterior u s r.
+    const double ri = r[i];
+    const double lambda = std::sqrt(qT3 / ri);
+    const double lambda2_3 = lambda * lambda / 3.0;
+    const double big_r = std::sqrt(lambda2_3 + 16.0);
+    const double w_minus_2 = 0.5 * (lambda + lambda2_3 / (big_r + 4.0));
+    const double w = 2.0 + w_minus_2;
+    const double s = std::sqrt(w_minus_2 * (w + 2.0));
+    out[i] = 2.0 / (w + s) * s * ri;
+  }
+}
+
+}  // namespace
+
+void SteadyPositionVariances(double q, double T, const double* r, double* out, std::size_t n,
+                             bool prior) {
+  if (prior) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = SteadyPositionVariance(q, T, r[i], true);
+    return;
+  }
+  SteadyPosteriorLoop(q * T * T * T, r, out, n);
 }
 
 SteadyUncertainty SteadyFromInformation(const Information& info, int cameras,

@@ -12,6 +12,7 @@
 /// rank 2 (nothing along its viewing ray), so two cameras with distinct centres make it full rank.
 
 #include <array>
+#include <cstddef>
 #include <optional>
 #include <vector>
 
@@ -37,6 +38,18 @@ inline constexpr double kRelativeObservability = 1e-12;
 /// is stiff (smallest over largest eigenvalue below 1e-8), the iterative QL solver, whose small
 /// eigenvalues are more accurate there. With `eigenvectors` false only eigenvalues are computed.
 Information DecomposeInformation(const Mat3& J, bool eigenvectors = true);
+
+/// Eigenvalues of n symmetric 3x3 matrices at once, for the field evaluation's per-block pass.
+/// `upper` holds six arrays of n entries each (xx, xy, xz, yy, yz, zz); `values` receives three
+/// arrays of n (ascending: smallest, middle, largest). Cyclic Jacobi rotations with a fixed number of
+/// sweeps on the matrix scaled by its largest diagonal entry, one branch-free loop vectorised over
+/// the matrices (AVX-512 / AVX2 chosen at run time). Accurate to about 1e-15 of the largest
+/// eigenvalue at every conditioning, double roots included (where the closed form in
+/// DecomposeInformation is good to about sqrt(eps)). `converged[i]` is set to 0 where the
+/// off-diagonal part did not fall below 1e-15 of the diagonal (call DecomposeInformation for those);
+/// values are not clipped.
+void SymmetricEigenvalues3(const double* const upper[6], double* const values[3],
+                           unsigned char* converged, std::size_t n);
 
 /// Accumulates J from per-camera Jacobians and pixel sigmas, then decomposes it.
 class InformationBuilder {
@@ -85,6 +98,13 @@ Eigen::Matrix2d ScalarSteadyState(double q, double T, double r, bool prior = fal
 /// ScalarSteadyState(q, T, r, prior)(0, 0), the position variance alone (m^2); the posterior costs
 /// three square roots and no matrix.
 double SteadyPositionVariance(double q, double T, double r, bool prior = false);
+
+/// SteadyPositionVariance for many finite measurement variances at once: out[i] for r[i] (both m^2,
+/// n entries, out may alias r). The same closed form as one branch-free loop that the compiler
+/// vectorises (AVX-512 or AVX2 where the CPU has them, chosen at run time): the field evaluation
+/// calls it once per block.
+void SteadyPositionVariances(double q, double T, const double* r, double* out, std::size_t n,
+                             bool prior = false);
 
 /// Steady-state uncertainty: per eigen-direction of J the scalar problem above, recombined.
 struct SteadyUncertainty {

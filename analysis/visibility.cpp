@@ -34,11 +34,14 @@ VisibilityTester::VisibilityTester(const std::vector<Camera>& cameras, const Ray
                                    double scene_scale)
     : cameras_(cameras), caster_(caster), epsilon_(kRelativeEpsilon * scene_scale) {
   camera_from_world_.reserve(cameras_.size());
-  for (const Camera& c : cameras_) camera_from_world_.push_back(c.camera_from_world());
+  for (const Camera& c : cameras_) {
+    camera_from_world_.push_back(c.camera_from_world());
+    rotation_.push_back(camera_from_world_.back().linear());
+  }
 }
 
-ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3* normal, Ray* segment,
-                                          Mat23* d_pixel_d_world) const {
+ViewResult VisibilityTester::TestGeometryCameraFrame(int camera, const Vec3& X, const Vec3* normal,
+                                                    Ray* segment, Mat23* d_pixel_d_camera) const {
   const Camera& cam = cameras_[camera];
   if (!cam.enabled) return ViewResult::kDisabled;
   const Vec3 to_point = X - cam.center();
@@ -46,21 +49,10 @@ ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3*
   if (distance < cam.near || distance > cam.far) return ViewResult::kOutOfRange;
   const Eigen::Isometry3d& cfw = camera_from_world_[camera];
   const Vec3 p_camera = cfw.linear() * X + cfw.translation();
-  Mat23 d_pixel_d_camera;
-  const std::optional<Vec2> pixel =
-      cam.model.Project(p_camera, d_pixel_d_world ? &d_pixel_d_camera : nullptr);
+  const std::optional<Vec2> pixel = cam.model.Project(p_camera, d_pixel_d_camera);
   if (!pixel) return ViewResult::kNotProjectable;
   if (!cam.model.InImage(*pixel)) return ViewResult::kOutsideImage;
   if (normal && normal->dot(-to_point) <= 0.0) return ViewResult::kBackFacing;
-  if (d_pixel_d_world) {
-    // d(pixel)/d(world) = d(pixel)/d(camera) R_camera_from_world, written out (hot path).
-    const Mat3& R = cfw.linear();
-    Mat23& out = *d_pixel_d_world;
-    for (int r = 0; r < 2; ++r)
-      for (int c = 0; c < 3; ++c)
-        out(r, c) = d_pixel_d_camera(r, 0) * R(0, c) + d_pixel_d_camera(r, 1) * R(1, c) +
-                    d_pixel_d_camera(r, 2) * R(2, c);
-  }
   if (segment) {
     segment->origin = cam.center();
     segment->direction = to_point / distance;
@@ -68,6 +60,23 @@ ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3*
     segment->t_far = std::max(epsilon_, distance - epsilon_);
   }
   return ViewResult::kSeen;
+}
+
+ViewResult VisibilityTester::TestGeometry(int camera, const Vec3& X, const Vec3* normal, Ray* segment,
+                                          Mat23* d_pixel_d_world) const {
+  Mat23 d_pixel_d_camera;
+  const ViewResult result = TestGeometryCameraFrame(camera, X, normal, segment,
+                                                    d_pixel_d_world ? &d_pixel_d_camera : nullptr);
+  if (result == ViewResult::kSeen && d_pixel_d_world) {
+    // d(pixel)/d(world) = d(pixel)/d(camera) R_camera_from_world, written out (hot path).
+    const Mat3& R = camera_rotation(camera);
+    Mat23& out = *d_pixel_d_world;
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 3; ++c)
+        out(r, c) = d_pixel_d_camera(r, 0) * R(0, c) + d_pixel_d_camera(r, 1) * R(1, c) +
+                    d_pixel_d_camera(r, 2) * R(2, c);
+  }
+  return result;
 }
 
 ViewResult VisibilityTester::Test(int camera, const Vec3& X, const Vec3* normal,

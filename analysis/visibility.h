@@ -53,6 +53,14 @@ class VisibilityTester {
   ViewResult TestGeometry(int camera, const Vec3& X, const Vec3* normal = nullptr,
                           Ray* segment = nullptr, Mat23* d_pixel_d_world = nullptr) const;
 
+  /// TestGeometry with the Jacobian left in the camera frame: `d_pixel_d_camera` receives
+  /// d(pixel)/d(camera-frame point); times camera_rotation(camera) it is d(pixel)/d(world). The
+  /// field evaluation uses this to rotate only the Jacobians of segments that turn out unoccluded.
+  /// Pixel density is rotation invariant: PixelDensity(d_pixel_d_camera) equals the world one.
+  ViewResult TestGeometryCameraFrame(int camera, const Vec3& X, const Vec3* normal, Ray* segment,
+                                     Mat23* d_pixel_d_camera) const;
+  /// R_camera_from_world of camera `camera`.
+  const Mat3& camera_rotation(int camera) const { return rotation_[camera]; }
   /// The full test: TestGeometry, then the occlusion segment against the ray caster.
   ViewResult Test(int camera, const Vec3& X, const Vec3* normal = nullptr,
                   Mat23* d_pixel_d_world = nullptr) const;
@@ -65,6 +73,7 @@ class VisibilityTester {
  private:
   std::vector<Camera> cameras_;
   std::vector<Eigen::Isometry3d> camera_from_world_;
+  std::vector<Mat3> rotation_;  // camera_from_world_[c].linear()
   const RayCaster& caster_;
   double epsilon_;
 };

@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -85,6 +86,7 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
 Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
                       const FieldOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
   if (auto problem = CheckFieldList(options.fields, scene.study.motion.has_value()))
     throw InputError(file, "$.study.fields[" + std::to_string(problem->index) + "]", problem->reason,
@@ -174,12 +176,24 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     // Scratch for the blocks of this TBB range (the information accumulators are 24 KB).
     std::array<Ray, 512> segments;
     std::array<std::int16_t, 512> where;
-    std::array<float, 512> segment_density;
-    std::array<Mat23, 512> segment_jacobian;
+    std::array<Mat23, 512> segment_jacobian;  // camera frame
     std::array<std::uint8_t, 512> occluded;
-    std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2
+    std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2; set by a voxel's first ray
     // Unit directions of the rays that see each voxel, [voxel * cameras + k] (triangulation angle).
     std::vector<Vec3> seen_directions(want_angle ? 512 * camera_count : 0);
+    // Measurement variances (m^2, three per triangulable voxel) and their offsets, for the
+    // block's steady-state pass.
+    std::array<double, 3 * 512> steady_variance;
+    std::array<std::int16_t, 512> steady_offset;
+    // Information matrices of the voxels seen by two or more cameras, as six arrays (xx xy xz yy
+    // yz zz), their eigenvalues as three (ascending), for one vectorised pass per block.
+    std::array<std::array<double, 512>, 6> upper;
+    std::array<std::array<double, 512>, 3> eigenvalue;
+    std::array<unsigned char, 512> converged;
+    std::array<std::int16_t, 512> candidate;
+    const double* upper_ptr[6];
+    for (int k = 0; k < 6; ++k) upper_ptr[k] = upper[k].data();
+    double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
     for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
       const Block& block = blocks[bi];
       BlockResult& res = results[bi];
@@ -190,8 +204,6 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       std::array<std::int32_t, 512> coverage{};
       std::array<std::uint64_t, 512> seen_by{};
       std::array<float, 512> density{};
-      if (want_information)
-        for (auto& row : information) row.fill(0.0);
       if (block.cameras != 0) {
         // Per camera: the geometric tests first, then the surviving segments traced together as
         // coherent packets (one origin, neighbouring directions).
@@ -204,15 +216,21 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                 if (!block.IsFree(x, y, z)) continue;
                 const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
                                                   block.origin.z() + z);
-                Mat23& J = segment_jacobian[n];
-                if (tester.TestGeometry(c, p, nullptr, &segments[n],
-                                        want_jacobian ? &J : nullptr) != ViewResult::kSeen)
+                // The Jacobian stays in the camera frame here: rotating it to the world frame is
+                // left to the segments that turn out unoccluded.
+                if (tester.TestGeometryCameraFrame(c, p, nullptr, &segments[n],
+                                                   want_jacobian ? &segment_jacobian[n] : nullptr) !=
+                    ViewResult::kSeen)
                   continue;
                 where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
-                if (want_resolution) segment_density[n] = static_cast<float>(PixelDensity(J));
                 ++n;
               }
           caster.OccludedPacket(segments.data(), n, occluded.data());
+          // R_camera_from_world row-major (R[3 * row + col]) and the camera's 1/sigma^2.
+          double R[9];
+          for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) R[3 * r + k] = tester.camera_rotation(c)(r, k);
+          const double w = inverse_variance[c];
           res.ray_count += static_cast<std::int64_t>(n);
           if (options.record_rays) res.rays.insert(res.rays.end(), segments.begin(), segments.begin() + n);
           for (std::size_t i = 0; i < n; ++i) {
@@ -222,18 +240,28 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             ++coverage[o];
             seen_by[o] |= std::uint64_t{1} << c;
             ++res.per_camera[c];
-            if (want_resolution) density[o] = std::max(density[o], segment_density[i]);
+            const Mat23& Jc = segment_jacobian[i];  // d pixel / d camera-frame point
+            // Pixel density is rotation invariant: the camera-frame Jacobian gives it directly.
+            if (want_resolution)
+              density[o] = std::max(density[o], static_cast<float>(PixelDensity(Jc)));
             if (want_information) {
-              // J += A^T A / sigma^2, upper triangle only.
-              const Mat23& A = segment_jacobian[i];
-              const double w = inverse_variance[c];
+              // A = Jc R (world frame), then J += A^T A / sigma^2, upper triangle only; written
+              // out in scalars (Eigen's small products were the largest part of this loop).
+              const double a00 = Jc(0, 0) * R[0] + Jc(0, 1) * R[3] + Jc(0, 2) * R[6];
+              const double a01 = Jc(0, 0) * R[1] + Jc(0, 1) * R[4] + Jc(0, 2) * R[7];
+              const double a02 = Jc(0, 0) * R[2] + Jc(0, 1) * R[5] + Jc(0, 2) * R[8];
+              const double a10 = Jc(1, 0) * R[0] + Jc(1, 1) * R[3] + Jc(1, 2) * R[6];
+              const double a11 = Jc(1, 0) * R[1] + Jc(1, 1) * R[4] + Jc(1, 2) * R[7];
+              const double a12 = Jc(1, 0) * R[2] + Jc(1, 1) * R[5] + Jc(1, 2) * R[8];
+              const double add[6] = {w * (a00 * a00 + a10 * a10), w * (a00 * a01 + a10 * a11),
+                                     w * (a00 * a02 + a10 * a12), w * (a01 * a01 + a11 * a11),
+                                     w * (a01 * a02 + a11 * a12), w * (a02 * a02 + a12 * a12)};
+              // The voxel's first ray sets its entry, so the 24 KB array is never cleared.
               std::array<double, 6>& I = information[o];
-              I[0] += w * A.col(0).squaredNorm();
-              I[1] += w * A.col(0).dot(A.col(1));
-              I[2] += w * A.col(0).dot(A.col(2));
-              I[3] += w * A.col(1).squaredNorm();
-              I[4] += w * A.col(1).dot(A.col(2));
-              I[5] += w * A.col(2).squaredNorm();
+              if (coverage[o] == 1)
+                for (int k = 0; k < 6; ++k) I[k] = add[k];
+              else
+                for (int k = 0; k < 6; ++k) I[k] += add[k];
             }
           }
         }
@@ -249,6 +277,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       if (any_seen)
         for (int f = 0; f < kFloatFieldCount; ++f)
           if (want_float[f]) res.floats[f] = new FloatLeaf(origin, 0.0f, false);
+      int steady_count = 0, candidate_count = 0;
       for (int x = 0; x < block.extent.x(); ++x)
         for (int y = 0; y < block.extent.y(); ++y)
           for (int z = 0; z < block.extent.z(); ++z) {
@@ -262,11 +291,25 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (res.floats[kResolution]) res.floats[kResolution]->setValueOn(o, density[o]);
             if (coverage[o] < 2) continue;  // not triangulable: no uncertainty work at all
             if (!want_information) continue;
-            const std::array<double, 6>& I = information[o];
-            Mat3 J;
-            J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-            const Information info = DecomposeInformation(J, /*eigenvectors=*/false);
-            if (!info.observable) {
+            // Gathered for the block's batched eigenvalue pass.
+            for (int k = 0; k < 6; ++k) upper[k][candidate_count] = information[o][k];
+            candidate[candidate_count++] = static_cast<std::int16_t>(o);
+          }
+      if (candidate_count > 0)
+        SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
+      for (int m = 0; m < candidate_count; ++m) {
+            const int o = candidate[m];
+            Vec3 eigenvalues(eigenvalue[0][m], eigenvalue[1][m], eigenvalue[2][m]);
+            if (!converged[m]) {  // never seen in practice; the general solver as a safety net
+              const std::array<double, 6>& I = information[o];
+              Mat3 J;
+              J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+              eigenvalues = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
+            }
+            eigenvalues = eigenvalues.cwiseMax(0.0);
+            const double largest = eigenvalues[2];
+            if (!(largest > 0 && std::isfinite(largest) &&
+                  eigenvalues[0] > kRelativeObservability * largest)) {
               ++res.unobservable;
               continue;
             }
@@ -283,11 +326,13 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                   const double dot = d[i].dot(d[j]);
                   if (dot < min_dot) min_dot = dot, best_i = i, best_j = j;
                 }
-              const double angle =
-                  std::atan2(d[best_i].cross(d[best_j]).norm(), d[best_i].dot(d[best_j]));
-              res.floats[kAngle]->setValueOn(o, static_cast<float>(angle * 180.0 / M_PI));
+              // Single precision suffices for a float grid: |cross| and dot keep their relative
+              // accuracy in float, and atan2f's error (< 1 ulp) is below the grid's rounding.
+              const float angle = std::atan2(static_cast<float>(d[best_i].cross(d[best_j]).norm()),
+                                             static_cast<float>(d[best_i].dot(d[best_j])));
+              res.floats[kAngle]->setValueOn(o, angle * static_cast<float>(180.0 / M_PI));
             }
-            const Vec3 variance = info.eigenvalues.cwiseInverse();  // m^2, descending
+            const Vec3 variance = eigenvalues.cwiseInverse();  // m^2, descending
             const float sigma_max_mm = static_cast<float>(1e3 * std::sqrt(variance[0]));
             res.sigma_max.push_back(sigma_max_mm);
             if (want_float[kSigmaMax]) res.floats[kSigmaMax]->setValueOn(o, sigma_max_mm);
@@ -296,20 +341,29 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                   o, static_cast<float>(1e3 * std::sqrt(variance.sum() / 3.0)));
             if (want_float[kCondition])
               res.floats[kCondition]->setValueOn(
-                  o, static_cast<float>(info.eigenvalues[2] / info.eigenvalues[0]));
+                  o, static_cast<float>(eigenvalues[2] / eigenvalues[0]));
             if (want_steady) {
-              Vec3 steady;
-              for (int k = 0; k < 3; ++k)
-                steady[k] = SteadyPositionVariance(motion.q, frame_period, variance[k],
-                                                   study.steady_prior);
-              const float steady_max = static_cast<float>(1e3 * std::sqrt(steady.maxCoeff()));
-              res.sigma_max_steady.push_back(steady_max);
-              if (want_float[kSigmaMaxSteady]) res.floats[kSigmaMaxSteady]->setValueOn(o, steady_max);
-              if (want_float[kSigmaMeanSteady])
-                res.floats[kSigmaMeanSteady]->setValueOn(
-                    o, static_cast<float>(1e3 * std::sqrt(steady.sum() / 3.0)));
+              // Gathered for one vectorised closed-form pass over the block (below).
+              steady_offset[steady_count] = static_cast<std::int16_t>(o);
+              for (int k = 0; k < 3; ++k) steady_variance[3 * steady_count + k] = variance[k];
+              ++steady_count;
             }
-          }
+      }
+      if (steady_count > 0) {
+        SteadyPositionVariances(motion.q, frame_period, steady_variance.data(),
+                                steady_variance.data(), 3 * steady_count, study.steady_prior);
+        for (int m = 0; m < steady_count; ++m) {
+          const double* v = &steady_variance[3 * m];
+          const int o = steady_offset[m];
+          const float steady_max =
+              static_cast<float>(1e3 * std::sqrt(std::max(v[0], std::max(v[1], v[2]))));
+          res.sigma_max_steady.push_back(steady_max);
+          if (want_float[kSigmaMaxSteady]) res.floats[kSigmaMaxSteady]->setValueOn(o, steady_max);
+          if (want_float[kSigmaMeanSteady])
+            res.floats[kSigmaMeanSteady]->setValueOn(
+                o, static_cast<float>(1e3 * std::sqrt((v[0] + v[1] + v[2]) / 3.0)));
+        }
+      }
       if (res.cameras && res.cameras->isEmpty()) {
         delete res.cameras;
         res.cameras = nullptr;
@@ -375,6 +429,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
       out.recorded_rays.insert(out.recorded_rays.end(), r.rays.begin(), r.rays.end());
   }
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   return out;
 }
 

@@ -57,6 +57,9 @@ struct FieldStats {
   std::int64_t point_camera_tests = 0;  ///< (voxel, camera) pairs decided, culled blocks included.
   std::int64_t rays = 0;                ///< Occlusion segments cast.
   double seconds = 0;                   ///< Wall time of the whole evaluation.
+  /// CPU time of the process during the evaluation (all threads). On a shared machine it is less
+  /// disturbed by other work than the wall time; `pandora bench` prints ratios of both.
+  double cpu_seconds = 0;
   double active_set_seconds = 0;        ///< Of which building the active set.
   double estimated_bytes = 0;           ///< The memory estimate checked against the budget.
 };
