@@ -125,32 +125,57 @@ PointEvaluator::~PointEvaluator() { delete impl_; }
 
 PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) const {
   PointValues v;
-  // J's upper triangle (xx xy xz yy yz zz), summed camera by camera as EvaluateFields does.
+  const VisibilityTester& tester = impl_->tester;
+  // J's upper triangle (xx xy xz yy yz zz), summed camera by camera as EvaluateFields does: the
+  // camera-frame Jacobian Jc gives the pixel density; A = Jc R (R = camera_from_world rotation) in
+  // the same scalar form, then J += A^T A / sigma^2.
   double I[6] = {0, 0, 0, 0, 0, 0};
-  const int cameras = static_cast<int>(impl_->tester.cameras().size());
+  const int cameras = static_cast<int>(tester.cameras().size());
   float best_density = 0;  // the grids store float
   for (int c = 0; c < cameras && c < 64; ++c) {
-    Mat23 A;
-    if (impl_->tester.Test(c, point, normal, &A) != ViewResult::kSeen) continue;
+    Ray segment;
+    Mat23 Jc;
+    if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen) continue;
+    if (segment.t_far > segment.t_near && tester.caster().Occluded(segment)) continue;
     ++v.coverage;
     v.cameras |= std::uint64_t{1} << c;
-    best_density = std::max(best_density, static_cast<float>(PixelDensity(A)));
+    best_density = std::max(best_density, static_cast<float>(PixelDensity(Jc)));
+    const Mat3& R = tester.camera_rotation(c);
+    const double a00 = Jc(0, 0) * R(0, 0) + Jc(0, 1) * R(1, 0) + Jc(0, 2) * R(2, 0);
+    const double a01 = Jc(0, 0) * R(0, 1) + Jc(0, 1) * R(1, 1) + Jc(0, 2) * R(2, 1);
+    const double a02 = Jc(0, 0) * R(0, 2) + Jc(0, 1) * R(1, 2) + Jc(0, 2) * R(2, 2);
+    const double a10 = Jc(1, 0) * R(0, 0) + Jc(1, 1) * R(1, 0) + Jc(1, 2) * R(2, 0);
+    const double a11 = Jc(1, 0) * R(0, 1) + Jc(1, 1) * R(1, 1) + Jc(1, 2) * R(2, 1);
+    const double a12 = Jc(1, 0) * R(0, 2) + Jc(1, 1) * R(1, 2) + Jc(1, 2) * R(2, 2);
     const double w = impl_->inverse_variance[c];
-    I[0] += w * A.col(0).squaredNorm();
-    I[1] += w * A.col(0).dot(A.col(1));
-    I[2] += w * A.col(0).dot(A.col(2));
-    I[3] += w * A.col(1).squaredNorm();
-    I[4] += w * A.col(1).dot(A.col(2));
-    I[5] += w * A.col(2).squaredNorm();
+    I[0] += w * (a00 * a00 + a10 * a10);
+    I[1] += w * (a00 * a01 + a10 * a11);
+    I[2] += w * (a00 * a02 + a10 * a12);
+    I[3] += w * (a01 * a01 + a11 * a11);
+    I[4] += w * (a01 * a02 + a11 * a12);
+    I[5] += w * (a02 * a02 + a12 * a12);
   }
   v.resolution = best_density;
   if (v.coverage < 2) return v;
-  Mat3 J;
-  J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-  const Information info = DecomposeInformation(J, /*eigenvectors=*/false);
-  if (!info.observable) return v;
+  // Eigenvalues as the fields compute them (SymmetricEigenvalues3, the general solver where it did
+  // not converge), clipped at 0, with the same observability rule.
+  const double* upper[6] = {&I[0], &I[1], &I[2], &I[3], &I[4], &I[5]};
+  double e[3];
+  double* values[3] = {&e[0], &e[1], &e[2]};
+  unsigned char converged = 0;
+  SymmetricEigenvalues3(upper, values, &converged, 1);
+  Vec3 eigenvalues(e[0], e[1], e[2]);
+  if (!converged) {
+    Mat3 J;
+    J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+    eigenvalues = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
+  }
+  eigenvalues = eigenvalues.cwiseMax(0.0);
+  const double largest = eigenvalues[2];
+  if (!(largest > 0 && std::isfinite(largest) && eigenvalues[0] > kRelativeObservability * largest))
+    return v;
   v.triangulable = true;
-  v.sigma_max_mm = 1e3 * std::sqrt(1.0 / info.eigenvalues[0]);
+  v.sigma_max_mm = 1e3 * std::sqrt(1.0 / eigenvalues[0]);
   return v;
 }
 

@@ -46,10 +46,11 @@ struct PointValues {
 };
 
 /// Evaluates points the way EvaluateFields evaluates voxel centres: for each camera in rig order the
-/// visibility test (VisibilityTester::Test, with the surface normal when given), the projection
-/// Jacobian A_c, J += A_c^T A_c / sigma_c^2 accumulated in the same order and precision, and the
-/// eigenvalues of J (DecomposeInformation without eigenvectors). At a voxel centre with no normal it
-/// gives the values stored in the grids. Immutable; safe for concurrent use.
+/// visibility rules (VisibilityTester, with the surface normal when given, then the occlusion
+/// segment), the projection Jacobian, J += A_c^T A_c / sigma_c^2 accumulated in the same order and
+/// the same scalar form, and the eigenvalues of J (SymmetricEigenvalues3, as the fields) with the
+/// same observability rule. At a voxel centre with no normal it gives the values stored in the grids
+/// (surface_test checks every voxel). Immutable; safe for concurrent use.
 class PointEvaluator {
  public:
   PointEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster);

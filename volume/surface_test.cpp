@@ -190,6 +190,7 @@ TEST(PointEvaluator, EqualsTheVolumeGridsAtVoxelCentres) {
   auto res = g.Float("resolution")->getConstAccessor();
   auto sig = g.Float("sigma_max")->getConstAccessor();
   std::int64_t checked = 0, triangulable = 0;
+  float worst_resolution = 0, worst_sigma = 0;
   for (auto it = g.coverage->cbeginValueOn(); it; ++it) {
     openvdb::CoordBBox box;
     it.getBoundingBox(box);
@@ -203,14 +204,22 @@ TEST(PointEvaluator, EqualsTheVolumeGridsAtVoxelCentres) {
         continue;
       }
       ASSERT_EQ(v.cameras, static_cast<std::uint64_t>(cams.getValue(c))) << c;
-      ASSERT_EQ(static_cast<float>(v.resolution), res.getValue(c)) << c;
+      // Same maths, stored as float: equal to within 2 float ulps (exactly equal today; the
+      // margin lets the fields' hot loop reorder its arithmetic).
+      const float r = res.getValue(c);
+      worst_resolution = std::max(worst_resolution, std::abs(float(v.resolution) - r) / r);
+      ASSERT_NEAR(float(v.resolution), r, 2.4e-7f * r) << c;
       ASSERT_EQ(v.triangulable, sig.isValueOn(c)) << c;
       if (v.triangulable) {
         ++triangulable;
-        ASSERT_EQ(static_cast<float>(v.sigma_max_mm), sig.getValue(c)) << c;
+        const float g = sig.getValue(c);
+        worst_sigma = std::max(worst_sigma, std::abs(float(v.sigma_max_mm) - g) / g);
+        ASSERT_NEAR(float(v.sigma_max_mm), g, 2.4e-7f * g) << c;
       }
     }
   }
+  std::printf("voxel centres: %lld, largest relative difference resolution %.3g, sigma_max %.3g\n",
+              static_cast<long long>(checked), worst_resolution, worst_sigma);
   EXPECT_EQ(checked, fields.stats.active_set.region_voxels);
   EXPECT_EQ(triangulable, fields.stats.triangulable_voxels);
   EXPECT_GT(triangulable, 1000);
