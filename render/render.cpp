@@ -521,6 +521,9 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::vector<int> owner;
     std::vector<Mat23> jacobians;
     std::vector<uint8_t> occluded;
+    std::vector<Ray> primary;
+    std::vector<int> primary_owner;
+    std::vector<std::optional<RayHit>> primary_hits;
     std::vector<double> resolution;        // per pixel of the tile (layers)
     std::vector<InformationBuilder> info;  // per pixel of the tile (layers)
     for (int tile = r.begin(); tile != r.end(); ++tile) {
@@ -558,14 +561,22 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
                 s.push_back(e);
               }
         }
-      // Primary rays.
-      for (Sample& smp : s) {
-        if (smp.d.squaredNorm() == 0) continue;
-        const Ray ray{rays.eye(), smp.d, 0.0, kInf};
-        if (record) tile_primary[tile].push_back(ray);
-        ++tile_primary_count[tile];
-        const auto hit = caster.Intersect(ray);
+      // Primary rays, a row of the tile at a time as packets.
+      primary.clear();
+      primary_owner.clear();
+      for (int i = 0; i < int(s.size()); ++i) {
+        if (s[i].d.squaredNorm() == 0) continue;
+        primary.push_back(Ray{rays.eye(), s[i].d, 0.0, kInf});
+        primary_owner.push_back(i);
+      }
+      primary_hits.resize(primary.size());
+      caster.IntersectPacket(primary.data(), primary.size(), primary_hits.data());
+      tile_primary_count[tile] += primary.size();
+      if (record) tile_primary[tile].insert(tile_primary[tile].end(), primary.begin(), primary.end());
+      for (std::size_t k = 0; k < primary.size(); ++k) {
+        const auto& hit = primary_hits[k];
         if (!hit) continue;
+        Sample& smp = s[primary_owner[k]];
         smp.hit = true;
         smp.t = hit->t;
         smp.triangle = hit->triangle;
