@@ -437,6 +437,12 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     throw InputError("--size", "", "the image size must be positive");
   if (view.camera >= int(rig.cameras.size()))
     throw InputError("--camera", "", "no camera " + std::to_string(view.camera) + " in the rig");
+  if (view.camera < 0) {
+    if (!(view.fov_deg > 0 && view.fov_deg < 180))
+      throw InputError("--fov", "", "must be in (0, 180) degrees");
+    if (!LookAt(view.from, view.at, view.up))
+      throw InputError("--at", "", "'at' equals 'from', or 'up' is parallel to the viewing direction");
+  }
   if (rig.cameras.size() > 64)
     throw InputError(scene.path, "$.rigs", "the renderer handles at most 64 cameras per rig");
   const int W = view.width, H = view.height;
@@ -468,7 +474,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   std::unique_ptr<RayCaster> iso_caster;
   if (!ov.slice_field.empty() || !ov.iso_field.empty()) {
     if (!fields)
-      throw InputError("--fields-vdb", "", "the slice and isosurface overlays need a fields file",
+      throw InputError("--fields", "", "the slice and isosurface overlays need a fields file",
                        "run `pandora analyze` and pass its fields.vdb");
   }
   if (!ov.slice_field.empty()) {
