@@ -404,16 +404,18 @@ struct Cull {
       : center(cam.center()), cfw(cam.camera_from_world()), near2(cam.near * cam.near),
         far2(cam.far * cam.far), bounds(cam.model.normalized_bounds()),
         use_bounds(cam.model.max_field_angle() < 0.5 * M_PI) {}
-  bool MaySee(const Vec3& X, const Vec3& n) const {
+  inline bool MaySee(const Vec3& X, const Vec3& n) const {
     const Vec3 v = center - X;
     if (n.dot(v) <= 0.0) return false;
     const double d2 = v.squaredNorm();
     if (d2 < near2 * (1 - 1e-12) || d2 > far2 * (1 + 1e-12)) return false;
     if (!use_bounds) return true;
     const Vec3 p = cfw.linear() * X + cfw.translation();
-    if (p.z() <= 0.0) return false;
-    const double x = p.x() / p.z(), y = p.y() / p.z();
-    return x >= bounds[0] && x <= bounds[1] && y >= bounds[2] && y <= bounds[3];
+    const double z = p.z();
+    if (z <= 0.0) return false;
+    // x / z within [bounds[0], bounds[1]] and y / z within [bounds[2], bounds[3]], for z > 0.
+    return p.x() >= bounds[0] * z && p.x() <= bounds[1] * z && p.y() >= bounds[2] * z &&
+           p.y() <= bounds[3] * z;
   }
   Vec3 center;
   Eigen::Isometry3d cfw;
