@@ -16,21 +16,22 @@ void WritePng(const Image& image, const std::string& path) {
   const std::size_t pixels = std::size_t(image.width) * image.height;
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() != 3 * pixels)
     throw std::invalid_argument("WritePng: empty or inconsistent image");
-  // sRGB encoding through a 4096-entry table of the transfer curve (exact to 8 bits).
+  // sRGB encoding through a 65537-entry table of the transfer curve: the table's step (1/65536 in
+  // linear light) moves the encoded value by at most 0.03 codes above 1/256, where it is used;
+  // below, the curve is evaluated directly.
   static const std::vector<uint8_t> table = [] {
-    std::vector<uint8_t> t(4097);
-    for (int i = 0; i <= 4096; ++i)
-      t[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(i / 4096.0)));
+    std::vector<uint8_t> t(65537);
+    for (int i = 0; i <= 65536; ++i)
+      t[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(i / 65536.0)));
     return t;
   }();
   std::vector<uint8_t> bytes(3 * pixels);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     const float v = image.rgb[i];
-    // Below 1/4096 the table would round: encode the linear toe exactly.
-    if (!(v > 0.0f)) bytes[i] = 0;
+    if (!(v > 0.0f)) bytes[i] = 0;  // also NaN
     else if (v >= 1.0f) bytes[i] = 255;
     else if (v < 1.0f / 256) bytes[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(v)));
-    else bytes[i] = table[std::size_t(std::lround(v * 4096.0))];
+    else bytes[i] = table[std::size_t(std::lround(double(v) * 65536.0))];
   }
   png_image png{};
   png.version = PNG_IMAGE_VERSION;

@@ -404,16 +404,18 @@ struct Cull {
       : center(cam.center()), cfw(cam.camera_from_world()), near2(cam.near * cam.near),
         far2(cam.far * cam.far), bounds(cam.model.normalized_bounds()),
         use_bounds(cam.model.max_field_angle() < 0.5 * M_PI) {}
-  bool MaySee(const Vec3& X, const Vec3& n) const {
+  inline bool MaySee(const Vec3& X, const Vec3& n) const {
     const Vec3 v = center - X;
     if (n.dot(v) <= 0.0) return false;
     const double d2 = v.squaredNorm();
     if (d2 < near2 * (1 - 1e-12) || d2 > far2 * (1 + 1e-12)) return false;
     if (!use_bounds) return true;
     const Vec3 p = cfw.linear() * X + cfw.translation();
-    if (p.z() <= 0.0) return false;
-    const double x = p.x() / p.z(), y = p.y() / p.z();
-    return x >= bounds[0] && x <= bounds[1] && y >= bounds[2] && y <= bounds[3];
+    const double z = p.z();
+    if (z <= 0.0) return false;
+    // x / z within [bounds[0], bounds[1]] and y / z within [bounds[2], bounds[3]], for z > 0.
+    return p.x() >= bounds[0] * z && p.x() <= bounds[1] * z && p.y() >= bounds[2] * z &&
+           p.y() <= bounds[3] * z;
   }
   Vec3 center;
   Eigen::Isometry3d cfw;
@@ -437,6 +439,12 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     throw InputError("--size", "", "the image size must be positive");
   if (view.camera >= int(rig.cameras.size()))
     throw InputError("--camera", "", "no camera " + std::to_string(view.camera) + " in the rig");
+  if (view.camera < 0) {
+    if (!(view.fov_deg > 0 && view.fov_deg < 180))
+      throw InputError("--fov", "", "must be in (0, 180) degrees");
+    if (!LookAt(view.from, view.at, view.up))
+      throw InputError("--at", "", "'at' equals 'from', or 'up' is parallel to the viewing direction");
+  }
   if (rig.cameras.size() > 64)
     throw InputError(scene.path, "$.rigs", "the renderer handles at most 64 cameras per rig");
   const int W = view.width, H = view.height;
@@ -468,7 +476,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   std::unique_ptr<RayCaster> iso_caster;
   if (!ov.slice_field.empty() || !ov.iso_field.empty()) {
     if (!fields)
-      throw InputError("--fields-vdb", "", "the slice and isosurface overlays need a fields file",
+      throw InputError("--fields", "", "the slice and isosurface overlays need a fields file",
                        "run `pandora analyze` and pass its fields.vdb");
   }
   if (!ov.slice_field.empty()) {
@@ -521,6 +529,9 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::vector<int> owner;
     std::vector<Mat23> jacobians;
     std::vector<uint8_t> occluded;
+    std::vector<Ray> primary;
+    std::vector<int> primary_owner;
+    std::vector<std::optional<RayHit>> primary_hits;
     std::vector<double> resolution;        // per pixel of the tile (layers)
     std::vector<InformationBuilder> info;  // per pixel of the tile (layers)
     for (int tile = r.begin(); tile != r.end(); ++tile) {
@@ -558,14 +569,22 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
                 s.push_back(e);
               }
         }
-      // Primary rays.
-      for (Sample& smp : s) {
-        if (smp.d.squaredNorm() == 0) continue;
-        const Ray ray{rays.eye(), smp.d, 0.0, kInf};
-        if (record) tile_primary[tile].push_back(ray);
-        ++tile_primary_count[tile];
-        const auto hit = caster.Intersect(ray);
+      // Primary rays, a row of the tile at a time as packets.
+      primary.clear();
+      primary_owner.clear();
+      for (int i = 0; i < int(s.size()); ++i) {
+        if (s[i].d.squaredNorm() == 0) continue;
+        primary.push_back(Ray{rays.eye(), s[i].d, 0.0, kInf});
+        primary_owner.push_back(i);
+      }
+      primary_hits.resize(primary.size());
+      caster.IntersectPacket(primary.data(), primary.size(), primary_hits.data());
+      tile_primary_count[tile] += primary.size();
+      if (record) tile_primary[tile].insert(tile_primary[tile].end(), primary.begin(), primary.end());
+      for (std::size_t k = 0; k < primary.size(); ++k) {
+        const auto& hit = primary_hits[k];
         if (!hit) continue;
+        Sample& smp = s[primary_owner[k]];
         smp.hit = true;
         smp.t = hit->t;
         smp.triangle = hit->triangle;

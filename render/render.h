@@ -66,7 +66,8 @@ struct OverlayOptions {
   /// (NaN: the field's range on the slice); a legend is drawn in the lower right corner.
   std::string slice_field;
   int slice_axis = 2;              ///< 0 x, 1 y, 2 z: the plane is perpendicular to this axis.
-  double slice_position = std::numeric_limits<double>::quiet_NaN();  ///< NaN: region centre.
+  /// Plane position along slice_axis (m); NaN: the middle voxel layer of the field's active voxels.
+  double slice_position = std::numeric_limits<double>::quiet_NaN();
   double slice_min = std::numeric_limits<double>::quiet_NaN();
   double slice_max = std::numeric_limits<double>::quiet_NaN();
   double slice_opacity = 0.75;
@@ -124,8 +125,10 @@ struct Image {
 
 /// Renders `scene` lit by the enabled cameras of `rig`. `caster` must be built from
 /// scene.AllTriangles() (the object index of each triangle is recomputed from the scene).
-/// `fields` (may be null) feeds the slice and isosurface overlays; asking for an overlay of a field
-/// it lacks throws InputError (file "--overlay"). Parallel over image tiles (TBB).
+/// `fields` (may be null) feeds the slice and isosurface overlays. Throws InputError when an overlay
+/// needs fields and there are none (file "--fields"), when the fields lack the grid ("--slice",
+/// "--iso"; the hint lists the grids present), for a bad view ("--size", "--fov", "--at",
+/// "--camera") and for rigs of more than 64 cameras. Parallel over image tiles (TBB).
 Image Render(const Scene& scene, const Rig& rig, const RayCaster& caster, const RenderView& view,
              const RenderOptions& options, const Fields* fields = nullptr);
 
@@ -135,8 +138,9 @@ struct RenderStats {
   std::size_t primary_rays = 0;
   std::size_t shadow_rays = 0;  ///< Occlusion segments cast (after the geometric tests).
 };
-/// Render that also reports stats and, if `rays` is given, records every ray it traced (primary
-/// rays first, then occlusion segments) so a benchmark can replay them through raw Embree.
+/// Render that also reports stats (may be null) and, when `primary` / `shadow` are given, records
+/// every primary ray and every occlusion segment it traced, tile by tile, so a benchmark can replay
+/// them through raw Embree.
 Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caster,
                       const RenderView& view, const RenderOptions& options, const Fields* fields,
                       RenderStats* stats, std::vector<Ray>* primary = nullptr,

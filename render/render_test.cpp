@@ -217,7 +217,12 @@ TEST(Render, OverlappingCamerasSumTheirColoursAndLayersMatchThePerPointComputati
   RenderOptions options = BlackOptions();
   options.brightness = 0.5;
   options.pixel_sigma = 0.4;
-  const Image img = Render(scene, rig, *caster, view, options);
+  const Image rendered = Render(scene, rig, *caster, view, options);
+  // The layers are checked as read back from the EXR file (WriteExr, then OpenEXR's reader).
+  const std::string exr = ::testing::TempDir() + "/two_cameras.exr";
+  WriteExr(rendered, exr, 2);
+  const Image img = ReadExr(exr);
+  ASSERT_EQ(img.width, rendered.width);
   int both = 0;
   for (int y = 0; y < view.height; ++y)
     for (int x = 0; x < view.width; ++x) {
@@ -380,6 +385,102 @@ TEST(Render, HiddenLineDrawsBoxEdgesButNotCoplanarDiagonals) {
     }
   EXPECT_GT(near_edges, 150);
   EXPECT_GT(interior, 1000);
+}
+
+TEST(Render, ContoursOutlineAPlateAboveTheFloor) {
+  Scene scene;
+  scene.objects.push_back(Floor());
+  SceneObject plate;
+  plate.name = "plate";
+  plate.mesh = MakePlane(Vec2(1, 1));
+  for (Vec3& v : plate.mesh.vertices) v.z() += 1.0;
+  scene.objects.push_back(plate);
+  Rig rig;
+  rig.name = "none";
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  RenderView view;
+  view.from = Vec3(0.1, 0.05, 3.0);
+  view.at = Vec3(0.1, 0.05, 0.0);
+  view.up = Vec3(0, 1, 0);
+  view.fov_deg = 60;
+  view.width = 90;
+  view.height = 70;
+  RenderOptions options = BlackOptions();
+  options.surface = Surface::kContours;
+  const Image img = Render(scene, rig, *caster, view, options);
+  // Which object each pixel centre sees, in closed form: the plate where the ray meets z = 1 within
+  // |x|, |y| < 0.5, else the floor. The contour is drawn on the plate's (nearer) pixels that have a
+  // floor pixel among their four neighbours; nothing else is grey (floor and plate are flat and
+  // parallel: no crease, no depth jump within either).
+  auto object = [&](int x, int y, bool* ambiguous) {
+    const Vec3 d = EyeRay(view, x, y);
+    const Vec3 X = view.from + ((1.0 - view.from.z()) / d.z()) * d;
+    const double m = 0.5 - std::max(std::abs(X.x()), std::abs(X.y()));
+    *ambiguous = std::abs(m) < 1e-6;
+    return m > 0 ? 1 : 0;
+  };
+  int outline = 0;
+  for (int y = 1; y + 1 < view.height; ++y)
+    for (int x = 1; x + 1 < view.width; ++x) {
+      bool amb = false, a2 = false;
+      const int o = object(x, y, &amb);
+      bool edge = false;
+      const int n[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+      for (const auto& k : n) {
+        edge |= object(x + k[0], y + k[1], &a2) != o;
+        amb |= a2;
+      }
+      if (amb) continue;
+      const double expected = (o == 1 && edge) ? options.line_grey : 0.0;
+      EXPECT_NEAR(img.Rgb(x, y).x(), expected, 1e-7) << x << "," << y;
+      EXPECT_EQ(img.object[y * view.width + x], o);
+      outline += expected > 0;
+    }
+  EXPECT_GT(outline, 80);
+}
+
+TEST(Render, EmbreeAndTheDoublePrecisionBruteForceCasterGiveTheSameImage) {
+  Scene scene;
+  scene.objects.push_back(Floor());
+  scene.objects.push_back(Sphere(Vec3(0.2, -0.1, 0.6), 0.35, 24));
+  SceneObject box;
+  box.name = "box";
+  box.mesh = MakeBox(Vec3(0.5, 0.3, 0.8));
+  for (Vec3& v : box.mesh.vertices) v += Vec3(-0.6, 0.4, 0.4);
+  scene.objects.push_back(box);
+  Rig rig;
+  rig.name = "three";
+  rig.cameras.push_back(MakeCamera("a", Vec3(1.5, -1.5, 2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 60,
+                                   Vec3(1, 0, 0), LensModel::kBrownConrady, -0.1, 0.01));
+  rig.cameras.push_back(
+      MakeCamera("b", Vec3(-1.5, -1.2, 1.8), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 70, Vec3(0, 1, 0)));
+  rig.cameras.push_back(MakeCamera("c", Vec3(0.2, 1.8, 2.2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 80,
+                                   Vec3(0, 0, 1), LensModel::kFisheye, 0.01));
+  const TriangleMesh all = scene.AllTriangles();
+  const auto embree = MakeEmbreeRayCaster(all);
+  const auto brute = MakeBruteForceRayCaster(all);
+  RenderView view;
+  view.from = Vec3(0.5, -3.0, 2.5);
+  view.at = Vec3(0, 0, 0.4);
+  view.fov_deg = 55;
+  view.width = 80;
+  view.height = 60;
+  for (Pattern pattern : {Pattern::kUniform, Pattern::kGrid}) {
+    RenderOptions options;
+    options.pattern = pattern;
+    options.grid_pixels = 8;
+    const Image a = Render(scene, rig, *embree, view, options);
+    const Image b = Render(scene, rig, *brute, view, options);
+    int same_cameras = 0, close = 0;
+    for (int p = 0; p < a.width * a.height; ++p) {
+      same_cameras += a.cameras[p] == b.cameras[p];
+      const Vec3 d = a.Rgb(p % a.width, p / a.width) - b.Rgb(p % a.width, p / a.width);
+      close += d.cwiseAbs().maxCoeff() < 1e-3;
+    }
+    // Single against double precision: rays through shared edges and silhouettes may differ.
+    EXPECT_GE(same_cameras, a.width * a.height - 12);
+    EXPECT_GE(close, a.width * a.height - 24);
+  }
 }
 
 TEST(Render, ViridisMatchesThePublishedTable) {
