@@ -20,6 +20,11 @@ void RayCaster::OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occl
   for (std::size_t i = 0; i < count; ++i) occluded[i] = Occluded(rays[i]) ? 1 : 0;
 }
 
+void RayCaster::IntersectPacket(const Ray* rays, std::size_t count,
+                                std::optional<RayHit>* hits) const {
+  for (std::size_t i = 0; i < count; ++i) hits[i] = Intersect(rays[i]);
+}
+
 namespace {
 
 class BruteForceRayCaster final : public RayCaster {

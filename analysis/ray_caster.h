@@ -45,6 +45,10 @@ class RayCaster {
   /// voxels): Embree traces them as SIMD packets (16, 8 or 4 wide, whichever the CPU runs natively).
   virtual void OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const;
 
+  /// Intersect() for `count` rays on the calling thread into hits[0..count). Neighbouring rays in the
+  /// array should be coherent (for example, a row of pixels): Embree traces them as SIMD packets.
+  virtual void IntersectPacket(const Ray* rays, std::size_t count, std::optional<RayHit>* hits) const;
+
   /// "embree" or "brute-force".
   virtual const char* name() const = 0;
   /// Number of triangles.
@@ -77,6 +81,12 @@ struct RawOcclusionResult {
 /// from MakeEmbreeRayCaster (throws std::invalid_argument otherwise).
 RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector<Ray>& rays,
                                       RawMode mode = RawMode::kSingle);
+
+/// The same baseline for first-hit queries: a bare TBB loop of rtcIntersect1 (kSingle) or of
+/// native-width packets of consecutive rays (kPacket) over `rays` (converted before the clock starts). In the result, `occluded` counts the rays that hit something. `caster`
+/// must come from MakeEmbreeRayCaster (throws std::invalid_argument otherwise).
+RawOcclusionResult RawEmbreeIntersection(const RayCaster& caster, const std::vector<Ray>& rays,
+                                         RawMode mode = RawMode::kSingle);
 
 /// The packet width OccludedPacket uses on this CPU (16, 8, 4, or 1).
 int EmbreePacketWidth(const RayCaster& caster);

@@ -40,6 +40,30 @@ struct Packet<16> {
   }
 };
 
+template <int W>
+struct HitPacket;
+template <>
+struct HitPacket<4> {
+  using Type = RTCRayHit4;
+  static void Intersect(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcIntersect4(valid, s, c, r);
+  }
+};
+template <>
+struct HitPacket<8> {
+  using Type = RTCRayHit8;
+  static void Intersect(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcIntersect8(valid, s, c, r);
+  }
+};
+template <>
+struct HitPacket<16> {
+  using Type = RTCRayHit16;
+  static void Intersect(const int* valid, RTCScene s, RTCIntersectContext* c, Type* r) {
+    rtcIntersect16(valid, s, c, r);
+  }
+};
+
 // Copies lane `lane` of a packet from a single RTCRay.
 template <typename P>
 void SetLane(P* p, int lane, const RTCRay& r) {
@@ -159,6 +183,56 @@ class EmbreeRayCaster final : public RayCaster {
     }
   }
 
+  void IntersectPacket(const Ray* rays, std::size_t count,
+                       std::optional<RayHit>* hits) const override {
+    switch (packet_width_) {
+      case 16: return IntersectPackets<16>(rays, count, hits);
+      case 8: return IntersectPackets<8>(rays, count, hits);
+      case 4: return IntersectPackets<4>(rays, count, hits);
+      default: RayCaster::IntersectPacket(rays, count, hits);
+    }
+  }
+
+  // First hits of already converted rays in packets of W; calls out(index, packet, lane) per ray.
+  template <int W, typename Out>
+  void IntersectConverted(const RTCRay* rays, std::size_t count, Out&& out) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(64) typename HitPacket<W>::Type packet;
+    alignas(64) int valid[W];
+    for (std::size_t start = 0; start < count; start += W) {
+      const int n = static_cast<int>(std::min<std::size_t>(W, count - start));
+      for (int lane = 0; lane < W; ++lane) {
+        valid[lane] = lane < n ? -1 : 0;
+        SetLane(&packet.ray, lane, rays[start + std::min(lane, n - 1)]);
+        packet.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.primID[lane] = RTC_INVALID_GEOMETRY_ID;
+      }
+      HitPacket<W>::Intersect(valid, scene_, &context, &packet);
+      for (int lane = 0; lane < n; ++lane) out(start + lane, packet, lane);
+    }
+  }
+
+  template <int W>
+  void IntersectPackets(const Ray* rays, std::size_t count, std::optional<RayHit>* hits) const {
+    constexpr std::size_t kChunk = 256;
+    RTCRay converted[kChunk];
+    for (std::size_t start = 0; start < count; start += kChunk) {
+      const std::size_t n = std::min(kChunk, count - start);
+      for (std::size_t i = 0; i < n; ++i) Fill(rays[start + i], &converted[i]);
+      IntersectConverted<W>(converted, n, [&](std::size_t i, const auto& p, int lane) {
+        std::optional<RayHit>& h = hits[start + i];
+        if (p.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID) {
+          h.reset();
+          return;
+        }
+        h = RayHit{p.ray.tfar[lane], static_cast<int>(p.hit.primID[lane]),
+                   Vec3(p.hit.Ng_x[lane], p.hit.Ng_y[lane], p.hit.Ng_z[lane]).normalized()};
+      });
+    }
+  }
+
   int packet_width() const { return packet_width_; }
   const char* name() const override { return "embree"; }
   std::size_t triangle_count() const override { return triangles_; }
@@ -260,6 +334,48 @@ RawOcclusionResult RawEmbreeOcclusion(const RayCaster& caster, const std::vector
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return RawOcclusionResult{seconds, rays.size(), occluded};
+}
+
+RawOcclusionResult RawEmbreeIntersection(const RayCaster& caster, const std::vector<Ray>& rays,
+                                         RawMode mode) {
+  const auto* embree = dynamic_cast<const EmbreeRayCaster*>(&caster);
+  if (!embree) throw std::invalid_argument("RawEmbreeIntersection needs an Embree ray caster");
+  std::vector<RTCRay> converted(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) embree->Fill(rays[i], &converted[i]);
+  const RTCScene scene = embree->scene();
+  const int width = mode == RawMode::kPacket ? embree->packet_width() : 1;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t hits = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, converted.size(), 1024), std::size_t{0},
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t count) {
+        if (width > 1) {
+          const RTCRay* first = converted.data() + r.begin();
+          auto tally = [&](std::size_t, const auto& p, int lane) {
+            count += p.hit.geomID[lane] != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+          };
+          switch (width) {
+            case 16: embree->IntersectConverted<16>(first, r.size(), tally); break;
+            case 8: embree->IntersectConverted<8>(first, r.size(), tally); break;
+            default: embree->IntersectConverted<4>(first, r.size(), tally); break;
+          }
+          return count;
+        }
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRayHit rh;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          rh.ray = converted[i];
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scene, &context, &rh);
+          count += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        return count;
+      },
+      [](std::size_t a, std::size_t b) { return a + b; });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return RawOcclusionResult{seconds, rays.size(), hits};
 }
 
 }  // namespace pandora

@@ -120,5 +120,44 @@ TEST(RayCaster, BatchAndRawLoopMatchSingleQueries) {
   EXPECT_THROW(RawEmbreeOcclusion(*MakeBruteForceRayCaster(mesh), rays), std::invalid_argument);
 }
 
+TEST(RayCaster, IntersectPacketMatchesSingleQueriesAndBruteForce) {
+  std::mt19937_64 rng(11);
+  const TriangleMesh mesh = testing::RandomScene(rng, 1.0, Vec3::Zero(), 30, 30);
+  const auto embree = MakeEmbreeRayCaster(mesh);
+  const auto brute = MakeBruteForceRayCaster(mesh);
+  std::uniform_real_distribution<double> u(0, 1);
+  // Coherent rays from one eye through a grid (as a renderer's rows), plus an odd count so the last
+  // packet is partly filled.
+  std::vector<Ray> rays;
+  const Vec3 eye(-0.5, 0.5, 0.5);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 43; ++x) {
+      const Vec3 target(1.5, x / 42.0, y / 39.0);
+      rays.push_back(Ray{eye, (target - eye).normalized(), 0.0, 10.0});
+    }
+  std::vector<std::optional<RayHit>> packet(rays.size()), reference(rays.size());
+  embree->IntersectPacket(rays.data(), rays.size(), packet.data());
+  brute->IntersectPacket(rays.data(), rays.size(), reference.data());
+  std::size_t hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const auto single = embree->Intersect(rays[i]);
+    ASSERT_EQ(packet[i].has_value(), single.has_value()) << i;
+    ASSERT_EQ(reference[i].has_value(), single.has_value()) << i;
+    if (!single) continue;
+    ++hits;
+    EXPECT_EQ(packet[i]->triangle, single->triangle);
+    EXPECT_NEAR(packet[i]->t, single->t, 1e-6);
+    EXPECT_LT((packet[i]->normal - single->normal).norm(), 1e-6);
+    EXPECT_EQ(reference[i]->triangle, single->triangle);
+    EXPECT_NEAR(reference[i]->t, single->t, 1e-5);
+  }
+  EXPECT_GT(hits, rays.size() / 4);
+  const RawOcclusionResult raw = RawEmbreeIntersection(*embree, rays);
+  const RawOcclusionResult raw_packets = RawEmbreeIntersection(*embree, rays, RawMode::kPacket);
+  EXPECT_EQ(raw.occluded, hits);
+  EXPECT_EQ(raw_packets.occluded, hits);
+  EXPECT_THROW(RawEmbreeIntersection(*brute, rays), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace pandora

@@ -20,6 +20,7 @@
 namespace pandora::app {
 
 int RunBench(const BenchArgs& args) {
+  if (args.render) return RunRenderBench(args);
   Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
   if (!std::isnan(args.voxel_size))

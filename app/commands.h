@@ -5,6 +5,7 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace pandora::app {
 
@@ -32,7 +33,14 @@ struct BenchArgs {
   double voxel_size = kUnset;
   int repeat = 3;
   std::string json_out;
+  /// `--render`: time the renderer instead of the fields (bench_render.cpp).
+  bool render = false;
+  std::string view;               ///< Named view; empty: the scene's first view.
+  std::string size = "1280x720";  ///< Image size.
 };
+/// `pandora bench --render`: Render() against raw Embree loops over the very same primary rays
+/// (rtcIntersect1) and occlusion segments (rtcOccluded packets and single rays), same run.
+int RunRenderBench(const BenchArgs& args);
 int RunBench(const BenchArgs& args);
 
 /// `pandora accuracy`: error against run time (issue 3, point 6) for (a) voxel size against the
@@ -46,5 +54,59 @@ struct AccuracyArgs {
   bool quick = false;  ///< Fewer voxel sizes, trials and sample points (tests).
 };
 int RunAccuracy(const AccuracyArgs& args);
+
+/// `pandora render`: the scene lit by the rig's cameras as projectors (render/render.h). One
+/// viewpoint: a named view, --from/--at, or a camera's own eye (--camera ID).
+struct RenderArgs {
+  std::string scene;
+  std::string rig;
+  std::string view;            ///< Name in the scene's "views".
+  std::string from, at, up;    ///< "X,Y,Z" each.
+  std::string camera;          ///< Camera id: render what that camera images.
+  double fov = kUnset;         ///< Horizontal field of view, degrees.
+  std::string size;            ///< "WxH"; empty: 1280x720, or the camera's resolution with --camera.
+  std::string out = "render.png";
+  std::string pattern = "uniform";   ///< uniform | grid
+  std::string surface = "material";  ///< material | black | hidden-line | contours
+  double brightness = kUnset;
+  int grid = 32;
+  int samples = 1;
+  bool no_cameras = false;
+  std::string fields;          ///< fields.vdb for the overlays.
+  std::string slice;           ///< Field shown on a slice plane.
+  std::string slice_axis = "z";
+  double slice_at = kUnset;
+  std::string iso;             ///< Field whose isosurface is drawn.
+  double iso_value = kUnset;
+  bool quiet = false;
+};
+int RunRender(const RenderArgs& args);
+
+/// `pandora export-surface`: the scene's surfaces sampled every `spacing` metres (area-weighted,
+/// deterministic), each sample with coverage, resolution and sigma_max for `rig`, written as a binary
+/// PLY point cloud (volume/surface.h, docs/report.md).
+struct ExportSurfaceArgs {
+  std::string scene;
+  std::string rig;
+  double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
+  std::string out;        ///< The .ply file.
+  unsigned long long seed = 1;
+  bool quiet = false;
+};
+int RunExportSurface(const ExportSurfaceArgs& args);
+
+/// `pandora report`: one self-contained HTML file (DIR/report.html) with renders, field slices,
+/// histograms, the camera table and the summary numbers, the rigs side by side (docs/report.md).
+struct ReportArgs {
+  std::string scene;
+  std::vector<std::string> rigs;  ///< Names (each may be comma-separated); empty: every rig.
+  std::string out = "report";
+  double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
+  int width = 640;                ///< Pixels across the renders from the named views.
+  int camera_width = 320;         ///< Pixels across each camera's own view.
+  double brightness = 1.0;        ///< Scale of every camera's light in the renders.
+  bool quiet = false;
+};
+int RunReport(const ReportArgs& args);
 
 }  // namespace pandora::app

@@ -40,6 +40,10 @@ int main(int argc, char** argv) {
   b->add_option("--voxel-size", bench.voxel_size, "Voxel size in metres (default: study.voxel_size)");
   b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")->check(CLI::PositiveNumber);
   b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
+  b->add_flag("--render", bench.render,
+              "Time `pandora render` (1280x720) against raw Embree loops over the same primary and shadow rays");
+  b->add_option("--view", bench.view, "With --render: the named view (default: the scene's first view)");
+  b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
   b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
 
   AccuracyArgs accuracy;
@@ -50,6 +54,60 @@ int main(int argc, char** argv) {
   acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
   acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+
+  RenderArgs render;
+  CLI::App* rn = app.add_subcommand(
+      "render", "Render the scene lit by every enabled camera as a projector of its own colour (PNG or EXR)");
+  rn->add_option("scene", render.scene, "Scene file (JSON)")->required();
+  rn->add_option("--rig", render.rig, "Rig name (default: the first rig)");
+  rn->add_option("--view", render.view, "Named view from the scene's \"views\"");
+  rn->add_option("--from", render.from, "Eye position X,Y,Z (with --at)");
+  rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
+  rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");
+  rn->add_option("--camera", render.camera, "Render what this camera (id) images, distortion included");
+  rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)");
+  rn->add_option("--size", render.size, "Image size WxH (default 1280x720; the camera's with --camera)");
+  rn->add_option("--out", render.out, "Output image: FILE.png or FILE.exr")->capture_default_str();
+  rn->add_option("--pattern", render.pattern, "uniform | grid (each camera's pixel grid)")->capture_default_str();
+  rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")->capture_default_str();
+  rn->add_option("--surface", render.surface, "material | black | hidden-line | contours")->capture_default_str();
+  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default 1)");
+  rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")->capture_default_str();
+  rn->add_flag("--no-cameras", render.no_cameras, "Do not draw the camera bodies and frusta");
+  rn->add_option("--fields", render.fields, "fields.vdb from `pandora analyze`, for --slice and --iso");
+  rn->add_option("--slice", render.slice, "Show this field on a slice plane (viridis, with a legend)");
+  rn->add_option("--slice-axis", render.slice_axis, "x | y | z: the slice plane's normal")->capture_default_str();
+  rn->add_option("--slice-at", render.slice_at, "Slice position along its axis in metres (default: the middle)");
+  rn->add_option("--iso", render.iso, "Draw the isosurface of this field");
+  rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)");
+  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
+
+  ExportSurfaceArgs surface;
+  CLI::App* es = app.add_subcommand(
+      "export-surface", "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
+  es->add_option("scene", surface.scene, "Scene file (JSON)")->required();
+  es->add_option("--rig", surface.rig, "Rig name (default: the first rig)");
+  es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
+  es->add_option("--out", surface.out, "Output PLY file")->required();
+  es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
+  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
+
+  ReportArgs report;
+  CLI::App* rep = app.add_subcommand(
+      "report", "One self-contained HTML report: renders, field slices, histograms, cameras, rigs side by side");
+  rep->add_option("scene", report.scene, "Scene file (JSON)")->required();
+  rep->add_option("--rig", report.rigs, "Rig name(s), repeatable or comma-separated (default: every rig)");
+  rep->add_option("--out", report.out, "Output folder (report.html is written there)")->capture_default_str();
+  rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)");
+  rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")
+      ->capture_default_str();
+  rep->add_option("--camera-width", report.camera_width, "Width in pixels of each camera's own view")
+      ->capture_default_str();
+  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders")->capture_default_str();
+  rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
 
   try {
     app.parse(argc, argv);
@@ -66,6 +124,9 @@ int main(int argc, char** argv) {
     if (*a) return RunAnalyze(analyze);
     if (*b) return RunBench(bench);
     if (*acc) return RunAccuracy(accuracy);
+    if (*rn) return RunRender(render);
+    if (*es) return RunExportSurface(surface);
+    if (*rep) return RunReport(report);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;

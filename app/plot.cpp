@@ -1,5 +1,7 @@
 #include "app/plot.h"
 
+#include "volume/colormap.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -263,4 +265,198 @@ std::string RenderLogLogSvg(const LogLogPlot& plot) {
   return o.str();
 }
 
+
+std::vector<double> NiceTicks(double max, int count) {
+  if (!(max > 0) || !std::isfinite(max)) return {0.0, 1.0};
+  const double raw = max / std::max(1, count);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = power;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * power >= raw * (1 - 1e-9)) {
+      step = m * power;
+      break;
+    }
+  std::vector<double> ticks;
+  for (int k = 0; k * step <= max * (1 + 1e-9) || ticks.size() < 2; ++k) ticks.push_back(k * step);
+  if (ticks.back() < max * (1 - 1e-9)) ticks.push_back(ticks.back() + step);
+  return ticks;
+}
+
+namespace {
+
+// Tick label: up to 3 significant digits, or a percentage.
+std::string TickLabel(double v, bool percent) {
+  char b[32];
+  if (percent)
+    std::snprintf(b, sizeof b, "%g%%", std::round(v * 1e5) / 1e3);
+  else
+    std::snprintf(b, sizeof b, "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return b;
+}
+
+std::string SvgHeader(int width, int height) {
+  std::ostringstream o;
+  o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+    << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << width
+    << "\" height=\"" << height << "\" viewBox=\"0 0 " << width << " " << height
+    << "\" font-family=\"DejaVu Sans, Arial, Helvetica, sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  return o.str();
+}
+
+}  // namespace
+
+std::string RenderBarChartSvg(const BarChart& chart) {
+  const std::size_t n = chart.categories.size();
+  double data_max = 0;
+  for (const BarSeries& s : chart.series)
+    for (double v : s.values)
+      if (std::isfinite(v)) data_max = std::max(data_max, v);
+  const double y_top_value = std::isfinite(chart.y_max) && chart.y_max > 0 ? chart.y_max : data_max;
+  const std::vector<double> ticks = NiceTicks(y_top_value > 0 ? y_top_value : 1.0);
+  const double y_top = ticks.back();
+  const bool legend = chart.series.size() > 1;
+  const double W = chart.width, H = chart.height;
+  const double left = 64, right = W - (legend ? 130 : 16), top = 40;
+  const double bottom = H - (chart.note.empty() ? 58 : 74);
+  auto py = [&](double y) { return bottom - std::min(y, y_top) / y_top * (bottom - top); };
+
+  std::ostringstream o;
+  o << SvgHeader(chart.width, chart.height);
+  o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"22\" text-anchor=\"middle\" "
+    << "font-size=\"14\" font-weight=\"bold\">" << Escape(chart.title) << "</text>\n";
+  o << "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
+  for (double t : ticks)
+    o << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(py(t)) << "\" x2=\"" << Num(right)
+      << "\" y2=\"" << Num(py(t)) << "\"/>\n";
+  o << "</g>\n<g text-anchor=\"end\" fill=\"#333\">\n";
+  for (double t : ticks)
+    o << "<text x=\"" << Num(left - 6) << "\" y=\"" << Num(py(t) + 4) << "\">"
+      << TickLabel(t, chart.percent) << "</text>\n";
+  o << "</g>\n";
+  if (n == 0) {
+    o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num((top + bottom) / 2)
+      << "\" text-anchor=\"middle\" fill=\"#888\">no data</text>\n";
+  } else {
+    const double bin = (right - left) / n;
+    const std::size_t k = std::max<std::size_t>(1, chart.series.size());
+    const double gap = std::min(0.15 * bin, 6.0);
+    const double bar = (bin - 2 * gap) / k;
+    for (std::size_t si = 0; si < chart.series.size(); ++si) {
+      const BarSeries& s = chart.series[si];
+      const std::string color = s.color.empty() ? kColors[si % kColorCount] : s.color;
+      o << "<g fill=\"" << Escape(color) << "\">\n";
+      for (std::size_t i = 0; i < n && i < s.values.size(); ++i) {
+        const double v = s.values[i];
+        if (!std::isfinite(v) || v <= 0) continue;
+        const double x = left + i * bin + gap + si * bar;
+        o << "<rect x=\"" << Num(x) << "\" y=\"" << Num(py(v)) << "\" width=\""
+          << Num(std::max(bar - 1, 0.5)) << "\" height=\"" << Num(bottom - py(v)) << "\"/>\n";
+      }
+      o << "</g>\n";
+    }
+    // Category labels: every one when they fit (about 7 px per character), else thinned.
+    std::size_t longest = 1;
+    for (const std::string& c : chart.categories) longest = std::max(longest, c.size());
+    const std::size_t every =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil((longest * 7.0 + 6) / bin)));
+    o << "<g text-anchor=\"middle\" fill=\"#333\">\n";
+    for (std::size_t i = 0; i < n; i += every)
+      o << "<text x=\"" << Num(left + (i + (chart.edge_labels ? 0.0 : 0.5)) * bin) << "\" y=\""
+        << Num(bottom + 16) << "\">"
+        << Escape(chart.categories[i]) << "</text>\n";
+    o << "</g>\n";
+    if (std::isfinite(chart.marker)) {
+      const double x = left + std::clamp(chart.marker, 0.0, double(n)) * bin;
+      o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(x) << "\" y2=\""
+        << Num(bottom) << "\" stroke=\"#d62728\" stroke-width=\"1.5\" stroke-dasharray=\"5,4\"/>\n"
+        << "<text x=\"" << Num(x + 4) << "\" y=\"" << Num(top + 12) << "\" fill=\"#d62728\">"
+        << Escape(chart.marker_label) << "</text>\n";
+    }
+  }
+  o << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(bottom) << "\" x2=\"" << Num(right)
+    << "\" y2=\"" << Num(bottom) << "\" stroke=\"#333\"/>\n"
+    << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(left) << "\" y2=\""
+    << Num(bottom) << "\" stroke=\"#333\"/>\n";
+  o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(bottom + 36)
+    << "\" text-anchor=\"middle\">" << Escape(chart.x_label) << "</text>\n";
+  if (!chart.note.empty())
+    o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(bottom + 54)
+      << "\" text-anchor=\"middle\" font-size=\"10\" fill=\"#666\">" << Escape(chart.note)
+      << "</text>\n";
+  o << "<text transform=\"translate(16," << Num((top + bottom) / 2)
+    << ") rotate(-90)\" text-anchor=\"middle\">" << Escape(chart.y_label) << "</text>\n";
+  if (legend) {
+    double y = top + 6;
+    for (std::size_t si = 0; si < chart.series.size(); ++si, y += 20) {
+      const std::string color =
+          chart.series[si].color.empty() ? kColors[si % kColorCount] : chart.series[si].color;
+      o << "<rect x=\"" << Num(right + 14) << "\" y=\"" << Num(y) << "\" width=\"12\" height=\"12\" "
+        << "fill=\"" << Escape(color) << "\"/><text x=\"" << Num(right + 32) << "\" y=\""
+        << Num(y + 11) << "\">" << Escape(chart.series[si].label) << "</text>\n";
+    }
+  }
+  o << "</svg>\n";
+  return o.str();
+}
+
+std::string RenderColorbarSvg(const Colorbar& bar) {
+  const double W = bar.width;
+  const double left = 14, top = 24, height = 16;
+  // Swatches take the right part: about 8 px per character plus the box.
+  double swatch_width = 0;
+  for (const auto& s : bar.swatches) swatch_width += 28 + 6.5 * s.second.size();
+  const double right = std::max(left + 120, W - 14 - swatch_width);
+  const double span = bar.max - bar.min;
+  std::ostringstream o;
+  o << SvgHeader(bar.width, bar.height);
+  o << "<text x=\"" << Num(left) << "\" y=\"16\" font-weight=\"bold\">" << Escape(bar.label)
+    << "</text>\n";
+  std::vector<double> ticks;
+  if (bar.discrete) {
+    const int lo = static_cast<int>(std::lround(bar.min)), hi = static_cast<int>(std::lround(bar.max));
+    const int count = std::max(1, hi - lo + 1);
+    const double w = (right - left) / count;
+    for (int k = 0; k < count; ++k) {
+      const double t = count > 1 ? double(k) / (count - 1) : 1.0;
+      o << "<rect x=\"" << Num(left + k * w) << "\" y=\"" << Num(top) << "\" width=\"" << Num(w)
+        << "\" height=\"" << Num(height) << "\" fill=\"" << HexColor(Viridis(t)).data() << "\"/>\n";
+      o << "<text x=\"" << Num(left + (k + 0.5) * w) << "\" y=\"" << Num(top + height + 14)
+        << "\" text-anchor=\"middle\" fill=\"#333\">" << (lo + k) << "</text>\n";
+    }
+  } else {
+    o << "<defs><linearGradient id=\"ramp\" x1=\"0\" x2=\"1\" y1=\"0\" y2=\"0\">\n";
+    for (int k = 0; k <= 16; ++k)
+      o << "<stop offset=\"" << Num(k / 16.0) << "\" stop-color=\"" << HexColor(Viridis(k / 16.0)).data()
+        << "\"/>\n";
+    o << "</linearGradient></defs>\n<rect x=\"" << Num(left) << "\" y=\"" << Num(top)
+      << "\" width=\"" << Num(right - left) << "\" height=\"" << Num(height)
+      << "\" fill=\"url(#ramp)\" stroke=\"#333\" stroke-width=\"0.5\"/>\n";
+    const double step_max = span > 0 ? span : 1.0;
+    for (double t : NiceTicks(step_max, 4)) {
+      if (t > span * (1 + 1e-9)) break;
+      const double x = left + (span > 0 ? t / span : 0) * (right - left);
+      const bool last = bar.max_is_open && std::abs(t - span) < 1e-9 * std::max(1.0, span);
+      o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top + height) << "\" x2=\"" << Num(x)
+        << "\" y2=\"" << Num(top + height + 4) << "\" stroke=\"#333\"/>\n"
+        << "<text x=\"" << Num(x) << "\" y=\"" << Num(top + height + 16)
+        << "\" text-anchor=\"middle\" fill=\"#333\">" << (last ? "\u2265" : "")
+        << TickLabel(bar.min + t, false) << "</text>\n";
+    }
+    if (bar.max_is_open && span > 0 && std::abs(NiceTicks(span, 4).back() - span) > 1e-9 * span)
+      o << "<text x=\"" << Num(right) << "\" y=\"" << Num(top - 4)
+        << "\" text-anchor=\"end\" font-size=\"10\" fill=\"#333\">\u2265" << TickLabel(bar.max, false)
+        << " in the top colour</text>\n";
+  }
+  double x = right + 14;
+  for (const auto& [color, label] : bar.swatches) {
+    o << "<rect x=\"" << Num(x) << "\" y=\"" << Num(top) << "\" width=\"16\" height=\""
+      << Num(height) << "\" fill=\"" << Escape(color) << "\" stroke=\"#333\" stroke-width=\"0.5\"/>"
+      << "<text x=\"" << Num(x + 20) << "\" y=\"" << Num(top + 12) << "\">" << Escape(label)
+      << "</text>\n";
+    x += 28 + 6.5 * label.size();
+  }
+  o << "</svg>\n";
+  return o.str();
+}
 }  // namespace pandora::app

@@ -5,7 +5,9 @@
 /// lines. No dependencies; the output is a standalone SVG 1.1 document that browsers, GitHub and
 /// Inkscape display.
 
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pandora::app {
@@ -45,5 +47,53 @@ struct LogLogPlot {
 /// Renders `plot` as an SVG document (UTF-8 text). Text is XML-escaped. With no plottable point the
 /// axes span 1 to 10 and the plot says "no data".
 std::string RenderLogLogSvg(const LogLogPlot& plot);
+
+/// One series of a bar chart: a value per category.
+struct BarSeries {
+  std::string label;           ///< Legend entry (no legend when there is one series).
+  std::vector<double> values;  ///< One per category; non-finite values draw no bar.
+  std::string color;           ///< Empty: the palette's colour for the series' index.
+};
+
+/// A bar chart on a linear y axis from 0: categories along x (bins), the series' bars side by side
+/// within each category.
+struct BarChart {
+  std::string title;
+  std::string x_label, y_label;
+  std::string note;                     ///< Small text under the x axis label.
+  std::vector<std::string> categories;  ///< Labels under the bars; thinned to fit when many.
+  std::vector<BarSeries> series;
+  double y_max = std::numeric_limits<double>::quiet_NaN();  ///< NaN: from the data.
+  bool percent = false;                 ///< Tick labels as percentages of 1 (0.25 -> "25%").
+  /// Category labels at the left edge of their bar (bins of a continuous value, labelled by their
+  /// lower bound) instead of under its centre.
+  bool edge_labels = false;
+  /// A vertical dashed line at a position in category units (0 = left edge of the first bin,
+  /// categories.size() = right edge of the last); NaN: none.
+  double marker = std::numeric_limits<double>::quiet_NaN();
+  std::string marker_label;
+  int width = 560, height = 320;
+};
+
+/// Renders `chart` as a standalone SVG document. With no category the plot says "no data".
+std::string RenderBarChartSvg(const BarChart& chart);
+
+/// A horizontal colour bar legend for a viridis-coloured image (volume/colormap.h): the ramp from
+/// `min` to `max` with ticks, the label (quantity and unit), and swatches for the special colours.
+struct Colorbar {
+  std::string label;   ///< E.g. "sigma_max (mm)".
+  double min = 0, max = 1;
+  /// Whole numbers from min to max in equal steps (coverage): one box per value instead of a ramp.
+  bool discrete = false;
+  bool max_is_open = false;  ///< Values above max are drawn in the max colour: label it ">= max".
+  std::vector<std::pair<std::string, std::string>> swatches;  ///< (colour "#rrggbb", label).
+  int width = 420, height = 74;
+};
+
+/// Renders `bar` as a standalone SVG document.
+std::string RenderColorbarSvg(const Colorbar& bar);
+
+/// "Nice" axis ticks (1, 2 or 5 times a power of ten) covering [0, max], about `count` of them.
+std::vector<double> NiceTicks(double max, int count = 5);
 
 }  // namespace pandora::app

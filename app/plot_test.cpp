@@ -67,5 +67,91 @@ TEST(LogLogPlot, NoDataAndEscaping) {
   EXPECT_EQ(svg.find("a < b"), std::string::npos);
 }
 
+
+TEST(NiceTicks, StepsOfOneTwoFiveCoverTheRange) {
+  const std::vector<double> one = NiceTicks(1.0, 5), expected{0, 0.2, 0.4, 0.6, 0.8, 1.0};
+  ASSERT_EQ(one.size(), expected.size());
+  for (std::size_t i = 0; i < one.size(); ++i) EXPECT_NEAR(one[i], expected[i], 1e-15);
+  EXPECT_EQ(NiceTicks(7.0, 5), (std::vector<double>{0, 2, 4, 6, 8}));
+  const std::vector<double> t = NiceTicks(0.0123, 4);
+  EXPECT_DOUBLE_EQ(t[1], 0.005);
+  EXPECT_GE(t.back(), 0.0123);
+  EXPECT_EQ(NiceTicks(0.0), (std::vector<double>{0, 1}));
+}
+
+// The heights of the <rect> bars (the background rect has no height attribute in pixels).
+std::vector<double> BarHeights(const std::string& svg) {
+  std::vector<double> heights;
+  const std::string key = "height=\"";
+  for (std::size_t p = svg.find("<rect x="); p != std::string::npos; p = svg.find("<rect x=", p + 1)) {
+    const std::size_t h = svg.find(key, p) + key.size();
+    heights.push_back(std::stod(svg.substr(h, svg.find('"', h) - h)));
+  }
+  return heights;
+}
+
+TEST(BarChart, BarHeightsAreProportionalToValues) {
+  BarChart chart;
+  chart.title = "coverage <histogram>";
+  chart.categories = {"0", "1", "2", "3"};
+  chart.series.push_back({"rig", {0.1, 0.2, 0.0, std::nan("")}, ""});
+  const std::string svg = RenderBarChartSvg(chart);
+  const std::vector<double> h = BarHeights(svg);
+  ASSERT_EQ(h.size(), 2u);  // zero and NaN draw nothing
+  EXPECT_NEAR(h[1] / h[0], 2.0, 0.02);
+  EXPECT_NE(svg.find("coverage &lt;histogram&gt;"), std::string::npos);
+  // A shared y_max shrinks the bars: 0.2 of 0.4 is half the plot height.
+  chart.y_max = 0.4;
+  const std::vector<double> h2 = BarHeights(RenderBarChartSvg(chart));
+  EXPECT_NEAR(h2[1] / h[1], 0.2 / 0.4 / (0.2 / 0.2), 0.02);
+  EXPECT_EQ(Count(RenderBarChartSvg(BarChart{}), "no data"), 1);
+}
+
+TEST(BarChart, GroupedSeriesLegendAndMarker) {
+  BarChart chart;
+  chart.categories = {"a", "b", "c"};
+  chart.series.push_back({"octagon", {1, 2, 3}, ""});
+  chart.series.push_back({"grid4x2", {3, 2, 1}, "#123456"});
+  chart.marker = 1.5;
+  chart.marker_label = "2 mm";
+  chart.percent = true;
+  const std::string svg = RenderBarChartSvg(chart);
+  EXPECT_EQ(Count(svg, "fill=\"#123456\""), 2);  // its group and its legend key
+  EXPECT_EQ(Count(svg, ">octagon<"), 1);
+  EXPECT_EQ(Count(svg, "stroke-dasharray"), 1);
+  EXPECT_EQ(Count(svg, ">2 mm<"), 1);
+  EXPECT_NE(svg.find("%<"), std::string::npos);
+  // Edge labels sit one half bin left of centred ones.
+  auto label_x = [](const std::string& text, const std::string& label) {
+    const std::size_t p = text.rfind("<text x=\"", text.find(">" + label + "<"));
+    return std::stod(text.substr(p + 9));
+  };
+  const double centred = label_x(svg, "b");
+  chart.edge_labels = true;
+  const std::string edges = RenderBarChartSvg(chart);
+  EXPECT_NEAR(centred - label_x(edges, "b"), (label_x(svg, "c") - label_x(svg, "b")) / 2, 0.02);
+}
+
+TEST(Colorbar, DiscreteBoxesAndSwatches) {
+  Colorbar bar;
+  bar.label = "coverage (cameras)";
+  bar.min = 0;
+  bar.max = 8;
+  bar.discrete = true;
+  bar.swatches = {{"#808080", "outside region"}};
+  const std::string svg = RenderColorbarSvg(bar);
+  EXPECT_EQ(Count(svg, "<rect x="), 9 + 1);
+  EXPECT_EQ(Count(svg, "fill=\"#440154\""), 1);  // viridis(0)
+  EXPECT_EQ(Count(svg, "fill=\"#fde725\""), 1);  // viridis(1)
+  EXPECT_EQ(Count(svg, ">outside region<"), 1);
+  Colorbar ramp;
+  ramp.label = "sigma_max (mm)";
+  ramp.min = 0;
+  ramp.max = 4;
+  ramp.max_is_open = true;
+  const std::string r = RenderColorbarSvg(ramp);
+  EXPECT_EQ(Count(r, "<stop "), 17);
+  EXPECT_NE(r.find("\u22654<"), std::string::npos) << r;
+}
 }  // namespace
 }  // namespace pandora::app

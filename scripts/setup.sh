@@ -7,8 +7,9 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build ccache g++ pkg-config git
   libopenvdb-dev libopenvdb-tools libembree-dev libcgal-dev libceres-dev libglm-dev
-  libopenexr-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
+  libopenexr-dev openexr libpng-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
+  chromium libxml2-utils jq
 )
 
 missing=()
@@ -32,4 +33,4 @@ fi
 echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
-$SUDO -E apt-get install -y -qq --no-install-recommends "${missing[@]}"
+${SUDO:+$SUDO -E} apt-get install -y -qq --no-install-recommends "${missing[@]}"

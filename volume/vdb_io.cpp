@@ -3,6 +3,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <mutex>
@@ -63,6 +64,50 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
                      "check that the output folder exists and is writable");
   }
   CommitTemporary(path);
+}
+
+Fields ReadFieldsVdb(const std::string& path) {
+  InitializeOpenVdb();
+  Fields fields;
+  Fields::Impl& g = fields.impl();
+  try {
+    openvdb::io::File file(path);
+    file.open();
+    for (auto it = file.beginName(); it != file.endName(); ++it) {
+      const std::string name = it.gridName();
+      const bool known = std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end();
+      if (!known) continue;
+      openvdb::GridBase::Ptr base = file.readGrid(name);
+      if (name == kCoverageGrid) {
+        g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base);
+      } else if (name == kCamerasGrid) {
+        g.cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
+      } else if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) {
+        g.floats[name] = f;
+      } else {
+        continue;  // a known name of an unexpected type: not ours
+      }
+      if (!g.transform) g.transform = base->transform().copy();
+    }
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    throw InputError(path, "", std::string("cannot read the VDB file: ") + e.what(),
+                     "pass the fields.vdb that `pandora analyze` wrote");
+  }
+  const openvdb::GridPtrVec grids = g.Grids();
+  if (grids.empty())
+    throw InputError(path, "", "the VDB file holds none of Pandora's field grids",
+                     "pass the fields.vdb that `pandora analyze` wrote");
+  // The lattice: voxel (0, 0, 0) at the transform's origin, extent from the active voxels.
+  const double vs = g.transform->voxelSize()[0];
+  const openvdb::Vec3d o = g.transform->indexToWorld(openvdb::Vec3d(0, 0, 0));
+  fields.lattice.voxel_size = vs;
+  fields.lattice.origin = Vec3(o.x(), o.y(), o.z());
+  openvdb::CoordBBox box;
+  for (const auto& grid : grids) box.expand(grid->evalActiveVoxelBoundingBox());
+  if (!box.empty())
+    fields.lattice.dims = Eigen::Vector3i(box.max().x() + 1, box.max().y() + 1, box.max().z() + 1);
+  return fields;
 }
 
 }  // namespace pandora

@@ -16,6 +16,11 @@ namespace pandora {
 void WriteFieldsVdb(const Fields& fields, const std::string& path,
                     const std::map<std::string, std::string>& metadata);
 
+/// Reads a .vdb written by WriteFieldsVdb back into Fields (grids by name; the lattice's voxel size
+/// and origin from the grids' transform; stats stay empty). Unknown grids are ignored. Throws
+/// InputError (file = path) when the file cannot be read or holds none of the known grids.
+Fields ReadFieldsVdb(const std::string& path);
+
 /// Initializes OpenVDB's type registry (idempotent, thread-safe). Called by WriteFieldsVdb and
 /// EvaluateFields; tools that read .vdb files call it first.
 void InitializeOpenVdb();

@@ -1,0 +1,170 @@
+// `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its own
+// colour (render/render.h), written as PNG or multi-layer OpenEXR.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "analysis/error.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+#include "app/commands.h"
+#include "render/render.h"
+#include "volume/fields.h"
+#include "volume/vdb_io.h"
+
+namespace pandora::app {
+namespace {
+
+Vec3 ParseTriple(const char* option, const std::string& text) {
+  std::stringstream ss(text);
+  std::string item;
+  std::vector<double> v;
+  while (std::getline(ss, item, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(x))
+      throw InputError(option, "", "expected three numbers X,Y,Z, got '" + text + "'",
+                       "e.g. " + std::string(option) + " 1.5,-2,1.8");
+    v.push_back(x);
+  }
+  if (v.size() != 3)
+    throw InputError(option, "", "expected three numbers X,Y,Z, got '" + text + "'",
+                     "e.g. " + std::string(option) + " 1.5,-2,1.8");
+  return Vec3(v[0], v[1], v[2]);
+}
+
+// "WxH" with 1 <= W, H <= 16384.
+std::pair<int, int> ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  const int n = std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra);
+  if (n != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1 || w > 16384 || h > 16384)
+    throw InputError("--size", "", "expected WIDTHxHEIGHT in pixels (1 to 16384 each), got '" + text + "'",
+                     "e.g. --size 1280x720");
+  return {w, h};
+}
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+}  // namespace
+
+int RunRender(const RenderArgs& args) {
+  // Options that need no scene first, so typos fail fast.
+  const std::string ext = Lower(std::filesystem::path(args.out).extension().string());
+  if (ext != ".png" && ext != ".exr")
+    throw InputError("--out", "", "unsupported image type '" + ext + "'",
+                     "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
+  const bool have_from = !args.from.empty() || !args.at.empty();
+  const int viewpoints = int(!args.view.empty()) + int(have_from) + int(!args.camera.empty());
+  if (viewpoints > 1)
+    throw InputError(!args.view.empty() ? "--view" : "--from", "",
+                     "give one viewpoint: --view NAME, --from X,Y,Z --at X,Y,Z, or --camera ID");
+  if (viewpoints == 0)
+    throw InputError("--view", "", "no viewpoint given",
+                     "give --view NAME, --from X,Y,Z --at X,Y,Z, or --camera ID");
+  if (have_from && (args.from.empty() || args.at.empty()))
+    throw InputError(args.from.empty() ? "--from" : "--at", "", "--from and --at go together");
+  if (!std::isnan(args.fov) && !(args.fov > 0 && args.fov < 180))
+    throw InputError("--fov", "", "must be in (0, 180) degrees");
+  RenderOptions options;
+  if (!std::isnan(args.brightness)) options.brightness = CheckPositiveOption("--brightness", args.brightness, "");
+  const std::string pattern = Lower(args.pattern);
+  if (pattern == "uniform") options.pattern = Pattern::kUniform;
+  else if (pattern == "grid") options.pattern = Pattern::kGrid;
+  else throw InputError("--pattern", "", "unknown pattern '" + args.pattern + "'", "use uniform or grid");
+  const std::string surface = Lower(args.surface);
+  if (surface == "material") options.surface = Surface::kMaterial;
+  else if (surface == "black") options.surface = Surface::kBlack;
+  else if (surface == "hidden-line") options.surface = Surface::kHiddenLine;
+  else if (surface == "contours") options.surface = Surface::kContours;
+  else
+    throw InputError("--surface", "", "unknown surface mode '" + args.surface + "'",
+                     "use material, black, hidden-line or contours");
+  if (args.grid < 1 || args.grid > 100000) throw InputError("--grid", "", "must be a whole number of camera pixels >= 1");
+  options.grid_pixels = args.grid;
+  if (args.samples < 1 || args.samples > 16) throw InputError("--samples", "", "must be 1 to 16 (per axis)");
+  options.samples = args.samples;
+  options.overlays.cameras = !args.no_cameras;
+  if (!args.slice.empty() || !args.iso.empty()) {
+    if (args.fields.empty())
+      throw InputError(!args.slice.empty() ? "--slice" : "--iso", "", "needs --fields FILE.vdb",
+                       "run `pandora analyze` first and pass its fields.vdb");
+  }
+  options.overlays.slice_field = args.slice;
+  const std::string axis = Lower(args.slice_axis);
+  if (axis == "x") options.overlays.slice_axis = 0;
+  else if (axis == "y") options.overlays.slice_axis = 1;
+  else if (axis == "z") options.overlays.slice_axis = 2;
+  else throw InputError("--slice-axis", "", "must be x, y or z");
+  options.overlays.slice_position = args.slice_at;
+  options.overlays.iso_field = args.iso;
+  if (!std::isnan(args.iso_value)) {
+    if (!std::isfinite(args.iso_value)) throw InputError("--iso-value", "", "must be finite");
+    options.overlays.iso_value = args.iso_value;
+  }
+
+  Scene scene = LoadScene(args.scene);
+  {
+    std::error_code ec;
+    if (std::filesystem::equivalent(args.out, args.scene, ec))
+      throw InputError(args.out, "", "--out would overwrite the scene file", "write the image to another file");
+  }
+  const Rig& rig = scene.FindRig(args.rig);
+  options.pixel_sigma = scene.study.pixel_sigma;
+
+  RenderView view;
+  if (!args.camera.empty()) {
+    auto it = std::find_if(rig.cameras.begin(), rig.cameras.end(),
+                           [&](const Camera& c) { return c.id == args.camera; });
+    if (it == rig.cameras.end()) {
+      std::string ids;
+      for (const Camera& c : rig.cameras) ids += (ids.empty() ? "" : ", ") + c.id;
+      throw InputError("--camera", "", "no camera '" + args.camera + "' in rig '" + rig.name + "'",
+                       "cameras: " + ids);
+    }
+    view.camera = int(it - rig.cameras.begin());
+    view.width = it->model.width();
+    view.height = it->model.height();
+  } else if (!args.view.empty()) {
+    auto it = scene.views.find(args.view);
+    if (it == scene.views.end()) {
+      std::string names;
+      for (const auto& [name, v] : scene.views) names += (names.empty() ? "" : ", ") + name;
+      throw InputError(scene.path, "$.views", "no view '" + args.view + "'",
+                       names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z"
+                                     : "views: " + names);
+    }
+    view = ViewFromScene(it->second, 1280, 720);
+  } else {
+    view.from = ParseTriple("--from", args.from);
+    view.at = ParseTriple("--at", args.at);
+    if (!args.up.empty()) view.up = ParseTriple("--up", args.up);
+    if (!LookAt(view.from, view.at, view.up))
+      throw InputError("--at", "", "--at equals --from, or --up is parallel to the viewing direction");
+  }
+  if (!std::isnan(args.fov)) view.fov_deg = args.fov;
+  if (!args.size.empty()) std::tie(view.width, view.height) = ParseSize(args.size);
+
+  std::unique_ptr<Fields> fields;
+  if (!args.fields.empty()) fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
+
+  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  options.layers = ext == ".exr";  // the PNG has no room for them
+  RenderStats stats;
+  const Image image = RenderWithStats(scene, rig, *caster, view, options, fields.get(), &stats);
+  if (ext == ".png") WritePng(image, args.out);
+  else WriteExr(image, args.out, int(rig.cameras.size()));
+  if (!args.quiet)
+    std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras), %zu triangles, %.3f s\n",
+                args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
+                caster->triangle_count(), stats.seconds);
+  return 0;
+}
+
+}  // namespace pandora::app

@@ -1,0 +1,103 @@
+#include "render/colormap.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+
+namespace pandora {
+
+Vec3 ViridisSrgb(double t) {
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
+  // Degree-6 polynomial fit (per channel, ascending powers) of matplotlib's viridis table.
+  static const double kC[7][3] = {
+      {0.2777273272234177, 0.005407344544966578, 0.3340998053353061},
+      {0.1050930431085774, 1.404613529898575, 1.384590162594685},
+      {-0.3308618287255563, 0.214847559468213, 0.09509516302823659},
+      {-4.634230498983486, -5.799100973351585, -19.33244095627987},
+      {6.228269936347081, 14.17993336680509, 56.69055260068105},
+      {4.776384997670288, -13.74514537774601, -65.35303263337234},
+      {-5.435455855934631, 4.645852612178535, 26.3124352495832}};
+  Vec3 c;
+  for (int k = 0; k < 3; ++k) {
+    double v = kC[6][k];
+    for (int p = 5; p >= 0; --p) v = v * t + kC[p][k];
+    c[k] = std::clamp(v, 0.0, 1.0);
+  }
+  return c;
+}
+
+double SrgbFromLinear(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+double LinearFromSrgb(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+Vec3 ViridisLinear(double t) {
+  const Vec3 s = ViridisSrgb(t);
+  return Vec3(LinearFromSrgb(s.x()), LinearFromSrgb(s.y()), LinearFromSrgb(s.z()));
+}
+
+namespace {
+
+// 3x5 glyphs, rows top to bottom, '#' set. Letters are drawn as capitals.
+const std::map<char, const char*>& Font() {
+  static const std::map<char, const char*> kFont{
+      {'0', "####.##.##.####"}, {'1', ".#.##..#..#.###"}, {'2', "###..#####..###"},
+      {'3', "###..#.##..####"}, {'4', "#.##.####..#..#"}, {'5', "####..###..####"},
+      {'6', "####..####.####"}, {'7', "###..#..#.#..#."}, {'8', "####.#####.####"},
+      {'9', "####.####..####"}, {'.', ".............#."}, {'-', "......###......"},
+      {'+', "....#.###.#...."}, {'/', "..#..#.#.#..#.."}, {'_', "............###"},
+      {'%', "#.#..#.#.#..#.#"}, {'=', "...###...###..."}, {'<', "..#.#.#...#...#"},
+      {'>', "#...#...#.#.#.."}, {' ', "..............."}, {'a', ".#.#.#####.##.#"},
+      {'b', "##.#.###.#.###."}, {'c', ".###..#..#...##"}, {'d', "##.#.##.##.###."},
+      {'e', "####..##.#..###"}, {'f', "####..##.#..#.."}, {'g', ".###..#.##.#.##"},
+      {'h', "#.##.#####.##.#"}, {'i', "###.#..#..#.###"}, {'j', "..#..#..##.#.#."},
+      {'k', "#.##.###.#.##.#"}, {'l', "#..#..#..#..###"}, {'m', "#.########.##.#"},
+      {'n', "##.#.##.##.##.#"}, {'o', ".#.#.##.##.#.#."}, {'p', "##.#.###.#..#.."},
+      {'q', ".#.#.##.###..##"}, {'r', "##.#.###.#.##.#"}, {'s', ".###...#...###."},
+      {'t', "###.#..#..#..#."}, {'u', "#.##.##.##.####"}, {'v', "#.##.##.##.#.#."},
+      {'w', "#.##.########.#"}, {'x', "#.##.#.#.#.##.#"}, {'y', "#.##.#.#..#..#."},
+      {'z', "###..#.#.#..###"}};
+  return kFont;
+}
+
+}  // namespace
+
+int TextWidth(const std::string& text, int scale) {
+  return text.empty() ? 0 : static_cast<int>(text.size()) * 4 * scale - scale;
+}
+
+int DrawText(float* rgb, int width, int height, int x, int y, const std::string& text,
+             const Vec3& color, int scale) {
+  static const char* kBox = "####.##.##.####";
+  int cx = x;
+  for (char ch : text) {
+    const char lower = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    auto it = Font().find(lower);
+    const char* glyph = it == Font().end() ? kBox : it->second;
+    const std::string g(glyph);
+    for (int row = 0; row < 5; ++row)
+      for (int col = 0; col < 3; ++col) {
+        const std::size_t k = static_cast<std::size_t>(row * 3 + col);
+        if (k >= g.size() || g[k] != '#') continue;
+        for (int sy = 0; sy < scale; ++sy)
+          for (int sx = 0; sx < scale; ++sx) {
+            const int px = cx + col * scale + sx, py = y + row * scale + sy;
+            if (px < 0 || py < 0 || px >= width || py >= height) continue;
+            float* p = rgb + 3 * (static_cast<std::size_t>(py) * width + px);
+            p[0] = static_cast<float>(color.x());
+            p[1] = static_cast<float>(color.y());
+            p[2] = static_cast<float>(color.z());
+          }
+      }
+    cx += 4 * scale;
+  }
+  return cx - x;
+}
+
+}  // namespace pandora

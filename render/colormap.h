@@ -1,0 +1,33 @@
+#pragma once
+/// \file colormap.h
+/// Internal to render/: the viridis colormap and a tiny bitmap font for legends.
+
+#include <string>
+
+#include "analysis/geometry.h"
+
+namespace pandora {
+
+/// Viridis (van der Walt and Smith, matplotlib's default), sRGB-encoded components in [0, 1], for
+/// t in [0, 1] (clamped). Evaluated from the degree-6 least-squares polynomial fit of the published
+/// 256-entry table (maximum deviation from the table about 0.01 per channel; render_test checks
+/// the table's end points and middle).
+Vec3 ViridisSrgb(double t);
+
+/// The same colour in linear RGB (what the renderer composites in).
+Vec3 ViridisLinear(double t);
+
+/// sRGB transfer curve and its inverse, per channel, on [0, 1].
+double SrgbFromLinear(double v);
+double LinearFromSrgb(double v);
+
+/// Draws `text` with a 3x5 pixel font scaled by `scale`, top-left corner at (x, y), into a linear
+/// RGB buffer of width x height (3 floats per pixel). Characters: digits, a-z, . - + / _ % = < >
+/// and space; others are drawn as a box. Returns the width drawn in pixels.
+int DrawText(float* rgb, int width, int height, int x, int y, const std::string& text,
+             const Vec3& color, int scale);
+
+/// Width in pixels DrawText would use.
+int TextWidth(const std::string& text, int scale);
+
+}  // namespace pandora

@@ -1,0 +1,113 @@
+// OpenEXR files (the only file that includes OpenEXR): RGB plus the per-pixel layers.
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "render/render.h"
+
+namespace pandora {
+
+void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
+  const int W = image.width, H = image.height;
+  const std::size_t pixels = std::size_t(W) * H;
+  if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels)
+    throw std::invalid_argument("WriteExr: empty or inconsistent image");
+  std::vector<uint32_t> lo(pixels), hi;
+  for (std::size_t i = 0; i < pixels; ++i) lo[i] = uint32_t(image.cameras[i] & 0xffffffffu);
+  const bool want_hi = rig_cameras > 32;
+  if (want_hi) {
+    hi.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) hi[i] = uint32_t(image.cameras[i] >> 32);
+  }
+  Imf::Header header(W, H);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.insert("pandora_layers",
+                Imf::StringAttribute(
+                    "R,G,B: linear light; coverage: cameras seeing the surface point; cameras: "
+                    "bitmask (bit c = rig camera c, bits 32-63 in cameras_hi); resolution: px/m; "
+                    "sigma_max: mm, inf = not triangulable; depth: m along the eye ray, inf = no "
+                    "surface"));
+  Imf::FrameBuffer fb;
+  const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
+  auto add_float = [&](const char* name, const float* data, std::size_t x_stride) {
+    header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    fb.insert(name, Imf::Slice(Imf::FLOAT, (char*)data, x_stride * fs, x_stride * fs * W));
+  };
+  add_float("R", image.rgb.data() + 0, 3);
+  add_float("G", image.rgb.data() + 1, 3);
+  add_float("B", image.rgb.data() + 2, 3);
+  add_float("coverage", image.coverage.data(), 1);
+  add_float("resolution", image.resolution.data(), 1);
+  add_float("sigma_max", image.sigma_max.data(), 1);
+  add_float("depth", image.depth.data(), 1);
+  header.channels().insert("cameras", Imf::Channel(Imf::UINT));
+  fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)lo.data(), us, us * W));
+  if (want_hi) {
+    header.channels().insert("cameras_hi", Imf::Channel(Imf::UINT));
+    fb.insert("cameras_hi", Imf::Slice(Imf::UINT, (char*)hi.data(), us, us * W));
+  }
+  const std::string tmp = TemporaryPath(path);
+  try {
+    Imf::OutputFile file(tmp.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(H);
+  } catch (const std::exception& e) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", std::string("cannot write the EXR file: ") + e.what(),
+                     "check that the output folder exists and is writable");
+  }
+  CommitTemporary(path);
+}
+
+Image ReadExr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    Image image;
+    const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+    image.width = W;
+    image.height = H;
+    const std::size_t pixels = std::size_t(W) * H;
+    image.rgb.assign(3 * pixels, 0.0f);
+    image.coverage.assign(pixels, 0.0f);
+    image.resolution.assign(pixels, 0.0f);
+    image.sigma_max.assign(pixels, 0.0f);
+    image.depth.assign(pixels, 0.0f);
+    std::vector<uint32_t> lo(pixels, 0), hi(pixels, 0);
+    const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
+    // Slices are addressed from the data window's origin.
+    const std::ptrdiff_t origin = std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * W;
+    Imf::FrameBuffer fb;
+    auto add_float = [&](const char* name, float* data, std::size_t x_stride) {
+      fb.insert(name, Imf::Slice(Imf::FLOAT, (char*)(data - origin * x_stride), x_stride * fs,
+                                 x_stride * fs * W, 1, 1, 0.0));
+    };
+    add_float("R", image.rgb.data() + 0, 3);
+    add_float("G", image.rgb.data() + 1, 3);
+    add_float("B", image.rgb.data() + 2, 3);
+    add_float("coverage", image.coverage.data(), 1);
+    add_float("resolution", image.resolution.data(), 1);
+    add_float("sigma_max", image.sigma_max.data(), 1);
+    add_float("depth", image.depth.data(), 1);
+    fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)(lo.data() - origin), us, us * W));
+    fb.insert("cameras_hi", Imf::Slice(Imf::UINT, (char*)(hi.data() - origin), us, us * W));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    image.cameras.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) image.cameras[i] = (uint64_t(hi[i]) << 32) | lo[i];
+    image.object.assign(pixels, -1);
+    return image;
+  } catch (const std::exception& e) {
+    throw InputError(path, "", std::string("cannot read the EXR file: ") + e.what());
+  }
+}
+
+}  // namespace pandora

@@ -1,0 +1,73 @@
+// PNG files through libpng's simplified API (the only file that includes png.h).
+#include <png.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "render/colormap.h"
+#include "render/render.h"
+
+namespace pandora {
+
+void WritePng(const Image& image, const std::string& path) {
+  const std::size_t pixels = std::size_t(image.width) * image.height;
+  if (image.width <= 0 || image.height <= 0 || image.rgb.size() != 3 * pixels)
+    throw std::invalid_argument("WritePng: empty or inconsistent image");
+  // sRGB encoding through a 65537-entry table of the transfer curve: the table's step (1/65536 in
+  // linear light) moves the encoded value by at most 0.03 codes above 1/256, where it is used;
+  // below, the curve is evaluated directly.
+  static const std::vector<uint8_t> table = [] {
+    std::vector<uint8_t> t(65537);
+    for (int i = 0; i <= 65536; ++i)
+      t[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(i / 65536.0)));
+    return t;
+  }();
+  std::vector<uint8_t> bytes(3 * pixels);
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    const float v = image.rgb[i];
+    if (!(v > 0.0f)) bytes[i] = 0;  // also NaN
+    else if (v >= 1.0f) bytes[i] = 255;
+    else if (v < 1.0f / 256) bytes[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(v)));
+    else bytes[i] = table[std::size_t(std::lround(double(v) * 65536.0))];
+  }
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = png_uint_32(image.width);
+  png.height = png_uint_32(image.height);
+  png.format = PNG_FORMAT_RGB;
+  const std::string tmp = TemporaryPath(path);
+  if (!png_image_write_to_file(&png, tmp.c_str(), 0, bytes.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    std::remove(tmp.c_str());
+    throw InputError(path, "", "cannot write the PNG file: " + message,
+                     "check that the output folder exists and is writable");
+  }
+  CommitTemporary(path);
+}
+
+Image ReadPng(const std::string& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str()))
+    throw InputError(path, "", std::string("cannot read the PNG file: ") + png.message);
+  png.format = PNG_FORMAT_RGB;
+  std::vector<uint8_t> bytes(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw InputError(path, "", "cannot read the PNG file: " + message);
+  }
+  Image image;
+  image.width = int(png.width);
+  image.height = int(png.height);
+  image.rgb.resize(bytes.size());
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    image.rgb[i] = float(LinearFromSrgb(bytes[i] / 255.0));
+  return image;
+}
+
+}  // namespace pandora

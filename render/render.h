@@ -1,0 +1,164 @@
+#pragma once
+/// \file render.h
+/// Projective-light rendering (paper Fig. 2 and 4): the scene seen from a viewpoint, lit by every
+/// enabled camera of a rig as a projector of its own colour. A surface point seen by camera c under
+/// the visibility rules (analysis/visibility.h: working range, image bounds with distortion, facing
+/// the camera, not occluded) receives c's colour; contributions add; points no camera sees stay
+/// unlit. The renderer is the exact CPU reference: one primary ray per sample through Embree, then
+/// one occlusion segment per (sample, camera), traced in packets.
+///
+/// This header is light (no Embree, OpenVDB, OpenEXR or libpng). Overlays from fields come in as a
+/// `Fields` (volume/fields.h), e.g. from ReadFieldsVdb (volume/vdb_io.h).
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/geometry.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+
+namespace pandora {
+
+class Fields;
+
+/// Where the image is seen from.
+struct RenderView {
+  /// Main view: a pinhole eye at `from` looking at `at`, `up` up, horizontal field of view `fov_deg`.
+  Vec3 from = Vec3::Zero();
+  Vec3 at = Vec3::UnitX();
+  Vec3 up = Vec3::UnitZ();
+  double fov_deg = 60.0;
+  /// Output size in pixels.
+  int width = 1280;
+  int height = 720;
+  /// Camera's-eye view: >= 0 renders what rig.cameras[camera] images (its pose and lens model,
+  /// distortion included: each output pixel is unprojected through the camera model, the camera's
+  /// image scaled to width x height). from/at/up/fov_deg are then ignored.
+  int camera = -1;
+};
+
+/// A RenderView from a named scene view (View::fov_deg unset: `default_fov_deg`).
+RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg = 60.0);
+
+/// What each camera projects.
+enum class Pattern {
+  kUniform,  ///< Uniform light of the camera's colour over its whole footprint.
+  kGrid,     ///< The camera's pixel grid: a line every `grid_pixels` of its pixels (Fig. 2 right).
+};
+
+/// How the surfaces themselves look under the projected light.
+enum class Surface {
+  kMaterial,    ///< Intrinsic material colour (Scene::materials), with a dim ambient term.
+  kBlack,       ///< Black: only the projected light shows (analytic tests use this).
+  kHiddenLine,  ///< Black with grey mesh edges, hidden lines removed (coplanar diagonals skipped).
+  kContours,    ///< Black with grey contours only: silhouette/crease/object boundaries in the image.
+};
+
+/// Overlays drawn in the main view.
+struct OverlayOptions {
+  bool cameras = true;             ///< Each enabled camera as a small body plus its frustum wireframe.
+  double frustum_length = 0.6;     ///< Metres along the axis (clipped to the camera's far distance).
+  /// Slice plane through the fields (needs `fields`): empty = none, else the field name, e.g.
+  /// "coverage", "resolution", "sigma_max". Coloured with viridis between slice_min and slice_max
+  /// (NaN: the field's range on the slice); a legend is drawn in the lower right corner.
+  std::string slice_field;
+  int slice_axis = 2;              ///< 0 x, 1 y, 2 z: the plane is perpendicular to this axis.
+  /// Plane position along slice_axis (m); NaN: the middle voxel layer of the field's active voxels.
+  double slice_position = std::numeric_limits<double>::quiet_NaN();
+  double slice_min = std::numeric_limits<double>::quiet_NaN();
+  double slice_max = std::numeric_limits<double>::quiet_NaN();
+  double slice_opacity = 0.75;
+  bool legend = true;              ///< Draw the slice's colour bar with its range and field name.
+  /// Isosurface (needs `fields`): empty = none, else a field name and an iso value; e.g.
+  /// "coverage" at 1.5 is the boundary of coverage >= 2, "sigma_max" at 2.0 the 2 mm boundary.
+  /// Extracted with OpenVDB's volumeToMesh, ray traced with the scene, alpha-composited.
+  std::string iso_field;
+  double iso_value = 1.5;
+  Vec3 iso_color{1.0, 0.55, 0.1};
+  double iso_opacity = 0.45;
+};
+
+struct RenderOptions {
+  Pattern pattern = Pattern::kUniform;
+  Surface surface = Surface::kMaterial;
+  /// Multiplies every camera's light, so many overlaps do not saturate to white (paper Fig. 4).
+  double brightness = 1.0;
+  /// Dim ambient light in kMaterial mode (fraction of the material colour shown unlit).
+  double ambient = 0.15;
+  int grid_pixels = 32;        ///< kGrid: a line every this many camera pixels.
+  double grid_fill = 0.15;     ///< kGrid: light between the lines, as a fraction of the lines'.
+  double line_width_px = 1.2;  ///< Grid lines, mesh edges and contours, in output pixels.
+  double line_grey = 0.25;     ///< Linear grey of mesh edges and contours.
+  int samples = 1;             ///< Samples per pixel per axis (samples^2 per pixel, stratified).
+  Vec3 background{0.02, 0.02, 0.03};  ///< Linear RGB where no surface is hit.
+  OverlayOptions overlays;
+  /// Compute the resolution and sigma_max layers (projection Jacobians and a 3x3 decomposition per
+  /// pixel); when false they stay 0 and +inf. `pandora render` computes them for EXR output only.
+  /// coverage, cameras, depth and object are always filled.
+  bool layers = true;
+  /// Study pixel sigma for the sigma_max layer, for cameras without their own (Study::pixel_sigma).
+  double pixel_sigma = 0.5;
+};
+
+/// The rendered image and its per-pixel layers (row-major, y down, index y * width + x). The layers
+/// are taken at the first surface hit of the pixel centre's ray (overlays do not change them).
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;          ///< Linear RGB, 3 per pixel, unclamped (>= 0).
+  std::vector<float> coverage;     ///< Number of enabled cameras that see the surface point.
+  std::vector<uint64_t> cameras;   ///< Bit c set when rig camera c sees it (c < 64).
+  std::vector<float> resolution;   ///< Best pixel density (px/m) among those cameras; 0 if none.
+  /// Worst-direction 1-sigma of the static triangulation (mm), as the sigma_max field;
+  /// +inf where fewer than two cameras see the point or a direction is unobservable.
+  std::vector<float> sigma_max;
+  std::vector<float> depth;        ///< Distance from the eye along the ray (m); +inf: no surface.
+  std::vector<int32_t> object;     ///< Scene object index hit, -1 for none.
+
+  Vec3 Rgb(int x, int y) const {
+    const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
+    return Vec3(rgb[i], rgb[i + 1], rgb[i + 2]);
+  }
+};
+
+/// Renders `scene` lit by the enabled cameras of `rig`. `caster` must be built from
+/// scene.AllTriangles() (the object index of each triangle is recomputed from the scene).
+/// `fields` (may be null) feeds the slice and isosurface overlays. Throws InputError when an overlay
+/// needs fields and there are none (file "--fields"), when the fields lack the grid ("--slice",
+/// "--iso"; the hint lists the grids present), for a bad view ("--size", "--fov", "--at",
+/// "--camera") and for rigs of more than 64 cameras. Parallel over image tiles (TBB).
+Image Render(const Scene& scene, const Rig& rig, const RayCaster& caster, const RenderView& view,
+             const RenderOptions& options, const Fields* fields = nullptr);
+
+/// Timing of Render's parts and the ray counts, for `pandora bench --render`.
+struct RenderStats {
+  double seconds = 0;          ///< Whole Render call.
+  std::size_t primary_rays = 0;
+  std::size_t shadow_rays = 0;  ///< Occlusion segments cast (after the geometric tests).
+};
+/// Render that also reports stats (may be null) and, when `primary` / `shadow` are given, records
+/// every primary ray and every occlusion segment it traced, tile by tile, so a benchmark can replay
+/// them through raw Embree.
+Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                      const RenderView& view, const RenderOptions& options, const Fields* fields,
+                      RenderStats* stats, std::vector<Ray>* primary = nullptr,
+                      std::vector<Ray>* shadow = nullptr);
+
+/// 8-bit sRGB PNG of image.rgb (clamped to [0, 1], sRGB transfer curve). Written to a temporary
+/// name and renamed; throws InputError (file = path) when it cannot be written.
+void WritePng(const Image& image, const std::string& path);
+
+/// Single-part, multi-layer scanline OpenEXR (ZIP): float R, G, B (linear) and float layers
+/// `coverage`, `resolution`, `sigma_max`, `depth`, and uint `cameras` (bits 0-31; `cameras_hi`
+/// holds bits 32-63 when the rig has more than 32 cameras). Temporary name, then renamed.
+void WriteExr(const Image& image, const std::string& path, int rig_cameras);
+
+/// Reads back an EXR written by WriteExr (tests, tools). Throws InputError when unreadable.
+Image ReadExr(const std::string& path);
+
+/// Reads a PNG (8-bit RGB or RGBA) into linear RGB (tests, reference images).
+Image ReadPng(const std::string& path);
+
+}  // namespace pandora

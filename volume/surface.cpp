@@ -1,0 +1,243 @@
+#include "volume/surface.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "analysis/uncertainty.h"
+#include "analysis/visibility.h"
+#include "volume/colormap.h"
+
+namespace pandora {
+namespace {
+
+// SplitMix64's finaliser: a bijective 64-bit mix, enough to turn counters into independent uniform
+// bits (the same on every platform, unlike std:: distributions).
+std::uint64_t Mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// Uniform in [0, 1) from 53 bits of a hash of (seed, a, b, c).
+double Uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  const std::uint64_t h = Mix(Mix(Mix(Mix(seed) ^ a) ^ b) ^ c);
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+double TriangleArea(const TriangleMesh& mesh, const Eigen::Vector3i& t, Vec3* normal) {
+  const Vec3& a = mesh.vertices[t[0]];
+  const Vec3 cross = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a);
+  const double twice = cross.norm();
+  if (normal && twice > 0) *normal = cross / twice;
+  return 0.5 * twice;
+}
+
+std::string Number(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+double SurfaceArea(const Scene& scene) {
+  double area = 0;
+  for (const SceneObject& o : scene.objects)
+    for (const Eigen::Vector3i& t : o.mesh.triangles) area += TriangleArea(o.mesh, t, nullptr);
+  return area;
+}
+
+std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, std::uint64_t seed,
+                                          const std::string& option) {
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw InputError(option, "", "must be a positive number of metres", "e.g. 0.02");
+  const double area = SurfaceArea(scene);
+  const double expected = area / (spacing * spacing);
+  if (expected > kMaxSurfaceSamples)
+    throw InputError(option, "",
+                     "spacing " + Number(spacing) + " m gives about " + Number(expected) +
+                         " samples over " + Number(area) + " m^2 of surface, over the limit of " +
+                         Number(kMaxSurfaceSamples),
+                     "use a spacing of at least " +
+                         Number(std::sqrt(area / kMaxSurfaceSamples) * 1.01) + " m");
+
+  // Counts first (per object, per triangle), then the points: the output order is object, triangle,
+  // sample, whatever the thread count.
+  std::vector<SurfaceSample> out;
+  out.reserve(static_cast<std::size_t>(expected * 1.01) + 16);
+  const double inv_cell = 1.0 / (spacing * spacing);
+  for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
+    const TriangleMesh& mesh = scene.objects[oi].mesh;
+    for (std::size_t ti = 0; ti < mesh.triangles.size(); ++ti) {
+      const Eigen::Vector3i& t = mesh.triangles[ti];
+      Vec3 normal;
+      const double a = TriangleArea(mesh, t, &normal);
+      if (!(a > 0)) continue;
+      const double e = a * inv_cell;
+      const double whole = std::floor(e);
+      std::uint64_t n = static_cast<std::uint64_t>(whole);
+      // The extra point uses sample index 2^63 so it never shares random numbers with the others.
+      if (Uniform(seed, oi, ti, std::uint64_t{1} << 63) < e - whole) ++n;
+      const Vec3& p0 = mesh.vertices[t[0]];
+      const Vec3& p1 = mesh.vertices[t[1]];
+      const Vec3& p2 = mesh.vertices[t[2]];
+      for (std::uint64_t s = 0; s < n; ++s) {
+        // Uniform on the triangle: with r1, r2 uniform, (1 - sqrt r1, sqrt r1 (1 - r2), sqrt r1 r2)
+        // are barycentric coordinates of uniform density (Osada et al. 2002).
+        const double r1 = std::sqrt(Uniform(seed, oi, ti, 2 * s));
+        const double r2 = Uniform(seed, oi, ti, 2 * s + 1);
+        SurfaceSample sample;
+        sample.position = (1 - r1) * p0 + r1 * (1 - r2) * p1 + r1 * r2 * p2;
+        sample.normal = normal;
+        sample.object = static_cast<int>(oi);
+        out.push_back(sample);
+      }
+    }
+  }
+  return out;
+}
+
+struct PointEvaluator::Impl {
+  Impl(const Scene& scene, const Rig& rig, const RayCaster& caster)
+      : tester(rig.cameras, caster, scene.Bounds().diagonal()) {
+    for (const Camera& c : rig.cameras) {
+      const double sigma = c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma;
+      inverse_variance.push_back(1.0 / (sigma * sigma));
+    }
+  }
+  VisibilityTester tester;
+  std::vector<double> inverse_variance;  // 1 / sigma_c^2, pixels^-2
+};
+
+PointEvaluator::PointEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster)
+    : impl_(new Impl(scene, rig, caster)) {}
+
+PointEvaluator::~PointEvaluator() { delete impl_; }
+
+PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) const {
+  PointValues v;
+  const VisibilityTester& tester = impl_->tester;
+  // J's upper triangle (xx xy xz yy yz zz), summed camera by camera as EvaluateFields does: the
+  // camera-frame Jacobian Jc gives the pixel density; A = Jc R (R = camera_from_world rotation) in
+  // the same scalar form, then J += A^T A / sigma^2.
+  double I[6] = {0, 0, 0, 0, 0, 0};
+  const int cameras = static_cast<int>(tester.cameras().size());
+  float best_density = 0;  // the grids store float
+  for (int c = 0; c < cameras && c < 64; ++c) {
+    Ray segment;
+    Mat23 Jc;
+    if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen) continue;
+    if (segment.t_far > segment.t_near && tester.caster().Occluded(segment)) continue;
+    ++v.coverage;
+    v.cameras |= std::uint64_t{1} << c;
+    best_density = std::max(best_density, static_cast<float>(PixelDensity(Jc)));
+    const Mat3& R = tester.camera_rotation(c);
+    const double a00 = Jc(0, 0) * R(0, 0) + Jc(0, 1) * R(1, 0) + Jc(0, 2) * R(2, 0);
+    const double a01 = Jc(0, 0) * R(0, 1) + Jc(0, 1) * R(1, 1) + Jc(0, 2) * R(2, 1);
+    const double a02 = Jc(0, 0) * R(0, 2) + Jc(0, 1) * R(1, 2) + Jc(0, 2) * R(2, 2);
+    const double a10 = Jc(1, 0) * R(0, 0) + Jc(1, 1) * R(1, 0) + Jc(1, 2) * R(2, 0);
+    const double a11 = Jc(1, 0) * R(0, 1) + Jc(1, 1) * R(1, 1) + Jc(1, 2) * R(2, 1);
+    const double a12 = Jc(1, 0) * R(0, 2) + Jc(1, 1) * R(1, 2) + Jc(1, 2) * R(2, 2);
+    const double w = impl_->inverse_variance[c];
+    I[0] += w * (a00 * a00 + a10 * a10);
+    I[1] += w * (a00 * a01 + a10 * a11);
+    I[2] += w * (a00 * a02 + a10 * a12);
+    I[3] += w * (a01 * a01 + a11 * a11);
+    I[4] += w * (a01 * a02 + a11 * a12);
+    I[5] += w * (a02 * a02 + a12 * a12);
+  }
+  v.resolution = best_density;
+  if (v.coverage < 2) return v;
+  // Eigenvalues as the fields compute them (SymmetricEigenvalues3, the general solver where it did
+  // not converge), clipped at 0, with the same observability rule.
+  const double* upper[6] = {&I[0], &I[1], &I[2], &I[3], &I[4], &I[5]};
+  double e[3];
+  double* values[3] = {&e[0], &e[1], &e[2]};
+  unsigned char converged = 0;
+  SymmetricEigenvalues3(upper, values, &converged, 1);
+  Vec3 eigenvalues(e[0], e[1], e[2]);
+  if (!converged) {
+    Mat3 J;
+    J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+    eigenvalues = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
+  }
+  eigenvalues = eigenvalues.cwiseMax(0.0);
+  const double largest = eigenvalues[2];
+  if (!(largest > 0 && std::isfinite(largest) && eigenvalues[0] > kRelativeObservability * largest))
+    return v;
+  v.triangulable = true;
+  v.sigma_max_mm = 1e3 * std::sqrt(1.0 / eigenvalues[0]);
+  return v;
+}
+
+std::vector<PointValues> PointEvaluator::EvaluateSamples(
+    const std::vector<SurfaceSample>& samples) const {
+  std::vector<PointValues> values(samples.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        values[i] = Evaluate(samples[i].position, &samples[i].normal);
+                    });
+  return values;
+}
+
+void WriteSurfacePly(const std::string& path, const std::vector<SurfaceSample>& samples,
+                     const std::vector<PointValues>& values, int enabled_cameras,
+                     const std::vector<std::string>& comments) {
+  if (samples.size() != values.size())
+    throw std::invalid_argument("WriteSurfacePly: one value per sample expected");
+  std::string header = "ply\nformat binary_little_endian 1.0\n";
+  for (std::string c : comments) {
+    for (char& ch : c)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    header += "comment " + c + "\n";
+  }
+  header += "element vertex " + std::to_string(samples.size()) + "\n";
+  for (const char* p : {"x", "y", "z", "nx", "ny", "nz"}) header += std::string("property float ") + p + "\n";
+  header +=
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "property float coverage\nproperty float resolution\nproperty float sigma_max\n"
+      "property uchar triangulable\nproperty int object\nend_header\n";
+
+  constexpr std::size_t kRecord = 6 * 4 + 3 + 3 * 4 + 1 + 4;
+  std::string data(header.size() + kRecord * samples.size(), '\0');
+  std::memcpy(data.data(), header.data(), header.size());
+  char* p = data.data() + header.size();
+  // PLY binary_little_endian: the host is little-endian (x86-64, ARM64 Linux).
+  static_assert(sizeof(float) == 4 && sizeof(std::int32_t) == 4);
+  auto put_float = [&p](double v) {
+    const float f = static_cast<float>(v);
+    std::memcpy(p, &f, 4);
+    p += 4;
+  };
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const SurfaceSample& s = samples[i];
+    const PointValues& v = values[i];
+    for (int k = 0; k < 3; ++k) put_float(s.position[k]);
+    for (int k = 0; k < 3; ++k) put_float(s.normal[k]);
+    Rgb8 color{128, 128, 128};
+    if (v.coverage > 0) color = Viridis(double(v.coverage) / std::max(1, enabled_cameras));
+    *p++ = static_cast<char>(color.r);
+    *p++ = static_cast<char>(color.g);
+    *p++ = static_cast<char>(color.b);
+    put_float(v.coverage);
+    put_float(v.resolution);
+    put_float(v.triangulable ? v.sigma_max_mm : 0.0);
+    *p++ = v.triangulable ? 1 : 0;
+    const std::int32_t object = s.object;
+    std::memcpy(p, &object, 4);
+    p += 4;
+  }
+  WriteFileAtomically(path, data);
+}
+
+}  // namespace pandora
