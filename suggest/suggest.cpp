@@ -647,7 +647,7 @@ Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caste
 
 Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& caster,
                           const std::vector<TargetPoint>& targets, const SuggestOptions& options,
-                          std::int64_t evaluation_budget, std::uint64_t seed) {
+                          std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step) {
   using namespace suggest_detail;
   CheckOptions(scene, rig, options);
   const auto t0 = std::chrono::steady_clock::now();
@@ -678,7 +678,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
-  double step = 0.3;  // in units of the limits
+  double step = 0.25;  // standard deviation per parameter, in units of the limits
   std::vector<std::vector<double>> cand = best;
   std::vector<Eigen::Isometry3d> poses = start;
   int rejected_in_a_row = 0;
@@ -701,8 +701,8 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       best_score = score;
       best_m = m;
       best = cand;
-      step = std::min(1.0, step * 1.5);
-    } else {
+      if (adaptive_step) step = std::min(1.0, step * 1.5);
+    } else if (adaptive_step) {
       step = std::max(1e-4, step * std::pow(1.5, -0.25));
     }
     s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});

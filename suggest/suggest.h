@@ -155,12 +155,14 @@ Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caste
 Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
                    const std::vector<TargetPoint>& targets, const SuggestOptions& options);
 
-/// The baseline: random perturbations of the selected cameras within the same limits, each judged
-/// by the exact objective, the better kept ((1+1) strategy with the 1/5 success rule for the step
-/// size), until `evaluation_budget` evaluations are spent. Same result structure and trace.
+/// The baseline: random perturbations of the selected cameras within the same limits (Gaussian,
+/// standard deviation 0.25 of each limit per parameter, around the best so far, projected onto the
+/// limits), each judged by the exact objective, the better kept, until `evaluation_budget`
+/// evaluations are spent. With `adaptive_step` the step size follows the 1/5 success rule (x1.5 on
+/// success, x1.5^-1/4 on failure). Same result structure and trace.
 Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& caster,
                           const std::vector<TargetPoint>& targets, const SuggestOptions& options,
-                          std::int64_t evaluation_budget, std::uint64_t seed);
+                          std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step = false);
 
 /// Scene-format Euler angles (degrees) of a world_from_camera rotation:
 /// R = Rz(yaw) Ry(-pitch) Rx(roll) R_base (docs/scene-format.md), and back.

@@ -30,8 +30,13 @@ using suggest_detail::PoseChart;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPenalty = 10.0;      // weight of the limit and keep-out penalties (cost ~ 1)
 constexpr double kStep = 1e-4;         // central-difference step, in units of the limits
-constexpr double kCountWidth = 0.25;   // soft ">= k": width of the sigmoid in cameras
+constexpr double kCountWidth = 0.4;   // soft ">= k": width of the sigmoid in cameras
 constexpr double kIncidenceWidth = 0.1;
+// Soft image border: margin and width as a fraction of the image width, halved at each of the first
+// outer iterations (0.04, 0.02, then 0.01: about 41, 20, 10 px on a 1024 px image).
+constexpr double kBorderWidth = 0.04;
+// Occlusion slopes from centres moved by this fraction of the largest move.
+constexpr double kOcclusionDelta = 0.25;
 
 double Sigmoid(double z) {
   if (z >= 0) return 1.0 / (1.0 + std::exp(-z));
@@ -385,26 +390,14 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // everything occluded) has no gradient: it stays where it is, and says so.
   std::vector<int> active;
   std::vector<Contribution> frozen_start(nsel);
-  auto occlusion_delta = [&](std::size_t c) { return 0.25 * charts[c].max_move; };
+  auto occlusion_delta = [&](std::size_t c) { return kOcclusionDelta * charts[c].max_move; };
   for (std::size_t c = 0; c < nsel; ++c)
     surrogate.UpdateOcclusion(static_cast<int>(c), start[c], occlusion_delta(c));
-  surrogate.set_border_width(0.08);
+  surrogate.set_border_width(kBorderWidth);
   for (int c : movable) {
     surrogate.Contribute(c, start[c], &frozen_start[c]);
     double wmax = 0;
     for (double w : frozen_start[c].w) wmax = std::max(wmax, w);
-    if (std::getenv("PANDORA_SUGGEST_DEBUG")) {
-      const VisibilityTester t(ev.selected_cameras(), caster, ev.scene_scale());
-      int soft = 0, exact = 0;
-      double sum = 0;
-      for (std::size_t i = 0; i < targets.size(); ++i) {
-        soft += frozen_start[c].w[i] > 0.5;
-        sum += frozen_start[c].w[i];
-        const Vec3* nrm = targets[i].normal ? &*targets[i].normal : nullptr;
-        exact += t.Test(c, targets[i].p, nrm) == ViewResult::kSeen;
-      }
-      std::fprintf(stderr, "camera %d: soft>0.5 %d, sum w %.1f, exact seen %d of %zu\n", c, soft, sum, exact, targets.size());
-    }
     if (wmax > 1e-12) {
       active.push_back(c);
     } else {
@@ -448,11 +441,6 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     if (!ok) return;
     const Metrics m = ev.Evaluate(poses);
     const double score = ev.Score(m);
-    if (std::getenv("PANDORA_SUGGEST_DEBUG")) {
-      std::fprintf(stderr, "exact %.4f at", m.objective);
-      for (auto& v : xs) for (double e : v) std::fprintf(stderr, " %.3f", e);
-      std::fprintf(stderr, "\n");
-    }
     if (score > best_score) {
       best_score = score;
       best_m = m;
@@ -464,7 +452,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   const int outer = std::max(1, options.outer_iterations);
   for (int o = 0; o < outer; ++o) {
     // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
-    surrogate.set_border_width(o == 0 ? 0.08 : (o == 1 ? 0.04 : 0.02));
+    surrogate.set_border_width(o == 0 ? kBorderWidth : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
     x = best_x;
     auto [poses, ok] = poses_of(x);
     (void)ok;
