@@ -118,7 +118,7 @@ void CheckContract(const Fixture& f, const SuggestOptions& o, const Suggestion& 
   }
 }
 
-TEST(Objective, ParsesNamesAndRejectsOthers) {
+TEST(SuggestObjective, ParsesNamesAndRejectsOthers) {
   ASSERT_TRUE(ParseObjective("coverage2"));
   EXPECT_EQ(ParseObjective("coverage2")->k, 2);
   EXPECT_EQ(ParseObjective("coverage")->k, 2);
@@ -137,7 +137,7 @@ TEST(Objective, ParsesNamesAndRejectsOthers) {
   EXPECT_EQ(ObjectiveName(*ParseObjective("coverage4")), "coverage4");
 }
 
-TEST(Euler, RoundTripAndBase) {
+TEST(SuggestEuler, RoundTripAndBase) {
   // All zero: camera looks along +X, image right is -Y, image down is -Z (docs/scene-format.md).
   const Mat3 base = RotationFromYawPitchRollDeg(Vec3::Zero());
   EXPECT_TRUE(base.col(0).isApprox(Vec3(0, -1, 0)));
@@ -156,7 +156,7 @@ TEST(Euler, RoundTripAndBase) {
   }
 }
 
-TEST(ExactEvaluation, CoverageEqualsDirectCount) {
+TEST(SuggestExact, CoverageEqualsDirectCount) {
   Fixture f(SceneText(1.0), 500);
   Objective o;
   const Metrics m = EvaluateExact(f.scene, f.rig(), *f.caster, f.targets, o);
@@ -383,7 +383,7 @@ TEST(Suggest, BaselineRespectsLimitsAndBudget) {
 // ------------------------------------------------------------------------------------------------
 // Accept cycle on files.
 
-class AcceptTest : public ::testing::Test {
+class SuggestAcceptTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("pandora_accept_" + std::to_string(::getpid()) + "_" +
@@ -427,7 +427,7 @@ void ExpectEqualButPoses(const std::string& a_text, const std::string& b_text, c
   EXPECT_EQ(a, b);
 }
 
-TEST_F(AcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
+TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   const fs::path scene_path = dir_ / "scene.json";
   const std::string original = SceneText(1.0);
   Write(scene_path, original);
@@ -473,7 +473,7 @@ TEST_F(AcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   EXPECT_TRUE(both.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
 }
 
-TEST_F(AcceptTest, UnknownCameraAndNoImprovementAreRefused) {
+TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
   const fs::path scene_path = dir_ / "scene.json";
   Write(scene_path, SceneText(1.0));
   const std::string suggestion = MakeSuggestion(scene_path);
@@ -489,7 +489,7 @@ TEST_F(AcceptTest, UnknownCameraAndNoImprovementAreRefused) {
   EXPECT_EQ(Read(scene_path), SceneText(1.0));
 }
 
-TEST_F(AcceptTest, MillimetreFileGetsMillimetres) {
+TEST_F(SuggestAcceptTest, MillimetreFileGetsMillimetres) {
   // The same scene written in millimetres: accept writes the position in the file's unit.
   const fs::path scene_path = dir_ / "scene_mm.json";
   const std::string original = SceneText(1000.0, Vec3(2.0, 0.0, 0.5), "mm");
@@ -503,7 +503,7 @@ TEST_F(AcceptTest, MillimetreFileGetsMillimetres) {
   EXPECT_NEAR(pos[1].get<double>(), s.cameras[1].after.translation().y() * 1000.0, 1e-9);
 }
 
-TEST(ReplacePoses, UntouchedTextIsByteIdentical) {
+TEST(SuggestReplacePoses, UntouchedTextIsByteIdentical) {
   // A file in nlohmann's own layout (any indentation) round-trips byte for byte when no pose
   // changes, and only the pose lines change when one does.
   for (int indent : {1, 2, 4}) {
