@@ -253,7 +253,12 @@ int RunSuggest(const SuggestArgs& args) {
     LogLogPlot plot;
     plot.title = "Ceres nudge vs random local search: " + rig.name + ", " + ObjectiveName(options.objective);
     plot.x_label = "seconds";
-    plot.y_label = "best exact " + ObjectiveName(options.objective);
+    // Coverage is plotted as the share still short of k cameras (1 - coverage), which a log axis shows.
+    const bool shortfall = options.objective.kind == ObjectiveKind::kCoverage;
+    auto y_of = [&](double v) { return shortfall ? 1.0 - v : v; };
+    plot.y_label = shortfall ? "share of targets seen by < " + std::to_string(options.objective.k) +
+                                   " cameras (1 - best exact " + ObjectiveName(options.objective) + ")"
+                             : "best exact " + ObjectiveName(options.objective);
     plot.note = std::to_string(s.target_points) + " target points; same evaluation budget (" +
                 std::to_string(s.evaluations) + " evaluations)";
     const char* labels[] = {"Ceres nudge", "random search, fixed step", "random search, 1/5 rule"};
@@ -263,7 +268,7 @@ int RunSuggest(const SuggestArgs& args) {
       series.markers = false;
       for (const TracePoint& t : runs[r].second->trace) {
         series.x.push_back(std::max(t.seconds, 1e-4));
-        series.y.push_back(t.objective);
+        series.y.push_back(y_of(t.objective));
       }
       plot.series.push_back(series);
     }
@@ -273,7 +278,7 @@ int RunSuggest(const SuggestArgs& args) {
       ref.dashed = true;
       ref.markers = false;
       ref.x = {1e-3, std::max({s.seconds, b.seconds, ba.seconds, 1e-2})};
-      ref.y = {original->objective, original->objective};
+      ref.y = {y_of(original->objective), y_of(original->objective)};
       plot.series.push_back(ref);
     }
     WriteFileAtomically(stem + ".svg", RenderLogLogSvg(plot));

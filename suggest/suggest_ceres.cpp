@@ -44,14 +44,14 @@ double Sigmoid(double z) {
   return e / (1.0 + e);
 }
 
-// A smooth clamp of v to [0, 1] (softplus differences, width 0.02), exactly 0 at 0 and 1 at 1.
+// A smooth clamp of v to [0, 1] (softplus differences, width 0.25), exactly 0 at 0 and 1 at 1.
 double SoftClamp01(double v) {
-  constexpr double kWidth = 0.02;
+  constexpr double kWidth = 0.25;
   auto softplus = [](double z) {
     const double a = z / kWidth;
     return kWidth * (a > 30 ? a : std::log1p(std::exp(a)));
   };
-  static const double s0 = softplus(0.0) - softplus(-1.0);
+  const double s0 = softplus(0.0) - softplus(-1.0);
   const double r = (softplus(v) - softplus(v - 1.0) - s0) / (1.0 - 2.0 * s0);
   return std::clamp(r, 0.0, 1.0);
 }
