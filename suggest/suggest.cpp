@@ -418,6 +418,10 @@ Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vect
 
 double ExactEvaluator::Score(const Metrics& m) const {
   if (std::isnan(m.objective)) return -kInf;
+  // A sigma percentile that falls on an untriangulable point is +inf; among those, fewer
+  // untriangulable points is better (and any finite percentile is better still).
+  if (objective_.kind == ObjectiveKind::kSigmaPercentile && std::isinf(m.objective))
+    return -1e300 * (1.0 + m.untriangulable);
   return ObjectiveHigherIsBetter(objective_) ? m.objective : -m.objective;
 }
 

@@ -44,7 +44,8 @@ struct CameraLimits {
 enum class ObjectiveKind {
   kCoverage,        ///< Share of target points seen by at least `k` cameras (higher is better).
   kSigmaMean,       ///< Mean sigma_max in mm (lower); untriangulable points count as `sigma_cap`.
-  kSigmaPercentile, ///< The `percentile` of sigma_max in mm (lower); untriangulable points are +inf.
+  kSigmaPercentile, ///< The `percentile` of sigma_max in mm (lower); untriangulable points are +inf,
+                    ///< and while the percentile is +inf a smaller untriangulable share is better.
   kResolution,      ///< Minimum over the points of the best pixel density, px/m (higher); unseen: 0.
   kMix,             ///< Weighted mix of the three, each relative to its value at the start (higher).
 };

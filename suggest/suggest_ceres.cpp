@@ -518,8 +518,12 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     s.after = best_m;
     FillChanges(rig, options, best_poses, &s);
     for (int c : active) s.cameras[c].note.clear();
+    std::string extra;
+    if (std::isinf(s.after.objective))
+      extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
+              Num("%.4g", s.before.untriangulable) + " to " + Num("%.4g", s.after.untriangulable);
     return finish(name + " improved from " + Num("%.6g", s.before.objective) + " to " +
-                  Num("%.6g", s.after.objective) + (higher ? " (higher is better)" : " (lower is better)"));
+                  Num("%.6g", s.after.objective) + (higher ? " (higher is better)" : " (lower is better)") + extra);
   }
   if (s.unsnapped)
     return finish("no improvement found: the optimum improved " + name + " to " +
