@@ -60,6 +60,7 @@ struct SuggestArgs {
   std::string objective = "coverage2";
   std::string weights;            ///< "wc,ws,wr" for the mix.
   std::string rail, plane, mount_box;  ///< At most one mount constraint.
+  std::string hfov_range;         ///< "MIN,MAX" degrees: the zoom range; empty: fixed focal length.
   std::vector<std::string> keep_out;   ///< Boxes "x0,y0,z0,x1,y1,z1".
   std::vector<std::string> target_surfaces;
   bool with_region = false;       ///< Region points as well as surface points.

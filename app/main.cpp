@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along DX,DY,DZ");
   sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal NX,NY,NZ");
   sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
+  sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within MIN,MAX degrees");
   sg->add_option("--keep-out", suggest.keep_out, "Box no camera centre may enter (repeatable)");
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");

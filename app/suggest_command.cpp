@@ -80,6 +80,9 @@ void PrintTable(const Suggestion& s, const Scene& scene, const Rig& rig, const s
     std::snprintf(pa, sizeof pa, "(%.3f, %.3f, %.3f)", a.x(), a.y(), a.z());
     std::snprintf(pb, sizeof pb, "(%.3f, %.3f, %.3f)", b.x(), b.y(), b.z());
     std::printf("%-10s %9.3f %12.2f  %-28s %-28s\n", c.id.c_str(), c.move_m, c.rotate_deg, pa, pb);
+    if (c.focal_scale != 1.0)
+      std::printf("           zoom: horizontal field of view %.2f -> %.2f deg\n", c.hfov_before_deg,
+                  c.hfov_after_deg);
     if (!c.note.empty()) std::printf("           note: %s\n", c.note.c_str());
   }
   auto row = [](const char* name, double a, double b) {
@@ -164,6 +167,13 @@ int RunSuggest(const SuggestArgs& args) {
       !(limits.mount.axis.norm() > 0))
     throw InputError(limits.mount.kind == MountConstraint::Kind::kLine ? "--rail" : "--plane", "",
                      "the direction must be a non-zero vector");
+  if (!args.hfov_range.empty()) {
+    const std::vector<double> v = Numbers("--hfov-range", args.hfov_range, 2);
+    if (!(v[0] > 0) || !(v[1] >= v[0]))
+      throw InputError("--hfov-range", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
+    limits.min_hfov_deg = v[0];
+    limits.max_hfov_deg = v[1];
+  }
   options.limits = {limits};
   for (const std::string& box : args.keep_out) options.keep_out.push_back(BoxOption("--keep-out", box));
   const std::optional<Objective> objective = ParseObjective(args.objective);

@@ -338,10 +338,13 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   });
 }
 
-Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses) const {
+Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
+                                 const std::vector<double>& focal_scales) const {
   ++evaluations_;
   std::vector<Camera> cams = selected_;
   for (std::size_t c = 0; c < cams.size() && c < poses.size(); ++c) cams[c].world_from_camera = poses[c];
+  for (std::size_t c = 0; c < cams.size() && c < focal_scales.size(); ++c)
+    if (focal_scales[c] != 1.0) cams[c] = Zoomed(cams[c], focal_scales[c]);
   const VisibilityTester tester(cams, caster_, scene_scale_);
   const std::size_t n = targets_.size();
   std::vector<int> count = fixed_.count;
@@ -453,8 +456,20 @@ PoseChart PoseChart::Make(const Camera& camera, const CameraLimits& limits) {
   }
   c.dims_t = c.max_move > 0 ? static_cast<int>(c.basis.cols()) : 0;
   c.dims_r = c.max_rotate > 0 ? 3 : 0;
+  double zoom_lo = 0, zoom_hi = 0;  // ln(f / f0) at the wide and the narrow end
+  if (limits.max_hfov_deg > 0) {
+    const Intrinsics& k = camera.model.intrinsics();
+    zoom_lo = std::log(FocalFromHfov(Rad(limits.max_hfov_deg), k.width, k.model) / k.fx);
+    zoom_hi = std::log(FocalFromHfov(Rad(limits.min_hfov_deg), k.width, k.model) / k.fx);
+    c.log_focal_range = std::max(std::abs(zoom_lo), std::abs(zoom_hi));
+    c.dims_f = c.log_focal_range > 0 ? 1 : 0;
+  }
   c.lower.assign(c.dims(), -1.0);
   c.upper.assign(c.dims(), 1.0);
+  if (c.dims_f > 0) {
+    c.lower[c.dims_t + c.dims_r] = std::min(0.0, zoom_lo / c.log_focal_range);
+    c.upper[c.dims_t + c.dims_r] = std::max(0.0, zoom_hi / c.log_focal_range);
+  }
   if (limits.mount.kind == MountConstraint::Kind::kBox && c.dims_t == 3) {
     const Vec3 c0 = camera.center();
     for (int a = 0; a < 3; ++a) {
@@ -493,18 +508,19 @@ void PoseChart::Project(double* x) const {
   };
   if (dims_t > 0) project(0, dims_t);
   if (dims_r > 0) project(dims_t, 3);
+  if (dims_f > 0) {
+    const int i = dims_t + dims_r;
+    x[i] = std::clamp(x[i], lower[i], upper[i]);
+  }
 }
 
-void PoseChart::Coordinates(const Eigen::Isometry3d& pose, double* x) const {
-  if (dims_t > 0) {
-    const Eigen::VectorXd t = basis.transpose() * (pose.translation() - start.translation());
-    for (int i = 0; i < dims_t; ++i) x[i] = t[i] / max_move;
-  }
-  if (dims_r > 0) {
-    const Eigen::AngleAxisd aa(start.linear().transpose() * pose.linear());
-    const Vec3 w = aa.axis() * aa.angle() / max_rotate;
-    for (int i = 0; i < 3; ++i) x[dims_t + i] = w[i];
-  }
+Camera Zoomed(const Camera& camera, double scale) {
+  Camera out = camera;
+  Intrinsics k = camera.model.intrinsics();
+  k.fx *= scale;
+  k.fy *= scale;
+  out.model = CameraModel(k);
+  return out;
 }
 
 bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p) {
@@ -541,6 +557,18 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
     if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
       throw InputError(file, "--max-rotate", "the largest rotation must be in [0, 180) degrees (got " +
                                                  Format("%g", l.max_rotate_deg) + ")");
+    if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
+      const Intrinsics& k = cam.model.intrinsics();
+      const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+      if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
+        throw InputError(file, "--hfov-range", "the field-of-view range must satisfy 0 < MIN <= MAX < " +
+                                                    Format("%g", limit) + " degrees");
+      const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
+      if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
+        throw InputError(file, "--hfov-range", "camera '" + cam.id + "' has a field of view of " +
+                                                    Format("%.6g", hfov) + " degrees, outside the range",
+                         "the range must hold the current field of view");
+    }
     const MountConstraint& m = l.mount;
     if ((m.kind == MountConstraint::Kind::kLine || m.kind == MountConstraint::Kind::kPlane) &&
         !(m.axis.norm() > 0 && m.axis.allFinite()))
@@ -618,7 +646,8 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
 }
 
 void FillChanges(const Rig& rig, const SuggestOptions& options,
-                 const std::vector<Eigen::Isometry3d>& poses, Suggestion* s) {
+                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
+                 Suggestion* s) {
   s->cameras.clear();
   for (std::size_t c = 0; c < options.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[options.cameras[c]];
@@ -629,6 +658,10 @@ void FillChanges(const Rig& rig, const SuggestOptions& options,
     ch.after = poses[c];
     ch.move_m = (ch.after.translation() - ch.before.translation()).norm();
     ch.rotate_deg = RotationAngleDeg(ch.before.linear(), ch.after.linear());
+    const Intrinsics& k = cam.model.intrinsics();
+    ch.focal_scale = c < focal_scales.size() ? focal_scales[c] : 1.0;
+    ch.hfov_before_deg = Deg(HfovFromFocal(k.fx, k.width, k.model));
+    ch.hfov_after_deg = Deg(HfovFromFocal(k.fx * ch.focal_scale, k.width, k.model));
     s->cameras.push_back(ch);
   }
 }
@@ -685,6 +718,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   double step = 0.25;  // standard deviation per parameter, in units of the limits
   std::vector<std::vector<double>> cand = best;
   std::vector<Eigen::Isometry3d> poses = start;
+  std::vector<double> scales(charts.size(), 1.0);
   int rejected_in_a_row = 0;
   while (total_dims > 0 && ev.evaluations() < evaluation_budget && rejected_in_a_row < 10000) {
     bool ok = true;
@@ -692,6 +726,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       for (int i = 0; i < charts[c].dims(); ++i) cand[c][i] = best[c][i] + step * normal(rng);
       charts[c].Project(cand[c].data());
       poses[c] = charts[c].Pose(cand[c].data());
+      scales[c] = charts[c].FocalScale(cand[c].data());
       ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
     }
     if (!ok) {  // an inadmissible candidate costs no evaluation
@@ -699,7 +734,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       continue;
     }
     rejected_in_a_row = 0;
-    const Metrics m = ev.Evaluate(poses);
+    const Metrics m = ev.Evaluate(poses, scales);
     const double score = ev.Score(m);
     if (score > best_score) {
       best_score = score;
@@ -711,11 +746,17 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     }
     s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});
   }
-  for (std::size_t c = 0; c < charts.size(); ++c) poses[c] = charts[c].Pose(best[c].data());
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    poses[c] = charts[c].Pose(best[c].data());
+    scales[c] = charts[c].FocalScale(best[c].data());
+  }
   s.improved = best_score > ev.Score(s.before);
-  if (!s.improved) poses = start;
+  if (!s.improved) {
+    poses = start;
+    scales.assign(charts.size(), 1.0);
+  }
   s.after = s.improved ? best_m : s.before;
-  FillChanges(rig, options, poses, &s);
+  FillChanges(rig, options, poses, scales, &s);
   s.evaluations = ev.evaluations();
   s.seconds = elapsed();
   s.message = s.improved ? "baseline improved the objective" : "baseline found no improvement";

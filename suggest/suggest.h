@@ -37,6 +37,10 @@ struct MountConstraint {
 struct CameraLimits {
   double max_move = 0.3;         ///< Largest distance of the new centre from the start, metres (>= 0).
   double max_rotate_deg = 10.0;  ///< Largest rotation angle between start and new orientation (>= 0).
+  /// Zoom range: the horizontal field of view (degrees, FocalFromHfov for the camera's lens model)
+  /// may change within [min_hfov_deg, max_hfov_deg], which must hold the current one. Both 0: the
+  /// focal length stays. A zoom scales fx and fy together; principal point and distortion stay.
+  double min_hfov_deg = 0, max_hfov_deg = 0;
   MountConstraint mount;
 };
 
@@ -104,6 +108,8 @@ struct CameraChange {
   Eigen::Isometry3d after = Eigen::Isometry3d::Identity();
   double move_m = 0;       ///< |centre change|, metres.
   double rotate_deg = 0;   ///< Angle of the relative rotation, degrees.
+  double focal_scale = 1;  ///< fx_after / fx_before (1 without a zoom range).
+  double hfov_before_deg = 0, hfov_after_deg = 0;  ///< Horizontal field of view, degrees.
   /// A message when this camera could not help (for example it sees none of the target and the
   /// surrogate has no gradient); empty otherwise.
   std::string note;

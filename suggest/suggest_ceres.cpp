@@ -132,7 +132,10 @@ class Surrogate {
     }
   }
 
-  void Contribute(int c, const Eigen::Isometry3d& pose, Contribution* out) const {
+  // With a zoom the focal lengths are scaled about the principal point: pixel' = c + s (pixel - c)
+  // for every lens model (the distortion acts on normalised coordinates), so the lens's valid domain
+  // is unchanged and only the pixels and the Jacobian scale.
+  void Contribute(int c, const Eigen::Isometry3d& pose, double focal_scale, Contribution* out) const {
     const Camera& cam = ev_.selected_cameras()[c];
     const auto& targets = ev_.targets();
     const std::size_t n = targets.size();
@@ -157,8 +160,13 @@ class Surrogate {
         const Vec3 v = targets[i].p - C;
         const double dist = v.norm();
         Mat23 Jc;
-        const std::optional<Vec2> px = cam.model.Project(Rt * v, &Jc);
+        std::optional<Vec2> px = cam.model.Project(Rt * v, &Jc);
         if (!px) continue;
+        if (focal_scale != 1.0) {
+          const Vec2 pp(cam.model.intrinsics().cx, cam.model.intrinsics().cy);
+          px = pp + focal_scale * (*px - pp);
+          Jc *= focal_scale;
+        }
         const double border = std::min(std::min(px->x() + 0.5, W - 0.5 - px->x()),
                                        std::min(px->y() + 0.5, H - 0.5 - px->y()));
         double w = Sigmoid((border - tau) / tau);
@@ -252,7 +260,7 @@ int PenaltyRows(const std::vector<Aabb>& keep_out) { return 2 + static_cast<int>
 void Penalties(const PoseChart& chart, const std::vector<Aabb>& keep_out, const double* x, double* r) {
   double t2 = 0, w2 = 0;
   for (int i = 0; i < chart.dims_t; ++i) t2 += x[i] * x[i];
-  for (int i = chart.dims_t; i < chart.dims(); ++i) w2 += x[i] * x[i];
+  for (int i = chart.dims_t; i < chart.dims_t + chart.dims_r; ++i) w2 += x[i] * x[i];
   r[0] = kPenalty * std::max(0.0, std::sqrt(t2) - 1.0);
   r[1] = kPenalty * std::max(0.0, std::sqrt(w2) - 1.0);
   const Vec3 C = chart.Pose(x).translation();
@@ -285,7 +293,8 @@ class SurrogateCost final : public ceres::CostFunction {
     for (const Contribution& f : *frozen_) ptrs.push_back(&f);
     const std::size_t base = ptrs.size();
     for (std::size_t a = 0; a < na; ++a) {
-      s_.Contribute(active_[a], charts_[active_[a]].Pose(parameters[a]), &current[a]);
+      const PoseChart& chart = charts_[active_[a]];
+      s_.Contribute(active_[a], chart.Pose(parameters[a]), chart.FocalScale(parameters[a]), &current[a]);
       ptrs.push_back(&current[a]);
     }
     const int rows = s_.rows();
@@ -308,7 +317,7 @@ class SurrogateCost final : public ceres::CostFunction {
         for (int sign = 0; sign < 2; ++sign) {
           std::vector<double> xs = x;
           xs[j] += sign == 0 ? kStep : -kStep;
-          s_.Contribute(active_[a], chart.Pose(xs.data()), &shifted);
+          s_.Contribute(active_[a], chart.Pose(xs.data()), chart.FocalScale(xs.data()), &shifted);
           ptrs[base + a] = &shifted;
           double* out = sign == 0 ? rp.data() : rm.data();
           s_.Residuals(ptrs, out);
@@ -357,7 +366,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   ev.SetReference(s.before.sigma_mean, s.before.min_resolution);
   if (options.objective.kind == ObjectiveKind::kMix) s.before = ev.Evaluate(start);
   s.after = s.before;
-  FillChanges(rig, options, start, &s);
+  FillChanges(rig, options, start, {}, &s);
   const double start_score = ev.Score(s.before);
   const std::string name = ObjectiveName(options.objective);
 
@@ -395,7 +404,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     surrogate.UpdateOcclusion(static_cast<int>(c), start[c], occlusion_delta(c));
   surrogate.set_border_width(kBorderWidth);
   for (int c : movable) {
-    surrogate.Contribute(c, start[c], &frozen_start[c]);
+    surrogate.Contribute(c, start[c], 1.0, &frozen_start[c]);
     double wmax = 0;
     for (double w : frozen_start[c].w) wmax = std::max(wmax, w);
     if (wmax > 1e-12) {
@@ -425,12 +434,14 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
       return ceres::SOLVER_CONTINUE;
     }
   } judge;
+  std::vector<double> scales(nsel, 1.0);
   auto poses_of = [&](std::vector<std::vector<double>>& xs) {
     std::vector<Eigen::Isometry3d> poses = start;
     bool ok = true;
     for (std::size_t c = 0; c < nsel; ++c) {
       charts[c].Project(xs[c].data());
       poses[c] = charts[c].Pose(xs[c].data());
+      scales[c] = charts[c].FocalScale(xs[c].data());
       ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
     }
     return std::make_pair(poses, ok);
@@ -439,7 +450,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     std::vector<std::vector<double>> xs = x;
     auto [poses, ok] = poses_of(xs);
     if (!ok) return;
-    const Metrics m = ev.Evaluate(poses);
+    const Metrics m = ev.Evaluate(poses, scales);
     const double score = ev.Score(m);
     if (score > best_score) {
       best_score = score;
@@ -458,13 +469,13 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     (void)ok;
     for (int c : active) surrogate.UpdateOcclusion(c, poses[c], occlusion_delta(c));
     for (std::size_t f = 0; f < inactive.size(); ++f)
-      surrogate.Contribute(inactive[f], start[inactive[f]], &frozen[f]);
+      surrogate.Contribute(inactive[f], start[inactive[f]], 1.0, &frozen[f]);
     {
       std::vector<Contribution> current(active.size());
       std::vector<const Contribution*> ptrs;
       for (const Contribution& f : frozen) ptrs.push_back(&f);
       for (std::size_t a = 0; a < active.size(); ++a) {
-        surrogate.Contribute(active[a], poses[active[a]], &current[a]);
+        surrogate.Contribute(active[a], poses[active[a]], scales[active[a]], &current[a]);
         ptrs.push_back(&current[a]);
       }
       surrogate.Normalise(ptrs);
@@ -503,12 +514,16 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   }
 
   std::vector<Eigen::Isometry3d> best_poses = start;
-  for (std::size_t c = 0; c < nsel; ++c) best_poses[c] = charts[c].Pose(best_x[c].data());
+  std::vector<double> best_scales(nsel, 1.0);
+  for (std::size_t c = 0; c < nsel; ++c) {
+    best_poses[c] = charts[c].Pose(best_x[c].data());
+    best_scales[c] = charts[c].FocalScale(best_x[c].data());
+  }
   if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
     if (best_score > start_score) {
       s.unsnapped = best_m;
       best_poses = SnapPoses(charts, best_poses, options);
-      best_m = ev.Evaluate(best_poses);
+      best_m = ev.Evaluate(best_poses, best_scales);
       best_score = ev.Score(best_m);
     }
   }
@@ -516,7 +531,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   const bool higher = ObjectiveHigherIsBetter(options.objective);
   if (s.improved) {
     s.after = best_m;
-    FillChanges(rig, options, best_poses, &s);
+    FillChanges(rig, options, best_poses, best_scales, &s);
     for (int c : active) s.cameras[c].note.clear();
     std::string extra;
     if (std::isinf(s.after.objective))

@@ -3,6 +3,7 @@
 /// Shared by suggest.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
 /// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected camera.
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -30,8 +31,10 @@ class ExactEvaluator {
                  const std::vector<TargetPoint>& targets, const Objective& objective,
                  const std::vector<int>& selected);
 
-  /// Metrics with the selected cameras at `poses` (world_from_camera, one per selected camera).
-  Metrics Evaluate(const std::vector<Eigen::Isometry3d>& poses) const;
+  /// Metrics with the selected cameras at `poses` (world_from_camera, one per selected camera) and,
+  /// when given, their focal lengths scaled by `focal_scales`.
+  Metrics Evaluate(const std::vector<Eigen::Isometry3d>& poses,
+                   const std::vector<double>& focal_scales = {}) const;
   /// Higher is better; -inf for an infinite sigma percentile.
   double Score(const Metrics& m) const;
   /// The mix objective is relative to the start: call once with the start metrics.
@@ -76,16 +79,18 @@ struct PoseChart {
   double max_move = 0, max_rotate = 0;  // metres, radians
   Eigen::Matrix<double, 3, Eigen::Dynamic> basis;  // orthonormal columns (0 to 3)
   MountConstraint mount;
-  int dims_t = 0, dims_r = 0;
-  int dims() const { return dims_t + dims_r; }
+  int dims_t = 0, dims_r = 0, dims_f = 0;  // translation, rotation, zoom (last)
+  double log_focal_range = 0;  // the zoom parameter is ln(f / f0) / log_focal_range
+  int dims() const { return dims_t + dims_r + dims_f; }
+  double FocalScale(const double* x) const {
+    return dims_f > 0 ? std::exp(x[dims_t + dims_r] * log_focal_range) : 1.0;
+  }
   std::vector<double> lower, upper;  // bounds of x
 
   static PoseChart Make(const Camera& camera, const CameraLimits& limits);
   Eigen::Isometry3d Pose(const double* x) const;
   /// Projects x onto the limits (norms <= 1, bounds); true when the result is admissible.
   void Project(double* x) const;
-  /// The parameters of a pose that lies in the chart (used after snapping).
-  void Coordinates(const Eigen::Isometry3d& pose, double* x) const;
 };
 
 /// True when `p` lies inside a keep-out box (closed).
@@ -102,9 +107,13 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
                                          const SuggestOptions& options);
 
-/// Fills the per-camera change records.
+/// Fills the per-camera change records (`focal_scales` empty: no zoom).
 void FillChanges(const Rig& rig, const SuggestOptions& options,
-                 const std::vector<Eigen::Isometry3d>& poses, Suggestion* s);
+                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
+                 Suggestion* s);
+
+/// The camera with its focal lengths scaled by `scale` (principal point and distortion kept).
+Camera Zoomed(const Camera& camera, double scale);
 
 double RotationAngleDeg(const Mat3& a, const Mat3& b);
 

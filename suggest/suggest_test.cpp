@@ -86,7 +86,13 @@ SuggestOptions Options(std::vector<int> cameras, double move, double rotate_deg)
 
 Rig WithPoses(const Rig& rig, const Suggestion& s) {
   Rig r = rig;
-  for (const CameraChange& c : s.cameras) r.cameras[c.index].world_from_camera = c.after;
+  for (const CameraChange& c : s.cameras) {
+    r.cameras[c.index].world_from_camera = c.after;
+    Intrinsics k = r.cameras[c.index].model.intrinsics();
+    k.fx *= c.focal_scale;
+    k.fy *= c.focal_scale;
+    if (c.focal_scale != 1.0) r.cameras[c.index].model = CameraModel(k);
+  }
   return r;
 }
 
@@ -284,6 +290,35 @@ TEST(Suggest, RailPlaneBoxAndKeepOutHold) {
   }
 }
 
+TEST(Suggest, ZoomOnlyStaysInItsRangeAndKeepsThePose) {
+  // c4 looks 26.6 degrees past the region with a 50 degree field of view: zooming out to 80
+  // degrees alone brings the region in.
+  Fixture f(SceneText(1.0));
+  SuggestOptions o = Options({3}, 0.0, 0.0);
+  o.limits[0].min_hfov_deg = 40;
+  o.limits[0].max_hfov_deg = 80;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  ASSERT_TRUE(s.improved) << s.message;
+  const CameraChange& c = s.cameras[0];
+  EXPECT_TRUE(c.after.matrix() == c.before.matrix());
+  EXPECT_NEAR(c.hfov_before_deg, 50.0, 1e-9);
+  EXPECT_GT(c.hfov_after_deg, 55.0);
+  EXPECT_LE(c.hfov_after_deg, 80.0 + 1e-9);
+  EXPECT_LT(c.focal_scale, 1.0);
+  // The reported metrics are those of the zoomed camera.
+  Rig zoomed = f.rig();
+  Intrinsics k = zoomed.cameras[3].model.intrinsics();
+  k.fx *= c.focal_scale;
+  k.fy *= c.focal_scale;
+  zoomed.cameras[3].model = CameraModel(k);
+  EXPECT_DOUBLE_EQ(EvaluateExact(f.scene, zoomed, *f.caster, f.targets, o.objective).objective,
+                   s.after.objective);
+  // A range that does not hold the current field of view is refused.
+  o.limits[0].min_hfov_deg = 60;
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, o), InputError);
+}
+
 TEST(Suggest, SnapRoundsToInstallableSteps) {
   Fixture f(SceneText(1.0));
   SuggestOptions o = Options({3}, 0.3, 30);
@@ -475,6 +510,35 @@ TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   EXPECT_TRUE(both.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
 }
 
+TEST_F(SuggestAcceptTest, ZoomWritesFocalLengthInPlaceOfTheFieldOfView) {
+  const fs::path scene_path = dir_ / "scene.json";
+  const std::string original = SceneText(1.0);
+  Write(scene_path, original);
+  const Scene scene = LoadScene(scene_path.string());
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const auto targets = SampleTargets(scene, 300, {}, false, 7);
+  SuggestOptions o = Options({3}, 0.1, 5);
+  o.limits[0].min_hfov_deg = 40;
+  o.limits[0].max_hfov_deg = 80;
+  const Suggestion s = Suggest(scene, scene.rigs[0], *caster, targets, o);
+  ASSERT_TRUE(s.improved) << s.message;
+  ASSERT_NE(s.cameras[0].focal_scale, 1.0);
+  const fs::path p = dir_ / "suggestion.json";
+  Write(p, SuggestionToJson(s, scene, scene.rigs[0], o));
+  AcceptSuggestion(p.string(), {});
+  const Scene after = LoadScene(scene_path.string());
+  const Intrinsics& k0 = scene.rigs[0].cameras[3].model.intrinsics();
+  const Intrinsics& k1 = after.rigs[0].cameras[3].model.intrinsics();
+  EXPECT_NEAR(k1.fx, k0.fx * s.cameras[0].focal_scale, 1e-9 * k0.fx);
+  EXPECT_NEAR(k1.fy, k0.fy * s.cameras[0].focal_scale, 1e-9 * k0.fy);
+  EXPECT_EQ(k1.cx, k0.cx);
+  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[0].after, 1e-12));
+  const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(Read(scene_path))["rigs"][0]["cameras"][3];
+  std::vector<std::string> keys;
+  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "quaternion", "resolution", "focal_px", "range"}));
+}
+
 TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
   const fs::path scene_path = dir_ / "scene.json";
   Write(scene_path, SceneText(1.0));
@@ -515,10 +579,10 @@ TEST(SuggestReplacePoses, UntouchedTextIsByteIdentical) {
   const std::string text = nlohmann::ordered_json::parse(SceneText(1.0)).dump(2) + "\n";
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = Vec3(1, 2, 3);
-  const std::string out = ReplacePoses(text, "x.json", "ring", {{"c1", pose}});
+  const std::string out = ReplacePoses(text, "x.json", "ring", {{"c1", pose, std::nullopt}});
   ExpectEqualButPoses(text, out, {"c1"});
-  EXPECT_THROW(ReplacePoses(text, "x.json", "nope", {{"c1", pose}}), InputError);
-  EXPECT_THROW(ReplacePoses(text, "x.json", "ring", {{"c9", pose}}), InputError);
+  EXPECT_THROW(ReplacePoses(text, "x.json", "nope", {{"c1", pose, std::nullopt}}), InputError);
+  EXPECT_THROW(ReplacePoses(text, "x.json", "ring", {{"c9", pose, std::nullopt}}), InputError);
 }
 
 }  // namespace

@@ -130,9 +130,15 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
     json limits = {{"max_move_m", l.max_move},
                    {"max_rotate_deg", l.max_rotate_deg},
                    {"mount", kinds[static_cast<int>(l.mount.kind)]}};
+    if (l.max_hfov_deg > 0) limits["hfov_range_deg"] = {l.min_hfov_deg, l.max_hfov_deg};
     json cj = {{"id", ch.id}, {"index", ch.index}, {"before", PoseJson(ch.before)},
                {"after", PoseJson(ch.after)}, {"move_m", ch.move_m}, {"rotate_deg", ch.rotate_deg},
+               {"hfov_deg", {{"before", ch.hfov_before_deg}, {"after", ch.hfov_after_deg}}},
                {"limits", limits}};
+    if (ch.focal_scale != 1.0) {
+      const Intrinsics& k = rig.cameras[ch.index].model.intrinsics();
+      cj["after"]["focal_px"] = {k.fx * ch.focal_scale, k.fy * ch.focal_scale};
+    }
     if (!ch.note.empty()) cj["note"] = ch.note;
     cams.push_back(cj);
   }
@@ -174,13 +180,13 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
     bool found = false;
     for (std::size_t c = 0; c < cameras.size(); ++c) {
       ordered_json& cam = cameras[c];
-      if (!cam.is_object() || !cam.contains("id") || IdOf(cam["id"]) != update.first) continue;
+      if (!cam.is_object() || !cam.contains("id") || IdOf(cam["id"]) != update.id) continue;
       found = true;
       const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
       if (!cam.contains("position"))
         throw InputError(scene_path, where, "the camera has no position");
-      const Vec3 p = update.second.translation() / mpu;
-      const Eigen::Quaterniond q(update.second.linear());
+      const Vec3 p = update.pose.translation() / mpu;
+      const Eigen::Quaterniond q(update.pose.linear());
       ordered_json rebuilt = ordered_json::object();
       for (auto it = cam.begin(); it != cam.end(); ++it) {
         const std::string& key = it.key();
@@ -189,6 +195,8 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
           rebuilt["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
         } else if (key == "look_at" || key == "up" || key == "quaternion" || key == "euler_deg") {
           continue;
+        } else if (update.focal_px && (key == "hfov_deg" || key == "focal_px" || key == "lens")) {
+          rebuilt["focal_px"] = {update.focal_px->x(), update.focal_px->y()};
         } else {
           rebuilt[key] = it.value();
         }
@@ -197,7 +205,7 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
     }
     if (!found)
       throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras",
-                       "no camera '" + update.first + "' in rig '" + rig_name + "'",
+                       "no camera '" + update.id + "' in rig '" + rig_name + "'",
                        "the scene file no longer matches the suggestion");
   }
   const auto [indent, ch] = Indentation(text);
@@ -235,14 +243,23 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   result.scene_path = scene_j["path"].get<std::string>();
 
   std::vector<PoseUpdate> updates;
-  std::map<std::string, Eigen::Isometry3d> offered;
+  std::map<std::string, PoseUpdate> offered;
   std::vector<std::string> order;
   for (std::size_t c = 0; c < cams.size(); ++c) {
     const std::string where = "$.cameras[" + std::to_string(c) + "]";
     if (!cams[c].is_object() || !cams[c].contains("id") || !cams[c]["id"].is_string())
       throw InputError(suggestion_path, where + ".id", "missing camera id");
     const std::string id = cams[c]["id"].get<std::string>();
-    offered[id] = ReadPose(cams[c].value("after", json()), suggestion_path, where + ".after");
+    const json after = cams[c].value("after", json());
+    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt};
+    if (after.is_object() && after.contains("focal_px")) {
+      const json& f = after["focal_px"];
+      if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_number() ||
+          !(f[0].get<double>() > 0) || !(f[1].get<double>() > 0))
+        throw InputError(suggestion_path, where + ".after.focal_px", "expected [fx, fy], positive");
+      u.focal_px = Vec2(f[0].get<double>(), f[1].get<double>());
+    }
+    offered[id] = u;
     order.push_back(id);
   }
   std::vector<std::string> chosen = options.cameras.empty() ? order : options.cameras;
@@ -254,7 +271,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       throw InputError(suggestion_path, "--cameras", "camera '" + id + "' is not in the suggestion",
                        "it offers: " + list);
     }
-    if (unique.insert(id).second) updates.push_back({id, offered[id]});
+    if (unique.insert(id).second) updates.push_back(offered[id]);
   }
 
   const std::string scene_text = ReadBytes(result.scene_path, "scene file");
@@ -275,9 +292,15 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       const Camera& a = before.rigs[r].cameras[c];
       const Camera& b = after.rigs[r].cameras[c];
       Eigen::Isometry3d expected = a.world_from_camera;
-      if (before.rigs[r].name == rig && unique.count(a.id)) expected = offered[a.id];
+      Vec2 focal(a.model.intrinsics().fx, a.model.intrinsics().fy);
+      if (before.rigs[r].name == rig && unique.count(a.id)) {
+        expected = offered[a.id].pose;
+        if (offered[a.id].focal_px) focal = *offered[a.id].focal_px;
+      }
+      const Vec2 focal_read(b.model.intrinsics().fx, b.model.intrinsics().fy);
       const bool same = (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
-                        (b.world_from_camera.linear() - expected.linear()).norm() <= 1e-9;
+                        (b.world_from_camera.linear() - expected.linear()).norm() <= 1e-9 &&
+                        (focal_read - focal).norm() <= 1e-9 * focal.norm();
       if (!same)
         throw InputError(result.scene_path, "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",
                          "internal check failed: the rewritten pose does not read back as intended",
@@ -291,7 +314,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   WriteFileAtomically(backup, scene_text);
   WriteFileAtomically(result.scene_path, new_text);
   result.backup_path = backup;
-  for (const PoseUpdate& u : updates) result.accepted.push_back(u.first);
+  for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
   return result;
 }
 

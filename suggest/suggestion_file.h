@@ -4,6 +4,7 @@
 /// (`pandora accept`): the scene file is rewritten only on accept, only the pose fields of the
 /// accepted cameras change, and the previous file is kept as a backup. No JSON types in this header.
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,12 +21,18 @@ namespace pandora {
 std::string SuggestionToJson(const Suggestion& suggestion, const Scene& scene, const Rig& rig,
                              const SuggestOptions& options);
 
-/// A pose to write: camera id and the new world_from_camera (metres).
-using PoseUpdate = std::pair<std::string, Eigen::Isometry3d>;
+/// A pose to write: camera id, the new world_from_camera (metres) and, after a zoom, the new focal
+/// lengths in pixels.
+struct PoseUpdate {
+  std::string id;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  std::optional<Vec2> focal_px;
+};
 
 /// The scene file text with the pose of each listed camera of `rig` replaced by `position` (in the
 /// file's units) and `quaternion`, at the place of the old `position`; its orientation keys
-/// (`look_at`, `up`, `quaternion`, `euler_deg`) removed. Everything else keeps its order and value;
+/// (`look_at`, `up`, `quaternion`, `euler_deg`) removed. With `focal_px`, the focal-length key
+/// (`hfov_deg`, `focal_px` or `lens`) is replaced by `focal_px` [fx, fy] at its place. Everything else keeps its order and value;
 /// the text is re-serialised with the file's indentation. Throws InputError (file = scene_path) when
 /// the JSON, the rig or a camera cannot be found.
 std::string ReplacePoses(const std::string& scene_text, const std::string& scene_path,
