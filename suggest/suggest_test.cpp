@@ -188,6 +188,46 @@ TEST(SuggestExact, CoverageEqualsDirectCount) {
   EXPECT_LT(share4, 0.9);  // c4 looks past the region: room for a nudge
 }
 
+TEST(SuggestTargets, SurfacePointsLieOnTheSurfaceWithOutwardNormals) {
+  const Scene scene = ParseScene(SceneText(1.0), "test.json");
+  const Vec3 centre(1.6, 1.6, 0.75), half(0.15, 0.15, 0.75);
+  const std::vector<TargetPoint> t = SampleTargets(scene, 200, {"pillar"}, false, 3);
+  ASSERT_EQ(t.size(), 200u);
+  int faces[6] = {0, 0, 0, 0, 0, 0};
+  for (const TargetPoint& p : t) {
+    ASSERT_TRUE(p.normal.has_value());
+    const Vec3 d = p.p - centre;
+    EXPECT_TRUE((d.cwiseAbs().array() <= half.array() + 1e-9).all()) << p.p.transpose();
+    // The normal is the outward axis of the face the point lies on.
+    int axis = -1;
+    p.normal->cwiseAbs().maxCoeff(&axis);
+    EXPECT_NEAR(p.normal->norm(), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs((*p.normal)[axis]), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs(d[axis]), half[axis], 1e-9) << p.p.transpose();
+    EXPECT_GT((*p.normal)[axis] * d[axis], 0.0);
+    ++faces[2 * axis + ((*p.normal)[axis] > 0 ? 1 : 0)];
+  }
+  // Area-weighted: the four tall sides (0.3 x 1.5) get most points, top and bottom (0.3 x 0.3) few.
+  for (int f = 0; f < 4; ++f) EXPECT_GT(faces[f], 25) << f;
+  EXPECT_LT(faces[4] + faces[5], 30);
+  // Half and half with the region; an unknown name is an input error.
+  const std::vector<TargetPoint> mixed = SampleTargets(scene, 200, {"pillar"}, true, 3);
+  int with_normal = 0;
+  for (const TargetPoint& p : mixed) with_normal += p.normal.has_value();
+  EXPECT_EQ(with_normal, 100);
+  EXPECT_THROW(SampleTargets(scene, 100, {"bed"}, false, 3), InputError);
+  EXPECT_THROW(SampleTargets(scene, 0, {}, false, 3), InputError);
+}
+
+TEST(Suggest, SurfaceTargetsEndCleanly) {
+  Fixture f(SceneText(1.0));
+  f.targets = SampleTargets(f.scene, 300, {"pillar"}, false, 3);
+  SuggestOptions o = Options({0, 3}, 0.3, 20);
+  o.objective.k = 2;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+}
+
 TEST(Suggest, RecoversTheObjectiveLostByATurnedCamera) {
   // The same rig with c4 looking at the region is the reference; from the turned pose the nudge must
   // recover at least 80% of the lost coverage.
