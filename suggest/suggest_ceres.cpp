@@ -398,15 +398,15 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // A camera whose smooth weight is zero at every target point (nothing in its image, its range, or
   // everything occluded) has no gradient: it stays where it is, and says so.
   std::vector<int> active;
-  std::vector<Contribution> frozen_start(nsel);
+  std::vector<Contribution> start_weights(nsel);
   auto occlusion_delta = [&](std::size_t c) { return kOcclusionDelta * charts[c].max_move; };
   for (std::size_t c = 0; c < nsel; ++c)
     surrogate.UpdateOcclusion(static_cast<int>(c), start[c], occlusion_delta(c));
   surrogate.set_border_width(kBorderWidth);
   for (int c : movable) {
-    surrogate.Contribute(c, start[c], 1.0, &frozen_start[c]);
+    surrogate.Contribute(c, start[c], 1.0, &start_weights[c]);
     double wmax = 0;
-    for (double w : frozen_start[c].w) wmax = std::max(wmax, w);
+    for (double w : start_weights[c].w) wmax = std::max(wmax, w);
     if (wmax > 1e-12) {
       active.push_back(c);
     } else {
