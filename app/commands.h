@@ -55,12 +55,13 @@ struct SuggestArgs {
   std::string scene;
   std::string rig;
   std::string cameras;            ///< Comma-separated camera ids.
-  double max_move = 0.3;          ///< Metres.
-  double max_rotate = 10.0;       ///< Degrees.
+  std::string max_move = "0.3";   ///< Metres: one value, or one per selected camera (commas).
+  std::string max_rotate = "10";  ///< Degrees: likewise.
   std::string objective = "coverage2";
   std::string weights;            ///< "wc,ws,wr" for the mix.
-  std::string rail, plane, mount_box;  ///< At most one mount constraint.
-  std::string hfov_range;         ///< "MIN,MAX" degrees: the zoom range; empty: fixed focal length.
+  /// Mounts (at most one per camera) and zoom ranges ("MIN,MAX" degrees): each entry applies to all
+  /// selected cameras, or to one with an "ID:" prefix.
+  std::vector<std::string> rail, plane, mount_box, hfov_range;
   std::vector<std::string> keep_out;   ///< Boxes "x0,y0,z0,x1,y1,z1".
   std::vector<std::string> target_surfaces;
   bool with_region = false;       ///< Region points as well as surface points.

@@ -57,15 +57,15 @@ int main(int argc, char** argv) {
   sg->add_option("scene", suggest.scene, "Scene file (JSON)")->required();
   sg->add_option("--rig", suggest.rig, "Rig name (default: the first rig)");
   sg->add_option("--cameras", suggest.cameras, "Comma-separated ids of the cameras that may move")->required();
-  sg->add_option("--max-move", suggest.max_move, "Largest move per camera, metres")->capture_default_str();
-  sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation per camera, degrees")->capture_default_str();
+  sg->add_option("--max-move", suggest.max_move, "Largest move, metres: one value, or one per camera in --cameras order")->capture_default_str();
+  sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation, degrees: one value, or one per camera")->capture_default_str();
   sg->add_option("--objective", suggest.objective,
                  "coverage2 (coverageK), sigma-mean, sigma-p90 (sigma-pNN), resolution, mix")->capture_default_str();
   sg->add_option("--weights", suggest.weights, "Mix weights WC,WS,WR (coverage, sigma, resolution)");
-  sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along DX,DY,DZ");
-  sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal NX,NY,NZ");
-  sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
-  sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within MIN,MAX degrees");
+  sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along [ID:]DX,DY,DZ (repeatable)");
+  sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal [ID:]NX,NY,NZ (repeatable)");
+  sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (repeatable)");
+  sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
   sg->add_option("--keep-out", suggest.keep_out, "Box no camera centre may enter (repeatable)");
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");

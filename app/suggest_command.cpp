@@ -136,45 +136,75 @@ int RunSuggest(const SuggestArgs& args) {
     }
     options.cameras.push_back(found);
   }
-  if (!(args.max_move >= 0) || !std::isfinite(args.max_move))
-    throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
-  if (!(args.max_rotate >= 0) || !(args.max_rotate < 180))
-    throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
-  CameraLimits limits;
-  limits.max_move = args.max_move;
-  limits.max_rotate_deg = args.max_rotate;
-  int mounts = 0;
-  if (!args.rail.empty()) {
-    const std::vector<double> v = Numbers("--rail", args.rail, 3);
-    limits.mount.kind = MountConstraint::Kind::kLine;
-    limits.mount.axis = Vec3(v[0], v[1], v[2]);
-    ++mounts;
+  // Limits per selected camera: one value for all, or one per camera in --cameras order; mounts and
+  // zoom ranges apply to all, or to one camera with an "ID:" prefix (repeatable).
+  const std::size_t nsel = options.cameras.size();
+  auto per_camera = [&](const char* option, const std::string& value) {
+    const std::vector<std::string> items = SplitComma(value);
+    if (items.size() != 1 && items.size() != nsel)
+      throw InputError(option, "", "give one value, or one per selected camera (" + std::to_string(nsel) + ")");
+    std::vector<double> out;
+    for (const std::string& item : items) out.push_back(Numbers(option, item, 1)[0]);
+    out.resize(nsel, out.back());
+    return out;
+  };
+  const std::vector<double> moves = per_camera("--max-move", args.max_move);
+  const std::vector<double> rotations = per_camera("--max-rotate", args.max_rotate);
+  options.limits.assign(nsel, CameraLimits());
+  for (std::size_t c = 0; c < nsel; ++c) {
+    if (!(moves[c] >= 0)) throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
+    if (!(rotations[c] >= 0) || !(rotations[c] < 180))
+      throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
+    options.limits[c].max_move = moves[c];
+    options.limits[c].max_rotate_deg = rotations[c];
   }
-  if (!args.plane.empty()) {
-    const std::vector<double> v = Numbers("--plane", args.plane, 3);
-    limits.mount.kind = MountConstraint::Kind::kPlane;
-    limits.mount.axis = Vec3(v[0], v[1], v[2]);
-    ++mounts;
+  // "ID:VALUE" or "VALUE": the selected cameras it applies to, and the value.
+  auto targets_of = [&](const char* option, const std::string& entry, std::string* value) {
+    std::vector<std::size_t> which;
+    const std::size_t colon = entry.find(':');
+    if (colon == std::string::npos) {
+      *value = entry;
+      for (std::size_t c = 0; c < nsel; ++c) which.push_back(c);
+      return which;
+    }
+    const std::string id = entry.substr(0, colon);
+    *value = entry.substr(colon + 1);
+    for (std::size_t c = 0; c < nsel; ++c)
+      if (file_rig.cameras[options.cameras[c]].id == id) which.push_back(c);
+    if (which.empty())
+      throw InputError(option, "", "camera '" + id + "' is not among the selected cameras (--cameras)");
+    return which;
+  };
+  std::vector<int> mounts(nsel, 0);
+  auto add_mount = [&](const char* option, const std::string& entry, MountConstraint::Kind kind) {
+    std::string value;
+    for (std::size_t c : targets_of(option, entry, &value)) {
+      MountConstraint& m = options.limits[c].mount;
+      m.kind = kind;
+      if (kind == MountConstraint::Kind::kBox) {
+        m.box = BoxOption(option, value);
+      } else {
+        const std::vector<double> v = Numbers(option, value, 3);
+        m.axis = Vec3(v[0], v[1], v[2]);
+        if (!(m.axis.norm() > 0)) throw InputError(option, "", "the direction must be a non-zero vector");
+      }
+      if (++mounts[c] > 1)
+        throw InputError(option, "", "give at most one of --rail, --plane, --mount-box per camera");
+    }
+  };
+  for (const std::string& e : args.rail) add_mount("--rail", e, MountConstraint::Kind::kLine);
+  for (const std::string& e : args.plane) add_mount("--plane", e, MountConstraint::Kind::kPlane);
+  for (const std::string& e : args.mount_box) add_mount("--mount-box", e, MountConstraint::Kind::kBox);
+  for (const std::string& e : args.hfov_range) {
+    std::string value;
+    for (std::size_t c : targets_of("--hfov-range", e, &value)) {
+      const std::vector<double> v = Numbers("--hfov-range", value, 2);
+      if (!(v[0] > 0) || !(v[1] >= v[0]))
+        throw InputError("--hfov-range", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
+      options.limits[c].min_hfov_deg = v[0];
+      options.limits[c].max_hfov_deg = v[1];
+    }
   }
-  if (!args.mount_box.empty()) {
-    limits.mount.kind = MountConstraint::Kind::kBox;
-    limits.mount.box = BoxOption("--mount-box", args.mount_box);
-    ++mounts;
-  }
-  if (mounts > 1)
-    throw InputError("--rail", "", "give at most one of --rail, --plane, --mount-box");
-  if ((limits.mount.kind == MountConstraint::Kind::kLine || limits.mount.kind == MountConstraint::Kind::kPlane) &&
-      !(limits.mount.axis.norm() > 0))
-    throw InputError(limits.mount.kind == MountConstraint::Kind::kLine ? "--rail" : "--plane", "",
-                     "the direction must be a non-zero vector");
-  if (!args.hfov_range.empty()) {
-    const std::vector<double> v = Numbers("--hfov-range", args.hfov_range, 2);
-    if (!(v[0] > 0) || !(v[1] >= v[0]))
-      throw InputError("--hfov-range", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
-    limits.min_hfov_deg = v[0];
-    limits.max_hfov_deg = v[1];
-  }
-  options.limits = {limits};
   for (const std::string& box : args.keep_out) options.keep_out.push_back(BoxOption("--keep-out", box));
   const std::optional<Objective> objective = ParseObjective(args.objective);
   if (!objective)
