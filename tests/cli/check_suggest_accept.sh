@@ -47,5 +47,12 @@ case "$err" in *"changed since"*) ;; *) fail "stale accept message: $err";; esac
 grep -q "limits are zero" "$work/zero.txt" || fail "zero limits message missing"
 err=$("$pandora" accept "$work/zero.json" 2>&1 >/dev/null); code=$?
 [ "$code" -eq 2 ] || fail "accepting a no-improvement suggestion: exit $code"
+"$pandora" suggest "$work/scene.json" --cameras c4 --perturb 0.2,10 --objective coverage4 --points 200 \
+  --out "$work/perturbed.json" > /dev/null || fail "perturbed suggest exit $?"
+before=$(sha256sum < "$work/scene.json")
+err=$("$pandora" accept "$work/perturbed.json" 2>&1 >/dev/null); code=$?
+[ "$code" -eq 2 ] || fail "accepting a perturbed suggestion: exit $code"
+case "$err" in *"perturbed"*) ;; *) fail "perturbed accept message: $err";; esac
+[ "$(sha256sum < "$work/scene.json")" = "$before" ] || fail "refused accept changed the scene"
 ls "$work" | grep -q "tmp-" && fail "temporary files left: $(ls "$work")"
 echo "ok"
