@@ -108,5 +108,41 @@ struct ReportArgs {
   bool quiet = false;
 };
 int RunReport(const ReportArgs& args);
+/// `pandora suggest` (issue 5): nudge the selected cameras within limits (docs/suggest.md); prints the
+/// before/after table and writes the suggestion file. With `compare_baseline` also runs the random
+/// local search with the same evaluation budget and writes CSV + SVG of objective against time.
+struct SuggestArgs {
+  std::string scene;
+  std::string rig;
+  std::string cameras;            ///< Comma-separated camera ids.
+  std::string max_move = "0.3";   ///< Metres: one value, or one per selected camera (commas).
+  std::string max_rotate = "10";  ///< Degrees: likewise.
+  std::string objective = "coverage2";
+  std::string weights;            ///< "wc,ws,wr" for the mix.
+  /// Mounts (at most one per camera) and zoom ranges ("MIN,MAX" degrees): each entry applies to all
+  /// selected cameras, or to one with an "ID:" prefix.
+  std::vector<std::string> rail, plane, mount_box, hfov_range;
+  std::vector<std::string> keep_out;   ///< Boxes "x0,y0,z0,x1,y1,z1".
+  std::vector<std::string> target_surfaces;
+  bool with_region = false;       ///< Region points as well as surface points.
+  int points = 1500;
+  double snap_move = 0, snap_rotate = 0;
+  int outer_iterations = 4;
+  std::string out = "suggestion.json";
+  std::string perturb;            ///< "MOVE,DEG": benchmark from perturbed poses.
+  std::string compare_baseline;   ///< Output folder for the baseline comparison.
+  unsigned long long seed = 1;
+  bool quiet = false;
+};
+int RunSuggest(const SuggestArgs& args);
+
+/// `pandora accept`: writes the suggested poses into the scene file (backup first).
+struct AcceptArgs {
+  std::string suggestion;
+  std::string cameras;  ///< Comma-separated ids; empty: all.
+  bool force = false;
+  bool quiet = false;
+};
+int RunAccept(const AcceptArgs& args);
 
 }  // namespace pandora::app

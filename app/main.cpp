@@ -108,6 +108,43 @@ int main(int argc, char** argv) {
   rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders")->capture_default_str();
   rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
+  SuggestArgs suggest;
+  CLI::App* sg = app.add_subcommand(
+      "suggest", "Nudge the selected cameras within limits to improve an objective; write a suggestion");
+  sg->add_option("scene", suggest.scene, "Scene file (JSON)")->required();
+  sg->add_option("--rig", suggest.rig, "Rig name (default: the first rig)");
+  sg->add_option("--cameras", suggest.cameras, "Comma-separated ids of the cameras that may move")->required();
+  sg->add_option("--max-move", suggest.max_move, "Largest move, metres: one value, or one per camera in --cameras order")->capture_default_str();
+  sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation, degrees: one value, or one per camera")->capture_default_str();
+  sg->add_option("--objective", suggest.objective,
+                 "coverage2 (coverageK), sigma-mean, sigma-p90 (sigma-pNN), resolution, mix")->capture_default_str();
+  sg->add_option("--weights", suggest.weights, "Mix weights WC,WS,WR (coverage, sigma, resolution)");
+  sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along [ID:]DX,DY,DZ (repeatable)");
+  sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal [ID:]NX,NY,NZ (repeatable)");
+  sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (repeatable)");
+  sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
+  sg->add_option("--keep-out", suggest.keep_out, "Box no camera centre may enter (repeatable)");
+  sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
+  sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
+  sg->add_option("--points", suggest.points, "Target points")->capture_default_str();
+  sg->add_option("--snap-move", suggest.snap_move, "Round moves to multiples of this, metres (0: off)");
+  sg->add_option("--snap-rotate", suggest.snap_rotate, "Round yaw/pitch/roll changes to multiples of this, degrees");
+  sg->add_option("--outer", suggest.outer_iterations, "Outer iterations (occlusion re-evaluated between)")
+      ->check(CLI::PositiveNumber);
+  sg->add_option("--out", suggest.out, "Suggestion file")->capture_default_str();
+  sg->add_option("--perturb", suggest.perturb, "Benchmark: first move and rotate the selected cameras by MOVE,DEG");
+  sg->add_option("--compare-baseline", suggest.compare_baseline,
+                 "Also run random local search with the same budget; write CSV and SVG to this folder");
+  sg->add_option("--seed", suggest.seed, "Seed for target points and perturbations")->capture_default_str();
+  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  sg->add_flag("--quiet,-q", suggest.quiet, "Print nothing but errors");
+
+  AcceptArgs accept;
+  CLI::App* ac = app.add_subcommand("accept", "Write a suggestion's poses into the scene file (keeps a backup)");
+  ac->add_option("suggestion", accept.suggestion, "Suggestion file from pandora suggest")->required();
+  ac->add_option("--cameras", accept.cameras, "Comma-separated ids to accept (default: all)");
+  ac->add_flag("--force", accept.force, "Accept even if the scene file changed since");
+  ac->add_flag("--quiet,-q", accept.quiet, "Print nothing but errors");
 
   try {
     app.parse(argc, argv);
@@ -127,6 +164,8 @@ int main(int argc, char** argv) {
     if (*rn) return RunRender(render);
     if (*es) return RunExportSurface(surface);
     if (*rep) return RunReport(report);
+    if (*sg) return RunSuggest(suggest);
+    if (*ac) return RunAccept(accept);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;

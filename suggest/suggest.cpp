@@ -1,0 +1,766 @@
+// Suggest (issue 5), the parts without Ceres: target points, the exact evaluation, objectives, the
+// pose chart of a selected camera, snapping, and the random-perturbation baseline.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <random>
+#include <set>
+#include <string>
+
+#include "analysis/error.h"
+#include "analysis/inside_mesh.h"
+#include "analysis/uncertainty.h"
+#include "analysis/visibility.h"
+#include "suggest/suggest.h"
+#include "suggest/suggest_internal.h"
+
+namespace pandora {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double Deg(double rad) { return rad * 180.0 / kPi; }
+double Rad(double deg) { return deg * kPi / 180.0; }
+
+std::string Format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+Mat3 BaseRotation() {
+  Mat3 b;
+  b.col(0) = Vec3(0, -1, 0);
+  b.col(1) = Vec3(0, 0, -1);
+  b.col(2) = Vec3(1, 0, 0);
+  return b;
+}
+
+double WrapDeg(double a) {
+  a = std::fmod(a + 180.0, 360.0);
+  if (a < 0) a += 360.0;
+  return a - 180.0;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Objectives
+
+std::optional<Objective> ParseObjective(const std::string& name) {
+  Objective o;
+  if (name == "coverage") {
+    o.kind = ObjectiveKind::kCoverage;
+    return o;
+  }
+  auto number = [](const std::string& s, double* v) {
+    if (s.empty() || s.size() > 8) return false;
+    char* end = nullptr;
+    *v = std::strtod(s.c_str(), &end);
+    return end && *end == '\0' && std::isfinite(*v);
+  };
+  double v = 0;
+  if (name.rfind("coverage", 0) == 0 && number(name.substr(8), &v)) {
+    if (v < 1 || v > 64 || v != std::floor(v)) return std::nullopt;
+    o.kind = ObjectiveKind::kCoverage;
+    o.k = static_cast<int>(v);
+    return o;
+  }
+  if (name == "sigma-mean") {
+    o.kind = ObjectiveKind::kSigmaMean;
+    return o;
+  }
+  if (name.rfind("sigma-p", 0) == 0 && number(name.substr(7), &v)) {
+    if (!(v > 0 && v <= 100)) return std::nullopt;
+    o.kind = ObjectiveKind::kSigmaPercentile;
+    o.percentile = v;
+    return o;
+  }
+  if (name == "resolution") {
+    o.kind = ObjectiveKind::kResolution;
+    return o;
+  }
+  if (name == "mix") {
+    o.kind = ObjectiveKind::kMix;
+    return o;
+  }
+  return std::nullopt;
+}
+
+std::string ObjectiveName(const Objective& o) {
+  switch (o.kind) {
+    case ObjectiveKind::kCoverage: return "coverage" + std::to_string(o.k);
+    case ObjectiveKind::kSigmaMean: return "sigma-mean";
+    case ObjectiveKind::kSigmaPercentile: {
+      std::string p = Format("%g", o.percentile);
+      return "sigma-p" + p;
+    }
+    case ObjectiveKind::kResolution: return "resolution";
+    case ObjectiveKind::kMix: return "mix";
+  }
+  return "?";
+}
+
+bool ObjectiveHigherIsBetter(const Objective& o) {
+  return o.kind == ObjectiveKind::kCoverage || o.kind == ObjectiveKind::kResolution ||
+         o.kind == ObjectiveKind::kMix;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Target points
+
+std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
+                                       const std::vector<std::string>& surfaces,
+                                       bool include_region, std::uint64_t seed) {
+  if (count < 1) throw InputError(scene.path, "", "the number of target points must be positive",
+                                  "use --points 1000 or more");
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::vector<TargetPoint> out;
+  const bool region = surfaces.empty() || include_region;
+  const int region_count = surfaces.empty() ? count : (include_region ? count / 2 : 0);
+  const int surface_count = count - region_count;
+
+  if (region && region_count > 0) {
+    const Region& r = scene.study.region;
+    const Aabb& box = r.box;
+    const Vec3 size = box.size();
+    // Cells of equal volume: about region_count of them, stratified per axis.
+    const double volume = std::max(size.x(), 1e-300) * std::max(size.y(), 1e-300) *
+                          std::max(size.z(), 1e-300);
+    const double h = std::cbrt(volume / region_count);
+    Eigen::Vector3i n;
+    for (int a = 0; a < 3; ++a)
+      n[a] = std::max(1, static_cast<int>(std::lround(size[a] / std::max(h, 1e-300))));
+    while (static_cast<long long>(n.x()) * n.y() * n.z() > 4LL * region_count) {
+      const int a = n.x() >= n.y() && n.x() >= n.z() ? 0 : (n.y() >= n.z() ? 1 : 2);
+      n[a] = std::max(1, n[a] / 2);
+    }
+    std::vector<const SceneObject*> solids;
+    for (const SceneObject& o : scene.objects) {
+      if (!o.solid || o.mesh.triangles.empty()) continue;
+      const Aabb b = o.mesh.Bounds();
+      if ((b.max.array() < box.min.array()).any() || (b.min.array() > box.max.array()).any())
+        continue;
+      solids.push_back(&o);
+    }
+    std::vector<std::unique_ptr<InsideMesh>> inside;
+    for (const SceneObject* o : solids) inside.push_back(std::make_unique<InsideMesh>(o->mesh));
+    std::unique_ptr<InsideMesh> region_mesh;
+    if (r.kind == Region::Kind::kMesh && !r.mesh.triangles.empty())
+      region_mesh = std::make_unique<InsideMesh>(r.mesh);
+    for (int i = 0; i < n.x(); ++i)
+      for (int j = 0; j < n.y(); ++j)
+        for (int k = 0; k < n.z(); ++k) {
+          const Vec3 u(uni(rng), uni(rng), uni(rng));
+          const Vec3 p = box.min + Vec3((i + u.x()) / n.x() * size.x(), (j + u.y()) / n.y() * size.y(),
+                                        (k + u.z()) / n.z() * size.z());
+          if (region_mesh && !region_mesh->Inside(p)) continue;
+          bool solid = false;
+          for (const auto& s : inside) solid = solid || s->Inside(p);
+          if (solid) continue;
+          out.push_back({p, std::nullopt});
+        }
+  }
+
+  if (!surfaces.empty() && surface_count > 0) {
+    struct Tri {
+      Vec3 a, b, c, n;
+      double area;
+    };
+    std::vector<Tri> tris;
+    for (const std::string& name : surfaces) {
+      bool found = false;
+      for (const SceneObject& o : scene.objects) {
+        if (o.name != name && o.name.rfind(name + "/", 0) != 0) continue;
+        found = true;
+        for (const Eigen::Vector3i& t : o.mesh.triangles) {
+          const Vec3& a = o.mesh.vertices[t[0]];
+          const Vec3& b = o.mesh.vertices[t[1]];
+          const Vec3& c = o.mesh.vertices[t[2]];
+          const Vec3 cr = (b - a).cross(c - a);
+          const double area = 0.5 * cr.norm();
+          if (!(area > 0)) continue;
+          tris.push_back({a, b, c, cr.normalized(), area});
+        }
+      }
+      if (!found) {
+        std::string names;
+        for (const SceneObject& o : scene.objects) names += (names.empty() ? "" : ", ") + o.name;
+        throw InputError(scene.path, "--target-surface",
+                         "no object called '" + name + "'", "objects: " + names);
+      }
+    }
+    if (tris.empty())
+      throw InputError(scene.path, "--target-surface", "the target surfaces have no area",
+                       "name objects with triangles");
+    std::vector<double> cumulative;
+    double total = 0;
+    for (const Tri& t : tris) cumulative.push_back(total += t.area);
+    for (int s = 0; s < surface_count; ++s) {
+      // Stratified in the cumulative area: one sample per equal-area slice.
+      const double a = (s + uni(rng)) / surface_count * total;
+      const std::size_t idx = std::min<std::size_t>(
+          tris.size() - 1,
+          std::upper_bound(cumulative.begin(), cumulative.end(), a) - cumulative.begin());
+      const Tri& t = tris[idx];
+      double r1 = uni(rng), r2 = uni(rng);
+      if (r1 + r2 > 1) {
+        r1 = 1 - r1;
+        r2 = 1 - r2;
+      }
+      out.push_back({t.a + r1 * (t.b - t.a) + r2 * (t.c - t.a), t.n});
+    }
+  }
+  if (out.empty())
+    throw InputError(scene.path, "$.study.region", "no target point could be placed",
+                     "the region lies inside solid objects; move the region or name target surfaces");
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Euler angles and perturbation
+
+Vec3 YawPitchRollDeg(const Mat3& R) {
+  const Mat3 M = R * BaseRotation().transpose();  // Rz(yaw) Ry(b) Rx(roll), b = -pitch
+  const double sb = std::clamp(-M(2, 0), -1.0, 1.0);
+  const double b = std::asin(sb);
+  double yaw, roll;
+  if (std::abs(sb) > 1.0 - 1e-12) {  // gimbal lock: roll folded into yaw
+    roll = 0;
+    yaw = std::atan2(-M(0, 1), M(1, 1));
+  } else {
+    yaw = std::atan2(M(1, 0), M(0, 0));
+    roll = std::atan2(M(2, 1), M(2, 2));
+  }
+  return Vec3(Deg(yaw), Deg(-b), Deg(roll));
+}
+
+Mat3 RotationFromYawPitchRollDeg(const Vec3& ypr) {
+  const Mat3 M = (Eigen::AngleAxisd(Rad(ypr.x()), Vec3::UnitZ()) *
+                  Eigen::AngleAxisd(-Rad(ypr.y()), Vec3::UnitY()) *
+                  Eigen::AngleAxisd(Rad(ypr.z()), Vec3::UnitX()))
+                     .toRotationMatrix();
+  return M * BaseRotation();
+}
+
+Rig PerturbCameras(const Rig& rig, const std::vector<int>& cameras, double move, double rotate_deg,
+                   std::uint64_t seed) {
+  Rig out = rig;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  auto direction = [&]() {
+    Vec3 d;
+    do d = Vec3(normal(rng), normal(rng), normal(rng));
+    while (d.norm() < 1e-6);
+    return d.normalized();
+  };
+  for (int idx : cameras) {
+    Camera& c = out.cameras.at(idx);
+    const Vec3 t = direction() * move;
+    // Pan / tilt away: the axis is perpendicular to the optical axis, so the view really turns.
+    const Vec3 z = c.world_from_camera.linear().col(2);
+    Vec3 axis = direction();
+    axis = axis - axis.dot(z) * z;
+    if (axis.norm() < 1e-6) axis = z.unitOrthogonal();
+    axis.normalize();
+    const Mat3 R = Eigen::AngleAxisd(Rad(rotate_deg), axis).toRotationMatrix() * c.world_from_camera.linear();
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = R;
+    pose.translation() = c.center() + t;
+    c.world_from_camera = pose;
+  }
+  return out;
+}
+
+namespace suggest_detail {
+
+double RotationAngleDeg(const Mat3& a, const Mat3& b) {
+  return Deg(Eigen::AngleAxisd(a.transpose() * b).angle());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Exact evaluation
+
+ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                               const std::vector<TargetPoint>& targets, const Objective& objective,
+                               const std::vector<int>& selected)
+    : caster_(caster), targets_(targets), objective_(objective) {
+  scene_scale_ = std::max(scene.Bounds().diagonal(), 1e-300);
+  region_scale_ = scene.study.region.box.diagonal();
+  if (!(region_scale_ > 0)) region_scale_ = scene_scale_;
+  sigma_cap_mm_ = region_scale_ * 1000.0;
+  pixel_sigma_ = scene.study.pixel_sigma;
+  std::vector<Camera> fixed;
+  const std::set<int> sel(selected.begin(), selected.end());
+  for (int i = 0; i < static_cast<int>(rig.cameras.size()); ++i) {
+    if (sel.count(i)) selected_.push_back(rig.cameras[i]);
+    else if (rig.cameras[i].enabled) fixed.push_back(rig.cameras[i]);
+  }
+  // A density scale for the soft maximum (keeps d^8 in range for any unit of length).
+  Vec3 centre = scene.study.region.box.empty() ? Vec3::Zero() : scene.study.region.box.center();
+  density_scale_ = 0;
+  for (const Camera& c : rig.cameras) {
+    const double dist = std::max((c.center() - centre).norm(), 1e-12 * scene_scale_);
+    density_scale_ = std::max(density_scale_, c.model.intrinsics().fx / dist);
+  }
+  if (!(density_scale_ > 0) || !std::isfinite(density_scale_)) density_scale_ = 1;
+
+  const std::size_t n = targets_.size();
+  fixed_.count.assign(n, 0);
+  fixed_.J.assign(n, Mat3::Zero());
+  fixed_.dmax.assign(n, 0.0);
+  fixed_.dpow.assign(n, 0.0);
+  const VisibilityTester tester(fixed, caster, scene_scale_);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const TargetPoint& t = targets_[i];
+      const Vec3* normal = t.normal ? &*t.normal : nullptr;
+      for (int c = 0; c < static_cast<int>(fixed.size()); ++c) {
+        Mat23 A;
+        if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
+        const double s = PixelSigma(fixed[c]);
+        fixed_.count[i] += 1;
+        fixed_.J[i] += A.transpose() * A / (s * s);
+        const double d = PixelDensity(A);
+        fixed_.dmax[i] = std::max(fixed_.dmax[i], d);
+        fixed_.dpow[i] += std::pow(d / density_scale_, kSoftMaxPower);
+      }
+    }
+  });
+}
+
+Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
+                                 const std::vector<double>& focal_scales) const {
+  ++evaluations_;
+  std::vector<Camera> cams = selected_;
+  for (std::size_t c = 0; c < cams.size() && c < poses.size(); ++c) cams[c].world_from_camera = poses[c];
+  for (std::size_t c = 0; c < cams.size() && c < focal_scales.size(); ++c)
+    if (focal_scales[c] != 1.0) cams[c] = Zoomed(cams[c], focal_scales[c]);
+  const VisibilityTester tester(cams, caster_, scene_scale_);
+  const std::size_t n = targets_.size();
+  std::vector<int> count = fixed_.count;
+  std::vector<Mat3> J = fixed_.J;
+  std::vector<double> dmax = fixed_.dmax;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const TargetPoint& t = targets_[i];
+      const Vec3* normal = t.normal ? &*t.normal : nullptr;
+      for (int c = 0; c < static_cast<int>(cams.size()); ++c) {
+        Mat23 A;
+        if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
+        const double s = PixelSigma(cams[c]);
+        count[i] += 1;
+        J[i] += A.transpose() * A / (s * s);
+        dmax[i] = std::max(dmax[i], PixelDensity(A));
+      }
+    }
+  });
+  return Summarise(count, J, dmax);
+}
+
+Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
+                                  const std::vector<double>& dmax) const {
+  Metrics m;
+  const std::size_t n = count.size();
+  if (n == 0) return m;
+  std::vector<double> sigma(n, kInf);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      if (count[i] < 2) continue;
+      const Information info = DecomposeInformation(J[i], false);
+      if (!info.observable) continue;
+      sigma[i] = 1000.0 / std::sqrt(info.eigenvalues(0));
+    }
+  });
+  std::size_t k_count = 0, two = 0, untri = 0;
+  double sum = 0, min_res = kInf;
+  for (std::size_t i = 0; i < n; ++i) {
+    k_count += count[i] >= objective_.k;
+    two += count[i] >= 2;
+    untri += std::isinf(sigma[i]);
+    sum += std::min(sigma[i], sigma_cap_mm_);
+    min_res = std::min(min_res, dmax[i]);
+  }
+  m.coverage_k = double(k_count) / n;
+  m.coverage2 = double(two) / n;
+  m.untriangulable = double(untri) / n;
+  m.sigma_mean = sum / n;
+  m.min_resolution = min_res;
+  std::sort(sigma.begin(), sigma.end());
+  auto rank = [&](double p) {
+    const std::size_t r = static_cast<std::size_t>(std::ceil(p / 100.0 * n));
+    return sigma[std::clamp<std::size_t>(r, 1, n) - 1];
+  };
+  m.sigma_p50 = rank(50);
+  m.sigma_p90 = rank(90);
+  m.sigma_p95 = rank(95);
+  switch (objective_.kind) {
+    case ObjectiveKind::kCoverage: m.objective = m.coverage_k; break;
+    case ObjectiveKind::kSigmaMean: m.objective = m.sigma_mean; break;
+    case ObjectiveKind::kSigmaPercentile: m.objective = rank(objective_.percentile); break;
+    case ObjectiveKind::kResolution: m.objective = m.min_resolution; break;
+    case ObjectiveKind::kMix: {
+      const double s = ref_sigma_mean_ > 0 ? ref_sigma_mean_ : m.sigma_mean;
+      const double r = ref_min_resolution_ > 0 ? ref_min_resolution_ : 0;
+      m.objective = objective_.w_coverage * m.coverage_k + objective_.w_sigma * (s / m.sigma_mean) +
+                    objective_.w_resolution * (r > 0 ? m.min_resolution / r : 0.0);
+      break;
+    }
+  }
+  return m;
+}
+
+double ExactEvaluator::Score(const Metrics& m) const {
+  if (std::isnan(m.objective)) return -kInf;
+  // A sigma percentile that falls on an untriangulable point is +inf; among those, fewer
+  // untriangulable points is better (and any finite percentile is better still).
+  if (objective_.kind == ObjectiveKind::kSigmaPercentile && std::isinf(m.objective))
+    return -1e300 * (1.0 + m.untriangulable);
+  return ObjectiveHigherIsBetter(objective_) ? m.objective : -m.objective;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pose chart
+
+PoseChart PoseChart::Make(const Camera& camera, const CameraLimits& limits) {
+  PoseChart c;
+  c.start = camera.world_from_camera;
+  c.max_move = limits.max_move;
+  c.max_rotate = Rad(limits.max_rotate_deg);
+  c.mount = limits.mount;
+  const Vec3 axis = limits.mount.axis.normalized();
+  switch (limits.mount.kind) {
+    case MountConstraint::Kind::kFree:
+    case MountConstraint::Kind::kBox: c.basis = Mat3::Identity(); break;
+    case MountConstraint::Kind::kLine: c.basis = axis; break;
+    case MountConstraint::Kind::kPlane: {
+      int a = 0;
+      for (int i = 1; i < 3; ++i)
+        if (std::abs(axis[i]) < std::abs(axis[a])) a = i;
+      const Vec3 u = axis.cross(Vec3::Unit(a)).normalized();
+      const Vec3 v = axis.cross(u).normalized();
+      c.basis.resize(3, 2);
+      c.basis.col(0) = u;
+      c.basis.col(1) = v;
+      break;
+    }
+  }
+  c.dims_t = c.max_move > 0 ? static_cast<int>(c.basis.cols()) : 0;
+  c.dims_r = c.max_rotate > 0 ? 3 : 0;
+  double zoom_lo = 0, zoom_hi = 0;  // ln(f / f0) at the wide and the narrow end
+  if (limits.max_hfov_deg > 0) {
+    const Intrinsics& k = camera.model.intrinsics();
+    zoom_lo = std::log(FocalFromHfov(Rad(limits.max_hfov_deg), k.width, k.model) / k.fx);
+    zoom_hi = std::log(FocalFromHfov(Rad(limits.min_hfov_deg), k.width, k.model) / k.fx);
+    c.log_focal_range = std::max(std::abs(zoom_lo), std::abs(zoom_hi));
+    c.dims_f = c.log_focal_range > 0 ? 1 : 0;
+  }
+  c.lower.assign(c.dims(), -1.0);
+  c.upper.assign(c.dims(), 1.0);
+  if (c.dims_f > 0) {
+    c.lower[c.dims_t + c.dims_r] = std::min(0.0, zoom_lo / c.log_focal_range);
+    c.upper[c.dims_t + c.dims_r] = std::max(0.0, zoom_hi / c.log_focal_range);
+  }
+  if (limits.mount.kind == MountConstraint::Kind::kBox && c.dims_t == 3) {
+    const Vec3 c0 = camera.center();
+    for (int a = 0; a < 3; ++a) {
+      c.lower[a] = std::max(-1.0, (limits.mount.box.min[a] - c0[a]) / c.max_move);
+      c.upper[a] = std::min(1.0, (limits.mount.box.max[a] - c0[a]) / c.max_move);
+    }
+  }
+  return c;
+}
+
+Eigen::Isometry3d PoseChart::Pose(const double* x) const {
+  Eigen::Isometry3d pose = start;
+  if (dims_t > 0) {
+    Eigen::VectorXd t(dims_t);
+    for (int i = 0; i < dims_t; ++i) t[i] = x[i] * max_move;
+    pose.translation() = start.translation() + basis * t;
+  }
+  if (dims_r > 0) {
+    const Vec3 w = Vec3(x[dims_t], x[dims_t + 1], x[dims_t + 2]) * max_rotate;
+    const double angle = w.norm();
+    if (angle > 0)
+      pose.linear() = start.linear() * Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+  }
+  return pose;
+}
+
+void PoseChart::Project(double* x) const {
+  auto project = [&](int from, int n) {
+    double norm2 = 0;
+    for (int i = from; i < from + n; ++i) norm2 += x[i] * x[i];
+    if (norm2 > 1.0) {
+      const double s = 1.0 / std::sqrt(norm2);
+      for (int i = from; i < from + n; ++i) x[i] *= s;
+    }
+    for (int i = from; i < from + n; ++i) x[i] = std::clamp(x[i], lower[i], upper[i]);
+  };
+  if (dims_t > 0) project(0, dims_t);
+  if (dims_r > 0) project(dims_t, 3);
+  if (dims_f > 0) {
+    const int i = dims_t + dims_r;
+    x[i] = std::clamp(x[i], lower[i], upper[i]);
+  }
+}
+
+Camera Zoomed(const Camera& camera, double scale) {
+  Camera out = camera;
+  Intrinsics k = camera.model.intrinsics();
+  k.fx *= scale;
+  k.fy *= scale;
+  out.model = CameraModel(k);
+  return out;
+}
+
+bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p) {
+  for (const Aabb& b : keep_out)
+    if (b.Contains(p)) return true;
+  return false;
+}
+
+const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i) {
+  return options.limits.size() == 1 ? options.limits[0] : options.limits[i];
+}
+
+void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options) {
+  const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
+  if (options.cameras.empty())
+    throw InputError(file, "--cameras", "no camera selected", "name the cameras to move, e.g. --cameras 3,5");
+  if (options.limits.size() != 1 && options.limits.size() != options.cameras.size())
+    throw InputError(file, "--max-move", "one set of limits, or one per selected camera, is needed");
+  std::set<int> seen;
+  for (std::size_t i = 0; i < options.cameras.size(); ++i) {
+    const int idx = options.cameras[i];
+    if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
+      throw InputError(file, "--cameras", "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
+    const Camera& cam = rig.cameras[idx];
+    if (!seen.insert(idx).second)
+      throw InputError(file, "--cameras", "camera '" + cam.id + "' is selected twice");
+    if (!cam.enabled)
+      throw InputError(file, "--cameras", "camera '" + cam.id + "' is disabled",
+                       "enable it in the scene file to move it");
+    const CameraLimits& l = LimitsOf(options, i);
+    if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
+      throw InputError(file, "--max-move", "the largest move must be a finite length >= 0 (got " +
+                                               Format("%g", l.max_move) + ")");
+    if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
+      throw InputError(file, "--max-rotate", "the largest rotation must be in [0, 180) degrees (got " +
+                                                 Format("%g", l.max_rotate_deg) + ")");
+    if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
+      const Intrinsics& k = cam.model.intrinsics();
+      const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+      if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
+        throw InputError(file, "--hfov-range", "the field-of-view range must satisfy 0 < MIN <= MAX < " +
+                                                    Format("%g", limit) + " degrees");
+      const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
+      if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
+        throw InputError(file, "--hfov-range", "camera '" + cam.id + "' has a field of view of " +
+                                                    Format("%.6g", hfov) + " degrees, outside the range",
+                         "the range must hold the current field of view");
+    }
+    const MountConstraint& m = l.mount;
+    if ((m.kind == MountConstraint::Kind::kLine || m.kind == MountConstraint::Kind::kPlane) &&
+        !(m.axis.norm() > 0 && m.axis.allFinite()))
+      throw InputError(file, m.kind == MountConstraint::Kind::kLine ? "--rail" : "--plane",
+                       "the direction must be a non-zero vector");
+    if (m.kind == MountConstraint::Kind::kBox && !m.box.Contains(cam.center()))
+      throw InputError(file, "--mount-box", "camera '" + cam.id + "' is outside its mounting box",
+                       "the box must hold the camera's current centre");
+    if (InKeepOut(options.keep_out, cam.center()))
+      throw InputError(file, "--keep-out", "camera '" + cam.id + "' is inside a keep-out box",
+                       "a keep-out box must not hold a selected camera's current centre");
+  }
+  if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
+    throw InputError(file, "--snap-move", "must be a finite length >= 0");
+  if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
+    throw InputError(file, "--snap-rotate", "must be a finite angle >= 0");
+  if (options.objective.k < 1 || options.objective.k > 64)
+    throw InputError(file, "--objective", "k must be in 1..64");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Snapping
+
+std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
+                                         const std::vector<Eigen::Isometry3d>& poses,
+                                         const SuggestOptions& options) {
+  std::vector<Eigen::Isometry3d> out = poses;
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    const PoseChart& ch = charts[c];
+    const Eigen::Isometry3d& p = poses[c];
+    Eigen::Isometry3d q = p;
+    // Translation in the mount's coordinates (metres).
+    if (options.snap_move > 0 && ch.dims_t > 0) {
+      const Eigen::VectorXd y = ch.basis.transpose() * (p.translation() - ch.start.translation());
+      auto make = [&](bool truncate) {
+        Eigen::VectorXd r(y.size());
+        for (int i = 0; i < y.size(); ++i) {
+          const double s = y[i] / options.snap_move;
+          r[i] = (truncate ? std::trunc(s) : std::round(s)) * options.snap_move;
+        }
+        return Vec3(ch.start.translation() + ch.basis * r);
+      };
+      auto admissible = [&](const Vec3& centre) {
+        if ((centre - ch.start.translation()).norm() > ch.max_move * (1 + 1e-12)) return false;
+        if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre)) return false;
+        return !InKeepOut(options.keep_out, centre);
+      };
+      Vec3 centre = make(false);
+      if (!admissible(centre)) centre = make(true);
+      if (!admissible(centre)) centre = ch.start.translation();
+      q.translation() = centre;
+    }
+    if (options.snap_rotate_deg > 0 && ch.dims_r > 0) {
+      const Vec3 y0 = YawPitchRollDeg(ch.start.linear());
+      const Vec3 y1 = YawPitchRollDeg(p.linear());
+      Vec3 delta;
+      for (int i = 0; i < 3; ++i) delta[i] = WrapDeg(y1[i] - y0[i]);
+      auto make = [&](bool truncate) {
+        Vec3 r;
+        for (int i = 0; i < 3; ++i) {
+          const double s = delta[i] / options.snap_rotate_deg;
+          r[i] = (truncate ? std::trunc(s) : std::round(s)) * options.snap_rotate_deg;
+        }
+        return Mat3(RotationFromYawPitchRollDeg(y0 + r));
+      };
+      const double limit = Deg(ch.max_rotate) * (1 + 1e-9) + 1e-9;
+      Mat3 R = make(false);
+      if (RotationAngleDeg(ch.start.linear(), R) > limit) R = make(true);
+      if (RotationAngleDeg(ch.start.linear(), R) > limit) R = ch.start.linear();
+      q.linear() = R;
+    }
+    out[c] = q;
+  }
+  return out;
+}
+
+void FillChanges(const Rig& rig, const SuggestOptions& options,
+                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
+                 Suggestion* s) {
+  s->cameras.clear();
+  for (std::size_t c = 0; c < options.cameras.size(); ++c) {
+    const Camera& cam = rig.cameras[options.cameras[c]];
+    CameraChange ch;
+    ch.index = options.cameras[c];
+    ch.id = cam.id;
+    ch.before = cam.world_from_camera;
+    ch.after = poses[c];
+    ch.move_m = (ch.after.translation() - ch.before.translation()).norm();
+    ch.rotate_deg = RotationAngleDeg(ch.before.linear(), ch.after.linear());
+    const Intrinsics& k = cam.model.intrinsics();
+    ch.focal_scale = c < focal_scales.size() ? focal_scales[c] : 1.0;
+    ch.hfov_before_deg = Deg(HfovFromFocal(k.fx, k.width, k.model));
+    ch.hfov_after_deg = Deg(HfovFromFocal(k.fx * ch.focal_scale, k.width, k.model));
+    s->cameras.push_back(ch);
+  }
+}
+
+}  // namespace suggest_detail
+
+// ---------------------------------------------------------------------------------------------
+// Exact evaluation of a whole rig, and the baseline
+
+Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                      const std::vector<TargetPoint>& targets, const Objective& objective) {
+  suggest_detail::ExactEvaluator ev(scene, rig, caster, targets, objective, {});
+  Metrics m = ev.Evaluate({});
+  if (objective.kind == ObjectiveKind::kMix) {
+    ev.SetReference(m.sigma_mean, m.min_resolution);
+    m = ev.Evaluate({});
+  }
+  return m;
+}
+
+Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                          const std::vector<TargetPoint>& targets, const SuggestOptions& options,
+                          std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step) {
+  using namespace suggest_detail;
+  CheckOptions(scene, rig, options);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&]() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  std::vector<PoseChart> charts;
+  std::vector<Eigen::Isometry3d> start;
+  for (std::size_t c = 0; c < options.cameras.size(); ++c) {
+    charts.push_back(PoseChart::Make(rig.cameras[options.cameras[c]], LimitsOf(options, c)));
+    start.push_back(rig.cameras[options.cameras[c]].world_from_camera);
+  }
+  Suggestion s;
+  s.objective = options.objective;
+  s.target_points = static_cast<int>(targets.size());
+  s.before = ev.Evaluate(start);
+  ev.SetReference(s.before.sigma_mean, s.before.min_resolution);
+  if (options.objective.kind == ObjectiveKind::kMix) s.before = ev.Evaluate(start);
+  std::vector<std::vector<double>> best(charts.size());
+  int total_dims = 0;
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    best[c].assign(charts[c].dims(), 0.0);
+    total_dims += charts[c].dims();
+  }
+  Metrics best_m = s.before;
+  double best_score = ev.Score(best_m);
+  s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  double step = 0.25;  // standard deviation per parameter, in units of the limits
+  std::vector<std::vector<double>> cand = best;
+  std::vector<Eigen::Isometry3d> poses = start;
+  std::vector<double> scales(charts.size(), 1.0);
+  int rejected_in_a_row = 0;
+  while (total_dims > 0 && ev.evaluations() < evaluation_budget && rejected_in_a_row < 10000) {
+    bool ok = true;
+    for (std::size_t c = 0; c < charts.size(); ++c) {
+      for (int i = 0; i < charts[c].dims(); ++i) cand[c][i] = best[c][i] + step * normal(rng);
+      charts[c].Project(cand[c].data());
+      poses[c] = charts[c].Pose(cand[c].data());
+      scales[c] = charts[c].FocalScale(cand[c].data());
+      ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
+    }
+    if (!ok) {  // an inadmissible candidate costs no evaluation
+      ++rejected_in_a_row;
+      continue;
+    }
+    rejected_in_a_row = 0;
+    const Metrics m = ev.Evaluate(poses, scales);
+    const double score = ev.Score(m);
+    if (score > best_score) {
+      best_score = score;
+      best_m = m;
+      best = cand;
+      if (adaptive_step) step = std::min(1.0, step * 1.5);
+    } else if (adaptive_step) {
+      step = std::max(1e-4, step * std::pow(1.5, -0.25));
+    }
+    s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});
+  }
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    poses[c] = charts[c].Pose(best[c].data());
+    scales[c] = charts[c].FocalScale(best[c].data());
+  }
+  s.improved = best_score > ev.Score(s.before);
+  if (!s.improved) {
+    poses = start;
+    scales.assign(charts.size(), 1.0);
+  }
+  s.after = s.improved ? best_m : s.before;
+  FillChanges(rig, options, poses, scales, &s);
+  s.evaluations = ev.evaluations();
+  s.seconds = elapsed();
+  s.message = s.improved ? "baseline improved the objective" : "baseline found no improvement";
+  return s;
+}
+
+}  // namespace pandora

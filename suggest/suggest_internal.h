@@ -1,0 +1,120 @@
+#pragma once
+/// \file suggest_internal.h
+/// Shared by suggest.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
+/// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected camera.
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "analysis/visibility.h"
+#include "suggest/suggest.h"
+
+namespace pandora::suggest_detail {
+
+/// Per target point: what the fixed (unselected, enabled) cameras contribute, exactly.
+struct FixedContribution {
+  std::vector<int> count;        ///< Cameras that see the point.
+  std::vector<Mat3> J;           ///< Information sum A^T A / sigma^2, 1/m^2.
+  std::vector<double> dmax;      ///< Best pixel density, px/m (0 when none sees it).
+  std::vector<double> dpow;      ///< Sum over seeing cameras of (d / density_scale)^kSoftMaxPower.
+};
+
+inline constexpr double kSoftMaxPower = 8.0;
+
+/// Exact evaluation with the fixed cameras precomputed: only the selected cameras are tested again
+/// at each candidate pose.
+class ExactEvaluator {
+ public:
+  ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                 const std::vector<TargetPoint>& targets, const Objective& objective,
+                 const std::vector<int>& selected);
+
+  /// Metrics with the selected cameras at `poses` (world_from_camera, one per selected camera) and,
+  /// when given, their focal lengths scaled by `focal_scales`.
+  Metrics Evaluate(const std::vector<Eigen::Isometry3d>& poses,
+                   const std::vector<double>& focal_scales = {}) const;
+  /// Higher is better; -inf for an infinite sigma percentile.
+  double Score(const Metrics& m) const;
+  /// The mix objective is relative to the start: call once with the start metrics.
+  void SetReference(double sigma_mean_mm, double min_resolution) {
+    ref_sigma_mean_ = sigma_mean_mm;
+    ref_min_resolution_ = min_resolution;
+  }
+
+  const FixedContribution& fixed() const { return fixed_; }
+  const std::vector<TargetPoint>& targets() const { return targets_; }
+  const std::vector<Camera>& selected_cameras() const { return selected_; }
+  const Objective& objective() const { return objective_; }
+  double scene_scale() const { return scene_scale_; }
+  double region_scale() const { return region_scale_; }
+  double density_scale() const { return density_scale_; }
+  double sigma_cap_mm() const { return sigma_cap_mm_; }
+  double PixelSigma(const Camera& c) const { return c.pixel_sigma > 0 ? c.pixel_sigma : pixel_sigma_; }
+  const RayCaster& caster() const { return caster_; }
+  std::int64_t evaluations() const { return evaluations_; }
+
+ private:
+  Metrics Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
+                    const std::vector<double>& dmax) const;
+
+  const RayCaster& caster_;
+  std::vector<TargetPoint> targets_;
+  Objective objective_;
+  std::vector<Camera> selected_;
+  FixedContribution fixed_;
+  double scene_scale_ = 1, region_scale_ = 1, density_scale_ = 1, sigma_cap_mm_ = 1;
+  double pixel_sigma_ = 0.5;
+  double ref_sigma_mean_ = 0, ref_min_resolution_ = 0;
+  mutable std::int64_t evaluations_ = 0;
+};
+
+/// How a selected camera's pose is parameterised: x = (translation coordinates, rotation vector),
+/// each scaled so that +-1 is the limit. Centre = C0 + basis * (x_t * max_move); rotation
+/// R = R0 * Exp(x_r * max_rotate) (a rotation vector in the camera frame around the start pose, a
+/// chart of SO(3) valid for angles below 180 degrees, so the rotation limit is a bound).
+struct PoseChart {
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  double max_move = 0, max_rotate = 0;  // metres, radians
+  Eigen::Matrix<double, 3, Eigen::Dynamic> basis;  // orthonormal columns (0 to 3)
+  MountConstraint mount;
+  int dims_t = 0, dims_r = 0, dims_f = 0;  // translation, rotation, zoom (last)
+  double log_focal_range = 0;  // the zoom parameter is ln(f / f0) / log_focal_range
+  int dims() const { return dims_t + dims_r + dims_f; }
+  double FocalScale(const double* x) const {
+    return dims_f > 0 ? std::exp(x[dims_t + dims_r] * log_focal_range) : 1.0;
+  }
+  std::vector<double> lower, upper;  // bounds of x
+
+  static PoseChart Make(const Camera& camera, const CameraLimits& limits);
+  Eigen::Isometry3d Pose(const double* x) const;
+  /// Projects x onto the limits (norms <= 1, bounds); true when the result is admissible.
+  void Project(double* x) const;
+};
+
+/// True when `p` lies inside a keep-out box (closed).
+bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p);
+
+/// Checks the selection and the limits; throws InputError naming the option.
+void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options);
+
+/// The limits of selected camera i.
+const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i);
+
+/// Rounds the change of each camera to the snap steps, within the limits; returns the new poses.
+std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
+                                         const std::vector<Eigen::Isometry3d>& poses,
+                                         const SuggestOptions& options);
+
+/// Fills the per-camera change records (`focal_scales` empty: no zoom).
+void FillChanges(const Rig& rig, const SuggestOptions& options,
+                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
+                 Suggestion* s);
+
+/// The camera with its focal lengths scaled by `scale` (principal point and distortion kept).
+Camera Zoomed(const Camera& camera, double scale);
+
+double RotationAngleDeg(const Mat3& a, const Mat3& b);
+
+}  // namespace pandora::suggest_detail

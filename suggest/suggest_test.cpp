@@ -1,0 +1,629 @@
+// Suggest and accept (issue 5): recovery, limits and mounts, stability cases, the exact evaluation
+// against a direct count, and the accept cycle on real files.
+#include "suggest/suggest.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <unistd.h>
+#include <sstream>
+#include <string>
+
+#include "analysis/error.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+#include "analysis/sha256.h"
+#include "analysis/visibility.h"
+#include "suggest/suggestion_file.h"
+
+namespace pandora {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+std::string Vec(double x, double y, double z, double s) {
+  return "[" + Num(x * s) + ", " + Num(y * s) + ", " + Num(z * s) + "]";
+}
+
+// Four cameras on a ring around a 1 m region with a pillar beside it; every length times `s`.
+// Camera c4 looks past the region (26.6 degrees off, half its 50 degree field of view), so a nudge
+// can bring it back. `c4_look` overrides where c4 looks (unscaled).
+std::string SceneText(double s, Vec3 c4_look = Vec3(2.0, 0.0, 0.5), const std::string& units = "m") {
+  std::string t = "{\n  \"pandora\": 1,\n  \"units\": \"" + units + "\",\n  \"objects\": [\n";
+  t += "    {\"name\": \"floor\", \"box\": {\"size\": " + Vec(8, 8, 0.1, s) + "}, \"position\": " +
+       Vec(0, 0, -0.05, s) + ", \"solid\": true},\n";
+  t += "    {\"name\": \"pillar\", \"box\": {\"size\": " + Vec(0.3, 0.3, 1.5, s) + "}, \"position\": " +
+       Vec(1.6, 1.6, 0.75, s) + ", \"solid\": true}\n  ],\n";
+  t += "  \"rigs\": [\n    {\"name\": \"ring\", \"cameras\": [\n";
+  const double pos[4][2] = {{4, 0}, {0, 4}, {-4, 0}, {0, -4}};
+  for (int c = 0; c < 4; ++c) {
+    const Vec3 look = c == 3 ? c4_look : Vec3(0, 0, 0.5);
+    t += "      {\"id\": \"c" + std::to_string(c + 1) + "\", \"position\": " +
+         Vec(pos[c][0], pos[c][1], 2.0, s) + ", \"look_at\": " + Vec(look.x(), look.y(), look.z(), s) +
+         ", \"resolution\": [640, 480], \"hfov_deg\": 50, \"range\": {\"near\": " + Num(0.2 * s) +
+         ", \"far\": " + Num(12 * s) + "}}" + (c < 3 ? ",\n" : "\n");
+  }
+  t += "    ]}\n  ],\n";
+  t += "  \"study\": {\"region\": {\"box\": {\"min\": " + Vec(-0.5, -0.5, 0, s) + ", \"max\": " +
+       Vec(0.5, 0.5, 1.0, s) + "}}, \"voxel_size\": " + Num(0.05 * s) + "}\n}\n";
+  return t;
+}
+
+struct Fixture {
+  Scene scene;
+  std::unique_ptr<RayCaster> caster;
+  std::vector<TargetPoint> targets;
+  explicit Fixture(const std::string& text, int points = 300, const std::string& path = "test.json")
+      : scene(ParseScene(text, path)) {
+    caster = MakeEmbreeRayCaster(scene.AllTriangles());
+    targets = SampleTargets(scene, points, {}, false, 7);
+  }
+  const Rig& rig() const { return scene.rigs[0]; }
+};
+
+SuggestOptions Options(std::vector<int> cameras, double move, double rotate_deg) {
+  SuggestOptions o;
+  o.objective.k = 4;  // the ring's three other cameras see the whole region: c4 decides coverage4
+  o.cameras = std::move(cameras);
+  CameraLimits l;
+  l.max_move = move;
+  l.max_rotate_deg = rotate_deg;
+  o.limits = {l};
+  return o;
+}
+
+Rig WithPoses(const Rig& rig, const Suggestion& s) {
+  Rig r = rig;
+  for (const CameraChange& c : s.cameras) {
+    r.cameras[c.index].world_from_camera = c.after;
+    Intrinsics k = r.cameras[c.index].model.intrinsics();
+    k.fx *= c.focal_scale;
+    k.fy *= c.focal_scale;
+    if (c.focal_scale != 1.0) r.cameras[c.index].model = CameraModel(k);
+  }
+  return r;
+}
+
+// Checks what every suggestion must satisfy: never worse, the limits hold, and `after` is what the
+// exact evaluation of the returned rig gives.
+void CheckContract(const Fixture& f, const SuggestOptions& o, const Suggestion& s) {
+  const bool higher = ObjectiveHigherIsBetter(o.objective);
+  if (s.improved && std::isinf(s.after.objective))  // sigma percentile on an untriangulable point
+    EXPECT_LT(s.after.untriangulable, s.before.untriangulable);
+  else if (s.improved)
+    EXPECT_TRUE(higher ? s.after.objective > s.before.objective : s.after.objective < s.before.objective);
+  else
+    EXPECT_EQ(s.after.objective, s.before.objective);
+  EXPECT_FALSE(s.message.empty());
+  ASSERT_EQ(s.cameras.size(), o.cameras.size());
+  for (std::size_t c = 0; c < s.cameras.size(); ++c) {
+    const CameraLimits& l = o.limits.size() == 1 ? o.limits[0] : o.limits[c];
+    const CameraChange& ch = s.cameras[c];
+    EXPECT_LE(ch.move_m, l.max_move * (1 + 1e-9) + 1e-15);
+    EXPECT_LE(ch.rotate_deg, l.max_rotate_deg + 1e-6);
+    EXPECT_NEAR(ch.move_m, (ch.after.translation() - ch.before.translation()).norm(), 1e-12 * (1 + ch.move_m));
+    EXPECT_TRUE(ch.after.matrix().allFinite());
+    if (!s.improved) {
+      EXPECT_TRUE(ch.after.isApprox(ch.before, 0.0)) << "not improved, yet a pose changed";
+    }
+  }
+  const Metrics check = EvaluateExact(f.scene, WithPoses(f.rig(), s), *f.caster, f.targets, o.objective);
+  if (o.objective.kind != ObjectiveKind::kMix) {
+    EXPECT_DOUBLE_EQ(check.objective, s.after.objective);
+    EXPECT_DOUBLE_EQ(check.coverage2, s.after.coverage2);
+  }
+}
+
+TEST(SuggestObjective, ParsesNamesAndRejectsOthers) {
+  ASSERT_TRUE(ParseObjective("coverage2"));
+  EXPECT_EQ(ParseObjective("coverage2")->k, 2);
+  EXPECT_EQ(ParseObjective("coverage")->k, 2);
+  EXPECT_EQ(ParseObjective("coverage3")->k, 3);
+  EXPECT_EQ(ParseObjective("sigma-p95")->kind, ObjectiveKind::kSigmaPercentile);
+  EXPECT_EQ(ParseObjective("sigma-p95")->percentile, 95);
+  EXPECT_EQ(ParseObjective("sigma-mean")->kind, ObjectiveKind::kSigmaMean);
+  EXPECT_EQ(ParseObjective("resolution")->kind, ObjectiveKind::kResolution);
+  EXPECT_EQ(ParseObjective("mix")->kind, ObjectiveKind::kMix);
+  EXPECT_FALSE(ParseObjective("coverage0"));
+  EXPECT_FALSE(ParseObjective("coverage2.5"));
+  EXPECT_FALSE(ParseObjective("sigma-p0"));
+  EXPECT_FALSE(ParseObjective("sigma-p101"));
+  EXPECT_FALSE(ParseObjective("covrage2"));
+  EXPECT_EQ(ObjectiveName(*ParseObjective("sigma-p90")), "sigma-p90");
+  EXPECT_EQ(ObjectiveName(*ParseObjective("coverage4")), "coverage4");
+}
+
+TEST(SuggestEuler, RoundTripAndBase) {
+  // All zero: camera looks along +X, image right is -Y, image down is -Z (docs/scene-format.md).
+  const Mat3 base = RotationFromYawPitchRollDeg(Vec3::Zero());
+  EXPECT_TRUE(base.col(0).isApprox(Vec3(0, -1, 0)));
+  EXPECT_TRUE(base.col(1).isApprox(Vec3(0, 0, -1)));
+  EXPECT_TRUE(base.col(2).isApprox(Vec3(1, 0, 0)));
+  // Positive yaw turns left toward +Y; positive pitch tilts the view up.
+  EXPECT_GT(RotationFromYawPitchRollDeg(Vec3(10, 0, 0)).col(2).y(), 0.1);
+  EXPECT_GT(RotationFromYawPitchRollDeg(Vec3(0, 10, 0)).col(2).z(), 0.1);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-170, 170), p(-85, 85);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 ypr(u(rng), p(rng), u(rng));
+    const Mat3 R = RotationFromYawPitchRollDeg(ypr);
+    EXPECT_TRUE(YawPitchRollDeg(R).isApprox(ypr, 1e-9)) << ypr.transpose();
+    EXPECT_TRUE(RotationFromYawPitchRollDeg(YawPitchRollDeg(R)).isApprox(R, 1e-12));
+  }
+}
+
+TEST(SuggestExact, CoverageEqualsDirectCount) {
+  Fixture f(SceneText(1.0), 500);
+  Objective o;
+  const Metrics m = EvaluateExact(f.scene, f.rig(), *f.caster, f.targets, o);
+  const VisibilityTester tester(f.rig().cameras, *f.caster, f.scene.Bounds().diagonal());
+  int two = 0, four = 0;
+  for (const TargetPoint& t : f.targets) {
+    int n = 0;
+    for (int c = 0; c < 4; ++c) n += tester.Test(c, t.p) == ViewResult::kSeen;
+    two += n >= 2;
+    four += n >= 4;
+  }
+  EXPECT_DOUBLE_EQ(m.coverage2, double(two) / f.targets.size());
+  EXPECT_DOUBLE_EQ(m.objective, m.coverage2);
+  Objective o4 = o;
+  o4.k = 4;
+  const double share4 = EvaluateExact(f.scene, f.rig(), *f.caster, f.targets, o4).objective;
+  EXPECT_DOUBLE_EQ(share4, double(four) / f.targets.size());
+  // Target points are inside the region and outside the solids.
+  for (const TargetPoint& t : f.targets) EXPECT_TRUE(f.scene.study.region.box.Contains(t.p));
+  EXPECT_GT(share4, 0.1);
+  EXPECT_LT(share4, 0.9);  // c4 looks past the region: room for a nudge
+}
+
+TEST(SuggestTargets, SurfacePointsLieOnTheSurfaceWithOutwardNormals) {
+  const Scene scene = ParseScene(SceneText(1.0), "test.json");
+  const Vec3 centre(1.6, 1.6, 0.75), half(0.15, 0.15, 0.75);
+  const std::vector<TargetPoint> t = SampleTargets(scene, 200, {"pillar"}, false, 3);
+  ASSERT_EQ(t.size(), 200u);
+  int faces[6] = {0, 0, 0, 0, 0, 0};
+  for (const TargetPoint& p : t) {
+    ASSERT_TRUE(p.normal.has_value());
+    const Vec3 d = p.p - centre;
+    EXPECT_TRUE((d.cwiseAbs().array() <= half.array() + 1e-9).all()) << p.p.transpose();
+    // The normal is the outward axis of the face the point lies on.
+    int axis = -1;
+    p.normal->cwiseAbs().maxCoeff(&axis);
+    EXPECT_NEAR(p.normal->norm(), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs((*p.normal)[axis]), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs(d[axis]), half[axis], 1e-9) << p.p.transpose();
+    EXPECT_GT((*p.normal)[axis] * d[axis], 0.0);
+    ++faces[2 * axis + ((*p.normal)[axis] > 0 ? 1 : 0)];
+  }
+  // Area-weighted: the four tall sides (0.3 x 1.5) get most points, top and bottom (0.3 x 0.3) few.
+  for (int f = 0; f < 4; ++f) EXPECT_GT(faces[f], 25) << f;
+  EXPECT_LT(faces[4] + faces[5], 30);
+  // Half and half with the region; an unknown name is an input error.
+  const std::vector<TargetPoint> mixed = SampleTargets(scene, 200, {"pillar"}, true, 3);
+  int with_normal = 0;
+  for (const TargetPoint& p : mixed) with_normal += p.normal.has_value();
+  EXPECT_EQ(with_normal, 100);
+  EXPECT_THROW(SampleTargets(scene, 100, {"bed"}, false, 3), InputError);
+  EXPECT_THROW(SampleTargets(scene, 0, {}, false, 3), InputError);
+}
+
+TEST(Suggest, SurfaceTargetsEndCleanly) {
+  Fixture f(SceneText(1.0));
+  f.targets = SampleTargets(f.scene, 300, {"pillar"}, false, 3);
+  SuggestOptions o = Options({0, 3}, 0.3, 20);
+  o.objective.k = 2;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+}
+
+TEST(Suggest, RecoversTheObjectiveLostByATurnedCamera) {
+  // The same rig with c4 looking at the region is the reference; from the turned pose the nudge must
+  // recover at least 80% of the lost coverage.
+  Fixture good(SceneText(1.0, Vec3(0, 0, 0.5)));
+  Fixture f(SceneText(1.0));
+  const SuggestOptions o = Options({3}, 0.3, 30);
+  const double reference = EvaluateExact(good.scene, good.rig(), *good.caster, f.targets, o.objective).objective;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  ASSERT_TRUE(s.improved) << s.message;
+  const double lost = reference - s.before.objective;
+  ASSERT_GT(lost, 0.05);
+  EXPECT_GE(s.after.objective - s.before.objective, 0.8 * lost)
+      << "before " << s.before.objective << " after " << s.after.objective << " reference " << reference;
+  EXPECT_GT(s.cameras[0].rotate_deg, 5.0);
+  EXPECT_GT(s.iterations, 0);
+  EXPECT_FALSE(s.trace.empty());
+  for (std::size_t i = 1; i < s.trace.size(); ++i) EXPECT_GE(s.trace[i].objective, s.trace[i - 1].objective);
+}
+
+TEST(Suggest, TraumaRoomRecoveryFromPerturbedCameras) {
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const std::vector<TargetPoint> targets = SampleTargets(scene, 400, {}, false, 1);
+  for (const char* name : {"octagon", "grid4x2"}) {
+    const Rig& rig = scene.FindRig(name);
+    const std::vector<int> sel{2, 5};
+    const Rig perturbed = PerturbCameras(rig, sel, 0.3, 25, 1);
+    Objective o;
+    const double original = EvaluateExact(scene, rig, *caster, targets, o).objective;
+    SuggestOptions opt = Options(sel, 0.4, 30);
+    opt.objective = o;  // coverage2, the default
+    const Suggestion s = Suggest(scene, perturbed, *caster, targets, opt);
+    ASSERT_TRUE(s.improved) << name << ": " << s.message;
+    // Recovers the loss: at least the original objective (the nudge often beats the original).
+    EXPECT_GE(s.after.objective, original) << name << " perturbed " << s.before.objective;
+  }
+}
+
+TEST(Suggest, ZeroLimitsReturnTheSamePoses) {
+  Fixture f(SceneText(1.0));
+  const SuggestOptions o = Options({1, 3}, 0.0, 0.0);
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  EXPECT_FALSE(s.improved);
+  EXPECT_NE(s.message.find("limits are zero"), std::string::npos) << s.message;
+  for (const CameraChange& c : s.cameras) {
+    EXPECT_TRUE(c.after.matrix() == c.before.matrix());
+    EXPECT_EQ(c.move_m, 0.0);
+    EXPECT_EQ(c.rotate_deg, 0.0);
+  }
+}
+
+TEST(Suggest, RotationOnlyKeepsTheCentre) {
+  Fixture f(SceneText(1.0));
+  const SuggestOptions o = Options({3}, 0.0, 30);
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  ASSERT_TRUE(s.improved) << s.message;
+  EXPECT_TRUE(s.cameras[0].after.translation() == s.cameras[0].before.translation());
+}
+
+TEST(Suggest, RailPlaneBoxAndKeepOutHold) {
+  Fixture f(SceneText(1.0));
+  const Rig& rig = f.rig();
+  const Vec3 c0 = rig.cameras[3].center();
+  {  // A rail along x: the centre moves only along x.
+    SuggestOptions o = Options({3}, 0.5, 30);
+    o.limits[0].mount.kind = MountConstraint::Kind::kLine;
+    o.limits[0].mount.axis = Vec3(2, 0, 0);
+    const Suggestion s = Suggest(f.scene, rig, *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    ASSERT_TRUE(s.improved) << s.message;
+    const Vec3 d = s.cameras[0].after.translation() - c0;
+    EXPECT_LT(std::hypot(d.y(), d.z()), 1e-12) << d.transpose();
+    EXPECT_GT(std::abs(d.x()), 1e-3);  // it did use the rail
+  }
+  {  // A ceiling plane (normal z): the height stays.
+    SuggestOptions o = Options({3}, 0.5, 30);
+    o.limits[0].mount.kind = MountConstraint::Kind::kPlane;
+    o.limits[0].mount.axis = Vec3(0, 0, 1);
+    const Suggestion s = Suggest(f.scene, rig, *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    EXPECT_NEAR(s.cameras[0].after.translation().z(), c0.z(), 1e-12);
+  }
+  {  // A mounting box, and a keep-out box on the side the rail result went to.
+    SuggestOptions o = Options({3}, 0.5, 30);
+    o.limits[0].mount.kind = MountConstraint::Kind::kBox;
+    o.limits[0].mount.box.min = c0 - Vec3(0.1, 0.05, 0.02);
+    o.limits[0].mount.box.max = c0 + Vec3(0.1, 0.05, 0.02);
+    Aabb keep;
+    keep.min = c0 + Vec3(0.02, -1, -1);
+    keep.max = c0 + Vec3(1, 1, 1);
+    o.keep_out = {keep};
+    const Suggestion s = Suggest(f.scene, rig, *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    const Vec3 p = s.cameras[0].after.translation();
+    EXPECT_TRUE(o.limits[0].mount.box.Contains(p)) << p.transpose();
+    EXPECT_FALSE(keep.Contains(p)) << p.transpose();
+  }
+}
+
+TEST(Suggest, ZoomOnlyStaysInItsRangeAndKeepsThePose) {
+  // c4 looks 26.6 degrees past the region with a 50 degree field of view: zooming out to 80
+  // degrees alone brings the region in.
+  Fixture f(SceneText(1.0));
+  SuggestOptions o = Options({3}, 0.0, 0.0);
+  o.limits[0].min_hfov_deg = 40;
+  o.limits[0].max_hfov_deg = 80;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  ASSERT_TRUE(s.improved) << s.message;
+  const CameraChange& c = s.cameras[0];
+  EXPECT_TRUE(c.after.matrix() == c.before.matrix());
+  EXPECT_NEAR(c.hfov_before_deg, 50.0, 1e-9);
+  EXPECT_GT(c.hfov_after_deg, 55.0);
+  EXPECT_LE(c.hfov_after_deg, 80.0 + 1e-9);
+  EXPECT_LT(c.focal_scale, 1.0);
+  // The reported metrics are those of the zoomed camera.
+  Rig zoomed = f.rig();
+  Intrinsics k = zoomed.cameras[3].model.intrinsics();
+  k.fx *= c.focal_scale;
+  k.fy *= c.focal_scale;
+  zoomed.cameras[3].model = CameraModel(k);
+  EXPECT_DOUBLE_EQ(EvaluateExact(f.scene, zoomed, *f.caster, f.targets, o.objective).objective,
+                   s.after.objective);
+  // A range that does not hold the current field of view is refused.
+  o.limits[0].min_hfov_deg = 60;
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, o), InputError);
+}
+
+TEST(Suggest, SnapRoundsToInstallableSteps) {
+  Fixture f(SceneText(1.0));
+  SuggestOptions o = Options({3}, 0.3, 30);
+  o.snap_move = 0.05;
+  o.snap_rotate_deg = 1.0;
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  ASSERT_TRUE(s.unsnapped.has_value());
+  if (!s.improved) GTEST_SKIP() << s.message;  // a clean outcome, checked by CheckContract
+  const CameraChange& c = s.cameras[0];
+  const Vec3 d = c.after.translation() - c.before.translation();
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(d[a] / 0.05, std::round(d[a] / 0.05), 1e-9) << d.transpose();
+  const Vec3 y0 = YawPitchRollDeg(c.before.linear()), y1 = YawPitchRollDeg(c.after.linear());
+  for (int a = 0; a < 3; ++a) {
+    double delta = std::remainder(y1[a] - y0[a], 360.0);
+    EXPECT_NEAR(delta, std::round(delta), 1e-7) << (y1 - y0).transpose();
+  }
+}
+
+TEST(Suggest, CameraThatSeesNothingEndsCleanly) {
+  // c4 turned completely away (looks outward): no gradient; with a small rotation limit it stays.
+  Fixture f(SceneText(1.0, Vec3(0, -8, 2.0)));
+  const SuggestOptions o = Options({3}, 0.2, 10);
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  EXPECT_FALSE(s.improved);
+  EXPECT_NE(s.message.find("no improvement"), std::string::npos) << s.message;
+  EXPECT_NE(s.cameras[0].note.find("sees none"), std::string::npos) << s.cameras[0].note;
+}
+
+TEST(Suggest, TargetOutsideEveryFrustumEndsCleanly) {
+  std::string text = SceneText(1.0);
+  // Move the region far behind every camera's working range.
+  nlohmann::json j = nlohmann::json::parse(text);
+  j["study"]["region"]["box"] = {{"min", {30, 30, 0}}, {"max", {31, 31, 1}}};
+  Fixture f(j.dump());
+  const SuggestOptions o = Options({0, 3}, 0.3, 10);
+  const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  CheckContract(f, o, s);
+  EXPECT_FALSE(s.improved);
+  EXPECT_EQ(s.before.coverage2, 0.0);
+  EXPECT_EQ(s.before.min_resolution, 0.0);
+  EXPECT_TRUE(std::isinf(s.before.sigma_p50));
+  EXPECT_NE(s.message.find("no selected camera sees any target point"), std::string::npos) << s.message;
+}
+
+TEST(Suggest, MillimetreAndKilometreScenesBehaveAlike) {
+  Fixture m(SceneText(1.0));
+  const Suggestion sm = Suggest(m.scene, m.rig(), *m.caster, m.targets, Options({3}, 0.3, 30));
+  ASSERT_TRUE(sm.improved);
+  for (double scale : {1e-3, 1e3}) {
+    Fixture f(SceneText(scale));
+    const SuggestOptions o = Options({3}, 0.3 * scale, 30);
+    const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    ASSERT_TRUE(s.improved) << "scale " << scale << ": " << s.message;
+    EXPECT_NEAR(s.before.objective, sm.before.objective, 0.02) << scale;
+    EXPECT_GE(s.after.objective, sm.after.objective - 0.03) << scale;
+    EXPECT_NEAR(s.cameras[0].move_m / scale, sm.cameras[0].move_m, 0.1) << scale;
+  }
+}
+
+TEST(Suggest, SigmaAndResolutionObjectivesNeverWorsen) {
+  Fixture f(SceneText(1.0));
+  for (const char* name : {"sigma-mean", "sigma-p90", "resolution", "mix"}) {
+    SuggestOptions o = Options({3}, 0.3, 30);
+    o.objective = *ParseObjective(name);
+    o.objective.k = 4;
+    const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    EXPECT_TRUE(s.improved) << name << ": " << s.message;
+  }
+}
+
+TEST(Suggest, BadSelectionAndLimitsAreInputErrors) {
+  Fixture f(SceneText(1.0));
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({}, 0.3, 10)), InputError);
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({7}, 0.3, 10)), InputError);
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1, 1}, 0.3, 10)), InputError);
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1}, -0.1, 10)), InputError);
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1}, 0.1, 180)), InputError);
+  SuggestOptions o = Options({3}, 0.3, 10);
+  Aabb inside;
+  inside.min = f.rig().cameras[3].center() - Vec3::Constant(0.1);
+  inside.max = f.rig().cameras[3].center() + Vec3::Constant(0.1);
+  o.keep_out = {inside};
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, o), InputError);
+}
+
+TEST(Suggest, BaselineRespectsLimitsAndBudget) {
+  Fixture f(SceneText(1.0));
+  const SuggestOptions o = Options({3}, 0.3, 30);
+  const Suggestion b = BaselineSearch(f.scene, f.rig(), *f.caster, f.targets, o, 200, 5);
+  CheckContract(f, o, b);
+  EXPECT_LE(b.evaluations, 200);
+  EXPECT_GE(b.evaluations, 199);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Accept cycle on files.
+
+class SuggestAcceptTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pandora_accept_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  static std::string Read(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  static void Write(const fs::path& p, const std::string& text) {
+    std::ofstream(p, std::ios::binary) << text;
+  }
+  // Suggests for c2 and c4 on the scene file and writes the suggestion next to it.
+  std::string MakeSuggestion(const fs::path& scene_path, Suggestion* out = nullptr) {
+    const Scene scene = LoadScene(scene_path.string());
+    const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+    const auto targets = SampleTargets(scene, 300, {}, false, 7);
+    const SuggestOptions o = Options({1, 3}, 0.3, 30);
+    const Suggestion s = Suggest(scene, scene.rigs[0], *caster, targets, o);
+    EXPECT_TRUE(s.improved) << s.message;
+    const fs::path p = dir_ / "suggestion.json";
+    Write(p, SuggestionToJson(s, scene, scene.rigs[0], o));
+    if (out) *out = s;
+    return p.string();
+  }
+  fs::path dir_;
+};
+
+// Everything but the pose keys of the named cameras is JSON-equal.
+void ExpectEqualButPoses(const std::string& a_text, const std::string& b_text, const std::set<std::string>& ids) {
+  nlohmann::ordered_json a = nlohmann::ordered_json::parse(a_text), b = nlohmann::ordered_json::parse(b_text);
+  for (auto* j : {&a, &b})
+    for (auto& cam : (*j)["rigs"][0]["cameras"])
+      if (ids.count(cam["id"].get<std::string>()))
+        for (const char* k : {"position", "look_at", "up", "quaternion", "euler_deg"}) cam.erase(k);
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
+  const fs::path scene_path = dir_ / "scene.json";
+  const std::string original = SceneText(1.0);
+  Write(scene_path, original);
+  Suggestion s;
+  const std::string suggestion = MakeSuggestion(scene_path, &s);
+  // Nothing changes until accept.
+  EXPECT_EQ(Read(scene_path), original);
+
+  AcceptOptions only_c4;
+  only_c4.cameras = {"c4"};
+  const AcceptResult r = AcceptSuggestion(suggestion, only_c4);
+  EXPECT_EQ(r.accepted, std::vector<std::string>{"c4"});
+  EXPECT_EQ(fs::path(r.backup_path), fs::path(scene_path.string() + ".bak"));
+  EXPECT_EQ(Read(r.backup_path), original);
+  const std::string updated = Read(scene_path);
+  ExpectEqualButPoses(original, updated, {"c4"});
+  // Key order: position then quaternion, where position was; id first as before.
+  const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(updated)["rigs"][0]["cameras"][3];
+  std::vector<std::string> keys;
+  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "quaternion", "resolution", "hfov_deg", "range"}));
+
+  const Scene after = LoadScene(scene_path.string());
+  const Scene before = ParseScene(original, scene_path.string());
+  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+  for (int c : {0, 1, 2})  // c2 was offered but not accepted
+    EXPECT_TRUE(after.rigs[0].cameras[c].world_from_camera.matrix() ==
+                before.rigs[0].cameras[c].world_from_camera.matrix());
+
+  // The scene changed since: accepting the rest is refused, nothing written.
+  AcceptOptions c2;
+  c2.cameras = {"c2"};
+  EXPECT_THROW(AcceptSuggestion(suggestion, c2), InputError);
+  EXPECT_EQ(Read(scene_path), updated);
+  EXPECT_FALSE(fs::exists(scene_path.string() + ".bak.1"));
+  // With force it goes through, with a second backup.
+  c2.force = true;
+  const AcceptResult r2 = AcceptSuggestion(suggestion, c2);
+  EXPECT_EQ(fs::path(r2.backup_path), fs::path(scene_path.string() + ".bak.1"));
+  EXPECT_EQ(Read(r2.backup_path), updated);
+  const Scene both = LoadScene(scene_path.string());
+  EXPECT_TRUE(both.rigs[0].cameras[1].world_from_camera.isApprox(s.cameras[0].after, 1e-12));
+  EXPECT_TRUE(both.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+}
+
+TEST_F(SuggestAcceptTest, ZoomWritesFocalLengthInPlaceOfTheFieldOfView) {
+  const fs::path scene_path = dir_ / "scene.json";
+  const std::string original = SceneText(1.0);
+  Write(scene_path, original);
+  const Scene scene = LoadScene(scene_path.string());
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const auto targets = SampleTargets(scene, 300, {}, false, 7);
+  SuggestOptions o = Options({3}, 0.1, 5);
+  o.limits[0].min_hfov_deg = 40;
+  o.limits[0].max_hfov_deg = 80;
+  const Suggestion s = Suggest(scene, scene.rigs[0], *caster, targets, o);
+  ASSERT_TRUE(s.improved) << s.message;
+  ASSERT_NE(s.cameras[0].focal_scale, 1.0);
+  const fs::path p = dir_ / "suggestion.json";
+  Write(p, SuggestionToJson(s, scene, scene.rigs[0], o));
+  AcceptSuggestion(p.string(), {});
+  const Scene after = LoadScene(scene_path.string());
+  const Intrinsics& k0 = scene.rigs[0].cameras[3].model.intrinsics();
+  const Intrinsics& k1 = after.rigs[0].cameras[3].model.intrinsics();
+  EXPECT_NEAR(k1.fx, k0.fx * s.cameras[0].focal_scale, 1e-9 * k0.fx);
+  EXPECT_NEAR(k1.fy, k0.fy * s.cameras[0].focal_scale, 1e-9 * k0.fy);
+  EXPECT_EQ(k1.cx, k0.cx);
+  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[0].after, 1e-12));
+  const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(Read(scene_path))["rigs"][0]["cameras"][3];
+  std::vector<std::string> keys;
+  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "quaternion", "resolution", "focal_px", "range"}));
+}
+
+TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
+  const fs::path scene_path = dir_ / "scene.json";
+  Write(scene_path, SceneText(1.0));
+  const std::string suggestion = MakeSuggestion(scene_path);
+  AcceptOptions bad;
+  bad.cameras = {"c3"};  // in the rig, but not in the suggestion
+  EXPECT_THROW(AcceptSuggestion(suggestion, bad), InputError);
+  EXPECT_FALSE(fs::exists(scene_path.string() + ".bak"));
+  // A suggestion that found nothing cannot be accepted.
+  nlohmann::json j = nlohmann::json::parse(Read(suggestion));
+  j["improved"] = false;
+  Write(suggestion, j.dump());
+  EXPECT_THROW(AcceptSuggestion(suggestion, {}), InputError);
+  EXPECT_EQ(Read(scene_path), SceneText(1.0));
+}
+
+TEST_F(SuggestAcceptTest, MillimetreFileGetsMillimetres) {
+  // The same scene written in millimetres: accept writes the position in the file's unit.
+  const fs::path scene_path = dir_ / "scene_mm.json";
+  const std::string original = SceneText(1000.0, Vec3(2.0, 0.0, 0.5), "mm");
+  Write(scene_path, original);
+  Suggestion s;
+  const std::string suggestion = MakeSuggestion(scene_path, &s);
+  AcceptSuggestion(suggestion, {});
+  const Scene after = LoadScene(scene_path.string());
+  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+  const auto pos = nlohmann::json::parse(Read(scene_path))["rigs"][0]["cameras"][3]["position"];
+  EXPECT_NEAR(pos[1].get<double>(), s.cameras[1].after.translation().y() * 1000.0, 1e-9);
+}
+
+TEST(SuggestReplacePoses, UntouchedTextIsByteIdentical) {
+  // A file in nlohmann's own layout (any indentation) round-trips byte for byte when no pose
+  // changes, and only the pose lines change when one does.
+  for (int indent : {1, 2, 4}) {
+    const std::string text = nlohmann::ordered_json::parse(SceneText(1.0)).dump(indent) + "\n";
+    EXPECT_EQ(ReplacePoses(text, "x.json", "ring", {}), text) << indent;
+  }
+  const std::string text = nlohmann::ordered_json::parse(SceneText(1.0)).dump(2) + "\n";
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Vec3(1, 2, 3);
+  const std::string out = ReplacePoses(text, "x.json", "ring", {{"c1", pose, std::nullopt}});
+  ExpectEqualButPoses(text, out, {"c1"});
+  EXPECT_THROW(ReplacePoses(text, "x.json", "nope", {{"c1", pose, std::nullopt}}), InputError);
+  EXPECT_THROW(ReplacePoses(text, "x.json", "ring", {{"c9", pose, std::nullopt}}), InputError);
+}
+
+}  // namespace
+}  // namespace pandora

@@ -1,0 +1,321 @@
+// The suggestion file and `pandora accept`: the scene file changes only here, only in the pose fields
+// of the accepted cameras, after a backup.
+#include "suggest/suggestion_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "analysis/sha256.h"
+
+namespace pandora {
+namespace {
+
+using json = nlohmann::json;
+using ordered_json = nlohmann::ordered_json;
+
+json Finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json MetricsJson(const Metrics& m) {
+  return json{{"objective", Finite(m.objective)},
+              {"coverage_k", m.coverage_k},
+              {"coverage2", m.coverage2},
+              {"sigma_max_mm", {{"p50", Finite(m.sigma_p50)}, {"p90", Finite(m.sigma_p90)}, {"p95", Finite(m.sigma_p95)}}},
+              {"sigma_max_mean_mm", Finite(m.sigma_mean)},
+              {"untriangulable", m.untriangulable},
+              {"min_resolution_px_per_m", Finite(m.min_resolution)}};
+}
+
+json PoseJson(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Vec3 p = pose.translation();
+  return json{{"position", {p.x(), p.y(), p.z()}}, {"quaternion", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+std::string ReadBytes(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open the " + what, "check the path");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string IdOf(const ordered_json& id) {
+  if (id.is_string()) return id.get<std::string>();
+  if (id.is_number_integer()) return std::to_string(id.get<int64_t>());
+  return id.dump();
+}
+
+double MetresPerUnit(const ordered_json& root, const std::string& path) {
+  if (!root.contains("units")) return 1.0;
+  const ordered_json& u = root["units"];
+  static const std::map<std::string, double> units{
+      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
+  if (u.is_string()) {
+    auto it = units.find(u.get<std::string>());
+    if (it != units.end()) return it->second;
+  }
+  throw InputError(path, "$.units", "unknown unit", "use m, cm, mm, in or ft");
+}
+
+// Indentation of a JSON text: the whitespace run after its first newline (-1: compact).
+std::pair<int, char> Indentation(const std::string& text) {
+  const std::size_t nl = text.find('\n');
+  if (nl == std::string::npos || nl + 1 >= text.size()) return {-1, ' '};
+  const char ch = text[nl + 1] == '\t' ? '\t' : ' ';
+  int n = 0;
+  for (std::size_t i = nl + 1; i < text.size() && text[i] == ch; ++i) ++n;
+  return {n, ch};
+}
+
+Vec3 ReadVec3(const json& j, const std::string& file, const std::string& path) {
+  if (!j.is_array() || j.size() != 3) throw InputError(file, path, "expected [x, y, z]");
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    if (!j[i].is_number()) throw InputError(file, path, "expected numbers");
+    v[i] = j[i].get<double>();
+  }
+  return v;
+}
+
+Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::string& path) {
+  if (!j.is_object() || !j.contains("position") || !j.contains("quaternion"))
+    throw InputError(file, path, "expected {\"position\", \"quaternion\"}");
+  const Vec3 p = ReadVec3(j["position"], file, path + ".position");
+  const json& q = j["quaternion"];
+  if (!q.is_array() || q.size() != 4) throw InputError(file, path + ".quaternion", "expected [w, x, y, z]");
+  for (int i = 0; i < 4; ++i)
+    if (!q[i].is_number()) throw InputError(file, path + ".quaternion", "expected numbers");
+  Eigen::Quaterniond quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>());
+  if (!(quat.norm() > 0.5)) throw InputError(file, path + ".quaternion", "not a unit quaternion");
+  quat.normalize();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = quat.toRotationMatrix();
+  pose.translation() = p;
+  return pose;
+}
+
+}  // namespace
+
+std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig& rig,
+                             const SuggestOptions& options) {
+  json j;
+  j["pandora_suggestion"] = 1;
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(scene.path, ec).lexically_normal().string();
+  j["scene"] = {{"path", ec ? scene.path : absolute}, {"sha256", scene.sha256}};
+  j["rig"] = rig.name;
+  j["improved"] = s.improved;
+  j["message"] = s.message;
+  j["objective"] = {{"name", ObjectiveName(s.objective)},
+                    {"higher_is_better", ObjectiveHigherIsBetter(s.objective)},
+                    {"before", Finite(s.before.objective)},
+                    {"after", Finite(s.after.objective)}};
+  j["target_points"] = s.target_points;
+  j["metrics"] = {{"before", MetricsJson(s.before)}, {"after", MetricsJson(s.after)}};
+  if (s.unsnapped) j["metrics"]["unsnapped"] = MetricsJson(*s.unsnapped);
+  j["snap"] = {{"move_m", options.snap_move}, {"rotate_deg", options.snap_rotate_deg}};
+  json cams = json::array();
+  for (std::size_t c = 0; c < s.cameras.size(); ++c) {
+    const CameraChange& ch = s.cameras[c];
+    const CameraLimits& l = options.limits.size() == 1 ? options.limits[0] : options.limits[c];
+    static const char* kinds[] = {"free", "plane", "line", "box"};
+    json limits = {{"max_move_m", l.max_move},
+                   {"max_rotate_deg", l.max_rotate_deg},
+                   {"mount", kinds[static_cast<int>(l.mount.kind)]}};
+    if (l.max_hfov_deg > 0) limits["hfov_range_deg"] = {l.min_hfov_deg, l.max_hfov_deg};
+    json cj = {{"id", ch.id}, {"index", ch.index}, {"before", PoseJson(ch.before)},
+               {"after", PoseJson(ch.after)}, {"move_m", ch.move_m}, {"rotate_deg", ch.rotate_deg},
+               {"hfov_deg", {{"before", ch.hfov_before_deg}, {"after", ch.hfov_after_deg}}},
+               {"limits", limits}};
+    if (ch.focal_scale != 1.0) {
+      const Intrinsics& k = rig.cameras[ch.index].model.intrinsics();
+      cj["after"]["focal_px"] = {k.fx * ch.focal_scale, k.fy * ch.focal_scale};
+    }
+    if (!ch.note.empty()) cj["note"] = ch.note;
+    cams.push_back(cj);
+  }
+  j["cameras"] = cams;
+  j["solver"] = {{"iterations", s.iterations},
+                 {"outer_iterations", s.outer_iterations},
+                 {"evaluations", s.evaluations},
+                 {"seconds", s.seconds}};
+  json trace = json::array();
+  for (const TracePoint& t : s.trace) trace.push_back({t.seconds, t.evaluations, Finite(t.objective)});
+  j["trace"] = {{"columns", {"seconds", "evaluations", "best_objective"}}, {"rows", trace}};
+  return j.dump(1) + "\n";
+}
+
+std::string ReplacePoses(const std::string& text, const std::string& scene_path,
+                         const std::string& rig_name, const std::vector<PoseUpdate>& poses) {
+  ordered_json root;
+  try {
+    root = ordered_json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(scene_path, "$", std::string("malformed JSON: ") + e.what());
+  }
+  const double mpu = MetresPerUnit(root, scene_path);
+  if (!root.contains("rigs") || !root["rigs"].is_array())
+    throw InputError(scene_path, "$.rigs", "no rigs");
+  ordered_json* rig = nullptr;
+  std::size_t rig_index = 0;
+  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
+    ordered_json& candidate = root["rigs"][r];
+    if (candidate.is_object() && candidate.contains("name") && candidate["name"] == rig_name) {
+      rig = &candidate;
+      rig_index = r;
+    }
+  }
+  if (!rig) throw InputError(scene_path, "$.rigs", "no rig called '" + rig_name + "'",
+                             "the scene file no longer matches the suggestion");
+  ordered_json& cameras = (*rig)["cameras"];
+  for (const PoseUpdate& update : poses) {
+    bool found = false;
+    for (std::size_t c = 0; c < cameras.size(); ++c) {
+      ordered_json& cam = cameras[c];
+      if (!cam.is_object() || !cam.contains("id") || IdOf(cam["id"]) != update.id) continue;
+      found = true;
+      const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
+      if (!cam.contains("position"))
+        throw InputError(scene_path, where, "the camera has no position");
+      const Vec3 p = update.pose.translation() / mpu;
+      const Eigen::Quaterniond q(update.pose.linear());
+      ordered_json rebuilt = ordered_json::object();
+      for (auto it = cam.begin(); it != cam.end(); ++it) {
+        const std::string& key = it.key();
+        if (key == "position") {
+          rebuilt["position"] = {p.x(), p.y(), p.z()};
+          rebuilt["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
+        } else if (key == "look_at" || key == "up" || key == "quaternion" || key == "euler_deg") {
+          continue;
+        } else if (update.focal_px && (key == "hfov_deg" || key == "focal_px" || key == "lens")) {
+          rebuilt["focal_px"] = {update.focal_px->x(), update.focal_px->y()};
+        } else {
+          rebuilt[key] = it.value();
+        }
+      }
+      cam = std::move(rebuilt);
+    }
+    if (!found)
+      throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras",
+                       "no camera '" + update.id + "' in rig '" + rig_name + "'",
+                       "the scene file no longer matches the suggestion");
+  }
+  const auto [indent, ch] = Indentation(text);
+  std::string out = root.dump(indent, ch);
+  if (!text.empty() && text.back() == '\n') out += "\n";
+  return out;
+}
+
+AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options) {
+  const std::string text = ReadBytes(suggestion_path, "suggestion file");
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(suggestion_path, "$", std::string("malformed JSON: ") + e.what());
+  }
+  auto need = [&](const char* key, bool (json::*is)() const noexcept) -> const json& {
+    if (!j.is_object() || !j.contains(key) || !(j[key].*is)())
+      throw InputError(suggestion_path, std::string("$.") + key, "missing or of the wrong type",
+                       "is this a file written by pandora suggest?");
+    return j[key];
+  };
+  need("pandora_suggestion", &json::is_number);
+  const json& scene_j = need("scene", &json::is_object);
+  const std::string rig = need("rig", &json::is_string).get<std::string>();
+  const bool improved = need("improved", &json::is_boolean).get<bool>();
+  const json& cams = need("cameras", &json::is_array);
+  if (!scene_j.contains("path") || !scene_j["path"].is_string() || !scene_j.contains("sha256") ||
+      !scene_j["sha256"].is_string())
+    throw InputError(suggestion_path, "$.scene", "expected {\"path\", \"sha256\"}");
+  if (!improved)
+    throw InputError(suggestion_path, "$.improved", "the suggestion offers no improvement; nothing to accept",
+                     "run pandora suggest with other limits or cameras");
+  AcceptResult result;
+  result.scene_path = scene_j["path"].get<std::string>();
+
+  std::vector<PoseUpdate> updates;
+  std::map<std::string, PoseUpdate> offered;
+  std::vector<std::string> order;
+  for (std::size_t c = 0; c < cams.size(); ++c) {
+    const std::string where = "$.cameras[" + std::to_string(c) + "]";
+    if (!cams[c].is_object() || !cams[c].contains("id") || !cams[c]["id"].is_string())
+      throw InputError(suggestion_path, where + ".id", "missing camera id");
+    const std::string id = cams[c]["id"].get<std::string>();
+    const json after = cams[c].value("after", json());
+    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt};
+    if (after.is_object() && after.contains("focal_px")) {
+      const json& f = after["focal_px"];
+      if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_number() ||
+          !(f[0].get<double>() > 0) || !(f[1].get<double>() > 0))
+        throw InputError(suggestion_path, where + ".after.focal_px", "expected [fx, fy], positive");
+      u.focal_px = Vec2(f[0].get<double>(), f[1].get<double>());
+    }
+    offered[id] = u;
+    order.push_back(id);
+  }
+  std::vector<std::string> chosen = options.cameras.empty() ? order : options.cameras;
+  std::set<std::string> unique;
+  for (const std::string& id : chosen) {
+    if (!offered.count(id)) {
+      std::string list;
+      for (const std::string& o : order) list += (list.empty() ? "" : ", ") + o;
+      throw InputError(suggestion_path, "--cameras", "camera '" + id + "' is not in the suggestion",
+                       "it offers: " + list);
+    }
+    if (unique.insert(id).second) updates.push_back(offered[id]);
+  }
+
+  const std::string scene_text = ReadBytes(result.scene_path, "scene file");
+  if (Sha256Hex(scene_text) != scene_j["sha256"].get<std::string>() && !options.force)
+    throw InputError(result.scene_path, "",
+                     "the scene file changed since the suggestion was made (SHA-256 differs)",
+                     "run pandora suggest again, or accept with --force");
+  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates);
+
+  // Check the new text before touching any file: the accepted poses are there, nothing else moved.
+  LoadOptions lo;
+  lo.load_meshes = false;
+  const Scene before = ParseScene(scene_text, result.scene_path, lo);
+  const Scene after = ParseScene(new_text, result.scene_path, lo);
+  const double tol = 1e-9 * std::max(1.0, before.Bounds().diagonal());
+  for (std::size_t r = 0; r < before.rigs.size(); ++r) {
+    for (std::size_t c = 0; c < before.rigs[r].cameras.size(); ++c) {
+      const Camera& a = before.rigs[r].cameras[c];
+      const Camera& b = after.rigs[r].cameras[c];
+      Eigen::Isometry3d expected = a.world_from_camera;
+      Vec2 focal(a.model.intrinsics().fx, a.model.intrinsics().fy);
+      if (before.rigs[r].name == rig && unique.count(a.id)) {
+        expected = offered[a.id].pose;
+        if (offered[a.id].focal_px) focal = *offered[a.id].focal_px;
+      }
+      const Vec2 focal_read(b.model.intrinsics().fx, b.model.intrinsics().fy);
+      const bool same = (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
+                        (b.world_from_camera.linear() - expected.linear()).norm() <= 1e-9 &&
+                        (focal_read - focal).norm() <= 1e-9 * focal.norm();
+      if (!same)
+        throw InputError(result.scene_path, "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",
+                         "internal check failed: the rewritten pose does not read back as intended",
+                         "the scene file was not changed");
+    }
+  }
+
+  // Backup first, then the scene file; both atomic.
+  std::string backup = result.scene_path + ".bak";
+  for (int n = 1; std::filesystem::exists(backup); ++n) backup = result.scene_path + ".bak." + std::to_string(n);
+  WriteFileAtomically(backup, scene_text);
+  WriteFileAtomically(result.scene_path, new_text);
+  result.backup_path = backup;
+  for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
+  return result;
+}
+
+}  // namespace pandora

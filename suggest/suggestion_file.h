@@ -1,0 +1,60 @@
+#pragma once
+/// \file suggestion_file.h
+/// The suggestion file (`pandora suggest --out suggestion.json`) and the accept cycle
+/// (`pandora accept`): the scene file is rewritten only on accept, only the pose fields of the
+/// accepted cameras change, and the previous file is kept as a backup. No JSON types in this header.
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "analysis/scene.h"
+#include "suggest/suggest.h"
+
+namespace pandora {
+
+/// The suggestion as JSON text (format in docs/suggest.md): the scene file's path (absolute) and
+/// SHA-256 at suggest time, the rig, the objective and metrics before/after, per camera the old and
+/// new pose (position in metres, quaternion [w, x, y, z] of world_from_camera) and the change,
+/// solver statistics and the trace. Infinite values are written as null.
+std::string SuggestionToJson(const Suggestion& suggestion, const Scene& scene, const Rig& rig,
+                             const SuggestOptions& options);
+
+/// A pose to write: camera id, the new world_from_camera (metres) and, after a zoom, the new focal
+/// lengths in pixels.
+struct PoseUpdate {
+  std::string id;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  std::optional<Vec2> focal_px;
+};
+
+/// The scene file text with the pose of each listed camera of `rig` replaced by `position` (in the
+/// file's units) and `quaternion`, at the place of the old `position`; its orientation keys
+/// (`look_at`, `up`, `quaternion`, `euler_deg`) removed. With `focal_px`, the focal-length key
+/// (`hfov_deg`, `focal_px` or `lens`) is replaced by `focal_px` [fx, fy] at its place. Everything else keeps its order and value;
+/// the text is re-serialised with the file's indentation. Throws InputError (file = scene_path) when
+/// the JSON, the rig or a camera cannot be found.
+std::string ReplacePoses(const std::string& scene_text, const std::string& scene_path,
+                         const std::string& rig, const std::vector<PoseUpdate>& poses);
+
+struct AcceptOptions {
+  std::vector<std::string> cameras;  ///< Ids to accept; empty: all cameras of the suggestion.
+  bool force = false;                ///< Accept even when the scene file changed since.
+};
+
+struct AcceptResult {
+  std::string scene_path;
+  std::string backup_path;
+  std::vector<std::string> accepted;  ///< Camera ids written.
+};
+
+/// Reads the suggestion file, checks it (an improvement, the scene file unchanged since: same
+/// SHA-256, unless force), writes a backup of the scene file (`SCENE.bak`, or `SCENE.bak.N` with the
+/// first free N), then the scene file with the accepted poses (atomically). Before writing, the new
+/// text is parsed as a scene and checked: the accepted cameras have the new poses (to 1e-9 of the
+/// scene size) and every other camera of every rig is unchanged. Throws InputError on any problem,
+/// leaving every file as it was.
+AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options);
+
+}  // namespace pandora
