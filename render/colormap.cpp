@@ -1,5 +1,7 @@
 #include "render/colormap.h"
 
+#include "volume/colormap.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -8,23 +10,8 @@
 namespace pandora {
 
 Vec3 ViridisSrgb(double t) {
-  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
-  // Degree-6 polynomial fit (per channel, ascending powers) of matplotlib's viridis table.
-  static const double kC[7][3] = {
-      {0.2777273272234177, 0.005407344544966578, 0.3340998053353061},
-      {0.1050930431085774, 1.404613529898575, 1.384590162594685},
-      {-0.3308618287255563, 0.214847559468213, 0.09509516302823659},
-      {-4.634230498983486, -5.799100973351585, -19.33244095627987},
-      {6.228269936347081, 14.17993336680509, 56.69055260068105},
-      {4.776384997670288, -13.74514537774601, -65.35303263337234},
-      {-5.435455855934631, 4.645852612178535, 26.3124352495832}};
-  Vec3 c;
-  for (int k = 0; k < 3; ++k) {
-    double v = kC[6][k];
-    for (int p = 5; p >= 0; --p) v = v * t + kC[p][k];
-    c[k] = std::clamp(v, 0.0, 1.0);
-  }
-  return c;
+  const std::array<double, 3> c = ViridisUnit(t);  // volume/colormap.h: one viridis everywhere
+  return Vec3(c[0], c[1], c[2]);
 }
 
 double SrgbFromLinear(double v) {

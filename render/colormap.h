@@ -9,9 +9,9 @@
 namespace pandora {
 
 /// Viridis (van der Walt and Smith, matplotlib's default), sRGB-encoded components in [0, 1], for
-/// t in [0, 1] (clamped). Evaluated from the degree-6 least-squares polynomial fit of the published
-/// 256-entry table (maximum deviation from the table about 0.01 per channel; render_test checks
-/// the table's end points and middle).
+/// t in [0, 1] (clamped): volume/colormap.h's ViridisUnit (nine stops of the published table,
+/// piecewise linear; within 5 8-bit steps of the table), so renders, report images and PLY colours
+/// agree. render_test checks the table's end points and middle.
 Vec3 ViridisSrgb(double t);
 
 /// The same colour in linear RGB (what the renderer composites in).

@@ -18,8 +18,10 @@ struct Rgb8 {
   std::uint8_t r = 0, g = 0, b = 0;
 };
 
-/// Viridis at t in [0, 1] (clamped; NaN gives the t = 0 colour).
-inline Rgb8 Viridis(double t) {
+/// Viridis at t in [0, 1] (clamped; NaN gives the t = 0 colour) as sRGB components in [0, 1],
+/// unrounded. The one viridis of the project: the renderer's slices and legends, the report's
+/// images and the PLY colours all come from here.
+inline std::array<double, 3> ViridisUnit(double t) {
   static constexpr std::array<std::array<int, 3>, 9> kStops{{{0x44, 0x01, 0x54},
                                                              {0x47, 0x2d, 0x7b},
                                                              {0x3b, 0x52, 0x8b},
@@ -34,11 +36,16 @@ inline Rgb8 Viridis(double t) {
   const double x = t * (kStops.size() - 1);
   const int i = std::min(static_cast<int>(x), static_cast<int>(kStops.size()) - 2);
   const double f = x - i;
-  auto mix = [&](int c) {
-    return static_cast<std::uint8_t>(
-        std::lround(kStops[i][c] + f * (kStops[i + 1][c] - kStops[i][c])));
-  };
-  return {mix(0), mix(1), mix(2)};
+  std::array<double, 3> c;
+  for (int k = 0; k < 3; ++k) c[k] = (kStops[i][k] + f * (kStops[i + 1][k] - kStops[i][k])) / 255.0;
+  return c;
+}
+
+/// Viridis at t as an 8-bit sRGB colour.
+inline Rgb8 Viridis(double t) {
+  const std::array<double, 3> c = ViridisUnit(t);
+  auto byte = [](double v) { return static_cast<std::uint8_t>(std::lround(255.0 * v)); };
+  return {byte(c[0]), byte(c[1]), byte(c[2])};
 }
 
 /// "#rrggbb" of a colour.
