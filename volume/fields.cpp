@@ -72,6 +72,72 @@ struct BlockResult {
   std::vector<float> sigma_max, sigma_max_steady;
 };
 
+// Rows of the per-candidate statistics arrays.
+enum StatRow {
+  kObservable,    // 1 or 0
+  kSigmaMaxMm,    // sqrt of the largest variance, mm
+  kSigmaMeanMm,   // sqrt(trace / 3), mm
+  kCond,          // largest / smallest eigenvalue of J
+  kVar0,          // variances 1 / lambda_k, m^2 (descending); the steady pass overwrites them
+  kVar1,
+  kVar2,
+  kSteadyMaxMm,
+  kSteadyMeanMm,
+  kStatRows
+};
+
+// From the eigenvalues of J (ascending, three arrays of n) the static statistics into out[row][m].
+// Eigenvalues are clipped at 0 (round-off); a voxel is observable when the smallest exceeds
+// kRelativeObservability times the largest, which is positive and finite. The other rows are
+// meaningless (inf or NaN) where it is not, and never read there.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void StaticStatistics(int n, double* const* eigenvalues, double* const* out) {
+  const double* l0p = eigenvalues[0];
+  const double* l1p = eigenvalues[1];
+  const double* l2p = eigenvalues[2];
+  double* __restrict observable = out[kObservable];
+  double* __restrict sigma_max = out[kSigmaMaxMm];
+  double* __restrict sigma_mean = out[kSigmaMeanMm];
+  double* __restrict condition = out[kCond];
+  double* __restrict v0 = out[kVar0];
+  double* __restrict v1 = out[kVar1];
+  double* __restrict v2 = out[kVar2];
+  const double kInf = std::numeric_limits<double>::infinity();
+#pragma omp simd
+  for (int m = 0; m < n; ++m) {
+    const double l0 = l0p[m] > 0 ? l0p[m] : 0.0;
+    const double l1 = l1p[m] > 0 ? l1p[m] : 0.0;
+    const double l2 = l2p[m] > 0 ? l2p[m] : 0.0;
+    observable[m] = (l2 > 0 && l2 < kInf && l0 > kRelativeObservability * l2) ? 1.0 : 0.0;
+    v0[m] = 1.0 / l0;
+    v1[m] = 1.0 / l1;
+    v2[m] = 1.0 / l2;
+    sigma_max[m] = 1e3 * std::sqrt(v0[m]);
+    sigma_mean[m] = 1e3 * std::sqrt((v0[m] + v1[m] + v2[m]) / 3.0);
+    condition[m] = l2 / l0;
+  }
+}
+
+// Steady-state statistics from the steady position variances in rows kVar0..kVar2.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void SteadyStatistics(int n, double* const* rows) {
+  const double* v0 = rows[kVar0];
+  const double* v1 = rows[kVar1];
+  const double* v2 = rows[kVar2];
+  double* __restrict steady_max = rows[kSteadyMaxMm];
+  double* __restrict steady_mean = rows[kSteadyMeanMm];
+#pragma omp simd
+  for (int m = 0; m < n; ++m) {
+    const double a = v0[m] > v1[m] ? v0[m] : v1[m];
+    steady_max[m] = 1e3 * std::sqrt(a > v2[m] ? a : v2[m]);
+    steady_mean[m] = 1e3 * std::sqrt((v0[m] + v1[m] + v2[m]) / 3.0);
+  }
+}
+
 // atan(t) for t >= 0 (+inf allowed) to 2.1e-8 relative (measured against std::atan over
 // 1e-12..1e12), branch-free so that it vectorises:
 // Cephes' single-precision reduction (t > tan(3 pi/8): pi/2 - atan(1/t); t > tan(pi/8):
@@ -271,10 +337,10 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::array<std::uint64_t, 512> cand_mask;
     std::array<float, 512> angle_deg;
     std::vector<double> directions(want_angle ? 3 * 64 * camera_count : 0);  // one tile
-    // Measurement variances (m^2, three per triangulable voxel) and their offsets, for the
-    // block's steady-state pass.
-    std::array<double, 3 * 512> steady_variance;
-    std::array<std::int16_t, 512> steady_offset;
+    // Per-candidate statistics (StatRow) for the block's vectorised passes.
+    std::array<std::array<double, 512>, kStatRows> stats;
+    double* stats_ptr[kStatRows];
+    for (int k = 0; k < kStatRows; ++k) stats_ptr[k] = stats[k].data();
     // Information matrices of the voxels seen by two or more cameras, as six arrays (xx xy xz yy
     // yz zz), their eigenvalues as three (ascending), for one vectorised pass per block.
     std::array<std::array<double, 512>, 6> upper;
@@ -376,7 +442,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         float_data[field][offset] = value;
         res.floats[field]->getValueMask().setOn(offset);
       };
-      int steady_count = 0, candidate_count = 0;
+      int candidate_count = 0;
       for (int x = 0; x < block.extent.x(); ++x)
         for (int y = 0; y < block.extent.y(); ++y)
           for (int z = 0; z < block.extent.z(); ++z) {
@@ -412,53 +478,42 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                               angle_deg.data());
       }
       for (int m = 0; m < candidate_count; ++m) {
-            const int o = candidate[m];
-            Vec3 eigenvalues(eigenvalue[0][m], eigenvalue[1][m], eigenvalue[2][m]);
-            if (!converged[m]) {  // never seen in practice; the general solver as a safety net
-              const std::array<double, 6>& I = information[o];
-              Mat3 J;
-              J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-              eigenvalues = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
-            }
-            eigenvalues = eigenvalues.cwiseMax(0.0);
-            const double largest = eigenvalues[2];
-            if (!(largest > 0 && std::isfinite(largest) &&
-                  eigenvalues[0] > kRelativeObservability * largest)) {
-              ++res.unobservable;
-              continue;
-            }
-            ++res.triangulable;
-            if (want_angle) put(kAngle, o, angle_deg[m]);
-            const Vec3 variance = eigenvalues.cwiseInverse();  // m^2, descending
-            const float sigma_max_mm = static_cast<float>(1e3 * std::sqrt(variance[0]));
-            res.sigma_max.push_back(sigma_max_mm);
-            if (want_float[kSigmaMax]) put(kSigmaMax, o, sigma_max_mm);
-            if (want_float[kSigmaMean])
-              put(kSigmaMean, 
-                  o, static_cast<float>(1e3 * std::sqrt(variance.sum() / 3.0)));
-            if (want_float[kCondition])
-              put(kCondition, 
-                  o, static_cast<float>(eigenvalues[2] / eigenvalues[0]));
-            if (want_steady) {
-              // Gathered for one vectorised closed-form pass over the block (below).
-              steady_offset[steady_count] = static_cast<std::int16_t>(o);
-              for (int k = 0; k < 3; ++k) steady_variance[3 * steady_count + k] = variance[k];
-              ++steady_count;
-            }
+        if (converged[m]) continue;  // never seen in practice; the general solver as a safety net
+        const std::array<double, 6>& I = information[candidate[m]];
+        Mat3 J;
+        J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
+        const Vec3 values = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
+        for (int k = 0; k < 3; ++k) eigenvalue[k][m] = values[k];
       }
-      if (steady_count > 0) {
-        SteadyPositionVariances(motion.q, frame_period, steady_variance.data(),
-                                steady_variance.data(), 3 * steady_count, study.steady_prior);
-        for (int m = 0; m < steady_count; ++m) {
-          const double* v = &steady_variance[3 * m];
-          const int o = steady_offset[m];
-          const float steady_max =
-              static_cast<float>(1e3 * std::sqrt(std::max(v[0], std::max(v[1], v[2]))));
+      // Static statistics and measurement variances for all candidates in one vectorised pass,
+      // the steady state in another; then the leaves (unobservable voxels are skipped there).
+      if (candidate_count > 0)
+        StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
+      if (want_steady && candidate_count > 0) {
+        for (int k = 0; k < 3; ++k)
+          SteadyPositionVariances(motion.q, frame_period, stats[kVar0 + k].data(),
+                                  stats[kVar0 + k].data(), candidate_count, study.steady_prior);
+        SteadyStatistics(candidate_count, stats_ptr);
+      }
+      for (int m = 0; m < candidate_count; ++m) {
+        const int o = candidate[m];
+        if (stats[kObservable][m] == 0.0) {
+          ++res.unobservable;
+          continue;
+        }
+        ++res.triangulable;
+        if (want_angle) put(kAngle, o, angle_deg[m]);
+        const float sigma_max_mm = static_cast<float>(stats[kSigmaMaxMm][m]);
+        res.sigma_max.push_back(sigma_max_mm);
+        if (want_float[kSigmaMax]) put(kSigmaMax, o, sigma_max_mm);
+        if (want_float[kSigmaMean]) put(kSigmaMean, o, static_cast<float>(stats[kSigmaMeanMm][m]));
+        if (want_float[kCondition]) put(kCondition, o, static_cast<float>(stats[kCond][m]));
+        if (want_steady) {
+          const float steady_max = static_cast<float>(stats[kSteadyMaxMm][m]);
           res.sigma_max_steady.push_back(steady_max);
           if (want_float[kSigmaMaxSteady]) put(kSigmaMaxSteady, o, steady_max);
           if (want_float[kSigmaMeanSteady])
-            put(kSigmaMeanSteady, 
-                o, static_cast<float>(1e3 * std::sqrt((v[0] + v[1] + v[2]) / 3.0)));
+            put(kSigmaMeanSteady, o, static_cast<float>(stats[kSteadyMeanMm][m]));
         }
       }
       if (res.cameras && res.cameras->isEmpty()) {
