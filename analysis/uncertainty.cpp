@@ -70,11 +70,11 @@ void JacobiLoop(const double* __restrict xx, const double* __restrict xy, const 
     const double inv = 1.0 / scale;
     double a00 = xx[i] * inv, a01 = xy[i] * inv, a02 = xz[i] * inv;
     double a11 = yy[i] * inv, a12 = yz[i] * inv, a22 = zz[i] * inv;
-    // Convergence is quadratic once the rotations are small; five sweeps take any 3x3 from O(1)
+    // Convergence is quadratic once the rotations are small; four sweeps take any 3x3 from O(1)
     // off-diagonal entries to round-off, and the check below catches the rest.
     // (Unrolled so that the outer loop is a single basic block the vectoriser accepts.)
-#pragma GCC unroll 5
-    for (int sweep = 0; sweep < 5; ++sweep) {
+#pragma GCC unroll 4
+    for (int sweep = 0; sweep < 4; ++sweep) {
       JacobiRotate(a00, a11, a01, a02, a12);  // (0,1), r = 2
       JacobiRotate(a00, a22, a02, a01, a12);  // (0,2), r = 1: a_10 -> a01, a_12 -> a12
       JacobiRotate(a11, a22, a12, a01, a02);  // (1,2), r = 0: a_01 -> a01, a_02 -> a02
