@@ -420,15 +420,20 @@ std::optional<Vec2> CameraModel::Project(const Vec3& p, Mat23* d_pixel_d_point) 
   if (d_pixel_d_point != nullptr) {
     // diag(fx, fy) * dd_dn * dn_dp with dn_dp = [1/Z 0 -x/Z; 0 1/Z -y/Z], written out (the
     // generic Eigen product showed up in profiles of the field evaluation).
+    // Everything in locals first: a store through the output pointer could alias the intrinsics,
+    // which would force them to be reloaded after every store.
     const double iz = 1 / Z;
+    const double fx = k_.fx * iz, fy = k_.fy * iz;
+    const double a0 = fx * dd_dn(0, 0), b0 = fx * dd_dn(0, 1);
+    const double a1 = fy * dd_dn(1, 0), b1 = fy * dd_dn(1, 1);
+    const double c0 = -(a0 * n.x() + b0 * n.y()), c1 = -(a1 * n.x() + b1 * n.y());
     Mat23& J = *d_pixel_d_point;
-    for (int r = 0; r < 2; ++r) {
-      const double f = r == 0 ? k_.fx : k_.fy;
-      const double a = f * dd_dn(r, 0) * iz, b = f * dd_dn(r, 1) * iz;
-      J(r, 0) = a;
-      J(r, 1) = b;
-      J(r, 2) = -(a * n.x() + b * n.y());
-    }
+    J(0, 0) = a0;
+    J(0, 1) = b0;
+    J(0, 2) = c0;
+    J(1, 0) = a1;
+    J(1, 1) = b1;
+    J(1, 2) = c1;
   }
   return Vec2(k_.fx * d.x() + k_.cx, k_.fy * d.y() + k_.cy);
 }

@@ -336,7 +336,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     std::array<double, 512> cand_x, cand_y, cand_z;
     std::array<std::uint64_t, 512> cand_mask;
     std::array<float, 512> angle_deg;
-    std::vector<double> directions(want_angle ? 3 * 64 * camera_count : 0);  // one tile
+    // One tile of directions per camera; left uninitialised (a vector would clear it per block).
+    std::unique_ptr<double[]> directions(want_angle ? new double[3 * 64 * camera_count] : nullptr);
     // Per-candidate statistics (StatRow) for the block's vectorised passes.
     std::array<std::array<double, 512>, kStatRows> stats;
     double* stats_ptr[kStatRows];
@@ -475,7 +476,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
         SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
         if (want_angle)
           TriangulationAngles(candidate_count, cand_x.data(), cand_y.data(), cand_z.data(),
-                              cand_mask.data(), centres, block.cameras, directions.data(),
+                              cand_mask.data(), centres, block.cameras, directions.get(),
                               angle_deg.data());
       }
       for (int m = 0; m < candidate_count; ++m) {
