@@ -39,6 +39,31 @@ inline constexpr double kRelativeObservability = 1e-12;
 /// eigenvalues are more accurate there. With `eigenvectors` false only eigenvalues are computed.
 Information DecomposeInformation(const Mat3& J, bool eigenvectors = true);
 
+/// R_camera_from_world / sigma_px, row-major (nine doubles): the whitened rotation with which
+/// AddCameraInformation turns a camera-frame projection Jacobian into information.
+inline void WhitenedRotation(const Mat3& R_camera_from_world, double sigma_px, double out[9]) {
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) out[3 * r + k] = R_camera_from_world(r, k) / sigma_px;
+}
+
+/// J += A^T A with A = Jc Rw (Rw from WhitenedRotation; Jc = d pixel / d camera-frame point), on
+/// J's upper triangle I = (xx, xy, xz, yy, yz, zz). The one accumulation the volume fields and the
+/// per-point evaluation share, written out in scalars (it runs once per seen voxel-camera pair).
+inline void AddCameraInformation(const Mat23& Jc, const double Rw[9], double I[6]) {
+  const double a00 = Jc(0, 0) * Rw[0] + Jc(0, 1) * Rw[3] + Jc(0, 2) * Rw[6];
+  const double a01 = Jc(0, 0) * Rw[1] + Jc(0, 1) * Rw[4] + Jc(0, 2) * Rw[7];
+  const double a02 = Jc(0, 0) * Rw[2] + Jc(0, 1) * Rw[5] + Jc(0, 2) * Rw[8];
+  const double a10 = Jc(1, 0) * Rw[0] + Jc(1, 1) * Rw[3] + Jc(1, 2) * Rw[6];
+  const double a11 = Jc(1, 0) * Rw[1] + Jc(1, 1) * Rw[4] + Jc(1, 2) * Rw[7];
+  const double a12 = Jc(1, 0) * Rw[2] + Jc(1, 1) * Rw[5] + Jc(1, 2) * Rw[8];
+  I[0] += a00 * a00 + a10 * a10;
+  I[1] += a00 * a01 + a10 * a11;
+  I[2] += a00 * a02 + a10 * a12;
+  I[3] += a01 * a01 + a11 * a11;
+  I[4] += a01 * a02 + a11 * a12;
+  I[5] += a02 * a02 + a12 * a12;
+}
+
 /// Eigenvalues of n symmetric 3x3 matrices at once, for the field evaluation's per-block pass.
 /// `upper` holds six arrays of n entries each (xx, xy, xz, yy, yz, zz); `values` receives three
 /// arrays of n (ascending: smallest, middle, largest). Cyclic Jacobi rotations with a fixed number of

@@ -20,12 +20,7 @@
 namespace pandora::app {
 
 int RunRenderBench(const BenchArgs& args) {
-  int width = 0, height = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(args.size.c_str(), "%d%c%d%c", &width, &x, &height, &extra) != 3 || x != 'x' ||
-      width < 1 || height < 1 || width > 16384 || height > 16384)
-    throw InputError("--size", "", "expected WIDTHxHEIGHT in pixels, got '" + args.size + "'",
-                     "e.g. --size 1280x720");
+  const auto [width, height] = ParseImageSize("--size", args.size);
   const Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
   if (!args.json_out.empty()) {

@@ -1,5 +1,8 @@
 #include "app/output.h"
 
+#include <cerrno>
+#include <cstdlib>
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -53,6 +56,29 @@ void ProgressBar::Finish() {
   finished_ = true;
   std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 40, "");
   std::fflush(stderr);
+}
+
+std::pair<int, int> ParseImageSize(const std::string& option, const std::string& text) {
+  const std::string hint = "e.g. " + option + " 1280x720";
+  const std::size_t x = text.find_first_of("xX");
+  auto side = [&](const std::string& part) {
+    char* end = nullptr;
+    errno = 0;
+    const long v = part.empty() ? 0 : std::strtol(part.c_str(), &end, 10);
+    if (part.empty() || *end != '\0' || errno != 0 || v < 1 || v > 16384)
+      throw InputError(option, "", "expected WIDTHxHEIGHT in pixels, 1 to 16384 each, got '" + text + "'",
+                       hint);
+    return static_cast<int>(v);
+  };
+  if (x == std::string::npos)
+    throw InputError(option, "", "expected WIDTHxHEIGHT in pixels, got '" + text + "'", hint);
+  const int w = side(text.substr(0, x)), h = side(text.substr(x + 1));
+  if (static_cast<long long>(w) * h > 64LL * 1024 * 1024)
+    throw InputError(option, "",
+                     "'" + text + "' is " + std::to_string(static_cast<long long>(w) * h / 1000000) +
+                         " Mpx; at most 64 Mpx (about 40 bytes per pixel with the float layers)",
+                     hint);
+  return {w, h};
 }
 
 }  // namespace pandora::app

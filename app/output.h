@@ -6,6 +6,7 @@
 #include <chrono>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "analysis/atomic_file.h"
 
@@ -14,6 +15,11 @@ namespace pandora::app {
 /// Creates `dir` (and parents) if needed and checks that a file can be created in it. Throws
 /// InputError (file = dir) otherwise.
 void PrepareOutputDir(const std::string& dir);
+
+/// Parses an image size "WxH" for the option `option` (e.g. "--size"): each side 1 to 16384 and at
+/// most 64 Mpx in all (a render keeps about 40 bytes per pixel with its layers, more for a camera's
+/// own view and contours). Throws InputError naming the option otherwise.
+std::pair<int, int> ParseImageSize(const std::string& option, const std::string& text);
 
 /// A one-line progress bar on stderr, drawn only when stderr is a terminal. Thread-safe; redraws at
 /// most ten times a second.

@@ -11,6 +11,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/output.h"
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/vdb_io.h"
@@ -34,17 +35,6 @@ Vec3 ParseTriple(const char* option, const std::string& text) {
     throw InputError(option, "", "expected three numbers X,Y,Z, got '" + text + "'",
                      "e.g. " + std::string(option) + " 1.5,-2,1.8");
   return Vec3(v[0], v[1], v[2]);
-}
-
-// "WxH" with 1 <= W, H <= 16384.
-std::pair<int, int> ParseSize(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  const int n = std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra);
-  if (n != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1 || w > 16384 || h > 16384)
-    throw InputError("--size", "", "expected WIDTHxHEIGHT in pixels (1 to 16384 each), got '" + text + "'",
-                     "e.g. --size 1280x720");
-  return {w, h};
 }
 
 std::string Lower(std::string s) {
@@ -149,7 +139,7 @@ int RunRender(const RenderArgs& args) {
       throw InputError("--at", "", "--at equals --from, or --up is parallel to the viewing direction");
   }
   if (!std::isnan(args.fov)) view.fov_deg = args.fov;
-  if (!args.size.empty()) std::tie(view.width, view.height) = ParseSize(args.size);
+  if (!args.size.empty()) std::tie(view.width, view.height) = ParseImageSize("--size", args.size);
 
   std::unique_ptr<Fields> fields;
   if (!args.fields.empty()) fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));

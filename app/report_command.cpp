@@ -322,6 +322,7 @@ int RunReport(const ReportArgs& args) {
         RenderOptions options;
         options.pixel_sigma = study.pixel_sigma;
         options.brightness = args.brightness;
+        options.layers = false;  // PNG only: no resolution / sigma_max per pixel
         const Image image = Render(scene, *r.rig, *caster, ViewFromScene(view, view_width, height), options);
         cells.push_back("<figure>" +
                         fig.Img("image/png", PngBytes(image), r.rig->name + " view " + name, "render") +
@@ -351,6 +352,7 @@ int RunReport(const ReportArgs& args) {
         RenderOptions options;
         options.pixel_sigma = study.pixel_sigma;
         options.brightness = args.brightness;
+        options.layers = false;  // PNG only: no resolution / sigma_max per pixel
         options.overlays.cameras = false;
         const Image image = Render(scene, *r.rig, *caster, view, options);
         cell += "<figure>" + fig.Img("image/png", PngBytes(image), r.rig->name + " camera " + cam.id, "thumb") +

@@ -18,8 +18,10 @@ namespace pandora {
 void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   const int W = image.width, H = image.height;
   const std::size_t pixels = std::size_t(W) * H;
-  if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels)
-    throw std::invalid_argument("WriteExr: empty or inconsistent image");
+  if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels ||
+      image.cameras.size() != pixels || image.resolution.size() != pixels ||
+      image.sigma_max.size() != pixels || image.depth.size() != pixels)
+    throw std::invalid_argument("WriteExr: empty or inconsistent image (every layer needs a value per pixel)");
   std::vector<uint32_t> lo(pixels), hi;
   for (std::size_t i = 0; i < pixels; ++i) lo[i] = uint32_t(image.cameras[i] & 0xffffffffu);
   const bool want_hi = rig_cameras > 32;

@@ -770,7 +770,6 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
         if (denom != 0) {
           Vec3 dp;
           const int xp = int(p % W), yp = int(p / W);
-          Vec3 ddx, ddy;
           rays.Center(xp, yp, &dp, nullptr, nullptr);
           const double predicted = image.depth[p] * n.dot(dp) / denom;
           jump = !(predicted > 0) || std::abs(predicted - image.depth[q]) > 0.05 * image.depth[p];
@@ -790,17 +789,22 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     tbb::parallel_for(0, H, [&](int y) {
       for (int x = 0; x < W; ++x) {
         const std::size_t p = std::size_t(y) * W + x;
-        Vec3 d, ddx, ddy;
+        Vec3 d;
         if (x + 1 < W && rays.Center(x + 1, y, &d, nullptr, nullptr)) edge(p, p + 1, d);
       }
     });
-    tbb::parallel_for(0, H - 1, [&](int y) {
-      for (int x = 0; x < W; ++x) {
-        const std::size_t p = std::size_t(y) * W + x;
-        Vec3 d, ddx, ddy;
-        if (rays.Center(x, y + 1, &d, nullptr, nullptr)) edge(p, p + W, d);
-      }
-    });
+    // Vertical pairs write rows y and y + 1: even rows first, then odd ones, so no two tasks ever
+    // write the same row at once.
+    for (int parity = 0; parity < 2; ++parity)
+      tbb::parallel_for(0, H / 2 + 1, [&](int half) {
+        const int y = 2 * half + parity;
+        if (y + 1 >= H) return;
+        for (int x = 0; x < W; ++x) {
+          const std::size_t p = std::size_t(y) * W + x;
+          Vec3 d;
+          if (rays.Center(x, y + 1, &d, nullptr, nullptr)) edge(p, p + W, d);
+        }
+      });
     for (std::size_t p = 0; p < pixels; ++p)
       for (int k = 0; k < 3; ++k)
         image.rgb[3 * p + k] = float((1.0 - a[p]) * image.rgb[3 * p + k] + a[p] * options.line_grey);

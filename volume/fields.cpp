@@ -310,12 +310,9 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
   const bool want_jacobian = want_resolution || want_information;
   const int enabled = rig.enabled_count();
   const VisibilityTester tester(rig.cameras, caster, scene.Bounds().diagonal());
-  std::vector<double> inverse_variance(camera_count);  // 1 / sigma_c^2, pixels^-2
-  for (int c = 0; c < camera_count; ++c) {
-    const double sigma =
-        rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
-    inverse_variance[c] = 1.0 / (sigma * sigma);
-  }
+  std::vector<double> pixel_sigma(camera_count);  // pixels
+  for (int c = 0; c < camera_count; ++c)
+    pixel_sigma[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
   std::vector<Vec3> centres;
   for (const Camera& cam : rig.cameras) centres.push_back(cam.center());
   const MotionModel motion = study.motion.value_or(MotionModel{});
@@ -383,12 +380,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                 ++n;
               }
           caster.OccludedPacket(segments.data(), n, occluded.data());
-          // R_camera_from_world row-major (R[3 * row + col]) times 1/sigma_c: then A = Jc R is
-          // whitened and A^T A is the information without a weight per entry.
-          double R[9];
-          const double whiten = std::sqrt(inverse_variance[c]);
-          for (int r = 0; r < 3; ++r)
-            for (int k = 0; k < 3; ++k) R[3 * r + k] = whiten * tester.camera_rotation(c)(r, k);
+          double Rw[9];  // R_camera_from_world / sigma_c
+          WhitenedRotation(tester.camera_rotation(c), pixel_sigma[c], Rw);
           res.ray_count += static_cast<std::int64_t>(n);
           if (options.record_rays) res.rays.insert(res.rays.end(), segments.begin(), segments.begin() + n);
           for (std::size_t i = 0; i < n; ++i) {
@@ -402,24 +395,10 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
             if (want_resolution)
               density[o] = std::max(density[o], static_cast<float>(PixelDensity(Jc)));
             if (want_information) {
-              // A = Jc R / sigma (world frame, whitened), then J += A^T A, upper triangle only; written
-              // out in scalars (Eigen's small products were the largest part of this loop; a
-              // vectorised pass over all of a block's segments was slower, occluded ones included).
-              const double a00 = Jc(0, 0) * R[0] + Jc(0, 1) * R[3] + Jc(0, 2) * R[6];
-              const double a01 = Jc(0, 0) * R[1] + Jc(0, 1) * R[4] + Jc(0, 2) * R[7];
-              const double a02 = Jc(0, 0) * R[2] + Jc(0, 1) * R[5] + Jc(0, 2) * R[8];
-              const double a10 = Jc(1, 0) * R[0] + Jc(1, 1) * R[3] + Jc(1, 2) * R[6];
-              const double a11 = Jc(1, 0) * R[1] + Jc(1, 1) * R[4] + Jc(1, 2) * R[7];
-              const double a12 = Jc(1, 0) * R[2] + Jc(1, 1) * R[5] + Jc(1, 2) * R[8];
-              const double add[6] = {a00 * a00 + a10 * a10, a00 * a01 + a10 * a11,
-                                     a00 * a02 + a10 * a12, a01 * a01 + a11 * a11,
-                                     a01 * a02 + a11 * a12, a02 * a02 + a12 * a12};
               // The voxel's first ray sets its entry, so the 24 KB array is never cleared.
               std::array<double, 6>& I = information[o];
-              if (coverage[o] == 1)
-                for (int k = 0; k < 6; ++k) I[k] = add[k];
-              else
-                for (int k = 0; k < 6; ++k) I[k] += add[k];
+              if (coverage[o] == 1) I.fill(0.0);
+              AddCameraInformation(Jc, Rw, I.data());
             }
           }
         }

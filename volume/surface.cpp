@@ -109,13 +109,16 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
 struct PointEvaluator::Impl {
   Impl(const Scene& scene, const Rig& rig, const RayCaster& caster)
       : tester(rig.cameras, caster, scene.Bounds().diagonal()) {
-    for (const Camera& c : rig.cameras) {
-      const double sigma = c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma;
-      inverse_variance.push_back(1.0 / (sigma * sigma));
-    }
+    if (rig.cameras.size() > 64)
+      throw InputError(scene.path, "$.rigs",
+                       "rig '" + rig.name + "' has " + std::to_string(rig.cameras.size()) +
+                           " cameras; the per-point evaluation supports at most 64",
+                       "split the rig or disable cameras in a copy of it");
+    for (const Camera& c : rig.cameras)
+      sigma.push_back(c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma);
   }
   VisibilityTester tester;
-  std::vector<double> inverse_variance;  // 1 / sigma_c^2, pixels^-2
+  std::vector<double> sigma;  // pixel noise per camera, pixels
 };
 
 PointEvaluator::PointEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster)
@@ -126,13 +129,12 @@ PointEvaluator::~PointEvaluator() { delete impl_; }
 PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) const {
   PointValues v;
   const VisibilityTester& tester = impl_->tester;
-  // J's upper triangle (xx xy xz yy yz zz), summed camera by camera as EvaluateFields does: the
-  // camera-frame Jacobian Jc gives the pixel density; A = Jc R (R = camera_from_world rotation) in
-  // the same scalar form, then J += A^T A / sigma^2.
+  // J's upper triangle (xx xy xz yy yz zz), summed camera by camera with EvaluateFields' own
+  // AddCameraInformation; the camera-frame Jacobian Jc gives the pixel density.
   double I[6] = {0, 0, 0, 0, 0, 0};
   const int cameras = static_cast<int>(tester.cameras().size());
   float best_density = 0;  // the grids store float
-  for (int c = 0; c < cameras && c < 64; ++c) {
+  for (int c = 0; c < cameras; ++c) {
     Ray segment;
     Mat23 Jc;
     if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen) continue;
@@ -140,20 +142,9 @@ PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) cons
     ++v.coverage;
     v.cameras |= std::uint64_t{1} << c;
     best_density = std::max(best_density, static_cast<float>(PixelDensity(Jc)));
-    const Mat3& R = tester.camera_rotation(c);
-    const double a00 = Jc(0, 0) * R(0, 0) + Jc(0, 1) * R(1, 0) + Jc(0, 2) * R(2, 0);
-    const double a01 = Jc(0, 0) * R(0, 1) + Jc(0, 1) * R(1, 1) + Jc(0, 2) * R(2, 1);
-    const double a02 = Jc(0, 0) * R(0, 2) + Jc(0, 1) * R(1, 2) + Jc(0, 2) * R(2, 2);
-    const double a10 = Jc(1, 0) * R(0, 0) + Jc(1, 1) * R(1, 0) + Jc(1, 2) * R(2, 0);
-    const double a11 = Jc(1, 0) * R(0, 1) + Jc(1, 1) * R(1, 1) + Jc(1, 2) * R(2, 1);
-    const double a12 = Jc(1, 0) * R(0, 2) + Jc(1, 1) * R(1, 2) + Jc(1, 2) * R(2, 2);
-    const double w = impl_->inverse_variance[c];
-    I[0] += w * (a00 * a00 + a10 * a10);
-    I[1] += w * (a00 * a01 + a10 * a11);
-    I[2] += w * (a00 * a02 + a10 * a12);
-    I[3] += w * (a01 * a01 + a11 * a11);
-    I[4] += w * (a01 * a02 + a11 * a12);
-    I[5] += w * (a02 * a02 + a12 * a12);
+    double Rw[9];
+    WhitenedRotation(tester.camera_rotation(c), impl_->sigma[c], Rw);
+    AddCameraInformation(Jc, Rw, I);
   }
   v.resolution = best_density;
   if (v.coverage < 2) return v;

@@ -93,6 +93,9 @@ Fields ReadFieldsVdb(const std::string& path) {
   } catch (const openvdb::Exception& e) {
     throw InputError(path, "", std::string("cannot read the VDB file: ") + e.what(),
                      "pass the fields.vdb that `pandora analyze` wrote");
+  } catch (const std::exception& e) {  // a truncated file can fail in the streams or allocation
+    throw InputError(path, "", std::string("cannot read the VDB file: ") + e.what(),
+                     "pass the fields.vdb that `pandora analyze` wrote");
   }
   const openvdb::GridPtrVec grids = g.Grids();
   if (grids.empty())
