@@ -25,12 +25,7 @@ int RunBench(const BenchArgs& args) {
   const Rig& rig = scene.FindRig(args.rig);
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  if (!args.json_out.empty()) {
-    std::error_code ec;
-    if (std::filesystem::equivalent(args.json_out, args.scene, ec))
-      throw InputError(args.json_out, "", "--json would overwrite the scene file",
-                       "write the results to another file");
-  }
+  if (!args.json_out.empty()) RefuseToOverwriteInputs(scene, args.json_out, "--json");
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));

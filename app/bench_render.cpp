@@ -23,12 +23,7 @@ int RunRenderBench(const BenchArgs& args) {
   const auto [width, height] = ParseImageSize("--size", args.size);
   const Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
-  if (!args.json_out.empty()) {
-    std::error_code ec;
-    if (std::filesystem::equivalent(args.json_out, args.scene, ec))
-      throw InputError(args.json_out, "", "--json would overwrite the scene file",
-                       "write the results to another file");
-  }
+  if (!args.json_out.empty()) RefuseToOverwriteInputs(scene, args.json_out, "--json");
   RenderView view;
   if (!args.view.empty()) {
     auto it = scene.views.find(args.view);

@@ -25,13 +25,11 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   const std::filesystem::path out(args.out);
   const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : ".";
   PrepareOutputDir(dir.string());
-  std::error_code ec;
   if (std::filesystem::is_directory(out))
     throw InputError(args.out, "", "--out names a folder, not a file", "e.g. --out surface.ply");
-  if (std::filesystem::equivalent(out, args.scene, ec))
-    throw InputError(args.out, "", "--out would overwrite the scene file", "choose another --out file");
 
   const Scene scene = LoadScene(args.scene);
+  RefuseToOverwriteInputs(scene, args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, args.spacing, args.seed);
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());

@@ -81,4 +81,21 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
   return {w, h};
 }
 
+void RefuseToOverwriteInputs(const Scene& scene, const std::string& out, const std::string& what) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(scene.path).parent_path();
+  auto refuse_if = [&](const std::string& input, const char* kind) {
+    if (input.empty()) return;
+    fs::path p(input);
+    if (p.is_relative()) p = folder / p;
+    std::error_code ec;
+    if (fs::equivalent(out, p, ec))
+      throw InputError(out, "", what + " would overwrite the " + kind + " '" + input + "'",
+                       "write the output to another file");
+  };
+  refuse_if(scene.path, "scene file");
+  for (const SceneObject& o : scene.objects) refuse_if(o.source, "mesh file");
+  for (const Material& m : scene.materials) refuse_if(m.texture, "texture");
+}
+
 }  // namespace pandora::app

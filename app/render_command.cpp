@@ -100,11 +100,7 @@ int RunRender(const RenderArgs& args) {
   }
 
   Scene scene = LoadScene(args.scene);
-  {
-    std::error_code ec;
-    if (std::filesystem::equivalent(args.out, args.scene, ec))
-      throw InputError(args.out, "", "--out would overwrite the scene file", "write the image to another file");
-  }
+  RefuseToOverwriteInputs(scene, args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
   options.pixel_sigma = scene.study.pixel_sigma;
 
