@@ -56,7 +56,7 @@ SceneObject Sphere(const Vec3& center, double radius, int segments) {
 }
 
 // The eye ray of output pixel (x, y) of a pinhole RenderView, computed independently of render.cpp.
-Vec3 EyeRay(const RenderView& v, int x, int y) {
+Vec3 EyeRay(const RenderView& v, double x, double y) {
   const Eigen::Isometry3d pose = *LookAt(v.from, v.at, v.up);
   const double f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * M_PI / 180.0);
   const Vec3 d((x - (0.5 * v.width - 0.5)) / f, (y - (0.5 * v.height - 0.5)) / f, 1.0);
@@ -140,6 +140,54 @@ TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {
   EXPECT_GT(lit, 1000);
   EXPECT_GT(dark, 1000);
   EXPECT_GT(curved, 50);  // barrel distortion widens the footprint
+  EXPECT_GE(checked, view.width * view.height - 20);
+}
+
+// Antialiasing: with samples = 3 each pixel's colour is the share of its 3 x 3 stratified sample
+// points (at x - 0.5 + (i + 0.5) / 3) inside the distorted footprint, in closed form; the layers
+// still come from the pixel centre.
+TEST(Render, StratifiedSamplesAverageTheFootprintInsideEachPixel) {
+  Scene scene;
+  scene.objects.push_back(Floor());
+  Rig rig;
+  rig.name = "one";
+  rig.cameras.push_back(MakeCamera("c0", Vec3(0.2, -0.1, 2.0), Vec3(0.5, 0.3, 0.0), Vec3(0, 1, 0),
+                                   64, 48, 70, Vec3(1, 0, 0), LensModel::kBrownConrady, -0.25,
+                                   0.05));
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  RenderView view;
+  view.from = Vec3(-1.5, -2.5, 3.5);
+  view.at = Vec3(0.4, 0.2, 0.0);
+  view.fov_deg = 75;
+  view.width = 80;
+  view.height = 60;
+  RenderOptions options = BlackOptions();
+  options.samples = 3;
+  const Image img = Render(scene, rig, *caster, view, options);
+  const Camera& cam = rig.cameras[0];
+  int partial = 0, checked = 0;
+  for (int y = 0; y < view.height; ++y)
+    for (int x = 0; x < view.width; ++x) {
+      int inside = 0;
+      bool undecided = false;
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+          const auto X = HitFloor(view.from, EyeRay(view, x - 0.5 + (i + 0.5) / 3, y - 0.5 + (j + 0.5) / 3));
+          ASSERT_TRUE(X);
+          const auto margin = BorderMargin(cam, *X);
+          if (margin && std::abs(*margin) < 1e-3) undecided = true;
+          inside += margin && *margin > 0;
+        }
+      if (undecided) continue;
+      ++checked;
+      partial += inside > 0 && inside < 9;
+      EXPECT_NEAR(img.Rgb(x, y).x(), inside / 9.0, 1e-6) << "pixel " << x << "," << y;
+      EXPECT_EQ(img.Rgb(x, y).y(), 0.0f);
+      const auto centre = BorderMargin(cam, *HitFloor(view.from, EyeRay(view, x, y)));
+      if (centre && std::abs(*centre) > 1e-3)
+        EXPECT_EQ(img.coverage[y * img.width + x], *centre > 0 ? 1.0f : 0.0f) << x << "," << y;
+    }
+  EXPECT_GT(partial, 40);  // the footprint's edge crosses many pixels part-way
   EXPECT_GE(checked, view.width * view.height - 20);
 }
 
