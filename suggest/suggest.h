@@ -130,8 +130,9 @@ struct SuggestOptions {
   int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
   /// Candidate poses per active camera at each of the three radii of the exact screening before the
-  /// Ceres nudge (three chains; see suggest_ceres.cpp). 0: no screening, the nudge starts from the
-  /// current poses only.
+  /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives; the others, whose
+  /// exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
+  /// poses only.
   int screening_candidates = 200;
   /// Installable steps (0: none): the change of each camera is rounded to multiples of snap_move
   /// (metres, per axis of its mount) and its yaw / pitch / roll change (scene-format Euler angles)
