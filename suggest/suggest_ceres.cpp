@@ -558,7 +558,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     }
     return std::make_pair(poses, ok);
   };
-  // The start of the current polish and its best pose so far (the global best is best_x).
+  // The polish's best pose so far (best_x is the best of all, the screening's included).
   std::vector<std::vector<double>> run_x;
   double run_score = -kInf;
   judge.on_step = [&]() {
@@ -582,13 +582,9 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // Polish the best start with the Ceres nudge: the screening's best pose when it beat the current
   // poses, else the current poses. (Polishing the current poses as well, as a second start, never
   // ended best on the trauma-room benchmark and doubled the time.)
-  std::vector<std::pair<std::vector<std::vector<double>>, double>> starts;
-  if (!screened_x.empty()) starts.push_back({screened_x, screened_score});
-  else starts.push_back({x, start_score});
+  run_x = screened_x.empty() ? x : screened_x;
+  run_score = screened_x.empty() ? start_score : screened_score;
   const int outer = std::max(1, options.outer_iterations);
-  for (const auto& [start_x, start_x_score] : starts) {
-  run_x = start_x;
-  run_score = start_x_score;
   for (int o = 0; o < outer; ++o) {
     // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
     surrogate.set_border_width(o == 0 ? kBorderWidth : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
@@ -639,7 +635,6 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     // The final state too (the callback saw every successful step already; this is cheap insurance).
     judge.on_step();
     if (o >= 2 && !(run_score > score_before_outer)) break;  // converged at the final width
-  }
   }
 
   std::vector<Eigen::Isometry3d> best_poses = start;
