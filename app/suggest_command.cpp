@@ -102,7 +102,10 @@ void PrintTable(const Suggestion& s, const Scene& scene, const Rig& rig, const s
   row("min resolution (px/m)", s.before.min_resolution, s.after.min_resolution);
   if (s.unsnapped)
     std::printf("(before snapping the optimum had objective %s)\n", Value(s.unsnapped->objective).c_str());
-  std::printf("\n%d iterations (%d outer), %lld evaluations, %.3f s\n%s\n", s.iterations,
+  std::printf("\n");
+  if (s.screened > 0)
+    std::printf("screening: %d exact evaluations, best %s; then ", s.screened, Value(s.screened_objective).c_str());
+  std::printf("%d iterations (%d outer), %lld evaluations, %.3f s\n%s\n", s.iterations,
               s.outer_iterations, static_cast<long long>(s.evaluations), s.seconds, s.message.c_str());
   if (scene.study.region.box.diagonal() > 0 && s.before.untriangulable > 0)
     std::printf("(inf: the percentile falls on a point that is not triangulable)\n");
@@ -274,7 +277,7 @@ int RunSuggest(const SuggestArgs& args) {
   if (!args.quiet) std::printf("wrote %s%s\n", args.out.c_str(), s.improved ? "" : " (no improvement: nothing to accept)");
 
   if (!args.compare_baseline.empty()) {
-    // The same evaluation budget as the Ceres nudge used (surrogate + exact evaluations).
+    // The same evaluation budget as the suggestion used (screening, surrogate and exact evaluations).
     const Suggestion b = BaselineSearch(scene, rig, *caster, targets, options, s.evaluations, args.seed + 1, false);
     const Suggestion ba = BaselineSearch(scene, rig, *caster, targets, options, s.evaluations, args.seed + 1, true);
     const bool higher = ObjectiveHigherIsBetter(options.objective);
@@ -291,7 +294,7 @@ int RunSuggest(const SuggestArgs& args) {
     const std::string stem = args.compare_baseline + "/suggest_vs_baseline";
     WriteFileAtomically(stem + ".csv", csv);
     LogLogPlot plot;
-    plot.title = "Ceres nudge vs random local search: " + rig.name + ", " + ObjectiveName(options.objective);
+    plot.title = "Suggestion (screening + Ceres nudge) vs random local search: " + rig.name + ", " + ObjectiveName(options.objective);
     plot.x_label = "seconds";
     // Coverage is plotted as the share still short of k cameras (1 - coverage), which a log axis shows.
     const bool shortfall = options.objective.kind == ObjectiveKind::kCoverage;
@@ -301,7 +304,7 @@ int RunSuggest(const SuggestArgs& args) {
                              : "best exact " + ObjectiveName(options.objective);
     plot.note = std::to_string(s.target_points) + " target points; same evaluation budget (" +
                 std::to_string(s.evaluations) + " evaluations)";
-    const char* labels[] = {"Ceres nudge", "random search, fixed step", "random search, 1/5 rule"};
+    const char* labels[] = {"screening + Ceres nudge", "random search, fixed step", "random search, 1/5 rule"};
     for (std::size_t r = 0; r < runs.size(); ++r) {
       PlotSeries series;
       series.label = labels[r];
@@ -323,11 +326,11 @@ int RunSuggest(const SuggestArgs& args) {
     }
     WriteFileAtomically(stem + ".svg", RenderLogLogSvg(plot));
     if (!args.quiet) {
-      // Targets: the Ceres nudge's final objective, and the better baseline's final objective.
+      // Targets: the suggestion's final objective, and the better baseline's final objective.
       double best_base = b.after.objective;
       if (higher ? ba.after.objective > best_base : ba.after.objective < best_base) best_base = ba.after.objective;
       std::printf("\n%-27s %9s %9s %7s %13s %13s %13s\n", "method (same budget)", "final", "seconds", "evals",
-                  ("at " + Value(s.seconds, "%.2f") + " s").c_str(), "to Ceres fin.", "to best base");
+                  ("at " + Value(s.seconds, "%.2f") + " s").c_str(), "to sugg. fin.", "to best base");
       for (std::size_t r = 0; r < runs.size(); ++r) {
         const Suggestion& x = *runs[r].second;
         double at = x.before.objective;
@@ -338,7 +341,7 @@ int RunSuggest(const SuggestArgs& args) {
                     Value(TimeToReach(x.trace, s.after.objective, higher), "%.3f").c_str(),
                     Value(TimeToReach(x.trace, best_base, higher), "%.3f").c_str());
       }
-      std::printf("(times in seconds to reach the Ceres nudge's final %s and the better baseline's final %s; inf: never)\n",
+      std::printf("(times in seconds to reach the suggestion's final %s and the better baseline's final %s; inf: never)\n",
                   Value(s.after.objective).c_str(), Value(best_base).c_str());
       std::printf("wrote %s.csv and %s.svg\n", stem.c_str(), stem.c_str());
     }

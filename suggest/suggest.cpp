@@ -367,6 +367,64 @@ Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
   return Summarise(count, J, dmax);
 }
 
+CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double focal_scale) const {
+  Camera cam = selected_[c];
+  cam.world_from_camera = pose;
+  if (focal_scale != 1.0) cam = Zoomed(cam, focal_scale);
+  const VisibilityTester tester({cam}, caster_, scene_scale_);
+  const std::size_t n = targets_.size();
+  CameraView v;
+  v.seen.assign(n, 0);
+  v.info.assign(n, Mat3::Zero());
+  v.density.assign(n, 0.0);
+  const double s = PixelSigma(cam);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const TargetPoint& t = targets_[i];
+      Mat23 A;
+      if (tester.Test(0, t.p, t.normal ? &*t.normal : nullptr, &A) != ViewResult::kSeen) continue;
+      v.seen[i] = 1;
+      v.info[i] = A.transpose() * A / (s * s);
+      v.density[i] = PixelDensity(A);
+    }
+  });
+  return v;
+}
+
+Metrics ExactEvaluator::Combine(const std::vector<const CameraView*>& views, bool objective_only) const {
+  ++evaluations_;
+  if (objective_only && objective_.kind == ObjectiveKind::kCoverage) {
+    const std::size_t n = targets_.size();
+    std::size_t k_count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int count = fixed_.count[i];
+      for (const CameraView* v : views) count += v->seen[i];
+      k_count += count >= objective_.k;
+    }
+    Metrics m;
+    m.coverage_k = n > 0 ? double(k_count) / n : 0.0;
+    m.objective = m.coverage_k;
+    return m;
+  }
+  return Summary(views);
+}
+
+Metrics ExactEvaluator::Summary(const std::vector<const CameraView*>& views) const {
+  const std::size_t n = targets_.size();
+  std::vector<int> count = fixed_.count;
+  std::vector<Mat3> J = fixed_.J;
+  std::vector<double> dmax = fixed_.dmax;
+  // Cameras in the order Evaluate adds them, so the sums round the same way.
+  for (const CameraView* v : views)
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!v->seen[i]) continue;
+      count[i] += 1;
+      J[i] += v->info[i];
+      dmax[i] = std::max(dmax[i], v->density[i]);
+    }
+  return Summarise(count, J, dmax);
+}
+
 Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
                                   const std::vector<double>& dmax) const {
   Metrics m;
@@ -720,6 +778,8 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   std::vector<Eigen::Isometry3d> poses = start;
   std::vector<double> scales(charts.size(), 1.0);
   int rejected_in_a_row = 0;
+  std::vector<CameraView> views(charts.size());
+  std::vector<const CameraView*> view_ptrs(charts.size());
   while (total_dims > 0 && ev.evaluations() < evaluation_budget && rejected_in_a_row < 10000) {
     bool ok = true;
     for (std::size_t c = 0; c < charts.size(); ++c) {
@@ -734,11 +794,17 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       continue;
     }
     rejected_in_a_row = 0;
-    const Metrics m = ev.Evaluate(poses, scales);
+    // The same fast exact evaluation as the nudge's screening: the objective alone (for coverage, no
+    // covariances), the full metrics only for a new best.
+    for (std::size_t c = 0; c < charts.size(); ++c) {
+      views[c] = ev.View(static_cast<int>(c), poses[c], scales[c]);
+      view_ptrs[c] = &views[c];
+    }
+    const Metrics m = ev.Combine(view_ptrs, /*objective_only=*/true);
     const double score = ev.Score(m);
     if (score > best_score) {
       best_score = score;
-      best_m = m;
+      best_m = ev.Summary(view_ptrs);
       best = cand;
       if (adaptive_step) step = std::min(1.0, step * 1.5);
     } else if (adaptive_step) {

@@ -129,6 +129,11 @@ struct SuggestOptions {
   Objective objective;
   int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
+  /// Candidate poses per active camera at each of the three radii of the exact screening before the
+  /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives; the others, whose
+  /// exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
+  /// poses only.
+  int screening_candidates = 200;
   /// Installable steps (0: none): the change of each camera is rounded to multiples of snap_move
   /// (metres, per axis of its mount) and its yaw / pitch / roll change (scene-format Euler angles)
   /// to multiples of snap_rotate_deg, never beyond the limits; then evaluated again.
@@ -147,6 +152,8 @@ struct Suggestion {
   int iterations = 0;         ///< Ceres iterations, all outer iterations together.
   int outer_iterations = 0;
   std::int64_t evaluations = 0;  ///< Surrogate + exact evaluations.
+  int screened = 0;              ///< Exact evaluations up to the end of the screening.
+  double screened_objective = 0; ///< The best exact objective at the end of the screening.
   double seconds = 0;
   std::vector<TracePoint> trace;
   int target_points = 0;

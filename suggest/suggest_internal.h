@@ -23,6 +23,14 @@ struct FixedContribution {
 
 inline constexpr double kSoftMaxPower = 8.0;
 
+/// What one selected camera at one pose sees of the target points, exactly (the visibility rules of
+/// ExactEvaluator::Evaluate): lets a search that moves one camera at a time reuse the others' views.
+struct CameraView {
+  std::vector<std::uint8_t> seen;  ///< 1 where the camera sees the point.
+  std::vector<Mat3> info;          ///< A^T A / sigma^2 where seen (zero elsewhere), 1/m^2.
+  std::vector<double> density;     ///< Pixel density where seen, px/m (0 elsewhere).
+};
+
 /// Exact evaluation with the fixed cameras precomputed: only the selected cameras are tested again
 /// at each candidate pose.
 class ExactEvaluator {
@@ -35,6 +43,16 @@ class ExactEvaluator {
   /// when given, their focal lengths scaled by `focal_scales`.
   Metrics Evaluate(const std::vector<Eigen::Isometry3d>& poses,
                    const std::vector<double>& focal_scales = {}) const;
+  /// The view of selected camera `c` at `pose` (focal lengths scaled by `focal_scale`). Not counted
+  /// as an evaluation: Combine counts.
+  CameraView View(int c, const Eigen::Isometry3d& pose, double focal_scale = 1.0) const;
+  /// Metrics with the selected cameras seeing what `views` say (one per selected camera): equal to
+  /// Evaluate at the poses the views were made at. Counts one evaluation. With `objective_only` and
+  /// a coverage objective only `objective` and `coverage_k` are set (no covariances: faster); the
+  /// other objectives always get the full metrics.
+  Metrics Combine(const std::vector<const CameraView*>& views, bool objective_only = false) const;
+  /// The full metrics of a combination already evaluated with Combine (not counted again).
+  Metrics Summary(const std::vector<const CameraView*>& views) const;
   /// Higher is better; -inf for an infinite sigma percentile.
   double Score(const Metrics& m) const;
   /// The mix objective is relative to the start: call once with the start metrics.

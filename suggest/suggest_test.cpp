@@ -19,6 +19,7 @@
 #include "analysis/scene.h"
 #include "analysis/sha256.h"
 #include "analysis/visibility.h"
+#include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
 
 namespace pandora {
@@ -188,6 +189,54 @@ TEST(SuggestExact, CoverageEqualsDirectCount) {
   EXPECT_LT(share4, 0.9);  // c4 looks past the region: room for a nudge
 }
 
+// The screening's per-camera views, combined, give exactly what Evaluate gives at the same poses
+// (every metric, bit for bit: the sums are made in the same order), and the objective-only path
+// gives the same objective.
+TEST(SuggestExact, CombinedCameraViewsEqualEvaluate) {
+  Fixture f(SceneText(1.0), 500);
+  const std::vector<int> sel{1, 3};
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  for (const char* name : {"coverage2", "coverage4", "sigma-mean", "resolution"}) {
+    const Objective o = *ParseObjective(name);
+    suggest_detail::ExactEvaluator ev(f.scene, f.rig(), *f.caster, f.targets, o, sel);
+    for (int trial = 0; trial < 4; ++trial) {
+      std::vector<Eigen::Isometry3d> poses;
+      std::vector<double> scales;
+      std::vector<suggest_detail::CameraView> views(sel.size());
+      std::vector<const suggest_detail::CameraView*> ptrs;
+      for (std::size_t c = 0; c < sel.size(); ++c) {
+        Eigen::Isometry3d p = f.rig().cameras[sel[c]].world_from_camera;
+        p.translation() += 0.1 * Vec3(n01(rng), n01(rng), n01(rng));
+        p.linear() = p.linear() * Eigen::AngleAxisd(0.1 * n01(rng), Vec3(n01(rng), n01(rng), n01(rng)).normalized()).toRotationMatrix();
+        poses.push_back(p);
+        scales.push_back(trial == 3 ? 1.2 : 1.0);  // a zoom too
+        views[c] = ev.View(static_cast<int>(c), p, scales[c]);
+        ptrs.push_back(&views[c]);
+      }
+      const Metrics a = ev.Evaluate(poses, scales);
+      const std::int64_t before = ev.evaluations();
+      const Metrics b = ev.Combine(ptrs);
+      const Metrics fast = ev.Combine(ptrs, /*objective_only=*/true);
+      EXPECT_EQ(ev.evaluations(), before + 2);  // each Combine is one evaluation
+      const Metrics full = ev.Summary(ptrs);
+      EXPECT_EQ(ev.evaluations(), before + 2);  // Summary is not counted again
+      for (const Metrics* m : {&b, &full}) {
+        EXPECT_EQ(m->objective, a.objective) << name;
+        EXPECT_EQ(m->coverage_k, a.coverage_k);
+        EXPECT_EQ(m->coverage2, a.coverage2);
+        EXPECT_EQ(m->sigma_mean, a.sigma_mean);
+        EXPECT_EQ(m->sigma_p50, a.sigma_p50);
+        EXPECT_EQ(m->sigma_p90, a.sigma_p90);
+        EXPECT_EQ(m->untriangulable, a.untriangulable);
+        EXPECT_EQ(m->min_resolution, a.min_resolution);
+      }
+      EXPECT_EQ(fast.objective, a.objective) << name;
+      EXPECT_EQ(ev.Score(fast), ev.Score(a));
+    }
+  }
+}
+
 TEST(SuggestTargets, SurfacePointsLieOnTheSurfaceWithOutwardNormals) {
   const Scene scene = ParseScene(SceneText(1.0), "test.json");
   const Vec3 centre(1.6, 1.6, 0.75), half(0.15, 0.15, 0.75);
@@ -265,6 +314,36 @@ TEST(Suggest, TraumaRoomRecoveryFromPerturbedCameras) {
     // Recovers the loss: at least the original objective (the nudge often beats the original).
     EXPECT_GE(s.after.objective, original) << name << " perturbed " << s.before.objective;
   }
+}
+
+// The screening's best start is polished, never lost (after >= screened >= before); on the trauma
+// room's perturbed cameras the result beats the Ceres nudge alone from the current poses.
+TEST(Suggest, ScreeningThenPolishBeatsTheNudgeAlone) {
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const std::vector<TargetPoint> targets = SampleTargets(scene, 400, {}, false, 2);
+  double gain = 0;
+  for (const char* name : {"octagon", "grid4x2"}) {
+    const Rig& rig = scene.FindRig(name);
+    const std::vector<int> sel{2, 5};
+    const Rig perturbed = PerturbCameras(rig, sel, 0.3, 25, 2);
+    SuggestOptions opt = Options(sel, 0.4, 30);
+    opt.objective = Objective{};  // coverage2
+    SuggestOptions alone = opt;
+    alone.screening_candidates = 0;
+    const Suggestion with = Suggest(scene, perturbed, *caster, targets, opt);
+    const Suggestion without = Suggest(scene, perturbed, *caster, targets, alone);
+    ASSERT_TRUE(with.improved) << name << ": " << with.message;
+    EXPECT_EQ(without.screened, 0);
+    EXPECT_GT(with.screened, 3 * 2 * 3 * opt.screening_candidates);  // 3 chains, 2 cameras, 3 radii
+    EXPECT_GE(with.screened_objective, with.before.objective);
+    EXPECT_GE(with.after.objective, with.screened_objective);
+    EXPECT_GE(with.after.objective, without.after.objective) << name;
+    gain += with.after.objective - without.after.objective;
+    for (std::size_t i = 1; i < with.trace.size(); ++i)
+      EXPECT_GE(with.trace[i].objective, with.trace[i - 1].objective) << name;
+  }
+  EXPECT_GT(gain, 0.0);
 }
 
 TEST(Suggest, ZeroLimitsReturnTheSamePoses) {

@@ -146,6 +146,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   j["solver"] = {{"iterations", s.iterations},
                  {"outer_iterations", s.outer_iterations},
                  {"evaluations", s.evaluations},
+                 {"screening_evaluations", s.screened},
+                 {"screening_best_objective", s.screened > 0 ? Finite(s.screened_objective) : json(nullptr)},
                  {"seconds", s.seconds}};
   json trace = json::array();
   for (const TracePoint& t : s.trace) trace.push_back({t.seconds, t.evaluations, Finite(t.objective)});
