@@ -86,22 +86,34 @@ std::optional<double> BorderMargin(const Camera& cam, const Vec3& X) {
   return std::min({px->x() + 0.5, w - px->x(), px->y() + 0.5, h - px->y()});
 }
 
-TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {
+// A floor lit by one red camera with strong barrel distortion (the footprint's edges are curves,
+// not the pinhole's straight lines), seen from above at an angle.
+struct OneCameraFloor {
   Scene scene;
-  scene.objects.push_back(Floor());
   Rig rig;
-  rig.name = "one";
-  // Strong barrel distortion: the footprint's edges are curves, not the pinhole's straight lines.
-  rig.cameras.push_back(MakeCamera("c0", Vec3(0.2, -0.1, 2.0), Vec3(0.5, 0.3, 0.0), Vec3(0, 1, 0),
-                                   64, 48, 70, Vec3(1, 0, 0), LensModel::kBrownConrady, -0.25,
-                                   0.05));
-  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   RenderView view;
-  view.from = Vec3(-1.5, -2.5, 3.5);
-  view.at = Vec3(0.4, 0.2, 0.0);
-  view.fov_deg = 75;
-  view.width = 160;
-  view.height = 120;
+};
+OneCameraFloor MakeOneCameraFloor(int width, int height) {
+  OneCameraFloor s;
+  s.scene.objects.push_back(Floor());
+  s.rig.name = "one";
+  s.rig.cameras.push_back(MakeCamera("c0", Vec3(0.2, -0.1, 2.0), Vec3(0.5, 0.3, 0.0), Vec3(0, 1, 0),
+                                     64, 48, 70, Vec3(1, 0, 0), LensModel::kBrownConrady, -0.25,
+                                     0.05));
+  s.view.from = Vec3(-1.5, -2.5, 3.5);
+  s.view.at = Vec3(0.4, 0.2, 0.0);
+  s.view.fov_deg = 75;
+  s.view.width = width;
+  s.view.height = height;
+  return s;
+}
+
+TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {
+  const OneCameraFloor setup = MakeOneCameraFloor(160, 120);
+  const Scene& scene = setup.scene;
+  const Rig& rig = setup.rig;
+  const RenderView& view = setup.view;
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const Image img = Render(scene, rig, *caster, view, BlackOptions());
   ASSERT_EQ(img.width, 160);
   const Camera& cam = rig.cameras[0];
@@ -147,20 +159,11 @@ TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {
 // points (at x - 0.5 + (i + 0.5) / 3) inside the distorted footprint, in closed form; the layers
 // still come from the pixel centre.
 TEST(Render, StratifiedSamplesAverageTheFootprintInsideEachPixel) {
-  Scene scene;
-  scene.objects.push_back(Floor());
-  Rig rig;
-  rig.name = "one";
-  rig.cameras.push_back(MakeCamera("c0", Vec3(0.2, -0.1, 2.0), Vec3(0.5, 0.3, 0.0), Vec3(0, 1, 0),
-                                   64, 48, 70, Vec3(1, 0, 0), LensModel::kBrownConrady, -0.25,
-                                   0.05));
+  const OneCameraFloor setup = MakeOneCameraFloor(80, 60);
+  const Scene& scene = setup.scene;
+  const Rig& rig = setup.rig;
+  const RenderView& view = setup.view;
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
-  RenderView view;
-  view.from = Vec3(-1.5, -2.5, 3.5);
-  view.at = Vec3(0.4, 0.2, 0.0);
-  view.fov_deg = 75;
-  view.width = 80;
-  view.height = 60;
   RenderOptions options = BlackOptions();
   options.samples = 3;
   const Image img = Render(scene, rig, *caster, view, options);
