@@ -591,6 +591,22 @@ const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i) {
   return options.limits.size() == 1 ? options.limits[0] : options.limits[i];
 }
 
+SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int target_points,
+                        ExactEvaluator& ev) {
+  SearchStart b;
+  for (std::size_t c = 0; c < options.cameras.size(); ++c) {
+    b.charts.push_back(PoseChart::Make(rig.cameras[options.cameras[c]], LimitsOf(options, c)));
+    b.start.push_back(rig.cameras[options.cameras[c]].world_from_camera);
+  }
+  Suggestion& s = b.suggestion;
+  s.objective = options.objective;
+  s.target_points = target_points;
+  s.before = ev.Evaluate(b.start);
+  ev.SetReference(s.before.sigma_mean, s.before.min_resolution);
+  if (options.objective.kind == ObjectiveKind::kMix) s.before = ev.Evaluate(b.start);
+  return b;
+}
+
 void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options) {
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
   if (options.cameras.empty())
@@ -750,18 +766,10 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
-  std::vector<PoseChart> charts;
-  std::vector<Eigen::Isometry3d> start;
-  for (std::size_t c = 0; c < options.cameras.size(); ++c) {
-    charts.push_back(PoseChart::Make(rig.cameras[options.cameras[c]], LimitsOf(options, c)));
-    start.push_back(rig.cameras[options.cameras[c]].world_from_camera);
-  }
-  Suggestion s;
-  s.objective = options.objective;
-  s.target_points = static_cast<int>(targets.size());
-  s.before = ev.Evaluate(start);
-  ev.SetReference(s.before.sigma_mean, s.before.min_resolution);
-  if (options.objective.kind == ObjectiveKind::kMix) s.before = ev.Evaluate(start);
+  SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
+  const std::vector<PoseChart>& charts = begin.charts;
+  const std::vector<Eigen::Isometry3d>& start = begin.start;
+  Suggestion& s = begin.suggestion;
   std::vector<std::vector<double>> best(charts.size());
   int total_dims = 0;
   for (std::size_t c = 0; c < charts.size(); ++c) {

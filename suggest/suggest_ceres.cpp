@@ -354,18 +354,10 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   };
   const std::size_t nsel = options.cameras.size();
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
-  std::vector<PoseChart> charts;
-  std::vector<Eigen::Isometry3d> start;
-  for (std::size_t c = 0; c < nsel; ++c) {
-    charts.push_back(PoseChart::Make(rig.cameras[options.cameras[c]], LimitsOf(options, c)));
-    start.push_back(rig.cameras[options.cameras[c]].world_from_camera);
-  }
-  Suggestion s;
-  s.objective = options.objective;
-  s.target_points = static_cast<int>(targets.size());
-  s.before = ev.Evaluate(start);
-  ev.SetReference(s.before.sigma_mean, s.before.min_resolution);
-  if (options.objective.kind == ObjectiveKind::kMix) s.before = ev.Evaluate(start);
+  SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
+  const std::vector<PoseChart>& charts = begin.charts;
+  const std::vector<Eigen::Isometry3d>& start = begin.start;
+  Suggestion& s = begin.suggestion;
   s.after = s.before;
   FillChanges(rig, options, start, {}, &s);
   const double start_score = ev.Score(s.before);

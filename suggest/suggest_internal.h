@@ -120,6 +120,16 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
 /// The limits of selected camera i.
 const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i);
 
+/// The common start of every search: each selected camera's pose chart and start pose, and the
+/// suggestion's "before" metrics (with the mix objective's reference scales set from them).
+struct SearchStart {
+  std::vector<PoseChart> charts;
+  std::vector<Eigen::Isometry3d> start;
+  Suggestion suggestion;
+};
+SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int target_points,
+                        ExactEvaluator& ev);
+
 /// Rounds the change of each camera to the snap steps, within the limits; returns the new poses.
 std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
