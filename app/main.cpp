@@ -121,9 +121,9 @@ int main(int argc, char** argv) {
   sg->add_option("--weights", suggest.weights, "Mix weights WC,WS,WR (coverage, sigma, resolution)");
   sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along [ID:]DX,DY,DZ (repeatable)");
   sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal [ID:]NX,NY,NZ (repeatable)");
-  sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (repeatable)");
+  sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, metres in the world frame (repeatable)");
   sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
-  sg->add_option("--keep-out", suggest.keep_out, "Box no camera centre may enter (repeatable)");
+  sg->add_option("--keep-out", suggest.keep_out, "Box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (metres, world frame) no camera centre may enter (repeatable)");
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
   sg->add_option("--points", suggest.points, "Target points")->capture_default_str();

@@ -353,15 +353,6 @@ int RunAccept(const AcceptArgs& args) {
   AcceptOptions options;
   options.force = args.force;
   if (!args.cameras.empty()) options.cameras = SplitComma(args.cameras);
-  {
-    std::ifstream in(args.suggestion, std::ios::binary);
-    std::ostringstream ss;
-    if (in) ss << in.rdbuf();
-    if (ss.str().find("\"perturbed_for_benchmark\": true") != std::string::npos)
-      throw InputError(args.suggestion, "$.perturbed_for_benchmark",
-                       "this suggestion was made from perturbed poses (--perturb), not the scene file's",
-                       "run pandora suggest without --perturb");
-  }
   const AcceptResult r = AcceptSuggestion(args.suggestion, options);
   std::string ids;
   for (const std::string& id : r.accepted) ids += (ids.empty() ? "" : ", ") + id;

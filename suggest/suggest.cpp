@@ -520,7 +520,7 @@ PoseChart PoseChart::Make(const Camera& camera, const CameraLimits& limits) {
     zoom_lo = std::log(FocalFromHfov(Rad(limits.max_hfov_deg), k.width, k.model) / k.fx);
     zoom_hi = std::log(FocalFromHfov(Rad(limits.min_hfov_deg), k.width, k.model) / k.fx);
     c.log_focal_range = std::max(std::abs(zoom_lo), std::abs(zoom_hi));
-    c.dims_f = c.log_focal_range > 0 ? 1 : 0;
+    c.dims_f = c.log_focal_range > 1e-12 ? 1 : 0;  // a one-value range is no zoom
   }
   c.lower.assign(c.dims(), -1.0);
   c.upper.assign(c.dims(), 1.0);

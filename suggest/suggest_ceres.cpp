@@ -605,6 +605,10 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     problem.AddResidualBlock(&cost, nullptr, blocks);
     for (int c : active)
       for (int i = 0; i < charts[c].dims(); ++i) {
+        // A flat mount box gives lower == upper on one axis, which Ceres rejects as infeasible
+        // (and then does not iterate at all); the projection onto the limits before every exact
+        // evaluation holds that axis anyway.
+        if (!(charts[c].lower[i] < charts[c].upper[i])) continue;
         problem.SetParameterLowerBound(x[c].data(), i, charts[c].lower[i]);
         problem.SetParameterUpperBound(x[c].data(), i, charts[c].upper[i]);
       }
@@ -622,7 +626,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     ceres::Solver::Summary summary;
     const double score_before_outer = run_score;
     ceres::Solve(so, &problem, &summary);
-    s.iterations += static_cast<int>(summary.iterations.size()) - 1;
+    s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
     s.outer_iterations = o + 1;
     // The final state too (the callback saw every successful step already; this is cheap insurance).
     judge.on_step();

@@ -674,6 +674,38 @@ TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
   EXPECT_EQ(Read(scene_path), SceneText(1.0));
 }
 
+// Library-level refusals and file handling: a suggestion made from perturbed poses (whatever its
+// JSON layout), a read-only scene, and a scene reached through a symbolic link (the file it names
+// is updated, the link stays a link, the permissions stay).
+TEST_F(SuggestAcceptTest, PerturbedReadOnlyAndSymlinkedScenes) {
+  const fs::path real = dir_ / "real_scene.json";
+  const std::string original = SceneText(1.0);
+  Write(real, original);
+  const fs::path link = dir_ / "scene.json";
+  fs::create_symlink(real.filename(), link);
+  const std::string suggestion = MakeSuggestion(link);
+
+  nlohmann::json j = nlohmann::json::parse(Read(suggestion));
+  j["perturbed_for_benchmark"] = true;
+  const fs::path perturbed = dir_ / "perturbed.json";
+  Write(perturbed, j.dump());  // compact: no "key": value spacing to search for
+  EXPECT_THROW(AcceptSuggestion(perturbed.string(), {}), InputError);
+
+  fs::permissions(real, fs::perms::owner_read | fs::perms::group_read);
+  EXPECT_THROW(AcceptSuggestion(suggestion, {}), InputError);
+  EXPECT_EQ(Read(real), original);
+  EXPECT_FALSE(fs::exists(dir_ / "real_scene.json.bak"));
+
+  const fs::perms mode = fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read;
+  fs::permissions(real, mode);
+  const AcceptResult r = AcceptSuggestion(suggestion, {});
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_NE(Read(real), original);
+  EXPECT_EQ(Read(r.backup_path), original);
+  EXPECT_EQ(fs::path(r.backup_path).filename(), "real_scene.json.bak");
+  EXPECT_EQ(fs::status(real).permissions() & fs::perms::all, mode);
+}
+
 TEST_F(SuggestAcceptTest, MillimetreFileGetsMillimetres) {
   // The same scene written in millimetres: accept writes the position in the file's unit.
   const fs::path scene_path = dir_ / "scene_mm.json";

@@ -241,6 +241,10 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   if (!improved)
     throw InputError(suggestion_path, "$.improved", "the suggestion offers no improvement; nothing to accept",
                      "run pandora suggest with other limits or cameras");
+  if (j.contains("perturbed_for_benchmark") && j["perturbed_for_benchmark"] == true)
+    throw InputError(suggestion_path, "$.perturbed_for_benchmark",
+                     "this suggestion was made from perturbed poses (--perturb), not the scene file's",
+                     "run pandora suggest without --perturb");
   AcceptResult result;
   result.scene_path = scene_j["path"].get<std::string>();
 
@@ -262,7 +266,10 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       u.focal_px = Vec2(f[0].get<double>(), f[1].get<double>());
     }
     offered[id] = u;
-    order.push_back(id);
+    // Accepting everything leaves the cameras the search did not move as the user wrote them.
+    const bool moved = !(cams[c].value("move_m", 1.0) == 0.0 && cams[c].value("rotate_deg", 1.0) == 0.0 &&
+                         !u.focal_px);
+    if (moved || !options.cameras.empty()) order.push_back(id);
   }
   std::vector<std::string> chosen = options.cameras.empty() ? order : options.cameras;
   std::set<std::string> unique;
@@ -310,11 +317,21 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     }
   }
 
-  // Backup first, then the scene file; both atomic.
-  std::string backup = result.scene_path + ".bak";
-  for (int n = 1; std::filesystem::exists(backup); ++n) backup = result.scene_path + ".bak." + std::to_string(n);
+  // Backup first, then the scene file; both atomic. Through a symbolic link to the file it names,
+  // keeping its permissions; a read-only scene file is refused.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path target = fs::canonical(result.scene_path, ec);
+  if (ec) throw InputError(result.scene_path, "", "cannot resolve the scene file: " + ec.message());
+  const fs::perms perms = fs::status(target, ec).permissions();
+  if (ec || (perms & fs::perms::owner_write) == fs::perms::none)
+    throw InputError(result.scene_path, "", "the scene file is read-only", "make it writable, then accept again");
+  const std::string path = target.string();
+  std::string backup = path + ".bak";
+  for (int n = 1; fs::exists(backup, ec); ++n) backup = path + ".bak." + std::to_string(n);
   WriteFileAtomically(backup, scene_text);
-  WriteFileAtomically(result.scene_path, new_text);
+  WriteFileAtomically(path, new_text);
+  fs::permissions(path, perms, ec);  // the temporary file was created with the default mode
   result.backup_path = backup;
   for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
   return result;
