@@ -400,6 +400,11 @@ TEST(Suggest, RailPlaneBoxAndKeepOutHold) {
     Aabb keep;
     keep.min = c0 + Vec3(0.02, -1, -1);
     keep.max = c0 + Vec3(1, 1, 1);
+    // Without the keep-out box the nudge goes into it, so the check below can fail.
+    const Suggestion free = Suggest(f.scene, rig, *f.caster, f.targets, o);
+    ASSERT_TRUE(free.improved) << free.message;
+    EXPECT_TRUE(keep.Contains(free.cameras[0].after.translation()))
+        << free.cameras[0].after.translation().transpose();
     o.keep_out = {keep};
     const Suggestion s = Suggest(f.scene, rig, *f.caster, f.targets, o);
     CheckContract(f, o, s);
