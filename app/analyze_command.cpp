@@ -47,7 +47,7 @@ std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& field
 }
 
 void PrintTable(const nlohmann::json& s) {
-  std::printf("rig %s: %d cameras, voxel %.4g m, %lld region voxels (%lld inside solids)\n",
+  std::printf("rig %s: %d cameras, voxel %.4g m, %lld free region voxels (and %lld inside solids)\n",
               s["rig"].get<std::string>().c_str(), s["cameras"].get<int>(),
               s["voxel_size_m"].get<double>(), s["region_voxels"].get<long long>(),
               s["solid_voxels"].get<long long>());
