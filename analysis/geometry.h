@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <limits>
+#include <array>
 #include <vector>
 
 namespace pandora {
@@ -42,6 +43,9 @@ struct Aabb {
 struct TriangleMesh {
   std::vector<Vec3> vertices;
   std::vector<Eigen::Vector3i> triangles;  ///< Counter-clockwise seen from outside.
+  /// Texture coordinates of each triangle's three corners (per corner, so seams survive welding),
+  /// parallel to `triangles`; empty when the mesh has none.
+  std::vector<std::array<Eigen::Vector2d, 3>> corner_uvs;
 
   Aabb Bounds() const {
     Aabb b;
@@ -52,8 +56,16 @@ struct TriangleMesh {
   void Append(const TriangleMesh& other) {
     const int offset = static_cast<int>(vertices.size());
     vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
+    const std::size_t before = triangles.size();
     for (const Eigen::Vector3i& t : other.triangles)
       triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+    if (!corner_uvs.empty() || !other.corner_uvs.empty()) {  // keep both parallel to triangles
+      corner_uvs.resize(before);
+      if (other.corner_uvs.empty())
+        corner_uvs.resize(triangles.size());
+      else
+        corner_uvs.insert(corner_uvs.end(), other.corner_uvs.begin(), other.corner_uvs.end());
+    }
   }
 };
 

@@ -852,6 +852,18 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
       out.triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]),
                                  offset + static_cast<int>(face.mIndices[1]),
                                  offset + static_cast<int>(face.mIndices[2]));
+      if (mesh.mTextureCoords[0] != nullptr) {
+        // Texture coordinates per corner; earlier triangles of this part without any get zeros.
+        out.corner_uvs.resize(out.triangles.size() - 1);
+        std::array<Eigen::Vector2d, 3> uv;
+        for (int k = 0; k < 3; ++k) {
+          const aiVector3D& t = mesh.mTextureCoords[0][face.mIndices[k]];
+          uv[k] = std::isfinite(t.x) && std::isfinite(t.y) ? Eigen::Vector2d(t.x, t.y) : Eigen::Vector2d::Zero();
+        }
+        out.corner_uvs.push_back(uv);
+      } else if (!out.corner_uvs.empty()) {
+        out.corner_uvs.resize(out.triangles.size());
+      }
     }
   }
 

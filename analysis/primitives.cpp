@@ -252,10 +252,13 @@ TriangleMesh WeldVertices(const TriangleMesh& mesh) {
     remap[i] = it->second;
   }
   welded.triangles.reserve(mesh.triangles.size());
-  for (const Eigen::Vector3i& t : mesh.triangles) {
+  const bool uvs = mesh.corner_uvs.size() == mesh.triangles.size() && !mesh.corner_uvs.empty();
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const Eigen::Vector3i& t = mesh.triangles[i];
     const Eigen::Vector3i r(remap[t[0]], remap[t[1]], remap[t[2]]);
     if (r[0] == r[1] || r[1] == r[2] || r[2] == r[0]) continue;
     welded.triangles.push_back(r);
+    if (uvs) welded.corner_uvs.push_back(mesh.corner_uvs[i]);
   }
   return welded;
 }

@@ -300,6 +300,21 @@ TEST(PrimitivesTest, WeldVerticesMergesEqualPositionsAndDropsDegenerates) {
   EXPECT_EQ(welded.vertices.size(), 10u);
   EXPECT_EQ(welded.triangles.size(), 12u);
   EXPECT_TRUE(CheckClosed(welded).closed);
+  EXPECT_TRUE(welded.corner_uvs.empty());
+
+  // Texture coordinates are per corner: they survive welding (seams included), and the dropped
+  // degenerate triangle takes its own with it.
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t)
+    soup.corner_uvs.push_back({Eigen::Vector2d(t, 0), Eigen::Vector2d(t, 1), Eigen::Vector2d(t, 2)});
+  const TriangleMesh welded_uv = WeldVertices(soup);
+  ASSERT_EQ(welded_uv.corner_uvs.size(), 12u);
+  for (std::size_t t = 0; t < 12; ++t) EXPECT_EQ(welded_uv.corner_uvs[t][2], Eigen::Vector2d(t, 2));
+  // Append keeps them parallel to the triangles, with zeros for a mesh that has none.
+  TriangleMesh both = box;
+  both.Append(welded_uv);
+  ASSERT_EQ(both.corner_uvs.size(), both.triangles.size());
+  EXPECT_EQ(both.corner_uvs[0][1], Eigen::Vector2d(0, 0));
+  EXPECT_EQ(both.corner_uvs[box.triangles.size() + 3][1], Eigen::Vector2d(3, 1));
 }
 
 // -------------------------------------------------------------------------------------------------

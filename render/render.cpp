@@ -9,6 +9,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <cctype>
+#include <filesystem>
 #include <cstdio>
 #include <unordered_map>
 
@@ -33,6 +36,66 @@ RenderView ViewFromScene(const View& view, int width, int height, double default
 }
 
 namespace {
+
+// Texture coordinate at point X of triangle t (barycentric interpolation of its corners).
+Eigen::Vector2d TextureCoordinate(const TriangleMesh& mesh, int t, const Vec3& X) {
+  const Eigen::Vector3i& tri = mesh.triangles[t];
+  const Vec3 a = mesh.vertices[tri[0]], b = mesh.vertices[tri[1]], c = mesh.vertices[tri[2]];
+  const Vec3 n = (b - a).cross(c - a);
+  const double area2 = n.squaredNorm();
+  if (!(area2 > 0)) return mesh.corner_uvs[t][0];
+  const double wb = (X - a).cross(c - a).dot(n) / area2;  // weight of b
+  const double wc = (b - a).cross(X - a).dot(n) / area2;  // weight of c
+  const auto& uv = mesh.corner_uvs[t];
+  return (1.0 - wb - wc) * uv[0] + wb * uv[1] + wc * uv[2];
+}
+
+// Bilinear lookup with repeat wrapping, linear RGB; v = 0 is the image's bottom row (the OpenGL /
+// OBJ / assimp convention), texel centres at (i + 0.5) / size.
+Vec3 SampleTexture(const Image& tex, const Eigen::Vector2d& uv) {
+  const double x = (uv.x() - std::floor(uv.x())) * tex.width - 0.5;
+  const double y = (1.0 - (uv.y() - std::floor(uv.y()))) * tex.height - 0.5;
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double ax = x - fx, ay = y - fy;
+  auto texel = [&](int i, int j) {
+    i = ((i % tex.width) + tex.width) % tex.width;
+    j = ((j % tex.height) + tex.height) % tex.height;
+    const float* p = &tex.rgb[3 * (std::size_t(j) * tex.width + i)];
+    return Vec3(p[0], p[1], p[2]);
+  };
+  const int i = int(fx), j = int(fy);
+  return (1 - ay) * ((1 - ax) * texel(i, j) + ax * texel(i + 1, j)) +
+         ay * ((1 - ax) * texel(i, j + 1) + ax * texel(i + 1, j + 1));
+}
+
+// Loads each textured material's PNG once; returns per object the index into `textures`, or -1.
+// A texture that cannot be read (missing file, not a PNG) leaves that object its plain colour,
+// with one warning line on stderr.
+std::vector<int> LoadTextures(const Scene& scene, std::vector<Image>* textures) {
+  std::vector<int> of_material(scene.materials.size(), -1);
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const std::string& path = scene.materials[m].texture;
+    if (path.empty()) continue;
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    try {
+      if (ext != ".png") throw std::runtime_error("only PNG textures are read");
+      textures->push_back(ReadPng(path));
+      of_material[m] = static_cast<int>(textures->size()) - 1;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "pandora: warning: texture %s not used (%s); the material colour stands in\n",
+                   path.c_str(), e.what());
+    }
+  }
+  std::vector<int> of_object(scene.objects.size(), -1);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const int m = scene.objects[o].material;
+    if (m >= 0 && m < int(of_material.size()) && !scene.objects[o].mesh.corner_uvs.empty())
+      of_object[o] = of_material[m];
+  }
+  return of_object;
+}
+
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kTile = 16;  // tile edge in pixels: 256 centre samples share a packet per camera
@@ -461,6 +524,11 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
     const int m = scene.objects[o].material;
     if (m >= 0 && m < int(scene.materials.size())) object_color[o] = scene.materials[m].color;
   }
+  // Diffuse textures (PNG) of the objects whose mesh has texture coordinates, for kMaterial.
+  std::vector<Image> textures;
+  std::vector<int> object_texture(scene.objects.size(), -1);
+  if (options.surface == Surface::kMaterial && !mesh.corner_uvs.empty())
+    object_texture = LoadTextures(scene, &textures);
 
   const double scene_scale = std::max(scene.Bounds().diagonal(), 1e-9);
   const VisibilityTester tester(rig.cameras, caster, scene_scale);
@@ -667,7 +735,10 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
           const int object = triangle_object[smp.triangle];
           switch (options.surface) {
             case Surface::kMaterial: {
-              const Vec3& albedo = object_color[object];
+              Vec3 albedo = object_color[object];
+              if (object_texture[object] >= 0)  // colour times texture (OBJ Kd x map_Kd, glTF)
+                albedo = albedo.cwiseProduct(
+                    SampleTexture(textures[object_texture[object]], TextureCoordinate(mesh, smp.triangle, smp.X)));
               const double shade = 0.4 + 0.6 * std::abs(smp.n.dot(smp.d));
               color = albedo.cwiseProduct(smp.light) + options.ambient * shade * albedo;
               break;

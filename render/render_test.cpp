@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "analysis/primitives.h"
 #include "analysis/scene.h"
@@ -662,6 +663,70 @@ TEST(RenderReference, TraumaRoomImagesMatchTheCommittedReferences) {
     const double pixels = img.width * img.height;
     EXPECT_GE(close / pixels, 0.99);
     EXPECT_LT(sum / (3 * pixels), 0.5);
+  }
+}
+
+// Textures end to end: an OBJ quad with texture coordinates and a 2x2 PNG (red, green / blue,
+// white; map_Kd in its MTL file), loaded as a scene and rendered from straight above with no camera
+// light: each quadrant shows its texel times the ambient shading, with v = 0 at the image's bottom.
+TEST(Render, ObjTextureAppearsOnItsQuadrants) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / "pandora_texture_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Image tex;
+  tex.width = tex.height = 2;
+  tex.rgb = {1, 0, 0, 0, 1, 0,   // top row: red, green
+             0, 0, 1, 1, 1, 1};  // bottom row: blue, white
+  WritePng(tex, (dir / "checker.png").string());
+  std::ofstream(dir / "quad.mtl") << "newmtl checker\nKd 1 1 1\nmap_Kd checker.png\n";
+  std::ofstream(dir / "quad.obj") << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                     "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl checker\n"
+                                     "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  std::ofstream(dir / "scene.json")
+      << R"({"pandora": 1, "objects": [{"name": "quad", "mesh": {"file": "quad.obj", "up_axis": "z"}}],
+  "rigs": [{"name": "away", "cameras": [{"id": "a", "position": [5, 5, 5], "look_at": [9, 9, 9],
+  "resolution": [64, 48], "hfov_deg": 40}]}],
+  "study": {"region": {"box": {"min": [0, 0, 0], "max": [1, 1, 0.5]}}, "voxel_size": 0.1}})";
+  const Scene scene = LoadScene((dir / "scene.json").string());
+  ASSERT_EQ(scene.objects.size(), 1u);
+  ASSERT_EQ(scene.objects[0].mesh.corner_uvs.size(), scene.objects[0].mesh.triangles.size());
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  RenderView view;
+  view.from = Vec3(0.5, 0.5, 2.0);
+  view.at = Vec3(0.5, 0.5, 0.0);
+  view.up = Vec3(0, 1, 0);
+  view.fov_deg = 40;
+  view.width = view.height = 101;
+  RenderOptions options;
+  options.surface = Surface::kMaterial;
+  options.overlays.cameras = false;
+  const Image img = Render(scene, scene.rigs[0], *caster, view, options);
+  // Quadrant centres (u, v) -> expected texel; the pixel whose centre ray hits nearest each.
+  const struct {
+    double u, v;
+    Vec3 texel;
+  } quadrants[] = {{0.25, 0.75, Vec3(1, 0, 0)}, {0.75, 0.75, Vec3(0, 1, 0)},
+                   {0.25, 0.25, Vec3(0, 0, 1)}, {0.75, 0.25, Vec3(1, 1, 1)}};
+  for (const auto& q : quadrants) {
+    double best = 1e9;
+    int bx = -1, by = -1;
+    Vec3 bd;
+    for (int y = 0; y < view.height; ++y)
+      for (int x = 0; x < view.width; ++x) {
+        const Vec3 d = EyeRay(view, x, y);
+        const auto X = HitFloor(view.from, d);
+        if (!X) continue;
+        const double e = std::hypot(X->x() - q.u, X->y() - q.v);
+        if (e < best) best = e, bx = x, by = y, bd = d;
+      }
+    ASSERT_LT(best, 0.01);
+    // No camera light: colour = ambient * (0.4 + 0.6 |n.d|) * texel; bilinear weights of the
+    // neighbouring texels are at most 2 * 2 * best.
+    const double k = options.ambient * (0.4 + 0.6 * std::abs(bd.z()));
+    const Vec3 rgb = img.Rgb(bx, by);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(rgb[c], k * q.texel[c], 4 * best * k + 1e-6) << "quadrant " << q.u << "," << q.v;
   }
 }
 
