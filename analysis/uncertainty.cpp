@@ -104,7 +104,17 @@ void SymmetricEigenvalues3(const double* const upper[6], double* const values[3]
     JacobiLoop(upper[0] + start, upper[1] + start, upper[2] + start, upper[3] + start,
                upper[4] + start, upper[5] + start, values[0] + start, values[1] + start,
                values[2] + start, residual, m);
-    for (std::size_t i = 0; i < m; ++i) converged[start + i] = residual[i] <= 1e-30;
+    for (std::size_t i = 0; i < m; ++i) {
+      converged[start + i] = residual[i] <= 1e-30;
+      if (converged[start + i]) continue;
+      // The general solver as a safety net (never needed on the trauma room).
+      const std::size_t j = start + i;
+      Mat3 J;
+      J << upper[0][j], upper[1][j], upper[2][j], upper[1][j], upper[3][j], upper[4][j],
+          upper[2][j], upper[4][j], upper[5][j];
+      const Vec3 e = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
+      for (int k = 0; k < 3; ++k) values[k][j] = e[k];
+    }
   }
 }
 

@@ -71,8 +71,8 @@ inline void AddCameraInformation(const Mat23& Jc, const double Rw[9], double I[6
 /// the matrices (AVX-512 / AVX2 chosen at run time). Accurate to about 1e-15 of the largest
 /// eigenvalue at every conditioning, double roots included (where the closed form in
 /// DecomposeInformation is good to about sqrt(eps)). `converged[i]` is set to 0 where the
-/// off-diagonal part did not fall below 1e-15 of the diagonal (call DecomposeInformation for those);
-/// values are not clipped.
+/// off-diagonal part did not fall below 1e-15 of the diagonal; those values come from
+/// DecomposeInformation instead. Values are not clipped.
 void SymmetricEigenvalues3(const double* const upper[6], double* const values[3],
                            unsigned char* converged, std::size_t n);
 

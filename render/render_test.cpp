@@ -188,8 +188,9 @@ TEST(Render, StratifiedSamplesAverageTheFootprintInsideEachPixel) {
       EXPECT_NEAR(img.Rgb(x, y).x(), inside / 9.0, 1e-6) << "pixel " << x << "," << y;
       EXPECT_EQ(img.Rgb(x, y).y(), 0.0f);
       const auto centre = BorderMargin(cam, *HitFloor(view.from, EyeRay(view, x, y)));
-      if (centre && std::abs(*centre) > 1e-3)
+      if (centre && std::abs(*centre) > 1e-3) {
         EXPECT_EQ(img.coverage[y * img.width + x], *centre > 0 ? 1.0f : 0.0f) << x << "," << y;
+      }
     }
   EXPECT_GT(partial, 40);  // the footprint's edge crosses many pixels part-way
   EXPECT_GE(checked, view.width * view.height - 20);

@@ -458,14 +458,6 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
                               cand_mask.data(), centres, block.cameras, directions.get(),
                               angle_deg.data());
       }
-      for (int m = 0; m < candidate_count; ++m) {
-        if (converged[m]) continue;  // never seen in practice; the general solver as a safety net
-        const std::array<double, 6>& I = information[candidate[m]];
-        Mat3 J;
-        J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-        const Vec3 values = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
-        for (int k = 0; k < 3; ++k) eigenvalue[k][m] = values[k];
-      }
       // Static statistics and measurement variances for all candidates in one vectorised pass,
       // the steady state in another; then the leaves (unobservable voxels are skipped there).
       if (candidate_count > 0)

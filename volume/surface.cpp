@@ -155,13 +155,7 @@ PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) cons
   double* values[3] = {&e[0], &e[1], &e[2]};
   unsigned char converged = 0;
   SymmetricEigenvalues3(upper, values, &converged, 1);
-  Vec3 eigenvalues(e[0], e[1], e[2]);
-  if (!converged) {
-    Mat3 J;
-    J << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
-    eigenvalues = DecomposeInformation(J, /*eigenvectors=*/false).eigenvalues;
-  }
-  eigenvalues = eigenvalues.cwiseMax(0.0);
+  const Vec3 eigenvalues = Vec3(e[0], e[1], e[2]).cwiseMax(0.0);
   const double largest = eigenvalues[2];
   if (!(largest > 0 && std::isfinite(largest) && eigenvalues[0] > kRelativeObservability * largest))
     return v;
