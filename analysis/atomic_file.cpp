@@ -18,6 +18,12 @@ std::string TemporaryPath(const std::string& path) {
 
 void CommitTemporary(const std::string& path) {
   const std::string tmp = TemporaryPath(path);
+  try {
+    SyncFile(tmp);
+  } catch (const InputError& e) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", e.reason(), e.hint());
+  }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
@@ -25,20 +31,6 @@ void CommitTemporary(const std::string& path) {
     throw InputError(path, "", "cannot rename the temporary file: " + ec.message(),
                      "check that the output folder is writable");
   }
-}
-
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = TemporaryPath(path);
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    f.flush();
-    if (!f) {
-      std::remove(tmp.c_str());
-      throw InputError(path, "", "cannot write the file", "check the output folder");
-    }
-  }
-  CommitTemporary(path);
 }
 
 }  // namespace pandora

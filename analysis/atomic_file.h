@@ -5,17 +5,17 @@
 
 #include <string>
 
+#include "analysis/output_transaction.h"
+
 namespace pandora {
 
 /// The temporary name used while `path` is being written: `path` + ".tmp-" + the process id.
 std::string TemporaryPath(const std::string& path);
 
-/// Renames TemporaryPath(path) to `path` (atomic on one file system). On failure removes the
-/// temporary file and throws InputError naming `path`.
+/// Flushes TemporaryPath(path) to disk and renames it to `path` (atomic on one file system). On
+/// failure (the temporary is missing or empty, a full disk) removes the temporary file and throws
+/// InputError naming `path`. Several outputs that belong together go through an OutputTransaction
+/// (output_transaction.h) instead.
 void CommitTemporary(const std::string& path);
-
-/// Writes `text` to TemporaryPath(path), then commits it. Throws InputError on failure, leaving
-/// neither file changed.
-void WriteFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace pandora

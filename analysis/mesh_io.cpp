@@ -5,7 +5,9 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
+#include <sys/stat.h>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -22,7 +24,9 @@
 #include <unordered_set>
 #include <utility>
 
+#include "analysis/allocation_budget.h"
 #include "analysis/error.h"
+#include "analysis/input_file.h"
 #include "analysis/primitives.h"
 
 namespace pandora {
@@ -779,6 +783,45 @@ void CheckImportedScene(const aiScene& scene, const std::string& path) {
   }
 }
 
+// Assimp's file access, refusing what is not a regular file of bounded size (it would block or
+// never end) instead of opening it.
+class CheckedIoSystem : public Assimp::DefaultIOSystem {
+ public:
+  // DefaultIOSystem::Exists opens the file (fopen), which blocks on a FIFO: stat instead.
+  bool Exists(const char* file) const override { return Readable(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (file == nullptr) return nullptr;
+    const std::string m = mode == nullptr ? "" : mode;
+    if (m.find_first_of("wa+") == std::string::npos && !Readable(file))
+      return nullptr;  // assimp reports "cannot open"; the main file was checked before
+    return Assimp::DefaultIOSystem::Open(file, mode);
+  }
+
+ private:
+  static bool Readable(const char* file) {
+    struct stat st {};
+    return file != nullptr && ::stat(file, &st) == 0 && S_ISREG(st.st_mode) &&
+           static_cast<std::uint64_t>(st.st_size) <= InputLimits::kMeshBytes;
+  }
+};
+
+// Bytes assimp may hold at once for a file of `file_size` bytes: 256 MiB plus 64 bytes per byte of
+// the file, at most half of the machine's memory.
+std::uint64_t AssimpBudgetBytes(std::uint64_t file_size) {
+  std::uint64_t budget = (256ull << 20) + 64 * file_size;
+  const std::uint64_t physical = PhysicalMemoryBytes();
+  if (physical > 0) budget = std::min(budget, physical / 2);
+  return budget;
+}
+
+[[noreturn]] void ThrowOverBudget(const std::string& path, std::uint64_t file_size) {
+  throw InputError(path, "",
+                   "cannot read mesh file: reading it needs more than " +
+                       ByteSize(AssimpBudgetBytes(file_size)) + " of memory for a file of " +
+                       ByteSize(file_size) + "; the file is damaged",
+                   "export it again");
+}
+
 }  // namespace
 
 std::vector<MeshPart> LoadMeshFile(const std::string& path) {
@@ -787,17 +830,19 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
     throw InputError(path, "", "mesh file not found",
                      "mesh paths are relative to the folder of the scene file");
   }
-  if (fs::is_directory(path, ec)) throw InputError(path, "", "is a folder, not a mesh file");
+  const std::uint64_t file_size = CheckInputFile(path, InputLimits::kMeshBytes, "mesh file");
   // Only formats whose readers survived our damage tests (scene_test, MeshFileRobustnessTest and
-  // the fuzzing recorded in docs/scene-format.md). Assimp reads more, but some of its readers
-  // (X3D, for one) crash on damaged files, and a scene loader must never crash.
+  // the fuzzing recorded in docs/robustness.md). Assimp reads more, but some of its readers crash
+  // or allocate without bound on damaged files: X3D crashes, and DirectX .x crashes or takes more
+  // than 11 GB from a 3 KB file. A scene loader must never crash.
   static const std::set<std::string> kSupported{".obj", ".gltf", ".glb", ".ply", ".stl",
-                                                ".dae", ".fbx", ".3ds", ".x"};
+                                                ".dae", ".fbx", ".3ds"};
   std::string extension = fs::path(path).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!kSupported.count(extension)) {
     throw InputError(path, "", "unsupported mesh format '" + extension + "'",
-                     "use OBJ, glTF/GLB, PLY, STL, COLLADA (.dae), FBX, 3DS or DirectX .x");
+                     "convert it to OBJ, glTF/GLB, PLY, STL, COLLADA (.dae), FBX or 3DS "
+                     "(e.g. with Blender)");
   }
 
   Assimp::Importer importer;
@@ -814,14 +859,26 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
     throw InputError(path, "", "cannot read mesh file: " + message,
                      "check that the file is a valid OBJ, glTF/GLB, PLY, STL, COLLADA or FBX file");
   };
+  // Every file assimp opens (the mesh, an OBJ's .mtl, a glTF's buffers) must be a regular file of
+  // bounded size: a FIFO or /dev/zero named inside a mesh file would block or never end.
+  importer.SetIOHandler(new CheckedIoSystem());
   CheckBeforeAssimp(path, importer);
-  // Read first, check what the post-processing steps trust, then run them.
-  const aiScene* raw = importer.ReadFile(path, 0);
-  if (raw == nullptr) fail();
-  CheckImportedScene(*raw, path);
-  const aiScene* scene =
-      importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                   aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  // What assimp may hold at once while it reads and post-processes: far above what a valid file
+  // of this size needs (measured in docs/robustness.md), far below what a damaged file's sizes
+  // could make it ask for.
+  AllocationBudget budget(AssimpBudgetBytes(file_size));
+  const aiScene* scene = nullptr;
+  try {
+    // Read first, check what the post-processing steps trust, then run them.
+    const aiScene* raw = importer.ReadFile(path, 0);
+    if (raw == nullptr) fail();
+    CheckImportedScene(*raw, path);
+    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                         aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  } catch (const std::bad_alloc&) {
+    ThrowOverBudget(path, file_size);
+  }
+  if (budget.exceeded()) ThrowOverBudget(path, file_size);  // assimp caught the bad_alloc itself
   if (scene == nullptr) fail();
   // A scene left without meshes (AI_SCENE_FLAGS_INCOMPLETE) is reported below as having no
   // triangles.

@@ -29,7 +29,8 @@ namespace {
 
 class BruteForceRayCaster final : public RayCaster {
  public:
-  explicit BruteForceRayCaster(const TriangleMesh& mesh) : mesh_(mesh) {}
+  explicit BruteForceRayCaster(const TriangleMesh& mesh) : mesh_(mesh), bounds_(mesh.Bounds()) {}
+  const Aabb& bounds() const override { return bounds_; }
 
   bool Occluded(const Ray& ray) const override {
     for (std::size_t i = 0; i < mesh_.triangles.size(); ++i)
@@ -79,6 +80,7 @@ class BruteForceRayCaster final : public RayCaster {
   }
 
   TriangleMesh mesh_;
+  Aabb bounds_;
 };
 
 }  // namespace

@@ -51,6 +51,9 @@ class RayCaster {
 
   /// "embree" or "brute-force".
   virtual const char* name() const = 0;
+  /// Bounds of the mesh the caster was built from (world frame). Embree works in single precision
+  /// in a frame centred on these bounds; VisibilityTester sizes its tolerance from them.
+  virtual const Aabb& bounds() const = 0;
   /// Number of triangles.
   virtual std::size_t triangle_count() const = 0;
 };

@@ -84,8 +84,8 @@ void SetLane(P* p, int lane, const RTCRay& r) {
 class EmbreeRayCaster final : public RayCaster {
  public:
   explicit EmbreeRayCaster(const TriangleMesh& mesh) : triangles_(mesh.triangles.size()) {
-    const Aabb bounds = mesh.Bounds();
-    offset_ = bounds.empty() ? Vec3::Zero() : bounds.center();
+    bounds_ = mesh.Bounds();
+    offset_ = bounds_.empty() ? Vec3::Zero() : bounds_.center();
 
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw std::runtime_error("Embree: cannot create a device");
@@ -250,6 +250,7 @@ class EmbreeRayCaster final : public RayCaster {
     }
   }
   const Vec3& offset() const { return offset_; }
+  const Aabb& bounds() const override { return bounds_; }
 
   // Converts to Embree's single-precision ray in the recentred frame.
   void Fill(const Ray& ray, RTCRay* r) const {
@@ -274,6 +275,7 @@ class EmbreeRayCaster final : public RayCaster {
   std::size_t triangles_ = 0;
   int packet_width_ = 1;
   Vec3 offset_ = Vec3::Zero();
+  Aabb bounds_;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
 };

@@ -7,12 +7,15 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <utility>
 
+#include "analysis/allocation_budget.h"
 #include "analysis/error.h"
+#include "analysis/input_file.h"
 #include "analysis/mesh_io.h"
 #include "analysis/primitives.h"
 #include "analysis/sha256.h"
@@ -51,6 +54,13 @@ std::string FormatNumber(double v) {
   s.precision(12);
   s << v;
   return s.str();
+}
+
+// Five significant digits, for limits and distances in messages.
+std::string Short(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.5g", v);
+  return text;
 }
 
 std::string Quoted(const std::string& s) { return "'" + s + "'"; }
@@ -225,10 +235,20 @@ class Node {
     return v;
   }
 
-  // A length in the file's unit, returned in metres.
+  // A length in the file's unit, returned in metres. Length() is not bounded (a camera's far
+  // range may be astronomical); the others are within SceneLimits::kMaxCoordinate.
   double Length() const { return Number() * context_->metres_per_unit; }
-  double PositiveLength() const { return Positive() * context_->metres_per_unit; }
-  double NonNegativeLength() const { return NonNegative() * context_->metres_per_unit; }
+  double PositiveLength() const { return Bounded(Positive() * context_->metres_per_unit); }
+  double NonNegativeLength() const { return Bounded(NonNegative() * context_->metres_per_unit); }
+
+  // `metres`, after checking it is within SceneLimits::kMaxCoordinate.
+  double Bounded(double metres) const {
+    if (!(std::abs(metres) <= SceneLimits::kMaxCoordinate))
+      Fail(Short(metres) + " m is beyond the limit of " + Short(SceneLimits::kMaxCoordinate) +
+               " m on coordinates and lengths",
+           "check the number and the file's \"units\"");
+    return metres;
+  }
 
   int Integer(int min, int max) const {
     const double v = Number();
@@ -270,7 +290,11 @@ class Node {
 
   Vec3 Vector3() const { return Numbers(3); }
   Vec2 Vector2() const { return Numbers(2); }
-  Vec3 Point() const { return Vector3() * context_->metres_per_unit; }
+  Vec3 Point() const {
+    const Vec3 p = Vector3() * context_->metres_per_unit;
+    for (int i = 0; i < 3; ++i) At(i).Bounded(p[i]);
+    return p;
+  }
 
   Vec3 PositiveVector3() const {
     Vec3 v = Vector3();
@@ -390,6 +414,7 @@ class PathTracker {
 };
 
 json ParseJson(const std::string& text, const std::string& file) {
+  CheckJsonLimits(text, file);
   PathTracker tracker(file);
   try {
     return json::parse(text, [&tracker](int, json::parse_event_t event, json& parsed) {
@@ -537,6 +562,18 @@ Material ReadMaterial(const Node& node, const std::string& name) {
   return material;
 }
 
+// Fails when a vertex of an object (after its unit, scale and transform) lies beyond
+// SceneLimits::kMaxCoordinate.
+void CheckObjectBounds(const TriangleMesh& mesh, const Node& node) {
+  const Aabb b = mesh.Bounds();
+  if (b.empty()) return;
+  const double reach = std::max(b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff());
+  if (!(reach <= SceneLimits::kMaxCoordinate))
+    node.Fail("the object reaches " + Short(reach) + " m from the origin, beyond the limit of " +
+                  Short(SceneLimits::kMaxCoordinate) + " m",
+              "check its scale, its unit_scale and the file's \"units\"");
+}
+
 void ReadObject(const Node& node, const std::map<std::string, int>& material_index,
                 std::set<std::string>* names, Scene* scene) {
   const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
@@ -630,6 +667,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
       }
       object.source = reference.file;
       object.mesh = Transformed(part.mesh, transform);
+      CheckObjectBounds(object.mesh, node);
       object.solid = solid;
       object.material = material;
       if (material < 0 && part.has_material) {
@@ -671,6 +709,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     mesh = MakePlane(size * unit);
   }
   scene->objects.push_back({name, kind, Transformed(mesh, world_from_object), material, solid});
+  CheckObjectBounds(scene->objects.back().mesh, node);
   // Primitives are closed by construction; the check guards against degenerate transforms.
   if (solid) {
     CheckSolid(scene->objects.back().mesh, node, "solid object " + Quoted(name),
@@ -925,6 +964,7 @@ Study ReadStudy(const Node& node) {
   if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->PixelSigma();
   if (auto n = node.Find("memory_budget_mb")) {
     study.memory_budget_bytes = n->Positive() * 1024.0 * 1024.0;
+    CheckMemoryBudget(study.memory_budget_bytes, node.context().file, n->path());
   }
   if (auto n = node.Find("max_sigma_mm")) study.max_sigma_mm = n->Positive();
   if (auto motion = node.Find("motion")) {
@@ -1011,6 +1051,41 @@ TriangleMesh Scene::AllTriangles(std::vector<int>* triangle_object) const {
   return all;
 }
 
+Aabb Scene::ContentBounds() const {
+  Aabb bounds;
+  for (const SceneObject& o : objects) bounds.Extend(o.mesh.Bounds());
+  bounds.Extend(study.region.box);
+  return bounds;
+}
+
+double Scene::MaxReach() const {
+  const Aabb b = ContentBounds();
+  if (b.empty()) return std::numeric_limits<double>::infinity();
+  // A floor for degenerate content (a single flat sheet has a diagonal; a point would not).
+  return SceneLimits::kReach * std::max(b.diagonal(), 1e-6);
+}
+
+void Scene::CheckReach(const Vec3& point, const std::string& option, const std::string& what) const {
+  const double d = (point - ContentBounds().center()).norm();
+  const double reach = MaxReach();
+  if (std::isfinite(reach) && !(d <= reach))
+    throw InputError(option, "",
+                     what + " is " + Short(d) + " m from the centre of the scene, beyond " +
+                         Short(reach) + " m (" + Short(SceneLimits::kReach) +
+                         " times the size of the scene's geometry and region)",
+                     "check the coordinates");
+}
+
+void Scene::CheckLength(double metres, const std::string& option, const std::string& what) const {
+  const double reach = MaxReach();
+  if (!std::isfinite(metres) || (std::isfinite(reach) && !(std::abs(metres) <= reach)))
+    throw InputError(option, "",
+                     what + " " + Short(metres) + " m is beyond " + Short(reach) +
+                         " m (" + Short(SceneLimits::kReach) +
+                         " times the size of the scene's geometry and region)",
+                     "give a length on the scale of the scene");
+}
+
 Aabb Scene::Bounds() const {
   Aabb bounds;
   for (const SceneObject& o : objects) bounds.Extend(o.mesh.Bounds());
@@ -1086,7 +1161,38 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
       scene.views[item.key()] = ReadView(v);
     }
   }
+
+  // Cameras and viewpoints within reach of the scene: beyond it, single-precision ray casting has
+  // no digits left for the scene (docs/robustness.md).
+  const double reach = scene.MaxReach();
+  const Vec3 centre = scene.ContentBounds().center();
+  auto check_reach = [&](const Node& node, const Vec3& p, const std::string& what) {
+    const double d = (p - centre).norm();
+    if (std::isfinite(reach) && !(d <= reach))
+      node.Fail(what + " is " + Short(d) + " m from the centre of the scene, beyond " +
+                    Short(reach) + " m (" + Short(SceneLimits::kReach) +
+                    " times the size of the scene's geometry and region)",
+                "check the coordinates and the file's \"units\"");
+  };
+  for (size_t r = 0; r < scene.rigs.size(); ++r)
+    for (size_t c = 0; c < scene.rigs[r].cameras.size(); ++c)
+      check_reach(rigs.At(r).Get("cameras").At(c).Get("position"), scene.rigs[r].cameras[c].center(),
+                  "the camera");
+  if (auto views = root.Find("views"))
+    for (const auto& [name, view] : scene.views)
+      check_reach(views->Get(name).Get("from"), view.from, "the viewpoint");
   return scene;
+}
+
+void CheckMemoryBudget(double bytes, const std::string& file, const std::string& json_path) {
+  const double physical = static_cast<double>(PhysicalMemoryBytes());
+  if (physical > 0 && bytes > physical) {
+    char text[160];
+    std::snprintf(text, sizeof text, "a budget of %.4g MiB is more than this machine's memory (%.0f MiB)",
+                  bytes / 1048576.0, physical / 1048576.0);
+    throw InputError(file, json_path, text,
+                     "give at most the memory this machine has, in MiB; the default is 4096");
+  }
 }
 
 const std::vector<std::string>& FieldNames() {
@@ -1119,17 +1225,7 @@ std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& f
 }
 
 Scene LoadScene(const std::string& path, const LoadOptions& options) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw InputError(path, "", "cannot open file: it is a folder");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(
-        path, "", "cannot open file",
-        fs::exists(path, ec) ? "check the file's permissions" : "no such file; check the path");
-  }
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path, "", "cannot read file");
-  return ParseScene(text, path, options);
+  return ParseScene(ReadInputFile(path, InputLimits::kJsonBytes, "scene file"), path, options);
 }
 
 json RigToJson(const Rig& rig) {

@@ -92,6 +92,11 @@ struct FieldListProblem {
 std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& fields,
                                                bool has_motion);
 
+/// Throws InputError(file, json_path, ...) when a memory budget of `bytes` is more than this
+/// machine's physical memory: a budget the machine cannot honour would end in an allocation failure
+/// after minutes of work. For a command-line option, `file` is the option and `json_path` empty.
+void CheckMemoryBudget(double bytes, const std::string& file, const std::string& json_path);
+
 /// A named viewpoint for rendering ("views" in the scene file). World frame, metres.
 struct View {
   Vec3 from = Vec3::Zero();  ///< Eye position.
@@ -99,6 +104,18 @@ struct View {
   Vec3 up = Vec3::UnitZ();   ///< Up direction (not parallel to at - from).
   /// Horizontal field of view in degrees, in (0, 180); unset means the renderer's default.
   std::optional<double> fov_deg;
+};
+
+/// Limits on coordinates and lengths, checked when a scene is loaded and on every length given as an
+/// option (docs/robustness.md). Embree casts rays in single precision, and OpenVDB indexes voxels
+/// with 32-bit integers: beyond these a finite number can still abort a library or mean nothing.
+struct SceneLimits {
+  /// Metres: any coordinate, object extent or length in a scene file (a camera's far range aside).
+  static constexpr double kMaxCoordinate = 1e7;
+  /// Cameras, viewpoints and lengths given as options stay within this many times the diagonal of
+  /// the scene's geometry and region of that content's centre (Scene::MaxReach()). At that
+  /// distance a float ray's rounding is about 1e-3 of the scene's size.
+  static constexpr double kReach = 1e4;
 };
 
 /// A loaded, validated scene file.
@@ -115,6 +132,16 @@ struct Scene {
   TriangleMesh AllTriangles(std::vector<int>* triangle_object = nullptr) const;
   /// Bounds of geometry, cameras of every rig, and the region.
   Aabb Bounds() const;
+  /// Bounds of the geometry and the region (no cameras): what the scene is about.
+  Aabb ContentBounds() const;
+  /// SceneLimits::kReach times the diagonal of ContentBounds(), metres (infinity when it is empty).
+  double MaxReach() const;
+  /// Throws InputError(option, "", ...) when `point` lies farther than MaxReach() from the centre
+  /// of ContentBounds(). `what` names the point in the message ("the eye").
+  void CheckReach(const Vec3& point, const std::string& option, const std::string& what) const;
+  /// Throws InputError(option, "", ...) when `metres` is not finite or its magnitude exceeds
+  /// MaxReach(). `what` names the length in the message ("the move").
+  void CheckLength(double metres, const std::string& option, const std::string& what) const;
   /// The rig called `name`, or the first rig when `name` is empty. Throws InputError (path
   /// "$.rigs") naming the available rigs when there is none of that name.
   const Rig& FindRig(const std::string& name) const;

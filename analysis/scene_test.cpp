@@ -25,6 +25,7 @@
 #include "analysis/mesh_io.h"
 #include "analysis/primitives.h"
 #include "analysis/sha256.h"
+#include "tests/temp_dir.h"
 
 namespace pandora {
 namespace {
@@ -48,28 +49,9 @@ fs::path SourceRoot() {
 fs::path TestData(const std::string& name) { return SourceRoot() / "tests" / "data" / name; }
 
 // A fresh folder, removed with its contents at the end of the test.
-class TempDir {
+class TempDir : public testing::TempDir {
  public:
-  TempDir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("pandora_scene_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-  void Write(const std::string& name, const std::string& bytes) const {
-    std::ofstream out(path_ / name, std::ios::binary);
-    out << bytes;
-  }
-
- private:
-  fs::path path_;
+  TempDir() : testing::TempDir("pandora_scene_test") {}
 };
 
 // The smallest valid scene: one rig with one camera, a box region.
@@ -837,7 +819,7 @@ TEST(SceneLoadTest, LoadSceneReadsFileAndHashesIt) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.json_path(), "");
     EXPECT_EQ(e.file(), dir.File("missing.json"));
-    EXPECT_CONTAINS(e.reason(), "cannot open file");
+    EXPECT_CONTAINS(e.reason(), "cannot open the scene file: no such file");
   }
 }
 
@@ -1428,7 +1410,7 @@ TEST(MeshFileRobustnessTest, DamagedExportsLoadOrFailWithAnInputError) {
 TEST(MeshFileRobustnessTest, EmptyFileOfEveryFormatIsAnError) {
   TempDir dir;
   for (const char* name :
-       {"e.obj", "e.ply", "e.stl", "e.glb", "e.gltf", "e.dae", "e.fbx", "e.3ds", "e.x"}) {
+       {"e.obj", "e.ply", "e.stl", "e.glb", "e.gltf", "e.dae", "e.fbx", "e.3ds"}) {
     SCOPED_TRACE(name);
     dir.Write(name, "");
     EXPECT_CONTAINS(LoadOrReason(dir, name), "the file is empty");
@@ -1437,7 +1419,8 @@ TEST(MeshFileRobustnessTest, EmptyFileOfEveryFormatIsAnError) {
 
 TEST(MeshFileRobustnessTest, UntestedFormatsAreRefused) {
   TempDir dir;
-  for (const char* name : {"m.x3d", "m.blend", "m.unknown", "m"}) {
+  // DirectX .x: assimp 5.2 crashes, or takes more than 11 GB, on damaged files (outside audit).
+  for (const char* name : {"m.x3d", "m.x", "m.X", "m.blend", "m.unknown", "m"}) {
     SCOPED_TRACE(name);
     dir.Write(name, "solid nothing\n");
     EXPECT_CONTAINS(LoadOrReason(dir, name), "unsupported mesh format");

@@ -34,9 +34,14 @@ VisibilityTester::VisibilityTester(const std::vector<Camera>& cameras, const Ray
                                    double scene_scale)
     : cameras_(cameras), caster_(caster), epsilon_(kRelativeEpsilon * scene_scale) {
   camera_from_world_.reserve(cameras_.size());
+  const Aabb& bounds = caster.bounds();
+  const Vec3 frame_origin = bounds.empty() ? Vec3::Zero() : bounds.center();
+  const double radius = 0.5 * bounds.diagonal();
   for (const Camera& c : cameras_) {
     camera_from_world_.push_back(c.camera_from_world());
     rotation_.push_back(camera_from_world_.back().linear());
+    float_error_base_.push_back(kFloatErrorFactor * 0x1p-24 *
+                                (radius + (c.center() - frame_origin).norm()));
   }
 }
 
@@ -54,10 +59,11 @@ ViewResult VisibilityTester::TestGeometryCameraFrame(int camera, const Vec3& X, 
   if (!cam.model.InImage(*pixel)) return ViewResult::kOutsideImage;
   if (normal && normal->dot(-to_point) <= 0.0) return ViewResult::kBackFacing;
   if (segment) {
+    const double tolerance = Tolerance(camera, distance);
     segment->origin = cam.center();
     segment->direction = to_point / distance;
-    segment->t_near = epsilon_;
-    segment->t_far = std::max(epsilon_, distance - epsilon_);
+    segment->t_near = tolerance;
+    segment->t_far = std::max(tolerance, distance - tolerance);
   }
   return ViewResult::kSeen;
 }

@@ -37,15 +37,27 @@ class VisibilityTester {
  public:
   /// Relative epsilon for occlusion segments (times the scene scale); see epsilon().
   static constexpr double kRelativeEpsilon = 1e-5;
+  /// Multiple of 2^-24 (float's unit round-off) in the per-ray float tolerance; see Tolerance().
+  static constexpr double kFloatErrorFactor = 4.0;
 
-  /// `scene_scale` is a length that bounds the scene (e.g. the diagonal of Scene::Bounds()); the
-  /// occlusion segment stops epsilon() = kRelativeEpsilon * scene_scale short of both ends, so a
-  /// point lying on a surface is not occluded by that surface and float round-off in the ray caster
-  /// (relative ~1e-7 of the scene size) cannot flip the answer.
+  /// `scene_scale` is a length on the scale of the scene's geometry and region (the diagonal of
+  /// Scene::ContentBounds(); not of Scene::Bounds(), which far cameras would inflate). The occlusion
+  /// segment from a camera to X stops Tolerance() short of both ends, so a point lying on a surface
+  /// is not occluded by that surface and single-precision round-off in the ray caster cannot flip
+  /// the answer for occluders farther than that from the segment's ends (docs/accuracy.md).
   VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster, double scene_scale);
 
   const std::vector<Camera>& cameras() const { return cameras_; }
+  /// The floor of the tolerance: kRelativeEpsilon * scene_scale, metres.
   double epsilon() const { return epsilon_; }
+  /// The tolerance of the occlusion segment from camera `camera` to a point `distance` metres away:
+  /// max(epsilon(), kFloatErrorFactor * 2^-24 * (R + |C - O| + distance)), with O and R the centre
+  /// and half-diagonal of the caster's bounds (Embree's float frame) and C the camera centre: the
+  /// rounding of the ray's origin and direction and of the triangles' vertices in float.
+  double Tolerance(int camera, double distance) const {
+    const double f = float_error_base_[camera] + kFloatErrorFactor * 0x1p-24 * distance;
+    return f > epsilon_ ? f : epsilon_;
+  }
 
   /// Every test but occlusion. On kSeen, `segment` (if given) receives the occlusion segment from the
   /// camera centre to X, and `d_pixel_d_world` (if given) the 2x3 projection Jacobian at X.
@@ -76,6 +88,7 @@ class VisibilityTester {
   std::vector<Mat3> rotation_;  // camera_from_world_[c].linear()
   const RayCaster& caster_;
   double epsilon_;
+  std::vector<double> float_error_base_;  // kFloatErrorFactor 2^-24 (R + |C - O|) per camera
 };
 
 }  // namespace pandora

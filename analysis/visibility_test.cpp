@@ -147,5 +147,69 @@ TEST(Visibility, EmbreeAgreesWithBruteForceOnRandomScenes) {
               grazing);
 }
 
+
+// Far cameras and a small object (the outside audit's case: cameras 300 m from a 2 cm object). The
+// reference is the double-precision brute force with segments shortened by only 1 nm. Embree casts in
+// single precision, so its rays and triangles are rounded by about 2^-24 of their distance from the
+// caster's centre (here ~20 um at 300 m): the tester's per-ray tolerance must cover that, and it must
+// not be sized from the far cameras (a 1e-5 share of the whole scene's diagonal would be 6 mm, a
+// third of the object). Every disagreement with the reference must be explained by the tolerance:
+// the point lies within it of a surface, or the segment passes within it of a triangle edge
+// (grazing); any other disagreement fails.
+TEST(Visibility, FarCamerasSmallObjectToleranceFromFloatError) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double size = 0.02;
+  // Three thin plates and a cube of 2 cm near the origin.
+  TriangleMesh mesh = testing::RandomScene(rng, size, Vec3::Constant(-size / 2), 6, 6);
+  const auto embree = MakeEmbreeRayCaster(mesh);
+  const auto brute = MakeBruteForceRayCaster(mesh);
+  std::vector<Camera> cams;
+  for (int c = 0; c < 8; ++c) {
+    const double az = 2 * M_PI * c / 8, el = 0.3 + 0.1 * c;
+    const Vec3 pos = 300.0 * Vec3(std::cos(az) * std::cos(el), std::sin(az) * std::cos(el), std::sin(el));
+    cams.push_back(MakePinhole(pos, Vec3::Zero(), 0.01, 1000, 1000));  // 5 cm across at 300 m
+  }
+  const double geometry_scale = mesh.Bounds().diagonal();
+  const VisibilityTester ve(cams, *embree, geometry_scale);
+  // The reference: exact segments from the camera to 1 nm short of the point.
+  int pairs = 0, disagree = 0, far_from_surfaces = 0;
+  double worst_tolerance = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 X = size * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+    const int c = static_cast<int>(rng() % cams.size());
+    Ray seg;
+    ASSERT_EQ(ve.TestGeometry(c, X, nullptr, &seg), ViewResult::kSeen);
+    const double tolerance = std::max(seg.t_near, (X - seg.origin).norm() - seg.t_far);
+    worst_tolerance = std::max(worst_tolerance, tolerance);
+    Ray exact = seg;
+    exact.t_near = 1e-9;
+    exact.t_far = (X - seg.origin).norm() - 1e-9;
+    const bool truth = brute->Occluded(exact);
+    const bool embree_says = ve.Test(c, X) == ViewResult::kOccluded;
+    ++pairs;
+    if (truth == embree_says) continue;
+    ++disagree;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& t : mesh.triangles)
+      nearest = std::min(nearest, testing::PointTriangleDistance(X, mesh.vertices[t[0]],
+                                                                 mesh.vertices[t[1]], mesh.vertices[t[2]]));
+    const Vec3 a = seg.origin + seg.t_near * seg.direction, b = seg.origin + seg.t_far * seg.direction;
+    if (!(nearest <= tolerance) && !testing::IsGrazing(mesh, a, b, tolerance, -1)) {
+      ++far_from_surfaces;
+      ADD_FAILURE() << "pair " << i << ": point " << nearest * 1e6 << " um from the nearest surface, "
+                    << "tolerance " << tolerance * 1e6 << " um; reference "
+                    << (truth ? "occluded" : "seen");
+    }
+  }
+  std::printf("far cameras: %d pairs, %d disagreements (all grazing or near a surface, within the "
+              "tolerance), worst tolerance %.1f um\n", pairs, disagree, worst_tolerance * 1e6);
+  EXPECT_EQ(far_from_surfaces, 0);
+  // The tolerance follows the float error (2^-24 of ~300 m, times a small factor), not the scene.
+  EXPECT_GT(worst_tolerance, 300.0 * std::ldexp(1.0, -24));
+  EXPECT_LT(worst_tolerance, 2 * VisibilityTester::kFloatErrorFactor * 0x1p-24 * 700.0);
+  EXPECT_LT(disagree, pairs / 100);
+}
+
 }  // namespace
 }  // namespace pandora

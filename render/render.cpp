@@ -530,7 +530,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   if (options.surface == Surface::kMaterial && !mesh.corner_uvs.empty())
     object_texture = LoadTextures(scene, &textures);
 
-  const double scene_scale = std::max(scene.Bounds().diagonal(), 1e-9);
+  const double scene_scale = std::max(scene.ContentBounds().diagonal(), 1e-9);
   const VisibilityTester tester(rig.cameras, caster, scene_scale);
   // Hit points are lifted off their surface by a tenth of the visibility epsilon along the facing
   // normal, so float round-off in the hit distance cannot make a surface shadow itself.

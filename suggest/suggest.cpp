@@ -294,7 +294,7 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
                                const std::vector<TargetPoint>& targets, const Objective& objective,
                                const std::vector<int>& selected)
     : caster_(caster), targets_(targets), objective_(objective) {
-  scene_scale_ = std::max(scene.Bounds().diagonal(), 1e-300);
+  scene_scale_ = std::max(scene.ContentBounds().diagonal(), 1e-300);
   region_scale_ = scene.study.region.box.diagonal();
   if (!(region_scale_ > 0)) region_scale_ = scene_scale_;
   sigma_cap_mm_ = region_scale_ * 1000.0;

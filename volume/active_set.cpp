@@ -21,6 +21,18 @@ VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::strin
   const Vec3 extent = region.size();
   double total = 1;
   for (int a = 0; a < 3; ++a) {
+    // Voxel centres sit at min + (i + 1/2) h and must lie inside the region: a region thinner than
+    // half a voxel would hold none, and the study would end with nothing evaluated.
+    if (!(extent[a] >= 0.5 * voxel_size)) {
+      char reason[200], hint[120];
+      std::snprintf(reason, sizeof reason,
+                    "the region is %.4g m along %c, less than half a voxel (voxel size %.4g m): no "
+                    "voxel centre lies inside it",
+                    extent[a], "xyz"[a], voxel_size);
+      std::snprintf(hint, sizeof hint, "use a voxel size of at most %.4g m, or a larger region",
+                    2 * extent[a]);
+      throw InputError(scene_path, json_path, reason, hint);
+    }
     const double n = std::max(1.0, std::ceil(extent[a] / voxel_size - 1e-9));
     if (!(n <= double(1 << 30)))
       throw InputError(scene_path, json_path,

@@ -309,7 +309,7 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
   const bool want_information = want_static || want_steady || want_angle;
   const bool want_jacobian = want_resolution || want_information;
   const int enabled = rig.enabled_count();
-  const VisibilityTester tester(rig.cameras, caster, scene.Bounds().diagonal());
+  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal());
   std::vector<double> pixel_sigma(camera_count);  // pixels
   for (int c = 0; c < camera_count; ++c)
     pixel_sigma[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;

@@ -83,7 +83,7 @@ Reference BruteForce(const Scene& scene, const Rig& rig, const RayCaster& caster
   std::vector<std::unique_ptr<InsideMesh>> solids;
   for (const SceneObject& o : scene.objects)
     if (o.solid) solids.push_back(std::make_unique<InsideMesh>(o.mesh));
-  const VisibilityTester vis(rig.cameras, caster, scene.Bounds().diagonal());
+  const VisibilityTester vis(rig.cameras, caster, scene.ContentBounds().diagonal());
   for (int i = 0; i < lat.dims.x(); ++i)
     for (int j = 0; j < lat.dims.y(); ++j)
       for (int k = 0; k < lat.dims.z(); ++k) {

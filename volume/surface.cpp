@@ -108,7 +108,7 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
 
 struct PointEvaluator::Impl {
   Impl(const Scene& scene, const Rig& rig, const RayCaster& caster)
-      : tester(rig.cameras, caster, scene.Bounds().diagonal()) {
+      : tester(rig.cameras, caster, scene.ContentBounds().diagonal()) {
     if (rig.cameras.size() > 64)
       throw InputError(scene.path, "$.rigs",
                        "rig '" + rig.name + "' has " + std::to_string(rig.cameras.size()) +

@@ -21,6 +21,7 @@
 #include "volume/slice.h"
 #include "volume/colormap.h"
 #include "volume/surface.h"
+#include "tests/random_scene.h"
 
 #include <unistd.h>
 
@@ -227,11 +228,12 @@ TEST(PointEvaluator, EqualsTheVolumeGridsAtVoxelCentres) {
 
 // The reference for a surface point, written from the rules (docs/fields.md) with the
 // double-precision brute-force caster: in front of the lens and in the image, within range, the
-// normal facing the camera, the segment (shortened by epsilon at both ends) free; the information
+// normal facing the camera, the segment (shortened by the tolerance of docs/accuracy.md at both
+// ends, VisibilityTester::Tolerance) free; the information
 // matrix through InformationBuilder and the covariance through StaticFromInformation.
 PointValues Reference(const Scene& scene, const Rig& rig, const RayCaster& brute, const Vec3& X,
                       const Vec3& n) {
-  const double eps = VisibilityTester::kRelativeEpsilon * scene.Bounds().diagonal();
+  const VisibilityTester rules(rig.cameras, brute, scene.ContentBounds().diagonal());
   PointValues v;
   InformationBuilder builder;
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
@@ -245,8 +247,8 @@ PointValues Reference(const Scene& scene, const Rig& rig, const RayCaster& brute
     Ray ray;
     ray.origin = cam.center();
     ray.direction = d.normalized();
-    ray.t_near = eps;
-    ray.t_far = d.norm() - eps;
+    ray.t_near = rules.Tolerance(static_cast<int>(c), d.norm());
+    ray.t_far = d.norm() - ray.t_near;
     if (brute.Occluded(ray)) continue;
     ++v.coverage;
     v.cameras |= std::uint64_t{1} << c;
@@ -275,7 +277,23 @@ TEST(PointEvaluator, SurfaceSamplesMatchABruteForceLoop) {
     const PointValues ref = Reference(scene, rig, *brute, samples[i].position, samples[i].normal);
     const PointValues& v = values[i];
     if (v.cameras != ref.cameras) {
-      ++mismatched;  // Embree (single precision) against double precision at grazing rays
+      // Embree (single precision) against double precision: each camera that differs must be
+      // explained by the tolerance (docs/accuracy.md): a segment passing within it of a triangle
+      // edge or ending within it of another triangle, or a surface seen within 0.6 degrees of its
+      // own plane.
+      ++mismatched;
+      const VisibilityTester rules(rig.cameras, *brute, scene.ContentBounds().diagonal());
+      for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+        if (((v.cameras ^ ref.cameras) >> c & 1) == 0) continue;
+        Ray seg;
+        ASSERT_EQ(rules.TestGeometry(static_cast<int>(c), samples[i].position, &samples[i].normal, &seg),
+                  ViewResult::kSeen);
+        const Vec3 a = seg.origin + seg.t_near * seg.direction;
+        const Vec3 b = seg.origin + seg.t_far * seg.direction;
+        const bool shallow = std::abs(samples[i].normal.normalized().dot(seg.direction)) < 0.01;
+        EXPECT_TRUE(shallow || testing::IsGrazing(all, a, b, seg.t_near))
+            << "sample " << i << " camera " << c << " is neither grazing nor shallow";
+      }
       continue;
     }
     if (samples[i].object == 0 && (v.cameras >> 3 & 1)) ++floor_seen_from_below;
@@ -289,7 +307,7 @@ TEST(PointEvaluator, SurfaceSamplesMatchABruteForceLoop) {
   }
   std::printf("surface samples: %zu, visibility differing from the double-precision loop: %zu\n",
               samples.size(), mismatched);
-  EXPECT_LE(mismatched, samples.size() / 1000) << "of " << samples.size();
+  EXPECT_LE(mismatched, samples.size() / 200) << "of " << samples.size();
   EXPECT_GT(triangulable, samples.size() / 4);
   // The floor faces up: the camera under it never sees it (its voxel-centre view would).
   EXPECT_EQ(floor_seen_from_below, 0u);
