@@ -1,5 +1,6 @@
 #include "analysis/atomic_file.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -31,6 +32,17 @@ void CommitTemporary(const std::string& path) {
     throw InputError(path, "", "cannot rename the temporary file: " + ec.message(),
                      "check that the output folder is writable");
   }
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& text) {
+  unsigned mode = 0666;
+  struct stat st {};
+  const bool exists = ::stat(path.c_str(), &st) == 0;
+  if (exists) mode = st.st_mode & 07777;
+  const std::string tmp = TemporaryPath(path);
+  WriteNewFile(tmp, text, mode, path);
+  if (exists) ::chmod(tmp.c_str(), mode);  // open() applied the umask
+  CommitTemporary(path);
 }
 
 }  // namespace pandora

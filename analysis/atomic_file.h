@@ -18,4 +18,9 @@ std::string TemporaryPath(const std::string& path);
 /// (output_transaction.h) instead.
 void CommitTemporary(const std::string& path);
 
+/// Writes `text` to TemporaryPath(path) (every write checked, flushed to disk), then commits it.
+/// When `path` exists, the new file keeps its mode. Throws InputError naming `path` on failure,
+/// leaving `path` unchanged.
+void WriteFileAtomically(const std::string& path, const std::string& text);
+
 }  // namespace pandora

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -42,10 +43,11 @@ int SyncPath(const std::string& path, bool folder) {
   return error;
 }
 
-// Writes `bytes` to a new file `path` with `mode`, checking every write, and syncs it.
-void WriteNewFile(const std::string& path, const std::string& bytes, mode_t mode,
+}  // namespace
+
+void WriteNewFile(const std::string& path, const std::string& bytes, unsigned mode,
                   const std::string& blame) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, mode);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, static_cast<mode_t>(mode));
   if (fd < 0)
     throw InputError(blame, "", "cannot create a file there: " + ErrnoText(errno),
                      "check that the output folder is writable");
@@ -67,6 +69,15 @@ void WriteNewFile(const std::string& path, const std::string& bytes, mode_t mode
     throw InputError(blame, "", "cannot write the file: " + ErrnoText(error),
                      error == ENOSPC ? "the disk is full; free some space" : "check the output folder");
   }
+}
+
+namespace {
+
+// Test hook: PANDORA_TEST_CRASH_AT=after-journal or after-first-rename kills the process at that
+// point of Commit(), as a power cut or `kill -9` would (tests/cli/check_transactions.sh).
+void MaybeCrash(const char* point) {
+  const char* at = std::getenv("PANDORA_TEST_CRASH_AT");
+  if (at != nullptr && std::strcmp(at, point) == 0) ::raise(SIGKILL);
 }
 
 bool ProcessAlive(long pid) {
@@ -322,8 +333,8 @@ std::string OutputTransaction::StageReplacement(const std::string& path, const s
 }
 
 void OutputTransaction::Write(const std::string& path, const std::string& option,
-                              const std::string& bytes) {
-  const std::string staged = Stage(path, option);
+                              const std::string& bytes, const std::string& mode_from) {
+  const std::string staged = Stage(path, option, mode_from);
   const Impl::Output& out = impl_->outputs.back();
   // Created with the final mode: the replaced file's, or the default one.
   mode_t mode = 0666;
@@ -338,7 +349,7 @@ void OutputTransaction::Commit() {
   if (m.committed) return;
   // 1. Every staged file whole and on disk, with the mode and owner of what it replaces.
   for (const Impl::Output& o : m.outputs) {
-    SyncFile(o.staged, 0);
+    SyncFile(o.staged, 1);
     struct stat st {};
     const std::string& source = o.mode_from.empty() ? o.final : o.mode_from;
     if (::stat(source.c_str(), &st) == 0) {
@@ -370,6 +381,7 @@ void OutputTransaction::Commit() {
     throw InputError(m.outputs.front().final, "", "cannot commit the outputs: " + ErrnoText(errno));
   SyncPath(primary.string(), true);
   m.committed = true;
+  MaybeCrash("after-journal");
   // 3. Into place. From here on, a failure is finished by RecoverOutputs on the next run.
   for (const Impl::Output& o : m.outputs) {
     if (::rename(o.staged.c_str(), o.final.c_str()) != 0)
@@ -377,6 +389,7 @@ void OutputTransaction::Commit() {
                        "cannot move the output into place: " + ErrnoText(errno) +
                            "; the next pandora run in this folder finishes it",
                        "check the output folder's permissions");
+    MaybeCrash("after-first-rename");
   }
   for (const Impl::Staging& s : m.stagings) SyncPath(s.folder.string(), true);
   std::error_code ec;
@@ -396,12 +409,6 @@ void OutputTransaction::Abandon() noexcept {
   m.stagings.clear();
   m.outputs.clear();
   m.created_folders.clear();
-}
-
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  OutputTransaction transaction;
-  transaction.Write(path, "", text);
-  transaction.Commit();
 }
 
 }  // namespace pandora

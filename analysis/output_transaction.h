@@ -43,9 +43,10 @@ class OutputTransaction {
   /// rewriting the scene file): `path` may be an input.
   std::string StageReplacement(const std::string& path, const std::string& option);
 
-  /// Stage(path, option), then writes `bytes` to the staged file (created with its final mode,
-  /// every write checked). Throws InputError(path, ...) when writing fails (a full disk).
-  void Write(const std::string& path, const std::string& option, const std::string& bytes);
+  /// Stage(path, option, mode_from), then writes `bytes` to the staged file (created with its final
+  /// mode, every write checked). Throws InputError(path, ...) when writing fails (a full disk).
+  void Write(const std::string& path, const std::string& option, const std::string& bytes,
+             const std::string& mode_from = "");
 
   /// Makes every staged output appear at its final path. Throws InputError when a staged file is
   /// missing or empty, or when syncing or renaming fails before the commit point (nothing changed
@@ -73,8 +74,10 @@ class OutputTransaction {
 /// removed. Never throws; does nothing when `folder` cannot be read.
 void RecoverOutputs(const std::string& folder);
 
-/// Writes `text` to `path` as a transaction of one output (see OutputTransaction).
-void WriteFileAtomically(const std::string& path, const std::string& text);
+/// Writes `bytes` to a new file `path` created with `mode` (umask applied), checking every write,
+/// and flushes it to disk. On failure removes it and throws InputError(blame, ...).
+void WriteNewFile(const std::string& path, const std::string& bytes, unsigned mode,
+                  const std::string& blame);
 
 /// Flushes `path` to disk (fsync) and checks that it is a regular file of at least `min_bytes`
 /// bytes. Throws InputError(path, ...) otherwise.

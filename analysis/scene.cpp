@@ -943,6 +943,7 @@ Study ReadStudy(const Node& node) {
   } else {
     study.region.kind = Region::Kind::kMesh;
     const MeshReference reference = ReadMeshReference(region.Get("mesh"));
+    study.region.file = reference.resolved;
     if (node.context().options.load_meshes) {
       TriangleMesh mesh;
       for (const MeshPart& part : LoadMeshParts(reference)) mesh.Append(part.mesh);
@@ -1049,6 +1050,21 @@ TriangleMesh Scene::AllTriangles(std::vector<int>* triangle_object) const {
     }
   }
   return all;
+}
+
+std::vector<std::pair<std::string, std::string>> Scene::InputFiles() const {
+  std::vector<std::pair<std::string, std::string>> files{{path, "scene file"}};
+  const fs::path folder = fs::path(path).parent_path();
+  for (const SceneObject& o : objects) {
+    static const std::set<std::string> kPrimitives{"box", "sphere", "cylinder", "capsule", "plane"};
+    if (o.source.empty() || kPrimitives.count(o.source)) continue;
+    const fs::path p(o.source);
+    files.emplace_back((p.is_absolute() ? p : folder / p).lexically_normal().string(), "mesh file");
+  }
+  if (!study.region.file.empty()) files.emplace_back(study.region.file, "mesh file");
+  for (const Material& m : materials)
+    if (!m.texture.empty()) files.emplace_back(m.texture, "texture");
+  return files;
 }
 
 Aabb Scene::ContentBounds() const {

@@ -54,6 +54,7 @@ struct Region {
   Kind kind = Kind::kBox;
   Aabb box;           ///< The box, or the bounds of the mesh.
   TriangleMesh mesh;  ///< Closed mesh when kind == kMesh.
+  std::string file;   ///< The mesh file (resolved against the scene file's folder) when kind == kMesh.
 };
 
 /// What to compute and where.
@@ -142,6 +143,9 @@ struct Scene {
   /// Throws InputError(option, "", ...) when `metres` is not finite or its magnitude exceeds
   /// MaxReach(). `what` names the length in the message ("the move").
   void CheckLength(double metres, const std::string& option, const std::string& what) const;
+  /// Every file the scene was read from, as (path, kind) pairs: the scene file ("scene file"), its
+  /// mesh files and region mesh ("mesh file") and textures ("texture"). Outputs must not replace any.
+  std::vector<std::pair<std::string, std::string>> InputFiles() const;
   /// The rig called `name`, or the first rig when `name` is empty. Throws InputError (path
   /// "$.rigs") naming the available rigs when there is none of that name.
   const Rig& FindRig(const std::string& name) const;

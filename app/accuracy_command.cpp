@@ -635,13 +635,15 @@ SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& mc, bool q
 // --------------------------------------------------------------------------------------------
 // Output.
 
+// Every file of the run goes through one transaction: they appear together at the end.
 struct Outputs {
   std::filesystem::path dir;
   std::string markdown;
   std::vector<std::string> written;
+  OutputTransaction* transaction = nullptr;
   void Write(const std::string& name, const std::string& text) {
     const std::string path = (dir / name).string();
-    WriteFileAtomically(path, text);
+    transaction->Write(path, "--out", text);
     written.push_back(path);
   }
 };
@@ -922,7 +924,11 @@ int RunAccuracy(const AccuracyArgs& args) {
   const Clock::time_point start = Clock::now();
   Scene scene = LoadScene(args.scene);
   const Rig rig = scene.FindRig(args.rig);
-  PrepareOutputDir(args.out);
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  // Staged first, so that a bad --out fails before minutes of work; written last.
+  const std::string tables_path =
+      output.Stage((std::filesystem::path(args.out) / "accuracy_tables.md").string(), "--out");
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   std::printf(
@@ -935,6 +941,7 @@ int RunAccuracy(const AccuracyArgs& args) {
 
   Outputs out;
   out.dir = args.out;
+  out.transaction = &output;
   out.markdown = Format("# pandora accuracy: %s, rig %s\n\n", scene.path.c_str(), rig.name.c_str());
 
   const VoxelStudy voxel = RunVoxelStudy(scene, rig, *caster, args.quick, threads);
@@ -944,7 +951,9 @@ int RunAccuracy(const AccuracyArgs& args) {
   const SteadyStudy steady = RunSteadyStudy(scene, mc, args.quick);
   ReportSteady(steady, &out);
 
-  out.Write("accuracy_tables.md", out.markdown);
+  WriteFileAtomically(tables_path, out.markdown);
+  out.written.push_back(tables_path);
+  output.Commit();
   std::printf("\n%.1f s; wrote", SecondsSince(start));
   for (const std::string& path : out.written)
     std::printf(" %s", std::filesystem::path(path).filename().c_str());

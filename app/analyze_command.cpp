@@ -85,10 +85,17 @@ int RunAnalyze(const AnalyzeArgs& args) {
   options.fields = scene.study.fields;
   if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
-  if (!std::isnan(args.memory_budget_mb))
+  if (!std::isnan(args.memory_budget_mb)) {
     options.memory_budget_bytes =
         CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
-  PrepareOutputDir(args.out);
+    CheckMemoryBudget(options.memory_budget_bytes, "--memory-budget", "");
+  }
+  // Both outputs appear together (summary.json last), or neither does.
+  const std::filesystem::path out(args.out);
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
+  const std::string summary_path = output.Stage((out / "summary.json").string(), "--out");
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   ProgressBar bar("analyze " + rig.name, !args.quiet);
@@ -98,9 +105,10 @@ int RunAnalyze(const AnalyzeArgs& args) {
 
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  const nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, threads);
-  const std::filesystem::path out(args.out);
+  nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, threads);
+  summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{
+      {"run_id", output.run_id()},
       {"units", "m"},
       {"tool", "pandora"},
       {"tool_version", PANDORA_VERSION},
@@ -110,8 +118,9 @@ int RunAnalyze(const AnalyzeArgs& args) {
       {"rig", RigToJson(rig).dump()},
       {"voxel_size_m", FormatNumber(scene.study.voxel_size)},
   };
-  WriteFieldsVdb(fields, (out / "fields.vdb").string(), meta);
-  WriteFileAtomically((out / "summary.json").string(), summary.dump(2) + "\n");
+  WriteFieldsVdb(fields, vdb_path, meta);
+  WriteFileAtomically(summary_path, summary.dump(2) + "\n");
+  output.Commit();
   if (!args.quiet) {
     PrintTable(summary);
     std::printf("wrote %s and %s\n", (out / "fields.vdb").c_str(), (out / "summary.json").c_str());

@@ -25,7 +25,9 @@ int RunBench(const BenchArgs& args) {
   const Rig& rig = scene.FindRig(args.rig);
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  if (!args.json_out.empty()) RefuseToOverwriteInputs(scene, args.json_out, "--json");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -137,7 +139,8 @@ int RunBench(const BenchArgs& args) {
                      {"coverage_only_cpu_seconds", cpu_coverage},
                      {"with_uncertainty_cpu_seconds", cpu_uncertainty},
                      {"uncertainty_overhead_cpu", cpu_overhead}};
-    WriteFileAtomically(args.json_out, j.dump(2) + "\n");
+    WriteFileAtomically(json_path, j.dump(2) + "\n");
+    output.Commit();
   }
   return 0;
 }

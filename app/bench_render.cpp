@@ -23,7 +23,9 @@ int RunRenderBench(const BenchArgs& args) {
   const auto [width, height] = ParseImageSize("--size", args.size);
   const Scene scene = LoadScene(args.scene);
   const Rig& rig = scene.FindRig(args.rig);
-  if (!args.json_out.empty()) RefuseToOverwriteInputs(scene, args.json_out, "--json");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
   RenderView view;
   if (!args.view.empty()) {
     auto it = scene.views.find(args.view);
@@ -124,7 +126,8 @@ int RunRenderBench(const BenchArgs& args) {
                      {"render_with_layers_seconds", best_layers},
                      {"ratio_with_layers", best_layers / raw},
                      {"ratio_single_with_layers", best_layers / raw_single}};
-    WriteFileAtomically(args.json_out, j.dump(2) + "\n");
+    WriteFileAtomically(json_path, j.dump(2) + "\n");
+    output.Commit();
   }
   return 0;
 }

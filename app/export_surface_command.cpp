@@ -22,14 +22,10 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   // Options first: a bad --spacing or --out is reported before the scene's meshes are read.
   CheckPositiveOption("--spacing", args.spacing, "metres");
   if (args.out.empty()) throw InputError("--out", "", "no output file given", "e.g. --out surface.ply");
-  const std::filesystem::path out(args.out);
-  const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : ".";
-  PrepareOutputDir(dir.string());
-  if (std::filesystem::is_directory(out))
-    throw InputError(args.out, "", "--out names a folder, not a file", "e.g. --out surface.ply");
-
   const Scene scene = LoadScene(args.scene);
-  RefuseToOverwriteInputs(scene, args.out, "--out");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string staged = output.Stage(args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, args.spacing, args.seed);
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
@@ -52,7 +48,8 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
       "red green blue: viridis of coverage / enabled cameras, grey where no camera sees the point"};
   for (std::size_t i = 0; i < scene.objects.size(); ++i)
     comments.push_back("object " + std::to_string(i) + " " + scene.objects[i].name);
-  WriteSurfacePly(args.out, samples, values, rig.enabled_count(), comments);
+  WriteSurfacePly(staged, samples, values, rig.enabled_count(), comments);
+  output.Commit();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!args.quiet) {

@@ -6,29 +6,10 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 
 #include "analysis/error.h"
 
 namespace pandora::app {
-
-void PrepareOutputDir(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec)
-    throw InputError(dir, "", "cannot create the output folder: " + ec.message(),
-                     "choose another --out folder");
-  if (!std::filesystem::is_directory(dir))
-    throw InputError(dir, "", "the output path exists and is not a folder",
-                     "choose another --out folder");
-  const std::string probe = (std::filesystem::path(dir) / ".pandora-write-test.tmp").string();
-  std::ofstream f(probe);
-  if (!f)
-    throw InputError(dir, "", "the output folder is not writable", "choose another --out folder");
-  f.close();
-  std::remove(probe.c_str());
-}
 
 ProgressBar::ProgressBar(std::string label, bool enabled)
     : label_(std::move(label)), active_(enabled && isatty(STDERR_FILENO)) {}
@@ -81,21 +62,8 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
   return {w, h};
 }
 
-void RefuseToOverwriteInputs(const Scene& scene, const std::string& out, const std::string& what) {
-  namespace fs = std::filesystem;
-  const fs::path folder = fs::path(scene.path).parent_path();
-  auto refuse_if = [&](const std::string& input, const char* kind) {
-    if (input.empty()) return;
-    fs::path p(input);
-    if (p.is_relative()) p = folder / p;
-    std::error_code ec;
-    if (fs::equivalent(out, p, ec))
-      throw InputError(out, "", what + " would overwrite the " + kind + " '" + input + "'",
-                       "write the output to another file");
-  };
-  refuse_if(scene.path, "scene file");
-  for (const SceneObject& o : scene.objects) refuse_if(o.source, "mesh file");
-  for (const Material& m : scene.materials) refuse_if(m.texture, "texture");
+void AddSceneInputs(OutputTransaction& transaction, const Scene& scene) {
+  for (const auto& [path, kind] : scene.InputFiles()) transaction.AddInput(path, kind);
 }
 
 }  // namespace pandora::app

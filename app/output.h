@@ -1,7 +1,7 @@
 #pragma once
 /// \file output.h
-/// Output helpers for the command-line tool: output folders, progress bar (atomic writes live in
-/// analysis/atomic_file.h).
+/// Output helpers for the command-line tool: image sizes, the progress bar, and the inputs every
+/// command's OutputTransaction (analysis/output_transaction.h) must not overwrite.
 
 #include <chrono>
 #include <mutex>
@@ -9,18 +9,14 @@
 #include <utility>
 
 #include "analysis/atomic_file.h"
+#include "analysis/output_transaction.h"
 #include "analysis/scene.h"
 
 namespace pandora::app {
 
-/// Creates `dir` (and parents) if needed and checks that a file can be created in it. Throws
-/// InputError (file = dir) otherwise.
-void PrepareOutputDir(const std::string& dir);
-
-/// Throws InputError(out, "", ...) when `out` is the scene file or any file the scene was loaded
-/// from (mesh files, textures): outputs never replace a user's inputs. `what` names the output in
-/// the message ("--out", "--json").
-void RefuseToOverwriteInputs(const Scene& scene, const std::string& out, const std::string& what);
+/// Registers every file `scene` was read from (Scene::InputFiles) as an input of `transaction`, so
+/// that no output replaces the scene file, a mesh file or a texture.
+void AddSceneInputs(OutputTransaction& transaction, const Scene& scene);
 
 /// Parses an image size "WxH" for the option `option` (e.g. "--size"): each side 1 to 16384 and at
 /// most 64 Mpx in all (a render keeps about 40 bytes per pixel with its layers, more for a camera's

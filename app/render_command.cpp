@@ -100,7 +100,10 @@ int RunRender(const RenderArgs& args) {
   }
 
   Scene scene = LoadScene(args.scene);
-  RefuseToOverwriteInputs(scene, args.out, "--out");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  output.AddInput(args.fields, "fields file");
+  const std::string staged = output.Stage(args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
   options.pixel_sigma = scene.study.pixel_sigma;
 
@@ -138,14 +141,19 @@ int RunRender(const RenderArgs& args) {
   if (!args.size.empty()) std::tie(view.width, view.height) = ParseImageSize("--size", args.size);
 
   std::unique_ptr<Fields> fields;
-  if (!args.fields.empty()) fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
+  if (!args.fields.empty()) {
+    // A run killed while committing its outputs is finished before they are read.
+    RecoverOutputs(std::filesystem::path(args.fields).parent_path().string());
+    fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
+  }
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   options.layers = ext == ".exr";  // the PNG has no room for them
   RenderStats stats;
   const Image image = RenderWithStats(scene, rig, *caster, view, options, fields.get(), &stats);
-  if (ext == ".png") WritePng(image, args.out);
-  else WriteExr(image, args.out, int(rig.cameras.size()));
+  if (ext == ".png") WritePng(image, staged);
+  else WriteExr(image, staged, int(rig.cameras.size()));
+  output.Commit();
   if (!args.quiet)
     std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras), %zu triangles, %.3f s\n",
                 args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),

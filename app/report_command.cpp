@@ -244,7 +244,10 @@ int RunReport(const ReportArgs& args) {
       throw InputError(option, "", "must be 16 to 8192 pixels, not " + std::to_string(value));
   CheckPositiveOption("--brightness", args.brightness, "");
   const int view_width = args.width;
-  PrepareOutputDir(args.out);
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string path = (std::filesystem::path(args.out) / "report.html").string();
+  const std::string staged = output.Stage(path, "--out");
 
   // Fields: the study's, plus what the figures need.
   std::vector<std::string> field_names;
@@ -551,8 +554,8 @@ int RunReport(const ReportArgs& args) {
           "    status.className = 'bad';\n"
           "  }\n"
           "});\n</script>\n</body>\n</html>\n";
-  const std::string path = (std::filesystem::path(args.out) / "report.html").string();
-  WriteFileAtomically(path, page.str());
+  WriteFileAtomically(staged, page.str());
+  output.Commit();
   if (!args.quiet)
     std::printf("wrote %s (%d images, %.1f MiB)\n", path.c_str(), fig.count(),
                 page.str().size() / 1048576.0);

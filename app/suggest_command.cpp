@@ -232,12 +232,16 @@ int RunSuggest(const SuggestArgs& args) {
     throw InputError("--snap-rotate", "", "must be a finite angle >= 0 in degrees");
   options.outer_iterations = args.outer_iterations;
 
-  std::error_code ec;
-  if (std::filesystem::equivalent(args.out, args.scene, ec))
-    throw InputError(args.out, "", "--out would overwrite the scene file", "write the suggestion to another file");
-  const std::filesystem::path out_parent = std::filesystem::path(args.out).parent_path();
-  PrepareOutputDir(out_parent.empty() ? "." : out_parent.string());
-  if (!args.compare_baseline.empty()) PrepareOutputDir(args.compare_baseline);
+  // The suggestion and the baseline comparison appear together, and replace no input.
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string suggestion_path = output.Stage(args.out, "--out");
+  const std::string stem = args.compare_baseline + "/suggest_vs_baseline";
+  std::string csv_path, svg_path;
+  if (!args.compare_baseline.empty()) {
+    csv_path = output.Stage(stem + ".csv", "--compare-baseline");
+    svg_path = output.Stage(stem + ".svg", "--compare-baseline");
+  }
 
   Rig rig = file_rig;
   bool perturbed = false;
@@ -273,8 +277,7 @@ int RunSuggest(const SuggestArgs& args) {
     const std::size_t pos = text.find('{');
     text.insert(pos + 1, "\n \"perturbed_for_benchmark\": true,");
   }
-  WriteFileAtomically(args.out, text);
-  if (!args.quiet) std::printf("wrote %s%s\n", args.out.c_str(), s.improved ? "" : " (no improvement: nothing to accept)");
+  WriteFileAtomically(suggestion_path, text);
 
   if (!args.compare_baseline.empty()) {
     // The same evaluation budget as the suggestion used (screening, surrogate and exact evaluations).
@@ -291,8 +294,7 @@ int RunSuggest(const SuggestArgs& args) {
                       static_cast<long long>(t.evaluations), t.objective);
         csv += line;
       }
-    const std::string stem = args.compare_baseline + "/suggest_vs_baseline";
-    WriteFileAtomically(stem + ".csv", csv);
+    WriteFileAtomically(csv_path, csv);
     LogLogPlot plot;
     plot.title = "Suggestion (screening + Ceres nudge) vs random local search: " + rig.name + ", " + ObjectiveName(options.objective);
     plot.x_label = "seconds";
@@ -324,7 +326,7 @@ int RunSuggest(const SuggestArgs& args) {
       ref.y = {y_of(original->objective), y_of(original->objective)};
       plot.series.push_back(ref);
     }
-    WriteFileAtomically(stem + ".svg", RenderLogLogSvg(plot));
+    WriteFileAtomically(svg_path, RenderLogLogSvg(plot));
     if (!args.quiet) {
       // Targets: the suggestion's final objective, and the better baseline's final objective.
       double best_base = b.after.objective;
@@ -343,8 +345,12 @@ int RunSuggest(const SuggestArgs& args) {
       }
       std::printf("(times in seconds to reach the suggestion's final %s and the better baseline's final %s; inf: never)\n",
                   Value(s.after.objective).c_str(), Value(best_base).c_str());
-      std::printf("wrote %s.csv and %s.svg\n", stem.c_str(), stem.c_str());
     }
+  }
+  output.Commit();
+  if (!args.quiet) {
+    std::printf("wrote %s%s\n", args.out.c_str(), s.improved ? "" : " (no improvement: nothing to accept)");
+    if (!args.compare_baseline.empty()) std::printf("wrote %s.csv and %s.svg\n", stem.c_str(), stem.c_str());
   }
   return 0;
 }
@@ -353,6 +359,8 @@ int RunAccept(const AcceptArgs& args) {
   AcceptOptions options;
   options.force = args.force;
   if (!args.cameras.empty()) options.cameras = SplitComma(args.cameras);
+  // A suggest run killed while committing its outputs is finished before its suggestion is read.
+  RecoverOutputs(std::filesystem::path(args.suggestion).parent_path().string());
   const AcceptResult r = AcceptSuggestion(args.suggestion, options);
   std::string ids;
   for (const std::string& id : r.accepted) ids += (ids.empty() ? "" : ", ") + id;

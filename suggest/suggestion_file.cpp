@@ -13,6 +13,8 @@
 
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
+#include "analysis/input_file.h"
+#include "analysis/output_transaction.h"
 #include "analysis/sha256.h"
 
 namespace pandora {
@@ -39,12 +41,11 @@ json PoseJson(const Eigen::Isometry3d& pose) {
   return json{{"position", {p.x(), p.y(), p.z()}}, {"quaternion", {q.w(), q.x(), q.y(), q.z()}}};
 }
 
-std::string ReadBytes(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open the " + what, "check the path");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+// A JSON file's text: a regular file of bounded size, nesting checked before any parser sees it.
+std::string ReadJsonText(const std::string& path, const std::string& what) {
+  std::string text = ReadInputFile(path, InputLimits::kJsonBytes, what);
+  CheckJsonLimits(text, path);
+  return text;
 }
 
 std::string IdOf(const ordered_json& id) {
@@ -217,7 +218,7 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
 }
 
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options) {
-  const std::string text = ReadBytes(suggestion_path, "suggestion file");
+  const std::string text = ReadJsonText(suggestion_path, "suggestion file");
   json j;
   try {
     j = json::parse(text);
@@ -277,13 +278,13 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     if (!offered.count(id)) {
       std::string list;
       for (const std::string& o : order) list += (list.empty() ? "" : ", ") + o;
-      throw InputError(suggestion_path, "--cameras", "camera '" + id + "' is not in the suggestion",
+      throw InputError("--cameras", "", "camera '" + id + "' is not in the suggestion " + suggestion_path,
                        "it offers: " + list);
     }
     if (unique.insert(id).second) updates.push_back(offered[id]);
   }
 
-  const std::string scene_text = ReadBytes(result.scene_path, "scene file");
+  const std::string scene_text = ReadJsonText(result.scene_path, "scene file");
   if (Sha256Hex(scene_text) != scene_j["sha256"].get<std::string>() && !options.force)
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
@@ -317,8 +318,9 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     }
   }
 
-  // Backup first, then the scene file; both atomic. Through a symbolic link to the file it names,
-  // keeping its permissions; a read-only scene file is refused.
+  // The backup and the new scene file appear together (OutputTransaction), the backup with the
+  // scene file's mode and owner, the scene file keeping its own. Through a symbolic link to the
+  // file it names; a read-only scene file is refused.
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path target = fs::canonical(result.scene_path, ec);
@@ -329,9 +331,12 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   const std::string path = target.string();
   std::string backup = path + ".bak";
   for (int n = 1; fs::exists(backup, ec); ++n) backup = path + ".bak." + std::to_string(n);
-  WriteFileAtomically(backup, scene_text);
-  WriteFileAtomically(path, new_text);
-  fs::permissions(path, perms, ec);  // the temporary file was created with the default mode
+  OutputTransaction output;
+  output.AddInput(suggestion_path, "suggestion file");
+  output.AddInput(path, "scene file");
+  output.Write(backup, "", scene_text, path);  // with the scene file's mode and owner
+  WriteFileAtomically(output.StageReplacement(path, ""), new_text);
+  output.Commit();
   result.backup_path = backup;
   for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
   return result;
