@@ -4,6 +4,7 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <fstream>
 #include <cstdio>
 #include <map>
 #include <mutex>
@@ -40,6 +41,26 @@ void Describe(openvdb::GridBase& grid) {
   grid.insertMeta("description", openvdb::StringMetadata(it->second.second));
 }
 
+// io::File::write does not check its stream: on a full disk it returns normally over a cut-short
+// file. This writes the same archive (seekable, with grid offsets) through a stream it checks.
+class CheckedVdbWriter : public openvdb::io::Archive {
+ public:
+  void Write(const std::string& path, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) {
+    std::ofstream os(path, std::ios::binary | std::ios::trunc);
+    if (!os) throw InputError(path, "", "cannot create the VDB file", "check the output folder");
+    openvdb::io::Archive::write(os, grids, /*seekable=*/true, meta);
+    os.flush();
+    const bool ok = static_cast<bool>(os);
+    os.close();
+    if (!ok || os.fail())
+      throw InputError(path, "", "cannot write the VDB file: the disk is full or the write failed",
+                       "free some space, then run again");
+  }
+  openvdb::io::Archive::Ptr copy() const override {
+    return openvdb::io::Archive::Ptr(new CheckedVdbWriter(*this));
+  }
+};
+
 }  // namespace
 
 void WriteFieldsVdb(const Fields& fields, const std::string& path,
@@ -54,14 +75,16 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
   }
   const std::string tmp = TemporaryPath(path);
   try {
-    openvdb::io::File file(tmp);
-    file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-    file.write(grids, file_meta);
-    file.close();
+    CheckedVdbWriter writer;
+    writer.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    writer.Write(tmp, grids, file_meta);
   } catch (const openvdb::Exception& e) {
     std::remove(tmp.c_str());
     throw InputError(path, "", std::string("cannot write the VDB file: ") + e.what(),
                      "check that the output folder exists and is writable");
+  } catch (const InputError& e) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", e.reason(), e.hint());
   }
   CommitTemporary(path);
 }
