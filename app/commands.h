@@ -72,6 +72,7 @@ struct RenderArgs {
   int grid = 32;
   int samples = 1;
   bool no_cameras = false;
+  bool no_key = false;         ///< `--no-key`: no colour key (camera id -> colour) in the image.
   std::string fields;          ///< fields.vdb for the overlays.
   std::string slice;           ///< Field shown on a slice plane.
   std::string slice_axis = "z";
@@ -104,7 +105,7 @@ struct ReportArgs {
   double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
   int width = 640;                ///< Pixels across the renders from the named views.
   int camera_width = 320;         ///< Pixels across each camera's own view.
-  double brightness = 1.0;        ///< Scale of every camera's light in the renders.
+  double brightness = kUnset;     ///< Scale of every camera's light; kUnset: DefaultBrightness.
   bool quiet = false;
 };
 int RunReport(const ReportArgs& args);

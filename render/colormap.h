@@ -22,7 +22,7 @@ double SrgbFromLinear(double v);
 double LinearFromSrgb(double v);
 
 /// Draws `text` with a 3x5 pixel font scaled by `scale`, top-left corner at (x, y), into a linear
-/// RGB buffer of width x height (3 floats per pixel). Characters: digits, a-z, . - + / _ % = < >
+/// RGB buffer of width x height (3 floats per pixel). Characters: digits, a-z, . - + / _ % = < > [ ] ( ) , :
 /// and space; others are drawn as a box. Returns the width drawn in pixels.
 int DrawText(float* rgb, int width, int height, int x, int y, const std::string& text,
              const Vec3& color, int scale);
