@@ -1,5 +1,5 @@
 // Plausibility checks of a rig (analysis/rig_check.h): cameras inside solids, outside the modelled
-// geometry, behind a wall, seeing nothing of the region, and lenses whose model folds back inside
+// geometry or the room, seeing nothing of the region, and lenses whose model folds back inside
 // the image.
 #include "analysis/rig_check.h"
 
@@ -51,12 +51,20 @@ class Solids {
       }
     tests_.resize(objects_.size());
   }
-  /// The object index of a solid containing p, or -1.
-  int Containing(const Vec3& p) {
+  /// The object index of a solid containing p, or -1. With `strict`, a point within `tolerance` of
+  /// the surface (some axis offset by it is outside) does not count.
+  int Containing(const Vec3& p, bool strict = false, double tolerance = 0) {
     for (std::size_t i = 0; i < objects_.size(); ++i) {
       if (!bounds_[i].Contains(p)) continue;
       if (!tests_[i]) tests_[i] = std::make_unique<InsideMesh>(scene_.objects[objects_[i]].mesh);
-      if (tests_[i]->Inside(p)) return objects_[i];
+      if (!tests_[i]->Inside(p)) continue;
+      bool on_surface = false;
+      for (int a = 0; strict && a < 6 && !on_surface; ++a) {
+        Vec3 q = p;
+        q[a / 2] += (a % 2 ? tolerance : -tolerance);
+        on_surface = !tests_[i]->Inside(q);
+      }
+      if (!on_surface) return objects_[i];
     }
     return -1;
   }
@@ -144,8 +152,7 @@ double EffectiveFov(const CameraModel& model, int axis) {
 const char* WarningKindName(Warning::Kind kind) {
   switch (kind) {
     case Warning::Kind::kInsideSolid: return "inside_solid";
-    case Warning::Kind::kOutsideGeometry: return "outside_geometry";
-    case Warning::Kind::kBehindSurface: return "behind_surface";
+    case Warning::Kind::kOutsideRoom: return "outside_room";
     case Warning::Kind::kSeesNoRegion: return "sees_no_region";
     case Warning::Kind::kLensDomain: return "lens_domain";
   }
@@ -196,7 +203,24 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
   Solids solids(scene);
   const std::vector<Vec3> samples =
       RegionSamples(scene, std::max(1, options.region_samples_per_axis), &solids);
-  const VisibilityTester tester(rig.cameras, caster, scene.Bounds().diagonal());
+  const double scale = std::max(scene.Bounds().diagonal(), 1e-9);
+  const VisibilityTester tester(rig.cameras, caster, scale);
+  const double eps = tester.epsilon();
+  // The reference point: the free region sample nearest the region's centre. The region is
+  // enclosed (a room) when every horizontal ray from it meets geometry.
+  Vec3 reference = scene.study.region.box.center();
+  bool enclosed = false;
+  if (!samples.empty()) {
+    reference = *std::min_element(samples.begin(), samples.end(), [&](const Vec3& a, const Vec3& b) {
+      return (a - scene.study.region.box.center()).squaredNorm() <
+             (b - scene.study.region.box.center()).squaredNorm();
+    });
+    enclosed = true;
+    for (int k = 0; k < 16 && enclosed; ++k) {
+      const double a = 2 * 3.14159265358979323846 * k / 16;
+      enclosed = caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
+    }
+  }
 
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[c];
@@ -208,46 +232,63 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
 
     // Where the camera is.
     bool placed = true;
-    const int solid = solids.Containing(centre);
+    const int solid = solids.Containing(centre, /*strict=*/true, 1e-6 * scale);
     if (solid >= 0) {
       add(Warning::Kind::kInsideSolid, ".position",
           "camera '" + cam.id + "' is inside the solid object " + ObjectName(scene, solid) +
               " (centre " + Point(centre) + " m): it sees nothing; move it out");
       placed = false;
-    } else if (!geometry.empty() &&
-               ((centre.array() < geometry.min.array() - pad).any() ||
-                (centre.array() > geometry.max.array() + pad).any())) {
-      add(Warning::Kind::kOutsideGeometry, ".position",
+    } else if (enclosed && ((centre.array() < geometry.min.array() - pad).any() ||
+                            (centre.array() > geometry.max.array() + pad).any())) {
+      add(Warning::Kind::kOutsideRoom, ".position",
           "camera '" + cam.id + "' is outside the modelled room: its centre " + Point(centre) +
               " m lies outside the bounds of the scene's geometry " + Point(geometry.min) + " to " +
               Point(geometry.max) + " m");
       placed = false;
+    } else if (enclosed) {
+      // From the reference point towards the camera: a surface before it and nothing after it.
+      const Vec3 to = centre - reference;
+      const double distance = to.norm();
+      if (distance > 2 * eps) {
+        const Vec3 d = to / distance;
+        const auto wall = caster.Intersect(Ray{reference, d, eps, distance - eps});
+        const bool beyond = caster.Occluded(Ray{centre, d, eps, 1e3 * scale});
+        // And the camera has no free line of sight to any region sample (a camera above a lamp
+        // in a room without a ceiling still sees around it).
+        bool all_blocked = wall && !beyond;
+        for (std::size_t k = 0; all_blocked && k < samples.size(); ++k) {
+          const Vec3 v = samples[k] - centre;
+          const double l = v.norm();
+          all_blocked = l > 2 * eps && caster.Occluded(Ray{centre, v / l, eps, l - eps});
+        }
+        if (all_blocked) {
+          const int object = wall->triangle >= 0 && wall->triangle < int(triangle_object.size())
+                                 ? triangle_object[wall->triangle]
+                                 : -1;
+          add(Warning::Kind::kOutsideRoom, ".position",
+              "camera '" + cam.id + "' is outside the modelled room: seen from the region it is "
+              "behind " + ObjectName(scene, object) + " with nothing beyond it (centre " +
+                  Point(centre) + " m)");
+          placed = false;
+        }
+      }
     }
 
-    // What it sees of the region's sample points, and why not. The line of sight to each point is
-    // traced whatever the image and range say (for the behind-a-wall test).
+    // What it sees of the region's sample points, and why not.
     std::map<ViewResult, int> why;
-    std::map<int, int> first_hit;  // object -> lines of sight it blocks first
-    std::map<int, int> occluders;  // likewise, only where the point is otherwise in view
-    int seen = 0, blocked = 0, from_behind = 0, segments = 0;
+    std::map<int, int> occluders;  // object -> lines of sight it blocks where the point is in view
+    int seen = 0;
     for (const Vec3& X : samples) {
       const ViewResult g = tester.TestGeometry(static_cast<int>(c), X);
       const Vec3 to = X - centre;
       const double distance = to.norm();
       std::optional<RayHit> hit;
-      if (distance > 2 * tester.epsilon()) {
-        ++segments;
+      if (g == ViewResult::kSeen && distance > 2 * tester.epsilon())
         hit = caster.Intersect(
             Ray{centre, to / distance, tester.epsilon(), distance - tester.epsilon()});
-      }
       int object = -1;
-      if (hit) {
-        ++blocked;
-        if (hit->normal.dot(to) > 0) ++from_behind;
-        if (hit->triangle >= 0 && hit->triangle < static_cast<int>(triangle_object.size()))
-          object = triangle_object[hit->triangle];
-        ++first_hit[object];
-      }
+      if (hit && hit->triangle >= 0 && hit->triangle < static_cast<int>(triangle_object.size()))
+        object = triangle_object[hit->triangle];
       if (g == ViewResult::kSeen && !hit) {
         ++seen;
       } else if (g == ViewResult::kSeen) {
@@ -256,18 +297,6 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
       } else {
         ++why[g];
       }
-    }
-    if (placed && segments > 0 && blocked == segments && 2 * from_behind > segments) {
-      int object = -1, most = 0;
-      for (const auto& [o, n] : first_hit)
-        if (n > most) object = o, most = n;
-      add(Warning::Kind::kBehindSurface, ".position",
-          "camera '" + cam.id + "' looks at the back of a surface" +
-              (object >= 0 ? " (" + ObjectName(scene, object) + ")" : std::string()) +
-              ": every line of sight to the region is blocked, " +
-              Format("%.0f", 100.0 * from_behind / segments) +
-              "% of them by a surface seen from behind; is it outside a wall?");
-      placed = false;
     }
     const bool sees_nothing = c < options.visible_voxels.size() ? options.visible_voxels[c] == 0
                                                                  : (!samples.empty() && seen == 0);

@@ -21,10 +21,9 @@ namespace pandora {
 /// One warning about one camera.
 struct Warning {
   enum class Kind {
-    kInsideSolid,      ///< The camera centre is inside a solid object.
-    kOutsideGeometry,  ///< The centre lies outside the bounding box of the scene's geometry.
-    kBehindSurface,    ///< Every line of sight to the region first meets the back of a surface.
-    kSeesNoRegion,     ///< The camera sees none of the study region.
+    kInsideSolid,   ///< The camera centre is inside a solid object.
+    kOutsideRoom,   ///< The centre lies outside the walls that enclose the region.
+    kSeesNoRegion,  ///< The camera sees none of the study region.
     kLensDomain,       ///< The distortion's valid (monotonic) domain ends inside the image.
   };
   Kind kind = Kind::kSeesNoRegion;
@@ -33,7 +32,7 @@ struct Warning {
   std::string reason;     ///< One line, without the file name.
 };
 
-/// "inside_solid", "outside_geometry", "behind_surface", "sees_no_region", "lens_domain".
+/// "inside_solid", "outside_room", "sees_no_region", "lens_domain".
 const char* WarningKindName(Warning::Kind kind);
 
 /// `FILE: JSON_PATH: REASON`, the form printed after "pandora: warning: ".
@@ -74,18 +73,23 @@ struct RigCheckOptions {
 
 /// Checks every enabled camera of `rig` (which must be one of scene.rigs, for the JSON paths) and
 /// returns the warnings in rig order. `caster` must be built from scene.AllTriangles(). Per camera:
-///  - inside a solid object (the loader's closed meshes; InsideMesh), the most specific: when it
-///    fires, the region and outside tests are skipped for that camera;
-///  - outside the bounding box of all objects' triangles (padded by 1e-9 of its diagonal): outside
-///    the modelled room, whatever it looks at;
-///  - behind a surface: inside that box, yet every occlusion segment from the centre to the region's
-///    sample points is blocked and most of them first meet a surface from its back side (the camera
-///    is on the outer side of a wall that faces the region);
+///  - inside a solid object (the loader's closed meshes; InsideMesh): strictly inside, a centre on
+///    the surface (within 1e-6 of the scene's size) does not count;
+///  - outside the room: only where the scene encloses the region (all 16 horizontal rays from the
+///    free region sample nearest the region's centre, the reference point, hit geometry: walls), a
+///    camera is outside when its centre lies outside the bounding box of all objects' triangles, or
+///    when the segment from the reference point to the camera crosses a surface, the ray goes on
+///    beyond the camera without meeting anything (the camera is past the last wall in that
+///    direction; a camera behind a pillar inside the room has the room's wall behind it), and no
+///    line of sight from the camera to a region sample is free;
 ///  - sees none of the region (from `options.visible_voxels` when given, else from the samples), with
-///    the commonest reason among the samples (outside the image, out of range, blocked by an object);
+///    the commonest reason among the samples (outside the image, behind it, out of range, blocked by
+///    an object);
 ///  - the lens's valid domain ends inside the image (ComputeLensCoverage), with the unreachable
 ///    share of the pixels.
-/// Never throws for a valid scene; cheap (a few thousand segments per camera).
+/// The placement warnings are the most specific: a camera inside a solid or outside the room gets
+/// no "sees none" warning on top. Never throws for a valid scene; cheap (a few thousand segments per
+/// camera).
 std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaster& caster,
                               const RigCheckOptions& options = {});
 

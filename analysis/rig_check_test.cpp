@@ -82,9 +82,9 @@ TEST(LensCoverage, FisheyeOver180DegreesIsReportedAsSuch) {
   EXPECT_FALSE(c.domain_ends_inside_image);
 }
 
-// A 7 x 5 x 3 m lab: floor, four one-sided walls facing in (planes), a solid cabinet, a one-sided
-// partition facing the region with a camera behind it, and a floor slab reaching 1 m beyond the
-// north wall (so that camera is still inside the geometry's bounds).
+// A 7 x 5 x 3 m lab with no ceiling: four one-sided walls facing in (planes), a floor slab reaching
+// 2 m beyond the north wall (so a camera just outside that wall is still inside the geometry's
+// bounds), a solid cabinet, and a solid screen that hides the region from a corner ("niche").
 std::string Lab() {
   return R"({
   "objects": [
@@ -93,7 +93,8 @@ std::string Lab() {
     {"name": "wall_w", "plane": {"size": [3, 5]}, "position": [-3.5, 0, 1.5], "rotation_deg": [0, 90, 0]},
     {"name": "wall_e", "plane": {"size": [3, 5]}, "position": [3.5, 0, 1.5], "rotation_deg": [0, -90, 0]},
     {"name": "wall_n", "plane": {"size": [7, 3]}, "position": [0, 2.5, 1.5], "rotation_deg": [90, 0, 0]},
-    {"name": "cabinet", "box": {"size": [0.6, 0.5, 2.0]}, "position": [3.0, -2.0, 1.0], "solid": true}
+    {"name": "cabinet", "box": {"size": [0.6, 0.5, 2.0]}, "position": [3.0, -2.0, 1.0], "solid": true},
+    {"name": "screen", "box": {"size": [0.5, 1.2, 3.0]}, "position": [-2.8, 1.8, 1.5], "solid": true}
   ],
   "rigs": [{"name": "lab", "cameras": [
     {"id": "ok", "position": [-3, -2, 2.5], "look_at": [0, 0, 1], "resolution": [1280, 800], "hfov_deg": 80},
@@ -103,6 +104,7 @@ std::string Lab() {
     {"id": "away", "position": [3, 2, 2.5], "look_at": [3, 2, 6], "up": [0, 1, 0], "resolution": [1280, 800], "hfov_deg": 60},
     {"id": "barrel", "position": [3, 2, 2.5], "look_at": [0, 0, 1], "resolution": [1280, 800], "focal_px": 500,
      "distortion": {"model": "brown_conrady", "k1": -0.2}},
+    {"id": "niche", "position": [-3.3, 2.3, 1.0], "look_at": [0, 0, 1], "resolution": [1280, 800], "hfov_deg": 80},
     {"id": "off", "enabled": false, "position": [3.0, -2.0, 1.5], "look_at": [0, 0, 1], "resolution": [640, 480], "hfov_deg": 60}
   ]}],
   "study": {"region": {"box": {"min": [-1, -1, 0.2], "max": [1, 1, 2]}}, "voxel_size": 0.1}
@@ -123,10 +125,12 @@ TEST(CheckRig, EachNonsenseCameraGetsItsOneWarning) {
   using K = Warning::Kind;
   EXPECT_EQ(by.count("ok"), 0u);
   EXPECT_EQ(by["in_box"], std::vector<K>{K::kInsideSolid});
-  EXPECT_EQ(by["outside"], std::vector<K>{K::kOutsideGeometry});
-  EXPECT_EQ(by["behind"], std::vector<K>{K::kBehindSurface});
+  EXPECT_EQ(by["outside"], std::vector<K>{K::kOutsideRoom});
+  EXPECT_EQ(by["behind"], std::vector<K>{K::kOutsideRoom});
   EXPECT_EQ(by["away"], std::vector<K>{K::kSeesNoRegion});
   EXPECT_EQ(by["barrel"], std::vector<K>{K::kLensDomain});
+  // Behind the screen inside the room: the room's walls are behind it, so it is not "outside".
+  EXPECT_EQ(by["niche"], std::vector<K>{K::kSeesNoRegion});
   EXPECT_EQ(by.count("off"), 0u) << "a disabled camera is not checked";
   for (const Warning& w : ws) {
     SCOPED_TRACE(w.reason);
@@ -146,6 +150,9 @@ TEST(CheckRig, EachNonsenseCameraGetsItsOneWarning) {
       EXPECT_EQ(w.json_path, "$.rigs[0].cameras[4]");
       EXPECT_NE(w.reason.find("the region is behind it"), std::string::npos);  // it looks at the ceiling
     }
+    if (w.camera == "niche") {
+      EXPECT_NE(w.reason.find("its view is blocked by 'screen'"), std::string::npos);
+    }
     if (w.camera == "barrel") {
       EXPECT_EQ(w.json_path, "$.rigs[0].cameras[5].distortion");
       // 1280 x 800 at f = 500: the reachable disc has radius 430.3 px, cut top and bottom.
@@ -163,14 +170,35 @@ TEST(CheckRig, VoxelCountsDecideWhatACameraSees) {
   const Scene scene = ParseScene(Lab(), "lab.json");
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   RigCheckOptions o;
-  o.visible_voxels = {0, 0, 0, 0, 5, 3, 0};  // "ok" sees nothing by the fields, "away" sees some
+  o.visible_voxels = {0, 0, 0, 0, 5, 3, 7, 0};  // "ok" sees nothing by the fields, "away" sees some
   auto by = ByCamera(CheckRig(scene, scene.rigs[0], *caster, o));
   using K = Warning::Kind;
   EXPECT_EQ(by["ok"], std::vector<K>{K::kSeesNoRegion});
   EXPECT_EQ(by.count("away"), 0u);
   // The placement warnings stay the most specific ones.
   EXPECT_EQ(by["in_box"], std::vector<K>{K::kInsideSolid});
-  EXPECT_EQ(by["outside"], std::vector<K>{K::kOutsideGeometry});
+  EXPECT_EQ(by["outside"], std::vector<K>{K::kOutsideRoom});
+}
+
+// Without walls around the region there is no inside or outside: cameras on stands around an
+// object, far outside the geometry's bounds, are fine. A centre on a solid's surface is not inside.
+TEST(CheckRig, NoRoomMeansNoOutside) {
+  const Scene scene = ParseScene(R"({
+  "objects": [{"name": "block", "box": {"size": [0.4, 0.4, 0.4]}, "position": [0, 0, 0.2], "solid": true}],
+  "rigs": [{"name": "stands", "cameras": [
+    {"id": "far", "position": [6, 0, 1], "look_at": [0, 0, 0.3], "resolution": [640, 480], "hfov_deg": 30},
+    {"id": "on_face", "position": [0.2, 0, 0.2], "look_at": [1, 0, 0.2], "resolution": [640, 480], "hfov_deg": 60},
+    {"id": "in_block", "position": [0.1, 0, 0.2], "look_at": [1, 0, 0.2], "resolution": [640, 480], "hfov_deg": 60}
+  ]}],
+  "study": {"region": {"box": {"min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0.6]}}, "voxel_size": 0.05}
+})", "stands.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  auto by = ByCamera(CheckRig(scene, scene.rigs[0], *caster));
+  using K = Warning::Kind;
+  EXPECT_EQ(by.count("far"), 0u);
+  // It looks away from most of the region, yet sees the part beside the block in front of it.
+  EXPECT_EQ(by.count("on_face"), 0u);
+  EXPECT_EQ(by["in_block"], std::vector<K>{K::kInsideSolid});
 }
 
 }  // namespace

@@ -92,6 +92,8 @@ struct ExportSurfaceArgs {
   double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
   std::string out;        ///< The .ply file.
   unsigned long long seed = 1;
+  /// `--all-surfaces`: every triangle; default: only those whose front faces the study region.
+  bool all_surfaces = false;
   bool quiet = false;
 };
 int RunExportSurface(const ExportSurfaceArgs& args);
@@ -128,6 +130,7 @@ struct SuggestArgs {
   bool with_region = false;       ///< Region points as well as surface points.
   int points = 1500;
   double snap_move = 0, snap_rotate = 0;
+  double clearance = 0.1;         ///< Metres from every scene surface (`--clearance`).
   int outer_iterations = 4;
   std::string out = "suggestion.json";
   std::string perturb;            ///< "MOVE,DEG": benchmark from perturbed poses.

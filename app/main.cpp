@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
   es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
   es->add_option("--out", surface.out, "Output PLY file")->required();
   es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
+  es->add_flag("--all-surfaces", surface.all_surfaces, "Sample every surface, also those facing away from the study region");
   es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 
@@ -125,6 +126,7 @@ int main(int argc, char** argv) {
   sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, metres in the world frame (repeatable)");
   sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
   sg->add_option("--keep-out", suggest.keep_out, "Box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (metres, world frame) no camera centre may enter (repeatable)");
+  sg->add_option("--clearance", suggest.clearance, "Keep every suggested camera centre this far from every scene surface, metres (a camera already closer never moves closer)")->capture_default_str();
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
   sg->add_option("--points", suggest.points, "Target points")->capture_default_str();

@@ -587,6 +587,16 @@ bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p) {
   return false;
 }
 
+Placement::Placement(const Scene& scene, const Rig& rig, const SuggestOptions& options)
+    : keep_out_(options.keep_out), distance_(scene.AllTriangles()) {
+  for (int index : options.cameras) {
+    const double start = index >= 0 && index < static_cast<int>(rig.cameras.size())
+                             ? distance_.Distance(rig.cameras[index].center(), options.clearance)
+                             : 0.0;
+    required_.push_back(std::min(options.clearance, start));
+  }
+}
+
 const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i) {
   return options.limits.size() == 1 ? options.limits[0] : options.limits[i];
 }
@@ -655,6 +665,8 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
       throw InputError(file, "--keep-out", "camera '" + cam.id + "' is inside a keep-out box",
                        "a keep-out box must not hold a selected camera's current centre");
   }
+  if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
+    throw InputError(file, "--clearance", "must be a finite length >= 0 (metres)");
   if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
     throw InputError(file, "--snap-move", "must be a finite length >= 0");
   if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
@@ -668,7 +680,7 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
 
 std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
-                                         const SuggestOptions& options) {
+                                         const SuggestOptions& options, const Placement& placement) {
   std::vector<Eigen::Isometry3d> out = poses;
   for (std::size_t c = 0; c < charts.size(); ++c) {
     const PoseChart& ch = charts[c];
@@ -688,7 +700,7 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
       auto admissible = [&](const Vec3& centre) {
         if ((centre - ch.start.translation()).norm() > ch.max_move * (1 + 1e-12)) return false;
         if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre)) return false;
-        return !InKeepOut(options.keep_out, centre);
+        return placement.Admissible(c, centre);
       };
       Vec3 centre = make(false);
       if (!admissible(centre)) centre = make(true);
@@ -721,7 +733,7 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
 
 void FillChanges(const Rig& rig, const SuggestOptions& options,
                  const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
-                 Suggestion* s) {
+                 const Placement& placement, Suggestion* s) {
   s->cameras.clear();
   for (std::size_t c = 0; c < options.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[options.cameras[c]];
@@ -736,6 +748,8 @@ void FillChanges(const Rig& rig, const SuggestOptions& options,
     ch.focal_scale = c < focal_scales.size() ? focal_scales[c] : 1.0;
     ch.hfov_before_deg = Deg(HfovFromFocal(k.fx, k.width, k.model));
     ch.hfov_after_deg = Deg(HfovFromFocal(k.fx * ch.focal_scale, k.width, k.model));
+    ch.surface_distance_before = placement.SurfaceDistanceAt(ch.before.translation());
+    ch.surface_distance_after = placement.SurfaceDistanceAt(ch.after.translation());
     s->cameras.push_back(ch);
   }
 }
@@ -766,6 +780,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
   const std::vector<Eigen::Isometry3d>& start = begin.start;
@@ -795,7 +810,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       charts[c].Project(cand[c].data());
       poses[c] = charts[c].Pose(cand[c].data());
       scales[c] = charts[c].FocalScale(cand[c].data());
-      ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
+      ok = ok && placement.Admissible(c, poses[c].translation());
     }
     if (!ok) {  // an inadmissible candidate costs no evaluation
       ++rejected_in_a_row;
@@ -830,7 +845,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     scales.assign(charts.size(), 1.0);
   }
   s.after = s.improved ? best_m : s.before;
-  FillChanges(rig, options, poses, scales, &s);
+  FillChanges(rig, options, poses, scales, placement, &s);
   s.evaluations = ev.evaluations();
   s.seconds = elapsed();
   s.message = s.improved ? "baseline improved the objective" : "baseline found no improvement";

@@ -110,6 +110,9 @@ struct CameraChange {
   double rotate_deg = 0;   ///< Angle of the relative rotation, degrees.
   double focal_scale = 1;  ///< fx_after / fx_before (1 without a zoom range).
   double hfov_before_deg = 0, hfov_after_deg = 0;  ///< Horizontal field of view, degrees.
+  /// Distance from the centre to the nearest scene surface before and after, metres (infinity in a
+  /// scene without geometry).
+  double surface_distance_before = 0, surface_distance_after = 0;
   /// A message when this camera could not help (for example it sees none of the target and the
   /// surrogate has no gradient); empty otherwise.
   std::string note;
@@ -126,6 +129,10 @@ struct SuggestOptions {
   std::vector<int> cameras;           ///< Rig indices of the selected cameras (distinct, enabled).
   std::vector<CameraLimits> limits;   ///< One per selected camera, or one for all.
   std::vector<Aabb> keep_out;         ///< Boxes no selected camera centre may enter.
+  /// Metres every suggested camera centre keeps from every scene surface (any object's triangles:
+  /// walls, floor, furniture, solid or not). A camera that starts closer may stay or move away but
+  /// never closer than it starts. 0: no clearance.
+  double clearance = 0.1;
   Objective objective;
   int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
@@ -165,7 +172,8 @@ Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caste
                       const std::vector<TargetPoint>& targets, const Objective& objective);
 
 /// Checks the selection and the limits (throws InputError naming `options.scene_path` and the
-/// option) and runs the Ceres nudge. Deterministic.
+/// option) and runs the Ceres nudge. Every candidate pose keeps the limits, the keep-out boxes and
+/// the clearance (SuggestOptions::clearance). Deterministic.
 Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
                    const std::vector<TargetPoint>& targets, const SuggestOptions& options);
 

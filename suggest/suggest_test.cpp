@@ -21,6 +21,7 @@
 #include "analysis/visibility.h"
 #include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
+#include "suggest/surface_distance.h"
 
 namespace pandora {
 namespace {
@@ -459,6 +460,96 @@ TEST(Suggest, SnapRoundsToInstallableSteps) {
   for (int a = 0; a < 3; ++a) {
     double delta = std::remainder(y1[a] - y0[a], 360.0);
     EXPECT_NEAR(delta, std::round(delta), 1e-7) << (y1 - y0).transpose();
+  }
+}
+
+// A camera 0.25 m in front of a wall (a solid box whose face is the plane y = -1.85), looking
+// through a narrow lens at a region it sees only part of; a camera overhead sees all of it. Backing
+// up towards the wall widens its view, so coverage2 pulls it back as far as it may go: through the
+// wall it would see nothing. `start_y` places it (the wall face is at -1.85).
+std::string WallText(double start_y) {
+  return R"({"objects": [
+    {"name": "floor", "box": {"size": [6, 6, 0.1]}, "position": [0, 0, -0.05], "solid": true},
+    {"name": "wall", "box": {"size": [6, 0.2, 3]}, "position": [0, -1.95, 1.5], "solid": true}],
+  "rigs": [{"name": "r", "cameras": [
+    {"id": "top", "position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "resolution": [640, 480], "hfov_deg": 60},
+    {"id": "back", "position": [0, )" + Num(start_y) + R"(, 0.5], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 40}]}],
+  "study": {"region": {"box": {"min": [-1, -1, 0], "max": [1, 1, 1]}}, "voxel_size": 0.1}})";
+}
+
+TEST(Suggest, ClearanceKeepsTheCentreOffTheWall) {
+  const double wall = -1.85;
+  auto run = [&](double start_y, double clearance) {
+    Fixture f(WallText(start_y), 400);
+    SuggestOptions o;
+    o.objective.k = 2;
+    o.cameras = {1};
+    CameraLimits l;
+    l.max_move = 0.3;
+    l.max_rotate_deg = 5;
+    o.limits = {l};
+    o.clearance = clearance;
+    const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    return s;
+  };
+  // No clearance: the objective takes the camera to within 10 cm of the wall, so the test below can
+  // fail.
+  const Suggestion free = run(-1.6, 0.0);
+  ASSERT_TRUE(free.improved) << free.message;
+  const double free_gap = free.cameras[0].after.translation().y() - wall;
+  EXPECT_LT(free_gap, 0.1) << "the objective no longer pushes the camera towards the wall";
+  EXPECT_GT(free_gap, 0.0);
+  EXPECT_NEAR(free.cameras[0].surface_distance_after, free_gap, 1e-9);
+  // 10 cm: improved, and the centre at least 10 cm from every surface (the wall is the nearest).
+  const Suggestion kept = run(-1.6, 0.1);
+  ASSERT_TRUE(kept.improved) << kept.message;
+  const double gap = kept.cameras[0].after.translation().y() - wall;
+  EXPECT_GE(gap, 0.1 - 1e-12);
+  EXPECT_NEAR(kept.cameras[0].surface_distance_before, 0.25, 1e-9);
+  EXPECT_NEAR(kept.cameras[0].surface_distance_after, gap, 1e-9);
+  EXPECT_LT(kept.cameras[0].after.translation().y(), -1.6) << "it did back up";
+  // A camera that starts 5 cm from the wall may stay or move away, never closer.
+  const Suggestion close = run(wall + 0.05, 0.1);
+  EXPECT_GE(close.cameras[0].after.translation().y() - wall, 0.05 - 1e-12);
+  EXPECT_GE(close.cameras[0].surface_distance_after, 0.05 - 1e-12);
+  // A clearance that is not a finite length >= 0 is refused.
+  Fixture f(WallText(-1.6), 50);
+  SuggestOptions bad = Options({1}, 0.3, 5);
+  bad.clearance = -0.1;
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, bad), InputError);
+}
+
+TEST(SurfaceDistance, MatchesBruteForceAndClosedForms) {
+  // A unit cube at the origin: outside a face the distance is the offset, beyond an edge or a corner
+  // the Euclidean distance to it; inside, the distance to the nearest face.
+  Scene scene = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}}],
+    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 0], "look_at": [0, 0, 0],
+    "resolution": [64, 48], "hfov_deg": 40}]}],
+    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "cube.json");
+  const TriangleMesh mesh = scene.AllTriangles();
+  const SurfaceDistance d(mesh);
+  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.1, -0.2)), 0.3, 1e-12);                 // face
+  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.9, 0.0)), std::hypot(0.3, 0.4), 1e-12);  // edge
+  EXPECT_NEAR(d.Distance(Vec3(1.5, 1.5, 1.5)), std::sqrt(3.0), 1e-12);        // corner
+  EXPECT_NEAR(d.Distance(Vec3(0.1, 0.0, 0.0)), 0.4, 1e-12);                 // inside
+  EXPECT_EQ(d.Distance(Vec3(5, 0, 0), 1.0), 1.0);                            // capped
+  // Against a brute-force loop on a finer mesh (a 64-segment sphere and the cube), random points.
+  Scene two = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}},
+    {"name": "s", "sphere": {"radius": 0.7, "segments": 64}, "position": [2, 0.5, 0]}],
+    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 3], "look_at": [0, 0, 0],
+    "resolution": [64, 48], "hfov_deg": 40}]}],
+    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "two.json");
+  const TriangleMesh all = two.AllTriangles();
+  const SurfaceDistance fast(all);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2, 4);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(u(rng), u(rng) * 0.5, u(rng) * 0.5);
+    double brute = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& t : all.triangles)
+      brute = std::min(brute, PointTriangleDistance(p, all.vertices[t[0]], all.vertices[t[1]], all.vertices[t[2]]));
+    ASSERT_EQ(fast.Distance(p), brute) << p.transpose();
   }
 }
 

@@ -122,6 +122,7 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   j["metrics"] = {{"before", MetricsJson(s.before)}, {"after", MetricsJson(s.after)}};
   if (s.unsnapped) j["metrics"]["unsnapped"] = MetricsJson(*s.unsnapped);
   j["snap"] = {{"move_m", options.snap_move}, {"rotate_deg", options.snap_rotate_deg}};
+  j["clearance_m"] = options.clearance;
   json cams = json::array();
   for (std::size_t c = 0; c < s.cameras.size(); ++c) {
     const CameraChange& ch = s.cameras[c];
@@ -134,6 +135,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
     json cj = {{"id", ch.id}, {"index", ch.index}, {"before", PoseJson(ch.before)},
                {"after", PoseJson(ch.after)}, {"move_m", ch.move_m}, {"rotate_deg", ch.rotate_deg},
                {"hfov_deg", {{"before", ch.hfov_before_deg}, {"after", ch.hfov_after_deg}}},
+               {"surface_distance_m",
+                {{"before", Finite(ch.surface_distance_before)}, {"after", Finite(ch.surface_distance_after)}}},
                {"limits", limits}};
     if (ch.focal_scale != 1.0) {
       const Intrinsics& k = rig.cameras[ch.index].model.intrinsics();
