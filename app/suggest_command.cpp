@@ -368,9 +368,11 @@ int RunAccept(const AcceptArgs& args) {
   const AcceptResult r = AcceptSuggestion(args.suggestion, options);
   std::string ids;
   for (const std::string& id : r.accepted) ids += (ids.empty() ? "" : ", ") + id;
-  if (!args.quiet)
+  if (!args.quiet) {
     std::printf("accepted %s into %s (previous file kept as %s)\n", ids.c_str(), r.scene_path.c_str(),
                 r.backup_path.c_str());
+    for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
+  }
   return 0;
 }
 

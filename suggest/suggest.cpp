@@ -686,25 +686,50 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
     const PoseChart& ch = charts[c];
     const Eigen::Isometry3d& p = poses[c];
     Eigen::Isometry3d q = p;
-    // Translation in the mount's coordinates (metres).
+    // A camera the search left where it was stays exactly there (not moved onto the grid).
+    if (p.translation() == ch.start.translation() && p.linear() == ch.start.linear()) continue;
+    // Translation in the mount's coordinates (metres). Along a mount direction that is a world
+    // axis the coordinate itself lands on a multiple of the step (installable numbers in the scene
+    // file); along any other direction the move is a multiple of the step.
     if (options.snap_move > 0 && ch.dims_t > 0) {
-      const Eigen::VectorXd y = ch.basis.transpose() * (p.translation() - ch.start.translation());
-      auto make = [&](bool truncate) {
+      const double step = options.snap_move;
+      const Vec3 c0 = ch.start.translation();
+      const Eigen::VectorXd y = ch.basis.transpose() * (p.translation() - c0);
+      // World axis k and sign of basis column i, or -1 when it is oblique.
+      auto world_axis = [&](int i, double* sign) {
+        for (int k = 0; k < 3; ++k)
+          if (std::abs(std::abs(ch.basis(k, i)) - 1.0) < 1e-12) {
+            *sign = ch.basis(k, i) > 0 ? 1.0 : -1.0;
+            return k;
+          }
+        return -1;
+      };
+      auto make = [&](bool toward_start) {
         Eigen::VectorXd r(y.size());
         for (int i = 0; i < y.size(); ++i) {
-          const double s = y[i] / options.snap_move;
-          r[i] = (truncate ? std::trunc(s) : std::round(s)) * options.snap_move;
+          double sign = 1;
+          const int k = world_axis(i, &sign);
+          if (k >= 0) {
+            const double target = c0[k] + sign * y[i];  // the world coordinate
+            double g = std::round(target / step);
+            if (toward_start) g = target > c0[k] ? std::floor(target / step) : std::ceil(target / step);
+            r[i] = sign * (g * step - c0[k]);
+          } else {
+            const double q = y[i] / step;
+            r[i] = (toward_start ? std::trunc(q) : std::round(q)) * step;
+          }
         }
-        return Vec3(ch.start.translation() + ch.basis * r);
+        return Vec3(c0 + ch.basis * r);
       };
       auto admissible = [&](const Vec3& centre) {
-        if ((centre - ch.start.translation()).norm() > ch.max_move * (1 + 1e-12)) return false;
+        if ((centre - c0).norm() > ch.max_move * (1 + 1e-12)) return false;
         if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre)) return false;
         return placement.Admissible(c, centre);
       };
       Vec3 centre = make(false);
       if (!admissible(centre)) centre = make(true);
-      if (!admissible(centre)) centre = ch.start.translation();
+      if (!admissible(centre)) centre = c0;
+      if ((centre - c0).norm() <= 1e-12 * std::max(1.0, c0.norm())) centre = c0;  // round-off
       q.translation() = centre;
     }
     if (options.snap_rotate_deg > 0 && ch.dims_r > 0) {
@@ -721,7 +746,9 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
         return Mat3(RotationFromYawPitchRollDeg(y0 + r));
       };
       const double limit = Deg(ch.max_rotate) * (1 + 1e-9) + 1e-9;
-      Mat3 R = make(false);
+      bool unchanged = true;
+      for (int i = 0; i < 3; ++i) unchanged = unchanged && std::round(delta[i] / options.snap_rotate_deg) == 0;
+      Mat3 R = unchanged ? ch.start.linear() : make(false);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = make(true);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = ch.start.linear();
       q.linear() = R;

@@ -141,9 +141,13 @@ struct SuggestOptions {
   /// exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
   /// poses only.
   int screening_candidates = 200;
-  /// Installable steps (0: none): the change of each camera is rounded to multiples of snap_move
-  /// (metres, per axis of its mount) and its yaw / pitch / roll change (scene-format Euler angles)
-  /// to multiples of snap_rotate_deg, never beyond the limits; then evaluated again.
+  /// Installable steps (0: none): each camera's centre is rounded per axis of its mount: along a
+  /// mount direction that is a world axis (free and box mounts, axis-aligned rails and planes) to a
+  /// coordinate that is a multiple of snap_move (metres: so the scene file shows k * step), along an
+  /// oblique one to a move that is a multiple of it; its yaw / pitch / roll change (scene-format
+  /// Euler angles) to multiples of snap_rotate_deg. Never beyond the limits or the placement rules
+  /// (the nearest grid point, else the one towards the start, else the start position); then
+  /// evaluated again.
   double snap_move = 0, snap_rotate_deg = 0;
   /// Used in error messages (the option or JSON path that set the selection and limits).
   std::string scene_path;

@@ -652,6 +652,46 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     best_poses[c] = charts[c].Pose(best_x[c].data());
     best_scales[c] = charts[c].FocalScale(best_x[c].data());
   }
+  // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
+  // costs nothing: the screening's random turns leave a roll about the optical axis that coverage
+  // rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
+  // orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25, judged
+  // exactly); the best is taken when it is no worse than the rolled pose.
+  if (best_score > start_score) {
+    for (std::size_t c = 0; c < nsel; ++c) {
+      const Mat3& R0 = start[c].linear();
+      const Mat3 R = best_poses[c].linear();
+      if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
+      const Vec3 ypr = YawPitchRollDeg(R);
+      if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
+      const double limit = charts[c].max_rotate * 180.0 / M_PI * (1 + 1e-9);
+      // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
+      const Vec3 axis = R.col(2);
+      const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / M_PI;
+      const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / M_PI;
+      std::vector<Eigen::Isometry3d> best_trial;
+      Metrics best_level;
+      double best_level_score = -kInf;
+      for (double dy : {0.0, -0.5, 0.5, -1.0, 1.0})
+        for (double dp : {0.0, -0.5, 0.5, -1.0, 1.0}) {
+          const Mat3 L = RotationFromYawPitchRollDeg(Vec3(yaw + dy, pitch + dp, 0.0));
+          if (RotationAngleDeg(R0, L) > limit) continue;
+          std::vector<Eigen::Isometry3d> trial = best_poses;
+          trial[c].linear() = L;
+          const Metrics m = ev.Evaluate(trial, best_scales);
+          if (ev.Score(m) > best_level_score) {
+            best_level_score = ev.Score(m);
+            best_level = m;
+            best_trial = trial;
+          }
+        }
+      if (!best_trial.empty() && best_level_score >= best_score) {
+        best_poses = best_trial;
+        best_m = best_level;
+        best_score = best_level_score;
+      }
+    }
+  }
   if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
     if (best_score > start_score) {
       s.unsnapped = best_m;

@@ -4,16 +4,22 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
 #include "analysis/sha256.h"
+#include "suggest/suggest.h"
 
 namespace pandora {
 namespace {
@@ -102,6 +108,51 @@ Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::st
   return pose;
 }
 
+// The double nearest the 12-significant-digit decimal of v: what a person would have typed.
+double Clean(double v) {
+  if (!std::isfinite(v)) return v;
+  char b[40];
+  std::snprintf(b, sizeof b, "%.12g", v);
+  const double c = std::strtod(b, nullptr);
+  return c == 0 ? 0.0 : c;  // no -0
+}
+
+// A coordinate in file units: the multiple of `step` when it is one (within 1e-6 of a step).
+double OnGrid(double v, double step) {
+  if (step > 0) {
+    const double k = std::round(v / step);
+    if (std::abs(v / step - k) < 1e-6) return Clean(k * step);
+  }
+  return Clean(v);
+}
+
+// A number as JSON: an integer when it is a whole number (as a person writes 4, not 4.0).
+ordered_json Number(double v) {
+  if (std::isfinite(v) && v == std::round(v) && std::abs(v) < 1e15)
+    return ordered_json(static_cast<std::int64_t>(v));
+  return ordered_json(v);
+}
+
+ordered_json Array(const Vec3& v) { return ordered_json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
+
+std::optional<Vec3> FileVec3(const ordered_json& cam, const char* key) {
+  if (!cam.contains(key)) return std::nullopt;
+  const ordered_json& a = cam[key];
+  if (!a.is_array() || a.size() != 3) return std::nullopt;
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    if (!a[i].is_number()) return std::nullopt;
+    v[i] = a[i].get<double>();
+  }
+  return v;
+}
+
+// Angle of the rotation between a and b, radians (accurate near 0, unlike acos of the trace).
+double AngleRad(const Mat3& a, const Mat3& b) {
+  const Eigen::Quaterniond q(Mat3(a.transpose() * b));
+  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
+}
+
 }  // namespace
 
 std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig& rig,
@@ -159,7 +210,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
 }
 
 std::string ReplacePoses(const std::string& text, const std::string& scene_path,
-                         const std::string& rig_name, const std::vector<PoseUpdate>& poses) {
+                         const std::string& rig_name, const std::vector<PoseUpdate>& poses,
+                         std::vector<std::string>* notes) {
   ordered_json root;
   try {
     root = ordered_json::parse(text);
@@ -190,14 +242,52 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
       const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
       if (!cam.contains("position"))
         throw InputError(scene_path, where, "the camera has no position");
-      const Vec3 p = update.pose.translation() / mpu;
-      const Eigen::Quaterniond q(update.pose.linear());
+      Vec3 p = update.pose.translation() / mpu;  // file units
+      const double step = update.snap_move / mpu;
+      for (int i = 0; i < 3; ++i) p[i] = OnGrid(p[i], step);
+      const Mat3 R = update.pose.linear();
+      // The orientation in the camera's own form.
+      ordered_json orientation = ordered_json::object();
+      const std::optional<Vec3> p0 = FileVec3(cam, "position"), t0 = FileVec3(cam, "look_at");
+      if (cam.contains("look_at") && p0 && t0 && (*t0 - *p0).norm() > 0) {
+        const double distance = (*t0 - *p0).norm();
+        Vec3 target = p + distance * R.col(2);
+        for (int i = 0; i < 3; ++i) target[i] = Clean(target[i]);
+        const std::optional<Vec3> up0 = FileVec3(cam, "up");
+        const Vec3 up = up0.value_or(Vec3::UnitZ());
+        orientation["look_at"] = Array(target);
+        const auto kept = LookAt(p * mpu, target * mpu, up);
+        if (kept && AngleRad(kept->linear(), R) <= 1e-9) {
+          if (up0) orientation["up"] = cam["up"];
+        } else {
+          // The roll look_at cannot express with this up: the camera's own up direction can.
+          Vec3 own = -R.col(1);
+          for (int i = 0; i < 3; ++i) own[i] = Clean(own[i]);
+          orientation["up"] = Array(own);
+          if (notes) {
+            char line[200];
+            std::snprintf(line, sizeof line,
+                          "%s: the suggestion also turns the camera %.3g deg about its optical axis "
+                          "(a roll the old 'up' cannot express): 'up' is now [%.6g, %.6g, %.6g]",
+                          update.id.c_str(), kept ? AngleRad(kept->linear(), R) * 57.29577951308232 : 0.0,
+                          own.x(), own.y(), own.z());
+            notes->push_back(line);
+          }
+        }
+      } else if (cam.contains("euler_deg")) {
+        const Vec3 ypr = YawPitchRollDeg(R);
+        orientation["euler_deg"] = ordered_json::object(
+            {{"yaw", Number(Clean(ypr.x()))}, {"pitch", Number(Clean(ypr.y()))}, {"roll", Number(Clean(ypr.z()))}});
+      } else {
+        const Eigen::Quaterniond q(R);
+        orientation["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
+      }
       ordered_json rebuilt = ordered_json::object();
       for (auto it = cam.begin(); it != cam.end(); ++it) {
         const std::string& key = it.key();
         if (key == "position") {
-          rebuilt["position"] = {p.x(), p.y(), p.z()};
-          rebuilt["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
+          rebuilt["position"] = Array(p);
+          for (auto o = orientation.begin(); o != orientation.end(); ++o) rebuilt[o.key()] = o.value();
         } else if (key == "look_at" || key == "up" || key == "quaternion" || key == "euler_deg") {
           continue;
         } else if (update.focal_px && (key == "hfov_deg" || key == "focal_px" || key == "lens")) {
@@ -250,6 +340,10 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
                      "run pandora suggest without --perturb");
   AcceptResult result;
   result.scene_path = scene_j["path"].get<std::string>();
+  double snap_move = 0;
+  if (j.contains("snap") && j["snap"].is_object() && j["snap"].contains("move_m") &&
+      j["snap"]["move_m"].is_number())
+    snap_move = std::max(0.0, j["snap"]["move_m"].get<double>());
 
   std::vector<PoseUpdate> updates;
   std::map<std::string, PoseUpdate> offered;
@@ -260,7 +354,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       throw InputError(suggestion_path, where + ".id", "missing camera id");
     const std::string id = cams[c]["id"].get<std::string>();
     const json after = cams[c].value("after", json());
-    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt};
+    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt, snap_move};
     if (after.is_object() && after.contains("focal_px")) {
       const json& f = after["focal_px"];
       if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_number() ||
@@ -291,7 +385,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with --force");
-  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates);
+  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates, &result.notes);
 
   // Check the new text before touching any file: the accepted poses are there, nothing else moved.
   LoadOptions lo;
@@ -311,7 +405,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       }
       const Vec2 focal_read(b.model.intrinsics().fx, b.model.intrinsics().fy);
       const bool same = (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
-                        (b.world_from_camera.linear() - expected.linear()).norm() <= 1e-9 &&
+                        AngleRad(b.world_from_camera.linear(), expected.linear()) <= 1e-9 &&
                         (focal_read - focal).norm() <= 1e-9 * focal.norm();
       if (!same)
         throw InputError(result.scene_path, "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",
