@@ -260,8 +260,13 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
         if (kept && AngleRad(kept->linear(), R) <= 1e-9) {
           if (up0) orientation["up"] = cam["up"];
         } else {
-          // The roll look_at cannot express with this up: the camera's own up direction can.
-          Vec3 own = -R.col(1);
+          // The roll look_at cannot express with this up: any up in the camera's own vertical plane
+          // (its up direction -y and its optical axis) can. Of those, the one nearest the world's
+          // +z (its projection on that plane), which reads best; the camera's up where +z is
+          // perpendicular to it.
+          const Vec3 u = -R.col(1), f = R.col(2);
+          Vec3 own = u;
+          if (u.z() > 1e-6) own = (u.z() * u + f.z() * f).normalized();
           for (int i = 0; i < 3; ++i) own[i] = Clean(own[i]);
           orientation["up"] = Array(own);
           if (notes) {

@@ -36,8 +36,9 @@ struct PoseUpdate {
 /// gives it (docs/suggest.md, "Accept"):
 ///  - `position` + `look_at` (+ `up`): the new position and a look_at point at the old look_at's
 ///    distance along the new optical axis; `up` is kept (or left out, as it was) when it reproduces
-///    the new orientation to 1e-9 rad, else it is written as the camera's own up direction (minus
-///    its image y axis), which expresses the roll the suggestion made (reported in `notes`);
+///    the new orientation to 1e-9 rad, else it is written as the direction nearest +z in the
+///    camera's vertical plane (its image up direction, minus y, and its optical axis), which
+///    expresses the roll the suggestion made (reported in `notes`);
 ///  - `position` + `euler_deg`: the new yaw, pitch and roll (scene-format angles, degrees);
 ///  - `position` + `quaternion`: the new quaternion [w, x, y, z].
 /// Positions are in the file's units; every written number is the double nearest its 12-digit
