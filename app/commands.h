@@ -92,7 +92,8 @@ struct ExportSurfaceArgs {
   double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
   std::string out;        ///< The .ply file.
   unsigned long long seed = 1;
-  /// `--all-surfaces`: every triangle; default: only those whose front faces the study region.
+  /// `--all-surfaces`: every triangle; default: only those whose front faces the study region or
+  /// an enabled camera of the rig.
   bool all_surfaces = false;
   bool quiet = false;
 };

@@ -33,9 +33,9 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   RefuseToOverwriteInputs(scene, args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
   const SurfaceSelection selection =
-      args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacingRegion;
+      args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
   const std::vector<SurfaceSample> samples =
-      SampleSurfaces(scene, args.spacing, args.seed, "--spacing", selection);
+      SampleSurfaces(scene, args.spacing, args.seed, "--spacing", selection, &rig);
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const std::vector<PointValues> values = PointEvaluator(scene, rig, *caster).EvaluateSamples(samples);
 
@@ -52,8 +52,8 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
       "rig " + rig.name + " (" + std::to_string(rig.enabled_count()) + " enabled cameras)",
       std::string("spacing_m ") + spacing + " seed " + std::to_string(args.seed),
       args.all_surfaces ? "surfaces: all (--all-surfaces)"
-                        : "surfaces: facing the region (some region point in front of the "
-                          "triangle's plane); --all-surfaces for all",
+                        : "surfaces: facing the region or a camera (some region point or enabled "
+                          "camera centre in front of the triangle's plane); --all-surfaces for all",
       "units: x y z metres; coverage cameras; resolution px/m (0: unseen); sigma_max mm "
       "(0 where triangulable is 0)",
       "red green blue: viridis of coverage / enabled cameras, grey where no camera sees the point"};
@@ -68,8 +68,8 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
                 rig.name.c_str(), samples.size(), spacing, 100.0 * seen / n,
                 100.0 * triangulable / n);
     if (!args.all_surfaces)
-      std::printf("surfaces facing the region: %.3g of %.3g m^2 (--all-surfaces for all)\n",
-                  SurfaceArea(scene, selection), SurfaceArea(scene));
+      std::printf("surfaces facing the region or a camera: %.3g of %.3g m^2 (--all-surfaces for all)\n",
+                  SurfaceArea(scene, selection, &rig), SurfaceArea(scene));
     std::printf("wrote %s (%.2f s)\n", args.out.c_str(), seconds);
     std::fflush(stdout);
     for (const Warning& w : CheckRig(scene, rig, *caster))

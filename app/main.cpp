@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
   es->add_option("--out", surface.out, "Output PLY file")->required();
   es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
-  es->add_flag("--all-surfaces", surface.all_surfaces, "Sample every surface, also those facing away from the study region");
+  es->add_flag("--all-surfaces", surface.all_surfaces, "Sample every surface, also those facing away from the study region and every camera");
   es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 

@@ -47,10 +47,14 @@ std::string Number(double v) {
   return s.str();
 }
 
-// The points whose extremes bound the region: the box's corners, or a mesh region's vertices.
-std::vector<Vec3> RegionExtremes(const Region& region) {
-  if (region.kind == Region::Kind::kMesh && !region.mesh.vertices.empty()) return region.mesh.vertices;
-  std::vector<Vec3> corners;
+// The points whose extremes bound the region (the box's corners, or a mesh region's vertices) and
+// the viewpoints.
+std::vector<Vec3> Extremes(const Region& region, const std::vector<Vec3>& viewpoints) {
+  std::vector<Vec3> corners = viewpoints;
+  if (region.kind == Region::Kind::kMesh && !region.mesh.vertices.empty()) {
+    corners.insert(corners.end(), region.mesh.vertices.begin(), region.mesh.vertices.end());
+    return corners;
+  }
   if (region.box.empty()) return corners;
   for (int i = 0; i < 8; ++i)
     corners.emplace_back(i & 1 ? region.box.max.x() : region.box.min.x(),
@@ -75,14 +79,23 @@ bool Selected(SurfaceSelection selection, const std::vector<Vec3>& extremes, con
          Faces(extremes, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
 }
 
-}  // namespace
-
-bool FacesRegion(const Region& region, const Vec3& a, const Vec3& b, const Vec3& c) {
-  return Faces(RegionExtremes(region), a, b, c);
+std::vector<Vec3> EnabledCentres(const Rig* rig) {
+  std::vector<Vec3> out;
+  if (rig)
+    for (const Camera& c : rig->cameras)
+      if (c.enabled) out.push_back(c.center());
+  return out;
 }
 
-double SurfaceArea(const Scene& scene, SurfaceSelection selection) {
-  const std::vector<Vec3> extremes = RegionExtremes(scene.study.region);
+}  // namespace
+
+bool FacesRegionOrViewpoints(const Region& region, const std::vector<Vec3>& viewpoints, const Vec3& a,
+                             const Vec3& b, const Vec3& c) {
+  return Faces(Extremes(region, viewpoints), a, b, c);
+}
+
+double SurfaceArea(const Scene& scene, SurfaceSelection selection, const Rig* rig) {
+  const std::vector<Vec3> extremes = Extremes(scene.study.region, EnabledCentres(rig));
   double area = 0;
   for (const SceneObject& o : scene.objects)
     for (const Eigen::Vector3i& t : o.mesh.triangles)
@@ -91,11 +104,12 @@ double SurfaceArea(const Scene& scene, SurfaceSelection selection) {
 }
 
 std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, std::uint64_t seed,
-                                          const std::string& option, SurfaceSelection selection) {
+                                          const std::string& option, SurfaceSelection selection,
+                                          const Rig* rig) {
   if (!(spacing > 0) || !std::isfinite(spacing))
     throw InputError(option, "", "must be a positive number of metres", "e.g. 0.02");
-  const std::vector<Vec3> extremes = RegionExtremes(scene.study.region);
-  const double area = SurfaceArea(scene, selection);
+  const std::vector<Vec3> extremes = Extremes(scene.study.region, EnabledCentres(rig));
+  const double area = SurfaceArea(scene, selection, rig);
   const double expected = area / (spacing * spacing);
   if (expected > kMaxSurfaceSamples)
     throw InputError(option, "",

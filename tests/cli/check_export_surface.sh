@@ -24,14 +24,15 @@ size=$(stat -c %s "$out/a.ply")
 [ "$size" -eq $((header_bytes + 44 * count)) ] || fail "size $size != $header_bytes + 44 * $count"
 cmp -s "$out/a.ply" "$out/b.ply" || fail "same seed, different files"
 cmp -s "$out/a.ply" "$out/c.ply" && fail "different seeds, same file"
-# --all-surfaces adds the faces the region cannot see (for the minimal scene's block standing on the
-# region's floor z = 0: its bottom, one face of six, so about 6/5 of the samples).
+# --all-surfaces adds the faces neither the region nor a camera faces (for the minimal scene's block
+# standing on the region's floor z = 0, cameras above: its bottom, one face of six, so about 6/5 of
+# the samples).
 "$pandora" export-surface "$scene" --spacing 0.02 --all-surfaces --out "$out/all.ply" --quiet
 all=$(head -c 4096 "$out/all.ply" | sed -n 's/^element vertex \([0-9]*\)$/\1/p')
 [ "$all" -gt "$count" ] || fail "--all-surfaces: $all samples, not more than $count"
 ratio=$(( 1000 * all / count ))
 [ "$ratio" -ge 1150 ] && [ "$ratio" -le 1250 ] || fail "--all-surfaces / default = $ratio / 1000, expected about 1200"
-head -c 4096 "$out/a.ply" | grep -q "^comment surfaces: facing the region" || fail "no 'surfaces' comment"
+head -c 4096 "$out/a.ply" | grep -q "^comment surfaces: facing the region or a camera" || fail "no 'surfaces' comment"
 leftover=$(find "$out" -name '*.tmp-*' | head -1)
 [ -z "$leftover" ] || fail "temporary file left: $leftover"
 echo "ok: $count samples facing the region ($all with --all-surfaces), $size bytes"
