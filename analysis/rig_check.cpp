@@ -133,8 +133,8 @@ double EffectiveFov(const CameraModel& model, int axis) {
   const Intrinsics& k = model.intrinsics();
   const double extent = axis == 0 ? k.width - 0.5 : k.height - 0.5;
   const double pp = axis == 0 ? k.cx : k.cy;
-  const double other = axis == 0 ? std::clamp(k.cy, -0.5, k.height - 0.5)
-                                  : std::clamp(k.cx, -0.5, k.width - 0.5);
+  const double other =
+      axis == 0 ? std::clamp(k.cy, -0.5, k.height - 0.5) : std::clamp(k.cx, -0.5, k.width - 0.5);
   auto pixel = [&](double t) { return axis == 0 ? Vec2(t, other) : Vec2(other, t); };
   const Vec2 centre = pixel(std::clamp(pp, -0.5, extent));
   if (!model.Unproject(centre)) return 0.0;
@@ -151,10 +151,14 @@ double EffectiveFov(const CameraModel& model, int axis) {
 
 const char* WarningKindName(Warning::Kind kind) {
   switch (kind) {
-    case Warning::Kind::kInsideSolid: return "inside_solid";
-    case Warning::Kind::kOutsideRoom: return "outside_room";
-    case Warning::Kind::kSeesNoRegion: return "sees_no_region";
-    case Warning::Kind::kLensDomain: return "lens_domain";
+    case Warning::Kind::kInsideSolid:
+      return "inside_solid";
+    case Warning::Kind::kOutsideRoom:
+      return "outside_room";
+    case Warning::Kind::kSeesNoRegion:
+      return "sees_no_region";
+    case Warning::Kind::kLensDomain:
+      return "lens_domain";
   }
   return "unknown";
 }
@@ -211,14 +215,16 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
   Vec3 reference = scene.study.region.box.center();
   bool enclosed = false;
   if (!samples.empty()) {
-    reference = *std::min_element(samples.begin(), samples.end(), [&](const Vec3& a, const Vec3& b) {
-      return (a - scene.study.region.box.center()).squaredNorm() <
-             (b - scene.study.region.box.center()).squaredNorm();
-    });
+    reference =
+        *std::min_element(samples.begin(), samples.end(), [&](const Vec3& a, const Vec3& b) {
+          return (a - scene.study.region.box.center()).squaredNorm() <
+                 (b - scene.study.region.box.center()).squaredNorm();
+        });
     enclosed = true;
     for (int k = 0; k < 16 && enclosed; ++k) {
       const double a = 2 * 3.14159265358979323846 * k / 16;
-      enclosed = caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
+      enclosed =
+          caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
     }
   }
 
@@ -266,9 +272,11 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
                                  ? triangle_object[wall->triangle]
                                  : -1;
           add(Warning::Kind::kOutsideRoom, ".position",
-              "camera '" + cam.id + "' is outside the modelled room: seen from the region it is "
-              "behind " + ObjectName(scene, object) + " with nothing beyond it (centre " +
-                  Point(centre) + " m)");
+              "camera '" + cam.id +
+                  "' is outside the modelled room: seen from the region it is "
+                  "behind " +
+                  ObjectName(scene, object) + " with nothing beyond it (centre " + Point(centre) +
+                  " m)");
           placed = false;
         }
       }
@@ -299,7 +307,7 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
       }
     }
     const bool sees_nothing = c < options.visible_voxels.size() ? options.visible_voxels[c] == 0
-                                                                 : (!samples.empty() && seen == 0);
+                                                                : (!samples.empty() && seen == 0);
     if (placed && sees_nothing) {
       ViewResult main = ViewResult::kOutsideImage;
       int most = -1;
@@ -307,8 +315,12 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
         if (n > most) main = r, most = n;
       std::string cause;
       switch (main) {
-        case ViewResult::kOutOfRange: cause = "the region is outside its working range"; break;
-        case ViewResult::kNotProjectable: cause = "the region is behind it"; break;
+        case ViewResult::kOutOfRange:
+          cause = "the region is outside its working range";
+          break;
+        case ViewResult::kNotProjectable:
+          cause = "the region is behind it";
+          break;
         case ViewResult::kOccluded: {
           int object = -1, n = 0;
           for (const auto& [o, count] : occluders)
@@ -316,7 +328,9 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
           cause = "its view is blocked" + (object >= 0 ? " by " + ObjectName(scene, object) : "");
           break;
         }
-        default: cause = "the region is outside its image"; break;
+        default:
+          cause = "the region is outside its image";
+          break;
       }
       const std::string basis =
           c < options.visible_voxels.size()
@@ -331,12 +345,14 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
     const LensCoverage lens = ComputeLensCoverage(cam.model);
     if (lens.domain_ends_inside_image)
       add(Warning::Kind::kLensDomain, ".distortion",
-          "camera '" + cam.id + "': the distortion model folds back inside the image (its valid, "
-          "monotonic domain ends there): " + Percent(lens.unreachable_fraction) +
-              " of the pixels are reached by no ray; effective FOV " + Format("%.1f", lens.hfov_deg) +
-              " x " + Format("%.1f", lens.vfov_deg) + " deg (nominal " +
-              Format("%.1f", lens.nominal_hfov_deg) + " x " + Format("%.1f", lens.nominal_vfov_deg) +
-              "); check the coefficients");
+          "camera '" + cam.id +
+              "': the distortion model folds back inside the image (its valid, "
+              "monotonic domain ends there): " +
+              Percent(lens.unreachable_fraction) +
+              " of the pixels are reached by no ray; effective FOV " +
+              Format("%.1f", lens.hfov_deg) + " x " + Format("%.1f", lens.vfov_deg) +
+              " deg (nominal " + Format("%.1f", lens.nominal_hfov_deg) + " x " +
+              Format("%.1f", lens.nominal_vfov_deg) + "); check the coefficients");
   }
   return out;
 }

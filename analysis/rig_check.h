@@ -3,8 +3,8 @@
 /// Plausibility checks of a rig in its scene: setups that load fine but make no sense (a camera
 /// inside a cabinet, outside the room, looking at nothing, or with a lens model that folds back
 /// inside the image). They are warnings, never errors: the commands print one line each on stderr
-/// (`pandora: warning: FILE: JSON_PATH: REASON`) after all input has been validated, and list them in
-/// summary.json and the report. docs/user-guide.md ("Warnings") explains each test.
+/// (`pandora: warning: FILE: JSON_PATH: REASON`) after all input has been validated, and list them
+/// in summary.json and the report. docs/user-guide.md ("Warnings") explains each test.
 ///
 /// Also the lens's effective field of view with distortion, beside the nominal one.
 
@@ -24,7 +24,7 @@ struct Warning {
     kInsideSolid,   ///< The camera centre is inside a solid object.
     kOutsideRoom,   ///< The centre lies outside the walls that enclose the region.
     kSeesNoRegion,  ///< The camera sees none of the study region.
-    kLensDomain,       ///< The distortion's valid (monotonic) domain ends inside the image.
+    kLensDomain,    ///< The distortion's valid (monotonic) domain ends inside the image.
   };
   Kind kind = Kind::kSeesNoRegion;
   std::string camera;     ///< Camera id.
@@ -82,14 +82,14 @@ struct RigCheckOptions {
 ///    beyond the camera without meeting anything (the camera is past the last wall in that
 ///    direction; a camera behind a pillar inside the room has the room's wall behind it), and no
 ///    line of sight from the camera to a region sample is free;
-///  - sees none of the region (from `options.visible_voxels` when given, else from the samples), with
-///    the commonest reason among the samples (outside the image, behind it, out of range, blocked by
-///    an object);
+///  - sees none of the region (from `options.visible_voxels` when given, else from the samples),
+///    with the commonest reason among the samples (outside the image, behind it, out of range,
+///    blocked by an object);
 ///  - the lens's valid domain ends inside the image (ComputeLensCoverage), with the unreachable
 ///    share of the pixels.
 /// The placement warnings are the most specific: a camera inside a solid or outside the room gets
-/// no "sees none" warning on top. Never throws for a valid scene; cheap (a few thousand segments per
-/// camera).
+/// no "sees none" warning on top. Never throws for a valid scene; cheap (a few thousand segments
+/// per camera).
 std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaster& caster,
                               const RigCheckOptions& options = {});
 

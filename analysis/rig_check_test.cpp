@@ -1,5 +1,6 @@
-// Rig plausibility checks (analysis/rig_check.h): the lens's effective field of view and unreachable
-// share against closed forms, and each warning on a lab built to trigger exactly one per camera.
+// Rig plausibility checks (analysis/rig_check.h): the lens's effective field of view and
+// unreachable share against closed forms, and each warning on a lab built to trigger exactly one
+// per camera.
 #include "analysis/rig_check.h"
 
 #include <gtest/gtest.h>
@@ -148,7 +149,8 @@ TEST(CheckRig, EachNonsenseCameraGetsItsOneWarning) {
     }
     if (w.camera == "away") {
       EXPECT_EQ(w.json_path, "$.rigs[0].cameras[4]");
-      EXPECT_NE(w.reason.find("the region is behind it"), std::string::npos);  // it looks at the ceiling
+      EXPECT_NE(w.reason.find("the region is behind it"),
+                std::string::npos);  // it looks at the ceiling
     }
     if (w.camera == "niche") {
       EXPECT_NE(w.reason.find("its view is blocked by 'screen'"), std::string::npos);
@@ -157,7 +159,8 @@ TEST(CheckRig, EachNonsenseCameraGetsItsOneWarning) {
       EXPECT_EQ(w.json_path, "$.rigs[0].cameras[5].distortion");
       // 1280 x 800 at f = 500: the reachable disc has radius 430.3 px, cut top and bottom.
       const double R = 500 * (2.0 / 3.0) / std::sqrt(0.6), d = 400.0;
-      const double inside = kPi * R * R - 2 * (R * R * std::acos(d / R) - d * std::sqrt(R * R - d * d));
+      const double inside =
+          kPi * R * R - 2 * (R * R * std::acos(d / R) - d * std::sqrt(R * R - d * d));
       char expected[32];
       std::snprintf(expected, sizeof expected, "%.1f%%", 100 * (1 - inside / (1280.0 * 800.0)));
       EXPECT_NE(w.reason.find(expected), std::string::npos) << expected;
@@ -191,7 +194,8 @@ TEST(CheckRig, NoRoomMeansNoOutside) {
     {"id": "in_block", "position": [0.1, 0, 0.2], "look_at": [1, 0, 0.2], "resolution": [640, 480], "hfov_deg": 60}
   ]}],
   "study": {"region": {"box": {"min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0.6]}}, "voxel_size": 0.05}
-})", "stands.json");
+})",
+                                 "stands.json");
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   auto by = ByCamera(CheckRig(scene, scene.rigs[0], *caster));
   using K = Warning::Kind;

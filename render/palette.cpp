@@ -1,10 +1,9 @@
 // The cameras' colour palette and the CIELAB / CIEDE2000 arithmetic behind it (render/palette.h).
 #include "render/palette.h"
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "render/colormap.h"
@@ -103,7 +102,8 @@ std::vector<std::vector<bool>> CamerasWithColor(const std::string& text) {
   for (const auto& rig : j["rigs"]) {
     std::vector<bool> has;
     if (rig.is_object() && rig.contains("cameras") && rig["cameras"].is_array())
-      for (const auto& cam : rig["cameras"]) has.push_back(cam.is_object() && cam.contains("color"));
+      for (const auto& cam : rig["cameras"])
+        has.push_back(cam.is_object() && cam.contains("color"));
     out.push_back(has);
   }
   return out;

@@ -3,8 +3,8 @@
 /// Camera colours that stay apart: a 24-colour palette for the cameras' lights, picked for
 /// distinguishability (greedy farthest-point selection under CIEDE2000 among saturated sRGB colours
 /// with L* >= 45 and chroma >= 45, so every colour shows as light on a dark surface), and the
-/// CIELAB / CIEDE2000 arithmetic its test checks it with. docs/rendering.md ("Camera colours") gives
-/// the table and the measured distances.
+/// CIELAB / CIEDE2000 arithmetic its test checks it with. docs/rendering.md ("Camera colours")
+/// gives the table and the measured distances.
 
 #include <string>
 #include <vector>

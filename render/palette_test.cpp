@@ -40,7 +40,8 @@ double MinDistance(int n, bool de2000) {
   double best = 1e9;
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) {
-      const Vec3 a = LabFromLinearRgb(CameraPaletteColor(i)), b = LabFromLinearRgb(CameraPaletteColor(j));
+      const Vec3 a = LabFromLinearRgb(CameraPaletteColor(i)),
+                 b = LabFromLinearRgb(CameraPaletteColor(j));
       best = std::min(best, de2000 ? DeltaE2000(a, b) : (a - b).norm());
     }
   return best;
@@ -55,7 +56,9 @@ TEST(Palette, TwentyFourColoursStayApart) {
   EXPECT_GE(MinDistance(24, false), 19.0);  // CIE76 (Euclidean in CIELAB)
   // The old default cycled 8 colours: cameras 0 and 8 were the same. Now they differ; the palette
   // cycles at 24.
-  EXPECT_GT(DeltaE2000(LabFromLinearRgb(CameraPaletteColor(0)), LabFromLinearRgb(CameraPaletteColor(8))), 14.0);
+  EXPECT_GT(
+      DeltaE2000(LabFromLinearRgb(CameraPaletteColor(0)), LabFromLinearRgb(CameraPaletteColor(8))),
+      14.0);
   EXPECT_EQ(CameraPaletteColor(24), CameraPaletteColor(0));
   for (int i = 0; i < kCameraPaletteSize; ++i) {
     const Vec3 lab = LabFromLinearRgb(CameraPaletteColor(i));
@@ -73,7 +76,8 @@ std::string CameraJson(int i, bool color) {
 }
 
 TEST(Palette, ApplyKeepsTheFilesColoursAndGivesTheRestDistinctOnes) {
-  const std::filesystem::path path = std::filesystem::path(::testing::TempDir()) / "pandora_palette.json";
+  const std::filesystem::path path =
+      std::filesystem::path(::testing::TempDir()) / "pandora_palette.json";
   std::string text = "{\"rigs\": [{\"name\": \"twelve\", \"cameras\": [";
   for (int i = 0; i < 12; ++i) text += (i ? ", " : "") + CameraJson(i, i == 3 || i == 9);
   text += "]}], \"study\": {\"region\": {\"box\": {\"min\": [-1, -1, 0], \"max\": [1, 1, 1]}}}}";

@@ -72,9 +72,12 @@ int SurfaceDistance::Build(int first, int count) {
   int axis = 0;
   if (size.y() > size[axis]) axis = 1;
   if (size.z() > size[axis]) axis = 2;
-  auto centroid = [&](const std::array<Vec3, 3>& t) { return t[0][axis] + t[1][axis] + t[2][axis]; };
+  auto centroid = [&](const std::array<Vec3, 3>& t) {
+    return t[0][axis] + t[1][axis] + t[2][axis];
+  };
   const int mid = first + count / 2;
-  std::nth_element(triangles_.begin() + first, triangles_.begin() + mid, triangles_.begin() + first + count,
+  std::nth_element(triangles_.begin() + first, triangles_.begin() + mid,
+                   triangles_.begin() + first + count,
                    [&](const auto& x, const auto& y) { return centroid(x) < centroid(y); });
   const int left = Build(first, mid - first);
   const int right = Build(mid, first + count - mid);
@@ -94,7 +97,8 @@ double SurfaceDistance::Distance(const Vec3& p, double limit) const {
     if (BoxDistance(n.box, p) >= best) continue;
     if (n.left < 0) {
       for (int i = n.first; i < n.first + n.count; ++i)
-        best = std::min(best, PointTriangleDistance(p, triangles_[i][0], triangles_[i][1], triangles_[i][2]));
+        best = std::min(
+            best, PointTriangleDistance(p, triangles_[i][0], triangles_[i][1], triangles_[i][2]));
       continue;
     }
     const double dl = BoxDistance(nodes_[n.left].box, p), dr = BoxDistance(nodes_[n.right].box, p);
