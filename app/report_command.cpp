@@ -374,8 +374,8 @@ int RunReport(const ReportArgs& args) {
     std::size_t total = 0;
     for (const RigReport& r : reports) total += r.warnings.size();
     body << "<h2 id=\"warnings\">Warnings</h2>\n<p class=\"note\">Checks of each enabled camera: "
-            "inside a solid object, outside the scene's geometry, behind a wall, seeing none of the "
-            "region, a lens model that folds back inside the image (docs/user-guide.md, "
+            "inside a solid object, outside the modelled room, seeing none of the region, a lens "
+            "model that folds back inside the image (docs/user-guide.md, "
             "&ldquo;Warnings&rdquo;).</p>\n";
     if (total == 0) {
       body << "<p>No warnings.</p>\n";
