@@ -17,6 +17,7 @@
 #include "analysis/error.h"
 #include "analysis/input_file.h"
 #include "analysis/mesh_io.h"
+#include "analysis/palette.h"
 #include "analysis/primitives.h"
 #include "analysis/sha256.h"
 
@@ -32,19 +33,6 @@ constexpr int kMaxResolution = 65536;
 constexpr int kMinSegments = 3;
 constexpr int kMaxSegments = 4096;
 constexpr int kDefaultSegments = 32;
-
-// Distinct camera colours (linear RGB), by camera index in its rig.
-const Vec3 kCameraPalette[8] = {
-    {0.90, 0.10, 0.10},  // red
-    {0.10, 0.60, 0.15},  // green
-    {0.10, 0.25, 0.90},  // blue
-    {0.95, 0.75, 0.05},  // yellow
-    {0.70, 0.15, 0.80},  // purple
-    {0.05, 0.75, 0.80},  // cyan
-    {0.95, 0.45, 0.05},  // orange
-    {0.95, 0.40, 0.65},  // pink
-};
-
 
 // -------------------------------------------------------------------------------------------------
 // Small string helpers.
@@ -314,10 +302,8 @@ class Node {
           });
       if (!ok) Fail("expected a colour \"#rrggbb\", got " + json(s).dump());
       Vec3 color;
-      for (int i = 0; i < 3; ++i) {
-        const double srgb = std::stoi(s.substr(1 + 2 * i, 2), nullptr, 16) / 255.0;
-        color[i] = srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4);
-      }
+      for (int i = 0; i < 3; ++i)
+        color[i] = LinearFromSrgb(std::stoi(s.substr(1 + 2 * i, 2), nullptr, 16) / 255.0);
       return color;
     }
     if (!value_->is_array()) {
@@ -868,7 +854,7 @@ Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
   }
   camera.name = camera.id;
   if (auto n = node.Find("name")) camera.name = n->NonEmptyString();
-  camera.color = kCameraPalette[index % 8];
+  camera.color = CameraPaletteColor(static_cast<int>(index));
   if (auto n = node.Find("color")) camera.color = n->Color();
   if (auto n = node.Find("enabled")) camera.enabled = n->Bool();
 

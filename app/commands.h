@@ -72,6 +72,7 @@ struct RenderArgs {
   int grid = 32;
   int samples = 1;
   bool no_cameras = false;
+  bool no_key = false;         ///< `--no-key`: no colour key (camera id -> colour) in the image.
   std::string fields;          ///< fields.vdb for the overlays.
   std::string slice;           ///< Field shown on a slice plane.
   std::string slice_axis = "z";
@@ -91,6 +92,9 @@ struct ExportSurfaceArgs {
   double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
   std::string out;        ///< The .ply file.
   unsigned long long seed = 1;
+  /// `--all-surfaces`: every triangle; default: only those whose front faces the study region or
+  /// an enabled camera of the rig.
+  bool all_surfaces = false;
   bool quiet = false;
 };
 int RunExportSurface(const ExportSurfaceArgs& args);
@@ -104,7 +108,7 @@ struct ReportArgs {
   double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
   int width = 640;                ///< Pixels across the renders from the named views.
   int camera_width = 320;         ///< Pixels across each camera's own view.
-  double brightness = 1.0;        ///< Scale of every camera's light in the renders.
+  double brightness = kUnset;     ///< Scale of every camera's light; kUnset: DefaultBrightness.
   bool quiet = false;
 };
 int RunReport(const ReportArgs& args);
@@ -127,6 +131,7 @@ struct SuggestArgs {
   bool with_region = false;       ///< Region points as well as surface points.
   int points = 1500;
   double snap_move = 0, snap_rotate = 0;
+  double clearance = 0.1;         ///< Metres from every scene surface (`--clearance`).
   int outer_iterations = 4;
   std::string out = "suggestion.json";
   std::string perturb;            ///< "MOVE,DEG": benchmark from perturbed poses.

@@ -6,6 +6,7 @@
 
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
+#include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
@@ -27,7 +28,10 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   AddSceneInputs(output, scene);
   const std::string staged = output.Stage(args.out, "--out");
   const Rig& rig = scene.FindRig(args.rig);
-  const std::vector<SurfaceSample> samples = SampleSurfaces(scene, args.spacing, args.seed);
+  const SurfaceSelection selection =
+      args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
+  const std::vector<SurfaceSample> samples =
+      SampleSurfaces(scene, args.spacing, args.seed, "--spacing", selection, &rig);
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const std::vector<PointValues> values = PointEvaluator(scene, rig, *caster).EvaluateSamples(samples);
 
@@ -43,6 +47,9 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
       "scene " + scene.path + " sha256 " + scene.sha256,
       "rig " + rig.name + " (" + std::to_string(rig.enabled_count()) + " enabled cameras)",
       std::string("spacing_m ") + spacing + " seed " + std::to_string(args.seed),
+      args.all_surfaces ? "surfaces: all (--all-surfaces)"
+                        : "surfaces: facing the region or a camera (some region point or enabled "
+                          "camera centre in front of the triangle's plane); --all-surfaces for all",
       "units: x y z metres; coverage cameras; resolution px/m (0: unseen); sigma_max mm "
       "(0 where triangulable is 0)",
       "red green blue: viridis of coverage / enabled cameras, grey where no camera sees the point"};
@@ -57,7 +64,13 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
     std::printf("rig %s: %zu surface samples at %s m spacing, %.1f%% seen, %.1f%% triangulable\n",
                 rig.name.c_str(), samples.size(), spacing, 100.0 * seen / n,
                 100.0 * triangulable / n);
+    if (!args.all_surfaces)
+      std::printf("surfaces facing the region or a camera: %.3g of %.3g m^2 (--all-surfaces for all)\n",
+                  SurfaceArea(scene, selection, &rig), SurfaceArea(scene));
     std::printf("wrote %s (%.2f s)\n", args.out.c_str(), seconds);
+    std::fflush(stdout);
+    for (const Warning& w : CheckRig(scene, rig, *caster))
+      std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   }
   return 0;
 }

@@ -71,9 +71,10 @@ int main(int argc, char** argv) {
   rn->add_option("--pattern", render.pattern, "uniform | grid (each camera's pixel grid)")->capture_default_str();
   rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")->capture_default_str();
   rn->add_option("--surface", render.surface, "material | black | hidden-line | contours")->capture_default_str();
-  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default 1)");
+  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default min(1, 3 / enabled cameras))");
   rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")->capture_default_str();
   rn->add_flag("--no-cameras", render.no_cameras, "Do not draw the camera bodies and frusta");
+  rn->add_flag("--no-key", render.no_key, "Do not draw the colour key (camera id -> colour)");
   rn->add_option("--fields", render.fields, "fields.vdb from `pandora analyze`, for --slice and --iso");
   rn->add_option("--slice", render.slice, "Show this field on a slice plane (viridis, with a legend)");
   rn->add_option("--slice-axis", render.slice_axis, "x | y | z: the slice plane's normal")->capture_default_str();
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
   es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
   es->add_option("--out", surface.out, "Output PLY file")->required();
   es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
+  es->add_flag("--all-surfaces", surface.all_surfaces, "Sample every surface, also those facing away from the study region and every camera");
   es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 
@@ -105,7 +107,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rep->add_option("--camera-width", report.camera_width, "Width in pixels of each camera's own view")
       ->capture_default_str();
-  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders")->capture_default_str();
+  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders (default min(1, 3 / enabled cameras))");
   rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
   SuggestArgs suggest;
@@ -124,6 +126,7 @@ int main(int argc, char** argv) {
   sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, metres in the world frame (repeatable)");
   sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
   sg->add_option("--keep-out", suggest.keep_out, "Box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (metres, world frame) no camera centre may enter (repeatable)");
+  sg->add_option("--clearance", suggest.clearance, "Keep every suggested camera centre this far from every scene surface, metres (a camera already closer never moves closer)")->capture_default_str();
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
   sg->add_option("--points", suggest.points, "Target points")->capture_default_str();

@@ -282,6 +282,29 @@ std::vector<double> NiceTicks(double max, int count) {
   return ticks;
 }
 
+double NiceStep(double raw) {
+  if (!(raw > 0) || !std::isfinite(raw)) return 1.0;
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * power >= raw * (1 - 1e-9)) return m * power;
+  return 10.0 * power;
+}
+
+double NiceLabelStep(double bin_width, double min_step) {
+  if (!(bin_width > 0) || !std::isfinite(bin_width)) return 1.0;
+  min_step = std::max(min_step, bin_width);
+  auto whole = [](double x) { return std::abs(x - std::round(x)) <= 1e-9 * std::max(1.0, x); };
+  // Candidates 1, 2, 5 x 10^k from NiceStep(min_step) upward; a 1-2-5 bin width always has one
+  // within three decades.
+  double power = std::pow(10.0, std::floor(std::log10(NiceStep(min_step))));
+  for (int decade = 0; decade < 4; ++decade, power *= 10)
+    for (double m : {1.0, 2.0, 5.0}) {
+      const double step = m * power;
+      if (step >= min_step * (1 - 1e-9) && whole(step / bin_width)) return step;
+    }
+  return std::ceil(min_step / bin_width - 1e-9) * bin_width;
+}
+
 namespace {
 
 // Tick label: up to 3 significant digits, or a percentage.
@@ -358,10 +381,20 @@ std::string RenderBarChartSvg(const BarChart& chart) {
     // Category labels: every one when they fit (about 7 px per character), else thinned.
     std::size_t longest = 1;
     for (const std::string& c : chart.categories) longest = std::max(longest, c.size());
-    const std::size_t every =
+    std::size_t every =
         std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil((longest * 7.0 + 6) / bin)));
+    std::size_t first = 0;
+    if (chart.bin_width > 0) {
+      // Numeric bins: label the lower edges that are multiples of a 1-2-5 step.
+      const double step = NiceLabelStep(chart.bin_width, every * chart.bin_width);
+      every = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(step / chart.bin_width)));
+      // Bin i's lower edge is bin_origin + i bin_width: the first label where it is a multiple.
+      const long long e = static_cast<long long>(every);
+      const long long origin_index = std::llround(chart.bin_origin / chart.bin_width);
+      first = static_cast<std::size_t>(((-origin_index) % e + e) % e);
+    }
     o << "<g text-anchor=\"middle\" fill=\"#333\">\n";
-    for (std::size_t i = 0; i < n; i += every)
+    for (std::size_t i = first; i < n; i += every)
       o << "<text x=\"" << Num(left + (i + (chart.edge_labels ? 0.0 : 0.5)) * bin) << "\" y=\""
         << Num(bottom + 16) << "\">"
         << Escape(chart.categories[i]) << "</text>\n";

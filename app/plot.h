@@ -68,6 +68,11 @@ struct BarChart {
   /// Category labels at the left edge of their bar (bins of a continuous value, labelled by their
   /// lower bound) instead of under its centre.
   bool edge_labels = false;
+  /// Numeric bins (a histogram): category i covers [bin_origin + i bin_width, + bin_width). When
+  /// bin_width > 0 the category labels are thinned to the bins whose lower edge is a multiple of a
+  /// 1-2-5 step (NiceLabelStep), so the axis reads 0, 0.1, 0.2, ... rather than 0, 0.06, 0.12.
+  double bin_width = 0;
+  double bin_origin = 0;
   /// A vertical dashed line at a position in category units (0 = left edge of the first bin,
   /// categories.size() = right edge of the last); NaN: none.
   double marker = std::numeric_limits<double>::quiet_NaN();
@@ -95,5 +100,13 @@ std::string RenderColorbarSvg(const Colorbar& bar);
 
 /// "Nice" axis ticks (1, 2 or 5 times a power of ten) covering [0, max], about `count` of them.
 std::vector<double> NiceTicks(double max, int count = 5);
+
+/// The smallest 1, 2 or 5 times a power of ten that is >= raw (raw > 0 and finite; else 1).
+double NiceStep(double raw);
+
+/// The label step of a histogram with bins of `bin_width`: the smallest 1, 2 or 5 times a power of
+/// ten that is at least `min_step` and a whole multiple of bin_width (to 1e-9 relative); when
+/// bin_width is not itself such a number, the smallest whole multiple of it >= min_step.
+double NiceLabelStep(double bin_width, double min_step);
 
 }  // namespace pandora::app

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -130,6 +132,50 @@ TEST(BarChart, GroupedSeriesLegendAndMarker) {
   chart.edge_labels = true;
   const std::string edges = RenderBarChartSvg(chart);
   EXPECT_NEAR(centred - label_x(edges, "b"), (label_x(svg, "c") - label_x(svg, "b")) / 2, 0.02);
+}
+
+TEST(NiceSteps, LabelStepsAreOneTwoFiveMultiplesOfTheBinWidth) {
+  EXPECT_DOUBLE_EQ(NiceStep(0.0267), 0.05);
+  EXPECT_DOUBLE_EQ(NiceStep(0.02), 0.02);
+  EXPECT_DOUBLE_EQ(NiceStep(3), 5);
+  EXPECT_DOUBLE_EQ(NiceStep(7), 10);
+  EXPECT_DOUBLE_EQ(NiceLabelStep(0.02, 0.06), 0.1);  // not 0.06, nor 0.08 (4 bins)
+  EXPECT_DOUBLE_EQ(NiceLabelStep(0.05, 0.1), 0.1);
+  EXPECT_DOUBLE_EQ(NiceLabelStep(0.05, 0.11), 0.2);  // 0.2 = 4 bins of 0.05
+  EXPECT_DOUBLE_EQ(NiceLabelStep(5, 11), 20);        // 20 = 4 bins; 25 is not 1-2-5
+  EXPECT_DOUBLE_EQ(NiceLabelStep(2, 5), 10);         // 6 and 8 are not 1-2-5
+  EXPECT_DOUBLE_EQ(NiceLabelStep(1, 3), 5);
+  EXPECT_DOUBLE_EQ(NiceLabelStep(0.03, 0.05), 0.06);  // not 1-2-5 itself: whole multiples
+}
+
+TEST(BarChart, HistogramLabelsSitOnRoundNumbers) {
+  // 30 bins of 0.02 mm and an overflow bin: too narrow to label each; the labels are the edges
+  // that are multiples of 0.1 (every 5th bin), starting at 0.
+  BarChart chart;
+  for (int b = 0; b < 30; ++b) {
+    char label[16];
+    std::snprintf(label, sizeof label, "%g", b * 0.02);
+    chart.categories.push_back(label);
+  }
+  chart.categories.push_back(">=0.6");
+  chart.series.push_back({"x", std::vector<double>(31, 0.01), ""});
+  chart.bin_width = 0.02;
+  chart.edge_labels = true;
+  const std::string svg = RenderBarChartSvg(chart);
+  EXPECT_EQ(Count(svg, ">0<"), 2);  // the x axis's first bin and the y axis's 0
+  for (const char* shown : {">0.1<", ">0.2<", ">0.5<"}) EXPECT_EQ(Count(svg, shown), 1) << shown;
+  for (const char* hidden : {">0.02<", ">0.06<", ">0.08<", ">0.12<", ">0.18<"})
+    EXPECT_EQ(Count(svg, hidden), 0) << hidden;
+  // Bins of 0.25 (not itself a 1-2-5 step) from 0.25: wide enough for every label, yet only the
+  // multiples of 0.5 are labelled. (y values of 7: ticks 0, 2, 4, 6, 8 do not collide.)
+  BarChart wide;
+  wide.categories = {"0.25", "0.5", "0.75", "1", "1.25"};
+  wide.series.push_back({"x", {7, 7, 7, 7, 7}, ""});
+  wide.bin_width = 0.25;
+  wide.bin_origin = 0.25;
+  const std::string w = RenderBarChartSvg(wide);
+  for (const char* shown : {">0.5<", ">1<"}) EXPECT_EQ(Count(w, shown), 1) << shown;
+  for (const char* hidden : {">0.25<", ">0.75<", ">1.25<"}) EXPECT_EQ(Count(w, hidden), 0) << hidden;
 }
 
 TEST(Colorbar, DiscreteBoxesAndSwatches) {

@@ -9,6 +9,7 @@
 
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
+#include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
@@ -81,6 +82,7 @@ int RunRender(const RenderArgs& args) {
   if (args.samples < 1 || args.samples > 16) throw InputError("--samples", "", "must be 1 to 16 (per axis)");
   options.samples = args.samples;
   options.overlays.cameras = !args.no_cameras;
+  options.overlays.key = !args.no_key;
   if (!args.slice.empty() || !args.iso.empty()) {
     if (args.fields.empty())
       throw InputError(!args.slice.empty() ? "--slice" : "--iso", "", "needs --fields FILE.vdb",
@@ -154,10 +156,18 @@ int RunRender(const RenderArgs& args) {
   if (ext == ".png") WritePng(image, staged);
   else WriteExr(image, staged, int(rig.cameras.size()));
   output.Commit();
-  if (!args.quiet)
-    std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras), %zu triangles, %.3f s\n",
+  const std::vector<Warning> warnings = args.quiet ? std::vector<Warning>() : CheckRig(scene, rig, *caster);
+  if (!args.quiet) {
+    const double brightness =
+        std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
+    std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras, brightness %.3g%s), %zu triangles, %.3f s\n",
                 args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
+                brightness, std::isnan(options.brightness) ? " by default" : "",
                 caster->triangle_count(), stats.seconds);
+    std::fflush(stdout);
+    for (const Warning& w : warnings)
+      std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
+  }
   return 0;
 }
 

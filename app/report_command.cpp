@@ -15,11 +15,13 @@
 
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
+#include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
 #include "app/plot.h"
 #include "app/report_images.h"
+#include "render/colormap.h"
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/slice.h"
@@ -69,8 +71,30 @@ std::vector<std::string> SplitList(const std::vector<std::string>& items) {
 struct RigReport {
   const Rig* rig = nullptr;
   Fields fields;
+  std::vector<Warning> warnings;
   nlohmann::json summary;
 };
+
+// "#rrggbb" of a linear-RGB light colour (clamped), as the PNGs show it.
+std::string HexOfLinear(const Vec3& c) {
+  char b[8];
+  int v[3];
+  for (int k = 0; k < 3; ++k) v[k] = static_cast<int>(std::lround(255.0 * SrgbFromLinear(c[k])));
+  std::snprintf(b, sizeof b, "#%02x%02x%02x", v[0], v[1], v[2]);
+  return b;
+}
+
+std::string Swatch(const Camera& cam) {
+  return "<span class=\"swatch\" style=\"background:" + HexOfLinear(cam.color) + "\"></span>";
+}
+
+// The colour key of a rig: each enabled camera's light colour and id.
+std::string ColourKey(const Rig& rig) {
+  std::string s = "<div class=\"key\">";
+  for (const Camera& cam : rig.cameras)
+    if (cam.enabled) s += "<span class=\"entry\">" + Swatch(cam) + Html(cam.id) + "</span> ";
+  return s + "</div>";
+}
 
 // An <img> the page embeds, counted so the page's own check knows how many to expect.
 class Figures {
@@ -114,30 +138,44 @@ double JsonNumber(const nlohmann::json& j, const std::vector<std::string>& path)
 struct Headline {
   std::string label;
   std::vector<std::string> path;
-  bool percent;        // a fraction shown as %
+  const char* format;  // printf format of the value; nullptr: a fraction shown as a percentage
   bool higher_better;  // for highlighting the best rig
 };
 
+std::string HeadlineText(const Headline& h, double x) {
+  if (!std::isfinite(x)) return "&mdash;";
+  return h.format ? Fmt(h.format, x) : Percent(x);
+}
+
+// The value as shown (rounded to the precision printed), so that rigs that look equal are equal.
+double Shown(const Headline& h, double x) {
+  const std::string t = h.format ? Fmt(h.format, x) : Fmt("%.1f", 100.0 * x);
+  return std::strtod(t.c_str(), nullptr);
+}
+
 std::string HeadlineTable(const std::vector<RigReport>& rigs, const Study& study) {
   std::vector<Headline> rows{
-      {"Coverage &ge; 1 camera", {"coverage", "ge1"}, true, true},
-      {"Coverage &ge; 2 cameras", {"coverage", "ge2"}, true, true},
-      {"Coverage &ge; 3 cameras", {"coverage", "ge3"}, true, true},
-      {"Triangulable", {"uncertainty", "triangulable"}, true, true},
-      {"&sigma;<sub>max</sub> p50 (mm)", {"uncertainty", "sigma_max_mm", "p50"}, false, false},
-      {"&sigma;<sub>max</sub> p90 (mm)", {"uncertainty", "sigma_max_mm", "p90"}, false, false},
-      {"&sigma;<sub>max</sub> p99 (mm)", {"uncertainty", "sigma_max_mm", "p99"}, false, false},
+      {"Coverage &ge; 1 camera", {"coverage", "ge1"}, nullptr, true},
+      {"Coverage &ge; 2 cameras", {"coverage", "ge2"}, nullptr, true},
+      {"Coverage &ge; 3 cameras", {"coverage", "ge3"}, nullptr, true},
+      {"Resolution p10 (px/m)", {"resolution_px_per_m", "p10"}, "%.0f", true},
+      {"Resolution p50 (px/m)", {"resolution_px_per_m", "p50"}, "%.0f", true},
+      {"Resolution p90 (px/m)", {"resolution_px_per_m", "p90"}, "%.0f", true},
+      {"Triangulable", {"uncertainty", "triangulable"}, nullptr, true},
+      {"&sigma;<sub>max</sub> p50 (mm)", {"uncertainty", "sigma_max_mm", "p50"}, "%.3f", false},
+      {"&sigma;<sub>max</sub> p90 (mm)", {"uncertainty", "sigma_max_mm", "p90"}, "%.3f", false},
+      {"&sigma;<sub>max</sub> p99 (mm)", {"uncertainty", "sigma_max_mm", "p99"}, "%.3f", false},
   };
   if (study.max_sigma_mm)
     rows.push_back({"Meets &sigma;<sub>max</sub> &le; " + Fmt("%g", *study.max_sigma_mm) + " mm",
-                    {"uncertainty", "meets_max_sigma"}, true, true});
+                    {"uncertainty", "meets_max_sigma"}, nullptr, true});
   if (study.motion) {
-    rows.push_back({"Steady-state &sigma;<sub>max</sub> p50 (mm)", {"uncertainty", "sigma_max_steady_mm", "p50"}, false, false});
-    rows.push_back({"Steady-state &sigma;<sub>max</sub> p90 (mm)", {"uncertainty", "sigma_max_steady_mm", "p90"}, false, false});
-    rows.push_back({"Steady-state &sigma;<sub>max</sub> p99 (mm)", {"uncertainty", "sigma_max_steady_mm", "p99"}, false, false});
+    rows.push_back({"Steady-state &sigma;<sub>max</sub> p50 (mm)", {"uncertainty", "sigma_max_steady_mm", "p50"}, "%.3f", false});
+    rows.push_back({"Steady-state &sigma;<sub>max</sub> p90 (mm)", {"uncertainty", "sigma_max_steady_mm", "p90"}, "%.3f", false});
+    rows.push_back({"Steady-state &sigma;<sub>max</sub> p99 (mm)", {"uncertainty", "sigma_max_steady_mm", "p99"}, "%.3f", false});
     if (study.max_sigma_mm)
       rows.push_back({"Steady state meets &sigma;<sub>max</sub> &le; " + Fmt("%g", *study.max_sigma_mm) + " mm",
-                      {"uncertainty", "meets_max_sigma_steady"}, true, true});
+                      {"uncertainty", "meets_max_sigma_steady"}, nullptr, true});
   }
   std::string s = "<table class=\"numbers\"><thead><tr><th></th>";
   for (const RigReport& r : rigs) s += "<th>" + Html(r.rig->name) + "</th>";
@@ -146,20 +184,28 @@ std::string HeadlineTable(const std::vector<RigReport>& rigs, const Study& study
   for (const RigReport& r : rigs) s += "<td>" + std::to_string(r.rig->enabled_count()) + "</td>";
   s += "</tr>\n";
   for (const Headline& h : rows) {
-    std::vector<double> v;
-    for (const RigReport& r : rigs) v.push_back(JsonNumber(r.summary, h.path));
-    double best = std::nan("");
-    for (double x : v)
-      if (std::isfinite(x)) best = std::isnan(best) ? x : h.higher_better ? std::max(best, x) : std::min(best, x);
+    // Compared as shown: a rig is bold when its shown value is the best and some rig's is worse.
+    std::vector<double> shown;
+    for (const RigReport& r : rigs) shown.push_back(Shown(h, JsonNumber(r.summary, h.path)));
+    double best = std::nan(""), worst = std::nan("");
+    for (double x : shown)
+      if (std::isfinite(x)) {
+        best = std::isnan(best) ? x : h.higher_better ? std::max(best, x) : std::min(best, x);
+        worst = std::isnan(worst) ? x : h.higher_better ? std::min(worst, x) : std::max(worst, x);
+      }
+    const bool differ = std::isfinite(best) && best != worst;
     s += "<tr><td>" + h.label + "</td>";
-    for (double x : v) {
-      const std::string text = !std::isfinite(x) ? "&mdash;" : h.percent ? Percent(x) : Fmt("%.3f", x);
-      const bool is_best = rigs.size() > 1 && std::isfinite(x) && x == best;
+    for (std::size_t i = 0; i < rigs.size(); ++i) {
+      const double x = JsonNumber(rigs[i].summary, h.path);
+      const std::string text = HeadlineText(h, x);
+      const bool is_best = rigs.size() > 1 && differ && std::isfinite(x) && shown[i] == best;
       s += is_best ? "<td class=\"best\">" + text + "</td>" : "<td>" + text + "</td>";
     }
     s += "</tr>\n";
   }
-  s += "<tr><td>Region voxels (free)</td>";
+  s += "<tr><td>Warnings</td>";
+  for (const RigReport& r : rigs) s += "<td>" + std::to_string(r.warnings.size()) + "</td>";
+  s += "</tr>\n<tr><td>Region voxels (free)</td>";
   for (const RigReport& r : rigs) s += "<td>" + std::to_string(r.summary["region_voxels"].get<long long>()) + "</td>";
   s += "</tr>\n<tr><td>Field evaluation (s)</td>";
   for (const RigReport& r : rigs) s += "<td>" + Fmt("%.2f", r.summary["timing"]["seconds"].get<double>()) + "</td>";
@@ -170,24 +216,39 @@ std::string HeadlineTable(const std::vector<RigReport>& rigs, const Study& study
 std::string CameraTable(const RigReport& r, const Study& study) {
   std::string s =
       "<table class=\"cameras\"><thead><tr><th>id</th><th>name</th><th>resolution (px)</th>"
-      "<th>FOV h &times; v (&deg;)</th><th>lens</th><th>region seen</th><th>pixel &sigma; (px)</th>"
-      "</tr></thead><tbody>\n";
+      "<th>FOV h &times; v (&deg;)</th><th>nominal (&deg;)</th><th>unreachable</th>"
+      "<th>lens</th><th>region seen</th><th>pixel &sigma; (px)</th></tr></thead><tbody>\n";
   const nlohmann::json& per_camera = r.summary["per_camera"];
   for (std::size_t c = 0; c < r.rig->cameras.size(); ++c) {
     const Camera& cam = r.rig->cameras[c];
     const Intrinsics& k = cam.model.intrinsics();
-    const double h = HfovFromFocal(k.fx, k.width, k.model) * 180.0 / M_PI;
-    const double v = HfovFromFocal(k.fy, k.height, k.model) * 180.0 / M_PI;
-    const double seen = c < per_camera.size() ? per_camera[c]["visible_fraction"].get<double>() : 0.0;
+    const nlohmann::json& pc = per_camera[c];
+    const auto& eff = pc["fov_deg"]["effective"];
+    const auto& nom = pc["fov_deg"]["nominal"];
+    const double seen = pc["visible_fraction"].get<double>();
+    const double unreachable = pc["unreachable_pixels"].get<double>();
     const std::string sigma = cam.pixel_sigma > 0 ? Fmt("%g", cam.pixel_sigma)
                                                   : Fmt("%g", study.pixel_sigma) + " (study)";
-    s += std::string("<tr") + (cam.enabled ? "" : " class=\"disabled\"") + "><td>" + Html(cam.id) +
-         "</td><td>" + Html(cam.name) + "</td><td>" + std::to_string(k.width) + " &times; " +
-         std::to_string(k.height) + "</td><td>" + Fmt("%.1f", h) + " &times; " + Fmt("%.1f", v) +
-         "</td><td>" + LensModelName(k.model) + "</td><td>" +
-         (cam.enabled ? Percent(seen) : "disabled") + "</td><td>" + sigma + "</td></tr>\n";
+    s += std::string("<tr") + (cam.enabled ? "" : " class=\"disabled\"") + "><td>" +
+         (cam.enabled ? Swatch(cam) : "") + Html(cam.id) + "</td><td>" + Html(cam.name) + "</td><td>" +
+         std::to_string(k.width) + " &times; " + std::to_string(k.height) + "</td><td>" +
+         Fmt("%.1f", eff[0].get<double>()) + " &times; " + Fmt("%.1f", eff[1].get<double>()) +
+         "</td><td>" + Fmt("%.1f", nom[0].get<double>()) + " &times; " +
+         Fmt("%.1f", nom[1].get<double>()) + "</td><td>" +
+         (unreachable > 0 ? Percent(unreachable) : "0") + "</td><td>" + LensModelName(k.model) +
+         "</td><td>" + (cam.enabled ? Percent(seen) : "disabled") + "</td><td>" + sigma +
+         "</td></tr>\n";
   }
   return s + "</tbody></table>\n";
+}
+
+// The rig's warnings as a list (or a line saying there are none).
+std::string WarningList(const RigReport& r, const std::string& file) {
+  if (r.warnings.empty()) return "<p class=\"note\">No warnings.</p>\n";
+  std::string s = "<ul class=\"warnings\">\n";
+  for (const Warning& w : r.warnings)
+    s += "<li><code>" + Html(file + ": " + w.json_path) + "</code>: " + Html(w.reason) + "</li>\n";
+  return s + "</ul>\n";
 }
 
 // The colour scale of one field, shared by every rig's slices.
@@ -242,7 +303,7 @@ int RunReport(const ReportArgs& args) {
                                std::pair<const char*, int>{"--camera-width", args.camera_width}})
     if (value < 16 || value > 8192)
       throw InputError(option, "", "must be 16 to 8192 pixels, not " + std::to_string(value));
-  CheckPositiveOption("--brightness", args.brightness, "");
+  if (!std::isnan(args.brightness)) CheckPositiveOption("--brightness", args.brightness, "");
   const int view_width = args.width;
   OutputTransaction output;
   AddSceneInputs(output, scene);
@@ -273,7 +334,10 @@ int RunReport(const ReportArgs& args) {
     r.rig = rig;
     r.fields = EvaluateFields(scene, *rig, *caster, options);
     bar.Finish();
-    r.summary = MakeSummary(scene, *rig, r.fields, field_names, threads);
+    RigCheckOptions check;
+    check.visible_voxels = r.fields.stats.per_camera_seen;
+    r.warnings = CheckRig(scene, *rig, *caster, check);
+    r.summary = MakeSummary(scene, *rig, r.fields, field_names, threads, r.warnings);
     reports.push_back(std::move(r));
   }
 
@@ -302,8 +366,30 @@ int RunReport(const ReportArgs& args) {
   body << "<h2 id=\"numbers\">" << (n > 1 ? "Rigs compared" : "Summary") << "</h2>\n"
        << "<p class=\"note\">Fractions are of the free region voxels (inside the region, outside "
           "solids); &sigma;<sub>max</sub> percentiles are over the triangulable voxels."
-       << (n > 1 ? " The better value of each row is in bold." : "") << "</p>\n"
+       << (n > 1 ? " The better value of each row is in bold, compared as shown (no bold where all "
+                  "rigs show the same value)." : "") << "</p>\n"
        << HeadlineTable(reports, study);
+
+  // Warnings (as `pandora analyze` prints them): nonsense placements and lenses.
+  {
+    std::size_t total = 0;
+    for (const RigReport& r : reports) total += r.warnings.size();
+    body << "<h2 id=\"warnings\">Warnings</h2>\n<p class=\"note\">Checks of each enabled camera: "
+            "inside a solid object, outside the modelled room, seeing none of the region, a lens "
+            "model that folds back inside the image (docs/user-guide.md, "
+            "&ldquo;Warnings&rdquo;).</p>\n";
+    if (total == 0) {
+      body << "<p>No warnings.</p>\n";
+    } else {
+      std::vector<std::string> heads, cells;
+      for (const RigReport& r : reports) {
+        heads.push_back("<h3 class=\"rig\">" + Html(r.rig->name) + " &mdash; " +
+                        std::to_string(r.rig->enabled_count()) + " cameras</h3>");
+        cells.push_back(WarningList(r, scene.path));
+      }
+      body << RigRow(heads) << RigRow(cells);
+    }
+  }
 
   // Rig headers for the column layout.
   std::vector<std::string> heads;
@@ -318,6 +404,11 @@ int RunReport(const ReportArgs& args) {
             "sees stay dark (visibility rules: range, image, facing, occlusion). Camera bodies and "
             "frusta are drawn in their colours.</p>\n"
          << RigRow(heads);
+    {
+      std::vector<std::string> keys;
+      for (const RigReport& r : reports) keys.push_back(ColourKey(*r.rig));
+      body << RigRow(keys);
+    }
     const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
     auto render_views = [&](const std::string& name, const View& view) {
       std::vector<std::string> cells;
@@ -343,7 +434,7 @@ int RunReport(const ReportArgs& args) {
   {
     std::vector<std::string> cells;
     for (const RigReport& r : reports) {
-      std::string cell = "<div class=\"thumbs\">";
+      std::string cell = ColourKey(*r.rig) + "<div class=\"thumbs\">";
       for (std::size_t c = 0; c < r.rig->cameras.size(); ++c) {
         const Camera& cam = r.rig->cameras[c];
         if (!cam.enabled) continue;
@@ -357,6 +448,7 @@ int RunReport(const ReportArgs& args) {
         options.brightness = args.brightness;
         options.layers = false;  // PNG only: no resolution / sigma_max per pixel
         options.overlays.cameras = false;
+        options.overlays.key = false;  // the key is above the views, once per rig
         const Image image = Render(scene, *r.rig, *caster, view, options);
         cell += "<figure>" + fig.Img("image/png", PngBytes(image), r.rig->name + " camera " + cam.id, "thumb") +
                 "<figcaption>" + Html(cam.id) + (cam.name != cam.id ? " (" + Html(cam.name) + ")" : "") +
@@ -439,6 +531,7 @@ int RunReport(const ReportArgs& args) {
       chart.y_label = "share of region voxels";
       chart.percent = true;
       chart.y_max = y_max;
+      chart.bin_width = 1;  // whole cameras: labels thinned to 1-2-5 steps
       BarSeries s;
       s.label = r.rig->name;
       const auto& h = r.fields.stats.coverage_histogram;
@@ -454,10 +547,12 @@ int RunReport(const ReportArgs& args) {
     body << RigRow(cells);
   }
   {
-    // sigma_max: 30 bins from 0 to the shared scale's top, an overflow bin after.
+    // sigma_max: up to 30 bins of a 1-2-5 width from 0 to the shared scale's top, an overflow bin
+    // after, so the bin edges (and the labels on them) are round numbers.
     const Scale scale = FieldScale("sigma_max", reports);
-    const int bins = 30;
-    const double width = scale.max / bins;
+    const double width = NiceStep(scale.max / 30);
+    const int bins = std::max(1, static_cast<int>(std::ceil(scale.max / width - 1e-9)));
+    const double top = bins * width;
     std::vector<std::vector<double>> shares;
     double y_max = 0;
     for (const RigReport& r : reports) {
@@ -477,12 +572,13 @@ int RunReport(const ReportArgs& args) {
       chart.x_label = "sigma_max (mm), bins of " + Fmt("%g", width) + " mm";
       chart.y_label = "share of region voxels";
       chart.note = "triangulable voxels only; bins labelled by their lower edge; the last bar: sigma_max >= " +
-                   Fmt("%g", scale.max) + " mm";
+                   Fmt("%g", top) + " mm";
       chart.edge_labels = true;
+      chart.bin_width = width;
       chart.percent = true;
       chart.y_max = y_max;
       for (int b = 0; b < bins; ++b) chart.categories.push_back(Fmt("%g", b * width));
-      chart.categories.push_back(">=" + Fmt("%g", scale.max));
+      chart.categories.push_back(">=" + Fmt("%g", top));
       chart.series.push_back({reports[i].rig->name, shares[i], "#21918c"});
       if (study.max_sigma_mm) {
         chart.marker = std::min(*study.max_sigma_mm / width, double(bins));
@@ -494,13 +590,16 @@ int RunReport(const ReportArgs& args) {
   }
 
   // Cameras.
-  body << "<h2 id=\"cameras\">Cameras</h2>\n<p class=\"note\">FOV edge to edge of the image "
-          "(distortion ignored); region seen: share of the free region voxels the camera sees "
+  body << "<h2 id=\"cameras\">Cameras</h2>\n<p class=\"note\">The swatch is the colour of the "
+          "camera's light in the renders. FOV: edge to edge of the image along the rows and columns "
+          "through the principal point, with the lens distortion; nominal FOV: from the focal length "
+          "alone (distortion ignored); unreachable pixels: share of the image beyond the distortion "
+          "model's valid domain; region seen: share of the free region voxels the camera sees "
           "(visibility rules, occlusion included).</p>\n"
        << RigRow(heads);
   {
     std::vector<std::string> cells;
-    for (const RigReport& r : reports) cells.push_back(CameraTable(r, study));
+    for (const RigReport& r : reports) cells.push_back("<div class=\"scroll\">" + CameraTable(r, study) + "</div>");
     body << RigRow(cells);
   }
 
@@ -533,6 +632,10 @@ int RunReport(const ReportArgs& args) {
           "table{border-collapse:collapse;font-size:13px;margin:6px 0}td,th{border:1px solid #ccc;"
           "padding:3px 8px;text-align:right}th{background:#f2f2f2}td:first-child,th:first-child{text-align:left}\n"
           "table.cameras td:nth-child(2){text-align:left}tr.disabled{color:#999}td.best{font-weight:bold}\n"
+          ".swatch{display:inline-block;width:12px;height:12px;margin-right:4px;vertical-align:-1px;"
+          "border:1px solid #555}.key{font-size:12px;margin:4px 0 8px}.key .entry{white-space:nowrap;"
+          "margin-right:8px}ul.warnings{color:#8a4b00}ul.warnings code{color:#555}\n"
+          ".scroll{overflow-x:auto}table.cameras td{white-space:nowrap}\n"
           ".meta,.note{color:#555}#image-check{font-size:12px}#image-check.bad{color:#b00;font-weight:bold}\n"
           "#image-check.ok{color:#070}\n</style>\n</head>\n<body data-expected-images=\""
        << fig.count() << "\">\n"
@@ -556,9 +659,14 @@ int RunReport(const ReportArgs& args) {
           "});\n</script>\n</body>\n</html>\n";
   WriteFileAtomically(staged, page.str());
   output.Commit();
-  if (!args.quiet)
+  if (!args.quiet) {
     std::printf("wrote %s (%d images, %.1f MiB)\n", path.c_str(), fig.count(),
                 page.str().size() / 1048576.0);
+    std::fflush(stdout);
+    for (const RigReport& r : reports)
+      for (const Warning& w : r.warnings)
+        std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
+  }
   return 0;
 }
 

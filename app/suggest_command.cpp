@@ -12,6 +12,7 @@
 
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
+#include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
@@ -83,6 +84,9 @@ void PrintTable(const Suggestion& s, const Scene& scene, const Rig& rig, const s
     if (c.focal_scale != 1.0)
       std::printf("           zoom: horizontal field of view %.2f -> %.2f deg\n", c.hfov_before_deg,
                   c.hfov_after_deg);
+    if (std::isfinite(c.surface_distance_after) && c.surface_distance_after < 1.0)
+      std::printf("           nearest surface: %.3f m -> %.3f m\n", c.surface_distance_before,
+                  c.surface_distance_after);
     if (!c.note.empty()) std::printf("           note: %s\n", c.note.c_str());
   }
   auto row = [](const char* name, double a, double b) {
@@ -231,6 +235,9 @@ int RunSuggest(const SuggestArgs& args) {
   if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
     throw InputError("--snap-rotate", "", "must be a finite angle >= 0 in degrees");
   options.outer_iterations = args.outer_iterations;
+  options.clearance = args.clearance;
+  if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
+    throw InputError("--clearance", "", "must be a finite length >= 0 in metres");
 
   // The suggestion and the baseline comparison appear together, and replace no input.
   OutputTransaction output;
@@ -278,6 +285,8 @@ int RunSuggest(const SuggestArgs& args) {
     text.insert(pos + 1, "\n \"perturbed_for_benchmark\": true,");
   }
   WriteFileAtomically(suggestion_path, text);
+  // The rig as the file has it: its warnings, after every input check.
+  const std::vector<Warning> warnings = args.quiet ? std::vector<Warning>() : CheckRig(scene, file_rig, *caster);
 
   if (!args.compare_baseline.empty()) {
     // The same evaluation budget as the suggestion used (screening, surrogate and exact evaluations).
@@ -352,6 +361,9 @@ int RunSuggest(const SuggestArgs& args) {
     std::printf("wrote %s%s\n", args.out.c_str(), s.improved ? "" : " (no improvement: nothing to accept)");
     if (!args.compare_baseline.empty()) std::printf("wrote %s.csv and %s.svg\n", stem.c_str(), stem.c_str());
   }
+  std::fflush(stdout);
+  for (const Warning& w : warnings)
+    std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   return 0;
 }
 
@@ -364,9 +376,11 @@ int RunAccept(const AcceptArgs& args) {
   const AcceptResult r = AcceptSuggestion(args.suggestion, options);
   std::string ids;
   for (const std::string& id : r.accepted) ids += (ids.empty() ? "" : ", ") + id;
-  if (!args.quiet)
+  if (!args.quiet) {
     std::printf("accepted %s into %s (previous file kept as %s)\n", ids.c_str(), r.scene_path.c_str(),
                 r.backup_path.c_str());
+    for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
+  }
   return 0;
 }
 

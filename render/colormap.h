@@ -5,6 +5,7 @@
 #include <string>
 
 #include "analysis/geometry.h"
+#include "analysis/palette.h"
 
 namespace pandora {
 
@@ -17,12 +18,11 @@ Vec3 ViridisSrgb(double t);
 /// The same colour in linear RGB (what the renderer composites in).
 Vec3 ViridisLinear(double t);
 
-/// sRGB transfer curve and its inverse, per channel, on [0, 1].
+/// sRGB transfer curve, per channel, on [0, 1] (its inverse, LinearFromSrgb, is in analysis/palette.h).
 double SrgbFromLinear(double v);
-double LinearFromSrgb(double v);
 
 /// Draws `text` with a 3x5 pixel font scaled by `scale`, top-left corner at (x, y), into a linear
-/// RGB buffer of width x height (3 floats per pixel). Characters: digits, a-z, . - + / _ % = < >
+/// RGB buffer of width x height (3 floats per pixel). Characters: digits, a-z, . - + / _ % = < > [ ] ( ) , :
 /// and space; others are drawn as a box. Returns the width drawn in pixels.
 int DrawText(float* rgb, int width, int height, int x, int y, const std::string& text,
              const Vec3& color, int scale);

@@ -81,6 +81,7 @@ TEST(Overlay, SliceShowsTheVoxelValueWhereTheEyeRayCrossesThePlane) {
   options.overlays.slice_max = 2;
   options.overlays.slice_opacity = 0.75;
   options.overlays.legend = false;
+  options.overlays.key = false;
   const Image img = Render(s.scene, rig, *s.caster, view, options, &s.fields);
   const openvdb::Int32Grid& grid = *s.fields.impl().coverage;
   auto acc = grid.getConstAccessor();

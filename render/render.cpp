@@ -24,6 +24,23 @@
 
 namespace pandora {
 
+double DefaultBrightness(int enabled_cameras) {
+  return enabled_cameras <= 3 ? 1.0 : 3.0 / enabled_cameras;
+}
+
+std::string FieldUnitLabel(const std::string& field) {
+  std::string base = field;
+  const std::string steady = "_steady";
+  if (base.size() > steady.size() && base.compare(base.size() - steady.size(), steady.size(), steady) == 0)
+    base.resize(base.size() - steady.size());
+  if (base == "coverage") return field + " [cameras]";
+  if (base == "resolution") return field + " [px/m]";
+  if (base == "sigma_max" || base == "sigma_mean") return field + " [mm]";
+  if (base == "triangulation_angle") return field + " [deg]";
+  if (base == "condition") return field + " [1]";
+  return field;
+}
+
 RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg) {
   RenderView v;
   v.from = view.from;
@@ -458,6 +475,45 @@ void DrawLegend(const std::string& field, double vmin, double vmax, Image* image
   DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by + bar_h - 5 * scale, bottom, white, scale);
 }
 
+// The colour key, upper left corner: a swatch of each enabled camera's light and its id (up to 12
+// characters), in as many columns as the image height needs; nothing when it would take more than
+// half the width.
+void DrawKey(const Rig& rig, Image* image) {
+  const int W = image->width, H = image->height;
+  std::vector<const Camera*> cams;
+  for (const Camera& c : rig.cameras)
+    if (c.enabled) cams.push_back(&c);
+  if (cams.empty()) return;
+  const int scale = H >= 400 ? 2 : 1;
+  const int margin = 4 * scale, row = 8 * scale, swatch = 8 * scale;
+  std::size_t longest = 1;
+  for (const Camera* c : cams) longest = std::max<std::size_t>(longest, std::min<std::size_t>(c->id.size(), 12));
+  const int col_w = swatch + 3 * scale + TextWidth(std::string(longest, 'm'), scale) + 2 * margin;
+  const int rows_fit = std::max(1, (H - 3 * margin) / row);
+  const int cols = (int(cams.size()) + rows_fit - 1) / rows_fit;
+  const int rows = (int(cams.size()) + cols - 1) / cols;
+  const int box_w = cols * col_w + margin, box_h = rows * row + 2 * margin - 2 * scale;
+  if (box_w > W / 2 || box_h > H - margin) return;
+  const int x0 = margin, y0 = margin;
+  for (int y = y0; y < y0 + box_h; ++y)
+    for (int x = x0; x < x0 + box_w; ++x)
+      for (int k = 0; k < 3; ++k) {
+        float& v = image->rgb[3 * (std::size_t(y) * W + x) + k];
+        v = 0.2f * v;  // darken what is behind the key
+      }
+  const Vec3 text = Vec3::Constant(0.9);
+  for (std::size_t i = 0; i < cams.size(); ++i) {
+    const int col = int(i) / rows, r = int(i) % rows;
+    const int x = x0 + margin + col * col_w, y = y0 + margin + r * row;
+    // The swatch shows the light's colour at full strength (clamped as the PNG will be).
+    const Vec3 c = cams[i]->color.cwiseMin(Vec3::Ones()).cwiseMax(Vec3::Zero());
+    for (int yy = y; yy < y + 5 * scale && yy < H; ++yy)
+      for (int xx = x; xx < x + swatch && xx < W; ++xx)
+        for (int k = 0; k < 3; ++k) image->rgb[3 * (std::size_t(yy) * W + xx) + k] = float(c[k]);
+    DrawText(image->rgb.data(), W, H, x + swatch + 3 * scale, y, cams[i]->id.substr(0, 12), text, scale);
+  }
+}
+
 // Cheap necessary conditions of VisibilityTester::TestGeometry's kSeen, tested first: the point
 // faces the camera, lies within its working range, and (for lenses under 180 degrees) in front of
 // it within the normalized-coordinate bounds of the whole (distorted) image. A point failing any of
@@ -530,6 +586,8 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   if (options.surface == Surface::kMaterial && !mesh.corner_uvs.empty())
     object_texture = LoadTextures(scene, &textures);
 
+  const double brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
+                                                          : options.brightness;
   const double scene_scale = std::max(scene.ContentBounds().diagonal(), 1e-9);
   const VisibilityTester tester(rig.cameras, caster, scene_scale);
   // Hit points are lifted off their surface by a tenth of the visibility epsilon along the facing
@@ -723,7 +781,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
             const double line = 1.0 - (1.0 - lu) * (1.0 - lv);
             w = options.grid_fill + (1.0 - options.grid_fill) * line;
           }
-          smp.light += options.brightness * w * cam.color;
+          smp.light += brightness * w * cam.color;
         }
       }
       // Shading and layers.
@@ -882,7 +940,8 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   }
 
   if (ov.cameras && rays.perspective()) DrawCameraOverlays(rig, rays.pinhole(), ov, options, &image);
-  if (have_slice && ov.legend) DrawLegend(ov.slice_field, slice.min, slice.max, &image);
+  if (have_slice && ov.legend) DrawLegend(FieldUnitLabel(ov.slice_field), slice.min, slice.max, &image);
+  if (ov.key) DrawKey(rig, &image);
 
   if (stats) {
     stats->primary_rays = 0;

@@ -71,7 +71,12 @@ struct OverlayOptions {
   double slice_min = std::numeric_limits<double>::quiet_NaN();
   double slice_max = std::numeric_limits<double>::quiet_NaN();
   double slice_opacity = 0.75;
-  bool legend = true;              ///< Draw the slice's colour bar with its range and field name.
+  /// Draw the slice's colour bar with its range and the field's name and unit (FieldUnitLabel).
+  bool legend = true;
+  /// Draw the colour key: each enabled camera's id beside a swatch of its light's colour, in the
+  /// upper left corner (in columns when the cameras do not fit one; left out when the key would
+  /// take more than half the image's width).
+  bool key = true;
   /// Isosurface (needs `fields`): empty = none, else a field name and an iso value; e.g.
   /// "coverage" at 1.5 is the boundary of coverage >= 2, "sigma_max" at 2.0 the 2 mm boundary.
   /// Extracted with OpenVDB's volumeToMesh, ray traced with the scene, alpha-composited.
@@ -81,11 +86,23 @@ struct OverlayOptions {
   double iso_opacity = 0.45;
 };
 
+/// The default light scale for `enabled_cameras` cameras: min(1, 3 / n). Where k cameras overlap
+/// their colours add, so with n cameras around a region the middle gets about n times one light;
+/// scaling by 3 / n keeps the sum near white there while a spot lit by one camera keeps a third of
+/// full light or more up to 9 cameras (docs/rendering.md, "Brightness", with measurements).
+double DefaultBrightness(int enabled_cameras);
+
+/// The label of a field with its unit, for legends: "coverage [cameras]", "resolution [px/m]",
+/// "sigma_max [mm]", "sigma_mean [mm]", "triangulation_angle [deg]", "condition [1]", and the
+/// steady-state fields like their static ones; other names unchanged.
+std::string FieldUnitLabel(const std::string& field);
+
 struct RenderOptions {
   Pattern pattern = Pattern::kUniform;
   Surface surface = Surface::kMaterial;
   /// Multiplies every camera's light, so many overlaps do not saturate to white (paper Fig. 4).
-  double brightness = 1.0;
+  /// NaN (the default): DefaultBrightness of the rig's enabled cameras.
+  double brightness = std::numeric_limits<double>::quiet_NaN();
   /// Dim ambient light in kMaterial mode (fraction of the material colour shown unlit).
   double ambient = 0.15;
   int grid_pixels = 32;        ///< kGrid: a line every this many camera pixels.

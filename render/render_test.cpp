@@ -76,6 +76,7 @@ RenderOptions BlackOptions() {
   o.surface = Surface::kBlack;
   o.background = Vec3::Zero();
   o.overlays.cameras = false;
+  o.overlays.key = false;  // the colour key has its own test (palette_test.cpp)
   return o;
 }
 
@@ -642,6 +643,7 @@ TEST(RenderReference, TraumaRoomImagesMatchTheCommittedReferences) {
     options.surface = ref.surface;
     options.grid_pixels = 64;
     options.brightness = 0.6;
+    options.overlays.key = false;  // the colour key has its own test (palette_test.cpp)
     const Image img = Render(scene, rig, *caster, view, options);
     const std::string path = std::string("tests/data/render/") + ref.file;
     if (update) {
@@ -702,6 +704,7 @@ TEST(Render, ObjTextureAppearsOnItsQuadrants) {
   RenderOptions options;
   options.surface = Surface::kMaterial;
   options.overlays.cameras = false;
+  options.overlays.key = false;
   const Image img = Render(scene, scene.rigs[0], *caster, view, options);
   // Quadrant centres (u, v) -> expected texel; the pixel whose centre ray hits nearest each.
   const struct {

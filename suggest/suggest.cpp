@@ -294,7 +294,8 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
                                const std::vector<TargetPoint>& targets, const Objective& objective,
                                const std::vector<int>& selected)
     : caster_(caster), targets_(targets), objective_(objective) {
-  scene_scale_ = std::max(scene.ContentBounds().diagonal(), 1e-300);
+  scene_scale_ = std::max(scene.Bounds().diagonal(), 1e-300);
+  geometry_scale_ = std::max(scene.ContentBounds().diagonal(), 1e-300);
   region_scale_ = scene.study.region.box.diagonal();
   if (!(region_scale_ > 0)) region_scale_ = scene_scale_;
   sigma_cap_mm_ = region_scale_ * 1000.0;
@@ -319,7 +320,7 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   fixed_.J.assign(n, Mat3::Zero());
   fixed_.dmax.assign(n, 0.0);
   fixed_.dpow.assign(n, 0.0);
-  const VisibilityTester tester(fixed, caster, scene_scale_);
+  const VisibilityTester tester(fixed, caster, geometry_scale_);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const TargetPoint& t = targets_[i];
@@ -345,7 +346,7 @@ Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
   for (std::size_t c = 0; c < cams.size() && c < poses.size(); ++c) cams[c].world_from_camera = poses[c];
   for (std::size_t c = 0; c < cams.size() && c < focal_scales.size(); ++c)
     if (focal_scales[c] != 1.0) cams[c] = Zoomed(cams[c], focal_scales[c]);
-  const VisibilityTester tester(cams, caster_, scene_scale_);
+  const VisibilityTester tester(cams, caster_, geometry_scale_);
   const std::size_t n = targets_.size();
   std::vector<int> count = fixed_.count;
   std::vector<Mat3> J = fixed_.J;
@@ -371,7 +372,7 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
   Camera cam = selected_[c];
   cam.world_from_camera = pose;
   if (focal_scale != 1.0) cam = Zoomed(cam, focal_scale);
-  const VisibilityTester tester({cam}, caster_, scene_scale_);
+  const VisibilityTester tester({cam}, caster_, geometry_scale_);
   const std::size_t n = targets_.size();
   CameraView v;
   v.seen.assign(n, 0);
@@ -587,6 +588,16 @@ bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p) {
   return false;
 }
 
+Placement::Placement(const Scene& scene, const Rig& rig, const SuggestOptions& options)
+    : keep_out_(options.keep_out), distance_(scene.AllTriangles()) {
+  for (int index : options.cameras) {
+    const double start = index >= 0 && index < static_cast<int>(rig.cameras.size())
+                             ? distance_.Distance(rig.cameras[index].center(), options.clearance)
+                             : 0.0;
+    required_.push_back(std::min(options.clearance, start));
+  }
+}
+
 const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i) {
   return options.limits.size() == 1 ? options.limits[0] : options.limits[i];
 }
@@ -655,6 +666,8 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
       throw InputError(file, "--keep-out", "camera '" + cam.id + "' is inside a keep-out box",
                        "a keep-out box must not hold a selected camera's current centre");
   }
+  if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
+    throw InputError(file, "--clearance", "must be a finite length >= 0 (metres)");
   if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
     throw InputError(file, "--snap-move", "must be a finite length >= 0");
   if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
@@ -668,31 +681,56 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
 
 std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
-                                         const SuggestOptions& options) {
+                                         const SuggestOptions& options, const Placement& placement) {
   std::vector<Eigen::Isometry3d> out = poses;
   for (std::size_t c = 0; c < charts.size(); ++c) {
     const PoseChart& ch = charts[c];
     const Eigen::Isometry3d& p = poses[c];
     Eigen::Isometry3d q = p;
-    // Translation in the mount's coordinates (metres).
+    // A camera the search left where it was stays exactly there (not moved onto the grid).
+    if (p.translation() == ch.start.translation() && p.linear() == ch.start.linear()) continue;
+    // Translation in the mount's coordinates (metres). Along a mount direction that is a world
+    // axis the coordinate itself lands on a multiple of the step (installable numbers in the scene
+    // file); along any other direction the move is a multiple of the step.
     if (options.snap_move > 0 && ch.dims_t > 0) {
-      const Eigen::VectorXd y = ch.basis.transpose() * (p.translation() - ch.start.translation());
-      auto make = [&](bool truncate) {
+      const double step = options.snap_move;
+      const Vec3 c0 = ch.start.translation();
+      const Eigen::VectorXd y = ch.basis.transpose() * (p.translation() - c0);
+      // World axis k and sign of basis column i, or -1 when it is oblique.
+      auto world_axis = [&](int i, double* sign) {
+        for (int k = 0; k < 3; ++k)
+          if (std::abs(std::abs(ch.basis(k, i)) - 1.0) < 1e-12) {
+            *sign = ch.basis(k, i) > 0 ? 1.0 : -1.0;
+            return k;
+          }
+        return -1;
+      };
+      auto make = [&](bool toward_start) {
         Eigen::VectorXd r(y.size());
         for (int i = 0; i < y.size(); ++i) {
-          const double s = y[i] / options.snap_move;
-          r[i] = (truncate ? std::trunc(s) : std::round(s)) * options.snap_move;
+          double sign = 1;
+          const int k = world_axis(i, &sign);
+          if (k >= 0) {
+            const double target = c0[k] + sign * y[i];  // the world coordinate
+            double g = std::round(target / step);
+            if (toward_start) g = target > c0[k] ? std::floor(target / step) : std::ceil(target / step);
+            r[i] = sign * (g * step - c0[k]);
+          } else {
+            const double q = y[i] / step;
+            r[i] = (toward_start ? std::trunc(q) : std::round(q)) * step;
+          }
         }
-        return Vec3(ch.start.translation() + ch.basis * r);
+        return Vec3(c0 + ch.basis * r);
       };
       auto admissible = [&](const Vec3& centre) {
-        if ((centre - ch.start.translation()).norm() > ch.max_move * (1 + 1e-12)) return false;
+        if ((centre - c0).norm() > ch.max_move * (1 + 1e-12)) return false;
         if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre)) return false;
-        return !InKeepOut(options.keep_out, centre);
+        return placement.Admissible(c, centre);
       };
       Vec3 centre = make(false);
       if (!admissible(centre)) centre = make(true);
-      if (!admissible(centre)) centre = ch.start.translation();
+      if (!admissible(centre)) centre = c0;
+      if ((centre - c0).norm() <= 1e-12 * std::max(1.0, c0.norm())) centre = c0;  // round-off
       q.translation() = centre;
     }
     if (options.snap_rotate_deg > 0 && ch.dims_r > 0) {
@@ -709,7 +747,9 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
         return Mat3(RotationFromYawPitchRollDeg(y0 + r));
       };
       const double limit = Deg(ch.max_rotate) * (1 + 1e-9) + 1e-9;
-      Mat3 R = make(false);
+      bool unchanged = true;
+      for (int i = 0; i < 3; ++i) unchanged = unchanged && std::round(delta[i] / options.snap_rotate_deg) == 0;
+      Mat3 R = unchanged ? ch.start.linear() : make(false);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = make(true);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = ch.start.linear();
       q.linear() = R;
@@ -721,7 +761,7 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
 
 void FillChanges(const Rig& rig, const SuggestOptions& options,
                  const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
-                 Suggestion* s) {
+                 const Placement& placement, Suggestion* s) {
   s->cameras.clear();
   for (std::size_t c = 0; c < options.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[options.cameras[c]];
@@ -736,6 +776,8 @@ void FillChanges(const Rig& rig, const SuggestOptions& options,
     ch.focal_scale = c < focal_scales.size() ? focal_scales[c] : 1.0;
     ch.hfov_before_deg = Deg(HfovFromFocal(k.fx, k.width, k.model));
     ch.hfov_after_deg = Deg(HfovFromFocal(k.fx * ch.focal_scale, k.width, k.model));
+    ch.surface_distance_before = placement.SurfaceDistanceAt(ch.before.translation());
+    ch.surface_distance_after = placement.SurfaceDistanceAt(ch.after.translation());
     s->cameras.push_back(ch);
   }
 }
@@ -766,6 +808,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
   const std::vector<Eigen::Isometry3d>& start = begin.start;
@@ -795,7 +838,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       charts[c].Project(cand[c].data());
       poses[c] = charts[c].Pose(cand[c].data());
       scales[c] = charts[c].FocalScale(cand[c].data());
-      ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
+      ok = ok && placement.Admissible(c, poses[c].translation());
     }
     if (!ok) {  // an inadmissible candidate costs no evaluation
       ++rejected_in_a_row;
@@ -830,7 +873,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
     scales.assign(charts.size(), 1.0);
   }
   s.after = s.improved ? best_m : s.before;
-  FillChanges(rig, options, poses, scales, &s);
+  FillChanges(rig, options, poses, scales, placement, &s);
   s.evaluations = ev.evaluations();
   s.seconds = elapsed();
   s.message = s.improved ? "baseline improved the objective" : "baseline found no improvement";

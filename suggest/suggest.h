@@ -110,6 +110,9 @@ struct CameraChange {
   double rotate_deg = 0;   ///< Angle of the relative rotation, degrees.
   double focal_scale = 1;  ///< fx_after / fx_before (1 without a zoom range).
   double hfov_before_deg = 0, hfov_after_deg = 0;  ///< Horizontal field of view, degrees.
+  /// Distance from the centre to the nearest scene surface before and after, metres (infinity in a
+  /// scene without geometry).
+  double surface_distance_before = 0, surface_distance_after = 0;
   /// A message when this camera could not help (for example it sees none of the target and the
   /// surrogate has no gradient); empty otherwise.
   std::string note;
@@ -126,6 +129,10 @@ struct SuggestOptions {
   std::vector<int> cameras;           ///< Rig indices of the selected cameras (distinct, enabled).
   std::vector<CameraLimits> limits;   ///< One per selected camera, or one for all.
   std::vector<Aabb> keep_out;         ///< Boxes no selected camera centre may enter.
+  /// Metres every suggested camera centre keeps from every scene surface (any object's triangles:
+  /// walls, floor, furniture, solid or not). A camera that starts closer may stay or move away but
+  /// never closer than it starts. 0: no clearance.
+  double clearance = 0.1;
   Objective objective;
   int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
@@ -134,9 +141,13 @@ struct SuggestOptions {
   /// exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
   /// poses only.
   int screening_candidates = 200;
-  /// Installable steps (0: none): the change of each camera is rounded to multiples of snap_move
-  /// (metres, per axis of its mount) and its yaw / pitch / roll change (scene-format Euler angles)
-  /// to multiples of snap_rotate_deg, never beyond the limits; then evaluated again.
+  /// Installable steps (0: none): each camera's centre is rounded per axis of its mount: along a
+  /// mount direction that is a world axis (free and box mounts, axis-aligned rails and planes) to a
+  /// coordinate that is a multiple of snap_move (metres: so the scene file shows k * step), along an
+  /// oblique one to a move that is a multiple of it; its yaw / pitch / roll change (scene-format
+  /// Euler angles) to multiples of snap_rotate_deg. Never beyond the limits or the placement rules
+  /// (the nearest grid point, else the one towards the start, else the start position); then
+  /// evaluated again.
   double snap_move = 0, snap_rotate_deg = 0;
   /// Used in error messages (the option or JSON path that set the selection and limits).
   std::string scene_path;
@@ -165,7 +176,8 @@ Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caste
                       const std::vector<TargetPoint>& targets, const Objective& objective);
 
 /// Checks the selection and the limits (throws InputError naming `options.scene_path` and the
-/// option) and runs the Ceres nudge. Deterministic.
+/// option) and runs the Ceres nudge. Every candidate pose keeps the limits, the keep-out boxes and
+/// the clearance (SuggestOptions::clearance). Deterministic.
 Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
                    const std::vector<TargetPoint>& targets, const SuggestOptions& options);
 

@@ -255,10 +255,14 @@ class Surrogate {
 };
 
 // Penalty rows of one camera: translation beyond the move limit, rotation beyond the rotation
-// limit, and one row per keep-out box (depth of the centre inside it, relative to the move limit).
-int PenaltyRows(const std::vector<Aabb>& keep_out) { return 2 + static_cast<int>(keep_out.size()); }
+// limit, one row per keep-out box (depth of the centre inside it, relative to the move limit), and
+// the clearance (how much closer to a surface than required, relative to the move limit, with a
+// margin of 2 % of it so the nudge stays clear of the boundary the exact check enforces).
+int PenaltyRows(const std::vector<Aabb>& keep_out) { return 3 + static_cast<int>(keep_out.size()); }
 
-void Penalties(const PoseChart& chart, const std::vector<Aabb>& keep_out, const double* x, double* r) {
+void Penalties(const PoseChart& chart, const suggest_detail::Placement& placement, std::size_t camera,
+               const double* x, double* r) {
+  const std::vector<Aabb>& keep_out = placement.keep_out();
   double t2 = 0, w2 = 0;
   for (int i = 0; i < chart.dims_t; ++i) t2 += x[i] * x[i];
   for (int i = chart.dims_t; i < chart.dims_t + chart.dims_r; ++i) w2 += x[i] * x[i];
@@ -272,6 +276,14 @@ void Penalties(const PoseChart& chart, const std::vector<Aabb>& keep_out, const 
     const double scale = chart.max_move > 0 ? chart.max_move : 1.0;
     r[2 + b] = kPenalty * std::max(0.0, depth / scale + 0.02);
   }
+  const double required = placement.required(camera);
+  double clearance = 0;
+  if (required > 0 && chart.max_move > 0) {
+    const double margin = 0.02 * chart.max_move;
+    const double d = placement.SurfaceDistanceAt(C, required + margin);
+    clearance = std::max(0.0, (required + margin - d) / chart.max_move);
+  }
+  r[2 + keep_out.size()] = kPenalty * clearance;
 }
 
 // One cost function for the whole problem: a parameter block per active camera. Jacobians by
@@ -279,11 +291,11 @@ void Penalties(const PoseChart& chart, const std::vector<Aabb>& keep_out, const 
 class SurrogateCost final : public ceres::CostFunction {
  public:
   SurrogateCost(const Surrogate& surrogate, const std::vector<PoseChart>& charts,
-                const std::vector<int>& active, const std::vector<Aabb>& keep_out,
+                const std::vector<int>& active, const suggest_detail::Placement& placement,
                 std::vector<Contribution>* frozen)
-      : s_(surrogate), charts_(charts), active_(active), keep_out_(keep_out), frozen_(frozen) {
+      : s_(surrogate), charts_(charts), active_(active), placement_(placement), frozen_(frozen) {
     for (int c : active_) mutable_parameter_block_sizes()->push_back(charts_[c].dims());
-    set_num_residuals(s_.rows() + static_cast<int>(active_.size()) * PenaltyRows(keep_out_));
+    set_num_residuals(s_.rows() + static_cast<int>(active_.size()) * PenaltyRows(placement_.keep_out()));
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
@@ -299,10 +311,10 @@ class SurrogateCost final : public ceres::CostFunction {
       ptrs.push_back(&current[a]);
     }
     const int rows = s_.rows();
-    const int prow = PenaltyRows(keep_out_);
+    const int prow = PenaltyRows(placement_.keep_out());
     s_.Residuals(ptrs, residuals);
     for (std::size_t a = 0; a < na; ++a)
-      Penalties(charts_[active_[a]], keep_out_, parameters[a], residuals + rows + a * prow);
+      Penalties(charts_[active_[a]], placement_, active_[a], parameters[a], residuals + rows + a * prow);
     if (!jacobians) return true;
     const int total = num_residuals();
     std::vector<double> rp(total), rm(total), x;
@@ -322,7 +334,7 @@ class SurrogateCost final : public ceres::CostFunction {
           ptrs[base + a] = &shifted;
           double* out = sign == 0 ? rp.data() : rm.data();
           s_.Residuals(ptrs, out);
-          Penalties(chart, keep_out_, xs.data(), out + rows + a * prow);
+          Penalties(chart, placement_, active_[a], xs.data(), out + rows + a * prow);
         }
         ptrs[base + a] = &current[a];
         for (int i = 0; i < rows; ++i) jac[i * dims + j] = (rp[i] - rm[i]) / (2 * kStep);
@@ -338,7 +350,7 @@ class SurrogateCost final : public ceres::CostFunction {
   const Surrogate& s_;
   const std::vector<PoseChart>& charts_;
   const std::vector<int>& active_;
-  const std::vector<Aabb>& keep_out_;
+  const suggest_detail::Placement& placement_;
   std::vector<Contribution>* frozen_;
 };
 
@@ -354,12 +366,13 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   };
   const std::size_t nsel = options.cameras.size();
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
   const std::vector<Eigen::Isometry3d>& start = begin.start;
   Suggestion& s = begin.suggestion;
   s.after = s.before;
-  FillChanges(rig, options, start, {}, &s);
+  FillChanges(rig, options, start, {}, placement, &s);
   const double start_score = ev.Score(s.before);
   const std::string name = ObjectiveName(options.objective);
 
@@ -463,7 +476,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     // Tries moving the cameras in `group` to `xs` (indexed by selected camera); keeps it if better.
     auto try_move = [&](const std::vector<int>& group, std::vector<std::vector<double>>& xs) {
       for (int c : group)
-        if (InKeepOut(options.keep_out, charts[c].Pose(xs[c].data()).translation())) return;  // free
+        if (!placement.Admissible(c, charts[c].Pose(xs[c].data()).translation())) return;  // free
       std::vector<CameraView> v(nsel);
       for (int c : group) {
         v[c] = ev.View(c, charts[c].Pose(xs[c].data()), charts[c].FocalScale(xs[c].data()));
@@ -546,7 +559,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
       charts[c].Project(xs[c].data());
       poses[c] = charts[c].Pose(xs[c].data());
       scales[c] = charts[c].FocalScale(xs[c].data());
-      ok = ok && !InKeepOut(options.keep_out, poses[c].translation());
+      ok = ok && placement.Admissible(c, poses[c].translation());
     }
     return std::make_pair(poses, ok);
   };
@@ -599,7 +612,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(problem_options);
-    SurrogateCost cost(surrogate, charts, active, options.keep_out, &frozen);
+    SurrogateCost cost(surrogate, charts, active, placement, &frozen);
     std::vector<double*> blocks;
     for (int c : active) blocks.push_back(x[c].data());
     problem.AddResidualBlock(&cost, nullptr, blocks);
@@ -639,10 +652,50 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     best_poses[c] = charts[c].Pose(best_x[c].data());
     best_scales[c] = charts[c].FocalScale(best_x[c].data());
   }
+  // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
+  // costs nothing: the screening's random turns leave a roll about the optical axis that coverage
+  // rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
+  // orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25, judged
+  // exactly); the best is taken when it is no worse than the rolled pose.
+  if (best_score > start_score) {
+    for (std::size_t c = 0; c < nsel; ++c) {
+      const Mat3& R0 = start[c].linear();
+      const Mat3 R = best_poses[c].linear();
+      if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
+      const Vec3 ypr = YawPitchRollDeg(R);
+      if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
+      const double limit = charts[c].max_rotate * 180.0 / M_PI * (1 + 1e-9);
+      // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
+      const Vec3 axis = R.col(2);
+      const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / M_PI;
+      const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / M_PI;
+      std::vector<Eigen::Isometry3d> best_trial;
+      Metrics best_level;
+      double best_level_score = -kInf;
+      for (double dy : {0.0, -0.5, 0.5, -1.0, 1.0})
+        for (double dp : {0.0, -0.5, 0.5, -1.0, 1.0}) {
+          const Mat3 L = RotationFromYawPitchRollDeg(Vec3(yaw + dy, pitch + dp, 0.0));
+          if (RotationAngleDeg(R0, L) > limit) continue;
+          std::vector<Eigen::Isometry3d> trial = best_poses;
+          trial[c].linear() = L;
+          const Metrics m = ev.Evaluate(trial, best_scales);
+          if (ev.Score(m) > best_level_score) {
+            best_level_score = ev.Score(m);
+            best_level = m;
+            best_trial = trial;
+          }
+        }
+      if (!best_trial.empty() && best_level_score >= best_score) {
+        best_poses = best_trial;
+        best_m = best_level;
+        best_score = best_level_score;
+      }
+    }
+  }
   if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
     if (best_score > start_score) {
       s.unsnapped = best_m;
-      best_poses = SnapPoses(charts, best_poses, options);
+      best_poses = SnapPoses(charts, best_poses, options, placement);
       best_m = ev.Evaluate(best_poses, best_scales);
       best_score = ev.Score(best_m);
     }
@@ -651,7 +704,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   const bool higher = ObjectiveHigherIsBetter(options.objective);
   if (s.improved) {
     s.after = best_m;
-    FillChanges(rig, options, best_poses, best_scales, &s);
+    FillChanges(rig, options, best_poses, best_scales, placement, &s);
     for (int c : active) s.cameras[c].note.clear();
     std::string extra;
     if (std::isinf(s.after.objective))

@@ -10,6 +10,7 @@
 
 #include "analysis/visibility.h"
 #include "suggest/suggest.h"
+#include "suggest/surface_distance.h"
 
 namespace pandora::suggest_detail {
 
@@ -83,6 +84,7 @@ class ExactEvaluator {
   std::vector<Camera> selected_;
   FixedContribution fixed_;
   double scene_scale_ = 1, region_scale_ = 1, density_scale_ = 1, sigma_cap_mm_ = 1;
+  double geometry_scale_ = 1;  // ContentBounds diagonal: the visibility tolerance's scale
   double pixel_sigma_ = 0.5;
   double ref_sigma_mean_ = 0, ref_min_resolution_ = 0;
   mutable std::int64_t evaluations_ = 0;
@@ -114,6 +116,33 @@ struct PoseChart {
 /// True when `p` lies inside a keep-out box (closed).
 bool InKeepOut(const std::vector<Aabb>& keep_out, const Vec3& p);
 
+/// Where the selected cameras' centres may go besides their limits: outside every keep-out box, and
+/// at least `required(c)` from every scene surface: the clearance, or for a camera that starts
+/// closer than that its start distance (it may stay or move away, never closer).
+class Placement {
+ public:
+  Placement(const Scene& scene, const Rig& rig, const SuggestOptions& options);
+  /// Distance from `p` to the nearest scene surface, metres (capped at `limit`).
+  double SurfaceDistanceAt(const Vec3& p, double limit = std::numeric_limits<double>::infinity()) const {
+    return distance_.Distance(p, limit);
+  }
+  double required(std::size_t c) const { return required_[c]; }
+  /// Metres by which `centre` of selected camera c is closer to a surface than required (0: none).
+  double ClearanceDeficit(std::size_t c, const Vec3& centre) const {
+    if (!(required_[c] > 0)) return 0.0;
+    return std::max(0.0, required_[c] - distance_.Distance(centre, required_[c]));
+  }
+  bool Admissible(std::size_t c, const Vec3& centre) const {
+    return !InKeepOut(keep_out_, centre) && ClearanceDeficit(c, centre) <= 0.0;
+  }
+  const std::vector<Aabb>& keep_out() const { return keep_out_; }
+
+ private:
+  std::vector<Aabb> keep_out_;
+  SurfaceDistance distance_;
+  std::vector<double> required_;  // per selected camera, metres
+};
+
 /// Checks the selection and the limits; throws InputError naming the option.
 void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options);
 
@@ -130,15 +159,16 @@ struct SearchStart {
 SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int target_points,
                         ExactEvaluator& ev);
 
-/// Rounds the change of each camera to the snap steps, within the limits; returns the new poses.
+/// Rounds the change of each camera to the snap steps, within the limits and the placement rules;
+/// returns the new poses.
 std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
-                                         const SuggestOptions& options);
+                                         const SuggestOptions& options, const Placement& placement);
 
 /// Fills the per-camera change records (`focal_scales` empty: no zoom).
 void FillChanges(const Rig& rig, const SuggestOptions& options,
                  const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
-                 Suggestion* s);
+                 const Placement& placement, Suggestion* s);
 
 /// The camera with its focal lengths scaled by `scale` (principal point and distortion kept).
 Camera Zoomed(const Camera& camera, double scale);

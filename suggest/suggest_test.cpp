@@ -21,6 +21,7 @@
 #include "analysis/visibility.h"
 #include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
+#include "suggest/surface_distance.h"
 
 namespace pandora {
 namespace {
@@ -460,6 +461,114 @@ TEST(Suggest, SnapRoundsToInstallableSteps) {
     double delta = std::remainder(y1[a] - y0[a], 360.0);
     EXPECT_NEAR(delta, std::round(delta), 1e-7) << (y1 - y0).transpose();
   }
+  // From a start off the 5 cm grid, a free camera lands on it: every coordinate k * 0.05 m.
+  nlohmann::json j = nlohmann::json::parse(SceneText(1.0));
+  j["rigs"][0]["cameras"][3]["position"] = {0.013, -4.021, 2.007};
+  Fixture g(j.dump());
+  const Suggestion t = Suggest(g.scene, g.rig(), *g.caster, g.targets, o);
+  CheckContract(g, o, t);
+  ASSERT_TRUE(t.improved) << t.message;
+  const Vec3 p = t.cameras[0].after.translation();
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(p[a] / 0.05, std::round(p[a] / 0.05), 1e-9) << p.transpose();
+  // On an oblique rail the camera stays on the rail and moves a multiple of the step along it.
+  SuggestOptions r = o;
+  r.limits[0].mount.kind = MountConstraint::Kind::kLine;
+  r.limits[0].mount.axis = Vec3(1, 1, 0);
+  const Suggestion u = Suggest(g.scene, g.rig(), *g.caster, g.targets, r);
+  CheckContract(g, r, u);
+  const Vec3 m = u.cameras[0].after.translation() - u.cameras[0].before.translation();
+  EXPECT_NEAR(m.normalized().cwiseAbs().dot(Vec3(1, 1, 0).normalized()) * m.norm(), m.norm(), 1e-9 + 1e-9 * m.norm());
+  EXPECT_NEAR(m.norm() / 0.05, std::round(m.norm() / 0.05), 1e-9) << m.transpose();
+}
+
+// A camera 0.25 m in front of a wall (a solid box whose face is the plane y = -1.85), looking
+// through a narrow lens at a region it sees only part of; a camera overhead sees all of it. Backing
+// up towards the wall widens its view, so coverage2 pulls it back as far as it may go: through the
+// wall it would see nothing. `start_y` places it (the wall face is at -1.85).
+std::string WallText(double start_y) {
+  return R"({"objects": [
+    {"name": "floor", "box": {"size": [6, 6, 0.1]}, "position": [0, 0, -0.05], "solid": true},
+    {"name": "wall", "box": {"size": [6, 0.2, 3]}, "position": [0, -1.95, 1.5], "solid": true}],
+  "rigs": [{"name": "r", "cameras": [
+    {"id": "top", "position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "resolution": [640, 480], "hfov_deg": 60},
+    {"id": "back", "position": [0, )" + Num(start_y) + R"(, 0.5], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 40}]}],
+  "study": {"region": {"box": {"min": [-1, -1, 0], "max": [1, 1, 1]}}, "voxel_size": 0.1}})";
+}
+
+TEST(Suggest, ClearanceKeepsTheCentreOffTheWall) {
+  const double wall = -1.85;
+  auto run = [&](double start_y, double clearance) {
+    Fixture f(WallText(start_y), 400);
+    SuggestOptions o;
+    o.objective.k = 2;
+    o.cameras = {1};
+    CameraLimits l;
+    l.max_move = 0.3;
+    l.max_rotate_deg = 5;
+    o.limits = {l};
+    o.clearance = clearance;
+    const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+    CheckContract(f, o, s);
+    return s;
+  };
+  // No clearance: the objective takes the camera to within 10 cm of the wall, so the test below can
+  // fail.
+  const Suggestion free = run(-1.6, 0.0);
+  ASSERT_TRUE(free.improved) << free.message;
+  const double free_gap = free.cameras[0].after.translation().y() - wall;
+  EXPECT_LT(free_gap, 0.1) << "the objective no longer pushes the camera towards the wall";
+  EXPECT_GT(free_gap, 0.0);
+  EXPECT_NEAR(free.cameras[0].surface_distance_after, free_gap, 1e-9);
+  // 10 cm: improved, and the centre at least 10 cm from every surface (the wall is the nearest).
+  const Suggestion kept = run(-1.6, 0.1);
+  ASSERT_TRUE(kept.improved) << kept.message;
+  const double gap = kept.cameras[0].after.translation().y() - wall;
+  EXPECT_GE(gap, 0.1 - 1e-12);
+  EXPECT_NEAR(kept.cameras[0].surface_distance_before, 0.25, 1e-9);
+  EXPECT_NEAR(kept.cameras[0].surface_distance_after, gap, 1e-9);
+  EXPECT_LT(kept.cameras[0].after.translation().y(), -1.6) << "it did back up";
+  // A camera that starts 5 cm from the wall may stay or move away, never closer.
+  const Suggestion close = run(wall + 0.05, 0.1);
+  EXPECT_GE(close.cameras[0].after.translation().y() - wall, 0.05 - 1e-12);
+  EXPECT_GE(close.cameras[0].surface_distance_after, 0.05 - 1e-12);
+  // A clearance that is not a finite length >= 0 is refused.
+  Fixture f(WallText(-1.6), 50);
+  SuggestOptions bad = Options({1}, 0.3, 5);
+  bad.clearance = -0.1;
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, bad), InputError);
+}
+
+TEST(SurfaceDistance, MatchesBruteForceAndClosedForms) {
+  // A unit cube at the origin: outside a face the distance is the offset, beyond an edge or a corner
+  // the Euclidean distance to it; inside, the distance to the nearest face.
+  Scene scene = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}}],
+    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 0], "look_at": [0, 0, 0],
+    "resolution": [64, 48], "hfov_deg": 40}]}],
+    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "cube.json");
+  const TriangleMesh mesh = scene.AllTriangles();
+  const SurfaceDistance d(mesh);
+  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.1, -0.2)), 0.3, 1e-12);                 // face
+  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.9, 0.0)), std::hypot(0.3, 0.4), 1e-12);  // edge
+  EXPECT_NEAR(d.Distance(Vec3(1.5, 1.5, 1.5)), std::sqrt(3.0), 1e-12);        // corner
+  EXPECT_NEAR(d.Distance(Vec3(0.1, 0.0, 0.0)), 0.4, 1e-12);                 // inside
+  EXPECT_EQ(d.Distance(Vec3(5, 0, 0), 1.0), 1.0);                            // capped
+  // Against a brute-force loop on a finer mesh (a 64-segment sphere and the cube), random points.
+  Scene two = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}},
+    {"name": "s", "sphere": {"radius": 0.7, "segments": 64}, "position": [2, 0.5, 0]}],
+    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 3], "look_at": [0, 0, 0],
+    "resolution": [64, 48], "hfov_deg": 40}]}],
+    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "two.json");
+  const TriangleMesh all = two.AllTriangles();
+  const SurfaceDistance fast(all);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2, 4);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(u(rng), u(rng) * 0.5, u(rng) * 0.5);
+    double brute = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3i& t : all.triangles)
+      brute = std::min(brute, PointTriangleDistance(p, all.vertices[t[0]], all.vertices[t[1]], all.vertices[t[2]]));
+    ASSERT_EQ(fast.Distance(p), brute) << p.transpose();
+  }
 }
 
 TEST(Suggest, CameraThatSeesNothingEndsCleanly) {
@@ -578,6 +687,22 @@ class SuggestAcceptTest : public ::testing::Test {
   fs::path dir_;
 };
 
+// A reloaded pose against the suggested one: centres within 1e-9 m, orientations within 1e-9 rad
+// (accept writes 12 significant digits).
+::testing::AssertionResult SamePose(const Eigen::Isometry3d& got, const Eigen::Isometry3d& want) {
+  const double dc = (got.translation() - want.translation()).norm();
+  const Eigen::Quaterniond q(Mat3(got.linear().transpose() * want.linear()));
+  const double angle = 2 * std::atan2(q.vec().norm(), std::abs(q.w()));
+  if (dc <= 1e-9 && angle <= 1e-9) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "centre off by " << dc << " m, orientation by " << angle << " rad";
+}
+
+std::vector<std::string> Keys(const nlohmann::ordered_json& cam) {
+  std::vector<std::string> keys;
+  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
+  return keys;
+}
+
 // Everything but the pose keys of the named cameras is JSON-equal.
 void ExpectEqualButPoses(const std::string& a_text, const std::string& b_text, const std::set<std::string>& ids) {
   nlohmann::ordered_json a = nlohmann::ordered_json::parse(a_text), b = nlohmann::ordered_json::parse(b_text);
@@ -605,15 +730,18 @@ TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   EXPECT_EQ(Read(r.backup_path), original);
   const std::string updated = Read(scene_path);
   ExpectEqualButPoses(original, updated, {"c4"});
-  // Key order: position then quaternion, where position was; id first as before.
+  // The camera keeps its look_at form, in the same place; `up` follows look_at when the suggestion
+  // rolled the camera (then accept says so).
   const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(updated)["rigs"][0]["cameras"][3];
-  std::vector<std::string> keys;
-  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "quaternion", "resolution", "hfov_deg", "range"}));
+  std::vector<std::string> keys = Keys(cam);
+  const bool rolled = cam.contains("up");
+  EXPECT_EQ(rolled, !r.notes.empty());
+  if (rolled) keys.erase(std::find(keys.begin(), keys.end(), "up"));
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "hfov_deg", "range"}));
 
   const Scene after = LoadScene(scene_path.string());
   const Scene before = ParseScene(original, scene_path.string());
-  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+  EXPECT_TRUE(SamePose(after.rigs[0].cameras[3].world_from_camera, s.cameras[1].after));
   for (int c : {0, 1, 2})  // c2 was offered but not accepted
     EXPECT_TRUE(after.rigs[0].cameras[c].world_from_camera.matrix() ==
                 before.rigs[0].cameras[c].world_from_camera.matrix());
@@ -630,8 +758,8 @@ TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   EXPECT_EQ(fs::path(r2.backup_path), fs::path(scene_path.string() + ".bak.1"));
   EXPECT_EQ(Read(r2.backup_path), updated);
   const Scene both = LoadScene(scene_path.string());
-  EXPECT_TRUE(both.rigs[0].cameras[1].world_from_camera.isApprox(s.cameras[0].after, 1e-12));
-  EXPECT_TRUE(both.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+  EXPECT_TRUE(SamePose(both.rigs[0].cameras[1].world_from_camera, s.cameras[0].after));
+  EXPECT_TRUE(SamePose(both.rigs[0].cameras[3].world_from_camera, s.cameras[1].after));
 }
 
 TEST_F(SuggestAcceptTest, ZoomWritesFocalLengthInPlaceOfTheFieldOfView) {
@@ -656,11 +784,11 @@ TEST_F(SuggestAcceptTest, ZoomWritesFocalLengthInPlaceOfTheFieldOfView) {
   EXPECT_NEAR(k1.fx, k0.fx * s.cameras[0].focal_scale, 1e-9 * k0.fx);
   EXPECT_NEAR(k1.fy, k0.fy * s.cameras[0].focal_scale, 1e-9 * k0.fy);
   EXPECT_EQ(k1.cx, k0.cx);
-  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[0].after, 1e-12));
+  EXPECT_TRUE(SamePose(after.rigs[0].cameras[3].world_from_camera, s.cameras[0].after));
   const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(Read(scene_path))["rigs"][0]["cameras"][3];
-  std::vector<std::string> keys;
-  for (auto it = cam.begin(); it != cam.end(); ++it) keys.push_back(it.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "quaternion", "resolution", "focal_px", "range"}));
+  std::vector<std::string> keys = Keys(cam);
+  if (cam.contains("up")) keys.erase(std::find(keys.begin(), keys.end(), "up"));
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "focal_px", "range"}));
 }
 
 TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
@@ -720,9 +848,108 @@ TEST_F(SuggestAcceptTest, MillimetreFileGetsMillimetres) {
   const std::string suggestion = MakeSuggestion(scene_path, &s);
   AcceptSuggestion(suggestion, {});
   const Scene after = LoadScene(scene_path.string());
-  EXPECT_TRUE(after.rigs[0].cameras[3].world_from_camera.isApprox(s.cameras[1].after, 1e-12));
+  EXPECT_TRUE(SamePose(after.rigs[0].cameras[3].world_from_camera, s.cameras[1].after));
   const auto pos = nlohmann::json::parse(Read(scene_path))["rigs"][0]["cameras"][3]["position"];
-  EXPECT_NEAR(pos[1].get<double>(), s.cameras[1].after.translation().y() * 1000.0, 1e-9);
+  EXPECT_NEAR(pos[1].get<double>(), s.cameras[1].after.translation().y() * 1000.0, 1e-6);  // mm
+}
+
+// The three forms of a pose survive accept: look_at (with up), euler_deg and quaternion; with
+// --snap-move 0.05 the positions in the file are multiples of 5 cm (in a centimetre file: of 5);
+// the reloaded poses are the suggested ones (SamePose) and the look_at point keeps its distance.
+TEST_F(SuggestAcceptTest, AcceptKeepsEachCamerasFormAndWritesSnappedNumbers) {
+  for (const std::string units : {"m", "cm"}) {
+    SCOPED_TRACE(units);
+    const double s_unit = units == "m" ? 1.0 : 100.0;
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(SceneText(s_unit, Vec3(2.0, 0.0, 0.5), units));
+    auto& cams = j["rigs"][0]["cameras"];
+    cams[3]["up"] = {0, 0, 1};
+    // c2 as Euler angles (it looks at the region's centre from (0, 4, 2): yaw -90, pitch down).
+    cams[1].erase("look_at");
+    cams[1]["euler_deg"] = {{"yaw", -90}, {"pitch", -20}};
+    cams[0].erase("look_at");  // c1 as a quaternion: looking along -x, tilted down 20 degrees
+    const Mat3 R1 = RotationFromYawPitchRollDeg(Vec3(180, -20, 0));
+    const Eigen::Quaterniond q1(R1);
+    cams[0]["quaternion"] = {q1.w(), q1.x(), q1.y(), q1.z()};
+    const fs::path scene_path = dir_ / ("forms_" + units + ".json");
+    Write(scene_path, j.dump(2) + "\n");
+    const double look_distance = (Vec3(2.0, 0.0, 0.5) - Vec3(0, -4, 2)).norm() * s_unit;
+
+    const Scene scene = LoadScene(scene_path.string());
+    const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+    const auto targets = SampleTargets(scene, 300, {}, false, 7);
+    SuggestOptions o = Options({0, 1, 3}, 0.3, 20);
+    o.snap_move = 0.05;
+    o.snap_rotate_deg = 1.0;
+    const Suggestion s = Suggest(scene, scene.rigs[0], *caster, targets, o);
+    ASSERT_TRUE(s.improved) << s.message;
+    const fs::path sp = dir_ / ("suggestion_" + units + ".json");
+    Write(sp, SuggestionToJson(s, scene, scene.rigs[0], o));
+    const AcceptResult r = AcceptSuggestion(sp.string(), {});
+
+    const nlohmann::ordered_json out = nlohmann::ordered_json::parse(Read(scene_path));
+    const auto& written = out["rigs"][0]["cameras"];
+    const Scene after = LoadScene(scene_path.string());
+    for (const CameraChange& ch : s.cameras) {
+      SCOPED_TRACE(ch.id);
+      const auto& cam = written[ch.index];
+      if (!(ch.move_m > 0 || ch.rotate_deg > 0)) continue;  // left as written
+      EXPECT_TRUE(SamePose(after.rigs[0].cameras[ch.index].world_from_camera, ch.after));
+      for (int a = 0; a < 3; ++a) {  // k * 5 cm, written as such (5 cm = 5 in the cm file)
+        const double v = cam["position"][a].get<double>();
+        const double step = 0.05 * s_unit;
+        EXPECT_EQ(v, std::strtod(Num(std::round(v / step) * step).c_str(), nullptr));
+        EXPECT_LT(std::abs(v / step - std::round(v / step)), 1e-9) << v;
+        std::ostringstream text;
+        text << cam["position"][a];
+        EXPECT_LE(text.str().size(), 8u) << text.str();  // e.g. -4.15 or 415, not -4.1499999999
+      }
+    }
+    EXPECT_TRUE(written[0].contains("quaternion"));
+    EXPECT_FALSE(written[0].contains("euler_deg") || written[0].contains("look_at"));
+    EXPECT_TRUE(written[1].contains("euler_deg"));
+    EXPECT_FALSE(written[1].contains("quaternion") || written[1].contains("look_at"));
+    ASSERT_TRUE(written[3].contains("look_at"));
+    EXPECT_FALSE(written[3].contains("quaternion"));
+    const Vec3 p(written[3]["position"][0].get<double>(), written[3]["position"][1].get<double>(),
+                 written[3]["position"][2].get<double>());
+    const Vec3 t(written[3]["look_at"][0].get<double>(), written[3]["look_at"][1].get<double>(),
+                 written[3]["look_at"][2].get<double>());
+    EXPECT_NEAR((t - p).norm(), look_distance, 1e-9 * look_distance);
+    // The roll change was snapped to whole degrees: either none (up kept as [0, 0, 1]) or a
+    // multiple of 1 degree that accept reports and writes into up.
+    ASSERT_TRUE(written[3].contains("up"));
+    const bool kept = written[3]["up"] == nlohmann::ordered_json({0, 0, 1});
+    bool noted = false;
+    for (const std::string& n : r.notes) noted = noted || n.rfind("c4:", 0) == 0;
+    EXPECT_EQ(kept, !noted);
+  }
+}
+
+TEST(SuggestReplacePoses, LookAtKeepsUpOrSaysWhyNot) {
+  const std::string text = nlohmann::ordered_json::parse(SceneText(1.0)).dump(2) + "\n";
+  // c1 at (4, 0, 2) looking at (0, 0, 0.5): move it 10 cm and turn it to look at (0, 0.5, 0.5).
+  const Vec3 p(4.1, 0.0, 2.0), target(0, 0.5, 0.5);
+  const double distance = (Vec3(0, 0, 0.5) - Vec3(4, 0, 2)).norm();
+  Eigen::Isometry3d pose = *LookAt(p, target, Vec3::UnitZ());
+  std::vector<std::string> notes;
+  std::string out = ReplacePoses(text, "x.json", "ring", {{"c1", pose, std::nullopt, 0}}, &notes);
+  nlohmann::ordered_json cam = nlohmann::ordered_json::parse(out)["rigs"][0]["cameras"][0];
+  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "resolution", "hfov_deg", "range"}));
+  EXPECT_TRUE(notes.empty());
+  const Vec3 t(cam["look_at"][0].get<double>(), cam["look_at"][1].get<double>(), cam["look_at"][2].get<double>());
+  EXPECT_NEAR((t - p).norm(), distance, 1e-9);  // the old look_at's distance, along the new axis
+  EXPECT_NEAR((t - p).normalized().dot((target - p).normalized()), 1.0, 1e-15);
+  EXPECT_TRUE(SamePose(ParseScene(out, "x.json").rigs[0].cameras[0].world_from_camera, pose));
+  // Rolled 5 degrees about its optical axis: up cannot stay [0, 0, 1]; it becomes the camera's up.
+  Eigen::Isometry3d rolled = pose;
+  rolled.linear() = pose.linear() * Eigen::AngleAxisd(5 * M_PI / 180, Vec3::UnitZ()).toRotationMatrix();
+  out = ReplacePoses(text, "x.json", "ring", {{"c1", rolled, std::nullopt, 0}}, &notes);
+  cam = nlohmann::ordered_json::parse(out)["rigs"][0]["cameras"][0];
+  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "up", "resolution", "hfov_deg", "range"}));
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("c1: the suggestion also turns the camera 5 deg about its optical axis"), std::string::npos)
+      << notes[0];
+  EXPECT_TRUE(SamePose(ParseScene(out, "x.json").rigs[0].cameras[0].world_from_camera, rolled));
 }
 
 TEST(SuggestReplacePoses, UntouchedTextIsByteIdentical) {

@@ -4,10 +4,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -16,6 +21,7 @@
 #include "analysis/input_file.h"
 #include "analysis/output_transaction.h"
 #include "analysis/sha256.h"
+#include "suggest/suggest.h"
 
 namespace pandora {
 namespace {
@@ -103,6 +109,51 @@ Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::st
   return pose;
 }
 
+// The double nearest the 12-significant-digit decimal of v: what a person would have typed.
+double Clean(double v) {
+  if (!std::isfinite(v)) return v;
+  char b[40];
+  std::snprintf(b, sizeof b, "%.12g", v);
+  const double c = std::strtod(b, nullptr);
+  return c == 0 ? 0.0 : c;  // no -0
+}
+
+// A coordinate in file units: the multiple of `step` when it is one (within 1e-6 of a step).
+double OnGrid(double v, double step) {
+  if (step > 0) {
+    const double k = std::round(v / step);
+    if (std::abs(v / step - k) < 1e-6) return Clean(k * step);
+  }
+  return Clean(v);
+}
+
+// A number as JSON: an integer when it is a whole number (as a person writes 4, not 4.0).
+ordered_json Number(double v) {
+  if (std::isfinite(v) && v == std::round(v) && std::abs(v) < 1e15)
+    return ordered_json(static_cast<std::int64_t>(v));
+  return ordered_json(v);
+}
+
+ordered_json Array(const Vec3& v) { return ordered_json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
+
+std::optional<Vec3> FileVec3(const ordered_json& cam, const char* key) {
+  if (!cam.contains(key)) return std::nullopt;
+  const ordered_json& a = cam[key];
+  if (!a.is_array() || a.size() != 3) return std::nullopt;
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    if (!a[i].is_number()) return std::nullopt;
+    v[i] = a[i].get<double>();
+  }
+  return v;
+}
+
+// Angle of the rotation between a and b, radians (accurate near 0, unlike acos of the trace).
+double AngleRad(const Mat3& a, const Mat3& b) {
+  const Eigen::Quaterniond q(Mat3(a.transpose() * b));
+  return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
+}
+
 }  // namespace
 
 std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig& rig,
@@ -123,6 +174,7 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   j["metrics"] = {{"before", MetricsJson(s.before)}, {"after", MetricsJson(s.after)}};
   if (s.unsnapped) j["metrics"]["unsnapped"] = MetricsJson(*s.unsnapped);
   j["snap"] = {{"move_m", options.snap_move}, {"rotate_deg", options.snap_rotate_deg}};
+  j["clearance_m"] = options.clearance;
   json cams = json::array();
   for (std::size_t c = 0; c < s.cameras.size(); ++c) {
     const CameraChange& ch = s.cameras[c];
@@ -135,6 +187,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
     json cj = {{"id", ch.id}, {"index", ch.index}, {"before", PoseJson(ch.before)},
                {"after", PoseJson(ch.after)}, {"move_m", ch.move_m}, {"rotate_deg", ch.rotate_deg},
                {"hfov_deg", {{"before", ch.hfov_before_deg}, {"after", ch.hfov_after_deg}}},
+               {"surface_distance_m",
+                {{"before", Finite(ch.surface_distance_before)}, {"after", Finite(ch.surface_distance_after)}}},
                {"limits", limits}};
     if (ch.focal_scale != 1.0) {
       const Intrinsics& k = rig.cameras[ch.index].model.intrinsics();
@@ -157,7 +211,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
 }
 
 std::string ReplacePoses(const std::string& text, const std::string& scene_path,
-                         const std::string& rig_name, const std::vector<PoseUpdate>& poses) {
+                         const std::string& rig_name, const std::vector<PoseUpdate>& poses,
+                         std::vector<std::string>* notes) {
   ordered_json root;
   try {
     root = ordered_json::parse(text);
@@ -188,14 +243,57 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
       const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
       if (!cam.contains("position"))
         throw InputError(scene_path, where, "the camera has no position");
-      const Vec3 p = update.pose.translation() / mpu;
-      const Eigen::Quaterniond q(update.pose.linear());
+      Vec3 p = update.pose.translation() / mpu;  // file units
+      const double step = update.snap_move / mpu;
+      for (int i = 0; i < 3; ++i) p[i] = OnGrid(p[i], step);
+      const Mat3 R = update.pose.linear();
+      // The orientation in the camera's own form.
+      ordered_json orientation = ordered_json::object();
+      const std::optional<Vec3> p0 = FileVec3(cam, "position"), t0 = FileVec3(cam, "look_at");
+      if (cam.contains("look_at") && p0 && t0 && (*t0 - *p0).norm() > 0) {
+        const double distance = (*t0 - *p0).norm();
+        Vec3 target = p + distance * R.col(2);
+        for (int i = 0; i < 3; ++i) target[i] = Clean(target[i]);
+        const std::optional<Vec3> up0 = FileVec3(cam, "up");
+        const Vec3 up = up0.value_or(Vec3::UnitZ());
+        orientation["look_at"] = Array(target);
+        const auto kept = LookAt(p * mpu, target * mpu, up);
+        if (kept && AngleRad(kept->linear(), R) <= 1e-9) {
+          if (up0) orientation["up"] = cam["up"];
+        } else {
+          // The roll look_at cannot express with this up: any up in the camera's own vertical plane
+          // (its up direction -y and its optical axis) can. Of those, the one nearest the world's
+          // +z (its projection on that plane), which reads best; the camera's up where +z is
+          // perpendicular to it.
+          const Vec3 u = -R.col(1), f = R.col(2);
+          Vec3 own = u;
+          if (u.z() > 1e-6) own = (u.z() * u + f.z() * f).normalized();
+          for (int i = 0; i < 3; ++i) own[i] = Clean(own[i]);
+          orientation["up"] = Array(own);
+          if (notes) {
+            char line[200];
+            std::snprintf(line, sizeof line,
+                          "%s: the suggestion also turns the camera %.3g deg about its optical axis "
+                          "(a roll the old 'up' cannot express): 'up' is now [%.6g, %.6g, %.6g]",
+                          update.id.c_str(), kept ? AngleRad(kept->linear(), R) * 57.29577951308232 : 0.0,
+                          own.x(), own.y(), own.z());
+            notes->push_back(line);
+          }
+        }
+      } else if (cam.contains("euler_deg")) {
+        const Vec3 ypr = YawPitchRollDeg(R);
+        orientation["euler_deg"] = ordered_json::object(
+            {{"yaw", Number(Clean(ypr.x()))}, {"pitch", Number(Clean(ypr.y()))}, {"roll", Number(Clean(ypr.z()))}});
+      } else {
+        const Eigen::Quaterniond q(R);
+        orientation["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
+      }
       ordered_json rebuilt = ordered_json::object();
       for (auto it = cam.begin(); it != cam.end(); ++it) {
         const std::string& key = it.key();
         if (key == "position") {
-          rebuilt["position"] = {p.x(), p.y(), p.z()};
-          rebuilt["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
+          rebuilt["position"] = Array(p);
+          for (auto o = orientation.begin(); o != orientation.end(); ++o) rebuilt[o.key()] = o.value();
         } else if (key == "look_at" || key == "up" || key == "quaternion" || key == "euler_deg") {
           continue;
         } else if (update.focal_px && (key == "hfov_deg" || key == "focal_px" || key == "lens")) {
@@ -248,6 +346,10 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
                      "run pandora suggest without --perturb");
   AcceptResult result;
   result.scene_path = scene_j["path"].get<std::string>();
+  double snap_move = 0;
+  if (j.contains("snap") && j["snap"].is_object() && j["snap"].contains("move_m") &&
+      j["snap"]["move_m"].is_number())
+    snap_move = std::max(0.0, j["snap"]["move_m"].get<double>());
 
   std::vector<PoseUpdate> updates;
   std::map<std::string, PoseUpdate> offered;
@@ -258,7 +360,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       throw InputError(suggestion_path, where + ".id", "missing camera id");
     const std::string id = cams[c]["id"].get<std::string>();
     const json after = cams[c].value("after", json());
-    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt};
+    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt, snap_move};
     if (after.is_object() && after.contains("focal_px")) {
       const json& f = after["focal_px"];
       if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_number() ||
@@ -289,7 +391,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with --force");
-  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates);
+  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates, &result.notes);
 
   // Check the new text before touching any file: the accepted poses are there, nothing else moved.
   LoadOptions lo;
@@ -309,7 +411,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       }
       const Vec2 focal_read(b.model.intrinsics().fx, b.model.intrinsics().fy);
       const bool same = (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
-                        (b.world_from_camera.linear() - expected.linear()).norm() <= 1e-9 &&
+                        AngleRad(b.world_from_camera.linear(), expected.linear()) <= 1e-9 &&
                         (focal_read - focal).norm() <= 1e-9 * focal.norm();
       if (!same)
         throw InputError(result.scene_path, "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",

@@ -27,16 +27,30 @@ struct PoseUpdate {
   std::string id;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   std::optional<Vec2> focal_px;
+  /// The suggestion's --snap-move (metres; 0: none): position coordinates within 1e-6 of a step of a
+  /// multiple of it are written as that multiple (in the file's units).
+  double snap_move = 0;
 };
 
-/// The scene file text with the pose of each listed camera of `rig` replaced by `position` (in the
-/// file's units) and `quaternion`, at the place of the old `position`; its orientation keys
-/// (`look_at`, `up`, `quaternion`, `euler_deg`) removed. With `focal_px`, the focal-length key
-/// (`hfov_deg`, `focal_px` or `lens`) is replaced by `focal_px` [fx, fy] at its place. Everything else keeps its order and value;
-/// the text is re-serialised with the file's indentation. Throws InputError (file = scene_path) when
-/// the JSON, the rig or a camera cannot be found.
+/// The scene file text with the pose of each listed camera of `rig` replaced, in the form the file
+/// gives it (docs/suggest.md, "Accept"):
+///  - `position` + `look_at` (+ `up`): the new position and a look_at point at the old look_at's
+///    distance along the new optical axis; `up` is kept (or left out, as it was) when it reproduces
+///    the new orientation to 1e-9 rad, else it is written as the direction nearest +z in the
+///    camera's vertical plane (its image up direction, minus y, and its optical axis), which
+///    expresses the roll the suggestion made (reported in `notes`);
+///  - `position` + `euler_deg`: the new yaw, pitch and roll (scene-format angles, degrees);
+///  - `position` + `quaternion`: the new quaternion [w, x, y, z].
+/// Positions are in the file's units; every written number is the double nearest its 12-digit
+/// decimal (no 0.30000000000000004), and coordinates on the snap grid are written as multiples of
+/// the step. With `focal_px`, the focal-length key (`hfov_deg`, `focal_px` or `lens`) is replaced by
+/// `focal_px` [fx, fy] at its place. Everything else keeps its order and value; the text is
+/// re-serialised with the file's indentation. Throws InputError (file = scene_path) when the JSON,
+/// the rig or a camera cannot be found. `notes` (may be null) receives one line per camera whose
+/// `up` had to change.
 std::string ReplacePoses(const std::string& scene_text, const std::string& scene_path,
-                         const std::string& rig, const std::vector<PoseUpdate>& poses);
+                         const std::string& rig, const std::vector<PoseUpdate>& poses,
+                         std::vector<std::string>* notes = nullptr);
 
 struct AcceptOptions {
   std::vector<std::string> cameras;  ///< Ids to accept; empty: all cameras of the suggestion.
@@ -47,13 +61,15 @@ struct AcceptResult {
   std::string scene_path;
   std::string backup_path;
   std::vector<std::string> accepted;  ///< Camera ids written.
+  std::vector<std::string> notes;     ///< E.g. a look_at camera whose `up` changed (a roll).
 };
 
 /// Reads the suggestion file, checks it (an improvement, the scene file unchanged since: same
 /// SHA-256, unless force), writes a backup of the scene file (`SCENE.bak`, or `SCENE.bak.N` with the
-/// first free N), then the scene file with the accepted poses (atomically). Before writing, the new
-/// text is parsed as a scene and checked: the accepted cameras have the new poses (to 1e-9 of the
-/// scene size) and every other camera of every rig is unchanged. Throws InputError on any problem,
+/// first free N), then the scene file with the accepted poses (atomically), each in its camera's form
+/// (ReplacePoses). Before writing, the new text is parsed as a scene and checked: the accepted
+/// cameras have the suggested poses (centres to 1e-9 of the scene size, orientations to 1e-9 rad)
+/// and every other camera of every rig is unchanged. Throws InputError on any problem,
 /// leaving every file as it was.
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options);
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "volume/fields_vdb.h"
+
 namespace pandora {
 namespace {
 
@@ -31,8 +33,26 @@ std::int64_t CountAtMost(const std::vector<float>& values, double limit) {
 
 }  // namespace
 
+nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
+                               const std::vector<int>& percentiles) {
+  std::vector<float> values;
+  if (const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name)) {
+    values.reserve(grid->activeVoxelCount());
+    for (auto it = grid->cbeginValueOn(); it; ++it) {
+      if (it.isVoxelValue())
+        values.push_back(*it);
+      else
+        values.insert(values.end(), it.getVoxelCount(), *it);
+    }
+  }
+  nlohmann::json j = nlohmann::json::object();
+  for (int p : percentiles) j["p" + std::to_string(p)] = Percentile(values, p);
+  return j;
+}
+
 nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
-                           const std::vector<std::string>& field_names, int threads) {
+                           const std::vector<std::string>& field_names, int threads,
+                           const std::vector<Warning>& warnings) {
   const FieldStats& st = fields.stats;
   const std::int64_t region = st.active_set.region_voxels;
   nlohmann::json j;
@@ -59,16 +79,24 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
                    {"ge2", Fraction(at_least[2], region)},
                    {"ge3", Fraction(at_least[3], region)},
                    {"histogram", st.coverage_histogram}};
+  if (std::find(field_names.begin(), field_names.end(), "resolution") != field_names.end())
+    j["resolution_px_per_m"] = GridPercentiles(fields, "resolution", {10, 50, 90});
 
   nlohmann::json per_camera = nlohmann::json::array();
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[c];
     const std::int64_t seen = c < st.per_camera_seen.size() ? st.per_camera_seen[c] : 0;
-    per_camera.push_back({{"id", cam.id},
-                          {"name", cam.name},
-                          {"enabled", cam.enabled},
-                          {"visible_voxels", seen},
-                          {"visible_fraction", Fraction(seen, region)}});
+    const LensCoverage lens = ComputeLensCoverage(cam.model);
+    per_camera.push_back(
+        {{"id", cam.id},
+         {"name", cam.name},
+         {"enabled", cam.enabled},
+         {"visible_voxels", seen},
+         {"visible_fraction", Fraction(seen, region)},
+         {"fov_deg",
+          {{"nominal", {lens.nominal_hfov_deg, lens.nominal_vfov_deg}},
+           {"effective", {lens.hfov_deg, lens.vfov_deg}}}},
+         {"unreachable_pixels", lens.unreachable_fraction}});
   }
   j["per_camera"] = per_camera;
 
@@ -95,6 +123,14 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
     }
     j["uncertainty"] = u;
   }
+
+  nlohmann::json list = nlohmann::json::array();
+  for (const Warning& w : warnings)
+    list.push_back({{"kind", WarningKindName(w.kind)},
+                    {"camera", w.camera},
+                    {"path", w.json_path},
+                    {"message", w.reason}});
+  j["warnings"] = list;
 
   const double secs = st.seconds;
   j["timing"] = {{"seconds", secs},

@@ -47,20 +47,69 @@ std::string Number(double v) {
   return s.str();
 }
 
+// The points whose extremes bound the region (the box's corners, or a mesh region's vertices) and
+// the viewpoints.
+std::vector<Vec3> Extremes(const Region& region, const std::vector<Vec3>& viewpoints) {
+  std::vector<Vec3> corners = viewpoints;
+  if (region.kind == Region::Kind::kMesh && !region.mesh.vertices.empty()) {
+    corners.insert(corners.end(), region.mesh.vertices.begin(), region.mesh.vertices.end());
+    return corners;
+  }
+  if (region.box.empty()) return corners;
+  for (int i = 0; i < 8; ++i)
+    corners.emplace_back(i & 1 ? region.box.max.x() : region.box.min.x(),
+                         i & 2 ? region.box.max.y() : region.box.min.y(),
+                         i & 4 ? region.box.max.z() : region.box.min.z());
+  return corners;
+}
+
+bool Faces(const std::vector<Vec3>& extremes, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 cross = (b - a).cross(c - a);
+  const double twice = cross.norm();
+  if (!(twice > 0)) return false;
+  const Vec3 n = cross / twice;
+  for (const Vec3& x : extremes)
+    if (n.dot(x - a) > 0) return true;
+  return false;
+}
+
+bool Selected(SurfaceSelection selection, const std::vector<Vec3>& extremes, const TriangleMesh& mesh,
+              const Eigen::Vector3i& t) {
+  return selection == SurfaceSelection::kAll ||
+         Faces(extremes, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
+}
+
+std::vector<Vec3> EnabledCentres(const Rig* rig) {
+  std::vector<Vec3> out;
+  if (rig)
+    for (const Camera& c : rig->cameras)
+      if (c.enabled) out.push_back(c.center());
+  return out;
+}
+
 }  // namespace
 
-double SurfaceArea(const Scene& scene) {
+bool FacesRegionOrViewpoints(const Region& region, const std::vector<Vec3>& viewpoints, const Vec3& a,
+                             const Vec3& b, const Vec3& c) {
+  return Faces(Extremes(region, viewpoints), a, b, c);
+}
+
+double SurfaceArea(const Scene& scene, SurfaceSelection selection, const Rig* rig) {
+  const std::vector<Vec3> extremes = Extremes(scene.study.region, EnabledCentres(rig));
   double area = 0;
   for (const SceneObject& o : scene.objects)
-    for (const Eigen::Vector3i& t : o.mesh.triangles) area += TriangleArea(o.mesh, t, nullptr);
+    for (const Eigen::Vector3i& t : o.mesh.triangles)
+      if (Selected(selection, extremes, o.mesh, t)) area += TriangleArea(o.mesh, t, nullptr);
   return area;
 }
 
 std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, std::uint64_t seed,
-                                          const std::string& option) {
+                                          const std::string& option, SurfaceSelection selection,
+                                          const Rig* rig) {
   if (!(spacing > 0) || !std::isfinite(spacing))
     throw InputError(option, "", "must be a positive number of metres", "e.g. 0.02");
-  const double area = SurfaceArea(scene);
+  const std::vector<Vec3> extremes = Extremes(scene.study.region, EnabledCentres(rig));
+  const double area = SurfaceArea(scene, selection, rig);
   const double expected = area / (spacing * spacing);
   if (expected > kMaxSurfaceSamples)
     throw InputError(option, "",
@@ -79,6 +128,7 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
     const TriangleMesh& mesh = scene.objects[oi].mesh;
     for (std::size_t ti = 0; ti < mesh.triangles.size(); ++ti) {
       const Eigen::Vector3i& t = mesh.triangles[ti];
+      if (!Selected(selection, extremes, mesh, t)) continue;
       Vec3 normal;
       const double a = TriangleArea(mesh, t, &normal);
       if (!(a > 0)) continue;

@@ -24,17 +24,39 @@ struct SurfaceSample {
 /// Sample counts above this are refused (about 1.6 GB of samples and values).
 inline constexpr double kMaxSurfaceSamples = 2.0e7;
 
-/// Total triangle area of the scene's objects, m^2 (degenerate triangles count 0).
-double SurfaceArea(const Scene& scene);
+/// Which surfaces SampleSurfaces covers.
+enum class SurfaceSelection {
+  kAll,     ///< Every triangle of every object.
+  kFacing,  ///< Triangles whose front faces the study region or an enabled camera (Faces).
+};
 
-/// Samples every triangle of every object uniformly by area: triangle t with area A_t gets
+/// True when some point of the study region, or one of `viewpoints`, lies strictly in front of the
+/// plane of triangle (a, b, c) (counter-clockwise front): max of n . (X - a) > 0 with n the unit
+/// normal, over the region box's 8 corners (a mesh region's vertices: the maximum of a linear
+/// function over a polyhedron is at a vertex) and the viewpoints. A necessary condition for the
+/// front to be visible from anywhere in the region or from those points; the outer faces of walls,
+/// the floor's underside and the ceiling's top fail it when the cameras are inside the room.
+/// Degenerate triangles: false.
+bool FacesRegionOrViewpoints(const Region& region, const std::vector<Vec3>& viewpoints, const Vec3& a,
+                             const Vec3& b, const Vec3& c);
+
+/// Total triangle area of the scene's objects, m^2 (degenerate triangles count 0), of the selected
+/// triangles (kFacing: facing the region or an enabled camera of `rig`; no rig: the region alone).
+double SurfaceArea(const Scene& scene, SurfaceSelection selection = SurfaceSelection::kAll,
+                   const Rig* rig = nullptr);
+
+/// Samples the selected triangles uniformly by area: triangle t with area A_t gets
 /// floor(A_t / spacing^2) points plus one more with probability frac(A_t / spacing^2), each point
 /// uniform on the triangle, so the expected density is one point per spacing^2 everywhere.
 /// Deterministic: the random numbers are a hash of (seed, object, triangle, sample), independent of
-/// threads and platform. Throws InputError (file `option`, e.g. "--spacing") when spacing is not a
-/// positive finite number or the expected count exceeds kMaxSurfaceSamples.
+/// threads and platform, so a selection's samples are exactly the kAll samples on its triangles.
+/// With kFacing and `rig`, no sample a camera of the rig sees is left out (a camera sees a surface
+/// point only from in front of it). Throws InputError (file `option`, e.g. "--spacing") when spacing
+/// is not a positive finite number or the expected count exceeds kMaxSurfaceSamples.
 std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, std::uint64_t seed = 1,
-                                          const std::string& option = "--spacing");
+                                          const std::string& option = "--spacing",
+                                          SurfaceSelection selection = SurfaceSelection::kAll,
+                                          const Rig* rig = nullptr);
 
 /// The volume fields' quantities at one point (volume/fields.h defines each).
 struct PointValues {

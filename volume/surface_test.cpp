@@ -159,6 +159,77 @@ TEST(SurfaceSampling, UniformOverAPlane) {
   EXPECT_LT(chi2, 51.2);
 }
 
+// The default of `pandora export-surface`: only triangles whose front faces the region or a camera.
+// A unit cube beside the region (x in [2, 3]; the region is [-1, 1]^3) shows it five faces: every
+// one but the far face x = 3, whose front (+x) has no region point before it; a camera at x = 4
+// brings that face back. Sheets (single-sided planes) facing into a room are kept, facing out not.
+TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
+  Scene scene;
+  scene.objects.push_back(Object("cube", MakeBox(Vec3(1, 1, 1)), Vec3(2.5, 0, 0), true));
+  scene.study.region.box.min = Vec3(-1, -1, -1);
+  scene.study.region.box.max = Vec3(1, 1, 1);
+  EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kAll), 6.0, 1e-12);
+  EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kFacing), 5.0, 1e-12);
+  const double spacing = 0.05;
+  const std::vector<SurfaceSample> all = SampleSurfaces(scene, spacing, 5);
+  const std::vector<SurfaceSample> facing =
+      SampleSurfaces(scene, spacing, 5, "--spacing", SurfaceSelection::kFacing);
+  // Exactly the samples of `all` that are not on the far face, in the same order.
+  std::vector<SurfaceSample> expected;
+  for (const SurfaceSample& x : all)
+    if (!(x.normal.x() > 0.5)) expected.push_back(x);
+  ASSERT_EQ(facing.size(), expected.size());
+  EXPECT_LT(facing.size(), all.size());
+  for (std::size_t i = 0; i < facing.size(); ++i) {
+    EXPECT_EQ(facing[i].position, expected[i].position);
+    EXPECT_LT(facing[i].normal.x(), 0.5);
+  }
+  Rig rig;
+  rig.cameras.push_back(MakeCamera("behind", Vec3(4, 0, 0), Vec3(2.5, 0, 0), 60));
+  EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kFacing, &rig), 6.0, 1e-12);
+  rig.cameras[0].enabled = false;  // a disabled camera does not count
+  EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kFacing, &rig), 5.0, 1e-12);
+
+  // Sheets (normal +z from counter-clockwise corners) against a room region [-1, 1]^2 x [0, 2].
+  Region room;
+  room.box.min = Vec3(-1, -1, 0);
+  room.box.max = Vec3(1, 1, 2);
+  const Vec3 a(-3, -3, 0), b(3, -3, 0), c(3, 3, 0), up(0, 0, 3);
+  EXPECT_TRUE(FacesRegionOrViewpoints(room, {}, a, b, c));             // the floor, facing up
+  EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a, c, b));            // its underside
+  EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a + up, b + up, c + up));  // a ceiling's top
+  EXPECT_TRUE(FacesRegionOrViewpoints(room, {}, a + up, c + up, b + up));   // its underside
+  // Touching the region's top face from above, facing away: no point strictly in front.
+  const Vec3 top(0, 0, 2);
+  EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a + top, b + top, c + top));
+  EXPECT_TRUE(FacesRegionOrViewpoints(room, {Vec3(0, 0, 2.5)}, a + top, b + top, c + top));
+}
+
+// No sample a camera sees is dropped: on the test scene (floor sheet, ball, post, five cameras, one
+// below the floor) plus a crate beside the region, whose far side neither the region nor a camera
+// faces, the facing selection drops samples, yet its seen samples are exactly those of all.
+TEST(SurfaceSampling, FacingDropsNoSeenSample) {
+  Scene scene = TestScene();
+  scene.objects.push_back(Object("crate", MakeBox(Vec3(1, 1, 1)), Vec3(0, -3, 0.5), true));
+  const Rig& rig = scene.rigs[0];
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const PointEvaluator evaluator(scene, rig, *caster);
+  auto seen = [&](const std::vector<SurfaceSample>& samples) {
+    std::vector<Vec3> out;
+    const std::vector<PointValues> v = evaluator.EvaluateSamples(samples);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      if (v[i].coverage > 0) out.push_back(samples[i].position);
+    return out;
+  };
+  const std::vector<SurfaceSample> all = SampleSurfaces(scene, 0.03, 2);
+  const std::vector<SurfaceSample> facing =
+      SampleSurfaces(scene, 0.03, 2, "--spacing", SurfaceSelection::kFacing, &rig);
+  EXPECT_LT(facing.size() + 900, all.size());  // the crate's far side: 1 m^2 = 1111 samples
+  const std::vector<Vec3> a = seen(all), f = seen(facing);
+  EXPECT_GT(a.size(), 100u);
+  EXPECT_EQ(a, f);
+}
+
 TEST(SurfaceSampling, BadSpacingIsAnInputError) {
   const Scene scene = TestScene();
   for (double bad : {0.0, -0.1, std::nan(""), std::numeric_limits<double>::infinity()}) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The suggest / accept cycle through the CLI on a copy of tests/data/suggest_ring.json:
 # suggest leaves the scene untouched; a partial accept writes a backup and changes only that camera's
-# pose; accepting the rest of the now stale suggestion is refused (exit 2, one line, file unchanged);
+# pose, in its look_at form; accepting the rest of the now stale suggestion is refused (exit 2, one line, file unchanged);
 # --force accepts it with a second backup.
 # Usage: check_suggest_accept.sh PANDORA SCENE WORK_DIR
 set -u
@@ -28,7 +28,9 @@ for j in (a, b):
     for k in ("position", "look_at", "up", "quaternion"):
         cam.pop(k, None)
 assert a == b
-assert "quaternion" in json.load(open(sys.argv[2]))["rigs"][0]["cameras"][3]
+# c4 keeps its look_at form (docs/suggest.md, "Accept"); c2 is untouched.
+c4 = json.load(open(sys.argv[2]))["rigs"][0]["cameras"][3]
+assert "look_at" in c4 and "quaternion" not in c4, c4
 assert "look_at" in json.load(open(sys.argv[2]))["rigs"][0]["cameras"][1]
 PY
 after=$(sha256sum < "$work/scene.json")
