@@ -923,7 +923,7 @@ void ReportSteady(const SteadyStudy& st, Outputs* out) {
 int RunAccuracy(const AccuracyArgs& args) {
   const Clock::time_point start = Clock::now();
   Scene scene = LoadScene(args.scene);
-  const Rig rig = scene.FindRig(args.rig);
+  const Rig rig = FindRigOption(scene, args.rig);
   OutputTransaction output;
   AddSceneInputs(output, scene);
   // Staged first, so that a bad --out fails before minutes of work; written last.

@@ -99,13 +99,13 @@ void PrintTable(const nlohmann::json& s) {
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
   if (!(value > 0) || !std::isfinite(value))
-    throw InputError(option, "", std::string("must be a positive number of ") + unit);
+    throw InputError(option, "", std::string("must be a positive number") + (*unit ? " of " : "") + unit);
   return value;
 }
 
 int RunAnalyze(const AnalyzeArgs& args) {
   Scene scene = LoadScene(args.scene);
-  const Rig& rig = scene.FindRig(args.rig);
+  const Rig& rig = FindRigOption(scene, args.rig);
   FieldOptions options;
   options.scene_path = scene.path;
   if (!std::isnan(args.voxel_size)) {
@@ -119,6 +119,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
     options.memory_budget_bytes =
         CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
     CheckMemoryBudget(options.memory_budget_bytes, "--memory-budget", "");
+    options.memory_budget_option = "--memory-budget";
   }
   // Both outputs appear together (summary.json last), or neither does.
   const std::filesystem::path out(args.out);

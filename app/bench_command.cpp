@@ -22,7 +22,7 @@ namespace pandora::app {
 int RunBench(const BenchArgs& args) {
   if (args.render) return RunRenderBench(args);
   Scene scene = LoadScene(args.scene);
-  const Rig& rig = scene.FindRig(args.rig);
+  const Rig& rig = FindRigOption(scene, args.rig);
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
   OutputTransaction output;

@@ -22,7 +22,7 @@ namespace pandora::app {
 int RunRenderBench(const BenchArgs& args) {
   const auto [width, height] = ParseImageSize("--size", args.size);
   const Scene scene = LoadScene(args.scene);
-  const Rig& rig = scene.FindRig(args.rig);
+  const Rig& rig = FindRigOption(scene, args.rig);
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
@@ -30,7 +30,7 @@ int RunRenderBench(const BenchArgs& args) {
   if (!args.view.empty()) {
     auto it = scene.views.find(args.view);
     if (it == scene.views.end())
-      throw InputError(scene.path, "$.views", "no view '" + args.view + "'");
+      throw InputError("--view", "", "no view '" + args.view + "' in " + scene.path);
     view = ViewFromScene(it->second, width, height);
   } else if (!scene.views.empty()) {
     view = ViewFromScene(scene.views.begin()->second, width, height);

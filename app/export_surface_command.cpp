@@ -27,7 +27,7 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = scene.FindRig(args.rig);
+  const Rig& rig = FindRigOption(scene, args.rig);
   const SurfaceSelection selection =
       args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
   const std::vector<SurfaceSample> samples =

@@ -3,8 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <new>
+#include <string>
+#include <vector>
 
 #include "analysis/error.h"
 #include "app/commands.h"
@@ -13,38 +20,149 @@
 #define PANDORA_VERSION "dev"
 #endif
 
+namespace {
+
+std::string Short(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+// A strict number option: the whole text is a finite number (no "nan", "inf", empty text or
+// trailing characters), a whole number when `whole`, within [min, max] (min excluded when
+// `min_exclusive`). The message names the unit; CLI11 prefixes the option's name.
+CLI::Validator Number(double min, double max, const std::string& unit, bool whole = false,
+                      bool min_exclusive = false, bool max_exclusive = false) {
+  const std::string kind = whole ? "a whole number" : "a number";
+  std::string range;
+  if (std::isinf(min) && std::isinf(max))
+    range = "finite";
+  else if (std::isinf(max))
+    range = min_exclusive ? "greater than " + Short(min) : "at least " + Short(min);
+  else if (std::isinf(min))
+    range = max_exclusive ? "less than " + Short(max) : "at most " + Short(max);
+  else
+    range = std::string("in ") + (min_exclusive ? "(" : "[") + Short(min) + ", " + Short(max) +
+            (max_exclusive ? ")" : "]");
+  const std::string expected = "must be " + kind + " of " + unit + ", " + range;
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const double v = whole ? static_cast<double>(std::strtoll(begin, &end, 10)) : std::strtod(begin, &end);
+        if (text.empty() || end == begin || *end != '\0')
+          return expected + ", got '" + text + "'";
+        if (errno == ERANGE || !std::isfinite(v)) return expected + ", got " + text;
+        if (v < min || v > max || (min_exclusive && v == min) || (max_exclusive && v == max))
+          return expected + ", got " + text;
+        return "";
+      },
+      "", "number");
+}
+
+// Every option that takes a value refuses an empty one ("--rig ''" is not "the default rig").
+void RefuseEmptyValues(CLI::App* app) {
+  for (CLI::Option* option : app->get_options()) {
+    if (option->get_type_size() == 0) continue;  // a flag
+    option->check(CLI::Validator(
+        [](std::string& text) -> std::string {
+          return text.empty() ? std::string("the value is empty (an empty value is not the default; leave the option out)") : std::string();
+        },
+        "", "non-empty"));
+  }
+  for (CLI::App* sub : app->get_subcommands({})) RefuseEmptyValues(sub);
+}
+
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A parse error in Pandora's one-line format: what the parser found, and where to read more.
+int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
+  std::string message = e.what();
+  for (char& c : message)
+    if (c == '\n') c = ' ';
+  std::string command;
+  for (const CLI::App* sub : app.get_subcommands()) command = sub->get_name();
+  std::string hint = "pandora " + (command.empty() ? std::string() : command + " ") + "--help lists the options";
+  // An unknown command: CLI11 calls it an extra argument.
+  const bool stray_word = command.empty() && !app.remaining().empty() &&
+                          (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr ||
+                           dynamic_cast<const CLI::RequiredError*>(&e) != nullptr);
+  if (stray_word) {
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+    const std::string word = app.remaining().empty() ? std::string() : app.remaining().front();
+    std::string list, closest;
+    std::size_t best = 3;  // suggest a command at most two edits away
+    for (const std::string& n : names) {
+      list += (list.empty() ? "" : ", ") + n;
+      const std::size_t d = EditDistance(word, n);
+      if (d < best) best = d, closest = n;
+    }
+    const std::string hint = closest.empty() ? "the commands are " + list
+                                             : "did you mean '" + closest + "'? the commands are " + list;
+    std::fprintf(stderr, "pandora: error: unknown command '%s' (hint: %s)\n", word.c_str(), hint.c_str());
+    return 2;
+  }
+  if (command.empty() && dynamic_cast<const CLI::RequiredError*>(&e) != nullptr && app.remaining().empty()) {
+    std::fprintf(stderr, "pandora: error: no command given (hint: pandora --help lists them)\n");
+    return 2;
+  }
+  std::fprintf(stderr, "pandora: error: %s (hint: %s)\n", message.c_str(), hint.c_str());
+  return 2;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace pandora::app;
   CLI::App app{"Pandora: design multi-camera setups (coverage, resolution and uncertainty fields)"};
   app.set_version_flag("--version", PANDORA_VERSION);
   app.require_subcommand(1);
   int threads = 0;
-  app.add_option("--threads", threads, "Worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  const CLI::Validator kThreads = Number(0, 4096, "threads (0: all cores)", true);
+  app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
 
   AnalyzeArgs analyze;
   CLI::App* a = app.add_subcommand("analyze", "Evaluate fields over the study region; write fields.vdb and summary.json");
   a->add_option("scene", analyze.scene, "Scene file (JSON)")->required();
   a->add_option("--rig", analyze.rig, "Rig name (default: the first rig)");
   a->add_option("--out", analyze.out, "Output folder")->capture_default_str();
-  a->add_option("--voxel-size", analyze.voxel_size, "Voxel size in metres (default: study.voxel_size)");
+  a->add_option("--voxel-size", analyze.voxel_size, "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
   a->add_option("--fields", analyze.fields, "Comma-separated fields (default: study.fields)");
-  a->add_option("--memory-budget", analyze.memory_budget_mb, "Memory budget in MiB (default: study.memory_budget_mb)");
-  a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  a->add_option("--memory-budget", analyze.memory_budget_mb, "Memory budget in MiB (default: study.memory_budget_mb)")
+      ->check(Number(0, HUGE_VAL, "MiB", false, true));
+  a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
 
   BenchArgs bench;
   CLI::App* b = app.add_subcommand("bench", "Time field evaluation against a raw Embree loop over the same rays");
   b->add_option("scene", bench.scene, "Scene file (JSON)")->required();
   b->add_option("--rig", bench.rig, "Rig name (default: the first rig)");
-  b->add_option("--voxel-size", bench.voxel_size, "Voxel size in metres (default: study.voxel_size)");
-  b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")->check(CLI::PositiveNumber);
+  b->add_option("--voxel-size", bench.voxel_size, "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")
+      ->check(Number(1, 1000, "repetitions", true));
   b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
   b->add_flag("--render", bench.render,
               "Time `pandora render` (1280x720) against raw Embree loops over the same primary and shadow rays");
   b->add_option("--view", bench.view, "With --render: the named view (default: the scene's first view)");
   b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
-  b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
 
   AccuracyArgs accuracy;
   CLI::App* acc = app.add_subcommand(
@@ -53,7 +171,7 @@ int main(int argc, char** argv) {
   acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
   acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
-  acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
 
   RenderArgs render;
   CLI::App* rn = app.add_subcommand(
@@ -65,23 +183,29 @@ int main(int argc, char** argv) {
   rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
   rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");
   rn->add_option("--camera", render.camera, "Render what this camera (id) images, distortion included");
-  rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)");
+  rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)")
+      ->check(Number(0, 180, "degrees", false, true, true));
   rn->add_option("--size", render.size, "Image size WxH (default 1280x720; the camera's with --camera)");
   rn->add_option("--out", render.out, "Output image: FILE.png or FILE.exr")->capture_default_str();
   rn->add_option("--pattern", render.pattern, "uniform | grid (each camera's pixel grid)")->capture_default_str();
-  rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")->capture_default_str();
+  rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")
+      ->capture_default_str()->check(Number(1, 100000, "camera pixels", true));
   rn->add_option("--surface", render.surface, "material | black | hidden-line | contours")->capture_default_str();
-  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default min(1, 3 / enabled cameras))");
-  rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")->capture_default_str();
+  rn->add_option("--brightness", render.brightness, "Scale of every camera's light (default min(1, 3 / enabled cameras))")
+      ->check(Number(0, 1e6, "times one camera's light", false, true));
+  rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")
+      ->capture_default_str()->check(Number(1, 16, "samples per pixel per axis", true));
   rn->add_flag("--no-cameras", render.no_cameras, "Do not draw the camera bodies and frusta");
   rn->add_flag("--no-key", render.no_key, "Do not draw the colour key (camera id -> colour)");
   rn->add_option("--fields", render.fields, "fields.vdb from `pandora analyze`, for --slice and --iso");
   rn->add_option("--slice", render.slice, "Show this field on a slice plane (viridis, with a legend)");
   rn->add_option("--slice-axis", render.slice_axis, "x | y | z: the slice plane's normal")->capture_default_str();
-  rn->add_option("--slice-at", render.slice_at, "Slice position along its axis in metres (default: the middle)");
+  rn->add_option("--slice-at", render.slice_at, "Slice position along its axis in metres (default: the middle)")
+      ->check(Number(-HUGE_VAL, HUGE_VAL, "metres"));
   rn->add_option("--iso", render.iso, "Draw the isosurface of this field");
-  rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)");
-  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)")
+      ->check(Number(-HUGE_VAL, HUGE_VAL, "the field's unit"));
+  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
 
   ExportSurfaceArgs surface;
@@ -89,11 +213,13 @@ int main(int argc, char** argv) {
       "export-surface", "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
   es->add_option("scene", surface.scene, "Scene file (JSON)")->required();
   es->add_option("--rig", surface.rig, "Rig name (default: the first rig)");
-  es->add_option("--spacing", surface.spacing, "Distance between samples in metres")->capture_default_str();
+  es->add_option("--spacing", surface.spacing, "Distance between samples in metres")
+      ->capture_default_str()->check(Number(0, HUGE_VAL, "metres", false, true));
   es->add_option("--out", surface.out, "Output PLY file")->required();
-  es->add_option("--seed", surface.seed, "Seed of the sample positions")->capture_default_str();
+  es->add_option("--seed", surface.seed, "Seed of the sample positions")
+      ->capture_default_str()->check(Number(0, 9.2e18, "(any whole number)", true));
   es->add_flag("--all-surfaces", surface.all_surfaces, "Sample every surface, also those facing away from the study region and every camera");
-  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 
   ReportArgs report;
@@ -102,13 +228,15 @@ int main(int argc, char** argv) {
   rep->add_option("scene", report.scene, "Scene file (JSON)")->required();
   rep->add_option("--rig", report.rigs, "Rig name(s), repeatable or comma-separated (default: every rig)");
   rep->add_option("--out", report.out, "Output folder (report.html is written there)")->capture_default_str();
-  rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)");
+  rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
   rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")
-      ->capture_default_str();
+      ->capture_default_str()->check(Number(16, 8192, "pixels", true));
   rep->add_option("--camera-width", report.camera_width, "Width in pixels of each camera's own view")
-      ->capture_default_str();
-  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders (default min(1, 3 / enabled cameras))");
-  rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+      ->capture_default_str()->check(Number(16, 8192, "pixels", true));
+  rep->add_option("--brightness", report.brightness, "Scale of every camera's light in the renders (default min(1, 3 / enabled cameras))")
+      ->check(Number(0, 1e6, "times one camera's light", false, true));
+  rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
   SuggestArgs suggest;
   CLI::App* sg = app.add_subcommand(
@@ -126,20 +254,25 @@ int main(int argc, char** argv) {
   sg->add_option("--mount-box", suggest.mount_box, "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, metres in the world frame (repeatable)");
   sg->add_option("--hfov-range", suggest.hfov_range, "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
   sg->add_option("--keep-out", suggest.keep_out, "Box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (metres, world frame) no camera centre may enter (repeatable)");
-  sg->add_option("--clearance", suggest.clearance, "Keep every suggested camera centre this far from every scene surface, metres (a camera already closer never moves closer)")->capture_default_str();
+  sg->add_option("--clearance", suggest.clearance, "Keep every suggested camera centre this far from every scene surface, metres (a camera already closer never moves closer)")
+      ->capture_default_str()->check(Number(0, HUGE_VAL, "metres"));
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
-  sg->add_option("--points", suggest.points, "Target points")->capture_default_str();
-  sg->add_option("--snap-move", suggest.snap_move, "Round moves to multiples of this, metres (0: off)");
-  sg->add_option("--snap-rotate", suggest.snap_rotate, "Round yaw/pitch/roll changes to multiples of this, degrees");
+  sg->add_option("--points", suggest.points, "Target points")
+      ->capture_default_str()->check(Number(1, 1000000, "target points", true));
+  sg->add_option("--snap-move", suggest.snap_move, "Round moves to multiples of this, metres (0: off)")
+      ->check(Number(0, HUGE_VAL, "metres (0: off)"));
+  sg->add_option("--snap-rotate", suggest.snap_rotate, "Round yaw/pitch/roll changes to multiples of this, degrees")
+      ->check(Number(0, 180, "degrees (0: off)"));
   sg->add_option("--outer", suggest.outer_iterations, "Outer iterations (occlusion re-evaluated between)")
-      ->check(CLI::PositiveNumber);
+      ->check(Number(1, 1000, "outer iterations", true));
   sg->add_option("--out", suggest.out, "Suggestion file")->capture_default_str();
   sg->add_option("--perturb", suggest.perturb, "Benchmark: first move and rotate the selected cameras by MOVE,DEG");
   sg->add_option("--compare-baseline", suggest.compare_baseline,
                  "Also run random local search with the same budget; write CSV and SVG to this folder");
-  sg->add_option("--seed", suggest.seed, "Seed for target points and perturbations")->capture_default_str();
-  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  sg->add_option("--seed", suggest.seed, "Seed for target points and perturbations")
+      ->capture_default_str()->check(Number(0, 9.2e18, "(any whole number)", true));
+  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   sg->add_flag("--quiet,-q", suggest.quiet, "Print nothing but errors");
 
   AcceptArgs accept;
@@ -149,11 +282,18 @@ int main(int argc, char** argv) {
   ac->add_flag("--force", accept.force, "Accept even if the scene file changed since");
   ac->add_flag("--quiet,-q", accept.quiet, "Print nothing but errors");
 
+  RefuseEmptyValues(&app);
+
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    return ReportParseError(app, e);
   }
 
   std::unique_ptr<tbb::global_control> limit;
@@ -171,6 +311,13 @@ int main(int argc, char** argv) {
     if (*ac) return RunAccept(accept);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // Budgets are checked before the work starts; this is what is left: another process took the
+    // memory meanwhile, or an estimate fell short (a bug then, to report).
+    std::fprintf(stderr,
+                 "pandora: error: out of memory (hint: close other programs, or lower the work: a larger "
+                 "--voxel-size, a smaller region or image)\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pandora: internal error: %s\n", e.what());

@@ -64,7 +64,7 @@ int RunRender(const RenderArgs& args) {
   if (!std::isnan(args.fov) && !(args.fov > 0 && args.fov < 180))
     throw InputError("--fov", "", "must be in (0, 180) degrees");
   RenderOptions options;
-  if (!std::isnan(args.brightness)) options.brightness = CheckPositiveOption("--brightness", args.brightness, "");
+  if (!std::isnan(args.brightness)) options.brightness = CheckPositiveOption("--brightness", args.brightness, "times one camera's light");
   const std::string pattern = Lower(args.pattern);
   if (pattern == "uniform") options.pattern = Pattern::kUniform;
   else if (pattern == "grid") options.pattern = Pattern::kGrid;
@@ -95,6 +95,8 @@ int RunRender(const RenderArgs& args) {
   else if (axis == "z") options.overlays.slice_axis = 2;
   else throw InputError("--slice-axis", "", "must be x, y or z");
   options.overlays.slice_position = args.slice_at;
+  if (!std::isnan(args.slice_at) && !(std::abs(args.slice_at) <= SceneLimits::kMaxCoordinate))
+    throw InputError("--slice-at", "", "is beyond the limit of 1e7 m on coordinates");
   options.overlays.iso_field = args.iso;
   if (!std::isnan(args.iso_value)) {
     if (!std::isfinite(args.iso_value)) throw InputError("--iso-value", "", "must be finite");
@@ -106,7 +108,7 @@ int RunRender(const RenderArgs& args) {
   AddSceneInputs(output, scene);
   output.AddInput(args.fields, "fields file");
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = scene.FindRig(args.rig);
+  const Rig& rig = FindRigOption(scene, args.rig);
   options.pixel_sigma = scene.study.pixel_sigma;
 
   RenderView view;
@@ -127,7 +129,7 @@ int RunRender(const RenderArgs& args) {
     if (it == scene.views.end()) {
       std::string names;
       for (const auto& [name, v] : scene.views) names += (names.empty() ? "" : ", ") + name;
-      throw InputError(scene.path, "$.views", "no view '" + args.view + "'",
+      throw InputError("--view", "", "no view '" + args.view + "' in " + scene.path,
                        names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z"
                                      : "views: " + names);
     }
@@ -136,6 +138,8 @@ int RunRender(const RenderArgs& args) {
     view.from = ParseTriple("--from", args.from);
     view.at = ParseTriple("--at", args.at);
     if (!args.up.empty()) view.up = ParseTriple("--up", args.up);
+    scene.CheckReach(view.from, "--from", "the eye");
+    scene.CheckReach(view.at, "--at", "the point looked at");
     if (!LookAt(view.from, view.at, view.up))
       throw InputError("--at", "", "--at equals --from, or --up is parallel to the viewing direction");
   }

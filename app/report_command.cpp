@@ -295,7 +295,7 @@ int RunReport(const ReportArgs& args) {
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (std::find(names.begin(), names.begin() + i, names[i]) != names.begin() + i)
       throw InputError("--rig", "", "rig '" + names[i] + "' listed twice");
-    rigs.push_back(&scene.FindRig(names[i]));
+    rigs.push_back(&FindRigOption(scene, names[i]));
   }
   if (!std::isnan(args.voxel_size))
     scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
@@ -303,7 +303,7 @@ int RunReport(const ReportArgs& args) {
                                std::pair<const char*, int>{"--camera-width", args.camera_width}})
     if (value < 16 || value > 8192)
       throw InputError(option, "", "must be 16 to 8192 pixels, not " + std::to_string(value));
-  if (!std::isnan(args.brightness)) CheckPositiveOption("--brightness", args.brightness, "");
+  if (!std::isnan(args.brightness)) CheckPositiveOption("--brightness", args.brightness, "times one camera's light");
   const int view_width = args.width;
   OutputTransaction output;
   AddSceneInputs(output, scene);

@@ -51,11 +51,13 @@ std::vector<double> Numbers(const std::string& option, const std::string& value,
   return out;
 }
 
-Aabb BoxOption(const std::string& option, const std::string& value) {
+Aabb BoxOption(const Scene& scene, const std::string& option, const std::string& value) {
   const std::vector<double> v = Numbers(option, value, 6);
   Aabb b;
   b.min = Vec3(v[0], v[1], v[2]);
   b.max = Vec3(v[3], v[4], v[5]);
+  scene.CheckReach(b.min, option, "the box's min corner");
+  scene.CheckReach(b.max, option, "the box's max corner");
   if ((b.min.array() > b.max.array()).any())
     throw InputError(option, "", "the box's min exceeds its max", "give XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
   return b;
@@ -126,7 +128,7 @@ double TimeToReach(const std::vector<TracePoint>& trace, double target, bool hig
 
 int RunSuggest(const SuggestArgs& args) {
   Scene scene = LoadScene(args.scene);
-  const Rig& file_rig = scene.FindRig(args.rig);
+  const Rig& file_rig = FindRigOption(scene, args.rig);
   SuggestOptions options;
   options.scene_path = scene.path;
 
@@ -160,6 +162,7 @@ int RunSuggest(const SuggestArgs& args) {
   options.limits.assign(nsel, CameraLimits());
   for (std::size_t c = 0; c < nsel; ++c) {
     if (!(moves[c] >= 0)) throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
+    scene.CheckLength(moves[c], "--max-move", "the move");
     if (!(rotations[c] >= 0) || !(rotations[c] < 180))
       throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
     options.limits[c].max_move = moves[c];
@@ -189,7 +192,7 @@ int RunSuggest(const SuggestArgs& args) {
       MountConstraint& m = options.limits[c].mount;
       m.kind = kind;
       if (kind == MountConstraint::Kind::kBox) {
-        m.box = BoxOption(option, value);
+        m.box = BoxOption(scene, option, value);
       } else {
         const std::vector<double> v = Numbers(option, value, 3);
         m.axis = Vec3(v[0], v[1], v[2]);
@@ -212,7 +215,7 @@ int RunSuggest(const SuggestArgs& args) {
       options.limits[c].max_hfov_deg = v[1];
     }
   }
-  for (const std::string& box : args.keep_out) options.keep_out.push_back(BoxOption("--keep-out", box));
+  for (const std::string& box : args.keep_out) options.keep_out.push_back(BoxOption(scene, "--keep-out", box));
   const std::optional<Objective> objective = ParseObjective(args.objective);
   if (!objective)
     throw InputError("--objective", "", "unknown objective '" + args.objective + "'",
@@ -232,12 +235,14 @@ int RunSuggest(const SuggestArgs& args) {
   options.snap_rotate_deg = args.snap_rotate;
   if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
     throw InputError("--snap-move", "", "must be a finite length >= 0 in metres");
+  scene.CheckLength(options.snap_move, "--snap-move", "the snap step");
   if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
     throw InputError("--snap-rotate", "", "must be a finite angle >= 0 in degrees");
   options.outer_iterations = args.outer_iterations;
   options.clearance = args.clearance;
   if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
     throw InputError("--clearance", "", "must be a finite length >= 0 in metres");
+  scene.CheckLength(options.clearance, "--clearance", "the clearance");
 
   // The suggestion and the baseline comparison appear together, and replace no input.
   OutputTransaction output;
@@ -256,6 +261,7 @@ int RunSuggest(const SuggestArgs& args) {
     const std::vector<double> p = Numbers("--perturb", args.perturb, 2);
     if (p[0] < 0 || p[1] < 0 || p[1] >= 180)
       throw InputError("--perturb", "", "expected MOVE >= 0 metres and DEG in [0, 180)");
+    scene.CheckLength(p[0], "--perturb", "the move");
     rig = PerturbCameras(file_rig, options.cameras, p[0], p[1], args.seed);
     perturbed = true;
   }

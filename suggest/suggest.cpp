@@ -195,12 +195,12 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
       if (!found) {
         std::string names;
         for (const SceneObject& o : scene.objects) names += (names.empty() ? "" : ", ") + o.name;
-        throw InputError(scene.path, "--target-surface",
-                         "no object called '" + name + "'", "objects: " + names);
+        throw InputError("--target-surface", "", "no object called '" + name + "' in " + scene.path,
+                         "objects: " + names);
       }
     }
     if (tris.empty())
-      throw InputError(scene.path, "--target-surface", "the target surfaces have no area",
+      throw InputError("--target-surface", "", "the target surfaces have no area",
                        "name objects with triangles");
     std::vector<double> cumulative;
     double total = 0;

@@ -268,6 +268,8 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
            << std::llround(options.memory_budget_bytes / 1048576.0) << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
          << "(--memory-budget or study.memory_budget_mb)";
+    if (options.voxel_size_option.empty() && !options.memory_budget_option.empty())
+      throw InputError(options.memory_budget_option, "", reason.str(), hint.str());
     throw InputError(size_file, size_path, reason.str(), hint.str());
   }
 

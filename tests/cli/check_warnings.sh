@@ -49,7 +49,7 @@ check_stderr "$work/rep.err" report
 grep -q "camera &#39;boxed&#39; is inside\|camera 'boxed' is inside" "$work/rep/report.html" || fail "the report does not list the warning"
 
 # Bad input: exactly the one error line, no warning.
-bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad1" "--voxel-size: must be a positive" -- \
+bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad1" "--voxel-size: must be a number of metres, greater than 0" -- \
   analyze "$scene" --voxel-size 0 --out "$work/bad1" >/dev/null || fail "analyze --voxel-size 0"
 bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad2" "output folder" -- \
   render "$scene" --from 3,-3,2 --at 0,0,0.3 --size 8x8 --out /proc/pandora_cannot_write_here/a.png >/dev/null ||
