@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <vector>
 
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
+#include "analysis/input_file.h"
 #include "render/colormap.h"
 #include "render/render.h"
 
@@ -50,10 +52,19 @@ void WritePng(const Image& image, const std::string& path) {
 }
 
 Image ReadPng(const std::string& path) {
+  // A regular file of bounded size (a FIFO would block, /dev/zero never end).
+  CheckInputFile(path, InputLimits::kImageBytes, "PNG file");
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&png, path.c_str()))
     throw InputError(path, "", std::string("cannot read the PNG file: ") + png.message);
+  // The header's size decides the allocation: a damaged or hostile header must not ask for gigabytes.
+  if (static_cast<std::uint64_t>(png.width) * png.height > (64ull << 20)) {
+    png_image_free(&png);
+    throw InputError(path, "", "the PNG is " + std::to_string(png.width) + " x " + std::to_string(png.height) +
+                                   " pixels; at most 64 Mpx is read",
+                     "scale the image down");
+  }
   png.format = PNG_FORMAT_RGB;
   std::vector<uint8_t> bytes(PNG_IMAGE_SIZE(png));
   if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr)) {

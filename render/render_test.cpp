@@ -7,7 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "analysis/error.h"
 #include "analysis/primitives.h"
 #include "analysis/scene.h"
 #include "analysis/uncertainty.h"
@@ -732,6 +737,50 @@ TEST(Render, ObjTextureAppearsOnItsQuadrants) {
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(rgb[c], k * q.texel[c], 4 * best * k + 1e-6) << "quadrant " << q.u << "," << q.v;
   }
+}
+
+// Textures are read like every other input: a special file or a PNG whose header asks for gigabytes
+// is refused with one InputError, before any allocation.
+TEST(ReadPng, SpecialFilesAndHugeHeadersAreRefused) {
+  auto reason = [](const std::string& path) -> std::string {
+    try {
+      ReadPng(path);
+    } catch (const InputError& e) {
+      return e.reason();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(reason("/dev/zero").find("character device"), std::string::npos);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("pandora_png_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string fifo = (dir / "fifo.png").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(reason(fifo).find("FIFO"), std::string::npos);
+  // A valid 1 x 1 PNG whose IHDR then claims 100000 x 100000 pixels, with the chunk's CRC
+  // recomputed so that libpng accepts the header: Pandora's size cap must refuse it.
+  Image one;
+  one.width = one.height = 1;
+  one.rgb = {0.5f, 0.5f, 0.5f};
+  const std::string png = (dir / "huge.png").string();
+  WritePng(one, png);
+  std::string bytes;
+  {
+    std::ifstream in(png, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_GT(bytes.size(), 24u);
+  const unsigned char big[4] = {0x00, 0x01, 0x86, 0xA0};  // 100000, big endian
+  for (int k = 0; k < 4; ++k) bytes[16 + k] = static_cast<char>(big[k]), bytes[20 + k] = static_cast<char>(big[k]);
+  std::uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of "IHDR" and its 13 data bytes (offsets 12..28)
+  for (int i = 12; i < 29; ++i) {
+    crc ^= static_cast<unsigned char>(bytes[i]);
+    for (int b = 0; b < 8; ++b) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  crc ^= 0xFFFFFFFFu;
+  for (int k = 0; k < 4; ++k) bytes[29 + k] = static_cast<char>(crc >> (24 - 8 * k));
+  std::ofstream(png, std::ios::binary) << bytes;
+  EXPECT_NE(reason(png).find("at most 64 Mpx"), std::string::npos) << reason(png);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
