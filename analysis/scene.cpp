@@ -950,8 +950,9 @@ Study ReadStudy(const Node& node) {
   }
   if (auto n = node.Find("pixel_sigma")) study.pixel_sigma = n->PixelSigma();
   if (auto n = node.Find("memory_budget_mb")) {
-    study.memory_budget_bytes = n->Positive() * 1024.0 * 1024.0;
-    CheckMemoryBudget(study.memory_budget_bytes, node.context().file, n->path());
+    const double mib = n->Positive();
+    CheckMemoryBudget(mib, node.context().file, n->path());
+    study.memory_budget_bytes = mib * 1024.0 * 1024.0;
   }
   if (auto n = node.Find("max_sigma_mm")) study.max_sigma_mm = n->Positive();
   if (auto motion = node.Find("motion")) {
@@ -1186,12 +1187,12 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   return scene;
 }
 
-void CheckMemoryBudget(double bytes, const std::string& file, const std::string& json_path) {
-  const double physical = static_cast<double>(PhysicalMemoryBytes());
-  if (physical > 0 && bytes > physical) {
+void CheckMemoryBudget(double mib, const std::string& file, const std::string& json_path) {
+  const double physical_mib = static_cast<double>(PhysicalMemoryBytes()) / 1048576.0;
+  if (physical_mib > 0 && !(mib <= physical_mib)) {
     char text[160];
     std::snprintf(text, sizeof text, "a budget of %.4g MiB is more than this machine's memory (%.0f MiB)",
-                  bytes / 1048576.0, physical / 1048576.0);
+                  mib, physical_mib);
     throw InputError(file, json_path, text,
                      "give at most the memory this machine has, in MiB; the default is 4096");
   }

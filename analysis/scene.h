@@ -93,10 +93,10 @@ struct FieldListProblem {
 std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& fields,
                                                bool has_motion);
 
-/// Throws InputError(file, json_path, ...) when a memory budget of `bytes` is more than this
+/// Throws InputError(file, json_path, ...) when a memory budget of `mib` MiB is more than this
 /// machine's physical memory: a budget the machine cannot honour would end in an allocation failure
 /// after minutes of work. For a command-line option, `file` is the option and `json_path` empty.
-void CheckMemoryBudget(double bytes, const std::string& file, const std::string& json_path);
+void CheckMemoryBudget(double mib, const std::string& file, const std::string& json_path);
 
 /// A named viewpoint for rendering ("views" in the scene file). World frame, metres.
 struct View {

@@ -118,7 +118,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   if (!std::isnan(args.memory_budget_mb)) {
     options.memory_budget_bytes =
         CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
-    CheckMemoryBudget(options.memory_budget_bytes, "--memory-budget", "");
+    CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
     options.memory_budget_option = "--memory-budget";
   }
   // Both outputs appear together (summary.json last), or neither does.

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs `pandora ARGS...` and checks the bad-input contract: exit code 2, exactly one line on stderr
-# that contains EXPECTED (and the JSON path when given), and no output file left in OUT_DIR.
+# that contains EXPECTED (and the JSON path when given), and nothing left at OUT_DIR (removed before
+# the run): no output, no staging file, no folder the command created.
 # Usage: expect_error.sh PANDORA OUT_DIR EXPECTED -- ARGS...
 set -u
 pandora=$1; out_dir=$2; expected=$3; shift 3
@@ -15,8 +16,9 @@ fail() { echo "FAIL: $*"; echo "  command: $pandora $*"; echo "  stderr: $err"; 
 lines=$(printf '%s\n' "$err" | grep -c .)
 [ "$lines" -eq 1 ] || fail "stderr has $lines lines, expected 1"
 case "$err" in *"$expected"*) ;; *) fail "stderr does not contain '$expected'";; esac
-if [ -d "$out_dir" ]; then
-  leftovers=$(find "$out_dir" -type f | head -5)
-  [ -z "$leftovers" ] || fail "partial outputs left: $leftovers"
+# Nothing left behind: not a file, not even the (removed above) output folder itself.
+if [ -e "$out_dir" ]; then
+  leftovers=$(find "$out_dir" | head -5)
+  fail "left behind: $leftovers"
 fi
 echo "ok: $err"
