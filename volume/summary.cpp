@@ -112,7 +112,10 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
       u["max_sigma_mm"] = *scene.study.max_sigma_mm;
       u["meets_max_sigma"] = Fraction(CountAtMost(st.sigma_max_mm, *scene.study.max_sigma_mm), region);
     }
-    if (scene.study.motion && !st.sigma_max_steady_mm.empty()) {
+    // With a motion model the steady-state keys are always there: percentiles are null when no
+    // voxel is triangulable (or the steady fields were not asked for), the share meeting the
+    // target is then 0.
+    if (scene.study.motion) {
       u["motion"] = {{"q", scene.study.motion->q},
                      {"rate_hz", scene.study.motion->rate_hz},
                      {"covariance", scene.study.steady_prior ? "prior" : "posterior"}};
