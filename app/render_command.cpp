@@ -138,7 +138,12 @@ int RunRender(const RenderArgs& args) {
   if (!args.size.empty()) std::tie(view.width, view.height) = ParseImageSize("--size", args.size);
 
   std::unique_ptr<Fields> fields;
-  if (!args.fields.empty()) fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
+  if (!args.fields.empty()) {
+    FieldsProvenance provenance;
+    fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields, &provenance));
+    for (const std::string& w : CheckFieldsProvenance(provenance, fields->lattice, scene, rig, args.fields))
+      std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
+  }
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
   options.layers = ext == ".exr";  // the PNG has no room for them
