@@ -2,9 +2,11 @@
 // format version 224), read from its sources; the comments name the function that reads each part.
 #include "volume/vdb_check.h"
 
+#include <blosc.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <bitset>
@@ -181,12 +183,22 @@ void AddActiveBox(GridWalk& g, const Coord& lo, std::int64_t dim, std::int64_t v
   ++info.active_tiles;
 }
 
+// Bytes decompressed by the validator, reused from chunk to chunk.
+std::vector<char>& Scratch(std::size_t bytes) {
+  thread_local std::vector<char> scratch;
+  if (scratch.size() < bytes) scratch.resize(bytes);
+  return scratch;
+}
+
 // c-blosc 1.x chunk of `length` bytes that must decompress to `expected` bytes (or to the 128-byte
 // padding of points/StreamCompression.cc when `pad_small`): the 16-byte header (version, flags,
 // nbytes, blocksize, cbytes) and, unless the chunk is a plain copy, the block start table and every
-// split's length, as blosc_run_decompression_with_context and blosc_d read them.
-void CheckBlosc(Cursor& c, std::uint64_t length, std::uint64_t expected, bool pad_small,
-                const std::string& what) {
+// split's length, as blosc_run_decompression_with_context and blosc_d read them. Then, when
+// `decompress`, the chunk is decompressed: OpenVDB throws on a chunk that fails, and some of its
+// readers leak the node they were filling when it does. Returns the decompressed bytes (empty when
+// not decompressed).
+std::string_view CheckBlosc(Cursor& c, std::uint64_t length, std::uint64_t expected, bool pad_small,
+                            const std::string& what, bool decompress = true) {
   const std::size_t start = c.pos();
   if (length < std::uint64_t(kBloscHeader))
     c.Fail(what + ": a Blosc chunk of " + std::to_string(length) +
@@ -213,7 +225,7 @@ void CheckBlosc(Cursor& c, std::uint64_t length, std::uint64_t expected, bool pa
     c.Fail(what + ": the Blosc chunk decompresses to " + std::to_string(nbytes) +
                " bytes, expected " + std::to_string(expected),
            start);
-  if (nbytes == 0) return;  // blosc returns at once
+  if (nbytes == 0) return {};  // blosc returns at once
   if (typesize < 1) c.Fail(what + ": Blosc type size 0", start);
   if (blocksize <= 0 || blocksize > nbytes || blocksize > kBloscMaxBlocksize)
     c.Fail(what + ": Blosc block size " + std::to_string(blocksize) + " for " +
@@ -224,70 +236,85 @@ void CheckBlosc(Cursor& c, std::uint64_t length, std::uint64_t expected, bool pa
   if (flags & kBloscMemcpyed) {
     if (cbytes != nbytes + kBloscHeader)
       c.Fail(what + ": a copied Blosc chunk must be its data plus the header", start);
-    return;
-  }
-  if (nblocks > (cbytes - kBloscHeader) / 4)
-    c.Fail(what + ": the Blosc block table does not fit in the chunk", start);
-  for (std::int64_t j = 0; j < nblocks; ++j) {
-    std::int64_t offset = i32(kBloscHeader + 4 * j);
-    const bool last_partial = j == nblocks - 1 && leftover > 0;
-    const std::int64_t bsize = last_partial ? leftover : blocksize;
-    const bool split =
-        !(flags & kBloscDontSplit) && typesize <= 16 && bsize / typesize >= 128 && !last_partial;
-    const int nsplits = split ? typesize : 1;
-    for (int s = 0; s < nsplits; ++s) {
-      if (offset < kBloscHeader + 4 * nblocks || offset > cbytes - 4)
-        c.Fail(what + ": Blosc block " + std::to_string(j) + " starts outside the chunk", start);
-      const std::int64_t split_bytes = i32(offset);
-      offset += 4;
-      if (split_bytes < 0 || split_bytes > cbytes - offset)
-        c.Fail(what + ": Blosc block " + std::to_string(j) + " runs past the chunk", start);
-      offset += split_bytes;
+  } else {
+    if (nblocks > (cbytes - kBloscHeader) / 4)
+      c.Fail(what + ": the Blosc block table does not fit in the chunk", start);
+    for (std::int64_t j = 0; j < nblocks; ++j) {
+      std::int64_t offset = i32(kBloscHeader + 4 * j);
+      const bool last_partial = j == nblocks - 1 && leftover > 0;
+      const std::int64_t bsize = last_partial ? leftover : blocksize;
+      const bool split =
+          !(flags & kBloscDontSplit) && typesize <= 16 && bsize / typesize >= 128 && !last_partial;
+      const int nsplits = split ? typesize : 1;
+      for (int s = 0; s < nsplits; ++s) {
+        if (offset < kBloscHeader + 4 * nblocks || offset > cbytes - 4)
+          c.Fail(what + ": Blosc block " + std::to_string(j) + " starts outside the chunk", start);
+        const std::int64_t split_bytes = i32(offset);
+        offset += 4;
+        if (split_bytes < 0 || split_bytes > cbytes - offset)
+          c.Fail(what + ": Blosc block " + std::to_string(j) + " runs past the chunk", start);
+        offset += split_bytes;
+      }
     }
   }
+  if (!decompress) return {};
+  std::vector<char>& out = Scratch(std::size_t(nbytes));
+  const int got = blosc_decompress_ctx(chunk.data(), out.data(), std::size_t(nbytes), 1);
+  if (got != nbytes) c.Fail(what + ": the Blosc chunk does not decompress", start);
+  return std::string_view(out.data(), std::size_t(nbytes));
+}
+
+void CheckBools(const Cursor& c, std::string_view values, const std::string& what, std::size_t at) {
+  for (char v : values)
+    if (std::uint8_t(v) > 1) c.Fail(what + ": a bool value that is neither 0 nor 1", at);
 }
 
 // io::readData of `count` values of `value_size` bytes under `compression`: a Blosc or zip chunk
-// behind an int64 size (negative for raw bytes), or the raw values.
+// behind an int64 size (negative for raw bytes), or the raw values. Compressed chunks are
+// decompressed to check that they give exactly the bytes expected.
 void CheckData(Cursor& c, const GridWalk& g, std::uint64_t count, const std::string& what) {
   const std::uint64_t expected = count * g.kind->value_size;
-  if (g.compression & (kCompressBlosc | kCompressZip)) {
-    const std::size_t at = c.pos();
-    const std::int64_t n = c.I64(what + " size");
-    if (n <= 0) {
-      // io::bloscFromStream / unzipFromStream read -n bytes into the buffer *before* comparing
-      // -n with its size: a mismatch would overrun the heap.
-      if (n < -(std::int64_t(1) << 40) || std::uint64_t(-n) != expected)
-        c.Fail(what + ": an uncompressed chunk of " +
-                   (n < -(std::int64_t(1) << 40) ? std::string("over 2^40") : std::to_string(-n)) +
-                   " bytes, expected " + std::to_string(expected),
-               at);
-      const std::string_view raw = c.Take(expected, what);
-      if (g.kind->is_bool)
-        for (char v : raw)
-          if (std::uint8_t(v) > 1) c.Fail(what + ": a bool value that is neither 0 nor 1");
-      return;
-    }
-    if (std::uint64_t(n) > c.left())
-      c.Fail("truncated: " + what + " needs " + std::to_string(n) + " bytes, " +
-             std::to_string(c.left()) + " left");
-    if (g.compression & kCompressBlosc) {
-      CheckBlosc(c, std::uint64_t(n), expected, false, what);
-    } else {
-      // zlib's uncompress() is bounded by both lengths and OpenVDB compares the result's size;
-      // io::zipToStream writes a zip chunk only when it is shorter than the raw values.
-      if (std::uint64_t(n) >= expected)
-        c.Fail(what + ": a zip chunk of " + std::to_string(n) + " bytes for " +
-                   std::to_string(expected) + " bytes of values",
-               at);
-      c.Skip(n, what);
-    }
+  const std::size_t at = c.pos();
+  if (!(g.compression & (kCompressBlosc | kCompressZip))) {
+    const std::string_view raw = c.Take(expected, what);
+    if (g.kind->is_bool) CheckBools(c, raw, what, at);
     return;
   }
-  const std::string_view raw = c.Take(expected, what);
-  if (g.kind->is_bool)
-    for (char v : raw)
-      if (std::uint8_t(v) > 1) c.Fail(what + ": a bool value that is neither 0 nor 1");
+  const std::int64_t n = c.I64(what + " size");
+  if (n <= 0) {
+    // io::bloscFromStream / unzipFromStream read -n bytes into the buffer *before* comparing
+    // -n with its size: a mismatch would overrun the heap.
+    if (n < -(std::int64_t(1) << 40) || std::uint64_t(-n) != expected)
+      c.Fail(what + ": an uncompressed chunk of " +
+                 (n < -(std::int64_t(1) << 40) ? std::string("over 2^40") : std::to_string(-n)) +
+                 " bytes, expected " + std::to_string(expected),
+             at);
+    const std::string_view raw = c.Take(expected, what);
+    if (g.kind->is_bool) CheckBools(c, raw, what, at);
+    return;
+  }
+  if (std::uint64_t(n) > c.left())
+    c.Fail("truncated: " + what + " needs " + std::to_string(n) + " bytes, " +
+           std::to_string(c.left()) + " left");
+  if (g.compression & kCompressBlosc) {
+    const std::string_view values = CheckBlosc(c, std::uint64_t(n), expected, false, what);
+    if (g.kind->is_bool) CheckBools(c, values, what, at);
+    return;
+  }
+  // io::zipToStream writes a zip chunk only when it is shorter than the raw values.
+  if (std::uint64_t(n) >= expected)
+    c.Fail(what + ": a zip chunk of " + std::to_string(n) + " bytes for " +
+               std::to_string(expected) + " bytes of values",
+           at);
+  const std::string_view chunk = c.Take(std::uint64_t(n), what);
+  std::vector<char>& out = Scratch(expected);
+  uLongf got = uLongf(expected);
+  if (uncompress(reinterpret_cast<Bytef*>(out.data()), &got,
+                 reinterpret_cast<const Bytef*>(chunk.data()), uLong(n)) != Z_OK ||
+      got != expected)
+    c.Fail(what + ": the zip chunk does not decompress to " + std::to_string(expected) + " bytes",
+           at);
+  if (g.kind->is_bool) CheckBools(c, std::string_view(out.data(), expected), what, at);
 }
 
 // io::readCompressedValues for a node of `count` values with value mask `mask`: the mask
@@ -462,8 +489,20 @@ void CheckTree(Cursor& c, Cursor& buf, GridWalk& g) {
 
 // Metadata::read of the registered types OpenVDB writes (TypedMetadata reads sizeof(T) bytes
 // whatever the stored size says, so the size must be exact), and DelayedLoadMetadata::readValue.
+// The delayed-load record of a grid: its leaf count and its Blosc chunks, decompressed only once
+// the tree has shown that count right (the count sizes what they decompress to).
+struct DelayedLoad {
+  std::int64_t leaves = -1;
+  struct Chunk {
+    std::size_t pos;
+    std::uint64_t length, expected;
+    std::string what;
+  };
+  std::vector<Chunk> chunks;
+};
+
 void CheckMetaMap(Cursor& c, const std::string& owner, std::map<std::string, std::string>* strings,
-                  std::map<std::string, std::int64_t>* integers, std::int64_t* delayed_count) {
+                  std::map<std::string, std::int64_t>* integers, DelayedLoad* delayed) {
   const std::size_t at = c.pos();
   const std::uint32_t count = c.U32(owner + " metadata count");
   if (std::uint64_t(count) * 12 > c.left())
@@ -508,27 +547,24 @@ void CheckMetaMap(Cursor& c, const std::string& owner, std::map<std::string, std
         c.Skip(size, what);
       }
     } else if (type == "__delayedload") {
-      if (!delayed_count) c.Fail(what + ": delayed-load metadata outside a grid", value_at);
+      if (!delayed) c.Fail(what + ": delayed-load metadata outside a grid", value_at);
       if (size == 0) continue;
       // DelayedLoadMetadata::readValue: leaf count, a Blosc or raw int8 mask per leaf, then
       // UINT32_MAX or a Blosc or raw int64 compressed size per leaf.
       const std::uint32_t leaves = c.U32(what + " leaf count");
-      const std::uint32_t mask_bytes = c.U32(what + " mask size");
-      if (mask_bytes > 0)
-        CheckBlosc(c, mask_bytes, leaves, true, what + " mask");
-      else
-        c.Skip(leaves, what + " mask");
+      auto chunk = [&](std::uint32_t bytes, std::uint64_t expected, const std::string& part) {
+        if (bytes == 0) return c.Skip(expected, what + " " + part);
+        delayed->chunks.push_back({c.pos(), bytes, expected, what + " " + part});
+        CheckBlosc(c, bytes, expected, true, what + " " + part, /*decompress=*/false);
+      };
+      chunk(c.U32(what + " mask size"), leaves, "mask");
       const std::uint32_t size_bytes = c.U32(what + " sizes size");
-      if (size_bytes != std::numeric_limits<std::uint32_t>::max()) {
-        if (size_bytes > 0)
-          CheckBlosc(c, size_bytes, std::uint64_t(leaves) * 8, true, what + " sizes");
-        else
-          c.Skip(std::uint64_t(leaves) * 8, what + " sizes");
-      }
+      if (size_bytes != std::numeric_limits<std::uint32_t>::max())
+        chunk(size_bytes, std::uint64_t(leaves) * 8, "sizes");
       if (c.pos() - value_at > size)
         c.Fail(what + ": holds more than its " + std::to_string(size) + " bytes", value_at);
       c.Seek(value_at + size);
-      *delayed_count = leaves;
+      delayed->leaves = leaves;
     } else {
       c.Fail(what + " has type " + Quote(type) + ", which pandora does not read", entry_at);
     }
@@ -608,8 +644,8 @@ void CheckGrid(Cursor& c, const VdbLimits& limits, VdbGridInfo& info,
       ((g.compression & kCompressZip) && (g.compression & kCompressBlosc)))
     c.Fail("grid " + name + ": compression flags " + std::to_string(g.compression), comp_at);
   info.compression = g.compression;
-  std::int64_t delayed_leaves = -1;
-  CheckMetaMap(c, "grid " + name, &info.strings, &info.integers, &delayed_leaves);
+  DelayedLoad delayed;
+  CheckMetaMap(c, "grid " + name, &info.strings, &info.integers, &delayed);
   if (auto it = info.strings.find("name"); it == info.strings.end() || it->second != info.name)
     c.Fail("grid " + name + ": its 'name' metadata differs from its descriptor", at);
   CheckTransform(c, info, name);
@@ -622,9 +658,14 @@ void CheckGrid(Cursor& c, const VdbLimits& limits, VdbGridInfo& info,
   if (buf.pos() != std::size_t(end_pos))
     buf.Fail("grid " + name + ": the buffers end at byte " + std::to_string(buf.pos()) +
              ", its descriptor says " + std::to_string(end_pos));
-  if (delayed_leaves >= 0 && delayed_leaves != info.leaf_count)
-    c.Fail("grid " + name + ": its delayed-load metadata counts " + std::to_string(delayed_leaves) +
+  if (delayed.leaves >= 0 && delayed.leaves != info.leaf_count)
+    c.Fail("grid " + name + ": its delayed-load metadata counts " + std::to_string(delayed.leaves) +
            " leaves, the tree has " + std::to_string(info.leaf_count));
+  for (const DelayedLoad::Chunk& chunk : delayed.chunks) {
+    Cursor d = c;
+    d.Seek(chunk.pos);
+    CheckBlosc(d, chunk.length, chunk.expected, true, chunk.what);
+  }
   if (!info.empty) {
     std::int64_t dims[3];
     for (int a = 0; a < 3; ++a) dims[a] = info.active_max[a] + 1;
