@@ -141,7 +141,8 @@ int RunRender(const RenderArgs& args) {
   if (!args.fields.empty()) {
     FieldsProvenance provenance;
     fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields, &provenance));
-    for (const std::string& w : CheckFieldsProvenance(provenance, fields->lattice, scene, rig, args.fields))
+    for (const std::string& w :
+         CheckFieldsProvenance(provenance, fields->lattice, scene, rig, args.fields))
       std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
 

@@ -26,7 +26,7 @@ struct VdbLimits {
   /// Product of any two extents of a grid's active index box [0, max]: bounds a slice image.
   std::int64_t max_face_voxels = std::int64_t(1) << 28;
   /// Active voxels of a grid, tiles counted voxel by voxel: bounds anything that densifies.
-  std::int64_t max_active_voxels = std::int64_t(1) << 32;
+  std::int64_t max_active_voxels = std::int64_t(1) << 31;
 };
 
 /// What the validator learned about one grid.
