@@ -146,15 +146,22 @@ std::string CoordText(const openvdb::Coord& c) {
          ")";
 }
 
-// Coverage stored as floats: every value (active or not, tiles included) a whole number of cameras.
-openvdb::Int32Grid::Ptr CoverageFromFloat(const openvdb::FloatGrid& grid, const std::string& path) {
-  auto ok = [](float v) { return v >= 0 && v <= kMaxCameras && v == std::floor(v); };
+// Every value of a coverage grid (active or not, tiles included) a whole number of cameras in
+// [0, 64].
+template <typename GridT>
+void CheckCameraCounts(const GridT& grid, const std::string& path) {
+  auto ok = [](auto v) { return v >= 0 && v <= kMaxCameras && v == std::floor(v); };
   if (!ok(grid.background()))
     Refuse(path, "grid 'coverage' has a background that is not a camera count");
   for (auto it = grid.cbeginValueAll(); it; ++it)
     if (!ok(*it))
       Refuse(path, "grid 'coverage' holds " + std::to_string(*it) + " at voxel " +
                        CoordText(it.getCoord()) + ", not a whole number of cameras in [0, 64]");
+}
+
+// Coverage stored as floats back to the in-memory Int32Grid.
+openvdb::Int32Grid::Ptr CoverageFromFloat(const openvdb::FloatGrid& grid, const std::string& path) {
+  CheckCameraCounts(grid, path);
   auto tree = std::make_shared<openvdb::Int32Tree>(grid.tree());  // converts every value and tile
   auto out = openvdb::Int32Grid::create(tree);
   out->setName(kCoverageGrid);
@@ -305,8 +312,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     if (name == kCoverageGrid) {
       if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base))
         g.coverage = CoverageFromFloat(*f, path);
-      else
-        g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base);
+      else if ((g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base)))
+        CheckCameraCounts(*g.coverage, path);  // the earlier layout
     } else if (name == kCamerasGrid) {
       g.cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
     } else if (name.rfind(kVisiblePrefix, 0) == 0) {

@@ -548,6 +548,10 @@ TEST(VdbValidator, GridTypesAndValuesAreChecked) {
                 "not a whole number");
   ExpectRefused(WriteGrids({Float("resolution", {{0, 0, 0}}, std::nanf(""))}, "nan.vdb"),
                 "non-finite");
+  auto earlier = openvdb::Int32Grid::create(0);  // the earlier layout is held to the same range
+  earlier->setName("coverage");
+  earlier->tree().setValueOn(openvdb::Coord(1, 1, 1), -3);
+  ExpectRefused(WriteGrids({earlier}, "negative_int.vdb"), "not a whole number");
   auto inf = Float("sigma_max", {{0, 0, 0}});
   inf->tree().setValueOff(openvdb::Coord(1, 0, 0), INFINITY);  // inactive values count too
   ExpectRefused(WriteGrids({inf}, "inf.vdb"), "non-finite");
