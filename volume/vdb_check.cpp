@@ -9,7 +9,6 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <bitset>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -17,7 +16,6 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "analysis/error.h"
 
@@ -44,7 +42,6 @@ constexpr int kLeafDim = 1 << kLog2Leaf;           // 8
 constexpr int kInt1Dim = kLeafDim << kLog2Int1;    // 128
 constexpr int kInt2Dim = kInt1Dim << kLog2Int2;    // 4096
 constexpr int kLeafValues = 1 << (3 * kLog2Leaf);  // 512
-constexpr int kInt1Values = 1 << (3 * kLog2Int1);  // 4096
 constexpr int kInt2Values = 1 << (3 * kLog2Int2);  // 32768
 
 struct TreeKind {
@@ -611,6 +608,8 @@ void CheckGrid(Cursor& c, const VdbLimits& limits, VdbGridInfo& info,
   const std::string name = Quote(info.name);
   if (info.name.empty() || info.name.find('\x1e') != std::string::npos)
     c.Fail("grid name " + name + " is empty or numbered (a duplicate name)", at);
+  for (unsigned char ch : info.name)
+    if (ch < 0x20 || ch == 0x7f) c.Fail("grid name " + name + " holds control characters", at);
   if (!names.insert(info.name).second) c.Fail("two grids named " + name, at);
   const std::size_t type_at = c.pos();
   info.tree_type = c.String("grid " + name + " type");
@@ -782,11 +781,11 @@ std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
         scene.path);
   }
   if (!p.rig_name.empty() && p.rig_name != rig.name)
-    throw InputError(
-        path, "",
-        "the fields were computed for rig '" + p.rig_name + "', not for rig '" + rig.name + "'",
-        "render with --rig " + p.rig_name + ", or run `pandora analyze " + scene.path + " --rig " +
-            rig.name + "` for these fields");
+    throw InputError(path, "",
+                     "the fields were computed for rig " + Quote(p.rig_name) + ", not for rig " +
+                         Quote(rig.name),
+                     "render with --rig " + p.rig_name + ", or run `pandora analyze " + scene.path +
+                         " --rig " + rig.name + "` for these fields");
   if (!p.scene_sha256.empty() && p.scene_sha256 != scene.sha256)
     warnings.push_back(path + " was computed from a different version of the scene file (SHA-256 " +
                        p.scene_sha256.substr(0, 12) + "..., " + scene.path + " is " +

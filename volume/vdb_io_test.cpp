@@ -449,6 +449,60 @@ TEST(VdbValidator, DamagedBloscChunksAreRefused) {
   }
 }
 
+// The delayed-load record OpenVDB adds to float grids: with more than 48 leaves its per-leaf mask
+// and compressed sizes are Blosc chunks, checked once the tree has confirmed the leaf count.
+TEST(VdbValidator, DelayedLoadRecordIsChecked) {
+  InitializeOpenVdb();
+  Fields f;
+  Fields::Impl& g = f.impl();
+  g.transform = LatticeTransform(0.05, openvdb::Vec3d(0, 0, 0));
+  g.coverage = openvdb::Int32Grid::create(0);
+  g.coverage->setName(kCoverageGrid);
+  g.coverage->setTransform(g.transform);
+  for (int i = 0; i < 64; ++i)
+    for (int j = 0; j < 64; ++j)
+      g.coverage->tree().setValueOn(openvdb::Coord(i, j, (i * j) % 8), (i + j) % 3);
+  ASSERT_EQ(g.coverage->tree().leafCount(), 64u);
+  const std::string bytes = WriteBytes(f, {}, "delayed.vdb");
+  ASSERT_NO_THROW(ReadFieldsVdbBytes(bytes, "delayed.vdb"));
+  // "file_delayed_load", its type "__delayedload", the value's size, the leaf count, the mask
+  // chunk.
+  const std::size_t name = bytes.find("file_delayed_load");
+  ASSERT_NE(name, std::string::npos);
+  const std::size_t type = name + 17;
+  ASSERT_EQ(bytes.substr(type + 4, Get32(bytes, type)), "__delayedload");
+  const std::size_t size = type + 4 + 13, count = size + 4, mask = count + 4;
+  ASSERT_EQ(Get32(bytes, count), 64u);
+  const std::uint32_t mask_bytes = Get32(bytes, mask);
+  ASSERT_GT(mask_bytes, 16u);  // a Blosc chunk, not 64 raw bytes
+  const std::size_t chunk = mask + 4, sizes = chunk + mask_bytes;
+  ASSERT_EQ(Get32(bytes, chunk + 4), 128u);  // nbytes: one int8 per leaf, padded to 128
+  std::string b = bytes;
+  Put32(b, count, 63);  // the sizes chunk holds 64 int64 values, not 63
+  ExpectRefused(b, "decompresses to 512 bytes, expected 504");
+  b = bytes;
+  Put32(b, chunk + 4, 129);
+  ExpectRefused(b, "decompresses to 129 bytes");
+  b = bytes;
+  for (std::size_t k = 16 + 4; k < mask_bytes; ++k) b[chunk + k] = char(0x5a ^ k);
+  ExpectRefused(b, "");
+  b = bytes;
+  const std::uint32_t sizes_bytes = Get32(bytes, sizes);
+  ASSERT_GT(sizes_bytes, 16u);
+  ASSERT_LT(sizes_bytes, 0xffffffffu);
+  for (std::size_t k = 16 + 4; k < sizes_bytes; ++k) b[sizes + 4 + k] = char(0x33 ^ k);
+  ExpectRefused(b, "");
+  b = bytes;
+  Put32(b, size, 12);  // the record is longer than its stated size
+  ExpectRefused(b, "holds more than its 12 bytes");
+  // A record of raw bytes (one leaf) that counts no leaf: it fits its size, the tree disagrees.
+  std::string small = SmallFile();
+  const std::size_t at = small.find("file_delayed_load") + 17 + 4 + 13 + 4;
+  ASSERT_EQ(Get32(small, at), 1u);
+  Put32(small, at, 0);
+  ExpectRefused(small, "counts 0 leaves, the tree has 1");
+}
+
 TEST(VdbValidator, SpecialFilesAreRefused) {
   const fs::path dir = TempDir();
   auto refused = [](const std::string& path, const std::string& reason) {
