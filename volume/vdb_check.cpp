@@ -722,22 +722,30 @@ std::string ReadVdbFileBytes(const std::string& path, const VdbLimits& limits) {
   const std::string hint = "pass the fields.vdb that `pandora analyze` wrote";
   // O_NONBLOCK: opening a FIFO must not wait for a writer.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno), hint);
+  if (fd < 0)
+    throw InputError(
+        path, "",
+        std::string("cannot read the VDB file: cannot open it (") + std::strerror(errno) + ")",
+        hint);
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st;
   if (::fstat(fd, &st) != 0)
-    throw InputError(path, "", std::string("cannot read: ") + std::strerror(errno), hint);
-  if (S_ISDIR(st.st_mode)) throw InputError(path, "", "is a folder, not a VDB file", hint);
+    throw InputError(path, "", std::string("cannot read the VDB file: ") + std::strerror(errno),
+                     hint);
+  if (S_ISDIR(st.st_mode))
+    throw InputError(path, "", "cannot read the VDB file: it is a folder", hint);
   if (!S_ISREG(st.st_mode))
-    throw InputError(path, "", "is not a regular file (a FIFO, device or socket)", hint);
-  if (st.st_size == 0) throw InputError(path, "", "the file is empty", hint);
+    throw InputError(
+        path, "", "cannot read the VDB file: it is not a regular file (a FIFO, device or socket)",
+        hint);
+  if (st.st_size == 0) throw InputError(path, "", "cannot read the VDB file: it is empty", hint);
   if (std::uint64_t(st.st_size) > limits.max_file_bytes)
     throw InputError(path, "",
-                     "the file has " + std::to_string(st.st_size) + " bytes, over the limit of " +
-                         std::to_string(limits.max_file_bytes),
+                     "cannot read the VDB file: it has " + std::to_string(st.st_size) +
+                         " bytes, over the limit of " + std::to_string(limits.max_file_bytes),
                      hint);
   std::string bytes(std::size_t(st.st_size), '\0');
   std::size_t got = 0;
@@ -745,13 +753,14 @@ std::string ReadVdbFileBytes(const std::string& path, const VdbLimits& limits) {
     const ssize_t n = ::read(fd, &bytes[got], bytes.size() - got);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n < 0)
-      throw InputError(path, "", std::string("cannot read: ") + std::strerror(errno), hint);
+      throw InputError(path, "", std::string("cannot read the VDB file: ") + std::strerror(errno),
+                       hint);
     if (n == 0) break;
     got += std::size_t(n);
   }
   char extra;
   if (got != bytes.size() || ::read(fd, &extra, 1) > 0)
-    throw InputError(path, "", "the file changed size while it was read",
+    throw InputError(path, "", "cannot read the VDB file: it changed size while it was read",
                      "read it again when it is complete");
   return bytes;
 }
