@@ -150,7 +150,11 @@ int RunRender(const RenderArgs& args) {
   if (!args.fields.empty()) {
     // A run killed while committing its outputs is finished before they are read.
     RecoverOutputs(std::filesystem::path(args.fields).parent_path().string());
-    fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields));
+    FieldsProvenance provenance;
+    fields = std::make_unique<Fields>(ReadFieldsVdb(args.fields, &provenance));
+    for (const std::string& w :
+         CheckFieldsProvenance(provenance, fields->lattice, scene, rig, args.fields))
+      std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
 
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());

@@ -9,7 +9,7 @@ PACKAGES=(
   libopenvdb-dev libopenvdb-tools libembree-dev libcgal-dev libceres-dev libglm-dev
   libopenexr-dev openexr libpng-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
-  chromium libxml2-utils jq
+  chromium libxml2-utils jq python3-openvdb
 )
 
 missing=()

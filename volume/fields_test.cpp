@@ -359,30 +359,59 @@ TEST(Fields, VdbRoundTrip) {
   WriteFieldsVdb(fields, path, {{"units", "m"}, {"scene_sha256", "abc"}});
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
 
+  // The layout docs/fields.md describes: coverage as floats, one BoolGrid per camera.
   openvdb::io::File file(path);
   file.open();
   EXPECT_EQ(file.getMetadata()->metaValue<std::string>("scene_sha256"), "abc");
   openvdb::GridPtrVecPtr grids = file.getGrids();
   file.close();
-  ASSERT_EQ(grids->size(), 3u);
+  // Without rig metadata the cameras are named by index, up to the last camera that sees a voxel
+  // (the test scene's last camera looks away).
+  int cameras = 0;
+  for (auto it = fields.impl().cameras->cbeginValueOn(); it; ++it)
+    cameras = std::max(cameras, 64 - __builtin_clzll(std::uint64_t(*it)));
+  EXPECT_EQ(cameras, int(scene.rigs[0].cameras.size()) - 1);
+  ASSERT_EQ(int(grids->size()), 2 + cameras);
   std::map<std::string, openvdb::GridBase::Ptr> by_name;
   for (const auto& g : *grids) by_name[g->getName()] = g;
-  auto coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(by_name["coverage"]);
-  auto cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(by_name["cameras"]);
+  auto coverage = openvdb::gridPtrCast<openvdb::FloatGrid>(by_name["coverage"]);
   auto resolution = openvdb::gridPtrCast<openvdb::FloatGrid>(by_name["resolution"]);
-  ASSERT_TRUE(coverage && cameras && resolution);
+  ASSERT_TRUE(coverage && resolution);
   EXPECT_EQ(coverage->metaValue<std::string>("value_units"), "cameras");
   EXPECT_EQ(coverage->metaValue<std::string>("units"), "m");
   EXPECT_EQ(resolution->metaValue<std::string>("value_units"), "px/m");
   EXPECT_EQ(coverage->metaValue<std::string>("scene_sha256"), "abc");
   EXPECT_EQ(coverage->activeVoxelCount(), fields.impl().coverage->activeVoxelCount());
+  EXPECT_EQ(coverage->tree().activeTileCount(), fields.impl().coverage->tree().activeTileCount());
   EXPECT_NEAR(coverage->voxelSize().x(), 0.05, 1e-15);
-  // Values survive the trip.
+  auto cov = fields.impl().coverage->getConstAccessor();
+  for (auto it = coverage->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, float(cov.getValue(it.getCoord())));
+  // Camera c's grid is bit c of the mask.
+  auto mask = fields.impl().cameras->getConstAccessor();
+  for (int c = 0; c < cameras; ++c) {
+    auto seen = openvdb::gridPtrCast<openvdb::BoolGrid>(by_name["visible/" + std::to_string(c)]);
+    ASSERT_TRUE(seen) << c;
+    EXPECT_EQ(seen->metaValue<std::int64_t>("camera_index"), c);
+    EXPECT_EQ(seen->metaValue<std::string>("camera_id"), std::to_string(c));
+    std::int64_t expected = 0;
+    for (auto it = fields.impl().cameras->cbeginValueOn(); it; ++it) expected += (*it >> c) & 1;
+    EXPECT_EQ(std::int64_t(seen->activeVoxelCount()), expected) << c;
+    for (auto it = seen->cbeginValueOn(); it; ++it) ASSERT_TRUE((mask.getValue(it.getCoord()) >> c) & 1);
+  }
+
+  // ReadFieldsVdb gives the in-memory grids back exactly.
+  const Fields back = ReadFieldsVdb(path);
+  ASSERT_TRUE(back.impl().coverage && back.impl().cameras && back.impl().Float("resolution"));
+  EXPECT_EQ(back.impl().coverage->activeVoxelCount(), fields.impl().coverage->activeVoxelCount());
+  EXPECT_TRUE(back.impl().coverage->tree().hasSameTopology(fields.impl().coverage->tree()));
+  for (auto it = back.impl().coverage->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, cov.getValue(it.getCoord()));
+  EXPECT_TRUE(back.impl().cameras->tree().hasSameTopology(fields.impl().cameras->tree()));
+  for (auto it = back.impl().cameras->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, mask.getValue(it.getCoord()));
   auto a = fields.impl().Float("resolution")->getConstAccessor();
-  for (auto it = resolution->cbeginValueOn(); it; ++it)
+  for (auto it = back.impl().Float("resolution")->cbeginValueOn(); it; ++it)
     ASSERT_EQ(*it, a.getValue(it.getCoord()));
-  auto b = fields.impl().cameras->getConstAccessor();
-  for (auto it = cameras->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, b.getValue(it.getCoord()));
+  EXPECT_EQ(back.lattice.voxel_size, fields.lattice.voxel_size);
+  EXPECT_EQ(back.lattice.origin, fields.lattice.origin);
 
   // An unwritable destination is an InputError naming the file, and leaves nothing behind.
   EXPECT_THROW(WriteFieldsVdb(fields, "/proc/pandora/nope.vdb", {}), InputError);

@@ -1,13 +1,19 @@
 #include "volume/vdb_io.h"
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <cstdio>
+#include <istream>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <streambuf>
 
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
@@ -22,12 +28,25 @@ void InitializeOpenVdb() {
 
 namespace {
 
+constexpr char kVisiblePrefix[] = "visible/";
+constexpr int kMaxCameras = 64;  // bits of the in-memory mask
+
+// How the grids' values are stored: see docs/fields.md ("Compression") for the measured trade-off.
+constexpr std::uint32_t kCompression =
+    openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK;
+
+// Transform::copy() re-derives the map from its matrix (the scale can move by a few ulps); the copy
+// constructor keeps it exactly.
+openvdb::math::Transform::Ptr ExactCopy(const openvdb::math::Transform& transform) {
+  return std::make_shared<openvdb::math::Transform>(transform);
+}
+
 // Per-grid description: units and meaning, for people reading `vdb_print -l`.
 void Describe(openvdb::GridBase& grid) {
   static const std::map<std::string, std::pair<const char*, const char*>> kDescriptions{
-      {"coverage", {"cameras", "number of cameras that see the voxel centre"}},
-      {"cameras", {"bitmask", "bit c set when camera c (rig order, see rig metadata) sees the voxel centre"}},
-      {"resolution", {"px/m", "best pixel density among the cameras that see the voxel (det(J J^T)^(1/4))"}},
+      {"coverage", {"cameras", "number of cameras that see the voxel centre (whole numbers)"}},
+      {"resolution",
+       {"px/m", "best pixel density among the cameras that see the voxel (det(J J^T)^(1/4))"}},
       {"sigma_max", {"mm", "worst-direction 1-sigma of the static triangulation covariance"}},
       {"sigma_mean", {"mm", "sqrt(trace/3) of the static triangulation covariance"}},
       {"triangulation_angle", {"deg", "largest angle between two rays that see the voxel"}},
@@ -61,22 +80,176 @@ class CheckedVdbWriter : public openvdb::io::Archive {
   }
 };
 
+
+// Camera ids in rig order from the "rig" metadata (RigToJson); empty when absent or unusable.
+std::vector<std::string> CameraIds(const std::map<std::string, std::string>& metadata) {
+  auto it = metadata.find("rig");
+  if (it == metadata.end()) return {};
+  const nlohmann::json rig = nlohmann::json::parse(it->second, nullptr, false);
+  if (rig.is_discarded() || !rig.is_object() || !rig.contains("cameras") ||
+      !rig["cameras"].is_array())
+    return {};
+  std::vector<std::string> ids;
+  std::set<std::string> unique;
+  for (const auto& camera : rig["cameras"]) {
+    if (!camera.is_object() || !camera.contains("id") || !camera["id"].is_string()) return {};
+    ids.push_back(camera["id"].get<std::string>());
+    if (!unique.insert(ids.back()).second) return {};
+  }
+  return ids;
+}
+
+// The cameras bitmask as one BoolGrid per camera, voxel by voxel (tiles, which the evaluator never
+// writes, are spelled out).
+openvdb::GridPtrVec CameraGrids(const openvdb::Int64Grid& cameras, std::vector<std::string> ids) {
+  int count = 0;
+  for (auto it = cameras.cbeginValueOn(); it; ++it) {
+    const std::uint64_t mask = static_cast<std::uint64_t>(*it);
+    if (mask) count = std::max(count, 64 - __builtin_clzll(mask));
+  }
+  if (int(ids.size()) < count) ids.clear();  // ids that do not cover the mask: name by index
+  if (ids.empty())
+    for (int c = 0; c < count; ++c) ids.push_back(std::to_string(c));
+  std::vector<openvdb::BoolGrid::Ptr> grids;
+  for (std::size_t c = 0; c < ids.size(); ++c) {
+    auto grid = openvdb::BoolGrid::create(false);
+    grid->setName(VisibilityGridName(ids[c]));
+    grid->setTransform(ExactCopy(cameras.transform()));
+    grid->insertMeta("camera_id", openvdb::StringMetadata(ids[c]));
+    grid->insertMeta("camera_index", openvdb::Int64Metadata(std::int64_t(c)));
+    grid->insertMeta("value_units", openvdb::StringMetadata("bool"));
+    grid->insertMeta("description", openvdb::StringMetadata(
+                                        "active and true where camera '" + ids[c] +
+                                        "' (index camera_index in the rig) sees the voxel centre"));
+    grids.push_back(grid);
+  }
+  std::vector<openvdb::BoolGrid::Accessor> acc;
+  for (auto& g : grids) acc.push_back(g->getAccessor());
+  for (auto it = cameras.cbeginValueOn(); it; ++it) {
+    const std::uint64_t mask = static_cast<std::uint64_t>(*it);
+    if (!mask) continue;
+    const openvdb::CoordBBox box = it.getBoundingBox();
+    for (auto xyz = box.begin(); xyz; ++xyz)
+      for (std::size_t c = 0; c < grids.size(); ++c)
+        if (mask >> c & 1) acc[c].setValueOn(*xyz, true);
+  }
+  return openvdb::GridPtrVec(grids.begin(), grids.end());
+}
+
+// A read-only stream buffer over bytes in memory, seekable, for openvdb::io::Stream.
+class MemoryBuffer : public std::streambuf {
+ public:
+  MemoryBuffer(const char* data, std::size_t size) {
+    char* p = const_cast<char*>(data);
+    setg(p, p, p + size);
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+    off_type base = dir == std::ios_base::beg   ? 0
+                    : dir == std::ios_base::cur ? gptr() - eback()
+                                                : egptr() - eback();
+    const off_type target = base + off;
+    if (target < 0 || target > egptr() - eback()) return pos_type(off_type(-1));
+    setg(eback(), eback() + target, egptr());
+    return pos_type(target);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+};
+
+[[noreturn]] void Refuse(const std::string& path, const std::string& reason) {
+  throw InputError(path, "", reason, "pass the fields.vdb that `pandora analyze` wrote");
+}
+
+std::string CoordText(const openvdb::Coord& c) {
+  return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+         ")";
+}
+
+// Every value of a coverage grid (active or not, tiles included) a whole number of cameras in
+// [0, 64].
+template <typename GridT>
+void CheckCameraCounts(const GridT& grid, const std::string& path) {
+  auto ok = [](auto v) { return v >= 0 && v <= kMaxCameras && v == std::floor(v); };
+  if (!ok(grid.background()))
+    Refuse(path, "grid 'coverage' has a background that is not a camera count");
+  for (auto it = grid.cbeginValueAll(); it; ++it)
+    if (!ok(*it))
+      Refuse(path, "grid 'coverage' holds " + std::to_string(*it) + " at voxel " +
+                       CoordText(it.getCoord()) + ", not a whole number of cameras in [0, 64]");
+}
+
+// Coverage stored as floats back to the in-memory Int32Grid.
+openvdb::Int32Grid::Ptr CoverageFromFloat(const openvdb::FloatGrid& grid, const std::string& path) {
+  CheckCameraCounts(grid, path);
+  auto tree = std::make_shared<openvdb::Int32Tree>(grid.tree());  // converts every value and tile
+  auto out = openvdb::Int32Grid::create(tree);
+  out->setName(kCoverageGrid);
+  out->setTransform(ExactCopy(grid.transform()));
+  out->insertMeta(static_cast<const openvdb::MetaMap&>(grid));
+  return out;
+}
+
+void CheckFinite(const openvdb::FloatGrid& grid, const std::string& path) {
+  if (!std::isfinite(grid.background()))
+    Refuse(path, "grid '" + grid.getName() + "' has a non-finite background");
+  for (auto it = grid.cbeginValueAll(); it; ++it)
+    if (!std::isfinite(*it))
+      Refuse(path, "grid '" + grid.getName() + "' holds a non-finite value at voxel " +
+                       CoordText(it.getCoord()));
+}
+
+std::string TypeWord(const std::string& tree_type) {
+  if (tree_type == "Tree_float_5_4_3") return "a FloatGrid";
+  if (tree_type == "Tree_bool_5_4_3") return "a BoolGrid";
+  if (tree_type == "Tree_int32_5_4_3") return "an Int32Grid";
+  if (tree_type == "Tree_int64_5_4_3") return "an Int64Grid";
+  return tree_type;
+}
+
 }  // namespace
 
 void WriteFieldsVdb(const Fields& fields, const std::string& path,
                     const std::map<std::string, std::string>& metadata) {
   InitializeOpenVdb();
-  openvdb::GridPtrVec grids = fields.impl().Grids();
-  openvdb::MetaMap file_meta;
-  for (const auto& [key, value] : metadata) file_meta.insertMeta(key, openvdb::StringMetadata(value));
+  const Fields::Impl& g = fields.impl();
+  openvdb::GridPtrVec grids;
+  if (g.coverage) {
+    auto coverage =
+        openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(g.coverage->tree()));
+    coverage->setName(kCoverageGrid);
+    coverage->setTransform(ExactCopy(g.coverage->transform()));
+    grids.push_back(coverage);
+  }
+  for (const std::string& name : FieldNames())
+    if (auto f = g.Float(name)) {
+      // Shares the tree and the transform (copyGrid() would re-derive the transform, see
+      // ExactCopy).
+      auto copy = openvdb::FloatGrid::create(f->treePtr());
+      copy->setTransform(f->transformPtr());
+      copy->insertMeta(static_cast<const openvdb::MetaMap&>(*f));
+      grids.push_back(copy);
+    }
   for (openvdb::GridBase::Ptr& grid : grids) {
     for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
     Describe(*grid);
   }
+  if (g.cameras) {
+    for (openvdb::GridBase::Ptr grid : CameraGrids(*g.cameras, CameraIds(metadata))) {
+      for (const auto& [key, value] : metadata)
+        if (key != "rig") grid->insertMeta(key, openvdb::StringMetadata(value));
+      grids.push_back(grid);
+    }
+  }
+  openvdb::MetaMap file_meta;
+  for (const auto& [key, value] : metadata)
+    file_meta.insertMeta(key, openvdb::StringMetadata(value));
   const std::string tmp = TemporaryPath(path);
   try {
     CheckedVdbWriter writer;
-    writer.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    writer.setCompression(kCompression);
     writer.Write(tmp, grids, file_meta);
   } catch (const openvdb::Exception& e) {
     std::remove(tmp.c_str());
@@ -89,50 +262,133 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
   CommitTemporary(path);
 }
 
-Fields ReadFieldsVdb(const std::string& path) {
+Fields ReadFieldsVdb(const std::string& path, FieldsProvenance* provenance) {
+  return ReadFieldsVdbBytes(ReadVdbFileBytes(path), path, provenance);
+}
+
+Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
+                          FieldsProvenance* provenance) {
+  const VdbFileInfo info = CheckVdbBytes(bytes, path);
   InitializeOpenVdb();
+
+  // Which grids to keep, by what the validator saw (names are unique, types known).
+  std::map<std::string, const VdbGridInfo*> by_name;
+  std::vector<const VdbGridInfo*> cameras_info;
+  std::set<std::int64_t> indices;
+  const VdbGridInfo* first = nullptr;
+  for (const VdbGridInfo& grid : info.grids) {
+    const std::string& name = grid.name;
+    std::vector<std::string> expected;
+    if (name == kCoverageGrid) {
+      expected = {"Tree_float_5_4_3", "Tree_int32_5_4_3"};
+    } else if (name == kCamerasGrid) {
+      expected = {"Tree_int64_5_4_3"};
+    } else if (name.rfind(kVisiblePrefix, 0) == 0) {
+      expected = {"Tree_bool_5_4_3"};
+    } else if (std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end()) {
+      expected = {"Tree_float_5_4_3"};
+    } else {
+      continue;  // not ours
+    }
+    if (std::find(expected.begin(), expected.end(), grid.tree_type) == expected.end())
+      Refuse(path, "grid '" + name + "' is " + TypeWord(grid.tree_type) + ", expected " +
+                       TypeWord(expected[0]));
+    if (name.rfind(kVisiblePrefix, 0) == 0) {
+      auto index = grid.integers.find("camera_index");
+      if (index == grid.integers.end() || index->second < 0 || index->second >= kMaxCameras ||
+          !indices.insert(index->second).second)
+        Refuse(path, "grid '" + name + "' lacks a camera_index in [0, 64) of its own");
+      if (grid.active_tiles > 0)
+        Refuse(path, "grid '" + name + "' holds active tiles; camera grids hold voxels only");
+      cameras_info.push_back(&grid);
+    }
+    auto same = [&](double a, double b) { return std::abs(a - b) <= 1e-9 * first->voxel_size; };
+    if (first && (!same(grid.voxel_size, first->voxel_size) ||
+                  !same(grid.translation[0], first->translation[0]) ||
+                  !same(grid.translation[1], first->translation[1]) ||
+                  !same(grid.translation[2], first->translation[2])))
+      Refuse(path, "grids '" + first->name + "' and '" + name + "' have different transforms");
+    if (!first) first = &grid;
+    by_name[name] = &grid;
+  }
+  if (by_name.empty()) Refuse(path, "the VDB file holds none of Pandora's field grids");
+  if (by_name.count(kCamerasGrid) && !cameras_info.empty())
+    Refuse(path, "the file holds both a 'cameras' grid and per-camera 'visible/' grids");
+
+  openvdb::GridPtrVecPtr grids;
+  try {
+    MemoryBuffer buffer(bytes.data(), bytes.size());
+    std::istream in(&buffer);
+    openvdb::io::Stream stream(in, /*delayLoad=*/false);
+    grids = stream.getGrids();
+  } catch (const std::exception& e) {  // openvdb::Exception, std::bad_alloc, ...
+    Refuse(path, std::string("cannot read the VDB file: ") + e.what());
+  }
+  if (!grids || grids->size() != info.grids.size())
+    Refuse(path, "OpenVDB read a different number of grids than the file holds");
+
   Fields fields;
   Fields::Impl& g = fields.impl();
-  try {
-    openvdb::io::File file(path);
-    file.open();
-    for (auto it = file.beginName(); it != file.endName(); ++it) {
-      const std::string name = it.gridName();
-      const bool known = std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end();
-      if (!known) continue;
-      openvdb::GridBase::Ptr base = file.readGrid(name);
-      if (name == kCoverageGrid) {
-        g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base);
-      } else if (name == kCamerasGrid) {
-        g.cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
-      } else if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) {
-        g.floats[name] = f;
-      } else {
-        continue;  // a known name of an unexpected type: not ours
-      }
-      if (!g.transform) g.transform = base->transform().copy();
+  std::map<std::int64_t, openvdb::BoolGrid::Ptr> visible;
+  for (const openvdb::GridBase::Ptr& base : *grids) {
+    const std::string name = base->getName();
+    if (!by_name.count(name)) continue;
+    if (name == kCoverageGrid) {
+      if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base))
+        g.coverage = CoverageFromFloat(*f, path);
+      else if ((g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base)))
+        CheckCameraCounts(*g.coverage, path);  // the earlier layout
+    } else if (name == kCamerasGrid) {
+      g.cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
+    } else if (name.rfind(kVisiblePrefix, 0) == 0) {
+      visible[by_name[name]->integers.at("camera_index")] =
+          openvdb::gridPtrCast<openvdb::BoolGrid>(base);
+    } else {
+      auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+      CheckFinite(*f, path);
+      g.floats[name] = f;
     }
-    file.close();
-  } catch (const openvdb::Exception& e) {
-    throw InputError(path, "", std::string("cannot read the VDB file: ") + e.what(),
-                     "pass the fields.vdb that `pandora analyze` wrote");
-  } catch (const std::exception& e) {  // a truncated file can fail in the streams or allocation
-    throw InputError(path, "", std::string("cannot read the VDB file: ") + e.what(),
-                     "pass the fields.vdb that `pandora analyze` wrote");
+    if (!g.transform) g.transform = base->transformPtr();
   }
-  const openvdb::GridPtrVec grids = g.Grids();
-  if (grids.empty())
-    throw InputError(path, "", "the VDB file holds none of Pandora's field grids",
-                     "pass the fields.vdb that `pandora analyze` wrote");
+  if ((by_name.count(kCoverageGrid) && !g.coverage) ||
+      (by_name.count(kCamerasGrid) && !g.cameras) || visible.size() != cameras_info.size())
+    Refuse(path, "OpenVDB read a grid of another type than the file declares");
+  if (!visible.empty()) {
+    g.cameras = openvdb::Int64Grid::create(0);
+    g.cameras->setName(kCamerasGrid);
+    g.cameras->setTransform(g.transform);
+    auto acc = g.cameras->getAccessor();
+    for (const auto& [index, grid] : visible) {
+      const std::int64_t bit = std::int64_t(std::uint64_t(1) << index);
+      for (auto it = grid->cbeginValueOn(); it; ++it)  // voxels only (checked above)
+        acc.setValueOn(it.getCoord(), acc.getValue(it.getCoord()) | bit);
+    }
+  }
+
   // The lattice: voxel (0, 0, 0) at the transform's origin, extent from the active voxels.
-  const double vs = g.transform->voxelSize()[0];
-  const openvdb::Vec3d o = g.transform->indexToWorld(openvdb::Vec3d(0, 0, 0));
-  fields.lattice.voxel_size = vs;
-  fields.lattice.origin = Vec3(o.x(), o.y(), o.z());
-  openvdb::CoordBBox box;
-  for (const auto& grid : grids) box.expand(grid->evalActiveVoxelBoundingBox());
-  if (!box.empty())
-    fields.lattice.dims = Eigen::Vector3i(box.max().x() + 1, box.max().y() + 1, box.max().z() + 1);
+  fields.lattice.voxel_size = first->voxel_size;
+  fields.lattice.origin = Vec3(first->translation[0], first->translation[1], first->translation[2]);
+  for (const auto& [name, grid] : by_name)
+    if (!grid->empty)
+      for (int a = 0; a < 3; ++a)
+        fields.lattice.dims[a] =
+            std::max<int>(fields.lattice.dims[a], int(grid->active_max[a] + 1));
+
+  if (provenance) {
+    FieldsProvenance p;
+    p.metadata = info.strings;
+    auto get = [&](const char* key) {
+      auto it = info.strings.find(key);
+      return it == info.strings.end() ? std::string() : it->second;
+    };
+    p.scene_file = get("scene_file");
+    p.scene_sha256 = get("scene_sha256");
+    p.rig_name = get("rig_name");
+    p.rig_json = get("rig");
+    p.tool = get("tool");
+    p.tool_version = get("tool_version");
+    *provenance = std::move(p);
+  }
   return fields;
 }
 
