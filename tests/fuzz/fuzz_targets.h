@@ -15,11 +15,6 @@ void FieldsTarget(const std::uint8_t* data, std::size_t size);
 
 /// Bytes as a scene file: ParseScene(text, MESH_DIR/fuzz.json) with meshes loaded, so relative mesh
 /// references resolve in tests/fuzz/meshes. Parses and validates only (no ray caster, no fields).
-/// Inputs that hit the loader's known, open issues are skipped (SkipKnownSceneIssue).
 void SceneTarget(const std::uint8_t* data, std::size_t size);
-
-/// True for scene inputs that reach a known open problem of the scene loader, being fixed
-/// separately (docs/robustness.md): JSON nested deeper than 64 levels, and .x mesh references.
-bool SkipKnownSceneIssue(const std::uint8_t* data, std::size_t size);
 
 }  // namespace pandora::fuzz
