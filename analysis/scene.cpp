@@ -887,6 +887,10 @@ Rig ReadRig(const Node& node, std::set<std::string>* names) {
   const Node cameras = node.Get("cameras");
   const size_t n = cameras.ArraySize("an array of cameras");
   if (n == 0) cameras.Fail("a rig needs at least one camera");
+  if (n > size_t(SceneLimits::kMaxCameras))
+    cameras.Fail(std::to_string(n) + " cameras, over the limit of " +
+                     std::to_string(SceneLimits::kMaxCameras) + " per rig",
+                 "split the site into several rigs (studies)");
   std::set<std::string> ids;
   for (size_t i = 0; i < n; ++i) rig.cameras.push_back(ReadCamera(cameras.At(i), i, &ids));
   return rig;

@@ -117,6 +117,9 @@ struct SceneLimits {
   /// the scene's geometry and region of that content's centre (Scene::MaxReach()). At that
   /// distance a float ray's rounding is about 1e-3 of the scene's size.
   static constexpr double kReach = 1e4;
+  /// Cameras in one rig: large surveillance sites and mocap stages use 100-1000; the fields file
+  /// holds one grid per camera.
+  static constexpr int kMaxCameras = 10000;
 };
 
 /// A loaded, validated scene file.

@@ -115,6 +115,16 @@ bool FrustumCuller::MayIntersect(int camera, const Aabb& box) const {
   return true;
 }
 
+Aabb BlockCentreBox(const VoxelLattice& lattice, const Block& block) {
+  const Eigen::Vector3i last = block.origin + block.extent - Eigen::Vector3i::Ones();
+  Aabb box;
+  box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
+  box.Extend(lattice.Center(last.x(), last.y(), last.z()));
+  box.min -= Vec3::Constant(1e-9 * lattice.voxel_size);
+  box.max += Vec3::Constant(1e-9 * lattice.voxel_size);
+  return box;
+}
+
 std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& region,
                                   const std::vector<const InsideMesh*>& solids,
                                   const InsideMesh* region_mesh, const FrustumCuller& culler,
@@ -196,12 +206,10 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
       keep[b] = 1;
       block.full = block.mask.empty() && n_vox == 512;
       if (block.free_voxels == 0) continue;
-      // Cameras: pad the box by round-off only (1e-9 of a voxel).
-      Aabb padded = box;
-      padded.min -= Vec3::Constant(1e-9 * h);
-      padded.max += Vec3::Constant(1e-9 * h);
+      // Cameras: the box padded by round-off only.
+      const Aabb padded = BlockCentreBox(lattice, block);
       for (int c = 0; c < camera_count; ++c)
-        if (culler.MayIntersect(c, padded)) block.cameras |= (std::uint64_t{1} << c);
+        if (culler.MayIntersect(c, padded)) block.cameras.push_back(c);
     }
   });
 
@@ -213,7 +221,7 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
     s.solid_voxels += all[b].solid_voxels;
     if (all[b].free_voxels == 0) continue;
     ++s.blocks;
-    if (all[b].cameras == 0) ++s.culled_blocks;
+    if (all[b].cameras.empty()) ++s.culled_blocks;
     blocks.push_back(std::move(all[b]));
   }
   if (stats) *stats = s;

@@ -58,7 +58,7 @@ class FrustumCuller {
 /// What is known about one 8^3 block before any ray is cast.
 struct Block {
   Eigen::Vector3i origin;      ///< Index of its first voxel (multiples of 8).
-  std::uint64_t cameras = 0;   ///< Bit c set when camera c's frustum may meet the block.
+  std::vector<std::int32_t> cameras;  ///< Cameras (rig indices, ascending) whose frustum may meet it.
   Eigen::Vector3i extent = Eigen::Vector3i::Constant(8);  ///< Voxels per axis (< 8 at the edge).
   bool full = false;  ///< All 8^3 voxels are free region voxels (no solid, not at the edge).
   /// Per voxel, at Offset(x, y, z): 1 when it is a free region voxel to evaluate. Empty when every
@@ -71,6 +71,10 @@ struct Block {
   std::int64_t free_voxels = 0;   ///< Region voxels outside solids in this block.
   std::int64_t solid_voxels = 0;  ///< Region voxels inside solids in this block.
 };
+
+/// The box of a block's voxel centres, padded by round-off (1e-9 of a voxel): what FrustumCuller
+/// tests for the block.
+Aabb BlockCentreBox(const VoxelLattice& lattice, const Block& block);
 
 /// Statistics of the active-set pass.
 struct ActiveSetStats {

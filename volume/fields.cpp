@@ -1,6 +1,7 @@
 #include "volume/fields.h"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -33,7 +34,7 @@ bool Wants(const std::vector<std::string>& fields, const std::string& name) {
   return std::find(fields.begin(), fields.end(), name) != fields.end();
 }
 
-// The float fields in a fixed order; index into BlockResult::floats.
+// The float fields in a fixed order.
 enum FloatField {
   kResolution,
   kSigmaMax,
@@ -58,19 +59,6 @@ double BytesPerVoxel(const std::string& field) {
   if (field == "cameras") return 8 + overhead;
   return 4 + overhead;  // float fields
 }
-
-// Results of one block, before they become OpenVDB leaves.
-struct BlockResult {
-  openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
-  openvdb::Int64Tree::LeafNodeType* cameras = nullptr;
-  std::array<FloatLeaf*, kFloatFieldCount> floats{};
-  bool coverage_tile = false;  // A whole leaf of zeros: stored as a tile.
-  std::vector<Ray> rays;
-  std::array<std::int64_t, 65> histogram{};
-  std::vector<std::int64_t> per_camera;
-  std::int64_t tests = 0, ray_count = 0, seen = 0, triangulable = 0, unobservable = 0;
-  std::vector<float> sigma_max, sigma_max_steady;
-};
 
 // Rows of the per-candidate statistics arrays.
 enum StatRow {
@@ -154,35 +142,36 @@ inline double AtanNonNegative(double t) {
          x;
 }
 
-// The triangulation angle of `count` voxels at (x, y, z) seen by the cameras in mask[m]: the
-// largest angle in degrees between two rays from camera centres that see the voxel. Vectorised
-// over voxels, in tiles of 64 that keep every camera's directions in L1: per camera the unit
-// directions (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so every
-// comparison with it fails), per camera pair the dot product, keeping the pair with the smallest,
-// then the angle as atan2(|cross|, dot) (both keep their relative
-// accuracy, so tiny and near-180 degree angles are as exact as at 90). No per-ray storage.
+// The triangulation angle of `count` voxels at (x, y, z) (block offsets `offset`): the largest angle
+// in degrees between two rays from camera centres that see the voxel. `sees[e]` is the 512-bit
+// mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). Vectorised over
+// voxels, in tiles of 64 that keep every camera's directions in L1: per camera the unit directions
+// (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so every comparison
+// with it fails), per camera pair the dot product, keeping the pair with the smallest, then the
+// angle as atan2(|cross|, dot) (both keep their relative accuracy, so tiny and near-180 degree
+// angles are as exact as at 90). No per-ray storage.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 void TriangulationAngles(int count, const double* x, const double* y, const double* z,
-                         const std::uint64_t* mask, const std::vector<Vec3>& centres,
-                         std::uint64_t cameras, double* dirs, float* degrees) {
+                         const std::int16_t* offset, int camera_count,
+                         const std::uint64_t* const* sees, const Vec3* centres, double* dirs,
+                         float* degrees) {
   constexpr int kTile = 64;
-  const int camera_count = static_cast<int>(centres.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int start = 0; start < count; start += kTile) {
     const int n = std::min(kTile, count - start);
     const double *tx = x + start, *ty = y + start, *tz = z + start;
-    const std::uint64_t* tmask = mask + start;
+    const std::int16_t* to = offset + start;
     for (int c = 0; c < camera_count; ++c) {
-      if (!(cameras >> c & 1)) continue;
       const double cx = centres[c].x(), cy = centres[c].y(), cz = centres[c].z();
+      const std::uint64_t* mask = sees[c];
       double* d = dirs + 3 * kTile * c;
 #pragma omp simd
       for (int m = 0; m < n; ++m) {
         const double vx = tx[m] - cx, vy = ty[m] - cy, vz = tz[m] - cz;
-        const double inv =
-            (tmask[m] >> c & 1) != 0 ? 1.0 / std::sqrt(vx * vx + vy * vy + vz * vz) : nan;
+        const bool seen = (mask[to[m] >> 6] >> (to[m] & 63) & 1) != 0;
+        const double inv = seen ? 1.0 / std::sqrt(vx * vx + vy * vy + vz * vz) : nan;
         d[m] = vx * inv;
         d[m + kTile] = vy * inv;
         d[m + 2 * kTile] = vz * inv;
@@ -192,10 +181,8 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
     std::int64_t best_a[kTile], best_b[kTile];  // camera indices of the best pair
     for (int m = 0; m < kTile; ++m) best_dot[m] = 2.0, best_a[m] = 0, best_b[m] = 0;
     for (int a = 0; a < camera_count; ++a) {
-      if (!(cameras >> a & 1)) continue;
       const double* ad = dirs + 3 * kTile * a;
       for (int b = a + 1; b < camera_count; ++b) {
-        if (!(cameras >> b & 1)) continue;
         const double* bd = dirs + 3 * kTile * b;
 #pragma omp simd
         for (int m = 0; m < n; ++m) {
@@ -222,58 +209,479 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
   }
 }
 
-}  // namespace
+// ---------------------------------------------------------------------------------------------
+// The evaluator's state.
 
-double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
-                          int camera_count) {
-  const double voxels = static_cast<double>(lattice.voxel_count());
-  const double blocks = voxels / 512.0 + 1.0;
-  // Active-set pass: one Block record per 8^3 block, a 512-byte mask where a block is partial.
-  double bytes = blocks * (sizeof(Block) + 512.0 + sizeof(BlockResult));
-  for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
-  return bytes + 64.0 * camera_count;
+constexpr int kWords = 8;  // 512 voxels of a block as bits
+using Bits = std::array<std::uint64_t, kWords>;
+inline bool TestBit(const Bits& b, int o) { return (b[o >> 6] >> (o & 63) & 1) != 0; }
+inline void SetBit(Bits& b, int o) { b[o >> 6] |= std::uint64_t{1} << (o & 63); }
+
+// What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,
+// its information contribution A^T A (six doubles, AddCameraInformation on zeros) and pixel density.
+struct CameraEntry {
+  std::int32_t camera = 0;
+  std::int32_t rays = 0;  // occlusion segments cast
+  std::int32_t seen = 0;  // bits set
+  Bits bits{};
+  std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
+  std::vector<double> information;  // with an information field
+  std::vector<float> density;       // with resolution
+  int Index(int o) const {
+    const int w = o >> 6;
+    return before[w] + __builtin_popcountll(bits[w] & ((std::uint64_t{1} << (o & 63)) - 1));
+  }
+  double Bytes() const {
+    return sizeof(CameraEntry) + information.capacity() * sizeof(double) +
+           density.capacity() * sizeof(float);
+  }
+};
+
+enum VoxelStatus : std::uint8_t { kUnseen, kSeenOnly, kTriangulable, kUnobservable };
+
+struct BlockState {
+  std::vector<std::int32_t> candidates;  // cameras whose frustum may meet the block, ascending
+  std::vector<CameraEntry> entries;      // cameras that cast rays here, ascending
+  // Per-voxel caches by offset (kept with keep_state): coverage, status, sigma_max, steady max.
+  std::vector<std::int32_t> coverage;
+  std::vector<std::uint8_t> status;
+  std::vector<float> sigma_max, sigma_steady;
+  // Summary.
+  std::vector<std::int64_t> histogram;  // [k] = free voxels seen by k cameras
+  std::int64_t seen = 0, triangulable = 0, unobservable = 0;
+  std::vector<float> sigma_list, steady_list;  // triangulable voxels in ascending offset
+  std::vector<Ray> rays;                       // with record_rays
+};
+
+bool SameForFields(const Camera& a, const Camera& b) {
+  const Intrinsics& p = a.model.intrinsics();
+  const Intrinsics& q = b.model.intrinsics();
+  return a.enabled == b.enabled && a.world_from_camera.matrix() == b.world_from_camera.matrix() &&
+         a.near == b.near && a.far == b.far && a.pixel_sigma == b.pixel_sigma &&
+         p.width == q.width && p.height == q.height && p.fx == q.fx && p.fy == q.fy &&
+         p.cx == q.cx && p.cy == q.cy && p.model == q.model && p.k1 == q.k1 && p.k2 == q.k2 &&
+         p.p1 == q.p1 && p.p2 == q.p2 && p.k3 == q.k3 && p.k4 == q.k4;
 }
 
-Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                      const FieldOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t cpu0 = std::clock();
-  const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
-  if (auto problem = CheckFieldList(options.fields, scene.study.motion.has_value()))
-    throw InputError(file, "$.study.fields[" + std::to_string(problem->index) + "]", problem->reason,
-                     problem->hint);
-  if (options.fields.empty())
-    throw InputError(file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
-  const int camera_count = static_cast<int>(rig.cameras.size());
-  if (camera_count > 64)
-    throw InputError(file, "$.rigs", "rig '" + rig.name + "' has " + std::to_string(camera_count) +
-                                         " cameras; fields support at most 64",
-                     "split the rig or disable cameras in a copy of it");
+// What a rig needs per camera during an update.
+struct RigData {
+  std::unique_ptr<VisibilityTester> tester;
+  std::unique_ptr<FrustumCuller> culler;
+  std::vector<std::array<double, 9>> whitened;  // R_camera_from_world / sigma_c
+  std::vector<Vec3> centres;
+  int enabled = 0;
+};
 
-  Fields out;
+// A block's new leaves, made in the parallel phase and put into the grids in the serial one.
+struct BlockLeaves {
+  openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
+  bool coverage_tile = false;
+  std::array<FloatLeaf*, kFloatFieldCount> floats{};
+  std::array<bool, kFloatFieldCount> remove_float{};
+  std::vector<std::pair<int, openvdb::BoolTree::LeafNodeType*>> visible;  // changed cameras
+  void Free() {
+    delete coverage;
+    for (FloatLeaf* f : floats) delete f;
+    for (auto& v : visible) delete v.second;
+  }
+};
+
+}  // namespace
+
+struct FieldEvaluator::State {
+  const Scene& scene;
+  const RayCaster& caster;
+  FieldOptions options;
+  bool keep = true;
+  std::string file;
+  double scene_scale = 0;
+
+  std::vector<Block> blocks;  // the active set (free voxels; Block::cameras unused)
+  std::vector<BlockState> states;
+  ActiveSetStats active_stats;
+  double active_set_seconds = 0;
+  Rig rig;  // as of the last update
+  bool evaluated = false;
+  Fields fields;
+
+  bool want_coverage = false, want_cameras = false, want_resolution = false;
+  bool want_static = false, want_steady = false, want_angle = false;
+  bool want_information = false, want_jacobian = false;
+  std::array<bool, kFloatFieldCount> want_float{};
+  MotionModel motion;
+  double frame_period = 0;
+
+  State(const Scene& s, const RayCaster& c) : scene(s), caster(c) {}
+
+  RigData Prepare(const Rig& rig) const;
+  void Cast(const Block& block, int camera, const RigData& rd, CameraEntry* entry,
+            std::vector<Ray>* rays) const;
+  void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
+              const Bits& dirty, const std::vector<Vec3>& centres, BlockState* next,
+              BlockLeaves* leaves) const;
+  void Totals(FieldStats* stats, int camera_count, int enabled) const;
+  void ResetGrids(int camera_count);
+};
+
+namespace {
+
+template <typename GridPtr>
+void MakeGrid(GridPtr& grid, const char* name, const openvdb::math::Transform::Ptr& transform) {
+  grid = std::decay_t<decltype(*grid)>::create(typename std::decay_t<decltype(*grid)>::ValueType());
+  grid->setName(name);
+  grid->setTransform(transform);
+}
+
+}  // namespace
+
+void FieldEvaluator::State::ResetGrids(int camera_count) {
+  Fields::Impl& g = fields.impl();
+  g.transform = openvdb::math::Transform::createLinearTransform(scene.study.voxel_size);
+  const VoxelLattice& lattice = fields.lattice;
+  g.transform->postTranslate(
+      openvdb::Vec3d(lattice.origin.x(), lattice.origin.y(), lattice.origin.z()));
+  g.coverage.reset();
+  g.floats.clear();
+  g.visible.clear();
+  if (want_coverage) MakeGrid(g.coverage, kCoverageGrid, g.transform);
+  for (int f = 0; f < kFloatFieldCount; ++f) {
+    if (!want_float[f]) continue;
+    openvdb::FloatGrid::Ptr grid;
+    MakeGrid(grid, kFloatFieldNames[f], g.transform);
+    g.floats[kFloatFieldNames[f]] = grid;
+  }
+  if (want_cameras) {
+    g.visible.resize(camera_count);
+    for (auto& v : g.visible) MakeGrid(v, "visible", g.transform);
+  }
+}
+
+RigData FieldEvaluator::State::Prepare(const Rig& r) const {
+  RigData rd;
+  rd.tester = std::make_unique<VisibilityTester>(r.cameras, caster, scene_scale);
+  rd.culler = std::make_unique<FrustumCuller>(r.cameras);
+  rd.whitened.resize(r.cameras.size());
+  for (std::size_t c = 0; c < r.cameras.size(); ++c) {
+    const Camera& cam = r.cameras[c];
+    const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene.study.pixel_sigma;
+    WhitenedRotation(rd.tester->camera_rotation(int(c)), sigma, rd.whitened[c].data());
+    rd.centres.push_back(cam.center());
+  }
+  rd.enabled = r.enabled_count();
+  return rd;
+}
+
+// Camera `camera`'s view of `block`: the geometric tests first, then the surviving segments traced
+// together as coherent packets (one origin, neighbouring directions).
+void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& rd,
+                                 CameraEntry* entry, std::vector<Ray>* rays) const {
+  std::array<Ray, 512> segments;
+  std::array<std::int16_t, 512> where;
+  std::array<Mat23, 512> jacobian;  // camera frame
+  std::array<std::uint8_t, 512> occluded;
+  const VoxelLattice& lattice = fields.lattice;
+  std::size_t n = 0;
+  for (int x = 0; x < block.extent.x(); ++x)
+    for (int y = 0; y < block.extent.y(); ++y)
+      for (int z = 0; z < block.extent.z(); ++z) {
+        if (!block.IsFree(x, y, z)) continue;
+        const Vec3 p =
+            lattice.Center(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z);
+        // The Jacobian stays in the camera frame: pixel density is rotation invariant, and the
+        // information takes the rotation in AddCameraInformation.
+        if (rd.tester->TestGeometryCameraFrame(camera, p, nullptr, &segments[n],
+                                               want_jacobian ? &jacobian[n] : nullptr) !=
+            ViewResult::kSeen)
+          continue;
+        where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
+        ++n;
+      }
+  caster.OccludedPacket(segments.data(), n, occluded.data());
+  if (rays) rays->insert(rays->end(), segments.begin(), segments.begin() + n);
+  entry->camera = camera;
+  entry->rays = static_cast<std::int32_t>(n);
+  // Offsets come in ascending order (x, y, z loops, Offset = 64 x + 8 y + z).
+  for (std::size_t i = 0; i < n; ++i) {
+    if (occluded[i]) continue;
+    SetBit(entry->bits, where[i]);
+    ++entry->seen;
+    if (want_resolution) entry->density.push_back(static_cast<float>(PixelDensity(jacobian[i])));
+    if (want_information) {
+      double contribution[6] = {0, 0, 0, 0, 0, 0};
+      AddCameraInformation(jacobian[i], rd.whitened[camera].data(), contribution);
+      entry->information.insert(entry->information.end(), contribution, contribution + 6);
+    }
+  }
+  int before = 0;
+  for (int w = 0; w < kWords; ++w) {
+    entry->before[w] = static_cast<std::int16_t>(before);
+    before += __builtin_popcountll(entry->bits[w]);
+  }
+}
+
+// Recomputes the voxels in `dirty` from the block's camera entries (`view`, ascending camera:
+// the kept ones and the re-cast ones), summing in rig order, and makes the block's new leaves:
+// copies of the current ones with the dirty voxels rewritten. The same arithmetic for a full
+// evaluation (every voxel dirty) and an update, so both give the same bits.
+void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
+                                   std::vector<const CameraEntry*> view, const Bits& dirty,
+                                   const std::vector<Vec3>& centres, BlockState* next,
+                                   BlockLeaves* leaves) const {
+  // Entries that see nothing take no part.
+  view.erase(std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
+             view.end());
+  const Fields::Impl& g = fields.impl();
+  const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+  const VoxelLattice& lattice = fields.lattice;
+
+  // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
+  if (old.coverage.empty()) {
+    next->coverage.assign(512, 0);
+    next->status.assign(512, kUnseen);
+    if (want_information) next->sigma_max.assign(512, 0.0f);
+    if (want_steady) next->sigma_steady.assign(512, 0.0f);
+  } else {
+    next->coverage = old.coverage;
+    next->status = old.status;
+    next->sigma_max = old.sigma_max;
+    next->sigma_steady = old.sigma_steady;
+  }
+
+  // Leaves to rewrite: copies of the grids' current ones, or new ones.
+  if (want_coverage) {
+    const auto* current = g.coverage->tree().probeConstLeaf(origin);
+    if (current) {
+      leaves->coverage = new openvdb::Int32Tree::LeafNodeType(*current);
+    } else {
+      // None yet, or a tile of zeros (a full block nobody saw): every voxel active at 0.
+      const bool tile = g.coverage->tree().isValueOn(origin);
+      leaves->coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, tile);
+    }
+  }
+  for (int f = 0; f < kFloatFieldCount; ++f) {
+    if (!want_float[f]) continue;
+    const auto* current = g.floats.at(kFloatFieldNames[f])->tree().probeConstLeaf(origin);
+    leaves->floats[f] = current ? new FloatLeaf(*current) : new FloatLeaf(origin, 0.0f, false);
+  }
+
+  // Per dirty voxel: coverage, density, information in rig order.
+  std::array<std::array<double, 512>, 6> upper;
+  std::array<std::array<double, 512>, 3> eigenvalue;
+  std::array<unsigned char, 512> converged;
+  std::array<std::int16_t, 512> candidate;
+  std::array<double, 512> cand_x, cand_y, cand_z;
+  std::array<float, 512> angle_deg;
+  std::array<std::array<double, 512>, kStatRows> stats;
+  double* stats_ptr[kStatRows];
+  for (int k = 0; k < kStatRows; ++k) stats_ptr[k] = stats[k].data();
+  const double* upper_ptr[6];
+  for (int k = 0; k < 6; ++k) upper_ptr[k] = upper[k].data();
+  double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
+  FloatLeaf* resolution = leaves->floats[kResolution];
+
+  int candidate_count = 0;
+  for (int w = 0; w < kWords; ++w) {
+    for (std::uint64_t bits = dirty[w]; bits; bits &= bits - 1) {
+      const int o = 64 * w + __builtin_ctzll(bits);
+      int coverage = 0;
+      float density = 0.0f;
+      double I[6] = {0, 0, 0, 0, 0, 0};
+      for (const CameraEntry* e : view) {
+        if (!TestBit(e->bits, o)) continue;
+        const int i = e->Index(o);
+        ++coverage;
+        if (want_resolution) density = std::max(density, e->density[i]);
+        if (want_information) {
+          const double* c = &e->information[6 * i];
+          if (coverage == 1)
+            for (int k = 0; k < 6; ++k) I[k] = c[k];
+          else
+            for (int k = 0; k < 6; ++k) I[k] += c[k];
+        }
+      }
+      next->coverage[o] = coverage;
+      next->status[o] = coverage == 0 ? kUnseen : kSeenOnly;
+      if (leaves->coverage) leaves->coverage->setValueOn(o, coverage);
+      if (resolution) {
+        if (coverage > 0)
+          resolution->setValueOn(o, density);
+        else
+          resolution->setValueOff(o, 0.0f);
+      }
+      for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
+        if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
+      if (!want_information || coverage < 2) continue;  // not triangulable: no uncertainty work
+      for (int k = 0; k < 6; ++k) upper[k][candidate_count] = I[k];
+      if (want_angle) {
+        const int x = o >> 6, y = (o >> 3) & 7, z = o & 7;
+        const Vec3 p =
+            lattice.Center(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z);
+        cand_x[candidate_count] = p.x();
+        cand_y[candidate_count] = p.y();
+        cand_z[candidate_count] = p.z();
+      }
+      candidate[candidate_count++] = static_cast<std::int16_t>(o);
+    }
+  }
+  if (candidate_count > 0) {
+    SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
+    StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
+    if (want_angle) {
+      std::vector<const std::uint64_t*> sees;
+      std::vector<Vec3> entry_centres;
+      for (const CameraEntry* e : view) {
+        sees.push_back(e->bits.data());
+        entry_centres.push_back(centres[e->camera]);
+      }
+      std::vector<double> directions(3 * 64 * view.size());
+      TriangulationAngles(candidate_count, cand_x.data(), cand_y.data(), cand_z.data(),
+                          candidate.data(), static_cast<int>(view.size()), sees.data(),
+                          entry_centres.data(), directions.data(), angle_deg.data());
+    }
+    if (want_steady) {
+      const double frame = frame_period;
+      for (int k = 0; k < 3; ++k)
+        SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(),
+                                stats[kVar0 + k].data(), candidate_count, scene.study.steady_prior);
+      SteadyStatistics(candidate_count, stats_ptr);
+    }
+  }
+  const auto put = [&](int field, int offset, float value) {
+    if (leaves->floats[field]) leaves->floats[field]->setValueOn(offset, value);
+  };
+  for (int m = 0; m < candidate_count; ++m) {
+    const int o = candidate[m];
+    if (stats[kObservable][m] == 0.0) {
+      next->status[o] = kUnobservable;
+      continue;
+    }
+    next->status[o] = kTriangulable;
+    const float sigma_max_mm = static_cast<float>(stats[kSigmaMaxMm][m]);
+    next->sigma_max[o] = sigma_max_mm;
+    if (want_angle) put(kAngle, o, angle_deg[m]);
+    put(kSigmaMax, o, sigma_max_mm);
+    put(kSigmaMean, o, static_cast<float>(stats[kSigmaMeanMm][m]));
+    put(kCondition, o, static_cast<float>(stats[kCond][m]));
+    if (want_steady) {
+      const float steady_max = static_cast<float>(stats[kSteadyMaxMm][m]);
+      next->sigma_steady[o] = steady_max;
+      put(kSigmaMaxSteady, o, steady_max);
+      put(kSigmaMeanSteady, o, static_cast<float>(stats[kSteadyMeanMm][m]));
+    }
+  }
+
+  // The block's summary from its caches (every free voxel, ascending offset).
+  next->histogram.clear();
+  next->seen = next->triangulable = next->unobservable = 0;
+  next->sigma_list.clear();
+  next->steady_list.clear();
+  for (int x = 0; x < block.extent.x(); ++x)
+    for (int y = 0; y < block.extent.y(); ++y)
+      for (int z = 0; z < block.extent.z(); ++z) {
+        if (!block.IsFree(x, y, z)) continue;
+        const int o = Block::Offset(x, y, z);
+        const int k = next->coverage[o];
+        if (int(next->histogram.size()) <= k) next->histogram.resize(k + 1, 0);
+        ++next->histogram[k];
+        if (k > 0) ++next->seen;
+        if (next->status[o] == kUnobservable) ++next->unobservable;
+        if (next->status[o] != kTriangulable) continue;
+        ++next->triangulable;
+        next->sigma_list.push_back(next->sigma_max[o]);
+        if (want_steady) next->steady_list.push_back(next->sigma_steady[o]);
+      }
+
+  // Leaves: a full block nobody sees keeps its coverage as a tile; empty float leaves go.
+  if (leaves->coverage && block.full && next->seen == 0) {
+    delete leaves->coverage;
+    leaves->coverage = nullptr;
+    leaves->coverage_tile = true;
+  }
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    if (leaves->floats[f] && leaves->floats[f]->isEmpty()) {
+      delete leaves->floats[f];
+      leaves->floats[f] = nullptr;
+      leaves->remove_float[f] = true;
+    }
+}
+
+void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled) const {
+  const ActiveSetStats active = st->active_set;
+  *st = FieldStats{};
+  st->active_set = active;
+  st->active_set.culled_blocks = 0;
+  st->coverage_histogram.assign(camera_count + 1, 0);
+  st->per_camera_seen.assign(camera_count, 0);
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    const BlockState& s = states[b];
+    if (s.candidates.empty()) ++st->active_set.culled_blocks;
+    for (std::size_t k = 0; k < s.histogram.size(); ++k) st->coverage_histogram[k] += s.histogram[k];
+    st->seen_voxels += s.seen;
+    st->triangulable_voxels += s.triangulable;
+    st->unobservable_voxels += s.unobservable;
+    st->sigma_max_mm.insert(st->sigma_max_mm.end(), s.sigma_list.begin(), s.sigma_list.end());
+    st->sigma_max_steady_mm.insert(st->sigma_max_steady_mm.end(), s.steady_list.begin(),
+                                   s.steady_list.end());
+    for (const CameraEntry& e : s.entries) {
+      st->per_camera_seen[e.camera] += e.seen;
+      st->rays += e.rays;
+    }
+    st->point_camera_tests += blocks[b].free_voxels * enabled;
+  }
+}
+
+FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, FieldOptions options,
+                               bool keep_state)
+    : state_(std::make_unique<State>(scene, caster)) {
+  const auto t0 = std::chrono::steady_clock::now();
+  State& S = *state_;
+  S.options = std::move(options);
+  S.keep = keep_state;
+  const FieldOptions& opt = S.options;
+  S.file = opt.scene_path.empty() ? scene.path : opt.scene_path;
+  if (auto problem = CheckFieldList(opt.fields, scene.study.motion.has_value()))
+    throw InputError(S.file, "$.study.fields[" + std::to_string(problem->index) + "]",
+                     problem->reason, problem->hint);
+  if (opt.fields.empty())
+    throw InputError(S.file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
+
   const Study& study = scene.study;
   // Errors about the voxel size name where it came from: the scene file or a command-line option.
-  const std::string size_file = options.voxel_size_option.empty() ? file : options.voxel_size_option;
-  const std::string size_path = options.voxel_size_option.empty() ? "$.study.voxel_size" : "";
-  out.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
-  const double estimate = EstimateFieldBytes(out.lattice, options.fields, camera_count);
-  out.stats.estimated_bytes = estimate;
-  if (estimate > options.memory_budget_bytes) {
+  const std::string size_file = opt.voxel_size_option.empty() ? S.file : opt.voxel_size_option;
+  const std::string size_path = opt.voxel_size_option.empty() ? "$.study.voxel_size" : "";
+  S.fields.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
+  const double estimate = EstimateFieldBytes(S.fields.lattice, opt.fields, 0);
+  S.fields.stats.estimated_bytes = estimate;
+  if (estimate > opt.memory_budget_bytes) {
     // Memory scales with 1/h^3: the smallest voxel size that fits.
-    const double h_min =
-        study.voxel_size * std::cbrt(estimate / options.memory_budget_bytes) * 1.01;
+    const double h_min = study.voxel_size * std::cbrt(estimate / opt.memory_budget_bytes) * 1.01;
     std::ostringstream reason, hint;
-    reason << "the region needs about " << std::llround(estimate / 1048576.0) << " MiB at voxel size "
-           << study.voxel_size << " m, over the budget of "
-           << std::llround(options.memory_budget_bytes / 1048576.0) << " MiB";
+    reason << "the region needs about " << std::llround(estimate / 1048576.0)
+           << " MiB at voxel size " << study.voxel_size << " m, over the budget of "
+           << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
          << "(--memory-budget or study.memory_budget_mb)";
-    if (options.voxel_size_option.empty() && !options.memory_budget_option.empty())
-      throw InputError(options.memory_budget_option, "", reason.str(), hint.str());
+    if (opt.voxel_size_option.empty() && !opt.memory_budget_option.empty())
+      throw InputError(opt.memory_budget_option, "", reason.str(), hint.str());
     throw InputError(size_file, size_path, reason.str(), hint.str());
   }
 
-  // Solids and the region mesh.
+  S.want_coverage = Wants(opt.fields, "coverage");
+  S.want_cameras = Wants(opt.fields, "cameras");
+  for (int f = 0; f < kFloatFieldCount; ++f) S.want_float[f] = Wants(opt.fields, kFloatFieldNames[f]);
+  S.want_resolution = S.want_float[kResolution];
+  S.want_static = S.want_float[kSigmaMax] || S.want_float[kSigmaMean] || S.want_float[kCondition];
+  S.want_steady = S.want_float[kSigmaMaxSteady] || S.want_float[kSigmaMeanSteady];
+  S.want_angle = S.want_float[kAngle];
+  // Any uncertainty field needs the triangulability decision, so J is built for all of them.
+  S.want_information = S.want_static || S.want_steady || S.want_angle;
+  S.want_jacobian = S.want_resolution || S.want_information;
+  S.motion = study.motion.value_or(MotionModel{});
+  S.frame_period = 1.0 / S.motion.rate_hz;
+  S.scene_scale = scene.ContentBounds().diagonal();
+
+  // The active set without cameras: which voxels are free region voxels (solids and the region
+  // mesh are classified once; cameras are culled per update).
   std::vector<std::unique_ptr<InsideMesh>> solid_meshes;
   std::vector<const InsideMesh*> solids;
   for (const SceneObject& o : scene.objects) {
@@ -283,281 +691,314 @@ Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caste
     if ((b.max.array() < study.region.box.min.array()).any() ||
         (b.min.array() > study.region.box.max.array()).any())
       continue;
-    {
-      solid_meshes.push_back(std::make_unique<InsideMesh>(o.mesh));
-      solids.push_back(solid_meshes.back().get());
-    }
+    solid_meshes.push_back(std::make_unique<InsideMesh>(o.mesh));
+    solids.push_back(solid_meshes.back().get());
   }
   std::unique_ptr<InsideMesh> region_mesh;
   if (study.region.kind == Region::Kind::kMesh)
     region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
-
-  const FrustumCuller culler(rig.cameras);
-  const std::vector<Block> blocks = BuildActiveSet(out.lattice, study.region, solids,
-                                                   region_mesh.get(), culler, camera_count,
-                                                   &out.stats.active_set);
-  out.stats.active_set_seconds =
+  const FrustumCuller no_cameras(std::vector<Camera>{});
+  S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh.get(), no_cameras,
+                            0, &S.active_stats);
+  S.active_set_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
-  const bool want_coverage = Wants(options.fields, "coverage");
-  const bool want_cameras = Wants(options.fields, "cameras");
-  std::array<bool, kFloatFieldCount> want_float{};
-  for (int f = 0; f < kFloatFieldCount; ++f) want_float[f] = Wants(options.fields, kFloatFieldNames[f]);
-  const bool want_resolution = want_float[kResolution];
-  const bool want_static = want_float[kSigmaMax] || want_float[kSigmaMean] || want_float[kCondition];
-  const bool want_steady = want_float[kSigmaMaxSteady] || want_float[kSigmaMeanSteady];
-  const bool want_angle = want_float[kAngle];
-  // Any uncertainty field needs the triangulability decision, so J is built for all of them.
-  const bool want_information = want_static || want_steady || want_angle;
-  const bool want_jacobian = want_resolution || want_information;
-  const int enabled = rig.enabled_count();
-  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal());
-  std::vector<double> pixel_sigma(camera_count);  // pixels
-  for (int c = 0; c < camera_count; ++c)
-    pixel_sigma[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : study.pixel_sigma;
-  std::vector<Vec3> centres;
-  for (const Camera& cam : rig.cameras) centres.push_back(cam.center());
-  const MotionModel motion = study.motion.value_or(MotionModel{});
-  const double frame_period = 1.0 / motion.rate_hz;
+FieldEvaluator::~FieldEvaluator() = default;
+FieldEvaluator::FieldEvaluator(FieldEvaluator&&) noexcept = default;
+FieldEvaluator& FieldEvaluator::operator=(FieldEvaluator&&) noexcept = default;
 
-  std::vector<BlockResult> results(blocks.size());
-  std::atomic<std::size_t> done{0};
-  const std::size_t report_every = std::max<std::size_t>(1, blocks.size() / 200);
+const Fields& FieldEvaluator::fields() const { return state_->fields; }
 
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const auto& range) {
-    // Scratch for the blocks of this TBB range (the information accumulators are 24 KB).
-    std::array<Ray, 512> segments;
-    std::array<std::int16_t, 512> where;
-    std::array<Mat23, 512> segment_jacobian;  // camera frame
-    std::array<std::uint8_t, 512> occluded;
-    std::array<std::array<double, 6>, 512> information;  // xx xy xz yy yz zz, 1/m^2; set by a voxel's first ray
-    // Triangulation angle scratch: candidate positions and camera masks, per-camera directions.
-    std::array<double, 512> cand_x, cand_y, cand_z;
-    std::array<std::uint64_t, 512> cand_mask;
-    std::array<float, 512> angle_deg;
-    // One tile of directions per camera; left uninitialised (a vector would clear it per block).
-    std::unique_ptr<double[]> directions(want_angle ? new double[3 * 64 * camera_count] : nullptr);
-    // Per-candidate statistics (StatRow) for the block's vectorised passes.
-    std::array<std::array<double, 512>, kStatRows> stats;
-    double* stats_ptr[kStatRows];
-    for (int k = 0; k < kStatRows; ++k) stats_ptr[k] = stats[k].data();
-    // Information matrices of the voxels seen by two or more cameras, as six arrays (xx xy xz yy
-    // yz zz), their eigenvalues as three (ascending), for one vectorised pass per block.
-    std::array<std::array<double, 512>, 6> upper;
-    std::array<std::array<double, 512>, 3> eigenvalue;
-    std::array<unsigned char, 512> converged;
-    std::array<std::int16_t, 512> candidate;
-    const double* upper_ptr[6];
-    for (int k = 0; k < 6; ++k) upper_ptr[k] = upper[k].data();
-    double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
-    for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
-      const Block& block = blocks[bi];
-      BlockResult& res = results[bi];
-      res.per_camera.assign(camera_count, 0);
-      res.tests = block.free_voxels * enabled;
-      const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+Fields FieldEvaluator::TakeFields() {
+  State& S = *state_;
+  Fields out = std::move(S.fields);
+  S.fields = Fields();
+  S.fields.lattice = out.lattice;
+  S.states.clear();
+  S.evaluated = false;
+  return out;
+}
 
-      std::array<std::int32_t, 512> coverage{};
-      std::array<std::uint64_t, 512> seen_by{};
-      std::array<float, 512> density{};
-      if (block.cameras != 0) {
-        // Per camera: the geometric tests first, then the surviving segments traced together as
-        // coherent packets (one origin, neighbouring directions).
-        for (int c = 0; c < camera_count; ++c) {
-          if (!(block.cameras >> c & 1)) continue;
-          std::size_t n = 0;
-          for (int x = 0; x < block.extent.x(); ++x)
-            for (int y = 0; y < block.extent.y(); ++y)
-              for (int z = 0; z < block.extent.z(); ++z) {
-                if (!block.IsFree(x, y, z)) continue;
-                const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
-                                                  block.origin.z() + z);
-                // The Jacobian stays in the camera frame here: rotating it to the world frame is
-                // left to the segments that turn out unoccluded.
-                if (tester.TestGeometryCameraFrame(c, p, nullptr, &segments[n],
-                                                   want_jacobian ? &segment_jacobian[n] : nullptr) !=
-                    ViewResult::kSeen)
-                  continue;
-                where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
-                ++n;
-              }
-          caster.OccludedPacket(segments.data(), n, occluded.data());
-          double Rw[9];  // R_camera_from_world / sigma_c
-          WhitenedRotation(tester.camera_rotation(c), pixel_sigma[c], Rw);
-          res.ray_count += static_cast<std::int64_t>(n);
-          if (options.record_rays) res.rays.insert(res.rays.end(), segments.begin(), segments.begin() + n);
-          for (std::size_t i = 0; i < n; ++i) {
-            if (occluded[i]) continue;
-            const int o = where[i];
-            ++coverage[o];
-            seen_by[o] |= std::uint64_t{1} << c;
-            ++res.per_camera[c];
-            const Mat23& Jc = segment_jacobian[i];  // d pixel / d camera-frame point
-            // Pixel density is rotation invariant: the camera-frame Jacobian gives it directly.
-            if (want_resolution)
-              density[o] = std::max(density[o], static_cast<float>(PixelDensity(Jc)));
-            if (want_information) {
-              // The voxel's first ray sets its entry, so the 24 KB array is never cleared.
-              std::array<double, 6>& I = information[o];
-              if (coverage[o] == 1) I.fill(0.0);
-              AddCameraInformation(Jc, Rw, I.data());
-            }
-          }
-        }
-      }
+double FieldEvaluator::state_bytes() const {
+  const State& S = *state_;
+  double bytes = double(S.states.capacity()) * sizeof(BlockState);
+  for (const BlockState& s : S.states) {
+    bytes += s.candidates.capacity() * sizeof(std::int32_t) + s.coverage.capacity() * 4 +
+             s.status.capacity() + (s.sigma_max.capacity() + s.sigma_steady.capacity()) * 4 +
+             s.histogram.capacity() * 8 + (s.sigma_list.capacity() + s.steady_list.capacity()) * 4;
+    for (const CameraEntry& e : s.entries) bytes += e.Bytes();
+  }
+  return bytes;
+}
 
-      // Statistics and leaves.
-      const bool any_seen = block.cameras != 0;
-      if (want_coverage && !any_seen && block.full) res.coverage_tile = true;
-      if (want_coverage && !res.coverage_tile)
-        res.coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, false);
-      if (any_seen && want_cameras)
-        res.cameras = new openvdb::Int64Tree::LeafNodeType(origin, 0, false);
-      if (any_seen)
-        for (int f = 0; f < kFloatFieldCount; ++f)
-          if (want_float[f]) res.floats[f] = new FloatLeaf(origin, 0.0f, false);
-      // Float values straight into the leaf buffers (setValueOn re-checks out-of-core loading on
-      // every call).
-      std::array<float*, kFloatFieldCount> float_data{};
-      for (int f = 0; f < kFloatFieldCount; ++f)
-        if (res.floats[f]) float_data[f] = res.floats[f]->buffer().data();
-      const auto put = [&](int field, int offset, float value) {
-        float_data[field][offset] = value;
-        res.floats[field]->getValueMask().setOn(offset);
-      };
-      int candidate_count = 0;
-      for (int x = 0; x < block.extent.x(); ++x)
-        for (int y = 0; y < block.extent.y(); ++y)
-          for (int z = 0; z < block.extent.z(); ++z) {
-            if (!block.IsFree(x, y, z)) continue;
-            const int o = Block::Offset(x, y, z);
-            ++res.histogram[coverage[o]];
-            if (res.coverage) res.coverage->setValueOn(o, coverage[o]);
-            if (coverage[o] == 0) continue;
-            ++res.seen;
-            if (res.cameras) res.cameras->setValueOn(o, static_cast<std::int64_t>(seen_by[o]));
-            if (res.floats[kResolution]) res.floats[kResolution]->setValueOn(o, density[o]);
-            if (coverage[o] < 2) continue;  // not triangulable: no uncertainty work at all
-            if (!want_information) continue;
-            // Gathered for the block's batched eigenvalue pass.
-            for (int k = 0; k < 6; ++k) upper[k][candidate_count] = information[o][k];
-            if (want_angle) {
-              const Vec3 p = out.lattice.Center(block.origin.x() + x, block.origin.y() + y,
-                                                block.origin.z() + z);
-              cand_x[candidate_count] = p.x();
-              cand_y[candidate_count] = p.y();
-              cand_z[candidate_count] = p.z();
-              cand_mask[candidate_count] = seen_by[o];
-            }
-            candidate[candidate_count++] = static_cast<std::int16_t>(o);
-          }
-      if (candidate_count > 0) {
-        res.sigma_max.reserve(candidate_count);
-        if (want_steady) res.sigma_max_steady.reserve(candidate_count);
-        SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
-        if (want_angle)
-          TriangulationAngles(candidate_count, cand_x.data(), cand_y.data(), cand_z.data(),
-                              cand_mask.data(), centres, block.cameras, directions.get(),
-                              angle_deg.data());
-      }
-      // Static statistics and measurement variances for all candidates in one vectorised pass,
-      // the steady state in another; then the leaves (unobservable voxels are skipped there).
-      if (candidate_count > 0)
-        StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
-      if (want_steady && candidate_count > 0) {
-        for (int k = 0; k < 3; ++k)
-          SteadyPositionVariances(motion.q, frame_period, stats[kVar0 + k].data(),
-                                  stats[kVar0 + k].data(), candidate_count, study.steady_prior);
-        SteadyStatistics(candidate_count, stats_ptr);
-      }
-      for (int m = 0; m < candidate_count; ++m) {
-        const int o = candidate[m];
-        if (stats[kObservable][m] == 0.0) {
-          ++res.unobservable;
+FieldUpdate FieldEvaluator::Update(const Rig& rig) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  State& S = *state_;
+  const FieldOptions& opt = S.options;
+  FieldUpdate update;
+  if (S.evaluated && !S.keep) TakeFields();  // nothing kept: evaluate again in full
+
+  // Which cameras changed (by index; cameras added or removed at the end count as changed).
+  const int new_count = static_cast<int>(rig.cameras.size());
+  const int old_count = S.evaluated ? static_cast<int>(S.rig.cameras.size()) : 0;
+  std::vector<int> changed;
+  for (int c = 0; c < std::max(new_count, old_count); ++c)
+    if (!S.evaluated || c >= old_count || c >= new_count ||
+        !SameForFields(S.rig.cameras[c], rig.cameras[c]))
+      changed.push_back(c);
+  update.full = !S.evaluated;
+  update.changed_cameras = static_cast<int>(changed.size());
+  if (S.evaluated && changed.empty()) {
+    S.rig = rig;  // names, colours and ids may differ
+    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return update;
+  }
+  const RigData rd = S.Prepare(rig);
+
+  // New candidate lists; the blocks to visit are those a changed camera's old or new frustum
+  // meets (all of them the first time).
+  if (!S.evaluated) {
+    S.states.assign(S.blocks.size(), BlockState{});
+    S.ResetGrids(new_count);
+    S.fields.stats.active_set = S.active_stats;
+  }
+  std::vector<std::vector<std::int32_t>> candidates(S.blocks.size());
+  std::vector<std::uint8_t> dirty_block(S.blocks.size(), 0);
+  const std::vector<std::uint8_t> is_changed = [&] {
+    std::vector<std::uint8_t> v(std::max(new_count, old_count) + 1, 0);
+    for (int c : changed) v[c] = 1;
+    return v;
+  }();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const BlockState& s = S.states[b];
+      std::vector<std::int32_t>& next = candidates[b];
+      bool dirty = !S.evaluated;
+      for (std::int32_t c : s.candidates) {
+        if (is_changed[c]) {
+          dirty = true;
           continue;
         }
-        ++res.triangulable;
-        if (want_angle) put(kAngle, o, angle_deg[m]);
-        const float sigma_max_mm = static_cast<float>(stats[kSigmaMaxMm][m]);
-        res.sigma_max.push_back(sigma_max_mm);
-        if (want_float[kSigmaMax]) put(kSigmaMax, o, sigma_max_mm);
-        if (want_float[kSigmaMean]) put(kSigmaMean, o, static_cast<float>(stats[kSigmaMeanMm][m]));
-        if (want_float[kCondition]) put(kCondition, o, static_cast<float>(stats[kCond][m]));
-        if (want_steady) {
-          const float steady_max = static_cast<float>(stats[kSteadyMaxMm][m]);
-          res.sigma_max_steady.push_back(steady_max);
-          if (want_float[kSigmaMaxSteady]) put(kSigmaMaxSteady, o, steady_max);
-          if (want_float[kSigmaMeanSteady])
-            put(kSigmaMeanSteady, o, static_cast<float>(stats[kSteadyMeanMm][m]));
-        }
+        next.push_back(c);
       }
-      if (res.cameras && res.cameras->isEmpty()) {
-        delete res.cameras;
-        res.cameras = nullptr;
-      }
-      for (FloatLeaf*& leaf : res.floats)
-        if (leaf && leaf->isEmpty()) {
-          delete leaf;
-          leaf = nullptr;
+      const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
+      for (int c : changed)
+        if (c < new_count && rd.culler->MayIntersect(c, box)) {
+          next.push_back(c);
+          dirty = true;
         }
-      const std::size_t n = done.fetch_add(1) + 1;
-      if (options.progress && (n % report_every == 0 || n == blocks.size()))
-        options.progress(double(n) / double(blocks.size()));
+      std::sort(next.begin(), next.end());
+      dirty_block[b] = dirty;
     }
   });
+  std::vector<std::size_t> dirty;
+  for (std::size_t b = 0; b < S.blocks.size(); ++b)
+    if (dirty_block[b]) dirty.push_back(b);
+  update.dirty_blocks = static_cast<std::int64_t>(dirty.size());
 
-  // Assemble the grids serially (adding leaves is cheap; building them was the work).
-  Fields::Impl& g = out.impl();
-  g.transform = openvdb::math::Transform::createLinearTransform(study.voxel_size);
-  g.transform->postTranslate(openvdb::Vec3d(out.lattice.origin.x(), out.lattice.origin.y(),
-                                            out.lattice.origin.z()));
-  if (want_coverage) {
-    g.coverage = openvdb::Int32Grid::create(0);
-    g.coverage->setName(kCoverageGrid);
-    g.coverage->setTransform(g.transform);
+  // Kept state: an upper bound (every candidate camera sees every free voxel) against the budget.
+  if (S.keep) {
+    const double per_pair = (S.want_information ? 48.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
+    double bytes = 0;
+    for (std::size_t b = 0; b < S.blocks.size(); ++b)
+      bytes += 512.0 * 13 + double(candidates[b].size()) *
+                                (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
+    const double total = bytes + S.fields.stats.estimated_bytes;
+    if (total > opt.memory_budget_bytes) {
+      std::ostringstream reason;
+      reason << "incremental updates of rig '" << rig.name << "' need up to "
+             << std::llround(total / 1048576.0) << " MiB, over the budget of "
+             << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
+      throw InputError(opt.memory_budget_option.empty() ? S.file : opt.memory_budget_option,
+                       opt.memory_budget_option.empty() ? "$.study.memory_budget_mb" : "",
+                       reason.str(),
+                       "use a coarser voxel_size, a smaller region, or raise the budget");
+    }
   }
-  if (want_cameras) {
-    g.cameras = openvdb::Int64Grid::create(0);
-    g.cameras->setName(kCamerasGrid);
-    g.cameras->setTransform(g.transform);
+
+  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves.
+  std::vector<BlockState> next(dirty.size());
+  std::vector<std::vector<CameraEntry>> cast(dirty.size());
+  std::vector<BlockLeaves> leaves(dirty.size());
+  std::atomic<std::size_t> done{0};
+  std::atomic<std::int64_t> dirty_voxels{0};
+  std::atomic<bool> cancelled{false};
+  const std::size_t report_every = std::max<std::size_t>(1, dirty.size() / 200);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      if (cancelled.load(std::memory_order_relaxed)) return;
+      if (opt.cancel && opt.cancel->load(std::memory_order_relaxed)) {
+        cancelled = true;
+        return;
+      }
+      const std::size_t b = dirty[i];
+      const Block& block = S.blocks[b];
+      const BlockState& old = S.states[b];
+      // The changed cameras that may see the block now.
+      for (int c : changed)
+        if (std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
+          cast[i].emplace_back();
+          S.Cast(block, c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
+        }
+      // Dirty voxels: where a changed camera saw or sees.
+      Bits voxels{};
+      if (old.coverage.empty()) {
+        for (int x = 0; x < block.extent.x(); ++x)
+          for (int y = 0; y < block.extent.y(); ++y)
+            for (int z = 0; z < block.extent.z(); ++z)
+              if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
+      } else {
+        for (const CameraEntry& e : old.entries)
+          if (is_changed[e.camera])
+            for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+        for (const CameraEntry& e : cast[i])
+          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+      }
+      std::int64_t count = 0;
+      for (std::uint64_t w : voxels) count += __builtin_popcountll(w);
+      dirty_voxels += count;
+      std::vector<const CameraEntry*> view;
+      for (const CameraEntry& e : old.entries)
+        if (!is_changed[e.camera]) view.push_back(&e);
+      for (const CameraEntry& e : cast[i]) view.push_back(&e);
+      std::sort(view.begin(), view.end(),
+                [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
+      if (count > 0 || old.coverage.empty())
+        S.Derive(block, old, view, voxels, rd.centres, &next[i], &leaves[i]);
+      // Camera grids: a leaf per re-cast camera that sees part of the block.
+      if (S.want_cameras)
+        for (const CameraEntry& e : cast[i]) {
+          if (e.seen == 0) continue;
+          const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+          auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
+          for (int w = 0; w < kWords; ++w)
+            for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
+              leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
+          leaves[i].visible.emplace_back(e.camera, leaf);
+        }
+      if (!S.keep) {
+        // One evaluation only: keep the summary, drop per-pair data and caches.
+        for (CameraEntry& e : cast[i]) {
+          std::vector<double>().swap(e.information);
+          std::vector<float>().swap(e.density);
+        }
+        std::vector<std::int32_t>().swap(next[i].coverage);
+        std::vector<std::uint8_t>().swap(next[i].status);
+        std::vector<float>().swap(next[i].sigma_max);
+        std::vector<float>().swap(next[i].sigma_steady);
+      }
+      const std::size_t n = done.fetch_add(1) + 1;
+      if (opt.progress && (n % report_every == 0 || n == dirty.size()))
+        opt.progress(double(n) / double(dirty.size()));
+    }
+  });
+  if (cancelled) {
+    for (BlockLeaves& l : leaves) l.Free();
+    if (!S.evaluated) {
+      S.states.clear();
+      S.fields.impl() = Fields::Impl();
+    }
+    update.cancelled = true;
+    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return update;
   }
-  for (int f = 0; f < kFloatFieldCount; ++f) {
-    if (!want_float[f]) continue;
-    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
-    grid->setName(kFloatFieldNames[f]);
-    grid->setTransform(g.transform);
-    g.floats[kFloatFieldNames[f]] = grid;
+
+  // The serial phase: the new leaves into the grids, the new entries and caches into the state.
+  Fields::Impl& g = S.fields.impl();
+  if (S.want_cameras && new_count != static_cast<int>(g.visible.size())) {
+    const std::size_t had = g.visible.size();
+    g.visible.resize(new_count);
+    for (std::size_t c = had; c < g.visible.size(); ++c) MakeGrid(g.visible[c], "visible", g.transform);
   }
-  FieldStats& st = out.stats;
-  st.coverage_histogram.assign(camera_count + 1, 0);
-  st.per_camera_seen.assign(camera_count, 0);
-  std::size_t total_rays = 0;
-  for (const BlockResult& r : results) total_rays += r.rays.size();
-  if (options.record_rays) out.recorded_rays.reserve(total_rays);
-  for (std::size_t bi = 0; bi < results.size(); ++bi) {
-    BlockResult& r = results[bi];
-    const openvdb::Coord origin(blocks[bi].origin.x(), blocks[bi].origin.y(), blocks[bi].origin.z());
-    if (r.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
-    if (r.coverage) g.coverage->tree().addLeaf(r.coverage);
-    if (r.cameras) g.cameras->tree().addLeaf(r.cameras);
-    for (int f = 0; f < kFloatFieldCount; ++f)
-      if (r.floats[f]) g.floats[kFloatFieldNames[f]]->tree().addLeaf(r.floats[f]);
-    st.triangulable_voxels += r.triangulable;
-    st.unobservable_voxels += r.unobservable;
-    st.sigma_max_mm.insert(st.sigma_max_mm.end(), r.sigma_max.begin(), r.sigma_max.end());
-    st.sigma_max_steady_mm.insert(st.sigma_max_steady_mm.end(), r.sigma_max_steady.begin(),
-                                  r.sigma_max_steady.end());
-    for (int k = 0; k <= camera_count; ++k) st.coverage_histogram[k] += r.histogram[k];
-    for (int c = 0; c < camera_count; ++c) st.per_camera_seen[c] += r.per_camera[c];
-    st.point_camera_tests += r.tests;
-    st.rays += r.ray_count;
-    st.seen_voxels += r.seen;
-    if (options.record_rays)
-      out.recorded_rays.insert(out.recorded_rays.end(), r.rays.begin(), r.rays.end());
+  for (std::size_t b = 0; b < S.blocks.size(); ++b) S.states[b].candidates = std::move(candidates[b]);
+  for (std::size_t i = 0; i < dirty.size(); ++i) {
+    const std::size_t b = dirty[i];
+    const Block& block = S.blocks[b];
+    const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+    BlockState& s = S.states[b];
+    BlockLeaves& l = leaves[i];
+    if (l.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
+    if (l.coverage) g.coverage->tree().addLeaf(l.coverage);
+    for (int f = 0; f < kFloatFieldCount; ++f) {
+      if (!S.want_float[f]) continue;
+      openvdb::FloatTree& tree = g.floats[kFloatFieldNames[f]]->tree();
+      if (l.floats[f])
+        tree.addLeaf(l.floats[f]);
+      else if (l.remove_float[f] && tree.probeConstLeaf(origin))
+        tree.addTile(1, origin, 0.0f, false);
+    }
+    if (S.want_cameras) {
+      // The changed cameras' old leaves go, their new ones come.
+      for (const CameraEntry& e : s.entries)
+        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0) {
+          openvdb::BoolTree& tree = g.visible[e.camera]->tree();
+          if (tree.probeConstLeaf(origin)) tree.addTile(1, origin, false, false);
+        }
+      for (auto& [c, leaf] : l.visible) g.visible[c]->tree().addLeaf(leaf);
+    }
+    // Entries: the kept ones and the re-cast ones, in camera order.
+    std::vector<CameraEntry> entries;
+    for (CameraEntry& e : s.entries)
+      if (!is_changed[e.camera]) entries.push_back(std::move(e));
+    for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));
+    std::sort(entries.begin(), entries.end(),
+              [](const CameraEntry& a, const CameraEntry& b) { return a.camera < b.camera; });
+    if (!S.keep)
+      for (CameraEntry& e : entries) e.information.clear();
+    BlockState& n = next[i];
+    if (!n.histogram.empty() || s.coverage.empty()) {
+      n.candidates = std::move(s.candidates);
+      n.entries = std::move(entries);
+      s = std::move(n);
+    } else {
+      s.entries = std::move(entries);  // nothing seen changed: caches and summary stay
+      s.rays = std::move(n.rays);
+    }
   }
-  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
+  if (S.evaluated) {
+    for (auto& [name, grid] : g.floats) openvdb::tools::pruneInactive(grid->tree());
+    for (auto& v : g.visible) openvdb::tools::pruneInactive(v->tree());
+  }
+
+  S.rig = rig;
+  S.evaluated = true;
+  update.dirty_voxels = dirty_voxels;
+  for (const auto& c : cast)
+    for (const CameraEntry& e : c) update.rays += e.rays;
+  FieldStats& st = S.fields.stats;
+  const double estimated = st.estimated_bytes;
+  S.Totals(&st, new_count, rd.enabled);
+  st.estimated_bytes = estimated;
+  st.active_set_seconds = update.full ? S.active_set_seconds : 0.0;
+  if (opt.record_rays && update.full) {
+    S.fields.recorded_rays.clear();
+    for (const BlockState& s : S.states)
+      S.fields.recorded_rays.insert(S.fields.recorded_rays.end(), s.rays.begin(), s.rays.end());
+  }
+  update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.seconds = update.seconds + (update.full ? S.active_set_seconds : 0.0);
   st.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  return out;
+  return update;
+}
+
+double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
+                          int camera_count) {
+  const double voxels = static_cast<double>(lattice.voxel_count());
+  const double blocks = voxels / 512.0 + 1.0;
+  // Active-set pass: one Block record per 8^3 block, a 512-byte mask where a block is partial.
+  double bytes = blocks * (sizeof(Block) + 512.0 + sizeof(BlockState));
+  for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
+  return bytes + 64.0 * camera_count;
+}
+
+Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                      const FieldOptions& options) {
+  FieldEvaluator evaluator(scene, caster, options, /*keep_state=*/false);
+  evaluator.Update(rig);
+  return evaluator.TakeFields();
 }
 
 }  // namespace pandora

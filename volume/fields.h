@@ -3,6 +3,7 @@
 /// Field evaluation over the study region into sparse OpenVDB grids. This header does not include
 /// OpenVDB; volume/fields_vdb.h gives access to the grids themselves.
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -18,8 +19,9 @@ namespace pandora {
 /// The fields (names from FieldNames(), analysis/scene.h):
 ///  - "coverage"   Int32: number of cameras that see the voxel centre. Active on every free region
 ///                 voxel (0 where none sees it); culled blocks are stored as constant tiles.
-///  - "cameras"    Int64: bit c set when camera c (index in the rig) sees the voxel. Active where at
-///                 least one camera sees it. Up to 64 cameras.
+///  - "cameras"    the set of cameras that see each voxel, kept sparse: one BoolGrid per camera of
+///                 the rig (Fields::Impl::visible[c], active and true where camera c sees the voxel;
+///                 written to fields.vdb as "visible/<id>"). Any number of cameras.
 ///  - "resolution" Float, px/m: the best pixel density (PixelDensity of the projection Jacobian) among
 ///                 the cameras that see the voxel. Active where at least one camera sees it.
 ///  - "sigma_max", "sigma_mean" Float, mm: worst-direction and RMS 1-sigma of the static
@@ -36,6 +38,9 @@ struct FieldOptions {
   std::function<void(double)> progress;
   /// Keep every occlusion segment cast, in evaluation order (benchmarks replay them).
   bool record_rays = false;
+  /// Set from another thread to stop FieldEvaluator::Update early; the evaluator then keeps the
+  /// fields of the previous update (nothing half updated). Checked once per block.
+  const std::atomic<bool>* cancel = nullptr;
   /// Used in error messages.
   std::string scene_path;
   /// Where the voxel size came from, for error messages: empty for the scene file's
@@ -92,11 +97,60 @@ class Fields {
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count);
 
-/// Evaluates the requested fields for the enabled cameras of `rig` over `scene.study.region`.
-/// Throws InputError when the memory estimate exceeds the budget (path "$.study.voxel_size", with the
-/// smallest voxel size that fits in the hint), when a field name is unknown ("$.study.fields"), when
-/// a steady-state field is asked for without study.motion, or when the rig has more than 64 cameras. Runs in parallel with TBB (limit threads with
-/// tbb::global_control).
+/// What one FieldEvaluator::Update did.
+struct FieldUpdate {
+  bool full = false;            ///< Every camera was evaluated (the first update, or all changed).
+  int changed_cameras = 0;      ///< Cameras re-cast: moved, re-aimed, new intrinsics, (dis)abled.
+  std::int64_t dirty_blocks = 0;  ///< 8^3 blocks inside a changed camera's old or new frustum.
+  std::int64_t dirty_voxels = 0;  ///< Voxels whose values were recomputed.
+  std::int64_t rays = 0;          ///< Occlusion segments cast by this update.
+  double seconds = 0;             ///< Wall time of the update.
+  bool cancelled = false;         ///< FieldOptions::cancel was set: nothing changed.
+};
+
+/// The incremental field evaluator. It keeps, per 8^3 block, which cameras see which voxel (a
+/// 512-bit mask per camera that sees the block: sparse, any number of cameras) and each seen
+/// (voxel, camera) pair's information contribution and pixel density. When cameras change it
+/// re-casts only those cameras, only inside their old and new frusta, and re-derives only the
+/// voxels whose camera set or contributions changed, summing contributions in rig order exactly as
+/// a full evaluation does: the fields equal a full recompute voxel for voxel, bit for bit
+/// (docs/architecture.md; test volume/field_evaluator_test.cpp). The scene and the ray caster must
+/// outlive the evaluator.
+class FieldEvaluator {
+ public:
+  /// Checks the field list and the memory budget as EvaluateFields does (same InputErrors) and builds
+  /// the active set's region and solid classification once. `keep_state` false: one evaluation
+  /// only, the per-pair data is dropped block by block (EvaluateFields' memory).
+  FieldEvaluator(const Scene& scene, const RayCaster& caster, FieldOptions options,
+                 bool keep_state = true);
+  ~FieldEvaluator();
+  FieldEvaluator(FieldEvaluator&&) noexcept;
+  FieldEvaluator& operator=(FieldEvaluator&&) noexcept;
+
+  /// Brings the fields up to date with `rig`: the first call evaluates every enabled camera; later
+  /// calls compare the rig camera by camera with the previous one (pose, lens, range, pixel sigma,
+  /// enabled; cameras added or removed at the end count as changed) and update only what changed.
+  /// The rig may have any number of cameras. Returns what it did; on cancellation the previous
+  /// fields stay. Throws InputError when the kept state would exceed the memory budget.
+  FieldUpdate Update(const Rig& rig);
+
+  const Fields& fields() const;
+  /// Moves the fields out (the evaluator is then empty: the next Update evaluates in full).
+  Fields TakeFields();
+  /// Bytes held for incremental updates (masks, per-pair contributions, per-voxel caches).
+  double state_bytes() const;
+
+  struct State;
+
+ private:
+  std::unique_ptr<State> state_;
+};
+
+/// Evaluates the requested fields for the enabled cameras of `rig` over `scene.study.region`: one
+/// FieldEvaluator update without kept state. Throws InputError when the memory estimate exceeds the
+/// budget (path "$.study.voxel_size", with the smallest voxel size that fits in the hint), when a
+/// field name is unknown ("$.study.fields"), or when a steady-state field is asked for without
+/// study.motion. Runs in parallel with TBB (limit threads with tbb::global_control).
 Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
                       const FieldOptions& options);
 

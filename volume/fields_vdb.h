@@ -7,6 +7,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "volume/fields.h"
 
@@ -19,7 +20,9 @@ inline constexpr const char* kCamerasGrid = "cameras";
 struct Fields::Impl {
   openvdb::math::Transform::Ptr transform;
   openvdb::Int32Grid::Ptr coverage;  ///< Null unless requested.
-  openvdb::Int64Grid::Ptr cameras;   ///< Null unless requested.
+  /// With the "cameras" field: per camera of the rig (index c), the voxels it sees (active, true).
+  /// Empty when the field was not requested.
+  std::vector<openvdb::BoolGrid::Ptr> visible;
   /// resolution, sigma_max, ...: the requested float fields by name.
   std::map<std::string, openvdb::FloatGrid::Ptr> floats;
 
@@ -29,11 +32,10 @@ struct Fields::Impl {
     return it == floats.end() ? nullptr : it->second;
   }
 
-  /// The non-null grids, in FieldNames() order.
+  /// The non-null field grids (not the per-camera ones), in FieldNames() order.
   openvdb::GridPtrVec Grids() const {
     openvdb::GridPtrVec grids;
     if (coverage) grids.push_back(coverage);
-    if (cameras) grids.push_back(cameras);
     for (const std::string& name : FieldNames())
       if (auto g = Float(name)) grids.push_back(g);
     return grids;

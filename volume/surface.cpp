@@ -159,11 +159,6 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
 struct PointEvaluator::Impl {
   Impl(const Scene& scene, const Rig& rig, const RayCaster& caster)
       : tester(rig.cameras, caster, scene.ContentBounds().diagonal()) {
-    if (rig.cameras.size() > 64)
-      throw InputError(scene.path, "$.rigs",
-                       "rig '" + rig.name + "' has " + std::to_string(rig.cameras.size()) +
-                           " cameras; the per-point evaluation supports at most 64",
-                       "split the rig or disable cameras in a copy of it");
     for (const Camera& c : rig.cameras)
       sigma.push_back(c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma);
   }
@@ -190,11 +185,14 @@ PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) cons
     if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen) continue;
     if (segment.t_far > segment.t_near && tester.caster().Occluded(segment)) continue;
     ++v.coverage;
-    v.cameras |= std::uint64_t{1} << c;
+    v.cameras.push_back(c);
     best_density = std::max(best_density, static_cast<float>(PixelDensity(Jc)));
     double Rw[9];
     WhitenedRotation(tester.camera_rotation(c), impl_->sigma[c], Rw);
-    AddCameraInformation(Jc, Rw, I);
+    // Each camera's contribution on its own, then summed in rig order: the fields' arithmetic.
+    double contribution[6] = {0, 0, 0, 0, 0, 0};
+    AddCameraInformation(Jc, Rw, contribution);
+    for (int k = 0; k < 6; ++k) I[k] = v.coverage == 1 ? contribution[k] : I[k] + contribution[k];
   }
   v.resolution = best_density;
   if (v.coverage < 2) return v;

@@ -5,6 +5,7 @@
 /// and the same projection Jacobians and information matrix as the volume fields, and written as a
 /// binary PLY point cloud (`pandora export-surface`, docs/report.md).
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -61,10 +62,13 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
 /// The volume fields' quantities at one point (volume/fields.h defines each).
 struct PointValues {
   int coverage = 0;             ///< Cameras that see the point.
-  std::uint64_t cameras = 0;    ///< Bit c: camera c (index in the rig) sees it.
+  std::vector<std::int32_t> cameras;  ///< The cameras (rig indices, ascending) that see it.
   double resolution = 0;        ///< px/m, best PixelDensity among those cameras; 0 when unseen.
   bool triangulable = false;    ///< >= 2 cameras and the information matrix observable.
   double sigma_max_mm = 0;      ///< Worst-direction static 1-sigma, mm; 0 when not triangulable.
+  bool Sees(int camera) const {
+    return std::binary_search(cameras.begin(), cameras.end(), camera);
+  }
 };
 
 /// Evaluates points the way EvaluateFields evaluates voxel centres: for each camera in rig order the

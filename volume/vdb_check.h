@@ -21,7 +21,7 @@ namespace pandora {
 /// it, so a damaged or hostile file can neither exhaust memory nor make the reader loop for long.
 struct VdbLimits {
   std::uint64_t max_file_bytes = std::uint64_t(1) << 32;  ///< 4 GiB.
-  int max_grids = 160;               ///< 9 fields + 64 cameras, with room to spare.
+  int max_grids = SceneLimits::kMaxCameras + 16;  ///< 9 fields + a rig's cameras, with room to spare.
   std::int64_t max_index = 1 << 20;  ///< Every node lies in [0, max_index)^3 (index space).
   /// Product of any two extents of a grid's active index box [0, max]: bounds a slice image.
   std::int64_t max_face_voxels = std::int64_t(1) << 28;

@@ -29,7 +29,7 @@ void InitializeOpenVdb() {
 namespace {
 
 constexpr char kVisiblePrefix[] = "visible/";
-constexpr int kMaxCameras = 64;  // bits of the in-memory mask
+constexpr int kMaxCameras = SceneLimits::kMaxCameras;  // per rig, so per fields file
 
 // How the grids' values are stored: see docs/fields.md ("Compression") for the measured trade-off.
 constexpr std::uint32_t kCompression =
@@ -99,22 +99,19 @@ std::vector<std::string> CameraIds(const std::map<std::string, std::string>& met
   return ids;
 }
 
-// The cameras bitmask as one BoolGrid per camera, voxel by voxel (tiles, which the evaluator never
-// writes, are spelled out).
-openvdb::GridPtrVec CameraGrids(const openvdb::Int64Grid& cameras, std::vector<std::string> ids) {
-  int count = 0;
-  for (auto it = cameras.cbeginValueOn(); it; ++it) {
-    const std::uint64_t mask = static_cast<std::uint64_t>(*it);
-    if (mask) count = std::max(count, 64 - __builtin_clzll(mask));
+// The per-camera grids as written: named by the camera ids (or by index when the ids do not match
+// the grids), with their index and units. They share the trees of the evaluated grids.
+openvdb::GridPtrVec CameraGrids(const std::vector<openvdb::BoolGrid::Ptr>& visible,
+                                std::vector<std::string> ids) {
+  if (ids.size() != visible.size()) {
+    ids.clear();
+    for (std::size_t c = 0; c < visible.size(); ++c) ids.push_back(std::to_string(c));
   }
-  if (int(ids.size()) < count) ids.clear();  // ids that do not cover the mask: name by index
-  if (ids.empty())
-    for (int c = 0; c < count; ++c) ids.push_back(std::to_string(c));
-  std::vector<openvdb::BoolGrid::Ptr> grids;
-  for (std::size_t c = 0; c < ids.size(); ++c) {
-    auto grid = openvdb::BoolGrid::create(false);
+  openvdb::GridPtrVec grids;
+  for (std::size_t c = 0; c < visible.size(); ++c) {
+    auto grid = openvdb::BoolGrid::create(visible[c]->treePtr());
     grid->setName(VisibilityGridName(ids[c]));
-    grid->setTransform(ExactCopy(cameras.transform()));
+    grid->setTransform(ExactCopy(visible[c]->transform()));
     grid->insertMeta("camera_id", openvdb::StringMetadata(ids[c]));
     grid->insertMeta("camera_index", openvdb::Int64Metadata(std::int64_t(c)));
     grid->insertMeta("value_units", openvdb::StringMetadata("bool"));
@@ -123,17 +120,7 @@ openvdb::GridPtrVec CameraGrids(const openvdb::Int64Grid& cameras, std::vector<s
                                         "' (index camera_index in the rig) sees the voxel centre"));
     grids.push_back(grid);
   }
-  std::vector<openvdb::BoolGrid::Accessor> acc;
-  for (auto& g : grids) acc.push_back(g->getAccessor());
-  for (auto it = cameras.cbeginValueOn(); it; ++it) {
-    const std::uint64_t mask = static_cast<std::uint64_t>(*it);
-    if (!mask) continue;
-    const openvdb::CoordBBox box = it.getBoundingBox();
-    for (auto xyz = box.begin(); xyz; ++xyz)
-      for (std::size_t c = 0; c < grids.size(); ++c)
-        if (mask >> c & 1) acc[c].setValueOn(*xyz, true);
-  }
-  return openvdb::GridPtrVec(grids.begin(), grids.end());
+  return grids;
 }
 
 // A read-only stream buffer over bytes in memory, seekable, for openvdb::io::Stream.
@@ -178,7 +165,8 @@ void CheckCameraCounts(const GridT& grid, const std::string& path) {
   for (auto it = grid.cbeginValueAll(); it; ++it)
     if (!ok(*it))
       Refuse(path, "grid 'coverage' holds " + std::to_string(*it) + " at voxel " +
-                       CoordText(it.getCoord()) + ", not a whole number of cameras in [0, 64]");
+                       CoordText(it.getCoord()) + ", not a whole number of cameras in [0, " +
+                       std::to_string(kMaxCameras) + "]");
 }
 
 // Coverage stored as floats back to the in-memory Int32Grid.
@@ -236,8 +224,8 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
     for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
     Describe(*grid);
   }
-  if (g.cameras) {
-    for (openvdb::GridBase::Ptr grid : CameraGrids(*g.cameras, CameraIds(metadata))) {
+  if (!g.visible.empty()) {
+    for (openvdb::GridBase::Ptr grid : CameraGrids(g.visible, CameraIds(metadata))) {
       for (const auto& [key, value] : metadata)
         if (key != "rig") grid->insertMeta(key, openvdb::StringMetadata(value));
       grids.push_back(grid);
@@ -297,7 +285,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
       auto index = grid.integers.find("camera_index");
       if (index == grid.integers.end() || index->second < 0 || index->second >= kMaxCameras ||
           !indices.insert(index->second).second)
-        Refuse(path, "grid '" + name + "' lacks a camera_index in [0, 64) of its own");
+        Refuse(path, "grid '" + name + "' lacks a camera_index in [0, " +
+                         std::to_string(kMaxCameras) + ") of its own");
       if (grid.active_tiles > 0)
         Refuse(path, "grid '" + name + "' holds active tiles; camera grids hold voxels only");
       cameras_info.push_back(&grid);
@@ -330,6 +319,7 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
   Fields fields;
   Fields::Impl& g = fields.impl();
   std::map<std::int64_t, openvdb::BoolGrid::Ptr> visible;
+  openvdb::Int64Grid::Ptr bitmask;
   for (const openvdb::GridBase::Ptr& base : *grids) {
     const std::string name = base->getName();
     if (!by_name.count(name)) continue;
@@ -339,7 +329,7 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
       else if ((g.coverage = openvdb::gridPtrCast<openvdb::Int32Grid>(base)))
         CheckCameraCounts(*g.coverage, path);  // the earlier layout
     } else if (name == kCamerasGrid) {
-      g.cameras = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
+      bitmask = openvdb::gridPtrCast<openvdb::Int64Grid>(base);
     } else if (name.rfind(kVisiblePrefix, 0) == 0) {
       visible[by_name[name]->integers.at("camera_index")] =
           openvdb::gridPtrCast<openvdb::BoolGrid>(base);
@@ -351,17 +341,36 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     if (!g.transform) g.transform = base->transformPtr();
   }
   if ((by_name.count(kCoverageGrid) && !g.coverage) ||
-      (by_name.count(kCamerasGrid) && !g.cameras) || visible.size() != cameras_info.size())
+      (by_name.count(kCamerasGrid) && !bitmask) || visible.size() != cameras_info.size())
     Refuse(path, "OpenVDB read a grid of another type than the file declares");
   if (!visible.empty()) {
-    g.cameras = openvdb::Int64Grid::create(0);
-    g.cameras->setName(kCamerasGrid);
-    g.cameras->setTransform(g.transform);
-    auto acc = g.cameras->getAccessor();
-    for (const auto& [index, grid] : visible) {
-      const std::int64_t bit = std::int64_t(std::uint64_t(1) << index);
-      for (auto it = grid->cbeginValueOn(); it; ++it)  // voxels only (checked above)
-        acc.setValueOn(it.getCoord(), acc.getValue(it.getCoord()) | bit);
+    // Indices 0..n-1 each once: a rig's cameras.
+    if (visible.rbegin()->first != std::int64_t(visible.size()) - 1)
+      Refuse(path, "the per-camera 'visible/' grids do not number the cameras 0.." +
+                       std::to_string(visible.size() - 1));
+    for (const auto& [index, grid] : visible) g.visible.push_back(grid);
+  }
+  if (bitmask) {
+    // The earlier layout: one Int64 bitmask of up to 64 cameras.
+    int count = 0;
+    for (auto it = bitmask->cbeginValueOn(); it; ++it) {
+      if (!it.isVoxelValue())
+        Refuse(path, "grid 'cameras' holds active tiles; it holds voxels only");
+      if (*it) count = std::max(count, 64 - __builtin_clzll(std::uint64_t(*it)));
+    }
+    for (int c = 0; c < count; ++c) {
+      auto grid = openvdb::BoolGrid::create(false);
+      grid->setTransform(g.transform);
+      g.visible.push_back(grid);
+    }
+    std::vector<openvdb::BoolGrid::Accessor> acc;
+    for (auto& grid : g.visible) acc.push_back(grid->getAccessor());
+    for (auto it = bitmask->cbeginValueOn(); it; ++it) {
+      const std::uint64_t mask = static_cast<std::uint64_t>(*it);
+      const openvdb::CoordBBox box = it.getBoundingBox();
+      for (auto xyz = box.begin(); xyz; ++xyz)
+        for (int c = 0; c < count; ++c)
+          if (mask >> c & 1) acc[c].setValueOn(*xyz, true);
     }
   }
 

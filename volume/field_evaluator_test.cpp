@@ -1,0 +1,299 @@
+// The incremental field evaluator against a full recompute: after every one of 200 random edits
+// (moves, re-aims, enable/disable, intrinsics, pixel noise, cameras added and removed) on two
+// scenes, every grid equals EvaluateFields' voxel for voxel and bit for bit (values, active states,
+// tree topology), and so do the summary statistics. Also: cancellation keeps the previous fields,
+// and the evaluator takes rigs of any size.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <random>
+
+#include "analysis/primitives.h"
+#include "volume/fields.h"
+#include "volume/fields_vdb.h"
+
+namespace pandora {
+namespace {
+
+template <typename GridT>
+void ExpectSameGrid(const GridT& a, const GridT& b, const std::string& what) {
+  ASSERT_TRUE(a.tree().hasSameTopology(b.tree())) << what;
+  ASSERT_EQ(a.activeVoxelCount(), b.activeVoxelCount()) << what;
+  ASSERT_EQ(a.tree().activeTileCount(), b.tree().activeTileCount()) << what;
+  auto acc = b.getConstAccessor();
+  for (auto it = a.cbeginValueAll(); it; ++it) {
+    const auto value = acc.getValue(it.getCoord());
+    // Bit for bit (memcmp, so that -0 and 0 would differ).
+    ASSERT_EQ(std::memcmp(&*it, &value, sizeof(value)), 0)
+        << what << " at " << it.getCoord() << ": " << *it << " vs " << value;
+    ASSERT_EQ(it.isValueOn(), acc.isValueOn(it.getCoord())) << what << " " << it.getCoord();
+  }
+}
+
+void ExpectSameFields(const Fields& inc, const Fields& full, const std::string& step) {
+  const Fields::Impl& a = inc.impl();
+  const Fields::Impl& b = full.impl();
+  ASSERT_EQ(bool(a.coverage), bool(b.coverage));
+  if (a.coverage) ExpectSameGrid(*a.coverage, *b.coverage, step + " coverage");
+  ASSERT_EQ(a.floats.size(), b.floats.size());
+  for (const auto& [name, grid] : b.floats) {
+    ASSERT_TRUE(a.Float(name)) << name;
+    ExpectSameGrid(*a.Float(name), *grid, step + " " + name);
+  }
+  ASSERT_EQ(a.visible.size(), b.visible.size()) << step;
+  for (std::size_t c = 0; c < a.visible.size(); ++c)
+    ExpectSameGrid(*a.visible[c], *b.visible[c], step + " visible/" + std::to_string(c));
+  const FieldStats& s = inc.stats;
+  const FieldStats& t = full.stats;
+  EXPECT_EQ(s.seen_voxels, t.seen_voxels) << step;
+  EXPECT_EQ(s.triangulable_voxels, t.triangulable_voxels) << step;
+  EXPECT_EQ(s.unobservable_voxels, t.unobservable_voxels) << step;
+  EXPECT_EQ(s.coverage_histogram, t.coverage_histogram) << step;
+  EXPECT_EQ(s.per_camera_seen, t.per_camera_seen) << step;
+  EXPECT_EQ(s.point_camera_tests, t.point_camera_tests) << step;
+  EXPECT_EQ(s.rays, t.rays) << step;
+  EXPECT_EQ(s.active_set.region_voxels, t.active_set.region_voxels) << step;
+  EXPECT_EQ(s.active_set.blocks, t.active_set.blocks) << step;
+  EXPECT_EQ(s.active_set.culled_blocks, t.active_set.culled_blocks) << step;
+  EXPECT_EQ(s.sigma_max_mm, t.sigma_max_mm) << step;  // same order: blocks, then offsets
+  EXPECT_EQ(s.sigma_max_steady_mm, t.sigma_max_steady_mm) << step;
+}
+
+Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, double hfov_deg,
+                  LensModel model, double k1 = 0) {
+  Intrinsics k;
+  k.width = 320;
+  k.height = 240;
+  k.model = model;
+  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, k.width, model);
+  k.cx = 159.5;
+  k.cy = 119.5;
+  k.k1 = k1;
+  Camera cam;
+  cam.id = id;
+  cam.model = CameraModel(k);
+  cam.world_from_camera = LookAt(position, target, Vec3(0, 0, 1)).value();
+  cam.near = 0.05;
+  cam.far = 20;
+  return cam;
+}
+
+// A room with solids (a ball, a post), a loose sheet, and six cameras of three lens models.
+Scene SyntheticScene() {
+  Scene scene;
+  scene.path = "synthetic.json";
+  auto add = [&](const std::string& name, TriangleMesh mesh, const Vec3& at, bool solid) {
+    for (Vec3& v : mesh.vertices) v += at;
+    SceneObject o;
+    o.name = name;
+    o.mesh = std::move(mesh);
+    o.solid = solid;
+    scene.objects.push_back(std::move(o));
+  };
+  add("ball", MakeSphere(0.3, 20), Vec3(0.1, 0.0, 0.1), true);
+  add("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true);
+  add("sheet", MakePlane(Vec2(0.6, 0.6)), Vec3(0.5, -0.5, 0.4), false);
+  Rig rig;
+  rig.name = "six";
+  rig.cameras.push_back(MakeCamera("a", Vec3(3, 0, 1), Vec3(0, 0, 0), 50, LensModel::kPinhole));
+  rig.cameras.push_back(
+      MakeCamera("b", Vec3(0, 3, 2), Vec3(0, 0, 0), 70, LensModel::kBrownConrady, -0.2));
+  rig.cameras.push_back(
+      MakeCamera("c", Vec3(-2, -2, 1.5), Vec3(0, 0, 0), 190, LensModel::kFisheye, 0.02));
+  rig.cameras.push_back(MakeCamera("d", Vec3(0, 0, 4), Vec3(0.2, 0.1, 0), 30, LensModel::kPinhole));
+  rig.cameras.push_back(MakeCamera("e", Vec3(-3, 0, 0.5), Vec3(0, 0, 0.2), 60, LensModel::kPinhole));
+  rig.cameras.push_back(MakeCamera("f", Vec3(2, -2, 2), Vec3(0, 0, 0), 80, LensModel::kPinhole));
+  scene.rigs.push_back(rig);
+  scene.study.region.box.min = Vec3(-1, -1, -0.5);
+  scene.study.region.box.max = Vec3(1, 1, 0.8);
+  scene.study.voxel_size = 0.06;
+  scene.study.motion = MotionModel{0.5, 30.0};
+  return scene;
+}
+
+// One random edit of the kinds a person makes in a session.
+std::string RandomEdit(std::mt19937_64& rng, Rig* rig, const Camera& spare) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = static_cast<int>(rig->cameras.size());
+  const int c = static_cast<int>(rng() % n);
+  Camera& cam = rig->cameras[c];
+  switch (rng() % 10) {
+    case 0:
+    case 1:
+    case 2: {  // move
+      cam.world_from_camera.translation() += 0.3 * Vec3(u(rng), u(rng), u(rng));
+      return "move " + cam.id;
+    }
+    case 3:
+    case 4: {  // re-aim (a small rotation)
+      const Eigen::AngleAxisd turn(0.2 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized());
+      cam.world_from_camera.linear() = cam.world_from_camera.linear() * turn.toRotationMatrix();
+      return "turn " + cam.id;
+    }
+    case 5:  // enable / disable
+      cam.enabled = !cam.enabled;
+      return std::string(cam.enabled ? "enable " : "disable ") + cam.id;
+    case 6: {  // zoom and distortion
+      Intrinsics k = cam.model.intrinsics();
+      k.fx *= 1.0 + 0.2 * u(rng);
+      k.fy = k.fx;
+      if (k.model == LensModel::kBrownConrady) k.k1 = 0.1 * u(rng);
+      cam.model = CameraModel(k);
+      return "zoom " + cam.id;
+    }
+    case 7:  // pixel noise: information changes, visibility does not
+      cam.pixel_sigma = 0.25 + 0.5 * (u(rng) + 1.0);
+      return "noise " + cam.id;
+    case 8:  // two cameras at once
+      cam.world_from_camera.translation() += 0.2 * Vec3(u(rng), u(rng), u(rng));
+      rig->cameras[(c + 1) % n].enabled = !rig->cameras[(c + 1) % n].enabled;
+      return "move " + cam.id + " and toggle the next";
+    default:  // a camera added at the end, or the last one removed
+      if (n > 3 && rng() % 2) {
+        rig->cameras.pop_back();
+        return "remove the last camera";
+      }
+      rig->cameras.push_back(spare);
+      rig->cameras.back().id = "spare" + std::to_string(n);
+      return "add a camera";
+  }
+}
+
+void RunRandomEdits(const Scene& scene, const Rig& start, int steps, std::uint64_t seed) {
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = scene.study.fields.empty() ? FieldNames() : scene.study.fields;
+  if (!scene.study.motion) {
+    options.fields.erase(std::remove_if(options.fields.begin(), options.fields.end(),
+                                        [](const std::string& f) {
+                                          return f.find("steady") != std::string::npos;
+                                        }),
+                         options.fields.end());
+  }
+  FieldEvaluator evaluator(scene, *caster, options);
+  Rig rig = start;
+  FieldUpdate first = evaluator.Update(rig);
+  EXPECT_TRUE(first.full);
+  ExpectSameFields(evaluator.fields(), EvaluateFields(scene, rig, *caster, options), "start");
+  std::mt19937_64 rng(seed);
+  const Camera spare = start.cameras[rng() % start.cameras.size()];
+  std::int64_t dirty_voxels = 0, full_voxels = 0;
+  for (int step = 0; step < steps; ++step) {
+    const std::string edit = RandomEdit(rng, &rig, spare);
+    const FieldUpdate u = evaluator.Update(rig);
+    EXPECT_FALSE(u.full);
+    EXPECT_FALSE(u.cancelled);
+    const Fields full = EvaluateFields(scene, rig, *caster, options);
+    dirty_voxels += u.dirty_voxels;
+    full_voxels += full.stats.active_set.region_voxels;
+    ExpectSameFields(evaluator.fields(), full, "step " + std::to_string(step) + " (" + edit + ")");
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+  std::printf("%s: %d edits, re-derived %.1f %% of the voxels a full evaluation computes\n",
+              scene.path.c_str(), steps, 100.0 * double(dirty_voxels) / double(full_voxels));
+}
+
+TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnASyntheticScene) {
+  const Scene scene = SyntheticScene();
+  RunRandomEdits(scene, scene.rigs[0], 200, 1);
+}
+
+TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnTheTraumaRoom) {
+  Scene scene = LoadScene("examples/trauma_room/scene.json");
+  scene.study.voxel_size = 0.008;  // 8 mm keeps 200 full recomputes under a few seconds
+  RunRandomEdits(scene, scene.FindRig("grid4x2"), 200, 2);
+}
+
+TEST(FieldEvaluator, NothingChangedCostsNothing) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldEvaluator evaluator(scene, *caster, FieldOptions{});
+  Rig rig = scene.rigs[0];
+  evaluator.Update(rig);
+  rig.cameras[2].name = "renamed";  // names and colours do not enter the fields
+  rig.cameras[2].color = Vec3(1, 0, 0);
+  const FieldUpdate u = evaluator.Update(rig);
+  EXPECT_EQ(u.changed_cameras, 0);
+  EXPECT_EQ(u.dirty_blocks, 0);
+  EXPECT_EQ(u.rays, 0);
+}
+
+TEST(FieldEvaluator, OneMovedCameraRecastsOnlyItsOwnRays) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldEvaluator evaluator(scene, *caster, FieldOptions{});
+  Rig rig = scene.rigs[0];
+  evaluator.Update(rig);
+  rig.cameras[3].world_from_camera.translation() += Vec3(0.1, 0, 0);
+  const FieldUpdate u = evaluator.Update(rig);
+  EXPECT_EQ(u.changed_cameras, 1);
+  // Only camera 3 casts, and only as many segments as it alone casts in a full evaluation.
+  Rig alone = rig;
+  for (std::size_t c = 0; c < alone.cameras.size(); ++c) alone.cameras[c].enabled = c == 3;
+  EXPECT_EQ(u.rays, EvaluateFields(scene, alone, *caster, FieldOptions{}).stats.rays);
+  EXPECT_GT(u.rays, 0);
+}
+
+TEST(FieldEvaluator, CancelledUpdateKeepsThePreviousFields) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  std::atomic<bool> cancel{false};
+  options.cancel = &cancel;
+  FieldEvaluator evaluator(scene, *caster, options);
+  const Rig before = scene.rigs[0];
+  evaluator.Update(before);
+  Rig after = before;
+  after.cameras[0].world_from_camera.translation() += Vec3(0, 0.5, 0);
+  cancel = true;
+  const FieldUpdate u = evaluator.Update(after);
+  EXPECT_TRUE(u.cancelled);
+  ExpectSameFields(evaluator.fields(), EvaluateFields(scene, before, *caster, FieldOptions{}),
+                   "cancelled");
+  cancel = false;
+  evaluator.Update(after);  // the edit is still pending: the next update applies it
+  ExpectSameFields(evaluator.fields(), EvaluateFields(scene, after, *caster, FieldOptions{}),
+                   "after");
+}
+
+// A rig of 1000 cameras on a dome: the per-camera sets are sparse grids, the coverage is the count
+// of those grids voxel by voxel, and a change of one camera updates like any other.
+TEST(FieldEvaluator, AThousandCameras) {
+  Scene scene = SyntheticScene();
+  scene.study.voxel_size = 0.1;
+  Rig rig;
+  rig.name = "dome";
+  for (int i = 0; i < 1000; ++i) {
+    const double z = 0.2 + 2.5 * (i + 0.5) / 1000.0;  // a spiral on a dome of radius ~4 m
+    const double a = i * 2.399963;                     // the golden angle
+    const double r = std::sqrt(std::max(0.5, 16.0 - z * z));
+    rig.cameras.push_back(MakeCamera("cam" + std::to_string(i), Vec3(r * std::cos(a), r * std::sin(a), z),
+                                     Vec3(0, 0, 0.1), 40 + (i % 5) * 10, LensModel::kPinhole));
+  }
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage", "cameras", "resolution", "sigma_max"};
+  FieldEvaluator evaluator(scene, *caster, options);
+  evaluator.Update(rig);
+  const Fields& f = evaluator.fields();
+  ASSERT_EQ(f.impl().visible.size(), 1000u);
+  // Coverage is the number of camera grids holding the voxel.
+  auto cov = f.impl().coverage->getConstAccessor();
+  int checked = 0, most = 0;
+  for (auto it = f.impl().coverage->cbeginValueOn(); it && checked < 300; ++it, ++checked) {
+    int count = 0;
+    for (const auto& grid : f.impl().visible) count += grid->tree().isValueOn(it.getCoord());
+    ASSERT_EQ(count, *it) << it.getCoord();
+    most = std::max(most, count);
+  }
+  EXPECT_GT(most, 64);  // beyond the old 64-bit mask
+  EXPECT_EQ(f.stats.coverage_histogram.size(), 1001u);
+  rig.cameras[500].world_from_camera.translation() += Vec3(0.3, 0, 0);
+  evaluator.Update(rig);
+  ExpectSameFields(evaluator.fields(), EvaluateFields(scene, rig, *caster, options), "moved");
+}
+
+}  // namespace
+}  // namespace pandora
