@@ -21,6 +21,7 @@ namespace pandora::app {
 
 int RunBench(const BenchArgs& args) {
   if (args.render) return RunRenderBench(args);
+  if (args.incremental) return RunIncrementalBench(args);
   Scene scene = LoadScene(args.scene);
   const Rig& rig = FindRigOption(scene, args.rig);
   if (!std::isnan(args.voxel_size))

@@ -37,10 +37,17 @@ struct BenchArgs {
   bool render = false;
   std::string view;               ///< Named view; empty: the scene's first view.
   std::string size = "1280x720";  ///< Image size.
+  /// `--incremental`: the time to update the fields after moving one camera, as a ratio to a
+  /// full evaluation (bench_incremental.cpp).
+  bool incremental = false;
+  double move = 0.05;  ///< With --incremental: how far each camera moves, metres.
 };
 /// `pandora bench --render`: Render() against raw Embree loops over the very same primary rays
 /// (rtcIntersect1) and occlusion segments (rtcOccluded packets and single rays), same run.
 int RunRenderBench(const BenchArgs& args);
+/// `pandora bench --incremental`: FieldEvaluator::Update after moving each camera in turn against a
+/// full EvaluateFields, same run, interleaved.
+int RunIncrementalBench(const BenchArgs& args);
 int RunBench(const BenchArgs& args);
 
 /// `pandora accuracy`: error against run time (issue 3, point 6) for (a) voxel size against the

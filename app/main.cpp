@@ -162,6 +162,11 @@ int main(int argc, char** argv) {
               "Time `pandora render` (1280x720) against raw Embree loops over the same primary and shadow rays");
   b->add_option("--view", bench.view, "With --render: the named view (default: the scene's first view)");
   b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
+  b->add_flag("--incremental", bench.incremental,
+              "Time the field update after moving one camera against a full evaluation");
+  b->add_option("--move", bench.move, "With --incremental: how far each camera moves, metres")
+      ->check(Number(0, HUGE_VAL, "metres", false, true))
+      ->capture_default_str();
   b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
 
   AccuracyArgs accuracy;

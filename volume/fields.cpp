@@ -144,18 +144,27 @@ inline double AtanNonNegative(double t) {
 
 // The triangulation angle of `count` voxels at (x, y, z) (block offsets `offset`): the largest angle
 // in degrees between two rays from camera centres that see the voxel. `sees[e]` is the 512-bit
-// mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). Vectorised over
-// voxels, in tiles of 64 that keep every camera's directions in L1: per camera the unit directions
-// (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so every comparison
-// with it fails), per camera pair the dot product, keeping the pair with the smallest, then the
-// angle as atan2(|cross|, dot) (both keep their relative accuracy, so tiny and near-180 degree
-// angles are as exact as at 90). No per-ray storage.
+// mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). The best pair is
+// the one with the smallest dot product of the unit directions, ties to the first pair in (a, b)
+// order; it is returned in best_dot / best_a / best_b (indices into `sees`).
+// With `changed` null every pair is tried. With `changed` (per camera, 1 for cameras that moved),
+// best_* come in as the best pair among the unchanged cameras (a previous result that involves no
+// changed camera) and only pairs with a changed camera are tried, keeping the lexicographically
+// smallest (dot, a, b): the same pair, so the same bits, as trying all pairs.
+// Vectorised over voxels, in tiles of 64 that keep every camera's directions in L1: per camera the
+// unit directions (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so
+// every comparison with it fails), per camera pair the dot product, then the angle as
+// atan2(|cross|, dot) (both keep their relative accuracy, so tiny and near-180 degree angles are as
+// exact as at 90). The file is compiled without floating-point contraction, so scalar and vector
+// code give the same bits. No per-ray storage.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 void TriangulationAngles(int count, const double* x, const double* y, const double* z,
                          const std::int16_t* offset, int camera_count,
-                         const std::uint64_t* const* sees, const Vec3* centres, double* dirs,
+                         const std::uint64_t* const* sees, const Vec3* centres,
+                         const unsigned char* changed, double* best_dot_io,
+                         std::int32_t* best_a_io, std::int32_t* best_b_io, double* dirs,
                          float* degrees) {
   constexpr int kTile = 64;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -179,19 +188,39 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
     }
     double best_dot[kTile];
     std::int64_t best_a[kTile], best_b[kTile];  // camera indices of the best pair
-    for (int m = 0; m < kTile; ++m) best_dot[m] = 2.0, best_a[m] = 0, best_b[m] = 0;
+    if (changed) {
+      for (int m = 0; m < n; ++m)
+        best_dot[m] = best_dot_io[start + m], best_a[m] = best_a_io[start + m],
+        best_b[m] = best_b_io[start + m];
+    } else {
+      for (int m = 0; m < kTile; ++m) best_dot[m] = 2.0, best_a[m] = 0, best_b[m] = 0;
+    }
     for (int a = 0; a < camera_count; ++a) {
       const double* ad = dirs + 3 * kTile * a;
       for (int b = a + 1; b < camera_count; ++b) {
         const double* bd = dirs + 3 * kTile * b;
+        if (!changed) {
 #pragma omp simd
-        for (int m = 0; m < n; ++m) {
-          const double dot =
-              ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] + ad[m + 2 * kTile] * bd[m + 2 * kTile];
-          const bool take = dot < best_dot[m];  // false for NaN: a camera that does not see it
-          best_dot[m] = take ? dot : best_dot[m];
-          best_a[m] = take ? a : best_a[m];
-          best_b[m] = take ? b : best_b[m];
+          for (int m = 0; m < n; ++m) {
+            const double dot = ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] +
+                               ad[m + 2 * kTile] * bd[m + 2 * kTile];
+            const bool take = dot < best_dot[m];  // false for NaN: a camera that does not see it
+            best_dot[m] = take ? dot : best_dot[m];
+            best_a[m] = take ? a : best_a[m];
+            best_b[m] = take ? b : best_b[m];
+          }
+        } else if (changed[a] || changed[b]) {
+#pragma omp simd
+          for (int m = 0; m < n; ++m) {
+            const double dot = ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] +
+                               ad[m + 2 * kTile] * bd[m + 2 * kTile];
+            const bool take = dot < best_dot[m] ||
+                              (dot == best_dot[m] &&
+                               (a < best_a[m] || (a == best_a[m] && b < best_b[m])));
+            best_dot[m] = take ? dot : best_dot[m];
+            best_a[m] = take ? a : best_a[m];
+            best_b[m] = take ? b : best_b[m];
+          }
         }
       }
     }
@@ -206,6 +235,11 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
       const double angle = AtanNonNegative(std::sqrt(cx * cx + cy * cy + cz * cz) / std::abs(dot));
       degrees[start + m] = static_cast<float>((dot < 0 ? M_PI - angle : angle) * (180.0 / M_PI));
     }
+    for (int m = 0; m < n; ++m) {
+      best_dot_io[start + m] = best_dot[m];
+      best_a_io[start + m] = static_cast<std::int32_t>(best_a[m]);
+      best_b_io[start + m] = static_cast<std::int32_t>(best_b[m]);
+    }
   }
 }
 
@@ -213,8 +247,19 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
 // The evaluator's state.
 
 constexpr int kWords = 8;  // 512 voxels of a block as bits
+
+// The hardware population count where the CPU has one (every x86-64 since 2008); GCC's generic
+// __builtin_popcountll is a library call without -mpopcnt.
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("popcnt"))) inline int PopcountHw(std::uint64_t x) { return __builtin_popcountll(x); }
+inline int Popcount(std::uint64_t x) {
+  static const bool hw = __builtin_cpu_supports("popcnt");
+  return hw ? PopcountHw(x) : __builtin_popcountll(x);
+}
+#else
+inline int Popcount(std::uint64_t x) { return __builtin_popcountll(x); }
+#endif
 using Bits = std::array<std::uint64_t, kWords>;
-inline bool TestBit(const Bits& b, int o) { return (b[o >> 6] >> (o & 63) & 1) != 0; }
 inline void SetBit(Bits& b, int o) { b[o >> 6] |= std::uint64_t{1} << (o & 63); }
 
 // What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,
@@ -227,10 +272,6 @@ struct CameraEntry {
   std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
   std::vector<double> information;  // with an information field
   std::vector<float> density;       // with resolution
-  int Index(int o) const {
-    const int w = o >> 6;
-    return before[w] + __builtin_popcountll(bits[w] & ((std::uint64_t{1} << (o & 63)) - 1));
-  }
   double Bytes() const {
     return sizeof(CameraEntry) + information.capacity() * sizeof(double) +
            density.capacity() * sizeof(float);
@@ -246,6 +287,10 @@ struct BlockState {
   std::vector<std::int32_t> coverage;
   std::vector<std::uint8_t> status;
   std::vector<float> sigma_max, sigma_steady;
+  // The best camera pair of each triangulable voxel (its smallest direction dot product and the
+  // cameras' rig indices; a = -1 where none), with triangulation_angle.
+  std::vector<double> pair_dot;
+  std::vector<std::int32_t> pair_a, pair_b;
   // Summary.
   std::vector<std::int64_t> histogram;  // [k] = free voxels seen by k cameras
   std::int64_t seen = 0, triangulable = 0, unobservable = 0;
@@ -317,8 +362,8 @@ struct FieldEvaluator::State {
   void Cast(const Block& block, int camera, const RigData& rd, CameraEntry* entry,
             std::vector<Ray>* rays) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
-              const Bits& dirty, const std::vector<Vec3>& centres, BlockState* next,
-              BlockLeaves* leaves) const;
+              const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
+              const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves) const;
   void Totals(FieldStats* stats, int camera_count, int enabled) const;
   void ResetGrids(int camera_count);
 };
@@ -425,6 +470,7 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
 // evaluation (every voxel dirty) and an update, so both give the same bits.
 void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
                                    std::vector<const CameraEntry*> view, const Bits& dirty,
+                                   const std::vector<std::uint8_t>& is_changed,
                                    const std::vector<Vec3>& centres, BlockState* next,
                                    BlockLeaves* leaves) const {
   // Entries that see nothing take no part.
@@ -435,16 +481,25 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   const VoxelLattice& lattice = fields.lattice;
 
   // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
-  if (old.coverage.empty()) {
+  const bool fresh = old.coverage.empty();
+  if (fresh) {
     next->coverage.assign(512, 0);
     next->status.assign(512, kUnseen);
     if (want_information) next->sigma_max.assign(512, 0.0f);
     if (want_steady) next->sigma_steady.assign(512, 0.0f);
+    if (want_angle) {
+      next->pair_dot.assign(512, 2.0);
+      next->pair_a.assign(512, -1);
+      next->pair_b.assign(512, -1);
+    }
   } else {
     next->coverage = old.coverage;
     next->status = old.status;
     next->sigma_max = old.sigma_max;
     next->sigma_steady = old.sigma_steady;
+    next->pair_dot = old.pair_dot;
+    next->pair_a = old.pair_a;
+    next->pair_b = old.pair_b;
   }
 
   // Leaves to rewrite: copies of the grids' current ones, or new ones.
@@ -479,26 +534,39 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
   FloatLeaf* resolution = leaves->floats[kResolution];
 
+  // Sums camera by camera in rig order (entry-major: each entry's seen voxels are walked once,
+  // with a running index into its contributions), the same order for every voxel.
+  std::array<std::int32_t, 512> cover{};
+  std::array<float, 512> best_density{};
+  // Per voxel, its six sums side by side (rows of 512 would put them 4 KiB apart: cache aliasing).
+  std::array<std::array<double, 6>, 512> sum;
+  if (want_information)
+    for (auto& row : sum) row.fill(0.0);
+  for (const CameraEntry* e : view) {
+    for (int w = 0; w < kWords; ++w) {
+      const std::uint64_t seen = e->bits[w];
+      const std::uint64_t wanted = seen & dirty[w];
+      if (!wanted) continue;
+      for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
+        const int bit = __builtin_ctzll(bits);
+        const int index = e->before[w] + Popcount(seen & ((std::uint64_t{1} << bit) - 1));
+        const int o = 64 * w + bit;
+        ++cover[o];
+        if (want_resolution) best_density[o] = std::max(best_density[o], e->density[index]);
+        if (want_information) {
+          const double* c = &e->information[6 * index];
+          for (int k = 0; k < 6; ++k) sum[o][k] += c[k];
+        }
+      }
+    }
+  }
+
   int candidate_count = 0;
   for (int w = 0; w < kWords; ++w) {
     for (std::uint64_t bits = dirty[w]; bits; bits &= bits - 1) {
       const int o = 64 * w + __builtin_ctzll(bits);
-      int coverage = 0;
-      float density = 0.0f;
-      double I[6] = {0, 0, 0, 0, 0, 0};
-      for (const CameraEntry* e : view) {
-        if (!TestBit(e->bits, o)) continue;
-        const int i = e->Index(o);
-        ++coverage;
-        if (want_resolution) density = std::max(density, e->density[i]);
-        if (want_information) {
-          const double* c = &e->information[6 * i];
-          if (coverage == 1)
-            for (int k = 0; k < 6; ++k) I[k] = c[k];
-          else
-            for (int k = 0; k < 6; ++k) I[k] += c[k];
-        }
-      }
+      const int coverage = cover[o];
+      const float density = best_density[o];
       next->coverage[o] = coverage;
       next->status[o] = coverage == 0 ? kUnseen : kSeenOnly;
       if (leaves->coverage) leaves->coverage->setValueOn(o, coverage);
@@ -510,8 +578,11 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       }
       for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
         if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
-      if (!want_information || coverage < 2) continue;  // not triangulable: no uncertainty work
-      for (int k = 0; k < 6; ++k) upper[k][candidate_count] = I[k];
+      if (!want_information || coverage < 2) {  // not triangulable: no uncertainty work
+        if (want_angle) next->pair_a[o] = next->pair_b[o] = -1;
+        continue;
+      }
+      for (int k = 0; k < 6; ++k) upper[k][candidate_count] = sum[o][k];
       if (want_angle) {
         const int x = o >> 6, y = (o >> 3) & 7, z = o & 7;
         const Vec3 p =
@@ -529,14 +600,59 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     if (want_angle) {
       std::vector<const std::uint64_t*> sees;
       std::vector<Vec3> entry_centres;
+      std::vector<unsigned char> entry_changed;
+      sees.reserve(view.size());
+      entry_centres.reserve(view.size());
       for (const CameraEntry* e : view) {
         sees.push_back(e->bits.data());
         entry_centres.push_back(centres[e->camera]);
+        entry_changed.push_back(is_changed[e->camera]);
+      }
+      const auto entry_of = [&](std::int32_t camera) {
+        const auto it = std::lower_bound(view.begin(), view.end(), camera,
+                                         [](const CameraEntry* e, int c) { return e->camera < c; });
+        return static_cast<std::int32_t>(it - view.begin());
+      };
+      // Two groups: voxels whose cached best pair involves no changed camera try only the pairs
+      // with a changed one; the others (new candidates, a changed camera in the pair) try all.
+      std::array<int, 512> group_of;  // candidate -> index within its group
+      std::array<std::int16_t, 512> offsets[2];
+      std::array<double, 512> gx[2], gy[2], gz[2], dot[2];
+      std::array<std::int32_t, 512> pa[2], pb[2];
+      std::array<float, 512> degrees[2];
+      int size[2] = {0, 0};
+      std::array<unsigned char, 512> which;
+      for (int m = 0; m < candidate_count; ++m) {
+        const int o = candidate[m];
+        const std::int32_t ca = next->pair_a[o], cb = next->pair_b[o];
+        const int g = (!fresh && ca >= 0 && !is_changed[ca] && !is_changed[cb]) ? 1 : 0;
+        const int k = size[g]++;
+        which[m] = static_cast<unsigned char>(g);
+        group_of[m] = k;
+        offsets[g][k] = static_cast<std::int16_t>(o);
+        gx[g][k] = cand_x[m];
+        gy[g][k] = cand_y[m];
+        gz[g][k] = cand_z[m];
+        if (g == 1) {
+          dot[g][k] = next->pair_dot[o];
+          pa[g][k] = entry_of(ca);
+          pb[g][k] = entry_of(cb);
+        }
       }
       std::vector<double> directions(3 * 64 * view.size());
-      TriangulationAngles(candidate_count, cand_x.data(), cand_y.data(), cand_z.data(),
-                          candidate.data(), static_cast<int>(view.size()), sees.data(),
-                          entry_centres.data(), directions.data(), angle_deg.data());
+      for (int g = 0; g < 2; ++g)
+        if (size[g] > 0)
+          TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
+                              static_cast<int>(view.size()), sees.data(), entry_centres.data(),
+                              g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
+                              pb[g].data(), directions.data(), degrees[g].data());
+      for (int m = 0; m < candidate_count; ++m) {
+        const int g = which[m], k = group_of[m], o = candidate[m];
+        angle_deg[m] = degrees[g][k];
+        next->pair_dot[o] = dot[g][k];
+        next->pair_a[o] = view[pa[g][k]]->camera;
+        next->pair_b[o] = view[pb[g][k]]->camera;
+      }
     }
     if (want_steady) {
       const double frame = frame_period;
@@ -866,7 +982,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       std::sort(view.begin(), view.end(),
                 [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
       if (count > 0 || old.coverage.empty())
-        S.Derive(block, old, view, voxels, rd.centres, &next[i], &leaves[i]);
+        S.Derive(block, old, view, voxels, is_changed, rd.centres, &next[i], &leaves[i]);
       // Camera grids: a leaf per re-cast camera that sees part of the block.
       if (S.want_cameras)
         for (const CameraEntry& e : cast[i]) {

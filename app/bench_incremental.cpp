@@ -1,0 +1,141 @@
+// `pandora bench --incremental`: how long the fields take to catch up after one camera moves, as a
+// ratio to a full evaluation measured in the same run (interleaved, so load drifts hit both).
+// Each camera in turn moves sideways by --move metres and back; every move is one
+// FieldEvaluator::Update, timed from the edit to fields that equal a full recompute.
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+#include "app/commands.h"
+#include "app/output.h"
+#include "volume/fields.h"
+
+namespace pandora::app {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+int RunIncrementalBench(const BenchArgs& args) {
+  Scene scene = LoadScene(args.scene);
+  const Rig& rig = FindRigOption(scene, args.rig);
+  if (!std::isnan(args.voxel_size))
+    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  scene.CheckLength(args.move, "--move", "the distance each camera moves");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
+  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const int threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+
+  FieldOptions options;
+  options.scene_path = scene.path;
+  if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
+  options.fields = scene.study.fields;  // the study's own workload
+  options.memory_budget_bytes = scene.study.memory_budget_bytes;
+
+  FieldEvaluator evaluator(scene, *caster, options);
+  const FieldUpdate first = evaluator.Update(rig);
+  const int n = static_cast<int>(rig.cameras.size());
+
+  double best_full = std::numeric_limits<double>::infinity();
+  double best_full_cpu = std::numeric_limits<double>::infinity();
+  std::vector<double> updates, updates_cpu;
+  std::int64_t dirty_voxels = 0, update_rays = 0, region_voxels = 0, full_rays = 0;
+  for (int r = 0; r < args.repeat; ++r) {
+    const std::clock_t cpu0 = std::clock();
+    const Fields full = EvaluateFields(scene, rig, *caster, options);
+    best_full_cpu = std::min(best_full_cpu, double(std::clock() - cpu0) / CLOCKS_PER_SEC);
+    best_full = std::min(best_full, full.stats.seconds);
+    region_voxels = full.stats.active_set.region_voxels;
+    full_rays = full.stats.rays;
+    Rig edited = rig;
+    for (int c = 0; c < n; ++c) {
+      // Sideways in the camera's own frame (its x axis), then back.
+      const Vec3 side = edited.cameras[c].world_from_camera.linear().col(0);
+      for (const double step : {args.move, -args.move}) {
+        edited.cameras[c].world_from_camera.translation() += step * side;
+        const std::clock_t u0 = std::clock();
+        const FieldUpdate u = evaluator.Update(edited);
+        updates_cpu.push_back(double(std::clock() - u0) / CLOCKS_PER_SEC);
+        updates.push_back(u.seconds);
+        dirty_voxels += u.dirty_voxels;
+        update_rays += u.rays;
+      }
+    }
+  }
+  const double mean = std::accumulate(updates.begin(), updates.end(), 0.0) / updates.size();
+  const double median = Median(updates);
+  const double worst = *std::max_element(updates.begin(), updates.end());
+  const double mean_cpu =
+      std::accumulate(updates_cpu.begin(), updates_cpu.end(), 0.0) / updates_cpu.size();
+  const double dirty_share = double(dirty_voxels) / double(updates.size()) / double(region_voxels);
+  const double ray_share = double(update_rays) / double(updates.size()) / double(full_rays);
+  const double ratio = mean / best_full;
+  const double ratio_cpu = mean_cpu / best_full_cpu;
+  const double state_mib = evaluator.state_bytes() / 1048576.0;
+
+  std::printf("pandora bench --incremental: %s, rig %s (%d cameras), voxel %.4g m, %zu fields, %d threads\n",
+              scene.path.c_str(), rig.name.c_str(), n, scene.study.voxel_size,
+              options.fields.size(), threads);
+  std::printf("  region voxels %lld, rays of a full evaluation %lld\n", (long long)region_voxels,
+              (long long)full_rays);
+  std::printf("  %-52s %9.4f s\n", "full evaluation (EvaluateFields, best of runs)", best_full);
+  std::printf("  %-52s %9.4f s  (keeps %.1f MiB for updates)\n",
+              "first update of the incremental evaluator", first.seconds, state_mib);
+  std::printf("  %-52s %9.4f s  median %.4f s, worst %.4f s (%zu updates)\n",
+              "update after moving one camera: mean", mean, median, worst, updates.size());
+  std::printf("  an update re-casts %.1f%% of a full evaluation's rays and re-derives %.1f%% of its voxels\n",
+              100.0 * ray_share, 100.0 * dirty_share);
+  std::printf("  ratio update / full = %.3f wall, %.3f CPU (ideal about 1/%d = %.3f)\n", ratio,
+              ratio_cpu, n, 1.0 / n);
+  std::printf("  edit-to-updated-fields latency: median %.1f ms, worst %.1f ms\n", 1e3 * median,
+              1e3 * worst);
+
+  if (!args.json_out.empty()) {
+    nlohmann::json j{{"scene", scene.path},
+                     {"rig", rig.name},
+                     {"cameras", n},
+                     {"voxel_size_m", scene.study.voxel_size},
+                     {"fields", options.fields},
+                     {"threads", threads},
+                     {"repeat", args.repeat},
+                     {"move_m", args.move},
+                     {"region_voxels", region_voxels},
+                     {"full_seconds", best_full},
+                     {"full_cpu_seconds", best_full_cpu},
+                     {"first_update_seconds", first.seconds},
+                     {"state_mib", state_mib},
+                     {"update_mean_seconds", mean},
+                     {"update_median_seconds", median},
+                     {"update_worst_seconds", worst},
+                     {"update_mean_cpu_seconds", mean_cpu},
+                     {"ray_share", ray_share},
+                     {"dirty_voxel_share", dirty_share},
+                     {"ratio", ratio},
+                     {"ratio_cpu", ratio_cpu}};
+    WriteFileAtomically(json_path, j.dump(2) + "\n");
+    output.Commit();
+  }
+  return 0;
+}
+
+}  // namespace pandora::app
