@@ -11,6 +11,7 @@
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/session.h"
 #include "app/output.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
@@ -104,14 +105,19 @@ double CheckPositiveOption(const char* option, double value, const char* unit) {
 }
 
 int RunAnalyze(const AnalyzeArgs& args) {
-  Scene scene = LoadScene(args.scene);
-  const Rig& rig = FindRigOption(scene, args.rig);
-  FieldOptions options;
+  // The study, with --voxel-size applied, and the rig, through the session layer.
+  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
+    if (!std::isnan(args.voxel_size))
+      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  });
+  const Scene& scene = study->scene();
+  session::SessionOptions so;
+  so.rig = args.rig;
+  so.rig_option = "--rig";
+  so.incremental = false;  // one evaluation: no per-pair state
+  FieldOptions& options = so.fields;
   options.scene_path = scene.path;
-  if (!std::isnan(args.voxel_size)) {
-    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-    options.voxel_size_option = "--voxel-size";
-  }
+  if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
   options.fields = scene.study.fields;
   if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
@@ -121,6 +127,10 @@ int RunAnalyze(const AnalyzeArgs& args) {
     CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
     options.memory_budget_option = "--memory-budget";
   }
+  ProgressBar bar("analyze " + study->FindRig(args.rig, "--rig").name, !args.quiet);
+  options.progress = [&bar](double f) { bar.Update(f); };
+  session::Session session(study, so);
+  const Rig& rig = session.rig().rig();
   // Both outputs appear together (summary.json last), or neither does.
   const std::filesystem::path out(args.out);
   OutputTransaction output;
@@ -128,18 +138,17 @@ int RunAnalyze(const AnalyzeArgs& args) {
   const std::string vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
   const std::string summary_path = output.Stage((out / "summary.json").string(), "--out");
 
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
-  ProgressBar bar("analyze " + rig.name, !args.quiet);
-  options.progress = [&bar](double f) { bar.Update(f); };
-  const Fields fields = EvaluateFields(scene, rig, *caster, options);
+  session.UpdateFields();
+  const Fields fields = session.TakeFields();
   bar.Finish();
+  const RayCaster& caster = study->caster();
 
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   // Plausibility warnings, after every input check (they are printed only when the run succeeds).
   RigCheckOptions check;
   check.visible_voxels = fields.stats.per_camera_seen;
-  const std::vector<Warning> warnings = CheckRig(scene, rig, *caster, check);
+  const std::vector<Warning> warnings = CheckRig(scene, rig, caster, check);
   nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, threads, warnings);
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{

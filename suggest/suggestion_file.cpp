@@ -420,28 +420,37 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     }
   }
 
+  const std::string backup =
+      ReplaceSceneFileWithBackup(result.scene_path, scene_text, new_text,
+                                 {{suggestion_path, "suggestion file"}});
+  result.backup_path = backup;
+  for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
+  return result;
+}
+
+std::string ReplaceSceneFileWithBackup(const std::string& scene_path, const std::string& old_text,
+                                       const std::string& new_text,
+                                       const std::vector<std::pair<std::string, std::string>>& inputs) {
   // The backup and the new scene file appear together (OutputTransaction), the backup with the
   // scene file's mode and owner, the scene file keeping its own. Through a symbolic link to the
   // file it names; a read-only scene file is refused.
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path target = fs::canonical(result.scene_path, ec);
-  if (ec) throw InputError(result.scene_path, "", "cannot resolve the scene file: " + ec.message());
+  const fs::path target = fs::canonical(scene_path, ec);
+  if (ec) throw InputError(scene_path, "", "cannot resolve the scene file: " + ec.message());
   const fs::perms perms = fs::status(target, ec).permissions();
   if (ec || (perms & fs::perms::owner_write) == fs::perms::none)
-    throw InputError(result.scene_path, "", "the scene file is read-only", "make it writable, then accept again");
+    throw InputError(scene_path, "", "the scene file is read-only", "make it writable, then accept again");
   const std::string path = target.string();
   std::string backup = path + ".bak";
   for (int n = 1; fs::exists(backup, ec); ++n) backup = path + ".bak." + std::to_string(n);
   OutputTransaction output;
-  output.AddInput(suggestion_path, "suggestion file");
+  for (const auto& [input, kind] : inputs) output.AddInput(input, kind);
   output.AddInput(path, "scene file");
-  output.Write(backup, "", scene_text, path);  // with the scene file's mode and owner
+  output.Write(backup, "", old_text, path);  // with the scene file's mode and owner
   WriteFileAtomically(output.StageReplacement(path, ""), new_text);
   output.Commit();
-  result.backup_path = backup;
-  for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
-  return result;
+  return backup;
 }
 
 }  // namespace pandora

@@ -73,4 +73,13 @@ struct AcceptResult {
 /// leaving every file as it was.
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options);
 
+/// Replaces the scene file `scene_path` (symbolic links followed) by `new_text`, keeping
+/// `old_text` as a backup (`SCENE.bak`, or `SCENE.bak.N` with the first free N, with the scene
+/// file's mode and owner); both appear together or neither does (OutputTransaction). `inputs` are
+/// other files of the command (path, kind) that no output may name. A read-only scene file is
+/// refused. Returns the backup's path. What `pandora accept` and a session's Save share.
+std::string ReplaceSceneFileWithBackup(const std::string& scene_path, const std::string& old_text,
+                                       const std::string& new_text,
+                                       const std::vector<std::pair<std::string, std::string>>& inputs = {});
+
 }  // namespace pandora

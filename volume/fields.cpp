@@ -826,6 +826,12 @@ FieldEvaluator& FieldEvaluator::operator=(FieldEvaluator&&) noexcept = default;
 
 const Fields& FieldEvaluator::fields() const { return state_->fields; }
 
+void FieldEvaluator::SetCallbacks(std::function<void(double)> progress,
+                                  const std::atomic<bool>* cancel) {
+  state_->options.progress = std::move(progress);
+  state_->options.cancel = cancel;
+}
+
 Fields FieldEvaluator::TakeFields() {
   State& S = *state_;
   Fields out = std::move(S.fields);

@@ -135,6 +135,9 @@ class FieldEvaluator {
   FieldUpdate Update(const Rig& rig);
 
   const Fields& fields() const;
+  /// Replaces FieldOptions::progress and FieldOptions::cancel for the next updates (a session's
+  /// background job passes its own).
+  void SetCallbacks(std::function<void(double)> progress, const std::atomic<bool>* cancel);
   /// Moves the fields out (the evaluator is then empty: the next Update evaluates in full).
   Fields TakeFields();
   /// Bytes held for incremental updates (masks, per-pair contributions, per-voxel caches).

@@ -1,0 +1,119 @@
+#include "app/session/editable_rig.h"
+
+#include <stdexcept>
+
+#include "analysis/error.h"
+
+namespace pandora::session {
+
+bool SameCameraGeometry(const Camera& a, const Camera& b) {
+  const Intrinsics& p = a.model.intrinsics();
+  const Intrinsics& q = b.model.intrinsics();
+  return a.enabled == b.enabled && a.world_from_camera.matrix() == b.world_from_camera.matrix() &&
+         a.near == b.near && a.far == b.far && a.pixel_sigma == b.pixel_sigma &&
+         p.width == q.width && p.height == q.height && p.fx == q.fx && p.fy == q.fy &&
+         p.cx == q.cx && p.cy == q.cy && p.model == q.model && p.k1 == q.k1 && p.k2 == q.k2 &&
+         p.p1 == q.p1 && p.p2 == q.p2 && p.k3 == q.k3 && p.k4 == q.k4;
+}
+
+namespace {
+
+bool SameCamera(const Camera& a, const Camera& b) {
+  return SameCameraGeometry(a, b) && a.id == b.id && a.name == b.name && a.color == b.color;
+}
+
+}  // namespace
+
+EditableRig::EditableRig(Rig rig)
+    : rig_(std::move(rig)), saved_(rig_), camera_versions_(rig_.cameras.size(), 0) {}
+
+void EditableRig::Set(const std::vector<CameraChange>& changes, bool forward) {
+  for (const CameraChange& c : changes) {
+    rig_.cameras.at(c.index) = forward ? c.after : c.before;
+    ++camera_versions_.at(c.index);
+  }
+  ++version_;
+}
+
+void EditableRig::Apply(Edit edit) {
+  for (const CameraChange& c : edit.changes) {
+    if (c.index < 0 || c.index >= static_cast<int>(rig_.cameras.size()))
+      throw std::logic_error("edit '" + edit.label + "': no camera " + std::to_string(c.index));
+    if (!SameCamera(rig_.cameras[c.index], c.before))
+      throw std::logic_error("edit '" + edit.label + "': camera " + rig_.cameras[c.index].id +
+                             " changed since the edit was made");
+  }
+  Set(edit.changes, true);
+  undo_.push_back(std::move(edit));
+  redo_.clear();
+}
+
+bool EditableRig::Undo() {
+  if (undo_.empty()) return false;
+  Set(undo_.back().changes, false);
+  redo_.push_back(std::move(undo_.back()));
+  undo_.pop_back();
+  return true;
+}
+
+bool EditableRig::Redo() {
+  if (redo_.empty()) return false;
+  Set(redo_.back().changes, true);
+  undo_.push_back(std::move(redo_.back()));
+  redo_.pop_back();
+  return true;
+}
+
+int EditableRig::Find(const std::string& id) const {
+  for (std::size_t c = 0; c < rig_.cameras.size(); ++c)
+    if (rig_.cameras[c].id == id) return static_cast<int>(c);
+  return -1;
+}
+
+void EditableRig::SetPose(int index, const Eigen::Isometry3d& world_from_camera) {
+  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  c.after.world_from_camera = world_from_camera;
+  Apply({"move " + c.before.id, {c}});
+}
+
+void EditableRig::SetEnabled(int index, bool enabled) {
+  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  c.after.enabled = enabled;
+  Apply({std::string(enabled ? "enable " : "disable ") + c.before.id, {c}});
+}
+
+void EditableRig::SetIntrinsics(int index, const Intrinsics& intrinsics) {
+  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  c.after.model = CameraModel(intrinsics);
+  Apply({"lens of " + c.before.id, {c}});
+}
+
+void EditableRig::SetPoses(const std::vector<Pose>& poses, const std::string& label,
+                           const std::string& file) {
+  Edit edit{label, {}};
+  for (const Pose& p : poses) {
+    const int index = Find(p.id);
+    if (index < 0)
+      throw InputError(file, "", "rig '" + rig_.name + "' has no camera '" + p.id + "'",
+                       "was the suggestion made for another rig or scene?");
+    CameraChange c{index, rig_.cameras[index], rig_.cameras[index]};
+    c.after.world_from_camera = p.pose;
+    if (p.focal_scale != 1.0) {
+      Intrinsics k = c.after.model.intrinsics();
+      k.fx *= p.focal_scale;
+      k.fy *= p.focal_scale;
+      c.after.model = CameraModel(k);
+    }
+    edit.changes.push_back(std::move(c));
+  }
+  Apply(std::move(edit));
+}
+
+std::vector<int> EditableRig::Unsaved() const {
+  std::vector<int> out;
+  for (std::size_t c = 0; c < rig_.cameras.size(); ++c)
+    if (!SameCamera(rig_.cameras[c], saved_.cameras[c])) out.push_back(static_cast<int>(c));
+  return out;
+}
+
+}  // namespace pandora::session

@@ -1,0 +1,108 @@
+#include "app/session/session.h"
+
+#include <algorithm>
+
+#include "analysis/error.h"
+#include "analysis/input_file.h"
+#include "analysis/sha256.h"
+#include "suggest/suggestion_file.h"
+
+namespace pandora::session {
+
+Session::Session(std::shared_ptr<const Study> study, SessionOptions options)
+    : study_(std::move(study)),
+      options_(std::move(options)),
+      rig_(study_->FindRig(options_.rig, options_.rig_option)),
+      saved_text_(study_->text()) {
+  evaluator_ = std::make_unique<FieldEvaluator>(study_->scene(), study_->caster(), options_.fields,
+                                                options_.incremental);
+}
+
+Session::~Session() = default;
+
+FieldUpdate Session::UpdateFields() {
+  std::lock_guard<std::mutex> lock(fields_mutex_);
+  evaluator_->SetCallbacks(options_.fields.progress, options_.fields.cancel);
+  const std::int64_t version = rig_.version();
+  const FieldUpdate u = evaluator_->Update(rig_.rig());
+  if (!u.cancelled) fields_version_ = version;
+  return u;
+}
+
+std::int64_t Session::UpdateFieldsInBackground() {
+  // The job evaluates a copy: the owner may edit on while it runs.
+  auto snapshot = std::make_shared<Rig>(rig_.rig());
+  const std::int64_t version = rig_.version();
+  return jobs_.Submit("fields", [this, snapshot, version](JobContext& job) {
+    std::lock_guard<std::mutex> lock(fields_mutex_);
+    if (job.cancelled()) return;
+    evaluator_->SetCallbacks([&job](double f) { job.Progress(f); }, &job.cancel_flag());
+    const FieldUpdate u = evaluator_->Update(*snapshot);
+    evaluator_->SetCallbacks(nullptr, nullptr);
+    if (!u.cancelled) fields_version_ = version;
+  });
+}
+
+void Session::ReadFields(const std::function<void(const Fields&, std::int64_t)>& fn) const {
+  std::lock_guard<std::mutex> lock(fields_mutex_);
+  fn(evaluator_->fields(), fields_version_);
+}
+
+Fields Session::TakeFields() {
+  std::lock_guard<std::mutex> lock(fields_mutex_);
+  fields_version_ = -1;
+  return evaluator_->TakeFields();
+}
+
+SaveResult Session::Save(bool force) {
+  const Scene& scene = study_->scene();
+  if (saved_text_.empty())
+    throw InputError(scene.path, "", "this study was not loaded from a file", "nothing to save to");
+  const Rig& now = rig_.rig();
+  const Rig& before = rig_.saved();
+  std::vector<PoseUpdate> poses;
+  std::string unsupported;
+  for (int c : rig_.Unsaved()) {
+    const Camera& a = before.cameras[c];
+    const Camera& b = now.cameras[c];
+    const Intrinsics& p = a.model.intrinsics();
+    const Intrinsics& q = b.model.intrinsics();
+    // What ReplacePoses writes: the pose and the focal lengths.
+    Camera other = a;
+    other.world_from_camera = b.world_from_camera;
+    Intrinsics k = p;
+    k.fx = q.fx;
+    k.fy = q.fy;
+    other.model = CameraModel(k);
+    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color) {
+      unsupported += (unsupported.empty() ? "" : ", ") + b.id;
+      continue;
+    }
+    PoseUpdate u;
+    u.id = b.id;
+    u.pose = b.world_from_camera;
+    if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
+    poses.push_back(std::move(u));
+  }
+  if (!unsupported.empty())
+    throw InputError(scene.path, "", "cameras " + unsupported +
+                                         " have changes other than pose and focal length, which "
+                                         "saving does not write yet",
+                     "undo those changes or edit the scene file by hand");
+  SaveResult result;
+  result.scene_path = scene.path;
+  if (poses.empty()) return result;
+  // The file must be the one the session knows, or the edits would overwrite someone's changes.
+  const std::string on_disk = ReadInputFile(scene.path, InputLimits::kJsonBytes, "scene file");
+  if (!force && Sha256Hex(on_disk) != Sha256Hex(saved_text_))
+    throw InputError(scene.path, "", "the scene file changed on disk since it was loaded",
+                     "reload it, or save with force to overwrite (a backup is kept)");
+  const std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);
+  result.backup_path = ReplaceSceneFileWithBackup(scene.path, on_disk, text);
+  for (const PoseUpdate& u : poses) result.saved.push_back(u.id);
+  saved_text_ = text;
+  rig_.MarkSaved();
+  return result;
+}
+
+}  // namespace pandora::session

@@ -1,0 +1,79 @@
+#pragma once
+/// \file session.h
+/// The session layer (docs/architecture.md): one open study, one rig being edited with undo, its
+/// fields kept up to date incrementally, and background jobs. The `pandora` commands run through
+/// it (synchronously) and the viewer will too (in the background, latest wins).
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "app/session/editable_rig.h"
+#include "app/session/jobs.h"
+#include "app/session/study.h"
+#include "volume/fields.h"
+
+namespace pandora::session {
+
+struct SessionOptions {
+  std::string rig;         ///< Rig to edit; empty: the first.
+  std::string rig_option;  ///< The option that named it ("--rig"), for errors.
+  FieldOptions fields;     ///< The fields to keep (names, budget, messages).
+  /// Keep the evaluator's per-pair state so that edits update incrementally (an interactive
+  /// session); false for one evaluation (a command), which then needs no more memory than
+  /// EvaluateFields.
+  bool incremental = true;
+};
+
+struct SaveResult {
+  std::string scene_path, backup_path;
+  std::vector<std::string> saved;  ///< Camera ids written.
+  std::vector<std::string> notes;  ///< As `pandora accept`'s (an `up` that changed, ...).
+};
+
+class Session {
+ public:
+  /// Throws InputError for an unknown rig or field list.
+  Session(std::shared_ptr<const Study> study, SessionOptions options);
+  ~Session();
+
+  const Study& study() const { return *study_; }
+  EditableRig& rig() { return rig_; }
+  const EditableRig& rig() const { return rig_; }
+  Jobs& jobs() { return jobs_; }
+
+  /// Brings the fields to the rig as it is now, on the calling thread (what a command does).
+  FieldUpdate UpdateFields();
+  /// The same as a background job of kind "fields" (latest wins: an edit while it runs cancels it
+  /// and the newest rig is evaluated next). Returns the job id.
+  std::int64_t UpdateFieldsInBackground();
+  JobStatus WaitFields() { return jobs_.Wait("fields"); }
+
+  /// Calls fn(fields, rig version they reflect) under the fields' lock (-1: none yet).
+  void ReadFields(const std::function<void(const Fields&, std::int64_t)>& fn) const;
+  /// Moves the fields out (a command that writes them); the next update evaluates in full.
+  Fields TakeFields();
+
+  /// Writes the edited cameras' poses and focal lengths into the scene file, keeping a backup, as
+  /// `pandora accept` does (each in its camera's own form). Refuses (InputError) when the file
+  /// changed on disk since it was loaded or last saved (unless `force`), when the study has no file
+  /// text, or when an edit is of a kind the scene file cannot take this way (enabled, lens model,
+  /// principal point, range, pixel noise): those are listed.
+  SaveResult Save(bool force = false);
+
+ private:
+  std::shared_ptr<const Study> study_;
+  SessionOptions options_;
+  EditableRig rig_;
+  std::string saved_text_;  // the scene file as loaded or last saved
+  mutable std::mutex fields_mutex_;
+  std::unique_ptr<FieldEvaluator> evaluator_;
+  std::int64_t fields_version_ = -1;
+  Jobs jobs_;  // last: destroyed (workers joined) first
+};
+
+}  // namespace pandora::session

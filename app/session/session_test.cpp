@@ -1,0 +1,223 @@
+// The session layer: edits with undo and redo restore cameras exactly; jobs run latest-wins with
+// cancellation and failures reported; a session's fields follow its edits (in the background too)
+// and equal a full evaluation of the rig as edited; saving writes the poses with a backup and
+// refuses what it cannot write or a file changed on disk.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "analysis/error.h"
+#include "app/session/session.h"
+#include "volume/fields.h"
+
+namespace pandora::session {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A copy of tests/data/minimal.json in a fresh folder (sessions save into it).
+fs::path CopyScene(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("session_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file("tests/data/minimal.json", dir / "scene.json");
+  return dir / "scene.json";
+}
+
+Eigen::Isometry3d Moved(const Camera& cam, const Vec3& by) {
+  Eigen::Isometry3d p = cam.world_from_camera;
+  p.translation() += by;
+  return p;
+}
+
+bool SameRig(const Rig& a, const Rig& b) {
+  if (a.cameras.size() != b.cameras.size()) return false;
+  for (std::size_t c = 0; c < a.cameras.size(); ++c)
+    if (!SameCameraGeometry(a.cameras[c], b.cameras[c])) return false;
+  return true;
+}
+
+TEST(EditableRig, UndoAndRedoRestoreEveryCameraExactly) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  EditableRig rig(study->FindRig(""));
+  const Rig original = rig.rig();
+  ASSERT_GE(original.cameras.size(), 2u);
+  rig.SetPose(0, Moved(original.cameras[0], Vec3(0.1, 0, 0)));
+  const Rig after_move = rig.rig();
+  rig.SetEnabled(1, false);
+  Intrinsics k = rig.rig().cameras[1].model.intrinsics();
+  k.fx *= 1.5;
+  k.fy *= 1.5;
+  rig.SetIntrinsics(1, k);
+  EXPECT_EQ(rig.version(), 3);
+  EXPECT_EQ(rig.camera_version(0), 1);
+  EXPECT_EQ(rig.camera_version(1), 2);
+  EXPECT_EQ(rig.undo_label(), "lens of " + original.cameras[1].id);
+  EXPECT_EQ(rig.Unsaved(), (std::vector<int>{0, 1}));
+  ASSERT_TRUE(rig.Undo());
+  ASSERT_TRUE(rig.Undo());
+  EXPECT_TRUE(SameRig(rig.rig(), after_move));
+  ASSERT_TRUE(rig.Undo());
+  EXPECT_TRUE(SameRig(rig.rig(), original));
+  EXPECT_FALSE(rig.Undo());
+  EXPECT_TRUE(rig.Unsaved().empty());
+  ASSERT_TRUE(rig.Redo());
+  EXPECT_TRUE(SameRig(rig.rig(), after_move));
+  // A new edit drops the redo stack.
+  rig.SetEnabled(0, false);
+  EXPECT_FALSE(rig.can_redo());
+  EXPECT_FALSE(rig.Redo());
+  // An edit made against an older state is refused.
+  CameraChange stale{0, original.cameras[0], original.cameras[0]};
+  EXPECT_THROW(rig.Apply({"stale", {stale}}), std::logic_error);
+  // Several cameras at once are one undo step.
+  rig.SetPoses({{original.cameras[0].id, original.cameras[0].world_from_camera, 1.0},
+                {original.cameras[1].id, Moved(original.cameras[1], Vec3(0, 0.2, 0)), 1.25}},
+               "accept suggestion", "s.json");
+  EXPECT_DOUBLE_EQ(rig.rig().cameras[1].model.intrinsics().fx,
+                   after_move.cameras[1].model.intrinsics().fx * 1.25);
+  ASSERT_TRUE(rig.Undo());
+  EXPECT_FALSE(rig.rig().cameras[0].enabled);  // back to before the suggestion, not further
+  EXPECT_THROW(rig.SetPoses({{"nope", Eigen::Isometry3d::Identity(), 1.0}}, "x", "s.json"),
+               InputError);
+}
+
+TEST(Jobs, LatestWinsAndFailuresAreReported) {
+  Jobs jobs;
+  std::atomic<int> started{0}, finished{0};
+  std::atomic<bool> first_saw_cancel{false};
+  // The first job runs until it is cancelled.
+  jobs.Submit("fields", [&](JobContext& job) {
+    ++started;
+    while (!job.cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    first_saw_cancel = true;
+  });
+  while (started == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // Two more while it runs: the second is replaced by the third before it starts.
+  jobs.Submit("fields", [&](JobContext&) { ++started; ++finished; });
+  const std::int64_t last = jobs.Submit("fields", [&](JobContext& job) {
+    job.Progress(0.5);
+    ++started;
+    ++finished;
+  });
+  const JobStatus s = jobs.Wait("fields");
+  EXPECT_TRUE(first_saw_cancel);
+  EXPECT_EQ(started, 2);  // the first and the last
+  EXPECT_EQ(finished, 1);
+  EXPECT_EQ(s.state, JobState::kDone);
+  EXPECT_EQ(s.id, last);
+  // A failure ends the job with its message; the worker lives on.
+  jobs.Submit("render", [](JobContext&) { throw InputError("x.json", "$.a", "broken"); });
+  const JobStatus f = jobs.Wait("render");
+  EXPECT_EQ(f.state, JobState::kFailed);
+  EXPECT_NE(f.error.find("broken"), std::string::npos);
+  jobs.Submit("render", [](JobContext&) {});
+  EXPECT_EQ(jobs.Wait("render").state, JobState::kDone);
+  EXPECT_EQ(jobs.Status("suggest").state, JobState::kIdle);
+}
+
+void ExpectFieldsOf(const Session& session, const Rig& rig, const FieldOptions& options) {
+  const Fields full =
+      EvaluateFields(session.study().scene(), rig, session.study().caster(), options);
+  session.ReadFields([&](const Fields& f, std::int64_t) {
+    EXPECT_EQ(f.stats.coverage_histogram, full.stats.coverage_histogram);
+    EXPECT_EQ(f.stats.per_camera_seen, full.stats.per_camera_seen);
+    EXPECT_EQ(f.stats.sigma_max_mm, full.stats.sigma_max_mm);
+  });
+}
+
+TEST(Session, FieldsFollowEditsUndoAndBackgroundUpdates) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  SessionOptions options;
+  options.fields.fields = {"coverage", "cameras", "resolution", "sigma_max"};
+  Session session(study, options);
+  const Rig original = session.rig().rig();
+  EXPECT_TRUE(session.UpdateFields().full);
+  ExpectFieldsOf(session, original, options.fields);
+
+  session.rig().SetPose(0, Moved(original.cameras[0], Vec3(0.05, 0.02, 0)));
+  const FieldUpdate u = session.UpdateFields();
+  EXPECT_FALSE(u.full);
+  EXPECT_EQ(u.changed_cameras, 1);
+  ExpectFieldsOf(session, session.rig().rig(), options.fields);
+
+  // In the background, several edits in a row: the fields end at the last state.
+  for (int i = 0; i < 5; ++i) {
+    session.rig().SetPose(0, Moved(session.rig().rig().cameras[0], Vec3(0.01, 0, 0)));
+    session.UpdateFieldsInBackground();
+  }
+  EXPECT_EQ(session.WaitFields().state, JobState::kDone);
+  std::int64_t version = -2;
+  session.ReadFields([&](const Fields&, std::int64_t v) { version = v; });
+  EXPECT_EQ(version, session.rig().version());
+  ExpectFieldsOf(session, session.rig().rig(), options.fields);
+
+  while (session.rig().Undo()) {
+  }
+  session.UpdateFields();
+  ExpectFieldsOf(session, original, options.fields);
+}
+
+TEST(Session, UnknownRigNamesTheOption) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  SessionOptions options;
+  options.rig = "nope";
+  options.rig_option = "--rig";
+  try {
+    Session session(study, options);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "--rig");
+  }
+}
+
+TEST(Session, SaveWritesPosesWithABackupAndRefusesWhatItCannotWrite) {
+  const fs::path path = CopyScene("save");
+  const std::string original_text = Read(path);
+  const auto study = Study::Load(path.string());
+  SessionOptions options;
+  Session session(study, options);
+  const Rig original = session.rig().rig();
+  EXPECT_TRUE(session.Save().saved.empty());  // nothing edited: nothing written
+  EXPECT_FALSE(fs::exists(path.string() + ".bak"));
+
+  const Eigen::Isometry3d pose = Moved(original.cameras[0], Vec3(0.25, -0.5, 0.125));
+  session.rig().SetPose(0, pose);
+  const SaveResult r = session.Save();
+  EXPECT_EQ(r.saved, std::vector<std::string>{original.cameras[0].id});
+  EXPECT_EQ(Read(r.backup_path), original_text);
+  const Scene saved = LoadScene(path.string());
+  EXPECT_LT((saved.rigs[0].cameras[0].center() - pose.translation()).norm(), 1e-9);
+  EXPECT_TRUE(session.rig().Unsaved().empty());
+
+  // A change saving cannot write is refused, the file untouched.
+  session.rig().SetEnabled(1, false);
+  const std::string text = Read(path);
+  EXPECT_THROW(session.Save(), InputError);
+  EXPECT_EQ(Read(path), text);
+  session.rig().Undo();
+
+  // Someone else changed the file: refused unless forced.
+  Eigen::Isometry3d higher = pose;
+  higher.translation() += Vec3(0, 0, 0.1);
+  session.rig().SetPose(0, higher);
+  { std::ofstream(path, std::ios::app) << "\n"; }
+  EXPECT_THROW(session.Save(), InputError);
+  const SaveResult forced = session.Save(true);
+  EXPECT_EQ(forced.saved.size(), 1u);
+  EXPECT_EQ(fs::path(forced.backup_path).filename(), "scene.json.bak.1");
+}
+
+}  // namespace
+}  // namespace pandora::session

@@ -1,0 +1,43 @@
+#include "app/session/study.h"
+
+#include "analysis/error.h"
+#include "analysis/input_file.h"
+#include "analysis/sha256.h"
+
+namespace pandora::session {
+
+std::shared_ptr<const Study> Study::Load(const std::string& path,
+                                         const std::function<void(Scene&)>& adjust) {
+  auto study = std::shared_ptr<Study>(new Study());
+  study->scene_ = LoadScene(path);
+  study->text_ = ReadInputFile(path, InputLimits::kJsonBytes, "scene file");
+  if (Sha256Hex(study->text_) != study->scene_.sha256)
+    throw InputError(path, "", "the scene file changed while it was being read",
+                     "wait until whatever writes it is done, then open it again");
+  if (adjust) adjust(study->scene_);
+  study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
+  return study;
+}
+
+std::shared_ptr<const Study> Study::FromScene(Scene scene, std::string text) {
+  auto study = std::shared_ptr<Study>(new Study());
+  study->scene_ = std::move(scene);
+  study->text_ = std::move(text);
+  study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
+  return study;
+}
+
+const Rig& Study::FindRig(const std::string& name, const std::string& option) const {
+  if (scene_.rigs.empty()) throw InputError(scene_.path, "$.rigs", "the scene has no rig");
+  if (name.empty()) return scene_.rigs.front();
+  for (const Rig& rig : scene_.rigs)
+    if (rig.name == name) return rig;
+  std::string names;
+  for (const Rig& rig : scene_.rigs) names += (names.empty() ? "'" : ", '") + rig.name + "'";
+  if (!option.empty())
+    throw InputError(option, "", "no rig named '" + name + "' in " + scene_.path,
+                     "rigs in this scene: " + names);
+  throw InputError(scene_.path, "$.rigs", "no rig named '" + name + "'", "rigs in this scene: " + names);
+}
+
+}  // namespace pandora::session

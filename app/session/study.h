@@ -1,0 +1,45 @@
+#pragma once
+/// \file study.h
+/// A loaded study: the scene file (parsed and as text), and the ray caster built once over its
+/// triangles, shared by fields, suggest and render for as long as the study is open (the session
+/// layer, docs/architecture.md). Immutable after loading, so safe to share between threads.
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+
+namespace pandora::session {
+
+class Study {
+ public:
+  /// Loads and validates the scene file (LoadScene: InputError naming the file and JSON path on any
+  /// problem), keeps its text, and builds the ray caster. Throws InputError if the file changes
+  /// while it is being read.
+  /// `adjust` (may be empty) changes the scene before the caster is built: a command's overrides
+  /// of the study (--voxel-size), checked by the caller.
+  static std::shared_ptr<const Study> Load(const std::string& path,
+                                           const std::function<void(Scene&)>& adjust = {});
+  /// A study over a scene built in memory (tests, generated scenes); `text` may be empty (then it
+  /// cannot be saved).
+  static std::shared_ptr<const Study> FromScene(Scene scene, std::string text = {});
+
+  const Scene& scene() const { return scene_; }
+  /// The scene file's bytes as loaded (their SHA-256 is scene().sha256).
+  const std::string& text() const { return text_; }
+  const RayCaster& caster() const { return *caster_; }
+
+  /// The rig named `name`, or the first rig when `name` is empty. An unknown name throws
+  /// InputError blaming `option` (e.g. "--rig") when given, else the scene's "$.rigs".
+  const Rig& FindRig(const std::string& name, const std::string& option = {}) const;
+
+ private:
+  Study() = default;
+  Scene scene_;
+  std::string text_;
+  std::unique_ptr<RayCaster> caster_;
+};
+
+}  // namespace pandora::session
