@@ -523,27 +523,39 @@ FrameRenderer::~FrameRenderer() = default;
 int FrameRenderer::GroupPixels(int tile, int level) const {
   const int x0 = (tile % tiles_x_) * kTile, y0 = (tile / tiles_x_) * kTile;
   const int x1 = std::min(width_, x0 + kTile), y1 = std::min(height_, y0 + kTile);
-  int n = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) n += PixelLevel(x, y) == level;
-  return n;
+  // Pixels of the tile whose x and y are multiples of b, for b = 8 >> level.
+  auto lattice = [&](int b) {
+    return ((x1 + b - 1) / b - (x0 + b - 1) / b) * ((y1 + b - 1) / b - (y0 + b - 1) / b);
+  };
+  const int finer = level == kLevels - 1 ? (x1 - x0) * (y1 - y0) : lattice(4 >> level);
+  return level == 0 ? lattice(8) : finer - lattice(8 >> level);
 }
 
 FrameBuffers FrameRenderer::Allocate() const {
   FrameBuffers b;
-  Image& image = b.image;
+  Reset(&b);
+  return b;
+}
+
+void FrameRenderer::Reset(FrameBuffers* b) const {
+  Image& image = b->image;
   image.width = width_;
   image.height = height_;
   const std::size_t pixels = std::size_t(width_) * height_;
+  // Every group writes every value of its pixels, so buffers of the right size need no clearing.
+  const bool same = image.rgb.size() == 3 * pixels && image.cameras.size() == (impl_->mask ? pixels : 0) &&
+                    b->normal.size() == (impl_->options.surface == Surface::kContours ? pixels : 0);
+  if (same) return;
   image.rgb.assign(3 * pixels, 0.0f);
   image.coverage.assign(pixels, 0.0f);
   if (impl_->mask) image.cameras.assign(pixels, 0);
+  else image.cameras.clear();
   image.resolution.assign(pixels, 0.0f);
   image.sigma_max.assign(pixels, std::numeric_limits<float>::infinity());
   image.depth.assign(pixels, std::numeric_limits<float>::infinity());
   image.object.assign(pixels, -1);
-  if (impl_->options.surface == Surface::kContours) b.normal.assign(pixels, Vec3::Zero());
-  return b;
+  if (impl_->options.surface == Surface::kContours) b->normal.assign(pixels, Vec3::Zero());
+  else b->normal.clear();
 }
 
 void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch,
@@ -788,18 +800,20 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       for (int k = 0; k < 3; ++k) color_sum[3 * smp.pixel + k] += float(smp.weight * color[k]);
       colored[smp.pixel] = 1;
     }
-    if (smp.layers && smp.hit) {
-      image.depth[p] = float(smp.t);
-      image.object[p] = scene.triangle_object[smp.triangle];
+    if (smp.layers) {  // every layer of the pixel, also where nothing is hit
+      image.depth[p] = smp.hit ? float(smp.t) : std::numeric_limits<float>::infinity();
+      image.object[p] = smp.hit ? scene.triangle_object[smp.triangle] : -1;
       if (m.mask) image.cameras[p] = smp.mask;
       image.coverage[p] = float(smp.seen);
-      if (options.layers) image.resolution[p] = float(resolution[smp.slot]);
+      image.resolution[p] = options.layers ? float(resolution[smp.slot]) : 0.0f;
+      float sigma = std::numeric_limits<float>::infinity();
       if (options.layers && info[smp.slot].cameras() >= 2) {
         const InformationBuilder& b = info[smp.slot];
         const StaticUncertainty u = StaticFromInformation(b.Decompose(), b.cameras());
-        if (u.triangulable) image.sigma_max[p] = float(1e3 * u.sigma_max);
+        if (u.triangulable) sigma = float(1e3 * u.sigma_max);
       }
-      if (!out->normal.empty()) out->normal[p] = smp.n;
+      image.sigma_max[p] = sigma;
+      if (!out->normal.empty()) out->normal[p] = smp.hit ? smp.n : Vec3::Zero();
     }
   }
   for (int i = 0; i < tw * th; ++i) {

@@ -107,6 +107,8 @@ class FrameRenderer {
 
   /// The buffers at their initial values (black, no hit, +inf depth and sigma).
   FrameBuffers Allocate() const;
+  /// The same into existing buffers (their memory is reused when the size is unchanged).
+  void Reset(FrameBuffers* buffers) const;
   /// Traces group (tile, level) into `out`: the layers of its centre pixels and their colour (at
   /// levels 0-2 with several samples per pixel: the centre sample's colour, replaced at level 3 by
   /// the stratified average). `record` (may be null) receives the counts and, when record_rays,

@@ -11,14 +11,13 @@
 namespace pandora::internal {
 namespace {
 
-// Antialiased 3D line segments with hidden parts dimmed, into an overlay (alpha, colour) buffer that
-// keeps the strongest line per pixel.
+// Antialiased 3D line segments with hidden parts dimmed, composited so that each pixel shows the
+// strongest line over it (the first drawn among equals). The lines touch few pixels, so they are
+// kept as a list of (pixel, coverage, colour) rather than image-sized buffers.
 class LineOverlay {
  public:
   LineOverlay(const Camera& view, const Image& image)
-      : view_(view), cfw_(view.camera_from_world()), image_(image),
-        alpha_(std::size_t(image.width) * image.height, 0.0f),
-        color_(std::size_t(image.width) * image.height, 0) {}
+      : view_(view), cfw_(view.camera_from_world()), image_(image) {}
 
   // Segments drawn after this call use `color` (up to 65535 colours per overlay).
   std::size_t colors() const { return palette_.size(); }
@@ -83,21 +82,28 @@ class LineOverlay {
         const double depth = (a + s * (b - a)).norm();
         const std::size_t p = std::size_t(y) * W + x;
         if (depth > image_.depth[p] * (1.0 + 1e-3)) cover *= 0.3;  // hidden behind the surface: dimmed
-        if (cover > alpha_[p]) {
-          alpha_[p] = float(cover);
-          color_[p] = current_;
-        }
+        touches_.push_back({p, cover, current_});
       }
     }
   }
 
-  void CompositeInto(Image* image) const {
-    for (std::size_t p = 0; p < alpha_.size(); ++p) {
-      const double a = alpha_[p];
+  void CompositeInto(Image* image) {
+    // Per pixel, in drawing order: a touch replaces the pixel's line when it covers more.
+    std::stable_sort(touches_.begin(), touches_.end(),
+                     [](const Touch& a, const Touch& b) { return a.pixel < b.pixel; });
+    for (std::size_t i = 0; i < touches_.size();) {
+      const std::size_t p = touches_[i].pixel;
+      float alpha = 0.0f;
+      uint16_t color = 0;
+      for (; i < touches_.size() && touches_[i].pixel == p; ++i)
+        if (touches_[i].cover > alpha) {
+          alpha = float(touches_[i].cover);
+          color = touches_[i].color;
+        }
+      const double a = alpha;
       if (a <= 0) continue;
       for (int k = 0; k < 3; ++k)
-        image->rgb[3 * p + k] =
-            float((1.0 - a) * image->rgb[3 * p + k] + a * palette_[color_[p]][k]);
+        image->rgb[3 * p + k] = float((1.0 - a) * image->rgb[3 * p + k] + a * palette_[color][k]);
     }
   }
 
@@ -105,8 +111,12 @@ class LineOverlay {
   const Camera& view_;
   Eigen::Isometry3d cfw_;
   const Image& image_;
-  std::vector<float> alpha_;
-  std::vector<uint16_t> color_;
+  struct Touch {
+    std::size_t pixel;
+    double cover;
+    uint16_t color;
+  };
+  std::vector<Touch> touches_;
   std::vector<Vec3> palette_;
   uint16_t current_ = 0;
 };

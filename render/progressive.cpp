@@ -16,42 +16,62 @@
 namespace pandora {
 
 struct ProgressiveRender::State {
-  State(const PreparedScene& scene, const Rig& r, const RenderView& view, const RenderOptions& options,
-        const PreparedOverlays* overlays)
-      : rig(r), frame(scene, rig, view, options, overlays) {
-    base = frame.Allocate();
-    done.assign(std::size_t(frame.tiles()) * internal::kLevels, 0);
-    total = std::int64_t(frame.width()) * frame.height();
+  explicit State(const PreparedScene& scene) : scene(scene) {}
+
+  // A new frame; the buffers keep their memory when the size is unchanged. Throws before changing
+  // anything.
+  void Start(const Rig& new_rig, const RenderView& view, const RenderOptions& options,
+             const PreparedOverlays* overlays) {
+    auto r = std::make_unique<const Rig>(new_rig);
+    auto f = std::make_unique<const internal::FrameRenderer>(scene, *r, view, options, overlays);
+    frame = std::move(f);  // before the rig it refers to is replaced
+    rig = std::move(r);
+    frame->Reset(&base);
+    done.assign(std::size_t(frame->tiles()) * internal::kLevels, 0);
+    passes = 0;
+    traced = 0;
+    total = std::int64_t(frame->width()) * frame->height();
+    reported = 0;
+    shown.image.width = shown.image.height = 0;  // no pass yet (the buffers stay allocated)
   }
 
-  const Rig rig;  // before `frame`, which refers to it
-  const internal::FrameRenderer frame;
-  internal::FrameBuffers base;  // the traced pixels
-  std::vector<uint8_t> done;    // per (level, tile): traced
+  const PreparedScene& scene;
+  std::unique_ptr<const Rig> rig;
+  std::unique_ptr<const internal::FrameRenderer> frame;  // refers to *rig
+  internal::FrameBuffers base;   // the traced pixels
+  std::vector<uint8_t> done;     // per (level, tile): traced
   int passes = 0;
-  Image image;
+  internal::FrameBuffers shown;  // the image of the last completed pass
   std::int64_t traced = 0, total = 1;
   double reported = 0;  // last fraction reported (non-decreasing over the frame)
 };
 
 ProgressiveRender::ProgressiveRender(const PreparedScene& scene, const Rig& rig, const RenderView& view,
                                      const RenderOptions& options, const PreparedOverlays* overlays)
-    : state_(std::make_unique<State>(scene, rig, view, options, overlays)) {}
+    : state_(std::make_unique<State>(scene)) {
+  state_->Start(rig, view, options, overlays);
+}
+
+void ProgressiveRender::Restart(const Rig& rig, const RenderView& view, const RenderOptions& options,
+                                const PreparedOverlays* overlays) {
+  state_->Start(rig, view, options, overlays);
+}
 ProgressiveRender::~ProgressiveRender() = default;
 ProgressiveRender::ProgressiveRender(ProgressiveRender&&) noexcept = default;
 ProgressiveRender& ProgressiveRender::operator=(ProgressiveRender&&) noexcept = default;
 
 int ProgressiveRender::passes_done() const { return state_->passes; }
-const Image& ProgressiveRender::image() const { return state_->image; }
+const Image& ProgressiveRender::image() const { return state_->shown.image; }
 
 namespace {
 
 // The buffers at full size after the pass of block edge b: pixel (x, y) takes the traced pixel
 // nearest to it, (round(x / b) * b, round(y / b) * b), clamped to the last traced row and column.
-internal::FrameBuffers Upsample(const internal::FrameBuffers& in, int b) {
+// Into `out`, whose buffers are reused from pass to pass.
+void Upsample(const internal::FrameBuffers& in, int b, internal::FrameBuffers* out_buffers) {
   const Image& src = in.image;
   const int W = src.width, H = src.height;
-  internal::FrameBuffers out;
+  internal::FrameBuffers& out = *out_buffers;
   Image& dst = out.image;
   dst.width = W;
   dst.height = H;
@@ -65,22 +85,24 @@ internal::FrameBuffers Upsample(const internal::FrameBuffers& in, int b) {
   dst.object.resize(pixels);
   out.normal.resize(in.normal.size());
   const int last_x = ((W - 1) / b) * b, last_y = ((H - 1) / b) * b;
+  std::vector<int> source_x(W);
+  for (int x = 0; x < W; ++x) source_x[x] = std::min(((x + b / 2) / b) * b, last_x);
+  const bool cameras = !src.cameras.empty(), normals = !in.normal.empty();
   tbb::parallel_for(0, H, [&](int y) {
     const int sy = std::min(((y + b / 2) / b) * b, last_y);
+    const std::size_t row = std::size_t(y) * W, source_row = std::size_t(sy) * W;
     for (int x = 0; x < W; ++x) {
-      const int sx = std::min(((x + b / 2) / b) * b, last_x);
-      const std::size_t p = std::size_t(y) * W + x, q = std::size_t(sy) * W + sx;
+      const std::size_t p = row + x, q = source_row + source_x[x];
       for (int k = 0; k < 3; ++k) dst.rgb[3 * p + k] = src.rgb[3 * q + k];
       dst.coverage[p] = src.coverage[q];
-      if (!src.cameras.empty()) dst.cameras[p] = src.cameras[q];
+      if (cameras) dst.cameras[p] = src.cameras[q];
       dst.resolution[p] = src.resolution[q];
       dst.sigma_max[p] = src.sigma_max[q];
       dst.depth[p] = src.depth[q];
       dst.object[p] = src.object[q];
-      if (!in.normal.empty()) out.normal[p] = in.normal[q];
+      if (normals) out.normal[p] = in.normal[q];
     }
   });
-  return out;
 }
 
 }  // namespace
@@ -89,7 +111,8 @@ bool ProgressiveRender::RunPass(const RenderControl& control) {
   State& s = *state_;
   if (s.passes == kPasses) return true;
   const int level = s.passes;
-  const int tiles = s.frame.tiles();
+  const internal::FrameRenderer& frame = *s.frame;
+  const int tiles = frame.tiles();
   uint8_t* done = s.done.data() + std::size_t(level) * tiles;
   std::atomic<std::int64_t> traced{s.traced};
   std::atomic<bool> stopped{false};
@@ -119,9 +142,9 @@ bool ProgressiveRender::RunPass(const RenderControl& control) {
         stopped = true;
         return;
       }
-      s.frame.RenderGroup(tile, level, &s.base, scratch.get(), nullptr, false);
+      frame.RenderGroup(tile, level, &s.base, scratch.get(), nullptr, false);
       done[tile] = 1;
-      traced += s.frame.GroupPixels(tile, level);
+      traced += frame.GroupPixels(tile, level);
       report(false);
     }
   });
@@ -129,15 +152,13 @@ bool ProgressiveRender::RunPass(const RenderControl& control) {
   if (stopped.load() && !std::all_of(done, done + tiles, [](uint8_t d) { return d != 0; })) return false;
   ++s.passes;
   if (s.passes == kPasses) {
-    // Every pixel traced: the buffers are Render's before its image-space passes.
-    internal::FrameBuffers out = std::move(s.base);
-    s.frame.Finish(&out);
-    s.image = std::move(out.image);
+    // Every pixel traced: the buffers are Render's before its image-space passes. (The swap keeps
+    // the preview's memory in `base` for Restart.)
+    std::swap(s.shown, s.base);
   } else {
-    internal::FrameBuffers out = Upsample(s.base, BlockSize(level));
-    s.frame.Finish(&out);
-    s.image = std::move(out.image);
+    Upsample(s.base, BlockSize(level), &s.shown);
   }
+  frame.Finish(&s.shown);
   report(true);
   return true;
 }

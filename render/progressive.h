@@ -47,6 +47,14 @@ class ProgressiveRender {
   ProgressiveRender(ProgressiveRender&&) noexcept;
   ProgressiveRender& operator=(ProgressiveRender&&) noexcept;
 
+  /// Starts a new frame of the same prepared scene with another rig, view, options or overlays
+  /// (a camera moved, the eye moved, ...), as a new ProgressiveRender would, but keeping the
+  /// image buffers when the size is unchanged, so the first pass of the next frame does not wait
+  /// for fresh memory. What a viewer calls after each edit once the running pass was cancelled.
+  /// Throws as the constructor does, and then leaves the current frame as it was.
+  void Restart(const Rig& rig, const RenderView& view, const RenderOptions& options,
+               const PreparedOverlays* overlays = nullptr);
+
   /// Runs the next pass and updates image(). Returns true when the pass completed (or all passes
   /// were already done), false when control.cancel stopped it: image() then still shows the last
   /// completed pass, and the next call resumes the pass, tracing only the tiles still missing.
@@ -59,8 +67,8 @@ class ProgressiveRender {
   /// Passes completed, 0 .. kPasses.
   int passes_done() const;
   bool done() const { return passes_done() == kPasses; }
-  /// The latest completed pass at full size with overlays, key and contours (size 0 before the
-  /// first pass). After the last pass: equal to Render's image bit for bit, every layer included.
+  /// The latest completed pass at full size with overlays, key and contours (width and height 0
+  /// before the first pass). After the last pass: equal to Render's image bit for bit, every layer included.
   const Image& image() const;
 
  private:
