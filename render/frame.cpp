@@ -527,8 +527,8 @@ int FrameRenderer::GroupPixels(int tile, int level) const {
   auto lattice = [&](int b) {
     return ((x1 + b - 1) / b - (x0 + b - 1) / b) * ((y1 + b - 1) / b - (y0 + b - 1) / b);
   };
-  const int finer = level == kLevels - 1 ? (x1 - x0) * (y1 - y0) : lattice(4 >> level);
-  return level == 0 ? lattice(8) : finer - lattice(8 >> level);
+  // Level l holds the pixels of lattice 8 >> l that are not on the coarser lattice 16 >> l.
+  return lattice(8 >> level) - (level == 0 ? 0 : lattice(16 >> level));
 }
 
 FrameBuffers FrameRenderer::Allocate() const {
@@ -898,32 +898,50 @@ void FrameRenderer::Finish(FrameBuffers* frame) const {
 
 }  // namespace internal
 
-std::optional<PixelPick> PickPixel(const PreparedScene& prepared, const Rig& rig, const RenderView& view,
-                                   int x, int y) {
+struct PixelPicker::Impl {
+  Impl(const internal::PreparedSceneData& scene, const Rig& rig, const RenderView& view)
+      : scene(scene), rig(rig), width(view.width), height(view.height),
+        rays(view, rig, /*table=*/false), tester(rig.cameras, *scene.caster, scene.scene_scale) {}
+  const internal::PreparedSceneData& scene;
+  const Rig& rig;
+  int width, height;
+  const internal::ViewRays rays;
+  const VisibilityTester tester;
+};
+
+PixelPicker::PixelPicker(const PreparedScene& scene, const Rig& rig, const RenderView& view) {
   internal::CheckView(view, rig);
-  if (x < 0 || y < 0 || x >= view.width || y >= view.height)
-    throw std::out_of_range("PickPixel: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
-                            ") outside the " + std::to_string(view.width) + " x " +
-                            std::to_string(view.height) + " image");
-  const internal::PreparedSceneData& scene = prepared.data();
-  const internal::ViewRays rays(view, rig, /*table=*/false);
+  impl_ = std::make_unique<Impl>(scene.data(), rig, view);
+}
+PixelPicker::~PixelPicker() = default;
+
+std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
+  const Impl& m = *impl_;
+  if (x < 0 || y < 0 || x >= m.width || y >= m.height)
+    throw std::out_of_range("PixelPicker: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") outside the " + std::to_string(m.width) + " x " +
+                            std::to_string(m.height) + " image");
   internal::Sample smp;
-  if (!rays.Center(x, y, &smp.d, nullptr, nullptr)) return std::nullopt;
-  const auto hit = scene.caster->Intersect(Ray{rays.eye(), smp.d, 0.0, internal::kInf});
+  if (!m.rays.Center(x, y, &smp.d, nullptr, nullptr)) return std::nullopt;
+  const auto hit = m.scene.caster->Intersect(Ray{m.rays.eye(), smp.d, 0.0, internal::kInf});
   if (!hit) return std::nullopt;
-  internal::SetHit(rays.eye(), *hit, &smp);
-  const VisibilityTester tester(rig.cameras, *scene.caster, scene.scene_scale);
-  const double lift = 0.1 * tester.epsilon();
+  internal::SetHit(m.rays.eye(), *hit, &smp);
+  const double lift = 0.1 * m.tester.epsilon();  // as FrameRenderer
   PixelPick pick;
   pick.point = smp.X;
   pick.normal = smp.n;
   pick.lit_point = smp.X + lift * smp.n;
   pick.depth = smp.t;
   pick.triangle = smp.triangle;
-  pick.object = scene.triangle_object[smp.triangle];
-  for (int c = 0; c < int(rig.cameras.size()); ++c)
-    if (tester.Test(c, pick.lit_point, &pick.normal) == ViewResult::kSeen) pick.cameras.push_back(c);
+  pick.object = m.scene.triangle_object[smp.triangle];
+  for (int c = 0; c < int(m.rig.cameras.size()); ++c)
+    if (m.tester.Test(c, pick.lit_point, &pick.normal) == ViewResult::kSeen) pick.cameras.push_back(c);
   return pick;
+}
+
+std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
+                                   int x, int y) {
+  return PixelPicker(scene, rig, view).Pick(x, y);
 }
 
 }  // namespace pandora

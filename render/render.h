@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -198,11 +199,27 @@ struct PixelPick {
   /// normal): the per-pixel camera set for rigs of any size; its size is the `coverage` layer.
   std::vector<int> cameras;
 };
-/// The pixel's centre ray is the one Render traces; it is cast alone here (Intersect), so with
-/// Embree a ray through a shared triangle edge may, rarely, resolve to the other triangle than in
-/// the image's packet. nullopt when the ray hits nothing or lies outside the lens's domain
-/// (camera's-eye view). Throws as Render does for a bad view, std::out_of_range for a pixel
-/// outside the image.
+/// Answers "what does output pixel (x, y) show, and which cameras light it" for one frame's rig and
+/// view (a viewer's hover or click; the per-pixel camera set of rigs over 64 cameras). The pixel's
+/// centre ray is the one Render traces, and the point and camera tests are the renderer's; the ray
+/// is cast alone here (RayCaster::Intersect), so with Embree a ray through a shared triangle edge
+/// may, rarely, resolve to the neighbouring triangle of the image's. Keeps references to `scene`
+/// and `rig`, which must outlive it. Immutable; Pick is safe to call from many threads.
+class PixelPicker {
+ public:
+  /// Throws as Render does for a bad view.
+  PixelPicker(const PreparedScene& scene, const Rig& rig, const RenderView& view);
+  ~PixelPicker();
+  /// nullopt when the centre ray hits nothing or lies outside the lens's domain (camera's-eye
+  /// view). Throws std::out_of_range for a pixel outside the image.
+  std::optional<PixelPick> Pick(int x, int y) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// PixelPicker(scene, rig, view).Pick(x, y), for a single pick.
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
                                    int x, int y);
 
