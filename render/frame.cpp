@@ -267,6 +267,36 @@ struct Sample {
   uint64_t mask = 0;      // bit c: camera c sees it (rigs of at most 64 cameras)
 };
 
+// A pixel of a tile, relative to its corner.
+struct TilePixel {
+  uint8_t x, y;
+};
+// The pixels of a kTile x kTile tile in Morton (Z) order: all of them, and those of each level.
+// Consecutive entries form compact clusters (2 x 2, 4 x 2, 4 x 4, ...), so the rays that share a
+// packet are coherent at every level.
+struct TileOrderTables {
+  std::vector<TilePixel> all;
+  std::vector<TilePixel> level[kLevels];
+};
+const TileOrderTables& TileOrder() {
+  static const TileOrderTables tables = [] {
+    static_assert(kTile == 16, "the Morton order below covers 16 x 16 tiles");
+    TileOrderTables t;
+    for (int m = 0; m < kTile * kTile; ++m) {
+      int x = 0, y = 0;
+      for (int bit = 0; bit < 4; ++bit) {
+        x |= ((m >> (2 * bit)) & 1) << bit;
+        y |= ((m >> (2 * bit + 1)) & 1) << bit;
+      }
+      const TilePixel p{uint8_t(x), uint8_t(y)};
+      t.all.push_back(p);
+      t.level[PixelLevel(x, y)].push_back(p);
+    }
+    return t;
+  }();
+  return tables;
+}
+
 // The hit of ray (eye, d): the point and the geometric normal turned towards the eye.
 inline void SetHit(const Vec3& eye, const RayHit& hit, Sample* smp) {
   smp->hit = true;
@@ -432,8 +462,6 @@ struct GroupScratch {
   std::vector<std::optional<RayHit>> primary_hits;
   std::vector<double> resolution;        // per centre sample (layers)
   std::vector<InformationBuilder> info;  // per centre sample (layers)
-  std::vector<float> color;              // per tile pixel, 3 floats: the colour being summed
-  std::vector<uint8_t> colored;          // per tile pixel: a sample added colour
 };
 void DeleteScratch(GroupScratch* scratch) { delete scratch; }
 std::unique_ptr<GroupScratch, ScratchDeleter> MakeScratch() {
@@ -570,7 +598,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   const int samples = m.samples;
   const int x0 = (tile % tiles_x_) * kTile, y0 = (tile / tiles_x_) * kTile;
   const int x1 = std::min(W, x0 + kTile), y1 = std::min(height_, y0 + kTile);
-  const int tw = x1 - x0, th = y1 - y0;
+  const int tw = x1 - x0;
   // At the last level with several samples per pixel, the stratified colour samples of every
   // pixel of the tile are traced; the coarser levels' centre samples give a preview colour.
   const bool last = level == kLevels - 1;
@@ -578,36 +606,36 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   std::vector<Sample>& s = scratch->s;
   s.clear();
   int centres = 0;
-  for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) {
-      const bool centre = PixelLevel(x, y) == level;
-      if (!centre && !stratified) continue;
-      Sample c;
-      c.pixel = (y - y0) * tw + (x - x0);
-      c.px = x;
-      c.py = y;
-      c.layers = true;
-      c.weight = samples == 1 || !last ? 1.0 : 0.0;
-      if (!rays.Center(x, y, &c.d, m.need_differentials ? &c.ddx : nullptr,
-                       m.need_differentials ? &c.ddy : nullptr))
-        c.d = Vec3::Zero();
-      if (centre) {
-        c.slot = centres++;
-        s.push_back(c);
-      }
-      if (stratified)
-        for (int j = 0; j < samples; ++j)
-          for (int i = 0; i < samples; ++i) {
-            Sample e = c;
-            e.layers = false;
-            e.slot = -1;
-            e.weight = 1.0 / (samples * samples);
-            e.px = x - 0.5 + (i + 0.5) / samples;
-            e.py = y - 0.5 + (j + 0.5) / samples;
-            if (c.d.squaredNorm() == 0 || !rays.Direction(e.px, e.py, &e.d)) e.d = Vec3::Zero();
-            s.push_back(e);
-          }
+  for (const TilePixel& t : stratified ? TileOrder().all : TileOrder().level[level]) {
+    const int x = x0 + t.x, y = y0 + t.y;
+    if (x >= x1 || y >= y1) continue;  // a partial tile at the image's edge
+    const bool centre = !stratified || PixelLevel(x, y) == level;
+    Sample c;
+    c.pixel = (y - y0) * tw + (x - x0);
+    c.px = x;
+    c.py = y;
+    c.layers = true;
+    c.weight = samples == 1 || !last ? 1.0 : 0.0;
+    if (!rays.Center(x, y, &c.d, m.need_differentials ? &c.ddx : nullptr,
+                     m.need_differentials ? &c.ddy : nullptr))
+      c.d = Vec3::Zero();
+    if (centre) {
+      c.slot = centres++;
+      s.push_back(c);
     }
+    if (stratified)
+      for (int j = 0; j < samples; ++j)
+        for (int i = 0; i < samples; ++i) {
+          Sample e = c;
+          e.layers = false;
+          e.slot = -1;
+          e.weight = 1.0 / (samples * samples);
+          e.px = x - 0.5 + (i + 0.5) / samples;
+          e.py = y - 0.5 + (j + 0.5) / samples;
+          if (c.d.squaredNorm() == 0 || !rays.Direction(e.px, e.py, &e.d)) e.d = Vec3::Zero();
+          s.push_back(e);
+        }
+  }
   if (s.empty()) return;
   std::vector<double>& resolution = scratch->resolution;
   std::vector<InformationBuilder>& info = scratch->info;
@@ -615,7 +643,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
     resolution.assign(centres, 0.0);
     info.assign(centres, InformationBuilder());
   }
-  // Primary rays, in pixel order (a tile row or two per packet).
+  // Primary rays, in sample order (Morton order: compact clusters per packet).
   std::vector<Ray>& primary = scratch->primary;
   std::vector<int>& primary_owner = scratch->primary_owner;
   std::vector<std::optional<RayHit>>& primary_hits = scratch->primary_hits;
@@ -712,11 +740,16 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
     }
   }
   // Shading, overlays in front of the surface, and the layers.
-  std::vector<float>& color_sum = scratch->color;
-  std::vector<uint8_t>& colored = scratch->colored;
-  color_sum.assign(3 * std::size_t(tw) * th, 0.0f);
-  colored.assign(std::size_t(tw) * th, 0);
+  // A pixel's samples are consecutive: its colour is summed in `sum` and stored when the next
+  // pixel's samples begin.
   Image& image = out->image;
+  int summing = -1;  // tile pixel being summed
+  float sum[3] = {0, 0, 0};
+  auto store = [&] {
+    if (summing < 0) return;
+    const std::size_t q = std::size_t(y0 + summing / tw) * W + (x0 + summing % tw);
+    for (int k = 0; k < 3; ++k) image.rgb[3 * q + k] = sum[k];
+  };
   const OverlayOptions& ov = options.overlays;
   const SliceImage* slice = m.have_slice ? &m.overlays->slice : nullptr;
   for (Sample& smp : s) {
@@ -797,8 +830,12 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
         color = (1.0 - layers[i].alpha) * color + layers[i].alpha * layers[i].color;
     }
     if (smp.weight > 0) {
-      for (int k = 0; k < 3; ++k) color_sum[3 * smp.pixel + k] += float(smp.weight * color[k]);
-      colored[smp.pixel] = 1;
+      if (smp.pixel != summing) {
+        store();
+        summing = smp.pixel;
+        sum[0] = sum[1] = sum[2] = 0.0f;
+      }
+      for (int k = 0; k < 3; ++k) sum[k] += float(smp.weight * color[k]);
     }
     if (smp.layers) {  // every layer of the pixel, also where nothing is hit
       image.depth[p] = smp.hit ? float(smp.t) : std::numeric_limits<float>::infinity();
@@ -816,11 +853,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       if (!out->normal.empty()) out->normal[p] = smp.hit ? smp.n : Vec3::Zero();
     }
   }
-  for (int i = 0; i < tw * th; ++i) {
-    if (!colored[i]) continue;
-    const std::size_t p = std::size_t(y0 + i / tw) * W + (x0 + i % tw);
-    for (int k = 0; k < 3; ++k) image.rgb[3 * p + k] = color_sum[3 * i + k];
-  }
+  store();
 }
 
 void FrameRenderer::Finish(FrameBuffers* frame) const {
