@@ -204,7 +204,8 @@ std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
     for (int i = 0; i < 3; ++i) {
       Vec3 a = mesh.vertices[mesh.triangles[t][(i + 1) % 3]];
       Vec3 b = mesh.vertices[mesh.triangles[t][(i + 2) % 3]];
-      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3)) std::swap(a, b);
+      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
+        std::swap(a, b);
       edges[Key{{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}}].push_back({uint32_t(t), uint8_t(i)});
     }
   const double cos_crease = std::cos(1.0 * M_PI / 180.0);
@@ -226,8 +227,11 @@ std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
 // them would fail TestGeometry too, so skipping it changes no result, only the time.
 struct Cull {
   explicit Cull(const Camera& cam)
-      : center(cam.center()), cfw(cam.camera_from_world()), near2(cam.near * cam.near),
-        far2(cam.far * cam.far), bounds(cam.model.normalized_bounds()),
+      : center(cam.center()),
+        cfw(cam.camera_from_world()),
+        near2(cam.near * cam.near),
+        far2(cam.far * cam.far),
+        bounds(cam.model.normalized_bounds()),
         use_bounds(cam.model.max_field_angle() < 0.5 * M_PI) {}
   inline bool MaySee(const Vec3& X, const Vec3& n) const {
     const Vec3 v = center - X;
@@ -249,7 +253,6 @@ struct Cull {
   bool use_bounds;
 };
 
-
 // What one sample (a ray through the pixel) found.
 struct Sample {
   int pixel = 0;          // index in the tile
@@ -260,11 +263,11 @@ struct Sample {
   bool hit = false;
   double t = kInf;
   int triangle = -1;
-  Vec3 d, ddx, ddy;       // direction and its per-pixel derivatives
-  Vec3 X, n;              // hit point and geometric normal facing the eye
+  Vec3 d, ddx, ddy;  // direction and its per-pixel derivatives
+  Vec3 X, n;         // hit point and geometric normal facing the eye
   Vec3 light = Vec3::Zero();
-  int seen = 0;           // cameras that see the point (centre samples)
-  uint64_t mask = 0;      // bit c: camera c sees it (rigs of at most 64 cameras)
+  int seen = 0;       // cameras that see the point (centre samples)
+  uint64_t mask = 0;  // bit c: camera c sees it (rigs of at most 64 cameras)
 };
 
 // A pixel of a tile, relative to its corner.
@@ -317,7 +320,8 @@ void CheckView(const RenderView& view, const Rig& rig) {
     if (!(view.fov_deg > 0 && view.fov_deg < 180))
       throw InputError("--fov", "", "must be in (0, 180) degrees");
     if (!LookAt(view.from, view.at, view.up))
-      throw InputError("--at", "", "'at' equals 'from', or 'up' is parallel to the viewing direction");
+      throw InputError("--at", "",
+                       "'at' equals 'from', or 'up' is parallel to the viewing direction");
   }
 }
 
@@ -341,13 +345,15 @@ const std::vector<int>& PreparedSceneData::ObjectTextures() const {
         textures.push_back(ReadPng(path));
         of_material[m] = static_cast<int>(textures.size()) - 1;
       } catch (const std::exception& e) {
-        std::fprintf(stderr, "pandora: warning: texture %s not used (%s); the material colour stands in\n",
+        std::fprintf(stderr,
+                     "pandora: warning: texture %s not used (%s); the material colour stands in\n",
                      path.c_str(), e.what());
       }
     }
     for (std::size_t o = 0; o < object_material.size(); ++o) {
       const int m = object_material[o];
-      if (m >= 0 && m < int(of_material.size()) && object_has_uvs[o]) object_texture[o] = of_material[m];
+      if (m >= 0 && m < int(of_material.size()) && object_has_uvs[o])
+        object_texture[o] = of_material[m];
     }
   });
   return object_texture;
@@ -360,7 +366,8 @@ const std::vector<uint8_t>& PreparedSceneData::DrawnEdges() const {
 
 namespace {
 
-std::unique_ptr<PreparedSceneData> Prepare(const Scene& scene, std::shared_ptr<const RayCaster> owned,
+std::unique_ptr<PreparedSceneData> Prepare(const Scene& scene,
+                                           std::shared_ptr<const RayCaster> owned,
                                            const RayCaster* caster) {
   auto d = std::make_unique<PreparedSceneData>();
   d->path = scene.path;
@@ -394,13 +401,14 @@ std::unique_ptr<PreparedSceneData> Prepare(const Scene& scene, std::shared_ptr<c
 }  // namespace
 }  // namespace internal
 
-PreparedScene::PreparedScene(const Scene& scene) : data_(internal::Prepare(scene, nullptr, nullptr)) {}
+PreparedScene::PreparedScene(const Scene& scene)
+    : data_(internal::Prepare(scene, nullptr, nullptr)) {}
 PreparedScene::PreparedScene(const Scene& scene, const RayCaster& caster)
     : data_(internal::Prepare(scene, nullptr, &caster)) {}
 PreparedScene::PreparedScene(const Scene& scene, std::shared_ptr<const RayCaster> caster)
-    : data_(internal::Prepare(scene, caster, caster.get())) {
-  if (!caster) throw std::invalid_argument("PreparedScene: null ray caster");
-}
+    : data_(internal::Prepare(
+          scene, caster,
+          caster ? caster.get() : throw std::invalid_argument("PreparedScene: null ray caster"))) {}
 PreparedScene::~PreparedScene() = default;
 PreparedScene::PreparedScene(PreparedScene&&) noexcept = default;
 PreparedScene& PreparedScene::operator=(PreparedScene&&) noexcept = default;
@@ -420,7 +428,8 @@ PreparedOverlays::PreparedOverlays(const Fields& fields, const OverlayOptions& o
   d.iso_field = ov.iso_field;
   d.iso_value = ov.iso_value;
   if (!ov.slice_field.empty()) {
-    if (ov.slice_axis < 0 || ov.slice_axis > 2) throw InputError("--slice-axis", "", "must be x, y or z");
+    if (ov.slice_axis < 0 || ov.slice_axis > 2)
+      throw InputError("--slice-axis", "", "must be x, y or z");
     d.slice = SampleSlice(fields, ov.slice_field, ov.slice_axis, ov.slice_position);
     d.have_slice = true;
   }
@@ -471,8 +480,12 @@ std::unique_ptr<GroupScratch, ScratchDeleter> MakeScratch() {
 struct FrameRenderer::Impl {
   Impl(const PreparedSceneData& scene, const Rig& rig, const RenderView& view,
        const RenderOptions& options, const PreparedOverlaysData* overlays, bool table)
-      : scene(scene), rig(rig), options(options), overlays(overlays),
-        tester(rig.cameras, *scene.caster, scene.scene_scale), rays(view, rig, table),
+      : scene(scene),
+        rig(rig),
+        options(options),
+        overlays(overlays),
+        tester(rig.cameras, *scene.caster, scene.scene_scale),
+        rays(view, rig, table),
         culler(rig.cameras) {}
 
   const PreparedSceneData& scene;
@@ -513,13 +526,14 @@ FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, cons
   tiles_x_ = (width_ + kTile - 1) / kTile;
   tiles_y_ = (height_ + kTile - 1) / kTile;
   const PreparedSceneData& scene = prepared.data();
-  impl_ = std::make_unique<Impl>(scene, rig, view, options, want_overlays ? &overlays->data() : nullptr,
-                                 /*table=*/true);
+  impl_ =
+      std::make_unique<Impl>(scene, rig, view, options, want_overlays ? &overlays->data() : nullptr,
+                             /*table=*/true);
   Impl& m = *impl_;
   m.samples = std::max(1, options.samples);
   m.rule.pattern = options.pattern;
-  m.rule.brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
-                                                     : options.brightness;
+  m.rule.brightness =
+      std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
   m.rule.grid_pixels = options.grid_pixels;
   m.rule.grid_fill = options.grid_fill;
   m.rule.line_width_px = options.line_width_px;
@@ -527,12 +541,14 @@ FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, cons
   // normal, so float round-off in the hit distance cannot make a surface shadow itself.
   m.lift = 0.1 * m.tester.epsilon();
   m.need_jacobian = options.layers || options.pattern == Pattern::kGrid;
-  m.need_differentials = options.pattern == Pattern::kGrid || options.surface == Surface::kHiddenLine;
+  m.need_differentials =
+      options.pattern == Pattern::kGrid || options.surface == Surface::kHiddenLine;
   m.mask = int(rig.cameras.size()) <= Image::kMaxMaskCameras;
   const int camera_count = int(rig.cameras.size());
   m.sigma_px.resize(camera_count);
   for (int c = 0; c < camera_count; ++c)
-    m.sigma_px[c] = rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : options.pixel_sigma;
+    m.sigma_px[c] =
+        rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : options.pixel_sigma;
   m.culls.reserve(camera_count);
   for (const Camera& cam : rig.cameras) m.culls.emplace_back(cam);
   if (m.overlays) {
@@ -571,19 +587,24 @@ void FrameRenderer::Reset(FrameBuffers* b) const {
   image.height = height_;
   const std::size_t pixels = std::size_t(width_) * height_;
   // Every group writes every value of its pixels, so buffers of the right size need no clearing.
-  const bool same = image.rgb.size() == 3 * pixels && image.cameras.size() == (impl_->mask ? pixels : 0) &&
+  const bool same = image.rgb.size() == 3 * pixels &&
+                    image.cameras.size() == (impl_->mask ? pixels : 0) &&
                     b->normal.size() == (impl_->options.surface == Surface::kContours ? pixels : 0);
   if (same) return;
   image.rgb.assign(3 * pixels, 0.0f);
   image.coverage.assign(pixels, 0.0f);
-  if (impl_->mask) image.cameras.assign(pixels, 0);
-  else image.cameras.clear();
+  if (impl_->mask)
+    image.cameras.assign(pixels, 0);
+  else
+    image.cameras.clear();
   image.resolution.assign(pixels, 0.0f);
   image.sigma_max.assign(pixels, std::numeric_limits<float>::infinity());
   image.depth.assign(pixels, std::numeric_limits<float>::infinity());
   image.object.assign(pixels, -1);
-  if (impl_->options.surface == Surface::kContours) b->normal.assign(pixels, Vec3::Zero());
-  else b->normal.clear();
+  if (impl_->options.surface == Surface::kContours)
+    b->normal.assign(pixels, Vec3::Zero());
+  else
+    b->normal.clear();
 }
 
 void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch,
@@ -658,7 +679,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   caster.IntersectPacket(primary.data(), primary.size(), primary_hits.data());
   if (record) {
     record->primary += primary.size();
-    if (record_rays) record->primary_rays.insert(record->primary_rays.end(), primary.begin(), primary.end());
+    if (record_rays)
+      record->primary_rays.insert(record->primary_rays.end(), primary.begin(), primary.end());
   }
   for (std::size_t k = 0; k < primary.size(); ++k)
     if (primary_hits[k]) SetHit(rays.eye(), *primary_hits[k], &s[primary_owner[k]]);
@@ -690,7 +712,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       if (!cull.MaySee(X, s[i].n)) continue;
       Ray seg;
       Mat23 J;
-      if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) != ViewResult::kSeen)
+      if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) !=
+          ViewResult::kSeen)
         continue;
       if (seg.t_far <= seg.t_near) seg.t_far = seg.t_near;  // at the centre: nothing between
       segments.push_back(seg);
@@ -702,7 +725,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
     caster.OccludedPacket(segments.data(), segments.size(), occluded.data());
     if (record) {
       record->shadow += segments.size();
-      if (record_rays) record->shadow_rays.insert(record->shadow_rays.end(), segments.begin(), segments.end());
+      if (record_rays)
+        record->shadow_rays.insert(record->shadow_rays.end(), segments.begin(), segments.end());
     }
     const Camera& cam = rig.cameras[c];
     for (std::size_t k = 0; k < segments.size(); ++k) {
@@ -763,12 +787,15 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
           Vec3 albedo = scene.object_color[object];
           const std::vector<int>& object_texture = *m.object_texture;
           if (object_texture[object] >= 0)  // colour times texture (OBJ Kd x map_Kd, glTF)
-            albedo = albedo.cwiseProduct(SampleTexture(scene.textures[object_texture[object]],
-                                                       TextureCoordinate(scene.mesh, smp.triangle, smp.X)));
+            albedo = albedo.cwiseProduct(
+                SampleTexture(scene.textures[object_texture[object]],
+                              TextureCoordinate(scene.mesh, smp.triangle, smp.X)));
           color = MaterialColor(albedo, smp.light, options.ambient, smp.n.dot(smp.d));
           break;
         }
-        default: color = smp.light; break;
+        default:
+          color = smp.light;
+          break;
       }
       if (m.drawn_edges && (*m.drawn_edges)[smp.triangle]) {
         const uint8_t drawn = (*m.drawn_edges)[smp.triangle];
@@ -921,11 +948,14 @@ void FrameRenderer::Finish(FrameBuffers* frame) const {
       });
     for (std::size_t p = 0; p < pixels; ++p)
       for (int k = 0; k < 3; ++k)
-        image.rgb[3 * p + k] = float((1.0 - a[p]) * image.rgb[3 * p + k] + a[p] * options.line_grey);
+        image.rgb[3 * p + k] =
+            float((1.0 - a[p]) * image.rgb[3 * p + k] + a[p] * options.line_grey);
   }
   const OverlayOptions& ov = options.overlays;
-  if (ov.cameras && rays.perspective()) DrawCameraOverlays(m.rig, rays.pinhole(), ov, options, &image);
-  if (m.have_slice && ov.legend) DrawLegend(FieldUnitLabel(ov.slice_field), m.slice_min, m.slice_max, &image);
+  if (ov.cameras && rays.perspective())
+    DrawCameraOverlays(m.rig, rays.pinhole(), ov, options, &image);
+  if (m.have_slice && ov.legend)
+    DrawLegend(FieldUnitLabel(ov.slice_field), m.slice_min, m.slice_max, &image);
   if (ov.key) DrawKey(m.rig, &image);
 }
 
@@ -933,8 +963,12 @@ void FrameRenderer::Finish(FrameBuffers* frame) const {
 
 struct PixelPicker::Impl {
   Impl(const internal::PreparedSceneData& scene, const Rig& rig, const RenderView& view)
-      : scene(scene), rig(rig), width(view.width), height(view.height),
-        rays(view, rig, /*table=*/false), tester(rig.cameras, *scene.caster, scene.scene_scale) {}
+      : scene(scene),
+        rig(rig),
+        width(view.width),
+        height(view.height),
+        rays(view, rig, /*table=*/false),
+        tester(rig.cameras, *scene.caster, scene.scene_scale) {}
   const internal::PreparedSceneData& scene;
   const Rig& rig;
   int width, height;
@@ -968,12 +1002,13 @@ std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
   pick.triangle = smp.triangle;
   pick.object = m.scene.triangle_object[smp.triangle];
   for (int c = 0; c < int(m.rig.cameras.size()); ++c)
-    if (m.tester.Test(c, pick.lit_point, &pick.normal) == ViewResult::kSeen) pick.cameras.push_back(c);
+    if (m.tester.Test(c, pick.lit_point, &pick.normal) == ViewResult::kSeen)
+      pick.cameras.push_back(c);
   return pick;
 }
 
-std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
-                                   int x, int y) {
+std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,
+                                   const RenderView& view, int x, int y) {
   return PixelPicker(scene, rig, view).Pick(x, y);
 }
 

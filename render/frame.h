@@ -25,8 +25,8 @@
 
 namespace pandora::internal {
 
-constexpr int kTile = 16;    // tile edge in pixels: 256 centre samples share a packet per camera
-constexpr int kLevels = 4;   // pixel levels per tile: blocks of 8, 4, 2, 1
+constexpr int kTile = 16;   // tile edge in pixels: 256 centre samples share a packet per camera
+constexpr int kLevels = 4;  // pixel levels per tile: blocks of 8, 4, 2, 1
 
 /// The level of pixel (x, y): 0 when x and y are multiples of 8, 1 of 4, 2 of 2, else 3.
 inline int PixelLevel(int x, int y) {
@@ -35,13 +35,13 @@ inline int PixelLevel(int x, int y) {
 }
 
 struct PreparedSceneData {
-  std::string path;  // the scene file (error messages)
+  std::string path;                        // the scene file (error messages)
   std::shared_ptr<const RayCaster> owned;  // when the caster is owned or shared
   const RayCaster* caster = nullptr;
-  TriangleMesh mesh;                  // scene.AllTriangles()
-  std::vector<int> triangle_object;   // object index of each triangle
-  std::vector<Vec3> object_color;     // material colour per object
-  double scene_scale = 1.0;           // diagonal of Scene::ContentBounds() (visibility epsilon)
+  TriangleMesh mesh;                 // scene.AllTriangles()
+  std::vector<int> triangle_object;  // object index of each triangle
+  std::vector<Vec3> object_color;    // material colour per object
+  double scene_scale = 1.0;          // diagonal of Scene::ContentBounds() (visibility epsilon)
   std::vector<std::string> material_texture;  // texture path per material ("" none)
   std::vector<int> object_material;           // material per object
   std::vector<bool> object_has_uvs;           // per object: its mesh has texture coordinates
@@ -63,11 +63,12 @@ struct PreparedOverlaysData {
   int slice_axis = 2;
   double slice_position = 0, iso_value = 0;
   bool have_slice = false;
-  SliceImage slice;  // auto range in slice.min / slice.max
+  SliceImage slice;                       // auto range in slice.min / slice.max
   std::unique_ptr<RayCaster> iso_caster;  // null when no isosurface (or an empty one)
 };
 
-/// Checks what a frame needs of the view: InputError naming "--size", "--camera", "--fov" or "--at".
+/// Checks what a frame needs of the view: InputError naming "--size", "--camera", "--fov" or
+/// "--at".
 void CheckView(const RenderView& view, const Rig& rig);
 
 /// The per-pixel outputs of the groups: the image and the centre rays' facing normals (contours).
@@ -113,8 +114,8 @@ class FrameRenderer {
   /// levels 0-2 with several samples per pixel: the centre sample's colour, replaced at level 3 by
   /// the stratified average). `record` (may be null) receives the counts and, when record_rays,
   /// the rays.
-  void RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch, TileRecord* record,
-                   bool record_rays) const;
+  void RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch,
+                   TileRecord* record, bool record_rays) const;
   /// The image-space passes after the groups: contours, camera wireframes, legend, key.
   void Finish(FrameBuffers* frame) const;
 

@@ -51,8 +51,10 @@ class LineOverlay {
     auto clip = [&](double p, double q) {  // keep p * s <= q
       if (p == 0) return q >= 0;
       const double r = q / p;
-      if (p < 0) s0 = std::max(s0, r);
-      else s1 = std::min(s1, r);
+      if (p < 0)
+        s0 = std::max(s0, r);
+      else
+        s1 = std::min(s1, r);
       return s0 <= s1;
     };
     if (!clip(-ab.x(), pa.x() + reach) || !clip(ab.x(), W - 1 + reach - pa.x()) ||
@@ -81,7 +83,8 @@ class LineOverlay {
         const double s = (sigma / b.z()) / ((1.0 - sigma) / a.z() + sigma / b.z());
         const double depth = (a + s * (b - a)).norm();
         const std::size_t p = std::size_t(y) * W + x;
-        if (depth > image_.depth[p] * (1.0 + 1e-3)) cover *= 0.3;  // hidden behind the surface: dimmed
+        if (depth > image_.depth[p] * (1.0 + 1e-3))
+          cover *= 0.3;  // hidden behind the surface: dimmed
         touches_.push_back({p, cover, current_});
       }
     }
@@ -172,7 +175,8 @@ void DrawLegend(const std::string& field, double vmin, double vmax, Image* image
   char top[32], bottom[32];
   std::snprintf(top, sizeof top, "%.3g", vmax);
   std::snprintf(bottom, sizeof bottom, "%.3g", vmin);
-  const int text_w = std::max({TextWidth(top, scale), TextWidth(bottom, scale), TextWidth(field, scale)});
+  const int text_w =
+      std::max({TextWidth(top, scale), TextWidth(bottom, scale), TextWidth(field, scale)});
   const int margin = 6 * scale;
   const int box_w = bar_w + 3 * margin + TextWidth(top, scale) * 0 + text_w;
   const int box_h = bar_h + 2 * margin + 8 * scale;
@@ -188,12 +192,14 @@ void DrawLegend(const std::string& field, double vmin, double vmax, Image* image
   for (int y = 0; y < bar_h; ++y) {
     const Vec3 c = ViridisLinear(1.0 - double(y) / (bar_h - 1));
     for (int x = 0; x < bar_w; ++x)
-      for (int k = 0; k < 3; ++k) image->rgb[3 * (std::size_t(by + y) * W + bx + x) + k] = float(c[k]);
+      for (int k = 0; k < 3; ++k)
+        image->rgb[3 * (std::size_t(by + y) * W + bx + x) + k] = float(c[k]);
   }
   const Vec3 white = Vec3::Constant(0.9);
   DrawText(image->rgb.data(), W, H, x0 + margin, y0 + margin, field, white, scale);
   DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by, top, white, scale);
-  DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by + bar_h - 5 * scale, bottom, white, scale);
+  DrawText(image->rgb.data(), W, H, bx + bar_w + margin, by + bar_h - 5 * scale, bottom, white,
+           scale);
 }
 
 // The colour key, upper left corner: a swatch of each enabled camera's light and its id (up to 12
@@ -208,7 +214,8 @@ void DrawKey(const Rig& rig, Image* image) {
   const int scale = H >= 400 ? 2 : 1;
   const int margin = 4 * scale, row = 8 * scale, swatch = 8 * scale;
   std::size_t longest = 1;
-  for (const Camera* c : cams) longest = std::max<std::size_t>(longest, std::min<std::size_t>(c->id.size(), 12));
+  for (const Camera* c : cams)
+    longest = std::max<std::size_t>(longest, std::min<std::size_t>(c->id.size(), 12));
   const int col_w = swatch + 3 * scale + TextWidth(std::string(longest, 'm'), scale) + 2 * margin;
   const int rows_fit = std::max(1, (H - 3 * margin) / row);
   const int cols = (int(cams.size()) + rows_fit - 1) / rows_fit;
@@ -231,7 +238,8 @@ void DrawKey(const Rig& rig, Image* image) {
     for (int yy = y; yy < y + 5 * scale && yy < H; ++yy)
       for (int xx = x; xx < x + swatch && xx < W; ++xx)
         for (int k = 0; k < 3; ++k) image->rgb[3 * (std::size_t(yy) * W + xx) + k] = float(c[k]);
-    DrawText(image->rgb.data(), W, H, x + swatch + 3 * scale, y, cams[i]->id.substr(0, 12), text, scale);
+    DrawText(image->rgb.data(), W, H, x + swatch + 3 * scale, y, cams[i]->id.substr(0, 12), text,
+             scale);
   }
 }
 

@@ -31,7 +31,6 @@
 /// rig order, starting from zero, in double precision.
 
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -55,9 +54,9 @@ inline double DefaultBrightness(int enabled_cameras) {
 /// The parameters of the rule for one frame (RenderOptions resolved: brightness is a number).
 struct LightRule {
   Pattern pattern = Pattern::kUniform;
-  double brightness = 1.0;     ///< Multiplies every camera's light.
-  int grid_pixels = 32;        ///< kGrid: a line every this many camera pixels (below 1 counts as 1).
-  double grid_fill = 0.15;     ///< kGrid: light between the lines, as a fraction of the lines'.
+  double brightness = 1.0;  ///< Multiplies every camera's light.
+  int grid_pixels = 32;     ///< kGrid: a line every this many camera pixels (below 1 counts as 1).
+  double grid_fill = 0.15;  ///< kGrid: light between the lines, as a fraction of the lines'.
   double line_width_px = 1.2;  ///< kGrid: line width in output pixels.
 };
 
@@ -70,7 +69,8 @@ struct CameraAtPoint {
   /// kGrid only: the point projects into the camera (its pixel coordinates u, v are defined). When
   /// false the camera adds its fill light only.
   bool projects = false;
-  double u = 0, v = 0;    ///< kGrid: pixel coordinates of the point in the camera (pixel centres at integers).
+  /// kGrid: pixel coordinates of the point in the camera (pixel centres at integers).
+  double u = 0, v = 0;
   double du = 0, dv = 0;  ///< kGrid: |grad u|, |grad v|: camera pixels per output pixel (>= 0).
 };
 
@@ -81,8 +81,8 @@ inline double LineCoverage(double distance, double width) {
 }
 
 /// Coverage of one family of grid lines (the camera pixel borders u = k n - 1/2, k integer) at
-/// camera coordinate `u`, where `g` camera pixels pass per output pixel, lines `width` output pixels
-/// wide. With s = n / g the line spacing in output pixels and d = |u - nearest line| / g:
+/// camera coordinate `u`, where `g` camera pixels pass per output pixel, lines `width` output
+/// pixels wide. With s = n / g the line spacing in output pixels and d = |u - nearest line| / g:
 ///   L = (1 - f) * LineCoverage(d, width) + f * min(1, width / s),  f = clamp((3 - s) / 1.5, 0, 1),
 /// i.e. lines closer than 3 output pixels fade into their mean coverage instead of aliasing.
 /// 0 when g is 0, negative, infinite or NaN.
@@ -98,14 +98,16 @@ inline double GridLineCoverage(double u, double g, int n, double width) {
 }
 
 /// The weight w of a camera that sees the point: 1 for kUniform; for kGrid
-/// fill + (1 - fill) * (1 - (1 - L_u) (1 - L_v)) with L from GridLineCoverage (0 when the point does
-/// not project). 0 when the camera does not see the point.
+/// fill + (1 - fill) * (1 - (1 - L_u) (1 - L_v)) with L from GridLineCoverage (0 when the point
+/// does not project). 0 when the camera does not see the point.
 inline double CameraLightWeight(const LightRule& rule, const CameraAtPoint& camera) {
   if (!camera.sees) return 0.0;
   if (rule.pattern != Pattern::kGrid) return 1.0;
   const int n = std::max(1, rule.grid_pixels);
-  const double lu = camera.projects ? GridLineCoverage(camera.u, camera.du, n, rule.line_width_px) : 0.0;
-  const double lv = camera.projects ? GridLineCoverage(camera.v, camera.dv, n, rule.line_width_px) : 0.0;
+  const double lu =
+      camera.projects ? GridLineCoverage(camera.u, camera.du, n, rule.line_width_px) : 0.0;
+  const double lv =
+      camera.projects ? GridLineCoverage(camera.v, camera.dv, n, rule.line_width_px) : 0.0;
   const double line = 1.0 - (1.0 - lu) * (1.0 - lv);
   return rule.grid_fill + (1.0 - rule.grid_fill) * line;
 }

@@ -106,15 +106,17 @@ TEST(Light, GridLinesLieOnTheCamerasPixelBordersWithBoxFilteredWidth) {
   EXPECT_NEAR(GridLineCoverage(15.75, 0.5, 8, 1.2), 0.6, 1e-15);
   // The term: (brightness * w) * colour.
   rule.brightness = 0.5;
-  EXPECT_EQ(CameraLight(rule, OnGrid(V3(1, 0.5, 0), 11.5, 3.5, 1, 1)),
-            (0.5 * CameraLightWeight(rule, OnGrid(V3(1, 0.5, 0), 11.5, 3.5, 1, 1))) * V3(1, 0.5, 0));
+  EXPECT_EQ(
+      CameraLight(rule, OnGrid(V3(1, 0.5, 0), 11.5, 3.5, 1, 1)),
+      (0.5 * CameraLightWeight(rule, OnGrid(V3(1, 0.5, 0), 11.5, 3.5, 1, 1))) * V3(1, 0.5, 0));
 }
 
 TEST(Light, DenseGridLinesFadeToTheirMeanCoverage) {
   // Spacing s = n / g output pixels; below 3 pixels the line fades into min(1, width / s):
   // fade f = clamp((3 - s) / 1.5, 0, 1).
   // s = 1.5 (n = 8, g = 16/3): fully faded, coverage 1.2 / 1.5 = 0.8 wherever u is.
-  for (double u : {7.5, 9.0, 11.5}) EXPECT_NEAR(GridLineCoverage(u, 16.0 / 3.0, 8, 1.2), 0.8, 1e-12) << u;
+  for (double u : {7.5, 9.0, 11.5})
+    EXPECT_NEAR(GridLineCoverage(u, 16.0 / 3.0, 8, 1.2), 0.8, 1e-12) << u;
   // s = 2.25 (g = 32/9): f = 0.5; on a line 0.5 * 1 + 0.5 * 1.2 / 2.25.
   EXPECT_NEAR(GridLineCoverage(7.5, 32.0 / 9.0, 8, 1.2), 0.5 + 0.5 * 1.2 / 2.25, 1e-12);
   // Midway between lines (4 camera pixels = 1.125 output pixels away): the line part is 0.
@@ -141,8 +143,10 @@ TEST(Light, DegenerateGradientsAndUnprojectablePointsGetTheFillOnly) {
 TEST(Light, MaterialColourIsAlbedoTimesLightPlusShadedAmbient) {
   const V3 albedo(0.8, 0.5, 0.2), light(0.5, 1.0, 2.0);
   // Facing the eye (cos 1): shade 1; grazing (cos 0): shade 0.4; the sign of cos does not matter.
-  EXPECT_TRUE(MaterialColor(albedo, light, 0.15, 1.0).isApprox(V3(0.4 + 0.12, 0.5 + 0.075, 0.4 + 0.03), 1e-15));
-  EXPECT_TRUE(MaterialColor(albedo, light, 0.15, -1.0).isApprox(MaterialColor(albedo, light, 0.15, 1.0), 1e-15));
+  EXPECT_TRUE(MaterialColor(albedo, light, 0.15, 1.0)
+                  .isApprox(V3(0.4 + 0.12, 0.5 + 0.075, 0.4 + 0.03), 1e-15));
+  EXPECT_TRUE(MaterialColor(albedo, light, 0.15, -1.0)
+                  .isApprox(MaterialColor(albedo, light, 0.15, 1.0), 1e-15));
   EXPECT_TRUE(MaterialColor(albedo, V3::Zero(), 0.15, 0.0).isApprox(0.15 * 0.4 * albedo, 1e-15));
   EXPECT_TRUE(MaterialColor(albedo, light, 0.0, 0.3).isApprox(V3(0.4, 0.5, 0.4), 1e-15));
 }

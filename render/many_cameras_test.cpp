@@ -56,7 +56,8 @@ Scene ManyCameraScene(int n) {
   std::mt19937 g(20240611);
   for (int c = 0; c < n; ++c) {
     const double azimuth = Uniform(g, 0, 2 * M_PI), radius = Uniform(g, 2.5, 5.0);
-    const Vec3 position(radius * std::cos(azimuth), radius * std::sin(azimuth), Uniform(g, 0.8, 4.0));
+    const Vec3 position(radius * std::cos(azimuth), radius * std::sin(azimuth),
+                        Uniform(g, 0.8, 4.0));
     const Vec3 target(Uniform(g, -2.5, 2.5), Uniform(g, -2.5, 2.5), Uniform(g, 0.0, 0.5));
     Camera cam;
     cam.id = cam.name = "c" + std::to_string(c);

@@ -62,8 +62,8 @@ class PreparedScene {
 };
 
 /// The field overlays of OverlayOptions (slice plane, isosurface) prepared from a Fields: the slice
-/// sampled on its plane (SampleSlice) and the isosurface extracted (OpenVDB volumeToMesh) and put in
-/// its own Embree BVH. Build once per (fields, overlay choice) and pass to every frame until the
+/// sampled on its plane (SampleSlice) and the isosurface extracted (OpenVDB volumeToMesh) and put
+/// in its own Embree BVH. Build once per (fields, overlay choice) and pass to every frame until the
 /// fields or the choice change; what a frame may still vary (slice range, opacities, colours, the
 /// legend) stays in RenderOptions. Immutable; the fields may go away after construction.
 class PreparedOverlays {

@@ -23,8 +23,8 @@
 namespace pandora {
 namespace {
 
-Camera Cam(const std::string& id, const Vec3& from, const Vec3& at, double hfov_deg, const Vec3& color,
-           LensModel lens = LensModel::kPinhole, double k1 = 0, double k2 = 0) {
+Camera Cam(const std::string& id, const Vec3& from, const Vec3& at, double hfov_deg,
+           const Vec3& color, LensModel lens = LensModel::kPinhole, double k1 = 0, double k2 = 0) {
   Camera c;
   c.id = c.name = id;
   c.color = color;
@@ -134,7 +134,8 @@ RenderView ViewOf(const Variant& v) {
 // Bit-for-bit equality of every buffer.
 template <class T>
 bool SameBits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 void ExpectSameImage(const Image& a, const Image& b, const std::string& what) {
   ASSERT_EQ(a.width, b.width) << what;
@@ -164,7 +165,8 @@ class CountingCaster final : public RayCaster {
     occluded_ += count;
     inner_.OccludedPacket(rays, count, occluded);
   }
-  void IntersectPacket(const Ray* rays, std::size_t count, std::optional<RayHit>* hits) const override {
+  void IntersectPacket(const Ray* rays, std::size_t count,
+                       std::optional<RayHit>* hits) const override {
     intersected_ += count;
     inner_.IntersectPacket(rays, count, hits);
   }
@@ -218,14 +220,16 @@ TEST(PreparedScene, FieldOverlaysPreparedOnceMatchTheOneShotOverlays) {
   EXPECT_TRUE(overlays.Matches(options.overlays));
   const RenderView view = MainView();
   ExpectSameImage(Render(prepared, w.rig(), view, options, &overlays),
-                  Render(w.scene, w.rig(), *w.caster, view, options, &fields), "slice and isosurface");
+                  Render(w.scene, w.rig(), *w.caster, view, options, &fields),
+                  "slice and isosurface");
   // What a frame may still vary (the slice's range, opacities) needs no new preparation.
   options.overlays.slice_min = 0;
   options.overlays.slice_max = 3;
   options.overlays.iso_opacity = 0.8;
   EXPECT_TRUE(overlays.Matches(options.overlays));
   ExpectSameImage(Render(prepared, w.rig(), view, options, &overlays),
-                  Render(w.scene, w.rig(), *w.caster, view, options, &fields), "range and opacity changed");
+                  Render(w.scene, w.rig(), *w.caster, view, options, &fields),
+                  "range and opacity changed");
   // Another plane or iso value does.
   RenderOptions moved = options;
   moved.overlays.slice_position = 0.55;
@@ -265,7 +269,9 @@ TEST(PreparedScene, OnePreparationServesEditedRigsAndMovedViews) {
   RenderOptions options;
   options.layers = true;
   for (int edit = 0; edit < 4; ++edit) {
-    if (edit == 1) rig.cameras[1].world_from_camera = *LookAt(Vec3(-1.2, -1.6, 1.5), Vec3(0.1, 0, 0.2), Vec3(0, 0, 1));
+    if (edit == 1)
+      rig.cameras[1].world_from_camera =
+          *LookAt(Vec3(-1.2, -1.6, 1.5), Vec3(0.1, 0, 0.2), Vec3(0, 0, 1));
     if (edit == 2) rig.cameras[2].enabled = false;
     if (edit == 3) {
       rig.cameras[0].color = Vec3(1, 1, 0);
@@ -273,8 +279,8 @@ TEST(PreparedScene, OnePreparationServesEditedRigsAndMovedViews) {
       view.width = 40;
       view.height = 70;
     }
-    ExpectSameImage(Render(prepared, rig, view, options), Render(w.scene, rig, *w.caster, view, options),
-                    "edit " + std::to_string(edit));
+    ExpectSameImage(Render(prepared, rig, view, options),
+                    Render(w.scene, rig, *w.caster, view, options), "edit " + std::to_string(edit));
   }
 }
 
@@ -312,12 +318,14 @@ TEST(PreparedScene, OwnsOrSharesItsCasterAndRefusesAForeignOne) {
   const Image expected = Render(w.scene, w.rig(), *raw, MainView(), RenderOptions());
   shared.reset();
   EXPECT_EQ(&prepared.caster(), raw);
-  ExpectSameImage(Render(prepared, w.rig(), MainView(), RenderOptions()), expected, "shared caster");
+  ExpectSameImage(Render(prepared, w.rig(), MainView(), RenderOptions()), expected,
+                  "shared caster");
   // Its own BVH, from the scene's triangles.
   const PreparedScene own(w.scene);
   EXPECT_EQ(own.triangle_count(), w.caster->triangle_count());
   EXPECT_EQ(own.caster().triangle_count(), w.caster->triangle_count());
-  // A caster of other triangles.
+  // No caster, or one of other triangles.
+  EXPECT_THROW(PreparedScene(w.scene, std::shared_ptr<const RayCaster>()), std::invalid_argument);
   const auto other = MakeEmbreeRayCaster(MakeBox(Vec3(1, 1, 1)));
   EXPECT_THROW(PreparedScene(w.scene, *other), std::invalid_argument);
   // The view is checked per frame, with the command line's option names.
@@ -379,10 +387,14 @@ TEST(Progressive, EachPassShowsItsTracedPixelsAndTheNearestTracedPixelElsewhere)
         const int sy = std::min(int(std::floor(double(y) / b + 0.5)) * b, (H - 1) / b * b);
         const std::size_t p = std::size_t(y) * W + x, q = std::size_t(sy) * W + sx;
         copies += p != q;
-        mismatches += img.rgb[3 * p] != final_image.rgb[3 * q] || img.rgb[3 * p + 1] != final_image.rgb[3 * q + 1] ||
-                      img.rgb[3 * p + 2] != final_image.rgb[3 * q + 2] || img.coverage[p] != final_image.coverage[q] ||
-                      img.cameras[p] != final_image.cameras[q] || img.depth[p] != final_image.depth[q] ||
-                      img.object[p] != final_image.object[q] || img.resolution[p] != final_image.resolution[q] ||
+        mismatches += img.rgb[3 * p] != final_image.rgb[3 * q] ||
+                      img.rgb[3 * p + 1] != final_image.rgb[3 * q + 1] ||
+                      img.rgb[3 * p + 2] != final_image.rgb[3 * q + 2] ||
+                      img.coverage[p] != final_image.coverage[q] ||
+                      img.cameras[p] != final_image.cameras[q] ||
+                      img.depth[p] != final_image.depth[q] ||
+                      img.object[p] != final_image.object[q] ||
+                      img.resolution[p] != final_image.resolution[q] ||
                       img.sigma_max[p] != final_image.sigma_max[q];
       }
     EXPECT_EQ(mismatches, 0) << "pass " << pass;
@@ -452,12 +464,14 @@ TEST(Progressive, RestartRendersTheNextFrameAsANewRenderWould) {
   ASSERT_TRUE(progressive.RunPass());
   // A camera moves while the frame is being refined: start over with the edited rig.
   Rig moved = w.rig();
-  moved.cameras[0].world_from_camera = *LookAt(Vec3(1.0, -1.8, 2.2), Vec3(0.2, 0, 0.3), Vec3(0, 0, 1));
+  moved.cameras[0].world_from_camera =
+      *LookAt(Vec3(1.0, -1.8, 2.2), Vec3(0.2, 0, 0.3), Vec3(0, 0, 1));
   progressive.Restart(moved, MainView(), options);
   EXPECT_EQ(progressive.passes_done(), 0);
   EXPECT_EQ(progressive.image().width, 0);
   ASSERT_TRUE(progressive.RunAll());
-  ExpectSameImage(progressive.image(), Render(prepared, moved, MainView(), options), "moved camera");
+  ExpectSameImage(progressive.image(), Render(prepared, moved, MainView(), options),
+                  "moved camera");
   // Then the eye moves and the size changes; and back to the first size with contours.
   RenderView other = MainView();
   other.from = Vec3(-1.5, -2.5, 1.2);
@@ -465,7 +479,8 @@ TEST(Progressive, RestartRendersTheNextFrameAsANewRenderWould) {
   other.height = 31;
   progressive.Restart(moved, other, options);
   ASSERT_TRUE(progressive.RunAll());
-  ExpectSameImage(progressive.image(), Render(prepared, moved, other, options), "moved eye, new size");
+  ExpectSameImage(progressive.image(), Render(prepared, moved, other, options),
+                  "moved eye, new size");
   RenderOptions contours;
   contours.surface = Surface::kContours;
   progressive.Restart(w.rig(), MainView(), contours);
@@ -476,7 +491,8 @@ TEST(Progressive, RestartRendersTheNextFrameAsANewRenderWould) {
   bad.width = 0;
   EXPECT_THROW(progressive.Restart(w.rig(), bad, options), InputError);
   EXPECT_TRUE(progressive.done());
-  ExpectSameImage(progressive.image(), Render(prepared, w.rig(), MainView(), contours), "after a refused restart");
+  ExpectSameImage(progressive.image(), Render(prepared, w.rig(), MainView(), contours),
+                  "after a refused restart");
 }
 
 }  // namespace

@@ -38,22 +38,23 @@ struct ProgressiveRender::State {
   const PreparedScene& scene;
   std::unique_ptr<const Rig> rig;
   std::unique_ptr<const internal::FrameRenderer> frame;  // refers to *rig
-  internal::FrameBuffers base;   // the traced pixels
-  std::vector<uint8_t> done;     // per (level, tile): traced
+  internal::FrameBuffers base;                           // the traced pixels
+  std::vector<uint8_t> done;                             // per (level, tile): traced
   int passes = 0;
   internal::FrameBuffers shown;  // the image of the last completed pass
   std::int64_t traced = 0, total = 1;
   double reported = 0;  // last fraction reported (non-decreasing over the frame)
 };
 
-ProgressiveRender::ProgressiveRender(const PreparedScene& scene, const Rig& rig, const RenderView& view,
-                                     const RenderOptions& options, const PreparedOverlays* overlays)
+ProgressiveRender::ProgressiveRender(const PreparedScene& scene, const Rig& rig,
+                                     const RenderView& view, const RenderOptions& options,
+                                     const PreparedOverlays* overlays)
     : state_(std::make_unique<State>(scene)) {
   state_->Start(rig, view, options, overlays);
 }
 
-void ProgressiveRender::Restart(const Rig& rig, const RenderView& view, const RenderOptions& options,
-                                const PreparedOverlays* overlays) {
+void ProgressiveRender::Restart(const Rig& rig, const RenderView& view,
+                                const RenderOptions& options, const PreparedOverlays* overlays) {
   state_->Start(rig, view, options, overlays);
 }
 ProgressiveRender::~ProgressiveRender() = default;
@@ -149,7 +150,8 @@ bool ProgressiveRender::RunPass(const RenderControl& control) {
     }
   });
   s.traced = traced.load();
-  if (stopped.load() && !std::all_of(done, done + tiles, [](uint8_t d) { return d != 0; })) return false;
+  if (stopped.load() && !std::all_of(done, done + tiles, [](uint8_t d) { return d != 0; }))
+    return false;
   ++s.passes;
   if (s.passes == kPasses) {
     // Every pixel traced: the buffers are Render's before its image-space passes. (The swap keeps

@@ -68,7 +68,8 @@ class ProgressiveRender {
   int passes_done() const;
   bool done() const { return passes_done() == kPasses; }
   /// The latest completed pass at full size with overlays, key and contours (width and height 0
-  /// before the first pass). After the last pass: equal to Render's image bit for bit, every layer included.
+  /// before the first pass). After the last pass: equal to Render's image bit for bit, every layer
+  /// included.
   const Image& image() const;
 
  private:

@@ -17,7 +17,8 @@ namespace pandora {
 std::string FieldUnitLabel(const std::string& field) {
   std::string base = field;
   const std::string steady = "_steady";
-  if (base.size() > steady.size() && base.compare(base.size() - steady.size(), steady.size(), steady) == 0)
+  if (base.size() > steady.size() &&
+      base.compare(base.size() - steady.size(), steady.size(), steady) == 0)
     base.resize(base.size() - steady.size());
   if (base == "coverage") return field + " [cameras]";
   if (base == "resolution") return field + " [px/m]";
@@ -53,8 +54,8 @@ Image RenderWithStats(const PreparedScene& scene, const Rig& rig, const RenderVi
     const auto scratch = internal::MakeScratch();
     for (int tile = r.begin(); tile != r.end(); ++tile)
       for (int level = 0; level < internal::kLevels; ++level)
-        frame.RenderGroup(tile, level, &buffers, scratch.get(), records.empty() ? nullptr : &records[tile],
-                          record_rays);
+        frame.RenderGroup(tile, level, &buffers, scratch.get(),
+                          records.empty() ? nullptr : &records[tile], record_rays);
   });
   frame.Finish(&buffers);
   if (stats) {
@@ -67,14 +68,17 @@ Image RenderWithStats(const PreparedScene& scene, const Rig& rig, const RenderVi
   }
   if (primary_out) {
     primary_out->clear();
-    for (const auto& t : records) primary_out->insert(primary_out->end(), t.primary_rays.begin(), t.primary_rays.end());
+    for (const auto& t : records)
+      primary_out->insert(primary_out->end(), t.primary_rays.begin(), t.primary_rays.end());
   }
   if (shadow_out) {
     shadow_out->clear();
-    for (const auto& t : records) shadow_out->insert(shadow_out->end(), t.shadow_rays.begin(), t.shadow_rays.end());
+    for (const auto& t : records)
+      shadow_out->insert(shadow_out->end(), t.shadow_rays.begin(), t.shadow_rays.end());
   }
   if (stats)
-    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return std::move(buffers.image);
 }
 
@@ -98,9 +102,11 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
                        "run `pandora analyze` and pass its fields.vdb");
     overlays = std::make_unique<PreparedOverlays>(*fields, ov);
   }
-  Image image = RenderWithStats(prepared, rig, view, options, overlays.get(), stats, primary_out, shadow_out);
+  Image image =
+      RenderWithStats(prepared, rig, view, options, overlays.get(), stats, primary_out, shadow_out);
   if (stats)
-    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
 
