@@ -3,6 +3,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,9 +17,18 @@
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
+#include "render/prepared_scene.h"
+#include "render/progressive.h"
 #include "render/render.h"
 
 namespace pandora::app {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+}  // namespace
 
 int RunRenderBench(const BenchArgs& args) {
   const auto [width, height] = ParseImageSize("--size", args.size);
@@ -60,6 +71,18 @@ int RunRenderBench(const BenchArgs& args) {
   double best_render = std::numeric_limits<double>::infinity(), best_layers = best_render;
   double best_primary = best_render, best_packet = best_render, best_single = best_render;
   double best_primary_packet = best_render;
+  // The prepared renderer against the one-shot form, and the progressive passes.
+  const PreparedScene prepared(scene, *caster);
+  RenderOptions hidden_line = options;
+  hidden_line.surface = Surface::kHiddenLine;
+  double best_prepared = best_render, best_with_bvh = best_render;
+  double best_hidden_once = best_render, best_hidden_prepared = best_render;
+  // Progressive: after Restart (a viewer's steady state: buffers reused) and freshly constructed.
+  std::array<double, ProgressiveRender::kPasses> best_pass;
+  best_pass.fill(best_render);
+  double best_progressive = best_render, best_first_fresh = best_render;
+  ProgressiveRender restarted(prepared, rig, view, options);
+  restarted.RunAll();
   std::size_t hits = 0, occluded = 0;
   for (int r = 0; r < args.repeat; ++r) {
     RenderStats s;
@@ -67,6 +90,34 @@ int RunRenderBench(const BenchArgs& args) {
     best_render = std::min(best_render, s.seconds);
     RenderWithStats(scene, rig, *caster, view, with_layers, nullptr, &s);
     best_layers = std::min(best_layers, s.seconds);
+    RenderWithStats(prepared, rig, view, options, nullptr, &s);
+    best_prepared = std::min(best_prepared, s.seconds);
+    {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::unique_ptr<RayCaster> own = MakeEmbreeRayCaster(scene.AllTriangles());
+      Render(scene, rig, *own, view, options);
+      best_with_bvh = std::min(best_with_bvh, Seconds(t0));
+    }
+    RenderWithStats(scene, rig, *caster, view, hidden_line, nullptr, &s);
+    best_hidden_once = std::min(best_hidden_once, s.seconds);
+    RenderWithStats(prepared, rig, view, hidden_line, nullptr, &s);
+    best_hidden_prepared = std::min(best_hidden_prepared, s.seconds);
+    {
+      // Each pass from the call to its image (the first includes starting the frame).
+      auto t0 = std::chrono::steady_clock::now();
+      const auto start = t0;
+      restarted.Restart(rig, view, options);
+      for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass) {
+        restarted.RunPass();
+        best_pass[pass] = std::min(best_pass[pass], Seconds(t0));
+        t0 = std::chrono::steady_clock::now();
+      }
+      best_progressive = std::min(best_progressive, Seconds(start));
+      t0 = std::chrono::steady_clock::now();
+      ProgressiveRender fresh(prepared, rig, view, options);
+      fresh.RunPass();
+      best_first_fresh = std::min(best_first_fresh, Seconds(t0));
+    }
     const RawOcclusionResult p = RawEmbreeIntersection(*caster, primary);
     best_primary = std::min(best_primary, p.seconds);
     hits = p.occluded;
@@ -104,6 +155,21 @@ int RunRenderBench(const BenchArgs& args) {
               "(our overhead over Embree itself)\n", packet_width, packet_width, ratio);
   std::printf("  with the EXR layers: ratio to the single-ray loops = %.3f, to the packet loops = %.3f\n",
               best_layers / raw_single, best_layers / raw);
+  std::printf("  %-58s %9.4f s\n", "one-shot Render, caster given (preparation per call)", best_render);
+  std::printf("  %-58s %9.4f s\n", "one-shot with its BVH build (as `pandora render`)", best_with_bvh);
+  std::printf("  %-58s %9.4f s\n", "prepared Render, per frame", best_prepared);
+  std::printf("  %-58s %9.4f s\n", "hidden-line: one-shot (edges found per call)", best_hidden_once);
+  std::printf("  %-58s %9.4f s\n", "hidden-line: prepared, per frame", best_hidden_prepared);
+  std::printf("  ratio prepared frame / one-shot = %.3f (with the BVH build: %.3f; hidden-line: %.3f)\n",
+              best_prepared / best_render, best_prepared / best_with_bvh,
+              best_hidden_prepared / best_hidden_once);
+  std::printf("  progressive passes after Restart (1 pixel per 8x8, 4x4, 2x2 block, then all):");
+  for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass) std::printf(" %.4f", best_pass[pass]);
+  std::printf(" s\n");
+  std::printf("  %-58s %9.4f s\n", "first pass of a new ProgressiveRender (fresh buffers)", best_first_fresh);
+  std::printf("  ratio first pass / prepared full frame = %.3f (new ProgressiveRender: %.3f); "
+              "all passes / prepared full frame = %.3f\n",
+              best_pass[0] / best_prepared, best_first_fresh / best_prepared, best_progressive / best_prepared);
   if (!args.json_out.empty()) {
     nlohmann::json j{{"scene", scene.path},
                      {"rig", rig.name},
@@ -125,7 +191,20 @@ int RunRenderBench(const BenchArgs& args) {
                      {"ratio_single", ratio_single},
                      {"render_with_layers_seconds", best_layers},
                      {"ratio_with_layers", best_layers / raw},
-                     {"ratio_single_with_layers", best_layers / raw_single}};
+                     {"ratio_single_with_layers", best_layers / raw_single},
+                     {"one_shot_seconds", best_render},
+                     {"one_shot_with_bvh_seconds", best_with_bvh},
+                     {"prepared_seconds", best_prepared},
+                     {"hidden_line_one_shot_seconds", best_hidden_once},
+                     {"hidden_line_prepared_seconds", best_hidden_prepared},
+                     {"ratio_prepared_to_one_shot", best_prepared / best_render},
+                     {"ratio_prepared_to_one_shot_with_bvh", best_prepared / best_with_bvh},
+                     {"ratio_hidden_line_prepared_to_one_shot", best_hidden_prepared / best_hidden_once},
+                     {"progressive_pass_seconds", best_pass},
+                     {"progressive_first_pass_fresh_seconds", best_first_fresh},
+                     {"ratio_first_pass_fresh_to_frame", best_first_fresh / best_prepared},
+                     {"ratio_first_pass_to_frame", best_pass[0] / best_prepared},
+                     {"ratio_all_passes_to_frame", best_progressive / best_prepared}};
     WriteFileAtomically(json_path, j.dump(2) + "\n");
     output.Commit();
   }

@@ -13,6 +13,7 @@
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/output.h"
+#include "render/prepared_scene.h"
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/vdb_io.h"
@@ -157,10 +158,14 @@ int RunRender(const RenderArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
 
+  // One BVH for the image and the rig checks: the prepared scene renders over it.
   const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const PreparedScene prepared(scene, *caster);
+  std::unique_ptr<PreparedOverlays> overlays;
+  if (fields) overlays = std::make_unique<PreparedOverlays>(*fields, options.overlays);
   options.layers = ext == ".exr";  // the PNG has no room for them
   RenderStats stats;
-  const Image image = RenderWithStats(scene, rig, *caster, view, options, fields.get(), &stats);
+  const Image image = RenderWithStats(prepared, rig, view, options, overlays.get(), &stats);
   if (ext == ".png") WritePng(image, staged);
   else WriteExr(image, staged, int(rig.cameras.size()));
   output.Commit();

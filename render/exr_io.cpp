@@ -18,25 +18,37 @@ namespace pandora {
 void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   const int W = image.width, H = image.height;
   const std::size_t pixels = std::size_t(W) * H;
+  const bool mask = !image.cameras.empty();
   if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels ||
-      image.cameras.size() != pixels || image.resolution.size() != pixels ||
+      (mask && image.cameras.size() != pixels) || image.resolution.size() != pixels ||
       image.sigma_max.size() != pixels || image.depth.size() != pixels)
     throw std::invalid_argument("WriteExr: empty or inconsistent image (every layer needs a value per pixel)");
-  std::vector<uint32_t> lo(pixels), hi;
-  for (std::size_t i = 0; i < pixels; ++i) lo[i] = uint32_t(image.cameras[i] & 0xffffffffu);
-  const bool want_hi = rig_cameras > 32;
+  if (mask != (rig_cameras <= Image::kMaxMaskCameras))
+    throw std::invalid_argument(mask ? "WriteExr: a cameras layer for a rig of more than 64 cameras"
+                                     : "WriteExr: the image has no cameras layer, but the rig has at most 64 cameras");
+  // The camera set: a bitmask for rigs of at most 64 cameras; larger rigs have none (coverage
+  // still counts them all).
+  std::vector<uint32_t> lo, hi;
+  const bool want_hi = mask && rig_cameras > 32;
+  if (mask) {
+    lo.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) lo[i] = uint32_t(image.cameras[i] & 0xffffffffu);
+  }
   if (want_hi) {
     hi.resize(pixels);
     for (std::size_t i = 0; i < pixels; ++i) hi[i] = uint32_t(image.cameras[i] >> 32);
   }
   Imf::Header header(W, H);
   header.compression() = Imf::ZIP_COMPRESSION;
+  const std::string cameras_meaning =
+      mask ? "cameras: bitmask (bit c = rig camera c, bits 32-63 in cameras_hi)"
+           : "cameras: not written, the rig has " + std::to_string(rig_cameras) +
+                 " cameras (a bitmask holds 64; coverage counts them all)";
   header.insert("pandora_layers",
-                Imf::StringAttribute(
-                    "R,G,B: linear light; coverage: cameras seeing the surface point; cameras: "
-                    "bitmask (bit c = rig camera c, bits 32-63 in cameras_hi); resolution: px/m; "
-                    "sigma_max: mm, inf = not triangulable; depth: m along the eye ray, inf = no "
-                    "surface"));
+                Imf::StringAttribute("R,G,B: linear light; coverage: cameras seeing the surface point; " +
+                                     cameras_meaning +
+                                     "; resolution: px/m; sigma_max: mm, inf = not triangulable; depth: "
+                                     "m along the eye ray, inf = no surface"));
   Imf::FrameBuffer fb;
   const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
   auto add_float = [&](const char* name, const float* data, std::size_t x_stride) {
@@ -50,8 +62,10 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   add_float("resolution", image.resolution.data(), 1);
   add_float("sigma_max", image.sigma_max.data(), 1);
   add_float("depth", image.depth.data(), 1);
-  header.channels().insert("cameras", Imf::Channel(Imf::UINT));
-  fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)lo.data(), us, us * W));
+  if (mask) {
+    header.channels().insert("cameras", Imf::Channel(Imf::UINT));
+    fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)lo.data(), us, us * W));
+  }
   if (want_hi) {
     header.channels().insert("cameras_hi", Imf::Channel(Imf::UINT));
     fb.insert("cameras_hi", Imf::Slice(Imf::UINT, (char*)hi.data(), us, us * W));
@@ -103,8 +117,11 @@ Image ReadExr(const std::string& path) {
     fb.insert("cameras_hi", Imf::Slice(Imf::UINT, (char*)(hi.data() - origin), us, us * W));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
-    image.cameras.resize(pixels);
-    for (std::size_t i = 0; i < pixels; ++i) image.cameras[i] = (uint64_t(hi[i]) << 32) | lo[i];
+    // Files of rigs over 64 cameras have no camera set: `cameras` stays empty.
+    if (file.header().channels().findChannel("cameras")) {
+      image.cameras.resize(pixels);
+      for (std::size_t i = 0; i < pixels; ++i) image.cameras[i] = (uint64_t(hi[i]) << 32) | lo[i];
+    }
     image.object.assign(pixels, -1);
     return image;
   } catch (const std::exception& e) {

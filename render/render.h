@@ -7,11 +7,19 @@
 /// unlit. The renderer is the exact CPU reference: one primary ray per sample through Embree, then
 /// one occlusion segment per (sample, camera), traced in packets.
 ///
+/// Two forms: the one-shot Render(scene, rig, caster, view, options, fields), which prepares the
+/// scene for that call, and Render(prepared, rig, view, options, overlays) over a PreparedScene
+/// (render/prepared_scene.h) that holds the per-scene work (triangles, edges, textures, the ray
+/// caster) across frames. Both give the same image bit for bit. ProgressiveRender
+/// (render/progressive.h) gives a coarse image first and refines it, for interactive use. The light
+/// rule itself is render/light.h.
+///
 /// This header is light (no Embree, OpenVDB, OpenEXR or libpng). Overlays from fields come in as a
 /// `Fields` (volume/fields.h), e.g. from ReadFieldsVdb (volume/vdb_io.h).
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,10 +27,13 @@
 #include "analysis/geometry.h"
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
+#include "render/light.h"
 
 namespace pandora {
 
 class Fields;
+class PreparedScene;
+class PreparedOverlays;
 
 /// Where the image is seen from.
 struct RenderView {
@@ -42,12 +53,6 @@ struct RenderView {
 
 /// A RenderView from a named scene view (View::fov_deg unset: `default_fov_deg`).
 RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg = 60.0);
-
-/// What each camera projects.
-enum class Pattern {
-  kUniform,  ///< Uniform light of the camera's colour over its whole footprint.
-  kGrid,     ///< The camera's pixel grid: a line every `grid_pixels` of its pixels (Fig. 2 right).
-};
 
 /// How the surfaces themselves look under the projected light.
 enum class Surface {
@@ -86,12 +91,6 @@ struct OverlayOptions {
   double iso_opacity = 0.45;
 };
 
-/// The default light scale for `enabled_cameras` cameras: min(1, 3 / n). Where k cameras overlap
-/// their colours add, so with n cameras around a region the middle gets about n times one light;
-/// scaling by 3 / n keeps the sum near white there while a spot lit by one camera keeps a third of
-/// full light or more up to 9 cameras (docs/rendering.md, "Brightness", with measurements).
-double DefaultBrightness(int enabled_cameras);
-
 /// The label of a field with its unit, for legends: "coverage [cameras]", "resolution [px/m]",
 /// "sigma_max [mm]", "sigma_mean [mm]", "triangulation_angle [deg]", "condition [1]", and the
 /// steady-state fields like their static ones; other names unchanged.
@@ -123,10 +122,18 @@ struct RenderOptions {
 /// The rendered image and its per-pixel layers (row-major, y down, index y * width + x). The layers
 /// are taken at the first surface hit of the pixel centre's ray (overlays do not change them).
 struct Image {
+  /// Rigs up to this many cameras get the per-pixel camera set as a bitmask (`cameras`).
+  static constexpr int kMaxMaskCameras = 64;
+
   int width = 0, height = 0;
   std::vector<float> rgb;          ///< Linear RGB, 3 per pixel, unclamped (>= 0).
-  std::vector<float> coverage;     ///< Number of enabled cameras that see the surface point.
-  std::vector<uint64_t> cameras;   ///< Bit c set when rig camera c sees it (c < 64).
+  /// Number of enabled cameras that see the surface point: exact for any number of cameras.
+  std::vector<float> coverage;
+  /// Bit c set when rig camera c sees the surface point, for rigs of at most kMaxMaskCameras
+  /// cameras. Empty for larger rigs: a per-pixel set of up to 1000 cameras would not fit a mask, and
+  /// a mask of the first 64 would read as the whole set. There, `coverage` still counts every camera
+  /// and PickPixel lists the cameras that see the point a pixel shows.
+  std::vector<uint64_t> cameras;
   std::vector<float> resolution;   ///< Best pixel density (px/m) among those cameras; 0 if none.
   /// Worst-direction 1-sigma of the static triangulation (mm), as the sigma_max field;
   /// +inf where fewer than two cameras see the point or a direction is unobservable.
@@ -140,18 +147,27 @@ struct Image {
   }
 };
 
-/// Renders `scene` lit by the enabled cameras of `rig`. `caster` must be built from
-/// scene.AllTriangles() (the object index of each triangle is recomputed from the scene).
-/// `fields` (may be null) feeds the slice and isosurface overlays. Throws InputError when an overlay
-/// needs fields and there are none (file "--fields"), when the fields lack the grid ("--slice",
-/// "--iso"; the hint lists the grids present), for a bad view ("--size", "--fov", "--at",
-/// "--camera") and for rigs of more than 64 cameras. Parallel over image tiles (TBB).
+/// Renders one frame of a prepared scene lit by the enabled cameras of `rig`: only per-frame work
+/// (the view's rays, the rig's visibility tests, shading, overlays). `overlays` (may be null) holds
+/// the prepared slice and isosurface that options.overlays asks for. Any number of cameras.
+/// Throws InputError for a bad view ("--size", "--fov", "--at", "--camera") and when an overlay
+/// needs fields and `overlays` is null (file "--fields"); std::invalid_argument when `overlays` was
+/// prepared for another slice or isosurface (PreparedOverlays::Matches). Parallel over image tiles
+/// (TBB); safe to call from several threads at once on the same PreparedScene.
+Image Render(const PreparedScene& scene, const Rig& rig, const RenderView& view,
+             const RenderOptions& options, const PreparedOverlays* overlays = nullptr);
+
+/// The one-shot convenience form: prepares `scene` over `caster` (no BVH is built) and, when
+/// options.overlays asks for them, the overlays from `fields`, then renders as above; the same image
+/// bit for bit. `caster` must be built from scene.AllTriangles(). `fields` may be null when no
+/// overlay needs it. Throws as above, and InputError when the fields lack the grid ("--slice",
+/// "--iso"; the hint lists the grids present).
 Image Render(const Scene& scene, const Rig& rig, const RayCaster& caster, const RenderView& view,
              const RenderOptions& options, const Fields* fields = nullptr);
 
 /// Timing of Render's parts and the ray counts, for `pandora bench --render`.
 struct RenderStats {
-  double seconds = 0;          ///< Whole Render call.
+  double seconds = 0;          ///< Whole Render call (with the preparation in the one-shot form).
   std::size_t primary_rays = 0;
   std::size_t shadow_rays = 0;  ///< Occlusion segments cast (after the geometric tests).
 };
@@ -162,6 +178,50 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
                       const RenderView& view, const RenderOptions& options, const Fields* fields,
                       RenderStats* stats, std::vector<Ray>* primary = nullptr,
                       std::vector<Ray>* shadow = nullptr);
+/// The same over a prepared scene (stats->seconds: the frame only).
+Image RenderWithStats(const PreparedScene& scene, const Rig& rig, const RenderView& view,
+                      const RenderOptions& options, const PreparedOverlays* overlays,
+                      RenderStats* stats, std::vector<Ray>* primary = nullptr,
+                      std::vector<Ray>* shadow = nullptr);
+
+/// What the centre of output pixel (x, y) shows: the surface point and the cameras that see it.
+struct PixelPick {
+  Vec3 point;       ///< First surface hit of the pixel's centre ray (world, m).
+  Vec3 normal;      ///< Geometric unit normal there, turned towards the eye.
+  /// The point the cameras are tested at: `point` lifted off the surface along `normal` by a
+  /// tenth of the visibility epsilon, as the renderer does, so float round-off in the hit cannot
+  /// make a surface shadow itself.
+  Vec3 lit_point;
+  double depth = 0;  ///< Distance from the eye along the ray, m.
+  int object = -1;   ///< Scene object index.
+  int triangle = -1;  ///< Index into scene.AllTriangles().
+  /// Indices (rig order) of the enabled cameras that see lit_point (VisibilityTester::Test with the
+  /// normal): the per-pixel camera set for rigs of any size; its size is the `coverage` layer.
+  std::vector<int> cameras;
+};
+/// Answers "what does output pixel (x, y) show, and which cameras light it" for one frame's rig and
+/// view (a viewer's hover or click; the per-pixel camera set of rigs over 64 cameras). The pixel's
+/// centre ray is the one Render traces, and the point and camera tests are the renderer's; the ray
+/// is cast alone here (RayCaster::Intersect), so with Embree a ray through a shared triangle edge
+/// may, rarely, resolve to the neighbouring triangle of the image's. Keeps references to `scene`
+/// and `rig`, which must outlive it. Immutable; Pick is safe to call from many threads.
+class PixelPicker {
+ public:
+  /// Throws as Render does for a bad view.
+  PixelPicker(const PreparedScene& scene, const Rig& rig, const RenderView& view);
+  ~PixelPicker();
+  /// nullopt when the centre ray hits nothing or lies outside the lens's domain (camera's-eye
+  /// view). Throws std::out_of_range for a pixel outside the image.
+  std::optional<PixelPick> Pick(int x, int y) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// PixelPicker(scene, rig, view).Pick(x, y), for a single pick.
+std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
+                                   int x, int y);
 
 /// 8-bit sRGB PNG of image.rgb (clamped to [0, 1], sRGB transfer curve). Written to a temporary
 /// name and renamed; throws InputError (file = path) when it cannot be written.
@@ -169,10 +229,14 @@ void WritePng(const Image& image, const std::string& path);
 
 /// Single-part, multi-layer scanline OpenEXR (ZIP): float R, G, B (linear) and float layers
 /// `coverage`, `resolution`, `sigma_max`, `depth`, and uint `cameras` (bits 0-31; `cameras_hi`
-/// holds bits 32-63 when the rig has more than 32 cameras). Temporary name, then renamed.
+/// holds bits 32-63 when the rig has more than 32 cameras). For rigs of more than
+/// Image::kMaxMaskCameras cameras (image.cameras empty) neither is written and the header's
+/// `pandora_layers` attribute says why. Temporary name, then renamed. Throws std::invalid_argument
+/// for an inconsistent image (a layer's size, or `cameras` empty for a rig of at most 64 cameras).
 void WriteExr(const Image& image, const std::string& path, int rig_cameras);
 
-/// Reads back an EXR written by WriteExr (tests, tools). Throws InputError when unreadable.
+/// Reads back an EXR written by WriteExr (tests, tools); `cameras` stays empty when the file has no
+/// `cameras` channel. Throws InputError when unreadable.
 Image ReadExr(const std::string& path);
 
 /// Reads a PNG (8-bit RGB or RGBA) into linear RGB (tests, reference images).
