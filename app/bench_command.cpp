@@ -14,6 +14,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "volume/fields.h"
 
@@ -22,14 +23,16 @@ namespace pandora::app {
 int RunBench(const BenchArgs& args) {
   if (args.render) return RunRenderBench(args);
   if (args.incremental) return RunIncrementalBench(args);
-  Scene scene = LoadScene(args.scene);
-  const Rig& rig = FindRigOption(scene, args.rig);
-  if (!std::isnan(args.voxel_size))
-    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
+    if (!std::isnan(args.voxel_size))
+      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  });
+  const Scene& scene = study->scene();
+  const Rig& rig = study->FindRig(args.rig, "--rig");
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 

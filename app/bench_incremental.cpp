@@ -19,6 +19,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "volume/fields.h"
 
@@ -34,15 +35,17 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 int RunIncrementalBench(const BenchArgs& args) {
-  Scene scene = LoadScene(args.scene);
-  const Rig& rig = FindRigOption(scene, args.rig);
-  if (!std::isnan(args.voxel_size))
-    scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
+    if (!std::isnan(args.voxel_size))
+      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
+  });
+  const Scene& scene = study->scene();
+  const Rig& rig = study->FindRig(args.rig, "--rig");
   scene.CheckLength(args.move, "--move", "the distance each camera moves");
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 

@@ -16,6 +16,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "render/prepared_scene.h"
 #include "render/progressive.h"
@@ -32,8 +33,9 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 int RunRenderBench(const BenchArgs& args) {
   const auto [width, height] = ParseImageSize("--size", args.size);
-  const Scene scene = LoadScene(args.scene);
-  const Rig& rig = FindRigOption(scene, args.rig);
+  const auto study = session::Study::Load(args.scene);
+  const Scene& scene = study->scene();
+  const Rig& rig = study->FindRig(args.rig, "--rig");
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
@@ -54,7 +56,7 @@ int RunRenderBench(const BenchArgs& args) {
     view.height = height;
   }
   const std::string view_name = args.view.empty() && !scene.views.empty() ? scene.views.begin()->first : args.view;
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   RenderOptions options;  // the defaults `pandora render` uses for a PNG (no float layers)

@@ -9,6 +9,7 @@
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "volume/surface.h"
 
@@ -23,16 +24,17 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   // Options first: a bad --spacing or --out is reported before the scene's meshes are read.
   CheckPositiveOption("--spacing", args.spacing, "metres");
   if (args.out.empty()) throw InputError("--out", "", "no output file given", "e.g. --out surface.ply");
-  const Scene scene = LoadScene(args.scene);
+  const auto study = session::Study::Load(args.scene);
+  const Scene& scene = study->scene();
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = FindRigOption(scene, args.rig);
+  const Rig& rig = study->FindRig(args.rig, "--rig");
   const SurfaceSelection selection =
       args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
   const std::vector<SurfaceSample> samples =
       SampleSurfaces(scene, args.spacing, args.seed, "--spacing", selection, &rig);
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const std::vector<PointValues> values = PointEvaluator(scene, rig, *caster).EvaluateSamples(samples);
 
   std::int64_t seen = 0, triangulable = 0;

@@ -12,6 +12,7 @@
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
@@ -104,12 +105,14 @@ int RunRender(const RenderArgs& args) {
     options.overlays.iso_value = args.iso_value;
   }
 
-  Scene scene = LoadScene(args.scene);
+  // The study (scene and its ray caster, built once) through the session layer.
+  const auto study = session::Study::Load(args.scene);
+  const Scene& scene = study->scene();
   OutputTransaction output;
   AddSceneInputs(output, scene);
   output.AddInput(args.fields, "fields file");
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = FindRigOption(scene, args.rig);
+  const Rig& rig = study->FindRig(args.rig, "--rig");
   options.pixel_sigma = scene.study.pixel_sigma;
 
   RenderView view;
@@ -158,8 +161,8 @@ int RunRender(const RenderArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
 
-  // One BVH for the image and the rig checks: the prepared scene renders over it.
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  // One BVH for the image and the rig checks: the prepared scene renders over the study's.
+  const RayCaster* caster = &study->caster();
   const PreparedScene prepared(scene, *caster);
   std::unique_ptr<PreparedOverlays> overlays;
   if (fields) overlays = std::make_unique<PreparedOverlays>(*fields, options.overlays);

@@ -15,6 +15,7 @@
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "app/plot.h"
 #include "suggest/suggest.h"
@@ -127,8 +128,10 @@ double TimeToReach(const std::vector<TracePoint>& trace, double target, bool hig
 }  // namespace
 
 int RunSuggest(const SuggestArgs& args) {
-  Scene scene = LoadScene(args.scene);
-  const Rig& file_rig = FindRigOption(scene, args.rig);
+  // The study (scene and its ray caster, built once) through the session layer.
+  const auto study = session::Study::Load(args.scene);
+  const Scene& scene = study->scene();
+  const Rig& file_rig = study->FindRig(args.rig, "--rig");
   SuggestOptions options;
   options.scene_path = scene.path;
 
@@ -266,7 +269,7 @@ int RunSuggest(const SuggestArgs& args) {
     perturbed = true;
   }
 
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const std::vector<TargetPoint> targets =
       SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
 
