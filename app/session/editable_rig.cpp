@@ -27,8 +27,8 @@ bool SameCamera(const Camera& a, const Camera& b) {
 EditableRig::EditableRig(Rig rig)
     : rig_(std::move(rig)), saved_(rig_), camera_versions_(rig_.cameras.size(), 0) {}
 
-void EditableRig::Set(const std::vector<CameraChange>& changes, bool forward) {
-  for (const CameraChange& c : changes) {
+void EditableRig::Set(const std::vector<CameraEdit>& changes, bool forward) {
+  for (const CameraEdit& c : changes) {
     rig_.cameras.at(c.index) = forward ? c.after : c.before;
     ++camera_versions_.at(c.index);
   }
@@ -36,7 +36,7 @@ void EditableRig::Set(const std::vector<CameraChange>& changes, bool forward) {
 }
 
 void EditableRig::Apply(Edit edit) {
-  for (const CameraChange& c : edit.changes) {
+  for (const CameraEdit& c : edit.changes) {
     if (c.index < 0 || c.index >= static_cast<int>(rig_.cameras.size()))
       throw std::logic_error("edit '" + edit.label + "': no camera " + std::to_string(c.index));
     if (!SameCamera(rig_.cameras[c.index], c.before))
@@ -71,19 +71,19 @@ int EditableRig::Find(const std::string& id) const {
 }
 
 void EditableRig::SetPose(int index, const Eigen::Isometry3d& world_from_camera) {
-  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  CameraEdit c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
   c.after.world_from_camera = world_from_camera;
   Apply({"move " + c.before.id, {c}});
 }
 
 void EditableRig::SetEnabled(int index, bool enabled) {
-  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  CameraEdit c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
   c.after.enabled = enabled;
   Apply({std::string(enabled ? "enable " : "disable ") + c.before.id, {c}});
 }
 
 void EditableRig::SetIntrinsics(int index, const Intrinsics& intrinsics) {
-  CameraChange c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
+  CameraEdit c{index, rig_.cameras.at(index), rig_.cameras.at(index)};
   c.after.model = CameraModel(intrinsics);
   Apply({"lens of " + c.before.id, {c}});
 }
@@ -96,7 +96,7 @@ void EditableRig::SetPoses(const std::vector<Pose>& poses, const std::string& la
     if (index < 0)
       throw InputError(file, "", "rig '" + rig_.name + "' has no camera '" + p.id + "'",
                        "was the suggestion made for another rig or scene?");
-    CameraChange c{index, rig_.cameras[index], rig_.cameras[index]};
+    CameraEdit c{index, rig_.cameras[index], rig_.cameras[index]};
     c.after.world_from_camera = p.pose;
     if (p.focal_scale != 1.0) {
       Intrinsics k = c.after.model.intrinsics();

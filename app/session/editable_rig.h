@@ -14,7 +14,7 @@
 namespace pandora::session {
 
 /// One camera's state before and after an edit.
-struct CameraChange {
+struct CameraEdit {
   int index = 0;  ///< In the rig.
   Camera before, after;
 };
@@ -22,7 +22,7 @@ struct CameraChange {
 /// A user action: one or more cameras changed together (a drag, a suggestion accepted in memory).
 struct Edit {
   std::string label;  ///< For menus: "move c03", "accept suggestion (3 cameras)".
-  std::vector<CameraChange> changes;
+  std::vector<CameraEdit> changes;
 };
 
 class EditableRig {
@@ -67,7 +67,7 @@ class EditableRig {
   void MarkSaved() { saved_ = rig_; }
 
  private:
-  void Set(const std::vector<CameraChange>& changes, bool forward);
+  void Set(const std::vector<CameraEdit>& changes, bool forward);
   Rig rig_, saved_;
   std::int64_t version_ = 0;
   std::vector<std::int64_t> camera_versions_;

@@ -54,6 +54,47 @@ Fields Session::TakeFields() {
   return evaluator_->TakeFields();
 }
 
+std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options) {
+  auto rig = std::make_shared<Rig>(rig_.rig());
+  auto data = std::make_shared<std::pair<std::vector<TargetPoint>, SuggestOptions>>(
+      std::move(targets), std::move(options));
+  {
+    std::lock_guard<std::mutex> lock(suggestion_mutex_);
+    suggestion_.reset();
+  }
+  const std::int64_t job = jobs_.Submit("suggest", [this, rig, data](JobContext& context) {
+    Suggestion s = Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
+    if (context.cancelled()) return;  // a newer suggestion was asked for
+    std::lock_guard<std::mutex> lock(suggestion_mutex_);
+    suggestion_ = std::move(s);
+  });
+  std::lock_guard<std::mutex> lock(suggestion_mutex_);
+  suggestion_job_ = job;
+  return job;
+}
+
+std::optional<Suggestion> Session::WaitSuggestion(JobStatus* status) {
+  const JobStatus s = jobs_.Wait("suggest");
+  if (status) *status = s;
+  std::lock_guard<std::mutex> lock(suggestion_mutex_);
+  if (s.state != JobState::kDone || s.id != suggestion_job_) return std::nullopt;
+  return suggestion_;
+}
+
+void Session::ApplySuggestion(const Suggestion& suggestion) {
+  std::vector<EditableRig::Pose> poses;
+  for (const pandora::CameraChange& c : suggestion.cameras) {
+    const int index = rig_.Find(c.id);
+    if (index < 0 || rig_.rig().cameras[index].world_from_camera.matrix() != c.before.matrix())
+      throw InputError(study_->scene().path, "",
+                       "camera '" + c.id + "' is no longer where the suggestion started from",
+                       "ask for a new suggestion on the rig as it is now");
+    poses.push_back({c.id, c.after, c.focal_scale});
+  }
+  rig_.SetPoses(poses, "accept suggestion (" + std::to_string(poses.size()) + " cameras)",
+                study_->scene().path);
+}
+
 SaveResult Session::Save(bool force) {
   const Scene& scene = study_->scene();
   if (saved_text_.empty())

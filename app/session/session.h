@@ -9,12 +9,14 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/session/editable_rig.h"
 #include "app/session/jobs.h"
 #include "app/session/study.h"
+#include "suggest/suggest.h"
 #include "volume/fields.h"
 
 namespace pandora::session {
@@ -58,6 +60,18 @@ class Session {
   /// Moves the fields out (a command that writes them); the next update evaluates in full.
   Fields TakeFields();
 
+  /// Runs Suggest on the rig as it is now, as a background job of kind "suggest" (latest wins: a
+  /// suggestion asked for later replaces a waiting one; a running one finishes but its result is
+  /// dropped). Returns the job id; WaitSuggestion() gives the result.
+  std::int64_t SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options);
+  /// Waits for the suggest job; the suggestion of the newest job, or nothing when it failed (the
+  /// status says why) or was replaced.
+  std::optional<Suggestion> WaitSuggestion(JobStatus* status = nullptr);
+  /// Applies a suggestion's poses and zooms to the rig in memory as one undo step (the person
+  /// accepts; nothing is written until Save). Throws InputError when a selected camera is no longer
+  /// where the suggestion started from (the rig was edited since).
+  void ApplySuggestion(const Suggestion& suggestion);
+
   /// Writes the edited cameras' poses and focal lengths into the scene file, keeping a backup, as
   /// `pandora accept` does (each in its camera's own form). Refuses (InputError) when the file
   /// changed on disk since it was loaded or last saved (unless `force`), when the study has no file
@@ -73,6 +87,9 @@ class Session {
   mutable std::mutex fields_mutex_;
   std::unique_ptr<FieldEvaluator> evaluator_;
   std::int64_t fields_version_ = -1;
+  std::mutex suggestion_mutex_;
+  std::optional<Suggestion> suggestion_;
+  std::int64_t suggestion_job_ = 0;
   Jobs jobs_;  // last: destroyed (workers joined) first
 };
 

@@ -79,7 +79,7 @@ TEST(EditableRig, UndoAndRedoRestoreEveryCameraExactly) {
   EXPECT_FALSE(rig.can_redo());
   EXPECT_FALSE(rig.Redo());
   // An edit made against an older state is refused.
-  CameraChange stale{0, original.cameras[0], original.cameras[0]};
+  CameraEdit stale{0, original.cameras[0], original.cameras[0]};
   EXPECT_THROW(rig.Apply({"stale", {stale}}), std::logic_error);
   // Several cameras at once are one undo step.
   rig.SetPoses({{original.cameras[0].id, original.cameras[0].world_from_camera, 1.0},
@@ -167,6 +167,42 @@ TEST(Session, FieldsFollowEditsUndoAndBackgroundUpdates) {
   }
   session.UpdateFields();
   ExpectFieldsOf(session, original, options.fields);
+}
+
+// The interactive suggest-and-accept loop in memory: a suggestion runs in the background on the rig
+// as it is, is applied as one undo step, undone, and refused once the rig has moved on.
+TEST(Session, SuggestInTheBackgroundThenApplyAndUndo) {
+  const auto study = Study::Load("tests/data/suggest_ring.json");
+  SessionOptions options;
+  options.fields.fields = {"coverage"};
+  Session session(study, options);
+  const Rig original = session.rig().rig();
+  SuggestOptions so;
+  so.cameras = {0};
+  so.limits.resize(1);
+  so.limits[0].max_move = 0.3;
+  so.limits[0].max_rotate_deg = 10;
+  so.screening_candidates = 20;
+  so.outer_iterations = 2;
+  so.scene_path = study->scene().path;
+  const auto targets = SampleTargets(study->scene(), 200, {}, false, 1);
+  session.SuggestInBackground(targets, so);
+  JobStatus status;
+  const std::optional<Suggestion> s = session.WaitSuggestion(&status);
+  ASSERT_TRUE(s) << JobStateName(status.state) << " " << status.error;
+  ASSERT_EQ(s->cameras.size(), 1u);
+  session.ApplySuggestion(*s);
+  EXPECT_EQ(session.rig().rig().cameras[0].world_from_camera.matrix(), s->cameras[0].after.matrix());
+  EXPECT_EQ(session.rig().undo_label(), "accept suggestion (1 cameras)");
+  // The fields follow the accepted poses.
+  session.UpdateFields();
+  ExpectFieldsOf(session, session.rig().rig(), options.fields);
+  ASSERT_TRUE(session.rig().Undo());
+  EXPECT_TRUE(SameRig(session.rig().rig(), original));
+  // Camera 0 moves by hand: the suggestion no longer applies.
+  session.rig().SetPose(0, Moved(original.cameras[0], Vec3(0.01, 0, 0)));
+  if (!s->cameras[0].after.isApprox(original.cameras[0].world_from_camera))
+    EXPECT_THROW(session.ApplySuggestion(*s), InputError);
 }
 
 TEST(Session, UnknownRigNamesTheOption) {
