@@ -557,4 +557,14 @@ std::optional<Eigen::Isometry3d> LookAt(const Vec3& position, const Vec3& target
   return world_from_camera;
 }
 
+bool SameCameraGeometry(const Camera& a, const Camera& b) {
+  const Intrinsics& p = a.model.intrinsics();
+  const Intrinsics& q = b.model.intrinsics();
+  return a.enabled == b.enabled && a.world_from_camera.matrix() == b.world_from_camera.matrix() &&
+         a.near == b.near && a.far == b.far && a.pixel_sigma == b.pixel_sigma &&
+         p.width == q.width && p.height == q.height && p.fx == q.fx && p.fy == q.fy &&
+         p.cx == q.cx && p.cy == q.cy && p.model == q.model && p.k1 == q.k1 && p.k2 == q.k2 &&
+         p.p1 == q.p1 && p.p2 == q.p2 && p.k3 == q.k3 && p.k4 == q.k4;
+}
+
 }  // namespace pandora

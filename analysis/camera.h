@@ -133,6 +133,11 @@ struct Camera {
 /// Builds world_from_camera from a position, a point to look at and an up vector (world frame). The
 /// camera's z axis points at `target`, its y axis (down in the image) is opposite `up` projected.
 /// Returns nullopt when target == position or up is parallel to the viewing direction.
+/// True when two cameras see alike: the same pose, lens (every intrinsic), working range, pixel noise
+/// and enabled state, bit for bit; ids, names and colours aside. What decides whether fields or
+/// images of a camera must be computed again.
+bool SameCameraGeometry(const Camera& a, const Camera& b);
+
 std::optional<Eigen::Isometry3d> LookAt(const Vec3& position, const Vec3& target, const Vec3& up);
 
 }  // namespace pandora

@@ -298,16 +298,6 @@ struct BlockState {
   std::vector<Ray> rays;                       // with record_rays
 };
 
-bool SameForFields(const Camera& a, const Camera& b) {
-  const Intrinsics& p = a.model.intrinsics();
-  const Intrinsics& q = b.model.intrinsics();
-  return a.enabled == b.enabled && a.world_from_camera.matrix() == b.world_from_camera.matrix() &&
-         a.near == b.near && a.far == b.far && a.pixel_sigma == b.pixel_sigma &&
-         p.width == q.width && p.height == q.height && p.fx == q.fx && p.fy == q.fy &&
-         p.cx == q.cx && p.cy == q.cy && p.model == q.model && p.k1 == q.k1 && p.k2 == q.k2 &&
-         p.p1 == q.p1 && p.p2 == q.p2 && p.k3 == q.k3 && p.k4 == q.k4;
-}
-
 // What a rig needs per camera during an update.
 struct RigData {
   std::unique_ptr<VisibilityTester> tester;
@@ -868,7 +858,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   std::vector<int> changed;
   for (int c = 0; c < std::max(new_count, old_count); ++c)
     if (!S.evaluated || c >= old_count || c >= new_count ||
-        !SameForFields(S.rig.cameras[c], rig.cameras[c]))
+        !SameCameraGeometry(S.rig.cameras[c], rig.cameras[c]))
       changed.push_back(c);
   update.full = !S.evaluated;
   update.changed_cameras = static_cast<int>(changed.size());

@@ -74,8 +74,6 @@ class EditableRig {
   std::vector<Edit> undo_, redo_;
 };
 
-/// True when two cameras give the same fields and images: pose, lens, range, pixel noise, enabled
-/// (names and colours aside).
-bool SameCameraGeometry(const Camera& a, const Camera& b);
+using pandora::SameCameraGeometry;  // analysis/camera.h
 
 }  // namespace pandora::session
