@@ -1,6 +1,6 @@
 #include "app/plot.h"
 
-#include "volume/colormap.h"
+#include "analysis/color.h"
 
 #include <algorithm>
 #include <cmath>

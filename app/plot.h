@@ -83,7 +83,7 @@ struct BarChart {
 /// Renders `chart` as a standalone SVG document. With no category the plot says "no data".
 std::string RenderBarChartSvg(const BarChart& chart);
 
-/// A horizontal colour bar legend for a viridis-coloured image (volume/colormap.h): the ramp from
+/// A horizontal colour bar legend for a viridis-coloured image (analysis/color.h): the ramp from
 /// `min` to `max` with ticks, the label (quantity and unit), and swatches for the special colours.
 struct Colorbar {
   std::string label;   ///< E.g. "sigma_max (mm)".

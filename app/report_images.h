@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "render/render.h"
-#include "volume/colormap.h"
+#include "analysis/color.h"
 #include "volume/slice.h"
 
 namespace pandora::app {

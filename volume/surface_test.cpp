@@ -19,7 +19,7 @@
 #include "analysis/visibility.h"
 #include "volume/fields_vdb.h"
 #include "volume/slice.h"
-#include "volume/colormap.h"
+#include "analysis/color.h"
 #include "volume/surface.h"
 #include "tests/random_scene.h"
 
