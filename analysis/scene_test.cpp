@@ -768,7 +768,8 @@ TEST(SceneQueriesTest, FindCameraById) {
     "look_at": [1, 1, 1], "resolution": [10, 10], "hfov_deg": 40})"));
   scene["rigs"][0]["cameras"].push_back(json::parse(R"({"id": "c 2", "position": [0, 2, 1],
     "look_at": [1, 2, 1], "resolution": [10, 10], "hfov_deg": 40, "enabled": false})"));
-  const Rig& rig = Parse(scene).rigs[0];
+  const Scene parsed = Parse(scene);
+  const Rig& rig = parsed.rigs[0];
   EXPECT_EQ(rig.FindCamera("c0"), 0);
   EXPECT_EQ(rig.FindCamera("7"), 1);  // numeric ids are read as text
   EXPECT_EQ(rig.FindCamera("c 2"), 2);  // disabled cameras are found too
