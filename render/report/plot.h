@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace pandora::app {
+namespace pandora::report {
 
 /// One data series. Points whose x or y is not finite and positive cannot be placed on log axes;
 /// they are skipped and break the line there.
@@ -109,4 +109,4 @@ double NiceStep(double raw);
 /// bin_width is not itself such a number, the smallest whole multiple of it >= min_step.
 double NiceLabelStep(double bin_width, double min_step);
 
-}  // namespace pandora::app
+}  // namespace pandora::report

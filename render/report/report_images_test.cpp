@@ -1,7 +1,7 @@
 // Report images: base64 against RFC 4648's test vectors, PNG bytes that decode to the same 8-bit
 // values, slice colours from the colour map (analysis/color.h, tested by color_test) and the two
 // special colours.
-#include "app/report_images.h"
+#include "render/report/report_images.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-namespace pandora::app {
+namespace pandora::report {
 namespace {
 
 TEST(Base64, Rfc4648TestVectors) {
@@ -47,8 +47,7 @@ TEST(EncodePng, EveryEightBitValueSurvives) {
   int worst = 0;
   for (std::size_t i = 0; i < r.rgb.size(); ++i) {
     // ReadPng returns linear RGB: encode with the sRGB curve to compare the stored bytes.
-    const double v = back.rgb[i];
-    const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+    const double s = SrgbFromLinear(back.rgb[i]);
     worst = std::max(worst, std::abs(int(std::lround(255 * s)) - int(r.rgb[i])));
   }
   EXPECT_EQ(worst, 0);
@@ -81,4 +80,4 @@ TEST(SliceRaster, ColoursAndScale) {
 }
 
 }  // namespace
-}  // namespace pandora::app
+}  // namespace pandora::report
