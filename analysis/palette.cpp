@@ -92,9 +92,4 @@ double DeltaE2000(const Vec3& lab1, const Vec3& lab2) {
   return std::sqrt(l * l + c * c + h * h + RT * c * h);
 }
 
-double LinearFromSrgb(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
 }  // namespace pandora

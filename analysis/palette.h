@@ -7,6 +7,7 @@
 /// gives the table and the measured distances. The scene loader gives every camera without a
 /// "color" in the file the palette colour of its index in the rig.
 
+#include "analysis/color.h"
 #include "analysis/geometry.h"
 
 namespace pandora {
@@ -25,8 +26,5 @@ Vec3 LabFromLinearRgb(const Vec3& rgb);
 
 /// CIEDE2000 colour difference of two CIELAB colours (Sharma, Wu and Dalal 2005, kL = kC = kH = 1).
 double DeltaE2000(const Vec3& lab1, const Vec3& lab2);
-
-/// The sRGB transfer curve's inverse, per channel: an sRGB value in [0, 1] (clamped) to linear.
-double LinearFromSrgb(double v);
 
 }  // namespace pandora

@@ -18,6 +18,7 @@
 #include "analysis/input_file.h"
 #include "analysis/mesh_io.h"
 #include "analysis/palette.h"
+#include "analysis/pose.h"
 #include "analysis/primitives.h"
 #include "analysis/sha256.h"
 
@@ -739,13 +740,7 @@ Eigen::Isometry3d ReadPose(const Node& node) {
   if (auto n = euler.Find("yaw")) yaw = n->Number() * kDegree;
   if (auto n = euler.Find("pitch")) pitch = n->Number() * kDegree;
   if (auto n = euler.Find("roll")) roll = n->Number() * kDegree;
-  Mat3 base;  // Columns: camera x, y, z in the world. Looks along +X, image right = -Y, down = -Z.
-  base << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  pose.linear() =
-      (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3::UnitY()) *
-       Eigen::AngleAxisd(roll, Vec3::UnitX()))
-          .toRotationMatrix() *
-      base;
+  pose.linear() = RotationFromYawPitchRoll(yaw, pitch, roll);  // analysis/pose.h
   return pose;
 }
 

@@ -46,6 +46,20 @@ struct Rig {
     for (const Camera& c : cameras) n += c.enabled ? 1 : 0;
     return n;
   }
+  /// Index in `cameras` of the camera with id `id`, or -1 when there is none (ids are unique in a
+  /// loaded rig; otherwise the first match).
+  int FindCamera(const std::string& id) const {
+    for (std::size_t c = 0; c < cameras.size(); ++c)
+      if (cameras[c].id == id) return static_cast<int>(c);
+    return -1;
+  }
+  /// The camera ids in rig order, comma-separated ("c0, c1, c2"), for the hint of an error about an
+  /// unknown id.
+  std::string CameraIds() const {
+    std::string ids;
+    for (const Camera& c : cameras) ids += (ids.empty() ? "" : ", ") + c.id;
+    return ids;
+  }
 };
 
 /// The region of interest: a box, or a closed mesh (voxels whose centre is inside it).

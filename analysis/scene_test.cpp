@@ -762,6 +762,24 @@ TEST(SceneStudyTest, ViewsAreParsed) {
   EXPECT_INPUT_ERROR(ErrorFor(scene), "$.views.top.at", "parallel");
 }
 
+TEST(SceneQueriesTest, FindCameraById) {
+  json scene = BaseScene();
+  scene["rigs"][0]["cameras"].push_back(json::parse(R"({"id": 7, "position": [0, 1, 1],
+    "look_at": [1, 1, 1], "resolution": [10, 10], "hfov_deg": 40})"));
+  scene["rigs"][0]["cameras"].push_back(json::parse(R"({"id": "c 2", "position": [0, 2, 1],
+    "look_at": [1, 2, 1], "resolution": [10, 10], "hfov_deg": 40, "enabled": false})"));
+  const Scene parsed = Parse(scene);
+  const Rig& rig = parsed.rigs[0];
+  EXPECT_EQ(rig.FindCamera("c0"), 0);
+  EXPECT_EQ(rig.FindCamera("7"), 1);  // numeric ids are read as text
+  EXPECT_EQ(rig.FindCamera("c 2"), 2);  // disabled cameras are found too
+  EXPECT_EQ(rig.FindCamera("c"), -1);
+  EXPECT_EQ(rig.FindCamera(""), -1);
+  EXPECT_EQ(rig.CameraIds(), "c0, 7, c 2");
+  EXPECT_EQ(Rig().FindCamera("c0"), -1);
+  EXPECT_EQ(Rig().CameraIds(), "");
+}
+
 TEST(SceneQueriesTest, AllTrianglesBoundsAndFindRig) {
   json scene = BaseScene();
   scene["objects"] = json::parse(R"([

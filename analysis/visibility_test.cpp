@@ -5,23 +5,16 @@
 #include <random>
 
 #include "analysis/visibility.h"
+#include "tests/fixtures.h"
 #include "tests/random_scene.h"
 
 namespace pandora {
 namespace {
 
+// A pinhole camera (tests/fixtures.h) with Z up and a working range.
 Camera MakePinhole(const Vec3& position, const Vec3& target, double hfov_deg, int w, int h,
                    double near = 0.0, double far = std::numeric_limits<double>::infinity()) {
-  Intrinsics k;
-  k.width = w;
-  k.height = h;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, w, LensModel::kPinhole);
-  k.cx = (w - 1) / 2.0;
-  k.cy = (h - 1) / 2.0;
-  Camera cam;
-  cam.id = "c";
-  cam.model = CameraModel(k);
-  cam.world_from_camera = *LookAt(position, target, Vec3(0, 0, 1));
+  Camera cam = testing::TestCamera("c", position, target, hfov_deg, w, h, LensModel::kPinhole, Vec3(0, 0, 1));
   cam.near = near;
   cam.far = far;
   return cam;

@@ -1,28 +1,11 @@
 #include "render/colormap.h"
 
-#include "volume/colormap.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <map>
 
 namespace pandora {
-
-Vec3 ViridisSrgb(double t) {
-  const std::array<double, 3> c = ViridisUnit(t);  // volume/colormap.h: one viridis everywhere
-  return Vec3(c[0], c[1], c[2]);
-}
-
-double SrgbFromLinear(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-}
-
-Vec3 ViridisLinear(double t) {
-  const Vec3 s = ViridisSrgb(t);
-  return Vec3(LinearFromSrgb(s.x()), LinearFromSrgb(s.y()), LinearFromSrgb(s.z()));
-}
 
 namespace {
 

@@ -36,14 +36,6 @@ std::string Format(const char* fmt, double v) {
   return buf;
 }
 
-Mat3 BaseRotation() {
-  Mat3 b;
-  b.col(0) = Vec3(0, -1, 0);
-  b.col(1) = Vec3(0, 0, -1);
-  b.col(2) = Vec3(1, 0, 0);
-  return b;
-}
-
 double WrapDeg(double a) {
   a = std::fmod(a + 180.0, 360.0);
   if (a < 0) a += 360.0;
@@ -227,30 +219,7 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
 }
 
 // ---------------------------------------------------------------------------------------------
-// Euler angles and perturbation
-
-Vec3 YawPitchRollDeg(const Mat3& R) {
-  const Mat3 M = R * BaseRotation().transpose();  // Rz(yaw) Ry(b) Rx(roll), b = -pitch
-  const double sb = std::clamp(-M(2, 0), -1.0, 1.0);
-  const double b = std::asin(sb);
-  double yaw, roll;
-  if (std::abs(sb) > 1.0 - 1e-12) {  // gimbal lock: roll folded into yaw
-    roll = 0;
-    yaw = std::atan2(-M(0, 1), M(1, 1));
-  } else {
-    yaw = std::atan2(M(1, 0), M(0, 0));
-    roll = std::atan2(M(2, 1), M(2, 2));
-  }
-  return Vec3(Deg(yaw), Deg(-b), Deg(roll));
-}
-
-Mat3 RotationFromYawPitchRollDeg(const Vec3& ypr) {
-  const Mat3 M = (Eigen::AngleAxisd(Rad(ypr.x()), Vec3::UnitZ()) *
-                  Eigen::AngleAxisd(-Rad(ypr.y()), Vec3::UnitY()) *
-                  Eigen::AngleAxisd(Rad(ypr.z()), Vec3::UnitX()))
-                     .toRotationMatrix();
-  return M * BaseRotation();
-}
+// Perturbation (the Euler angles are analysis/pose.h)
 
 Rig PerturbCameras(const Rig& rig, const std::vector<int>& cameras, double move, double rotate_deg,
                    std::uint64_t seed) {

@@ -15,6 +15,7 @@
 
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
+#include "analysis/pose.h"  // the Euler angles snap_rotate_deg rounds
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 
@@ -189,11 +190,6 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
 Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& caster,
                           const std::vector<TargetPoint>& targets, const SuggestOptions& options,
                           std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step = false);
-
-/// Scene-format Euler angles (degrees) of a world_from_camera rotation:
-/// R = Rz(yaw) Ry(-pitch) Rx(roll) R_base (docs/scene-format.md), and back.
-Vec3 YawPitchRollDeg(const Mat3& world_from_camera);
-Mat3 RotationFromYawPitchRollDeg(const Vec3& yaw_pitch_roll_deg);
 
 /// Moves each listed camera `move` metres in a random direction and turns it `rotate_deg` about a
 /// random axis perpendicular to its optical axis (a pan / tilt away from where it looked; seeded),

@@ -147,25 +147,6 @@ TEST(SuggestObjective, ParsesNamesAndRejectsOthers) {
   EXPECT_EQ(ObjectiveName(*ParseObjective("coverage4")), "coverage4");
 }
 
-TEST(SuggestEuler, RoundTripAndBase) {
-  // All zero: camera looks along +X, image right is -Y, image down is -Z (docs/scene-format.md).
-  const Mat3 base = RotationFromYawPitchRollDeg(Vec3::Zero());
-  EXPECT_TRUE(base.col(0).isApprox(Vec3(0, -1, 0)));
-  EXPECT_TRUE(base.col(1).isApprox(Vec3(0, 0, -1)));
-  EXPECT_TRUE(base.col(2).isApprox(Vec3(1, 0, 0)));
-  // Positive yaw turns left toward +Y; positive pitch tilts the view up.
-  EXPECT_GT(RotationFromYawPitchRollDeg(Vec3(10, 0, 0)).col(2).y(), 0.1);
-  EXPECT_GT(RotationFromYawPitchRollDeg(Vec3(0, 10, 0)).col(2).z(), 0.1);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-170, 170), p(-85, 85);
-  for (int i = 0; i < 200; ++i) {
-    const Vec3 ypr(u(rng), p(rng), u(rng));
-    const Mat3 R = RotationFromYawPitchRollDeg(ypr);
-    EXPECT_TRUE(YawPitchRollDeg(R).isApprox(ypr, 1e-9)) << ypr.transpose();
-    EXPECT_TRUE(RotationFromYawPitchRollDeg(YawPitchRollDeg(R)).isApprox(R, 1e-12));
-  }
-}
-
 TEST(SuggestExact, CoverageEqualsDirectCount) {
   Fixture f(SceneText(1.0), 500);
   Objective o;

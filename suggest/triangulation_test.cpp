@@ -17,36 +17,33 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "analysis/visibility.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
 
+// A 1280 x 960 camera (tests/fixtures.h) with Z up, an off-centre principal point and the lens
+// model's coefficients (Brown-Conrady k1 k2 p1 p2 k3, fisheye k1..k4).
 Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, LensModel model,
                   double hfov_deg, const std::array<double, 5>& coefficients = {}) {
-  Intrinsics k;
-  k.width = 1280;
-  k.height = 960;
-  k.model = model;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, k.width, model);
-  k.cx = (k.width - 1) / 2.0 + 7.3;  // off-centre principal point
-  k.cy = (k.height - 1) / 2.0 - 4.1;
-  if (model == LensModel::kBrownConrady) {
-    k.k1 = coefficients[0];
-    k.k2 = coefficients[1];
-    k.p1 = coefficients[2];
-    k.p2 = coefficients[3];
-    k.k3 = coefficients[4];
-  } else if (model == LensModel::kFisheye) {
-    k.k1 = coefficients[0];
-    k.k2 = coefficients[1];
-    k.k3 = coefficients[2];
-    k.k4 = coefficients[3];
-  }
-  Camera c;
-  c.id = id;
-  c.model = CameraModel(k);
-  c.world_from_camera = LookAt(position, target, Vec3(0, 0, 1)).value();
-  return c;
+  return testing::WithIntrinsics(
+      testing::TestCamera(id, position, target, hfov_deg, 1280, 960, model, Vec3(0, 0, 1)),
+      [&](Intrinsics& k) {
+        k.cx += 7.3;  // off-centre principal point
+        k.cy -= 4.1;
+        if (model == LensModel::kBrownConrady) {
+          k.k1 = coefficients[0];
+          k.k2 = coefficients[1];
+          k.p1 = coefficients[2];
+          k.p2 = coefficients[3];
+          k.k3 = coefficients[4];
+        } else if (model == LensModel::kFisheye) {
+          k.k1 = coefficients[0];
+          k.k2 = coefficients[1];
+          k.k3 = coefficients[2];
+          k.k4 = coefficients[3];
+        }
+      });
 }
 
 // Three rigs around a point near (0.3, -0.2, 1.1): pinhole, strongly distorted Brown-Conrady (all

@@ -1,58 +1,6 @@
 #pragma once
 /// \file colormap.h
-/// The viridis colour map (perceptually uniform, readable in greyscale and by colour-blind readers)
-/// for field images, surface-sample colours and legends. Piecewise linear in sRGB through nine
-/// evenly spaced stops of matplotlib's viridis table (#440154 ... #fde725). Against the table's
-/// samples at k/9 (R's viridis(10)) it is within 5 8-bit steps per channel (report_images_test),
-/// invisible in a figure.
+/// Moved: viridis, Rgb8 and HexColor are analysis/color.h, the one colour module. This forwarding
+/// header only keeps branches written before the move compiling; include analysis/color.h.
 
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstdint>
-
-namespace pandora {
-
-/// An 8-bit sRGB colour.
-struct Rgb8 {
-  std::uint8_t r = 0, g = 0, b = 0;
-};
-
-/// Viridis at t in [0, 1] (clamped; NaN gives the t = 0 colour) as sRGB components in [0, 1],
-/// unrounded. The one viridis of the project: the renderer's slices and legends, the report's
-/// images and the PLY colours all come from here.
-inline std::array<double, 3> ViridisUnit(double t) {
-  static constexpr std::array<std::array<int, 3>, 9> kStops{{{0x44, 0x01, 0x54},
-                                                             {0x47, 0x2d, 0x7b},
-                                                             {0x3b, 0x52, 0x8b},
-                                                             {0x2c, 0x72, 0x8e},
-                                                             {0x21, 0x91, 0x8c},
-                                                             {0x28, 0xae, 0x80},
-                                                             {0x5e, 0xc9, 0x62},
-                                                             {0xad, 0xdc, 0x30},
-                                                             {0xfd, 0xe7, 0x25}}};
-  if (!(t > 0)) t = 0;  // also NaN
-  if (t > 1) t = 1;
-  const double x = t * (kStops.size() - 1);
-  const int i = std::min(static_cast<int>(x), static_cast<int>(kStops.size()) - 2);
-  const double f = x - i;
-  std::array<double, 3> c;
-  for (int k = 0; k < 3; ++k) c[k] = (kStops[i][k] + f * (kStops[i + 1][k] - kStops[i][k])) / 255.0;
-  return c;
-}
-
-/// Viridis at t as an 8-bit sRGB colour.
-inline Rgb8 Viridis(double t) {
-  const std::array<double, 3> c = ViridisUnit(t);
-  auto byte = [](double v) { return static_cast<std::uint8_t>(std::lround(255.0 * v)); };
-  return {byte(c[0]), byte(c[1]), byte(c[2])};
-}
-
-/// "#rrggbb" of a colour.
-inline std::array<char, 8> HexColor(Rgb8 c) {
-  static constexpr char kHex[] = "0123456789abcdef";
-  return {'#',           kHex[c.r >> 4], kHex[c.r & 15], kHex[c.g >> 4],
-          kHex[c.g & 15], kHex[c.b >> 4], kHex[c.b & 15], '\0'};
-}
-
-}  // namespace pandora
+#include "analysis/color.h"

@@ -12,29 +12,35 @@ double Fraction(std::int64_t part, std::int64_t whole) {
   return whole > 0 ? static_cast<double>(part) / static_cast<double>(whole) : 0.0;
 }
 
-// Percentile p in [0, 100] by the nearest-rank method (a value that occurs in the data), or null
-// when there is none.
-nlohmann::json Percentile(std::vector<float> values, double p) {
-  if (values.empty()) return nullptr;
-  const std::size_t rank = static_cast<std::size_t>(
-      std::clamp(std::ceil(p / 100.0 * values.size()), 1.0, double(values.size())));
-  std::nth_element(values.begin(), values.begin() + (rank - 1), values.end());
-  return values[rank - 1];
-}
-
-nlohmann::json Percentiles(const std::vector<float>& values) {
-  return {{"p50", Percentile(values, 50)}, {"p90", Percentile(values, 90)},
-          {"p99", Percentile(values, 99)}};
+SigmaPercentiles Percentiles(const std::vector<float>& values) {
+  return {NearestRankPercentile(values, 50), NearestRankPercentile(values, 90),
+          NearestRankPercentile(values, 99)};
 }
 
 std::int64_t CountAtMost(const std::vector<float>& values, double limit) {
   return std::count_if(values.begin(), values.end(), [&](float v) { return v <= limit; });
 }
 
+nlohmann::json Value(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json Json(const SigmaPercentiles& p) {
+  return {{"p50", Value(p.p50)}, {"p90", Value(p.p90)}, {"p99", Value(p.p99)}};
+}
+
 }  // namespace
 
-nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
-                               const std::vector<int>& percentiles) {
+std::optional<double> NearestRankPercentile(std::vector<float> values, double p) {
+  if (values.empty()) return std::nullopt;
+  const std::size_t rank = static_cast<std::size_t>(
+      std::clamp(std::ceil(p / 100.0 * values.size()), 1.0, double(values.size())));
+  std::nth_element(values.begin(), values.begin() + (rank - 1), values.end());
+  return values[rank - 1];
+}
+
+std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, const std::string& name,
+                                                        const std::vector<int>& percentiles) {
   std::vector<float> values;
   if (const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name)) {
     values.reserve(grid->activeVoxelCount());
@@ -45,104 +51,169 @@ nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
         values.insert(values.end(), it.getVoxelCount(), *it);
     }
   }
+  std::vector<std::optional<double>> out;
+  for (int p : percentiles) out.push_back(NearestRankPercentile(values, p));
+  return out;
+}
+
+nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
+                               const std::vector<int>& percentiles) {
+  const std::vector<std::optional<double>> values = GridPercentileValues(fields, name, percentiles);
   nlohmann::json j = nlohmann::json::object();
-  for (int p : percentiles) j["p" + std::to_string(p)] = Percentile(values, p);
+  for (std::size_t i = 0; i < percentiles.size(); ++i)
+    j["p" + std::to_string(percentiles[i])] = Value(values[i]);
   return j;
 }
 
-nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
-                           const std::vector<std::string>& field_names, int threads,
-                           const std::vector<Warning>& warnings) {
+Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
+                  const std::vector<std::string>& field_names, int threads,
+                  const std::vector<Warning>& warnings) {
   const FieldStats& st = fields.stats;
   const std::int64_t region = st.active_set.region_voxels;
-  nlohmann::json j;
-  j["scene"] = scene.path;
-  j["scene_sha256"] = scene.sha256;
-  j["rig"] = rig.name;
-  j["cameras"] = rig.enabled_count();
-  j["fields"] = field_names;
-  j["voxel_size_m"] = fields.lattice.voxel_size;
-  const Aabb& box = scene.study.region.box;
-  j["region"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
-                 {"max", {box.max.x(), box.max.y(), box.max.z()}},
-                 {"dims", {fields.lattice.dims.x(), fields.lattice.dims.y(), fields.lattice.dims.z()}},
-                 {"kind", scene.study.region.kind == Region::Kind::kBox ? "box" : "mesh"}};
-  j["region_voxels"] = region;
-  j["solid_voxels"] = st.active_set.solid_voxels;
-  j["active_voxels"] = st.seen_voxels;
+  Summary s;
+  s.scene = scene.path;
+  s.scene_sha256 = scene.sha256;
+  s.rig = rig.name;
+  s.cameras = rig.enabled_count();
+  s.fields = field_names;
+  s.voxel_size_m = fields.lattice.voxel_size;
+  s.region = scene.study.region.box;
+  s.region_dims = fields.lattice.dims;
+  s.region_kind = scene.study.region.kind;
+  s.region_voxels = region;
+  s.solid_voxels = st.active_set.solid_voxels;
+  s.active_voxels = st.seen_voxels;
 
   std::int64_t at_least[4] = {0, 0, 0, 0};
   for (std::size_t k = 0; k < st.coverage_histogram.size(); ++k)
     for (std::size_t m = 1; m <= 3; ++m)
       if (k >= m) at_least[m] += st.coverage_histogram[k];
-  j["coverage"] = {{"ge1", Fraction(at_least[1], region)},
-                   {"ge2", Fraction(at_least[2], region)},
-                   {"ge3", Fraction(at_least[3], region)},
-                   {"histogram", st.coverage_histogram}};
-  if (std::find(field_names.begin(), field_names.end(), "resolution") != field_names.end())
-    j["resolution_px_per_m"] = GridPercentiles(fields, "resolution", {10, 50, 90});
+  s.coverage.ge1 = Fraction(at_least[1], region);
+  s.coverage.ge2 = Fraction(at_least[2], region);
+  s.coverage.ge3 = Fraction(at_least[3], region);
+  s.coverage.histogram = st.coverage_histogram;
+  if (std::find(field_names.begin(), field_names.end(), "resolution") != field_names.end()) {
+    const std::vector<std::optional<double>> p = GridPercentileValues(fields, "resolution", {10, 50, 90});
+    s.resolution_px_per_m = ResolutionPercentiles{p[0], p[1], p[2]};
+  }
 
-  nlohmann::json per_camera = nlohmann::json::array();
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[c];
-    const std::int64_t seen = c < st.per_camera_seen.size() ? st.per_camera_seen[c] : 0;
-    const LensCoverage lens = ComputeLensCoverage(cam.model);
-    per_camera.push_back(
-        {{"id", cam.id},
-         {"name", cam.name},
-         {"enabled", cam.enabled},
-         {"visible_voxels", seen},
-         {"visible_fraction", Fraction(seen, region)},
-         {"fov_deg",
-          {{"nominal", {lens.nominal_hfov_deg, lens.nominal_vfov_deg}},
-           {"effective", {lens.hfov_deg, lens.vfov_deg}}}},
-         {"unreachable_pixels", lens.unreachable_fraction}});
+    CameraSummary pc;
+    pc.id = cam.id;
+    pc.name = cam.name;
+    pc.enabled = cam.enabled;
+    pc.visible_voxels = c < st.per_camera_seen.size() ? st.per_camera_seen[c] : 0;
+    pc.visible_fraction = Fraction(pc.visible_voxels, region);
+    pc.lens = ComputeLensCoverage(cam.model);
+    s.per_camera.push_back(std::move(pc));
   }
-  j["per_camera"] = per_camera;
 
-  const bool uncertainty = std::any_of(field_names.begin(), field_names.end(), IsUncertaintyField);
-  if (uncertainty) {
-    // Fractions of the free region voxels; sigma in mm over the triangulable voxels.
-    nlohmann::json u{{"triangulable", Fraction(st.triangulable_voxels, region)},
-                     {"triangulable_voxels", st.triangulable_voxels},
-                     {"unobservable_voxels", st.unobservable_voxels},
-                     {"pixel_sigma", scene.study.pixel_sigma},
-                     {"sigma_max_mm", Percentiles(st.sigma_max_mm)}};
+  if (std::any_of(field_names.begin(), field_names.end(), IsUncertaintyField)) {
+    UncertaintySummary u;
+    u.triangulable = Fraction(st.triangulable_voxels, region);
+    u.triangulable_voxels = st.triangulable_voxels;
+    u.unobservable_voxels = st.unobservable_voxels;
+    u.pixel_sigma = scene.study.pixel_sigma;
+    u.sigma_max_mm = Percentiles(st.sigma_max_mm);
     if (scene.study.max_sigma_mm) {
-      u["max_sigma_mm"] = *scene.study.max_sigma_mm;
-      u["meets_max_sigma"] = Fraction(CountAtMost(st.sigma_max_mm, *scene.study.max_sigma_mm), region);
+      u.max_sigma_mm = *scene.study.max_sigma_mm;
+      u.meets_max_sigma = Fraction(CountAtMost(st.sigma_max_mm, *scene.study.max_sigma_mm), region);
     }
-    // With a motion model the steady-state keys are always there: percentiles are null when no
-    // voxel is triangulable (or the steady fields were not asked for), the share meeting the
-    // target is then 0.
     if (scene.study.motion) {
-      u["motion"] = {{"q", scene.study.motion->q},
-                     {"rate_hz", scene.study.motion->rate_hz},
-                     {"covariance", scene.study.steady_prior ? "prior" : "posterior"}};
-      u["sigma_max_steady_mm"] = Percentiles(st.sigma_max_steady_mm);
+      u.motion = *scene.study.motion;
+      u.steady_prior = scene.study.steady_prior;
+      u.sigma_max_steady_mm = Percentiles(st.sigma_max_steady_mm);
       if (scene.study.max_sigma_mm)
-        u["meets_max_sigma_steady"] =
+        u.meets_max_sigma_steady =
             Fraction(CountAtMost(st.sigma_max_steady_mm, *scene.study.max_sigma_mm), region);
     }
-    j["uncertainty"] = u;
+    s.uncertainty = u;
   }
+  s.warnings = warnings;
+  s.timing.seconds = st.seconds;
+  s.timing.active_set_seconds = st.active_set_seconds;
+  s.timing.rays = st.rays;
+  s.timing.point_camera_tests = st.point_camera_tests;
+  s.timing.threads = threads;
+  return s;
+}
 
+void to_json(nlohmann::json& j, const Summary& s) {
+  j = nlohmann::json::object();
+  j["scene"] = s.scene;
+  j["scene_sha256"] = s.scene_sha256;
+  j["rig"] = s.rig;
+  j["cameras"] = s.cameras;
+  j["fields"] = s.fields;
+  j["voxel_size_m"] = s.voxel_size_m;
+  const Aabb& box = s.region;
+  j["region"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
+                 {"max", {box.max.x(), box.max.y(), box.max.z()}},
+                 {"dims", {s.region_dims.x(), s.region_dims.y(), s.region_dims.z()}},
+                 {"kind", s.region_kind == Region::Kind::kBox ? "box" : "mesh"}};
+  j["region_voxels"] = s.region_voxels;
+  j["solid_voxels"] = s.solid_voxels;
+  j["active_voxels"] = s.active_voxels;
+  j["coverage"] = {{"ge1", s.coverage.ge1},
+                   {"ge2", s.coverage.ge2},
+                   {"ge3", s.coverage.ge3},
+                   {"histogram", s.coverage.histogram}};
+  if (s.resolution_px_per_m)
+    j["resolution_px_per_m"] = {{"p10", Value(s.resolution_px_per_m->p10)},
+                                {"p50", Value(s.resolution_px_per_m->p50)},
+                                {"p90", Value(s.resolution_px_per_m->p90)}};
+  nlohmann::json per_camera = nlohmann::json::array();
+  for (const CameraSummary& c : s.per_camera)
+    per_camera.push_back({{"id", c.id},
+                          {"name", c.name},
+                          {"enabled", c.enabled},
+                          {"visible_voxels", c.visible_voxels},
+                          {"visible_fraction", c.visible_fraction},
+                          {"fov_deg",
+                           {{"nominal", {c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg}},
+                            {"effective", {c.lens.hfov_deg, c.lens.vfov_deg}}}},
+                          {"unreachable_pixels", c.lens.unreachable_fraction}});
+  j["per_camera"] = per_camera;
+  if (s.uncertainty) {
+    const UncertaintySummary& u = *s.uncertainty;
+    nlohmann::json uj{{"triangulable", u.triangulable},
+                      {"triangulable_voxels", u.triangulable_voxels},
+                      {"unobservable_voxels", u.unobservable_voxels},
+                      {"pixel_sigma", u.pixel_sigma},
+                      {"sigma_max_mm", Json(u.sigma_max_mm)}};
+    if (u.max_sigma_mm) uj["max_sigma_mm"] = *u.max_sigma_mm;
+    if (u.meets_max_sigma) uj["meets_max_sigma"] = *u.meets_max_sigma;
+    if (u.motion) {
+      uj["motion"] = {{"q", u.motion->q},
+                      {"rate_hz", u.motion->rate_hz},
+                      {"covariance", u.steady_prior ? "prior" : "posterior"}};
+      uj["sigma_max_steady_mm"] = Json(u.sigma_max_steady_mm);
+      if (u.meets_max_sigma_steady) uj["meets_max_sigma_steady"] = *u.meets_max_sigma_steady;
+    }
+    j["uncertainty"] = uj;
+  }
   nlohmann::json list = nlohmann::json::array();
-  for (const Warning& w : warnings)
+  for (const Warning& w : s.warnings)
     list.push_back({{"kind", WarningKindName(w.kind)},
                     {"camera", w.camera},
                     {"path", w.json_path},
                     {"message", w.reason}});
   j["warnings"] = list;
+  j["timing"] = {{"seconds", s.timing.seconds},
+                 {"active_set_seconds", s.timing.active_set_seconds},
+                 {"rays", s.timing.rays},
+                 {"rays_per_second", s.timing.rays_per_second()},
+                 {"point_camera_tests", s.timing.point_camera_tests},
+                 {"tests_per_second", s.timing.tests_per_second()},
+                 {"threads", s.timing.threads}};
+}
 
-  const double secs = st.seconds;
-  j["timing"] = {{"seconds", secs},
-                 {"active_set_seconds", st.active_set_seconds},
-                 {"rays", st.rays},
-                 {"rays_per_second", secs > 0 ? st.rays / secs : 0.0},
-                 {"point_camera_tests", st.point_camera_tests},
-                 {"tests_per_second", secs > 0 ? st.point_camera_tests / secs : 0.0},
-                 {"threads", threads}};
+nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
+                           const std::vector<std::string>& field_names, int threads,
+                           const std::vector<Warning>& warnings) {
+  nlohmann::json j;
+  to_json(j, Summarize(scene, rig, fields, field_names, threads, warnings));
   return j;
 }
 

@@ -12,7 +12,7 @@
 #include "analysis/error.h"
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
-#include "volume/colormap.h"
+#include "analysis/color.h"
 
 namespace pandora {
 namespace {

@@ -19,8 +19,9 @@
 #include "analysis/visibility.h"
 #include "volume/fields_vdb.h"
 #include "volume/slice.h"
-#include "volume/colormap.h"
+#include "analysis/color.h"
 #include "volume/surface.h"
+#include "tests/fixtures.h"
 #include "tests/random_scene.h"
 
 #include <unistd.h>
@@ -28,33 +29,14 @@
 namespace pandora {
 namespace {
 
+// A 640 x 480 camera (tests/fixtures.h) with a working range of 5 cm to 20 m and an optional k1.
 Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, double hfov_deg,
                   LensModel model = LensModel::kPinhole, double k1 = 0) {
-  Intrinsics k;
-  k.width = 640;
-  k.height = 480;
-  k.model = model;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, k.width, model);
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.k1 = k1;
-  Camera cam;
-  cam.id = id;
-  cam.model = CameraModel(k);
-  const Vec3 up = std::abs((target - position).normalized().z()) > 0.99 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
-  cam.world_from_camera = LookAt(position, target, up).value();
+  Camera cam = testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 640, 480, model),
+                                       [&](Intrinsics& k) { k.k1 = k1; });
   cam.near = 0.05;
   cam.far = 20;
   return cam;
-}
-
-SceneObject Object(const std::string& name, TriangleMesh mesh, const Vec3& at, bool solid) {
-  for (Vec3& v : mesh.vertices) v += at;
-  SceneObject o;
-  o.name = name;
-  o.mesh = std::move(mesh);
-  o.solid = solid;
-  return o;
 }
 
 // A floor sheet, a solid ball and a solid post; five cameras (one below the floor, one with
@@ -62,9 +44,9 @@ SceneObject Object(const std::string& name, TriangleMesh mesh, const Vec3& at, b
 Scene TestScene() {
   Scene scene;
   scene.path = "test.json";
-  scene.objects.push_back(Object("floor", MakePlane(Vec2(2.0, 2.0)), Vec3(0, 0, -0.01), false));
-  scene.objects.push_back(Object("ball", MakeSphere(0.3, 24), Vec3(0.1, 0.0, 0.35), true));
-  scene.objects.push_back(Object("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true));
+  scene.objects.push_back(testing::TestObject("floor", MakePlane(Vec2(2.0, 2.0)), Vec3(0, 0, -0.01), false));
+  scene.objects.push_back(testing::TestObject("ball", MakeSphere(0.3, 24), Vec3(0.1, 0.0, 0.35), true));
+  scene.objects.push_back(testing::TestObject("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true));
   Rig rig;
   rig.name = "mixed";
   rig.cameras.push_back(MakeCamera("c0", Vec3(3, 0, 1.5), Vec3(0, 0, 0), 50));
@@ -143,7 +125,7 @@ TEST(SurfaceSampling, UniformOverAPlane) {
   // 24 degrees of freedom below its 0.999 quantile (51.2). Sampling without the square root in the
   // barycentric map crowds the points towards one corner and fails this by far.
   Scene scene;
-  scene.objects.push_back(Object("plane", MakePlane(Vec2(1.0, 1.0)), Vec3(0, 0, 0), false));
+  scene.objects.push_back(testing::TestObject("plane", MakePlane(Vec2(1.0, 1.0)), Vec3(0, 0, 0), false));
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, 0.01, 3);
   ASSERT_NEAR(double(samples.size()), 10000.0, 3.0);
   std::vector<double> cells(25, 0.0);
@@ -165,7 +147,7 @@ TEST(SurfaceSampling, UniformOverAPlane) {
 // brings that face back. Sheets (single-sided planes) facing into a room are kept, facing out not.
 TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
   Scene scene;
-  scene.objects.push_back(Object("cube", MakeBox(Vec3(1, 1, 1)), Vec3(2.5, 0, 0), true));
+  scene.objects.push_back(testing::TestObject("cube", MakeBox(Vec3(1, 1, 1)), Vec3(2.5, 0, 0), true));
   scene.study.region.box.min = Vec3(-1, -1, -1);
   scene.study.region.box.max = Vec3(1, 1, 1);
   EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kAll), 6.0, 1e-12);
@@ -210,7 +192,7 @@ TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
 // faces, the facing selection drops samples, yet its seen samples are exactly those of all.
 TEST(SurfaceSampling, FacingDropsNoSeenSample) {
   Scene scene = TestScene();
-  scene.objects.push_back(Object("crate", MakeBox(Vec3(1, 1, 1)), Vec3(0, -3, 0.5), true));
+  scene.objects.push_back(testing::TestObject("crate", MakeBox(Vec3(1, 1, 1)), Vec3(0, -3, 0.5), true));
   const Rig& rig = scene.rigs[0];
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const PointEvaluator evaluator(scene, rig, *caster);
@@ -405,7 +387,7 @@ TEST(PointEvaluator, TwoOrthogonalPinholesClosedForm) {
   rig.cameras.push_back(MakeCamera("y", Vec3(0, d, 0), Vec3(0, 0, 0), 60));
   scene.rigs.push_back(rig);
   scene.study.pixel_sigma = sigma;
-  scene.objects.push_back(Object("far", MakeBox(Vec3(0.1, 0.1, 0.1)), Vec3(5, 5, 5), true));
+  scene.objects.push_back(testing::TestObject("far", MakeBox(Vec3(0.1, 0.1, 0.1)), Vec3(5, 5, 5), true));
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const PointValues v = PointEvaluator(scene, rig, *caster).Evaluate(Vec3::Zero());
   const double f = rig.cameras[0].model.intrinsics().fx;

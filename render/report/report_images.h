@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "analysis/color.h"
 #include "render/render.h"
-#include "volume/colormap.h"
 #include "volume/slice.h"
 
-namespace pandora::app {
+namespace pandora::report {
 
 /// Row-major 8-bit sRGB, 3 bytes per pixel, row 0 at the top.
 struct Raster {
@@ -48,4 +48,4 @@ std::string Base64(const std::string& bytes);
 /// "data:MIME;base64,..." of `bytes`.
 std::string DataUri(const std::string& mime, const std::string& bytes);
 
-}  // namespace pandora::app
+}  // namespace pandora::report

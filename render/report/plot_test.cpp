@@ -1,5 +1,5 @@
 // The SVG log-log plot writer: decade ranges, skipped points, escaping, legend-only keys.
-#include "app/plot.h"
+#include "render/report/plot.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <limits>
 #include <string>
 
-namespace pandora::app {
+namespace pandora::report {
 namespace {
 
 int Count(const std::string& text, const std::string& what) {
@@ -200,4 +200,4 @@ TEST(Colorbar, DiscreteBoxesAndSwatches) {
   EXPECT_NE(r.find("\u22654<"), std::string::npos) << r;
 }
 }  // namespace
-}  // namespace pandora::app
+}  // namespace pandora::report

@@ -1,6 +1,6 @@
-#include "app/plot.h"
+#include "render/report/plot.h"
 
-#include "volume/colormap.h"
+#include "analysis/color.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <sstream>
 
-namespace pandora::app {
+namespace pandora::report {
 namespace {
 
 // Tableau 10, colour-blind friendly enough for a handful of series.
@@ -492,4 +492,4 @@ std::string RenderColorbarSvg(const Colorbar& bar) {
   o << "</svg>\n";
   return o.str();
 }
-}  // namespace pandora::app
+}  // namespace pandora::report

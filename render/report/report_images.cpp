@@ -1,4 +1,4 @@
-#include "app/report_images.h"
+#include "render/report/report_images.h"
 
 #include <unistd.h>
 
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace pandora::app {
+namespace pandora::report {
 
 Raster SliceRaster(const FieldSlice& slice, double min, double max, int scale) {
   scale = std::max(1, scale);
@@ -56,13 +56,10 @@ std::string EncodePng(const Raster& raster) {
   if (raster.width <= 0 || raster.height <= 0 ||
       raster.rgb.size() != 3 * static_cast<std::size_t>(raster.width) * raster.height)
     throw std::invalid_argument("EncodePng: empty raster or wrong buffer size");
-  // Inverse sRGB transfer curve per 8-bit value.
+  // Inverse sRGB transfer curve per 8-bit value (analysis/color.h).
   static const std::array<float, 256> linear = [] {
     std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) {
-      const double v = i / 255.0;
-      t[i] = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-    }
+    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(LinearFromSrgb(i / 255.0));
     return t;
   }();
   Image image;
@@ -103,4 +100,4 @@ std::string DataUri(const std::string& mime, const std::string& bytes) {
   return "data:" + mime + ";base64," + Base64(bytes);
 }
 
-}  // namespace pandora::app
+}  // namespace pandora::report

@@ -1,0 +1,44 @@
+#pragma once
+/// \file accuracy_tables.h
+/// The outputs of `pandora accuracy` from the studies of suggest/accuracy.h: per study a titled
+/// table (aligned text for the terminal, Markdown for accuracy_tables.md) with notes, a CSV file and
+/// an SVG log-log plot of error against run time.
+
+#include <string>
+#include <vector>
+
+#include "render/report/table.h"
+#include "suggest/accuracy.h"
+
+namespace pandora::report {
+
+/// One study's outputs.
+struct AccuracySection {
+  std::string title;
+  Table table;
+  std::vector<std::string> notes;
+  std::string csv_name, csv;  ///< e.g. "accuracy_voxel.csv" and its text.
+  std::string svg_name, svg;  ///< e.g. "accuracy_voxel.svg" and its SVG document.
+
+  /// What the terminal shows: a blank line, the title, the table, then "  note: ..." lines.
+  std::string Text() const;
+  /// The section of accuracy_tables.md: "## title", the table, the notes as a list.
+  std::string Markdown() const;
+};
+
+/// (a) accuracy_voxel.{csv,svg}: per voxel size its time, the coverage errors in percentage points
+/// and the sigma_max percentile errors in percent against the finest size.
+AccuracySection VoxelSection(const VoxelStudy& study);
+
+/// (b) accuracy_montecarlo.{csv,svg}: per trial count the time per point and the mean and largest
+/// relative errors against J^-1, with the prediction's own time; `threads` is noted (the trials run
+/// in parallel, the prediction on one thread).
+AccuracySection MonteCarloSection(const MonteCarloStudy& study, int threads);
+
+/// (c) accuracy_steady.{csv,svg}: per case and solver the iterations, time per voxel and error.
+AccuracySection SteadySection(const SteadyStudy& study);
+
+/// "# pandora accuracy: SCENE, rig RIG" and a blank line: the head of accuracy_tables.md.
+std::string AccuracyTablesHeading(const std::string& scene_path, const std::string& rig);
+
+}  // namespace pandora::report

@@ -1,0 +1,179 @@
+// The typed summary (volume/summary.h) against closed forms and brute force: nearest-rank
+// percentiles of known lists, the free-voxel count of a box region around a solid cube, coverage
+// and per-camera counts from VisibilityTester on every voxel centre, the sigma_max and resolution
+// percentiles from the per-point evaluation (analysis/uncertainty.h), and summary.json as the
+// typed value's JSON form.
+#include "volume/summary.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/primitives.h"
+#include "analysis/uncertainty.h"
+#include "analysis/visibility.h"
+#include "tests/fixtures.h"
+#include "volume/active_set.h"
+
+namespace pandora {
+namespace {
+
+TEST(NearestRankPercentile, KnownLists) {
+  std::vector<float> v{10, 1, 9, 2, 8, 3, 7, 4, 6, 5};  // 1..10 shuffled
+  EXPECT_EQ(*NearestRankPercentile(v, 50), 5.0);   // ceil(0.5 * 10) = 5th smallest
+  EXPECT_EQ(*NearestRankPercentile(v, 90), 9.0);
+  EXPECT_EQ(*NearestRankPercentile(v, 99), 10.0);  // ceil(9.9) = 10th
+  EXPECT_EQ(*NearestRankPercentile(v, 0), 1.0);    // at least the first
+  EXPECT_EQ(*NearestRankPercentile(v, 100), 10.0);
+  EXPECT_EQ(*NearestRankPercentile({0.25f}, 50), 0.25);
+  EXPECT_FALSE(NearestRankPercentile({}, 50));
+}
+
+// The box room with a solid cube in the middle of a 1 m region at 0.1 m voxels, a ring of six
+// cameras and a seventh that is disabled.
+struct RoomSetup {
+  Scene scene;
+  Rig rig;
+  std::unique_ptr<RayCaster> caster;
+  RoomSetup() {
+    scene = testing::BoxRoom(Vec3(4, 4, 2.5), 0.1);
+    scene.objects.push_back(testing::TestObject("cube", MakeBox(Vec3(0.35, 0.35, 0.35)), Vec3(0, 0, 0.5), true));
+    scene.study.pixel_sigma = 0.5;
+    scene.study.max_sigma_mm = 2.0;
+    rig = testing::RingRig(6, 1.8, 1.2, Vec3(0, 0, 0.5), 70);
+    rig.cameras.push_back(testing::TestCamera("off", Vec3(0, 1.8, 1.5), Vec3(0, 0, 0.5)));
+    rig.cameras.back().enabled = false;
+    rig.name = "ring";
+    scene.rigs = {rig};
+    caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  }
+};
+
+TEST(Summarize, CountsAndPercentilesMatchBruteForce) {
+  const RoomSetup s;
+  const std::vector<std::string> names{"coverage", "cameras", "resolution", "sigma_max"};
+  FieldOptions options;
+  options.fields = names;
+  const Fields fields = EvaluateFields(s.scene, s.rig, *s.caster, options);
+  const Summary summary = Summarize(s.scene, s.rig, fields, names, 3);
+
+  // Closed form: 10 x 10 x 10 centres, of which 4 x 4 x 4 lie inside the 0.35 m cube.
+  EXPECT_EQ(summary.region_dims, Eigen::Vector3i(10, 10, 10));
+  EXPECT_EQ(summary.solid_voxels, 64);
+  EXPECT_EQ(summary.region_voxels, 1000 - 64);
+  EXPECT_EQ(summary.cameras, 6);
+  EXPECT_EQ(summary.rig, "ring");
+  EXPECT_EQ(summary.timing.threads, 3);
+
+  // Brute force over every free voxel centre with the exact visibility rules.
+  std::vector<Camera> enabled(s.rig.cameras.begin(), s.rig.cameras.begin() + 6);
+  const VisibilityTester tester(enabled, *s.caster, s.scene.ContentBounds().diagonal());
+  const VoxelLattice lattice = MakeLattice(s.scene.study.region.box, 0.1, s.scene.path);
+  const Aabb cube{Vec3(-0.175, -0.175, 0.325), Vec3(0.175, 0.175, 0.675)};
+  std::int64_t free = 0, at_least[4] = {0, 0, 0, 0};
+  std::vector<std::int64_t> seen_by(7, 0);
+  std::vector<float> sigma_mm, resolution;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 10; ++k) {
+        const Vec3 X = lattice.Center(i, j, k);
+        if (cube.Contains(X)) continue;
+        ++free;
+        int count = 0;
+        double best = 0;
+        InformationBuilder info;
+        for (int c = 0; c < 6; ++c) {
+          Mat23 A;
+          if (tester.Test(c, X, nullptr, &A) != ViewResult::kSeen) continue;
+          ++count;
+          ++seen_by[c];
+          best = std::max(best, PixelDensity(A));
+          info.Add(A, 0.5);
+        }
+        for (int m = 1; m <= 3; ++m) at_least[m] += count >= m;
+        if (count > 0) resolution.push_back(static_cast<float>(best));
+        const StaticUncertainty u = StaticFromInformation(info.Decompose(), info.cameras());
+        if (u.triangulable) sigma_mm.push_back(static_cast<float>(1e3 * u.sigma_max));
+      }
+  ASSERT_EQ(free, summary.region_voxels);
+  EXPECT_GT(at_least[2], 0);
+  EXPECT_LT(at_least[3], free);  // the cube hides some voxels from most cameras
+  EXPECT_DOUBLE_EQ(summary.coverage.ge1, double(at_least[1]) / free);
+  EXPECT_DOUBLE_EQ(summary.coverage.ge2, double(at_least[2]) / free);
+  EXPECT_DOUBLE_EQ(summary.coverage.ge3, double(at_least[3]) / free);
+  ASSERT_EQ(summary.per_camera.size(), 7u);
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_EQ(summary.per_camera[c].visible_voxels, seen_by[c]) << c;
+    EXPECT_DOUBLE_EQ(summary.per_camera[c].visible_fraction, double(seen_by[c]) / free);
+    EXPECT_TRUE(summary.per_camera[c].enabled);
+  }
+  EXPECT_FALSE(summary.per_camera[6].enabled);
+  EXPECT_EQ(summary.per_camera[6].visible_voxels, 0);
+  EXPECT_EQ(summary.per_camera[6].id, "off");
+  // A pinhole's effective FOV is its nominal one: 70 degrees across.
+  EXPECT_NEAR(summary.per_camera[0].lens.hfov_deg, 70.0, 1e-9);
+
+  // Percentiles from the per-point evaluation (the fields' fast path agrees to round-off).
+  ASSERT_TRUE(summary.uncertainty);
+  EXPECT_EQ(summary.uncertainty->triangulable_voxels, static_cast<std::int64_t>(sigma_mm.size()));
+  for (auto [p, value] : {std::pair{50, summary.uncertainty->sigma_max_mm.p50},
+                          std::pair{90, summary.uncertainty->sigma_max_mm.p90},
+                          std::pair{99, summary.uncertainty->sigma_max_mm.p99}}) {
+    ASSERT_TRUE(value) << p;
+    EXPECT_NEAR(*value, *NearestRankPercentile(sigma_mm, p), 1e-5 * *value) << p;
+  }
+  const double meets = std::count_if(sigma_mm.begin(), sigma_mm.end(), [](float v) { return v <= 2.0; });
+  EXPECT_NEAR(*summary.uncertainty->meets_max_sigma, meets / free, 2.0 / free);
+  EXPECT_FALSE(summary.uncertainty->motion);
+  ASSERT_TRUE(summary.resolution_px_per_m);
+  EXPECT_NEAR(*summary.resolution_px_per_m->p50, *NearestRankPercentile(resolution, 50),
+              1e-5 * *summary.resolution_px_per_m->p50);
+  EXPECT_NEAR(*summary.resolution_px_per_m->p10, *NearestRankPercentile(resolution, 10),
+              1e-5 * *summary.resolution_px_per_m->p10);
+}
+
+TEST(Summarize, JsonIsTheTypedValue) {
+  RoomSetup s;
+  s.scene.study.motion = MotionModel{1.0, 60.0};
+  const std::vector<std::string> names{"coverage", "sigma_max", "sigma_max_steady"};
+  FieldOptions options;
+  options.fields = names;
+  const Fields fields = EvaluateFields(s.scene, s.rig, *s.caster, options);
+  std::vector<Warning> warnings{{Warning::Kind::kSeesNoRegion, "c9", "$.rigs[0].cameras[9]", "sees nothing"}};
+  const Summary typed = Summarize(s.scene, s.rig, fields, names, 2, warnings);
+  const nlohmann::json j = MakeSummary(s.scene, s.rig, fields, names, 2, warnings);
+  EXPECT_EQ(j, nlohmann::json(typed));
+  EXPECT_EQ(j["region_voxels"].get<std::int64_t>(), typed.region_voxels);
+  EXPECT_EQ(j["coverage"]["ge2"].get<double>(), typed.coverage.ge2);
+  EXPECT_EQ(j["coverage"]["histogram"].get<std::vector<std::int64_t>>(), typed.coverage.histogram);
+  EXPECT_FALSE(j.contains("resolution_px_per_m"));  // not asked for
+  const nlohmann::json& u = j["uncertainty"];
+  EXPECT_EQ(u["sigma_max_mm"]["p90"].get<double>(), *typed.uncertainty->sigma_max_mm.p90);
+  EXPECT_EQ(u["motion"]["rate_hz"].get<double>(), 60.0);
+  EXPECT_EQ(u["motion"]["covariance"], "posterior");
+  EXPECT_EQ(u["sigma_max_steady_mm"]["p50"].get<double>(), *typed.uncertainty->sigma_max_steady_mm.p50);
+  EXPECT_EQ(u["max_sigma_mm"].get<double>(), 2.0);
+  EXPECT_TRUE(u.contains("meets_max_sigma_steady"));
+  // The steady state is tighter than one frame.
+  EXPECT_LT(*typed.uncertainty->sigma_max_steady_mm.p50, *typed.uncertainty->sigma_max_mm.p50);
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["warnings"][0]["kind"], "sees_no_region");
+  EXPECT_EQ(j["warnings"][0]["camera"], "c9");
+  EXPECT_EQ(j["per_camera"][6]["enabled"], false);
+  EXPECT_EQ(j["region"]["dims"], nlohmann::json({10, 10, 10}));
+  EXPECT_EQ(j["timing"]["threads"], 2);
+
+  // No triangulable voxel: the percentiles are null, the steady keys still there.
+  RoomSetup one;
+  one.rig.cameras.resize(1);
+  one.scene.study.motion = MotionModel{1.0, 60.0};
+  const Fields single = EvaluateFields(one.scene, one.rig, *one.caster, options);
+  const nlohmann::json j1 = MakeSummary(one.scene, one.rig, single, names, 1);
+  EXPECT_TRUE(j1["uncertainty"]["sigma_max_mm"]["p50"].is_null());
+  EXPECT_TRUE(j1["uncertainty"]["sigma_max_steady_mm"]["p99"].is_null());
+  EXPECT_EQ(j1["uncertainty"]["meets_max_sigma_steady"], 0.0);
+}
+
+}  // namespace
+}  // namespace pandora
