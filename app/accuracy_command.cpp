@@ -13,6 +13,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "render/report/accuracy_tables.h"
 #include "suggest/accuracy.h"
@@ -22,8 +23,9 @@ namespace pandora::app {
 int RunAccuracy(const AccuracyArgs& args) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = Clock::now();
-  const Scene scene = LoadScene(args.scene);
-  const Rig rig = FindRigOption(scene, args.rig);
+  const auto study = session::Study::Load(args.scene);  // the scene and its ray caster, once
+  const Scene& scene = study->scene();
+  const Rig rig = study->FindRig(args.rig, "--rig");
   const AccuracyOptions options = args.quick ? AccuracyOptions::Quick() : AccuracyOptions();
   options.Check();
   OutputTransaction output;
@@ -37,7 +39,7 @@ int RunAccuracy(const AccuracyArgs& args) {
               scene.path.c_str(), rig.name.c_str(), rig.enabled_count(), 1e3 * scene.study.voxel_size,
               scene.study.pixel_sigma, threads, args.quick ? ", quick" : "");
   std::fflush(stdout);
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
 
   std::string markdown = report::AccuracyTablesHeading(scene.path, rig.name);
   std::vector<std::string> written;

@@ -62,16 +62,6 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
   return {w, h};
 }
 
-const Rig& FindRigOption(const Scene& scene, const std::string& name, const char* option) {
-  if (name.empty()) return scene.FindRig(name);
-  for (const Rig& rig : scene.rigs)
-    if (rig.name == name) return rig;
-  std::string names;
-  for (const Rig& rig : scene.rigs) names += (names.empty() ? "'" : ", '") + rig.name + "'";
-  throw InputError(option, "", "no rig named '" + name + "' in " + scene.path,
-                   "rigs in this scene: " + names);
-}
-
 void AddSceneInputs(OutputTransaction& transaction, const Scene& scene) {
   for (const auto& [path, kind] : scene.InputFiles()) transaction.AddInput(path, kind);
 }

@@ -16,11 +16,6 @@
 
 namespace pandora::app {
 
-/// The rig named by the command-line option `option` (e.g. "--rig"), or the first rig when `name` is
-/// empty. Throws InputError(option, "", ...) naming the scene's rigs when there is none of that name:
-/// the option is at fault, not the scene file.
-const Rig& FindRigOption(const Scene& scene, const std::string& name, const char* option = "--rig");
-
 /// Registers every file `scene` was read from (Scene::InputFiles) as an input of `transaction`, so
 /// that no output replaces the scene file, a mesh file or a texture.
 void AddSceneInputs(OutputTransaction& transaction, const Scene& scene);

@@ -8,6 +8,7 @@
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/session/study.h"
 #include "app/output.h"
 #include "render/report/report.h"
 
@@ -34,7 +35,8 @@ int RunReport(const ReportArgs& args) {
                         {"view_width", "--width"},
                         {"camera_width", "--camera-width"},
                         {"brightness", "--brightness"}};
-  const Scene scene = LoadScene(args.scene);
+  const auto study = session::Study::Load(args.scene);  // the scene and its ray caster, once
+  const Scene& scene = study->scene();
   report::ReportOptions options;
   options.rigs = SplitList(args.rigs);
   options.voxel_size = args.voxel_size;
@@ -49,7 +51,7 @@ int RunReport(const ReportArgs& args) {
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const report::ReportTarget target = report::StageReport(output, args.out, "--out");
-  const std::unique_ptr<RayCaster> caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RayCaster* caster = &study->caster();
   const report::ReportData data =
       WithFlagNames(flags, [&] { return report::ComputeReport(scene, *caster, options); });
   bar.reset();
