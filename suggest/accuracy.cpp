@@ -18,6 +18,8 @@
 #include "volume/fields.h"
 #include "volume/summary.h"
 
+#include "analysis/text.h"
+
 namespace pandora {
 namespace {
 
@@ -28,15 +30,6 @@ double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string Format(const char* format, ...) {
-  char buffer[256];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof buffer, format, args);
-  va_end(args);
-  return buffer;
-}
 
 std::string Millimetres(double metres) { return Format("%g mm", 1e3 * metres); }
 

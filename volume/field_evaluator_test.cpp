@@ -11,6 +11,7 @@
 #include <random>
 
 #include "analysis/primitives.h"
+#include "tests/fixtures.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
 
@@ -61,20 +62,11 @@ void ExpectSameFields(const Fields& inc, const Fields& full, const std::string& 
   EXPECT_EQ(s.sigma_max_steady_mm, t.sigma_max_steady_mm) << step;
 }
 
+// A 320 x 240 test camera (tests/fixtures.h) with a working range and, for distorting lenses, k1.
 Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, double hfov_deg,
                   LensModel model, double k1 = 0) {
-  Intrinsics k;
-  k.width = 320;
-  k.height = 240;
-  k.model = model;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, k.width, model);
-  k.cx = 159.5;
-  k.cy = 119.5;
-  k.k1 = k1;
-  Camera cam;
-  cam.id = id;
-  cam.model = CameraModel(k);
-  cam.world_from_camera = LookAt(position, target, Vec3(0, 0, 1)).value();
+  Camera cam = testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 320, 240, model),
+                              [&](Intrinsics& k) { k.k1 = k1; });
   cam.near = 0.05;
   cam.far = 20;
   return cam;
@@ -85,12 +77,7 @@ Scene SyntheticScene() {
   Scene scene;
   scene.path = "synthetic.json";
   auto add = [&](const std::string& name, TriangleMesh mesh, const Vec3& at, bool solid) {
-    for (Vec3& v : mesh.vertices) v += at;
-    SceneObject o;
-    o.name = name;
-    o.mesh = std::move(mesh);
-    o.solid = solid;
-    scene.objects.push_back(std::move(o));
+    scene.objects.push_back(testing::TestObject(name, std::move(mesh), at, solid));
   };
   add("ball", MakeSphere(0.3, 20), Vec3(0.1, 0.0, 0.1), true);
   add("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true);

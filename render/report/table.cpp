@@ -19,14 +19,6 @@ std::size_t Length(const std::string& s) {
 
 }  // namespace
 
-std::string Format(const char* format, ...) {
-  char buffer[256];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof buffer, format, args);
-  va_end(args);
-  return buffer;
-}
 
 std::string Cell(const char* format, double v) { return std::isfinite(v) ? Format(format, v) : "-"; }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "analysis/text.h"
+
 namespace pandora::report {
 
 /// A table of already formatted cells.
@@ -41,7 +43,6 @@ std::string CsvNumber(double v);
 /// A number for a table cell: printf `format` when finite, "-" otherwise.
 std::string Cell(const char* format, double v);
 
-/// printf into a std::string (at most 255 characters).
-std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
+using pandora::Format;  // analysis/text.h
 
 }  // namespace pandora::report
