@@ -106,10 +106,7 @@ double CheckPositiveOption(const char* option, double value, const char* unit) {
 
 int RunAnalyze(const AnalyzeArgs& args) {
   // The study, with --voxel-size applied, and the rig, through the session layer.
-  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
-    if (!std::isnan(args.voxel_size))
-      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  });
+  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
   const Scene& scene = study->scene();
   session::SessionOptions so;
   so.rig = args.rig;

@@ -23,10 +23,7 @@ namespace pandora::app {
 int RunBench(const BenchArgs& args) {
   if (args.render) return RunRenderBench(args);
   if (args.incremental) return RunIncrementalBench(args);
-  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
-    if (!std::isnan(args.voxel_size))
-      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  });
+  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
   const Scene& scene = study->scene();
   const Rig& rig = study->FindRig(args.rig, "--rig");
   OutputTransaction output;

@@ -35,10 +35,7 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 int RunIncrementalBench(const BenchArgs& args) {
-  const auto study = session::Study::Load(args.scene, [&](Scene& scene) {
-    if (!std::isnan(args.voxel_size))
-      scene.study.voxel_size = CheckPositiveOption("--voxel-size", args.voxel_size, "metres");
-  });
+  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
   const Scene& scene = study->scene();
   const Rig& rig = study->FindRig(args.rig, "--rig");
   scene.CheckLength(args.move, "--move", "the distance each camera moves");

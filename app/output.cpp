@@ -1,6 +1,7 @@
 #include "app/output.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include <cstdio>
 
 #include "analysis/error.h"
+#include "app/commands.h"
 
 namespace pandora::app {
 
@@ -60,6 +62,14 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
                          " Mpx; at most 64 Mpx (about 40 bytes per pixel with the float layers)",
                      hint);
   return {w, h};
+}
+
+std::shared_ptr<const session::Study> LoadStudyWithVoxelSize(const std::string& scene_path,
+                                                             double voxel_size) {
+  return session::Study::Load(scene_path, [&](Scene& scene) {
+    if (!std::isnan(voxel_size))
+      scene.study.voxel_size = CheckPositiveOption("--voxel-size", voxel_size, "metres");
+  });
 }
 
 void AddSceneInputs(OutputTransaction& transaction, const Scene& scene) {

@@ -12,9 +12,17 @@
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
 #include "analysis/output_transaction.h"
+#include <memory>
+
 #include "analysis/scene.h"
+#include "app/session/study.h"
 
 namespace pandora::app {
+
+/// The study of `scene_path` with `--voxel-size` applied when given (not NaN; checked positive):
+/// what analyze and the field benches open.
+std::shared_ptr<const session::Study> LoadStudyWithVoxelSize(const std::string& scene_path,
+                                                             double voxel_size);
 
 /// Registers every file `scene` was read from (Scene::InputFiles) as an input of `transaction`, so
 /// that no output replaces the scene file, a mesh file or a texture.

@@ -1057,8 +1057,6 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));
     std::sort(entries.begin(), entries.end(),
               [](const CameraEntry& a, const CameraEntry& b) { return a.camera < b.camera; });
-    if (!S.keep)
-      for (CameraEntry& e : entries) e.information.clear();
     BlockState& n = next[i];
     if (!n.histogram.empty() || s.coverage.empty()) {
       n.candidates = std::move(s.candidates);

@@ -74,6 +74,5 @@ class EditableRig {
   std::vector<Edit> undo_, redo_;
 };
 
-using pandora::SameCameraGeometry;  // analysis/camera.h
 
 }  // namespace pandora::session

@@ -4,7 +4,6 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
-#include "analysis/sha256.h"
 #include "suggest/suggestion_file.h"
 
 namespace pandora::session {
@@ -135,7 +134,7 @@ SaveResult Session::Save(bool force) {
   if (poses.empty()) return result;
   // The file must be the one the session knows, or the edits would overwrite someone's changes.
   const std::string on_disk = ReadInputFile(scene.path, InputLimits::kJsonBytes, "scene file");
-  if (!force && Sha256Hex(on_disk) != Sha256Hex(saved_text_))
+  if (!force && on_disk != saved_text_)
     throw InputError(scene.path, "", "the scene file changed on disk since it was loaded",
                      "reload it, or save with force to overwrite (a backup is kept)");
   const std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);

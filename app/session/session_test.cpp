@@ -201,8 +201,9 @@ TEST(Session, SuggestInTheBackgroundThenApplyAndUndo) {
   EXPECT_TRUE(SameRig(session.rig().rig(), original));
   // Camera 0 moves by hand: the suggestion no longer applies.
   session.rig().SetPose(0, Moved(original.cameras[0], Vec3(0.01, 0, 0)));
-  if (!s->cameras[0].after.isApprox(original.cameras[0].world_from_camera))
+  if (!s->cameras[0].after.isApprox(original.cameras[0].world_from_camera)) {
     EXPECT_THROW(session.ApplySuggestion(*s), InputError);
+  }
 }
 
 TEST(Session, UnknownRigNamesTheOption) {

@@ -2,18 +2,15 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
-#include "analysis/sha256.h"
 
 namespace pandora::session {
 
 std::shared_ptr<const Study> Study::Load(const std::string& path,
                                          const std::function<void(Scene&)>& adjust) {
   auto study = std::shared_ptr<Study>(new Study());
-  study->scene_ = LoadScene(path);
+  // Read once: the parsed scene and the kept text are the same bytes (scene_.sha256 is theirs).
   study->text_ = ReadInputFile(path, InputLimits::kJsonBytes, "scene file");
-  if (Sha256Hex(study->text_) != study->scene_.sha256)
-    throw InputError(path, "", "the scene file changed while it was being read",
-                     "wait until whatever writes it is done, then open it again");
+  study->scene_ = ParseScene(study->text_, path);
   if (adjust) adjust(study->scene_);
   study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
   return study;

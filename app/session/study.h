@@ -15,9 +15,8 @@ namespace pandora::session {
 
 class Study {
  public:
-  /// Loads and validates the scene file (LoadScene: InputError naming the file and JSON path on any
-  /// problem), keeps its text, and builds the ray caster. Throws InputError if the file changes
-  /// while it is being read.
+  /// Reads the scene file once, validates it (ParseScene: InputError naming the file and JSON path
+  /// on any problem), keeps its text, and builds the ray caster.
   /// `adjust` (may be empty) changes the scene before the caster is built: a command's overrides
   /// of the study (--voxel-size), checked by the caller.
   static std::shared_ptr<const Study> Load(const std::string& path,
