@@ -1,51 +1,21 @@
 // `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its own
 // colour (render/render.h), written as PNG or multi-layer OpenEXR.
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 
 #include "analysis/error.h"
-#include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
-#include "analysis/scene.h"
 #include "app/commands.h"
-#include "app/session/study.h"
+#include "app/options.h"
 #include "app/output.h"
+#include "app/session/session.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/vdb_io.h"
 
 namespace pandora::app {
-namespace {
-
-Vec3 ParseTriple(const char* option, const std::string& text) {
-  std::stringstream ss(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(x))
-      throw InputError(option, "", "expected three numbers X,Y,Z, got '" + text + "'",
-                       "e.g. " + std::string(option) + " 1.5,-2,1.8");
-    v.push_back(x);
-  }
-  if (v.size() != 3)
-    throw InputError(option, "", "expected three numbers X,Y,Z, got '" + text + "'",
-                     "e.g. " + std::string(option) + " 1.5,-2,1.8");
-  return Vec3(v[0], v[1], v[2]);
-}
-
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
-}  // namespace
 
 int RunRender(const RenderArgs& args) {
   // Options that need no scene first, so typos fail fast.
@@ -105,29 +75,24 @@ int RunRender(const RenderArgs& args) {
     options.overlays.iso_value = args.iso_value;
   }
 
-  // The study (scene and its ray caster, built once) through the session layer.
-  const auto study = session::Study::Load(args.scene);
-  const Scene& scene = study->scene();
+  // The study (scene, ray caster and prepared scene, built once) through the session layer.
+  session::SessionOptions session_options;
+  session_options.rig = args.rig;
+  session_options.rig_option = "--rig";
+  const session::Session session(session::Study::Load(args.scene), session_options);
+  const Scene& scene = session.study().scene();
+  const Rig& rig = session.rig().rig();
   OutputTransaction output;
   AddSceneInputs(output, scene);
   output.AddInput(args.fields, "fields file");
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = study->FindRig(args.rig, "--rig");
   options.pixel_sigma = scene.study.pixel_sigma;
 
   RenderView view;
   if (!args.camera.empty()) {
-    auto it = std::find_if(rig.cameras.begin(), rig.cameras.end(),
-                           [&](const Camera& c) { return c.id == args.camera; });
-    if (it == rig.cameras.end()) {
-      std::string ids;
-      for (const Camera& c : rig.cameras) ids += (ids.empty() ? "" : ", ") + c.id;
-      throw InputError("--camera", "", "no camera '" + args.camera + "' in rig '" + rig.name + "'",
-                       "cameras: " + ids);
-    }
-    view.camera = int(it - rig.cameras.begin());
-    view.width = it->model.width();
-    view.height = it->model.height();
+    view.camera = CameraOption(rig, "--camera", args.camera);
+    view.width = rig.cameras[view.camera].model.width();
+    view.height = rig.cameras[view.camera].model.height();
   } else if (!args.view.empty()) {
     auto it = scene.views.find(args.view);
     if (it == scene.views.end()) {
@@ -139,9 +104,9 @@ int RunRender(const RenderArgs& args) {
     }
     view = ViewFromScene(it->second, 1280, 720);
   } else {
-    view.from = ParseTriple("--from", args.from);
-    view.at = ParseTriple("--at", args.at);
-    if (!args.up.empty()) view.up = ParseTriple("--up", args.up);
+    view.from = ParseVec3("--from", args.from);
+    view.at = ParseVec3("--at", args.at);
+    if (!args.up.empty()) view.up = ParseVec3("--up", args.up);
     scene.CheckReach(view.from, "--from", "the eye");
     scene.CheckReach(view.at, "--at", "the point looked at");
     if (!LookAt(view.from, view.at, view.up))
@@ -161,25 +126,23 @@ int RunRender(const RenderArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
 
-  // One BVH for the image and the rig checks: the prepared scene renders over the study's.
-  const RayCaster* caster = &study->caster();
-  const PreparedScene prepared(scene, *caster);
+  // One BVH for the image and the rig checks: the study's, under its prepared scene.
   std::unique_ptr<PreparedOverlays> overlays;
   if (fields) overlays = std::make_unique<PreparedOverlays>(*fields, options.overlays);
   options.layers = ext == ".exr";  // the PNG has no room for them
   RenderStats stats;
-  const Image image = RenderWithStats(prepared, rig, view, options, overlays.get(), &stats);
+  const Image image = session.Render(view, options, overlays.get(), &stats);
   if (ext == ".png") WritePng(image, staged);
   else WriteExr(image, staged, int(rig.cameras.size()));
   output.Commit();
-  const std::vector<Warning> warnings = args.quiet ? std::vector<Warning>() : CheckRig(scene, rig, *caster);
+  const std::vector<Warning> warnings = args.quiet ? std::vector<Warning>() : CheckRig(scene, rig, session.study().caster());
   if (!args.quiet) {
     const double brightness =
         std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
     std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras, brightness %.3g%s), %zu triangles, %.3f s\n",
                 args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
                 brightness, std::isnan(options.brightness) ? " by default" : "",
-                caster->triangle_count(), stats.seconds);
+                session.study().caster().triangle_count(), stats.seconds);
     std::fflush(stdout);
     for (const Warning& w : warnings)
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());

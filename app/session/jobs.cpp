@@ -38,7 +38,7 @@ std::int64_t Jobs::Submit(const std::string& kind, std::function<void(JobContext
   if (w.running) w.running->cancel_ = true;  // latest wins
   w.pending = std::move(work);
   w.pending_id = id;
-  w.status = JobStatus{JobState::kQueued, id, 0.0, {}};
+  w.status = JobStatus{JobState::kQueued, id, 0.0, {}, {}};
   if (!w.busy) {
     if (w.thread.joinable()) w.thread.join();  // the previous loop has ended
     w.busy = true;
@@ -56,17 +56,18 @@ void Jobs::Loop(const std::string& kind) {
     const std::int64_t id = w.pending_id;
     auto context = std::make_shared<JobContext>();
     w.running = context;
-    w.status = JobStatus{JobState::kRunning, id, 0.0, {}};
+    w.status = JobStatus{JobState::kRunning, id, 0.0, {}, {}};
     lock.unlock();
-    JobStatus end{JobState::kDone, id, 1.0, {}};
+    JobStatus end{JobState::kDone, id, 1.0, {}, {}};
     try {
       work(*context);
       if (context->cancelled()) end.state = JobState::kCancelled;
     } catch (const std::exception& e) {
       end = JobStatus{context->cancelled() ? JobState::kCancelled : JobState::kFailed, id,
-                      context->progress_.load(), e.what()};
+                      context->progress_.load(), e.what(), std::current_exception()};
     } catch (...) {
-      end = JobStatus{JobState::kFailed, id, context->progress_.load(), "unknown error"};
+      end = JobStatus{JobState::kFailed, id, context->progress_.load(), "unknown error",
+                      std::current_exception()};
     }
     lock.lock();
     w.running.reset();
@@ -83,7 +84,7 @@ void Jobs::Cancel(const std::string& kind) {
   Worker& w = it->second;
   if (w.pending) {
     w.pending = nullptr;
-    w.status = JobStatus{JobState::kCancelled, w.pending_id, 0.0, {}};
+    w.status = JobStatus{JobState::kCancelled, w.pending_id, 0.0, {}, {}};
   }
   if (w.running) w.running->cancel_ = true;
 }

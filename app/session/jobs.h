@@ -9,6 +9,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <map>
 #include <memory>
@@ -41,6 +42,9 @@ struct JobStatus {
   std::int64_t id = 0;   ///< Of the job the state describes (0: none yet).
   double progress = 0;   ///< Of the running job.
   std::string error;     ///< With kFailed: the message.
+  /// With kFailed: the exception itself, so a caller that waits can rethrow it (a command turns an
+  /// InputError into its one-line message and exit code 2).
+  std::exception_ptr exception;
 };
 
 class Jobs {

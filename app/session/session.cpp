@@ -4,6 +4,7 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
+#include "render/progressive.h"
 #include "suggest/suggestion_file.h"
 
 namespace pandora::session {
@@ -53,6 +54,36 @@ Fields Session::TakeFields() {
   return evaluator_->TakeFields();
 }
 
+Suggestion Session::Suggest(const std::vector<TargetPoint>& targets,
+                            const SuggestOptions& options) const {
+  return pandora::Suggest(study_->scene(), rig_.rig(), study_->caster(), targets, options);
+}
+
+Image Session::Render(const RenderView& view, const RenderOptions& options,
+                      const PreparedOverlays* overlays, RenderStats* stats) const {
+  return RenderWithStats(study_->prepared(), rig_.rig(), view, options, overlays, stats);
+}
+
+std::int64_t Session::RenderInBackground(
+    const RenderView& view, const RenderOptions& options,
+    std::shared_ptr<const PreparedOverlays> overlays,
+    std::function<void(const Image&, int, std::int64_t)> on_pass) {
+  auto rig = std::make_shared<Rig>(rig_.rig());
+  const std::int64_t version = rig_.version();
+  const Study* study = study_.get();
+  return jobs_.Submit("render", [study, rig, version, view, options, overlays = std::move(overlays),
+                                 on_pass = std::move(on_pass)](JobContext& job) {
+    ProgressiveRender frame(study->prepared(), *rig, view, options, overlays.get());
+    RenderControl control;
+    control.cancel = &job.cancel_flag();
+    control.progress = [&job](double f) { job.Progress(f); };
+    while (!frame.done()) {
+      if (!frame.RunPass(control)) return;  // a newer frame was asked for
+      if (on_pass) on_pass(frame.image(), frame.passes_done() - 1, version);
+    }
+  });
+}
+
 std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options) {
   auto rig = std::make_shared<Rig>(rig_.rig());
   auto data = std::make_shared<std::pair<std::vector<TargetPoint>, SuggestOptions>>(
@@ -62,7 +93,7 @@ std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, Sugg
     suggestion_.reset();
   }
   const std::int64_t job = jobs_.Submit("suggest", [this, rig, data](JobContext& context) {
-    Suggestion s = Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
+    Suggestion s = pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
     if (context.cancelled()) return;  // a newer suggestion was asked for
     std::lock_guard<std::mutex> lock(suggestion_mutex_);
     suggestion_ = std::move(s);

@@ -16,6 +16,7 @@
 #include "app/session/editable_rig.h"
 #include "app/session/jobs.h"
 #include "app/session/study.h"
+#include "render/render.h"
 #include "suggest/suggest.h"
 #include "volume/fields.h"
 
@@ -60,7 +61,9 @@ class Session {
   /// Moves the fields out (a command that writes them); the next update evaluates in full.
   Fields TakeFields();
 
-  /// Runs Suggest on the rig as it is now, as a background job of kind "suggest" (latest wins: a
+  /// Runs Suggest on the rig as it is now, on the calling thread (what `pandora suggest` does).
+  Suggestion Suggest(const std::vector<TargetPoint>& targets, const SuggestOptions& options) const;
+  /// The same as a background job of kind "suggest" (latest wins: a
   /// suggestion asked for later replaces a waiting one; a running one finishes but its result is
   /// dropped). Returns the job id; WaitSuggestion() gives the result.
   std::int64_t SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options);
@@ -71,6 +74,20 @@ class Session {
   /// accepts; nothing is written until Save). Throws InputError when a selected camera is no longer
   /// where the suggestion started from (the rig was edited since).
   void ApplySuggestion(const Suggestion& suggestion);
+
+  /// Renders the rig as it is now from `view` over the study's prepared scene, on the calling
+  /// thread (what `pandora render` does). Throws as pandora::Render does.
+  Image Render(const RenderView& view, const RenderOptions& options,
+               const PreparedOverlays* overlays = nullptr, RenderStats* stats = nullptr) const;
+  /// The same as a background job of kind "render", progressively (render/progressive.h): coarse
+  /// first, then refined; `on_pass` is called on the worker after each completed pass with the
+  /// image, the pass (ProgressiveRender::kPasses - 1 is the exact image) and the rig version it
+  /// shows. Latest wins: a newer render cancels this one between tiles. `overlays` (may be null) is
+  /// kept alive by the job. Returns the job id; jobs().Wait("render") waits for it.
+  std::int64_t RenderInBackground(
+      const RenderView& view, const RenderOptions& options,
+      std::shared_ptr<const PreparedOverlays> overlays,
+      std::function<void(const Image& image, int pass, std::int64_t rig_version)> on_pass);
 
   /// Writes the edited cameras' poses and focal lengths into the scene file, keeping a backup, as
   /// `pandora accept` does (each in its camera's own form). Refuses (InputError) when the file

@@ -122,6 +122,13 @@ TEST(Jobs, LatestWinsAndFailuresAreReported) {
   const JobStatus f = jobs.Wait("render");
   EXPECT_EQ(f.state, JobState::kFailed);
   EXPECT_NE(f.error.find("broken"), std::string::npos);
+  // The exception itself comes back, so a command can rethrow it as its one-line error.
+  ASSERT_TRUE(f.exception);
+  try {
+    std::rethrow_exception(f.exception);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.json_path(), "$.a");
+  }
   jobs.Submit("render", [](JobContext&) {});
   EXPECT_EQ(jobs.Wait("render").state, JobState::kDone);
   EXPECT_EQ(jobs.Status("suggest").state, JobState::kIdle);
@@ -204,6 +211,71 @@ TEST(Session, SuggestInTheBackgroundThenApplyAndUndo) {
   if (!s->cameras[0].after.isApprox(original.cameras[0].world_from_camera)) {
     EXPECT_THROW(session.ApplySuggestion(*s), InputError);
   }
+}
+
+TEST(Session, SuggestOnTheCallingThreadEqualsTheBackgroundJob) {
+  const auto study = Study::Load("tests/data/suggest_ring.json");
+  Session session(study, SessionOptions());
+  SuggestOptions so;
+  so.cameras = {1};
+  so.limits.resize(1);
+  so.limits[0].max_move = 0.2;
+  so.limits[0].max_rotate_deg = 5;
+  so.screening_candidates = 10;
+  so.outer_iterations = 1;
+  const auto targets = SampleTargets(study->scene(), 150, {}, false, 2);
+  const Suggestion now = session.Suggest(targets, so);
+  session.SuggestInBackground(targets, so);
+  const std::optional<Suggestion> later = session.WaitSuggestion();
+  ASSERT_TRUE(later);
+  ASSERT_EQ(now.cameras.size(), later->cameras.size());
+  EXPECT_EQ(now.cameras[0].after.matrix(), later->cameras[0].after.matrix());  // deterministic
+  EXPECT_EQ(now.after.objective, later->after.objective);
+}
+
+TEST(Session, RenderInTheBackgroundRefinesToTheExactFrameOfTheNewestRig) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  Session session(study, SessionOptions());
+  RenderView view;
+  view.from = Vec3(3, -3, 2.5);
+  view.at = Vec3(0, 0, 0.5);
+  view.width = 96;
+  view.height = 64;
+  RenderOptions options;
+  options.layers = true;
+  const Rig original = session.rig().rig();
+  // A frame of the original rig is asked for, then one with camera 0 off: the newest wins.
+  std::mutex mutex;
+  std::vector<std::pair<int, std::int64_t>> passes;  // (pass, rig version)
+  Image last;
+  auto on_pass = [&](const Image& image, int pass, std::int64_t version) {
+    std::lock_guard<std::mutex> lock(mutex);
+    passes.emplace_back(pass, version);
+    last = image;
+  };
+  session.RenderInBackground(view, options, nullptr, on_pass);
+  session.rig().SetEnabled(0, false);
+  const std::int64_t moved_version = session.rig().version();
+  session.RenderInBackground(view, options, nullptr, on_pass);
+  EXPECT_EQ(session.jobs().Wait("render").state, JobState::kDone);
+  ASSERT_FALSE(passes.empty());
+  // The newest frame ran every pass in order, and its last pass is the exact frame, bit for bit.
+  std::vector<int> newest;
+  for (const auto& [pass, version] : passes)
+    if (version == moved_version) newest.push_back(pass);
+  EXPECT_EQ(newest, (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(passes.back(), std::make_pair(3, moved_version));
+  RenderStats stats;
+  const Image exact = session.Render(view, options, nullptr, &stats);
+  EXPECT_EQ(last.rgb, exact.rgb);
+  EXPECT_EQ(last.cameras, exact.cameras);
+  EXPECT_EQ(last.sigma_max, exact.sigma_max);
+  // The session's frame is the one-shot renderer's for the edited rig.
+  const Image one_shot = pandora::Render(study->scene(), session.rig().rig(), study->caster(), view, options);
+  EXPECT_EQ(one_shot.rgb, exact.rgb);
+  // ...and differs from the original rig's (camera 0 lit part of the block).
+  const Image before = pandora::Render(study->scene(), original, study->caster(), view, options);
+  EXPECT_NE(before.cameras, exact.cameras);
 }
 
 TEST(Session, UnknownRigNamesTheOption) {

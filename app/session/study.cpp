@@ -24,6 +24,11 @@ std::shared_ptr<const Study> Study::FromScene(Scene scene, std::string text) {
   return study;
 }
 
+const PreparedScene& Study::prepared() const {
+  std::call_once(prepared_once_, [this] { prepared_ = std::make_unique<PreparedScene>(scene_, *caster_); });
+  return *prepared_;
+}
+
 const Rig& Study::FindRig(const std::string& name, const std::string& option) const {
   if (scene_.rigs.empty()) throw InputError(scene_.path, "$.rigs", "the scene has no rig");
   if (name.empty()) return scene_.rigs.front();

@@ -6,10 +6,12 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
+#include "render/prepared_scene.h"
 
 namespace pandora::session {
 
@@ -29,6 +31,9 @@ class Study {
   /// The scene file's bytes as loaded (their SHA-256 is scene().sha256).
   const std::string& text() const { return text_; }
   const RayCaster& caster() const { return *caster_; }
+  /// The scene prepared for the renderer over the same ray caster (no second BVH), built at first
+  /// use, once, thread-safely.
+  const PreparedScene& prepared() const;
 
   /// The rig named `name`, or the first rig when `name` is empty. An unknown name throws
   /// InputError blaming `option` (e.g. "--rig") when given, else the scene's "$.rigs".
@@ -39,6 +44,8 @@ class Study {
   Scene scene_;
   std::string text_;
   std::unique_ptr<RayCaster> caster_;
+  mutable std::once_flag prepared_once_;
+  mutable std::unique_ptr<PreparedScene> prepared_;
 };
 
 }  // namespace pandora::session

@@ -1,0 +1,111 @@
+#include "app/suggest_options.h"
+
+#include <cmath>
+
+#include "analysis/error.h"
+#include "app/options.h"
+
+namespace pandora::app {
+namespace {
+
+// One value for every selected camera, or one each in --cameras order.
+std::vector<double> PerCamera(const char* option, const std::string& value, std::size_t selected) {
+  const std::vector<std::string> items = SplitList(value);
+  if (items.size() != 1 && items.size() != selected)
+    throw InputError(option, "", "give one value, or one per selected camera (" + std::to_string(selected) + ")");
+  std::vector<double> out;
+  for (const std::string& item : items) out.push_back(ParseNumbers(option, item, 1)[0]);
+  out.resize(selected, out.back());
+  return out;
+}
+
+// "ID:VALUE" or "VALUE": the positions in the selection it applies to; *value gets VALUE.
+std::vector<std::size_t> Targets(const char* option, const std::string& entry, const Rig& rig,
+                                 const std::vector<int>& selection, std::string* value) {
+  std::vector<std::size_t> which;
+  const std::size_t colon = entry.find(':');
+  *value = colon == std::string::npos ? entry : entry.substr(colon + 1);
+  for (std::size_t c = 0; c < selection.size(); ++c)
+    if (colon == std::string::npos || rig.cameras[selection[c]].id == entry.substr(0, colon)) which.push_back(c);
+  if (which.empty() && colon != std::string::npos)
+    throw InputError(option, "", "camera '" + entry.substr(0, colon) + "' is not among the selected cameras (--cameras)");
+  return which;
+}
+
+}  // namespace
+
+SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
+  SuggestOptions options;
+  options.scene_path = scene.path;
+  for (const std::string& id : SplitList(args.cameras)) options.cameras.push_back(CameraOption(rig, "--cameras", id));
+  const std::size_t n = options.cameras.size();
+
+  const std::vector<double> moves = PerCamera("--max-move", args.max_move, n);
+  const std::vector<double> rotations = PerCamera("--max-rotate", args.max_rotate, n);
+  options.limits.assign(n, CameraLimits());
+  for (std::size_t c = 0; c < n; ++c) {
+    if (!(moves[c] >= 0)) throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
+    scene.CheckLength(moves[c], "--max-move", "the move");
+    if (!(rotations[c] >= 0) || !(rotations[c] < 180))
+      throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
+    options.limits[c].max_move = moves[c];
+    options.limits[c].max_rotate_deg = rotations[c];
+  }
+
+  std::vector<int> mounts(n, 0);
+  auto add_mount = [&](const char* option, const std::string& entry, MountConstraint::Kind kind) {
+    std::string value;
+    for (std::size_t c : Targets(option, entry, rig, options.cameras, &value)) {
+      MountConstraint& m = options.limits[c].mount;
+      m.kind = kind;
+      if (kind == MountConstraint::Kind::kBox) {
+        m.box = ParseBox(scene, option, value);
+      } else {
+        const std::vector<double> v = ParseNumbers(option, value, 3);
+        m.axis = Vec3(v[0], v[1], v[2]);
+        if (!(m.axis.norm() > 0)) throw InputError(option, "", "the direction must be a non-zero vector");
+      }
+      if (++mounts[c] > 1)
+        throw InputError(option, "", "give at most one of --rail, --plane, --mount-box per camera");
+    }
+  };
+  for (const std::string& e : args.rail) add_mount("--rail", e, MountConstraint::Kind::kLine);
+  for (const std::string& e : args.plane) add_mount("--plane", e, MountConstraint::Kind::kPlane);
+  for (const std::string& e : args.mount_box) add_mount("--mount-box", e, MountConstraint::Kind::kBox);
+  for (const std::string& e : args.hfov_range) {
+    std::string value;
+    for (std::size_t c : Targets("--hfov-range", e, rig, options.cameras, &value)) {
+      const std::vector<double> v = ParseNumbers("--hfov-range", value, 2);
+      if (!(v[0] > 0) || !(v[1] >= v[0]))
+        throw InputError("--hfov-range", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
+      options.limits[c].min_hfov_deg = v[0];
+      options.limits[c].max_hfov_deg = v[1];
+    }
+  }
+  for (const std::string& box : args.keep_out) options.keep_out.push_back(ParseBox(scene, "--keep-out", box));
+
+  const std::optional<Objective> objective = ParseObjective(args.objective);
+  if (!objective)
+    throw InputError("--objective", "", "unknown objective '" + args.objective + "'",
+                     "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution or mix");
+  options.objective = *objective;
+  if (!args.weights.empty()) {
+    const std::vector<double> w = ParseNumbers("--weights", args.weights, 3);
+    if (w[0] < 0 || w[1] < 0 || w[2] < 0 || w[0] + w[1] + w[2] <= 0)
+      throw InputError("--weights", "", "the weights must be >= 0 and not all zero");
+    options.objective.w_coverage = w[0];
+    options.objective.w_sigma = w[1];
+    options.objective.w_resolution = w[2];
+  }
+  // The number options' ranges are checked as they are parsed (app/main.cpp); lengths against the
+  // scene's scale here.
+  options.snap_move = args.snap_move;
+  options.snap_rotate_deg = args.snap_rotate;
+  scene.CheckLength(options.snap_move, "--snap-move", "the snap step");
+  options.outer_iterations = args.outer_iterations;
+  options.clearance = args.clearance;
+  scene.CheckLength(options.clearance, "--clearance", "the clearance");
+  return options;
+}
+
+}  // namespace pandora::app
