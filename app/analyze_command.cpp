@@ -48,54 +48,6 @@ std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& field
   return fields;
 }
 
-// "p10 123  p50 456 ..." of a percentile object, or "-" for values that are null.
-std::string PercentileLine(const nlohmann::json& p, const std::vector<const char*>& keys,
-                           const char* format) {
-  std::string line;
-  for (const char* key : keys) {
-    char cell[48];
-    const nlohmann::json& v = p.contains(key) ? p[key] : nlohmann::json();
-    char value[24] = "-";
-    if (v.is_number()) std::snprintf(value, sizeof value, format, v.get<double>());
-    std::snprintf(cell, sizeof cell, "  %s %7s", key, value);
-    line += cell;
-  }
-  return line;
-}
-
-void PrintTable(const nlohmann::json& s) {
-  std::printf("rig %s: %d cameras, voxel %.4g m, %lld free region voxels (and %lld inside solids)\n",
-              s["rig"].get<std::string>().c_str(), s["cameras"].get<int>(),
-              s["voxel_size_m"].get<double>(), s["region_voxels"].get<long long>(),
-              s["solid_voxels"].get<long long>());
-  std::printf("coverage  >=1 %5.1f%%   >=2 %5.1f%%   >=3 %5.1f%%\n",
-              100 * s["coverage"]["ge1"].get<double>(), 100 * s["coverage"]["ge2"].get<double>(),
-              100 * s["coverage"]["ge3"].get<double>());
-  if (s.contains("resolution_px_per_m"))
-    std::printf("resolution px/m  %s   (voxels seen by >= 1 camera, best camera)\n",
-                PercentileLine(s["resolution_px_per_m"], {"p10", "p50", "p90"}, "%.0f").c_str());
-  if (s.contains("uncertainty"))
-    std::printf("sigma_max mm     %s   (triangulable voxels: %.1f%% of the region)\n",
-                PercentileLine(s["uncertainty"]["sigma_max_mm"], {"p50", "p90", "p99"}, "%.3g").c_str(),
-                100 * s["uncertainty"]["triangulable"].get<double>());
-  std::printf("%-12s %-20s %8s   %-15s %s\n", "camera", "name", "sees", "FOV h x v deg",
-              "(nominal, no distortion)");
-  for (const auto& c : s["per_camera"]) {
-    const auto& eff = c["fov_deg"]["effective"];
-    const auto& nom = c["fov_deg"]["nominal"];
-    char fov[40], nominal[40];
-    std::snprintf(fov, sizeof fov, "%.1f x %.1f", eff[0].get<double>(), eff[1].get<double>());
-    std::snprintf(nominal, sizeof nominal, "(%.1f x %.1f)", nom[0].get<double>(), nom[1].get<double>());
-    std::printf("%-12s %-20s %7.1f%%   %-15s %s%s\n", c["id"].get<std::string>().c_str(),
-                c["name"].get<std::string>().c_str(), 100 * c["visible_fraction"].get<double>(), fov,
-                nominal, c["enabled"].get<bool>() ? "" : "  (disabled)");
-  }
-  const auto& t = s["timing"];
-  std::printf("%.3f s, %.3g rays (%.3g rays/s), %.3g point-camera tests\n",
-              t["seconds"].get<double>(), t["rays"].get<double>(),
-              t["rays_per_second"].get<double>(), t["point_camera_tests"].get<double>());
-}
-
 }  // namespace
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
@@ -146,7 +98,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   RigCheckOptions check;
   check.visible_voxels = fields.stats.per_camera_seen;
   const std::vector<Warning> warnings = CheckRig(scene, rig, caster, check);
-  nlohmann::json summary = MakeSummary(scene, rig, fields, options.fields, threads, warnings);
+  const Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
+  nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{
       {"run_id", output.run_id()},
@@ -163,7 +116,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   WriteFileAtomically(summary_path, summary.dump(2) + "\n");
   output.Commit();
   if (!args.quiet) {
-    PrintTable(summary);
+    std::fputs(FormatSummary(typed).c_str(), stdout);
     std::printf("wrote %s and %s\n", (out / "fields.vdb").c_str(), (out / "summary.json").c_str());
     std::fflush(stdout);
     for (const Warning& w : warnings)

@@ -17,6 +17,7 @@
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/session/study.h"
+#include "app/options.h"
 #include "app/output.h"
 #include "render/prepared_scene.h"
 #include "render/progressive.h"
@@ -41,10 +42,7 @@ int RunRenderBench(const BenchArgs& args) {
   const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
   RenderView view;
   if (!args.view.empty()) {
-    auto it = scene.views.find(args.view);
-    if (it == scene.views.end())
-      throw InputError("--view", "", "no view '" + args.view + "' in " + scene.path);
-    view = ViewFromScene(it->second, width, height);
+    view = NamedView(scene, "--view", args.view, width, height);
   } else if (!scene.views.empty()) {
     view = ViewFromScene(scene.views.begin()->second, width, height);
   } else {

@@ -67,6 +67,18 @@ int CameraOption(const Rig& rig, const std::string& option, const std::string& i
   return index;
 }
 
+RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name, int width,
+                     int height) {
+  const auto it = scene.views.find(name);
+  if (it == scene.views.end()) {
+    std::string names;
+    for (const auto& [view_name, view] : scene.views) names += (names.empty() ? "" : ", ") + view_name;
+    throw InputError(option, "", "no view '" + name + "' in " + scene.path,
+                     names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z" : "views: " + names);
+  }
+  return ViewFromScene(it->second, width, height);
+}
+
 std::string Lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
   return text;

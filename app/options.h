@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/scene.h"
+#include "render/render.h"
 
 namespace pandora::app {
 
@@ -26,6 +27,11 @@ Aabb ParseBox(const Scene& scene, const std::string& option, const std::string& 
 
 /// The index of camera `id` in `rig`; an unknown id names the option and lists the rig's ids.
 int CameraOption(const Rig& rig, const std::string& option, const std::string& id);
+
+/// The scene's view `name` at `width` x `height`; an unknown name names the option and lists the
+/// scene's views.
+RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name, int width,
+                     int height);
 
 /// `text` in lower case (ASCII), for keyword options.
 std::string Lower(std::string text);

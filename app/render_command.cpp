@@ -94,15 +94,7 @@ int RunRender(const RenderArgs& args) {
     view.width = rig.cameras[view.camera].model.width();
     view.height = rig.cameras[view.camera].model.height();
   } else if (!args.view.empty()) {
-    auto it = scene.views.find(args.view);
-    if (it == scene.views.end()) {
-      std::string names;
-      for (const auto& [name, v] : scene.views) names += (names.empty() ? "" : ", ") + name;
-      throw InputError("--view", "", "no view '" + args.view + "' in " + scene.path,
-                       names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z"
-                                     : "views: " + names);
-    }
-    view = ViewFromScene(it->second, 1280, 720);
+    view = NamedView(scene, "--view", args.view, 1280, 720);
   } else {
     view.from = ParseVec3("--from", args.from);
     view.at = ParseVec3("--at", args.at);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "analysis/text.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
@@ -215,6 +217,52 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
   nlohmann::json j;
   to_json(j, Summarize(scene, rig, fields, field_names, threads, warnings));
   return j;
+}
+
+namespace {
+
+// "  p10    1134  p50    1229 ..." with "-" where a percentile has no value.
+std::string PercentileCells(const std::vector<std::pair<const char*, std::optional<double>>>& cells,
+                            const char* format) {
+  std::string line;
+  for (const auto& [key, value] : cells) {
+    char text[24] = "-";
+    if (value) std::snprintf(text, sizeof text, format, *value);
+    line += Format("  %s %7s", key, text);
+  }
+  return line;
+}
+
+}  // namespace
+
+std::string FormatSummary(const Summary& s) {
+  std::string out = Format("rig %s: %d cameras, voxel %.4g m, %lld free region voxels (and %lld inside solids)\n",
+                           s.rig.c_str(), s.cameras, s.voxel_size_m, static_cast<long long>(s.region_voxels),
+                           static_cast<long long>(s.solid_voxels));
+  out += Format("coverage  >=1 %5.1f%%   >=2 %5.1f%%   >=3 %5.1f%%\n", 100 * s.coverage.ge1,
+                100 * s.coverage.ge2, 100 * s.coverage.ge3);
+  if (s.resolution_px_per_m) {
+    const ResolutionPercentiles& r = *s.resolution_px_per_m;
+    out += "resolution px/m  " + PercentileCells({{"p10", r.p10}, {"p50", r.p50}, {"p90", r.p90}}, "%.0f") +
+           "   (voxels seen by >= 1 camera, best camera)\n";
+  }
+  if (s.uncertainty) {
+    const SigmaPercentiles& p = s.uncertainty->sigma_max_mm;
+    out += "sigma_max mm     " + PercentileCells({{"p50", p.p50}, {"p90", p.p90}, {"p99", p.p99}}, "%.3g") +
+           Format("   (triangulable voxels: %.1f%% of the region)\n", 100 * s.uncertainty->triangulable);
+  }
+  out += Format("%-12s %-20s %8s   %-15s %s\n", "camera", "name", "sees", "FOV h x v deg",
+                "(nominal, no distortion)");
+  for (const CameraSummary& c : s.per_camera) {
+    const std::string fov = Format("%.1f x %.1f", c.lens.hfov_deg, c.lens.vfov_deg);
+    const std::string nominal = Format("(%.1f x %.1f)", c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg);
+    out += Format("%-12s %-20s %7.1f%%   %-15s %s%s\n", c.id.c_str(), c.name.c_str(), 100 * c.visible_fraction,
+                  fov.c_str(), nominal.c_str(), c.enabled ? "" : "  (disabled)");
+  }
+  out += Format("%.3f s, %.3g rays (%.3g rays/s), %.3g point-camera tests\n", s.timing.seconds,
+                static_cast<double>(s.timing.rays), s.timing.rays_per_second(),
+                static_cast<double>(s.timing.point_camera_tests));
+  return out;
 }
 
 }  // namespace pandora

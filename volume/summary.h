@@ -118,6 +118,12 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
                            const std::vector<std::string>& field_names, int threads,
                            const std::vector<Warning>& warnings = {});
 
+/// The table `pandora analyze` prints: the rig and region, coverage shares, the resolution and
+/// sigma_max percentiles when present ("-" for a percentile without a value), one line per camera
+/// (share of the region seen, effective and nominal FOV, disabled ones marked) and the timing.
+/// Lines end in '\n'.
+std::string FormatSummary(const Summary& summary);
+
 /// Nearest-rank percentiles of the active values of the float grid `name` of `fields` (tiles count
 /// once per voxel they cover), one per entry of `percentiles` (each in [0, 100]); nullopt values
 /// when the grid is missing or has no active value.

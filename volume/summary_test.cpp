@@ -177,3 +177,57 @@ TEST(Summarize, JsonIsTheTypedValue) {
 
 }  // namespace
 }  // namespace pandora
+
+namespace pandora {
+namespace {
+
+TEST(FormatSummary, TheTableAnalyzePrints) {
+  Summary s;
+  s.rig = "ring";
+  s.cameras = 1;
+  s.voxel_size_m = 0.05;
+  s.region_voxels = 1000;
+  s.solid_voxels = 64;
+  s.coverage.ge1 = 0.9;
+  s.coverage.ge2 = 0.5;
+  s.coverage.ge3 = 0.125;
+  s.resolution_px_per_m = ResolutionPercentiles{1134.4, 1229.0, std::nullopt};
+  UncertaintySummary u;
+  u.triangulable = 0.5;
+  u.sigma_max_mm = {0.991, 3.48, 4.72};
+  s.uncertainty = u;
+  CameraSummary on, off;
+  on.id = "c0";
+  on.name = "left";
+  on.visible_fraction = 0.595;
+  on.lens.hfov_deg = 40.4;
+  on.lens.vfov_deg = 30.7;
+  on.lens.nominal_hfov_deg = 40;
+  on.lens.nominal_vfov_deg = 30.5;
+  off = on;
+  off.id = "c1";
+  off.enabled = false;
+  s.per_camera = {on, off};
+  s.timing.seconds = 0.5;
+  s.timing.rays = 1000000;
+  s.timing.point_camera_tests = 2000000;
+  const std::string t = FormatSummary(s);
+  EXPECT_EQ(t,
+            "rig ring: 1 cameras, voxel 0.05 m, 1000 free region voxels (and 64 inside solids)\n"
+            "coverage  >=1  90.0%   >=2  50.0%   >=3  12.5%\n"
+            "resolution px/m    p10    1134  p50    1229  p90       -   (voxels seen by >= 1 camera, best camera)\n"
+            "sigma_max mm       p50   0.991  p90    3.48  p99    4.72   (triangulable voxels: 50.0% of the region)\n"
+            "camera       name                     sees   FOV h x v deg   (nominal, no distortion)\n"
+            "c0           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)\n"
+            "c1           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)  (disabled)\n"
+            "0.500 s, 1e+06 rays (2e+06 rays/s), 2e+06 point-camera tests\n");
+  // Without the resolution and uncertainty fields their lines are left out.
+  s.resolution_px_per_m.reset();
+  s.uncertainty.reset();
+  const std::string bare = FormatSummary(s);
+  EXPECT_EQ(bare.find("resolution"), std::string::npos);
+  EXPECT_EQ(bare.find("sigma_max"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pandora
