@@ -430,7 +430,7 @@ PreparedOverlays::PreparedOverlays(const Fields& fields, const OverlayOptions& o
   if (!ov.slice_field.empty()) {
     if (ov.slice_axis < 0 || ov.slice_axis > 2)
       throw InputError("--slice-axis", "", "must be x, y or z");
-    d.slice = SampleSlice(fields, ov.slice_field, ov.slice_axis, ov.slice_position);
+    d.slice = SampleSlice(fields, ov.slice_field, ov.slice_axis, ov.slice_position, &d.slice_plane);
     d.have_slice = true;
   }
   if (!ov.iso_field.empty()) {
@@ -775,7 +775,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
     for (int k = 0; k < 3; ++k) image.rgb[3 * q + k] = sum[k];
   };
   const OverlayOptions& ov = options.overlays;
-  const SliceImage* slice = m.have_slice ? &m.overlays->slice : nullptr;
+  const FieldSlice* slice = m.have_slice ? &m.overlays->slice : nullptr;
+  const double slice_plane = m.have_slice ? m.overlays->slice_plane : 0.0;
   for (Sample& smp : s) {
     const int x = x0 + smp.pixel % tw, y = y0 + smp.pixel / tw;
     const std::size_t p = std::size_t(y) * W + x;
@@ -835,7 +836,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       Layer layers[2];
       int nl = 0;
       if (slice && smp.d[slice->axis] != 0) {
-        const double tp = (slice->position - rays.eye()[slice->axis]) / smp.d[slice->axis];
+        const double tp = (slice_plane - rays.eye()[slice->axis]) / smp.d[slice->axis];
         if (tp > 0 && tp < t_surface) {
           const double v = slice->Sample(rays.eye() + tp * smp.d);
           if (std::isfinite(v)) {

@@ -63,7 +63,8 @@ struct PreparedOverlaysData {
   int slice_axis = 2;
   double slice_position = 0, iso_value = 0;
   bool have_slice = false;
-  SliceImage slice;                       // auto range in slice.min / slice.max
+  FieldSlice slice;                       // auto range in slice.min / slice.max
+  double slice_plane = 0;                 // coordinate along slice_axis the plane is drawn at
   std::unique_ptr<RayCaster> iso_caster;  // null when no isosurface (or an empty one)
 };
 

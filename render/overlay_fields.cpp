@@ -37,58 +37,17 @@ bool LowIsGood(const std::string& name) {
 
 }  // namespace
 
-double SliceImage::Sample(const Vec3& p) const {
-  if (nu <= 0 || nv <= 0 || !(spacing > 0)) return std::numeric_limits<double>::quiet_NaN();
-  const double fu = (p[u_axis] - u0) / spacing, fv = (p[v_axis] - v0) / spacing;
-  if (!(fu >= 0 && fv >= 0 && fu < nu && fv < nv)) return std::numeric_limits<double>::quiet_NaN();
-  return values[std::size_t(int(fv)) * nu + int(fu)];
-}
-
-SliceImage SampleSlice(const Fields& fields, const std::string& name, int axis, double position) {
-  SliceImage s;
+FieldSlice SampleSlice(const Fields& fields, const std::string& name, int axis, double position,
+                       double* plane) {
   WithGrid(fields, name, "--slice", [&](const auto& grid) {
+    if (std::isfinite(position)) return;
+    // The middle plane of the active voxels (of the lattice when there are none).
     const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
-    const openvdb::math::Transform& xf = grid.transform();
-    const double vs = xf.voxelSize()[0];
-    const openvdb::Vec3d o = xf.indexToWorld(openvdb::Vec3d(0, 0, 0));
-    const Vec3 origin(o.x(), o.y(), o.z());
-    s.axis = axis;
-    s.u_axis = (axis + 1) % 3;
-    s.v_axis = (axis + 2) % 3;
-    s.spacing = vs;
-    if (box.empty()) return;
-    const int lo = box.min()[axis], hi = box.max()[axis];
-    int k = (lo + hi) / 2;
-    if (std::isfinite(position)) k = int(std::lround((position - origin[axis]) / vs));
-    s.position = std::isfinite(position) ? position : origin[axis] + vs * k;
-    const int u_lo = box.min()[s.u_axis], v_lo = box.min()[s.v_axis];
-    s.nu = box.max()[s.u_axis] - u_lo + 1;
-    s.nv = box.max()[s.v_axis] - v_lo + 1;
-    s.u0 = origin[s.u_axis] + vs * (u_lo - 0.5);
-    s.v0 = origin[s.v_axis] + vs * (v_lo - 0.5);
-    s.values.assign(std::size_t(s.nu) * s.nv, std::numeric_limits<float>::quiet_NaN());
-    if (k < lo || k > hi) return;  // the plane misses the fields: an empty slice
-    auto acc = grid.getConstAccessor();
-    double mn = std::numeric_limits<double>::infinity(), mx = -mn;
-    for (int iv = 0; iv < s.nv; ++iv)
-      for (int iu = 0; iu < s.nu; ++iu) {
-        openvdb::Coord c;
-        c[axis] = k;
-        c[s.u_axis] = u_lo + iu;
-        c[s.v_axis] = v_lo + iv;
-        typename std::decay_t<decltype(grid)>::ValueType v;
-        if (!acc.probeValue(c, v)) continue;
-        const double d = double(v);
-        s.values[std::size_t(iv) * s.nu + iu] = float(d);
-        mn = std::min(mn, d);
-        mx = std::max(mx, d);
-      }
-    if (mn <= mx) {
-      s.min = mn;
-      s.max = mx;
-    }
+    const int k = box.empty() ? fields.lattice.dims[axis] / 2 : (box.min()[axis] + box.max()[axis]) / 2;
+    position = fields.lattice.origin[axis] + fields.lattice.voxel_size * k;
   });
-  return s;
+  *plane = position;
+  return SliceField(fields, name, axis, position, false);
 }
 
 TriangleMesh ExtractIsosurface(const Fields& fields, const std::string& name, double iso) {

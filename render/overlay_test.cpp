@@ -161,11 +161,14 @@ TEST(Overlay, FieldsVdbRoundTrip) {
   for (auto it = back.impl().Float("resolution")->cbeginValueOn(); it; ++it)
     EXPECT_EQ(*it, a.getValue(it.getCoord()));
   // Slices of the original and the copy are identical.
-  const SliceImage s1 = SampleSlice(s.fields, "resolution", 0, 0.1);
-  const SliceImage s2 = SampleSlice(back, "resolution", 0, 0.1);
+  double plane1 = 0, plane2 = 0;
+  const FieldSlice s1 = SampleSlice(s.fields, "resolution", 0, 0.1, &plane1);
+  const FieldSlice s2 = SampleSlice(back, "resolution", 0, 0.1, &plane2);
+  EXPECT_EQ(plane1, 0.1);
+  EXPECT_EQ(plane2, 0.1);
   ASSERT_EQ(s1.values.size(), s2.values.size());
-  for (std::size_t i = 0; i < s1.values.size(); ++i)
-    EXPECT_TRUE(s1.values[i] == s2.values[i] || (std::isnan(s1.values[i]) && std::isnan(s2.values[i])));
+  EXPECT_EQ(s1.has_value, s2.has_value);
+  EXPECT_EQ(s1.values, s2.values);
 }
 
 

@@ -1,6 +1,8 @@
 #pragma once
 /// \file slice.h
-/// Axis-aligned slices through evaluated fields, for figures (`pandora report`).
+/// Axis-aligned slices through evaluated fields: the one slice type of Pandora, for the report's
+/// figures (`pandora report`), the renderer's slice overlay (`pandora render --slice`) and the
+/// viewer's slice planes.
 
 #include <string>
 #include <vector>
@@ -24,11 +26,24 @@ struct FieldSlice {
   /// fields). `values`: the grid value there, 0 elsewhere.
   std::vector<unsigned char> inside, has_value;
   std::vector<double> values;
+  double voxel_size = 0;            ///< The lattice's, m.
+  double min = 0, max = 0;          ///< Range of `values` where has_value (0, 0 when none).
+
+  int u_axis() const { return axis == 0 ? 1 : 0; }
+  int v_axis() const { return axis == 2 ? 1 : 2; }
+  /// The value of the voxel whose cell (the cube of edge voxel_size around its centre) holds the
+  /// world point `p` projected along `axis` onto the plane; NaN outside the slice or where the
+  /// field has no value.
+  double Sample(const Vec3& p) const;
 };
 
-/// The slice of grid `field` (a FieldNames() entry that was evaluated; "coverage" must have been
-/// evaluated too, for `inside`) through the voxel plane nearest `coordinate` along `axis` (clamped
-/// into the lattice). Throws std::invalid_argument for a field that was not evaluated.
-FieldSlice SliceField(const Fields& fields, const std::string& field, int axis, double coordinate);
+/// The slice of grid `field` (a FieldNames() entry that was evaluated) through the voxel plane
+/// nearest `coordinate` along `axis`. With `clamp` a plane beyond the lattice is clamped to its
+/// first or last plane (a figure always shows something); without, such a slice has no value
+/// anywhere (an overlay plane that misses the fields shows nothing). `inside` needs the coverage
+/// grid; without it, it equals `has_value`. Throws std::invalid_argument for a field that was not
+/// evaluated or an axis other than 0, 1, 2.
+FieldSlice SliceField(const Fields& fields, const std::string& field, int axis, double coordinate,
+                      bool clamp = true);
 
 }  // namespace pandora

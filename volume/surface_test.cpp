@@ -492,6 +492,41 @@ TEST(FieldSlice, PicksTheNearestPlaneAndMarksTheRegion) {
   EXPECT_EQ(y.width, fields.lattice.dims.x());
   EXPECT_EQ(y.height, fields.lattice.dims.z());
   EXPECT_THROW(SliceField(fields, "cameras", 2, 0.0), std::invalid_argument);
+  // Without clamping, a plane beyond the lattice has no value anywhere.
+  const FieldSlice off = SliceField(fields, "sigma_max", 1, 100.0, false);
+  EXPECT_EQ(off.index, -1);
+  EXPECT_EQ(std::count(off.has_value.begin(), off.has_value.end(), 1), 0);
+  EXPECT_TRUE(std::isnan(off.Sample(Vec3(0, 100.0, 0.3))));
+
+  // Sample: every world point inside a voxel's cell reads that voxel; its range is min / max.
+  const FieldSlice r = SliceField(fields, "resolution", 2, 0.351);
+  auto res = fields.impl().Float("resolution")->getConstAccessor();
+  const VoxelLattice& L = fields.lattice;
+  double lo = 1e300, hi = -1e300;
+  int valued = 0;
+  for (int i = 0; i < L.dims.x(); ++i)
+    for (int j = 0; j < L.dims.y(); ++j) {
+      const Vec3 centre = L.Center(i, j, 7);
+      for (const Vec3& d : {Vec3(0, 0, 0), Vec3(0.49, -0.49, 3), Vec3(-0.49, 0.49, -2)}) {
+        const double v = r.Sample(centre + L.voxel_size * d);  // the z offset is projected away
+        float expected = 0;
+        if (res.probeValue(openvdb::Coord(i, j, 7), expected)) {
+          ASSERT_EQ(v, expected) << i << " " << j;
+        } else {
+          ASSERT_TRUE(std::isnan(v)) << i << " " << j;
+        }
+      }
+      float value = 0;
+      if (res.probeValue(openvdb::Coord(i, j, 7), value)) {
+        lo = std::min<double>(lo, value);
+        hi = std::max<double>(hi, value);
+        ++valued;
+      }
+    }
+  ASSERT_GT(valued, 0);
+  EXPECT_EQ(r.min, lo);
+  EXPECT_EQ(r.max, hi);
+  EXPECT_TRUE(std::isnan(r.Sample(L.Center(0, 0, 7) - Vec3(L.voxel_size, 0, 0))));  // outside
 }
 
 }  // namespace
