@@ -10,21 +10,15 @@
 
 #include "analysis/camera.h"
 #include "analysis/uncertainty.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
 
 Camera Pinhole(const Vec3& position, const Vec3& target, double f_px, int w = 2000, int h = 2000,
                const Vec3& up = Vec3(0, 0, 1)) {
-  Intrinsics k;
-  k.width = w;
-  k.height = h;
-  k.fx = k.fy = f_px;
-  k.cx = (w - 1) / 2.0;
-  k.cy = (h - 1) / 2.0;
-  Camera c;
-  c.model = CameraModel(k);
-  c.world_from_camera = LookAt(position, target, up).value();
+  Camera c = testing::WithIntrinsics(testing::TestCamera("", position, target, 60, w, h, LensModel::kPinhole, up),
+                                     [&](Intrinsics& k) { k.fx = k.fy = f_px; });
   return c;
 }
 

@@ -12,22 +12,14 @@
 #include "volume/fields_vdb.h"
 #include "volume/surface.h"
 #include "volume/vdb_io.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
 
 Camera DownCamera(const std::string& id, const Vec3& from, const Vec3& at, const Vec3& color) {
-  Camera c;
-  c.id = c.name = id;
+  Camera c = testing::TestCamera(id, from, at, 50, 64, 48, LensModel::kPinhole, Vec3(0, 1, 0));
   c.color = color;
-  c.world_from_camera = *LookAt(from, at, Vec3(0, 1, 0));
-  Intrinsics k;
-  k.width = 64;
-  k.height = 48;
-  k.fx = k.fy = FocalFromHfov(50 * M_PI / 180.0, 64, LensModel::kPinhole);
-  k.cx = 31.5;
-  k.cy = 23.5;
-  c.model = CameraModel(k);
   return c;
 }
 

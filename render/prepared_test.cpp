@@ -19,26 +19,16 @@
 #include "render/progressive.h"
 #include "render/render.h"
 #include "volume/fields.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
 
 Camera Cam(const std::string& id, const Vec3& from, const Vec3& at, double hfov_deg,
            const Vec3& color, LensModel lens = LensModel::kPinhole, double k1 = 0, double k2 = 0) {
-  Camera c;
-  c.id = c.name = id;
+  Camera c = testing::WithIntrinsics(testing::TestCamera(id, from, at, hfov_deg, 64, 48, lens, Vec3(0, 0, 1)),
+                                     [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
   c.color = color;
-  c.world_from_camera = *LookAt(from, at, Vec3(0, 0, 1));
-  Intrinsics k;
-  k.width = 64;
-  k.height = 48;
-  k.model = lens;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, 64, lens);
-  k.cx = 31.5;
-  k.cy = 23.5;
-  k.k1 = k1;
-  k.k2 = k2;
-  c.model = CameraModel(k);
   return c;
 }
 

@@ -19,6 +19,7 @@
 #include "analysis/visibility.h"
 #include "render/colormap.h"
 #include "render/render.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
@@ -26,20 +27,9 @@ namespace {
 Camera MakeCamera(const std::string& id, const Vec3& from, const Vec3& at, const Vec3& up, int w,
                   int h, double hfov_deg, const Vec3& color, LensModel lens = LensModel::kPinhole,
                   double k1 = 0, double k2 = 0) {
-  Camera c;
-  c.id = c.name = id;
+  Camera c = testing::WithIntrinsics(testing::TestCamera(id, from, at, hfov_deg, w, h, lens, up),
+                                     [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
   c.color = color;
-  c.world_from_camera = *LookAt(from, at, up);
-  Intrinsics k;
-  k.width = w;
-  k.height = h;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, w, lens);
-  k.cx = 0.5 * w - 0.5;
-  k.cy = 0.5 * h - 0.5;
-  k.model = lens;
-  k.k1 = k1;
-  k.k2 = k2;
-  c.model = CameraModel(k);
   return c;
 }
 

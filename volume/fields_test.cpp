@@ -15,25 +15,16 @@
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 #include "volume/vdb_io.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
 
 Camera MakeCamera(const Vec3& position, const Vec3& target, double hfov_deg, LensModel model,
                   double k1 = 0, double k2 = 0, const Vec3& up = Vec3(0, 0, 1)) {
-  Intrinsics k;
-  k.width = 640;
-  k.height = 480;
-  k.model = model;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, k.width, model);
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.k1 = k1;
-  k.k2 = k2;
-  Camera cam;
-  cam.id = "cam";
-  cam.model = CameraModel(k);
-  cam.world_from_camera = LookAt(position, target, up).value();
+  Camera cam = testing::WithIntrinsics(testing::TestCamera("cam", position, target, hfov_deg, 640, 480, model, up),
+                                       [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
+  cam.name.clear();
   cam.near = 0.05;
   cam.far = 20;
   return cam;
