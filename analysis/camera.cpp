@@ -255,6 +255,26 @@ FieldBounds ComputeFieldBounds(const CameraModel& model) {
   // Some ray has z <= 0: normalized coordinates are unbounded.
   bool behind = false;
 
+  if (k.model == LensModel::kPinhole) {
+    // Closed form: x / z = (u - cx) / fx is affine in the pixel, so its extremes over the image
+    // border lie at the corners, and so does the largest angle from the axis (the largest
+    // |(x, y) / z|). No sampling: a rig of 1000 cameras loads in milliseconds.
+    ext = Eigen::Vector4d((x0 - k.cx) / k.fx, (x1 - k.cx) / k.fx, (y0 - k.cy) / k.fy, (y1 - k.cy) / k.fy);
+    if (ext(0) > ext(1)) std::swap(ext(0), ext(1));  // a negative focal length mirrors
+    if (ext(2) > ext(3)) std::swap(ext(2), ext(3));
+    const double far_x = std::max(std::abs(ext(0)), std::abs(ext(1)));
+    const double far_y = std::max(std::abs(ext(2)), std::abs(ext(3)));
+    FieldBounds bounds;
+    bounds.max_angle = std::min(kPi, std::atan(std::hypot(far_x, far_y)) * (1 + kRelativeMargin));
+    if (ext.allFinite()) {
+      bounds.normalized = ext + Eigen::Vector4d(-kRelativeMargin * far_x, kRelativeMargin * far_x,
+                                                -kRelativeMargin * far_y, kRelativeMargin * far_y);
+    } else {
+      bounds.normalized = Eigen::Vector4d(-kInf, kInf, -kInf, kInf);
+    }
+    return bounds;
+  }
+
   // Records the ray through `pixel`; returns (angle, x/z, y/z), or nullopt outside the domain.
   auto sample = [&](const Vec2& pixel) -> std::optional<Eigen::Vector3d> {
     const std::optional<Vec3> ray = model.Unproject(pixel);
