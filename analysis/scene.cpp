@@ -1267,4 +1267,12 @@ json RigToJson(const Rig& rig) {
   return json{{"name", rig.name}, {"cameras", std::move(cameras)}};
 }
 
+Rig ParseRigJson(const json& rig, const std::string& path, const std::string& json_path) {
+  Context context;
+  context.file = path;
+  context.folder = fs::path(path).parent_path();
+  std::set<std::string> names;
+  return ReadRig(Node(&rig, json_path, &context), &names);
+}
+
 }  // namespace pandora

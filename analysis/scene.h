@@ -187,4 +187,9 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
 /// pixels, distortion by OpenCV names). Used as metadata in outputs and by `pandora accept`.
 nlohmann::json RigToJson(const Rig& rig);
 
+/// Reads a rig in the scene file's form (metres; RigToJson's output reads back), e.g. from a
+/// viewer's autosave file: the same checks as a rig in a scene file, with errors (InputError) naming
+/// `path` and the JSON path below `json_path` (e.g. "$.rig").
+Rig ParseRigJson(const nlohmann::json& rig, const std::string& path, const std::string& json_path);
+
 }  // namespace pandora

@@ -697,6 +697,22 @@ TEST(SceneCameraTest, RigToJsonRoundTrip) {
     }
   }
   EXPECT_EQ(copy.cameras[1].id, "7");
+  // ParseRigJson reads the same form on its own (a viewer's autosave), with errors under its path.
+  const Rig alone = ParseRigJson(RigToJson(rig), "autosave.json", "$.rig");
+  ASSERT_EQ(alone.cameras.size(), copy.cameras.size());
+  for (size_t i = 0; i < copy.cameras.size(); ++i) {
+    EXPECT_TRUE(SameCameraGeometry(alone.cameras[i], copy.cameras[i])) << i;
+    EXPECT_EQ(alone.cameras[i].enabled, copy.cameras[i].enabled);
+  }
+  json broken = RigToJson(rig);
+  broken["cameras"][2]["resolution"] = {640};
+  try {
+    ParseRigJson(broken, "autosave.json", "$.rig");
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "autosave.json");
+    EXPECT_EQ(e.json_path().rfind("$.rig.cameras[2].resolution", 0), 0u) << e.what();
+  }
   const json emitted = RigToJson(rig);
   EXPECT_EQ(emitted["cameras"][0]["range"].count("far"), 1u);
   EXPECT_FALSE(emitted["cameras"][0].contains("distortion"));

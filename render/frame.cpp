@@ -1008,6 +1008,14 @@ std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
   return pick;
 }
 
+std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, double y) {
+  internal::CheckView(view, rig);
+  const internal::ViewRays rays(view, rig, /*table=*/false);
+  Vec3 d;
+  if (!rays.Direction(x, y, &d)) return std::nullopt;
+  return Ray{rays.eye(), d, 0.0, internal::kInf};
+}
+
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,
                                    const RenderView& view, int x, int y) {
   return PixelPicker(scene, rig, view).Pick(x, y);

@@ -219,6 +219,12 @@ class PixelPicker {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The ray through output pixel coordinates (x, y) of `view` (pixel centres at integers; any real
+/// coordinates, e.g. a mouse position), as Render traces it: origin at the eye, unit direction,
+/// t from 0 to infinity. nullopt outside the lens's domain (a camera's-eye view). Throws as Render
+/// does for a bad view. What a viewer's picking and gizmo drags use.
+std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, double y);
+
 /// PixelPicker(scene, rig, view).Pick(x, y), for a single pick.
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
                                    int x, int y);

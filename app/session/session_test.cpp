@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "analysis/error.h"
+#include "app/session/autosave.h"
 #include "app/session/session.h"
 #include "volume/fields.h"
 
@@ -276,6 +277,80 @@ TEST(Session, RenderInTheBackgroundRefinesToTheExactFrameOfTheNewestRig) {
   // ...and differs from the original rig's (camera 0 lit part of the block).
   const Image before = pandora::Render(study->scene(), original, study->caster(), view, options);
   EXPECT_NE(before.cameras, exact.cameras);
+}
+
+TEST(Autosave, WritesOnlyEditedCamerasAndRecoversThemAsOneUndoStep) {
+  const fs::path scene = CopyScene("autosave");
+  const std::string path = AutosavePath(scene.string());
+  Rig edited;
+  {
+    Session session(Study::Load(scene.string()), SessionOptions());
+    WriteAutosave(session, path);
+    EXPECT_FALSE(fs::exists(path));  // nothing edited: no file
+    const Rig& rig = session.rig().rig();
+    session.rig().SetPose(1, Moved(rig.cameras[1], Vec3(0.05, -0.02, 0.1)));
+    Intrinsics k = session.rig().rig().cameras[1].model.intrinsics();
+    k.fx *= 1.25;
+    k.fy *= 1.25;
+    session.rig().SetIntrinsics(1, k);
+    session.rig().SetEnabled(0, false);
+    WriteAutosave(session, path);
+    edited = session.rig().rig();
+    // The session "crashes" here: the scene file was never written.
+  }
+  ASSERT_TRUE(fs::exists(path));
+  const std::string scene_text = Read(scene);
+  Session again(Study::Load(scene.string()), SessionOptions());
+  const Rig original = again.rig().rig();
+  const std::optional<Autosave> a = ReadAutosave(path, again.study());
+  ASSERT_TRUE(a);
+  EXPECT_FALSE(a->stale);
+  ASSERT_EQ(a->cameras.size(), 2u);  // only the two edited cameras
+  const std::vector<std::string> ids = RecoverAutosave(again, *a, path);
+  EXPECT_EQ(ids, (std::vector<std::string>{original.cameras[0].id, original.cameras[1].id}));
+  EXPECT_EQ(again.rig().undo_label(), "recover autosave (2 cameras)");
+  for (int c : {0, 1}) {
+    const Camera& x = again.rig().rig().cameras[c];
+    const Camera& y = edited.cameras[c];
+    EXPECT_EQ(x.enabled, y.enabled);
+    EXPECT_LT((x.world_from_camera.matrix() - y.world_from_camera.matrix()).norm(), 1e-12);
+    EXPECT_EQ(x.model.intrinsics().fx, y.model.intrinsics().fx);
+  }
+  EXPECT_EQ(Read(scene), scene_text);  // recovery writes nothing into the scene
+  ASSERT_TRUE(again.rig().Undo());
+  EXPECT_TRUE(SameRig(again.rig().rig(), original));
+
+  // Damaged autosaves name the file and the JSON path; a changed scene makes it stale.
+  auto expect_error = [&](const std::string& text, const std::string& json_path) {
+    std::ofstream(path, std::ios::binary) << text;
+    try {
+      ReadAutosave(path, again.study());
+      ADD_FAILURE() << "expected InputError for " << text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_EQ(e.json_path(), json_path) << e.what();
+    }
+  };
+  expect_error("{not json", "$");
+  expect_error("[]", "$");
+  expect_error(R"({"pandora_autosave": 2})", "$.pandora_autosave");
+  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": "nope", "cameras": []})", "$.rig");
+  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": ")" + original.name +
+                   R"(", "cameras": [{"id": "zz", "position": [0, 0, 1], "look_at": [1, 0, 1],
+                   "resolution": [64, 48], "hfov_deg": 60}]})",
+               "$.cameras[0].id");
+  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": ")" + original.name +
+                   R"(", "cameras": [{"id": ")" + original.cameras[0].id +
+                   R"(", "position": [0, 0, "one"], "look_at": [1, 0, 1], "resolution": [64, 48], "hfov_deg": 60}]})",
+               "$.cameras[0].position[2]");
+  std::ofstream(path, std::ios::binary)
+      << R"({"pandora_autosave": 1, "scene_sha256": "0000", "rig": ")" + original.name +
+             R"(", "cameras": [{"id": ")" + original.cameras[0].id +
+             R"(", "position": [0, 0, 1], "look_at": [1, 0, 1], "resolution": [64, 48], "hfov_deg": 60}]})";
+  const std::optional<Autosave> stale = ReadAutosave(path, again.study());
+  ASSERT_TRUE(stale);
+  EXPECT_TRUE(stale->stale);
+  EXPECT_THROW(RecoverAutosave(again, *stale, path), InputError);
 }
 
 TEST(Session, UnknownRigNamesTheOption) {

@@ -1,0 +1,97 @@
+#include "app/session/autosave.h"
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <system_error>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "analysis/input_file.h"
+
+namespace pandora::session {
+
+using nlohmann::json;
+
+std::string AutosavePath(const std::string& scene_path) { return scene_path + ".autosave.json"; }
+
+void WriteAutosave(const Session& session, const std::string& path) {
+  const EditableRig& rig = session.rig();
+  const std::vector<int> unsaved = rig.Unsaved();
+  if (unsaved.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    return;
+  }
+  Rig changed;
+  changed.name = rig.rig().name;
+  for (int c : unsaved) changed.cameras.push_back(rig.rig().cameras[c]);
+  const json j = {{"pandora_autosave", 1},
+                  {"scene", session.study().scene().path},
+                  {"scene_sha256", session.study().scene().sha256},
+                  {"rig", changed.name},
+                  {"cameras", RigToJson(changed)["cameras"]}};
+  WriteFileAtomically(path, j.dump(1) + "\n");
+}
+
+std::optional<Autosave> ReadAutosave(const std::string& path, const Study& study) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  const std::string text = ReadInputFile(path, InputLimits::kJsonBytes, "autosave file");
+  CheckJsonLimits(text, path);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(path, "$", std::string("malformed JSON: ") + e.what(),
+                     "delete the autosave file to start from the scene file");
+  }
+  if (!j.is_object()) throw InputError(path, "$", "expected an object");
+  if (!j.contains("pandora_autosave") || j["pandora_autosave"] != 1)
+    throw InputError(path, "$.pandora_autosave", "not a Pandora autosave file (version 1)");
+  for (const char* key : {"scene_sha256", "rig"})
+    if (!j.contains(key) || !j[key].is_string())
+      throw InputError(path, std::string("$.") + key, "expected a string");
+  if (!j.contains("cameras") || !j["cameras"].is_array())
+    throw InputError(path, "$.cameras", "expected an array of cameras");
+  Autosave a;
+  a.rig = j["rig"].get<std::string>();
+  a.stale = j["scene_sha256"].get<std::string>() != study.scene().sha256;
+  const Rig* found = nullptr;
+  for (const Rig& r : study.scene().rigs)
+    if (r.name == a.rig) found = &r;
+  if (!found) throw InputError(path, "$.rig", "the scene has no rig '" + a.rig + "'");
+  const Rig& rig = *found;
+  // The cameras, through the scene file's own checks (a rig needs a name and >= 1 camera).
+  if (j["cameras"].empty()) throw InputError(path, "$.cameras", "an autosave lists at least one camera");
+  const json as_rig = {{"name", a.rig}, {"cameras", j["cameras"]}};
+  a.cameras = ParseRigJson(as_rig, path, "$").cameras;
+  for (std::size_t i = 0; i < a.cameras.size(); ++i)
+    if (rig.FindCamera(a.cameras[i].id) < 0)
+      throw InputError(path, "$.cameras[" + std::to_string(i) + "].id",
+                       "rig '" + rig.name + "' has no camera '" + a.cameras[i].id + "'",
+                       "cameras: " + rig.CameraIds());
+  return a;
+}
+
+std::vector<std::string> RecoverAutosave(Session& session, const Autosave& autosave,
+                                         const std::string& path) {
+  if (autosave.stale)
+    throw InputError(path, "$.scene_sha256", "the scene file changed since this autosave was written",
+                     "delete the autosave file, or restore the scene file it was made for");
+  EditableRig& rig = session.rig();
+  if (autosave.rig != rig.rig().name)
+    throw InputError(path, "$.rig", "the autosave is of rig '" + autosave.rig + "', the session edits '" +
+                                        rig.rig().name + "'");
+  Edit edit;
+  std::vector<std::string> ids;
+  for (const Camera& camera : autosave.cameras) {
+    const int index = rig.Find(camera.id);
+    edit.changes.push_back({index, rig.rig().cameras[index], camera});
+    ids.push_back(camera.id);
+  }
+  edit.label = "recover autosave (" + std::to_string(ids.size()) + " cameras)";
+  rig.Apply(std::move(edit));
+  return ids;
+}
+
+}  // namespace pandora::session
