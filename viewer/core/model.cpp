@@ -1,0 +1,400 @@
+#include "viewer/core/model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "analysis/error.h"
+#include "app/session/autosave.h"
+#include "render/prepared_scene.h"
+#include "viewer/core/manipulate.h"
+#include "volume/fields.h"
+#include "volume/summary.h"
+
+namespace pandora::viewer {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+std::vector<std::string> DefaultFields() { return {"coverage", "cameras", "resolution", "sigma_max"}; }
+
+Vec3 UpFor(const Vec3& from, const Vec3& at) {
+  return std::abs((at - from).normalized().z()) > 0.99 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+}
+
+// Refuses an output path that is one of the scene's input files.
+void CheckOutputPath(const Scene& scene, const std::string& path, const std::string& where) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(path, ec);
+  for (const auto& [file, what] : scene.InputFiles()) {
+    std::error_code ec2;
+    if (!ec && fs::weakly_canonical(file, ec2) == out && !ec2)
+      throw InputError(where, "", "the screenshot path '" + path + "' is the " + what + " " + file,
+                       "write the screenshot elsewhere");
+  }
+}
+
+}  // namespace
+
+void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, int camera) {
+  RenderOptions options = model.display;
+  options.layers = false;
+  options.pixel_sigma = model.scene().study.pixel_sigma;
+  RenderView view = model.MainView();
+  if (camera >= 0) {
+    // The camera's own image, scaled to fit the main view's size.
+    const CameraModel& m = model.rig().cameras[camera].model;
+    const double scale = std::min({1.0, double(model.width) / m.width(), double(model.height) / m.height()});
+    view = RenderView();
+    view.camera = camera;
+    view.width = std::max(16, int(std::lround(m.width() * scale)));
+    view.height = std::max(16, int(std::lround(m.height() * scale)));
+  }
+  std::unique_ptr<PreparedOverlays> overlays;
+  if (!options.overlays.slice_field.empty() || !options.overlays.iso_field.empty())
+    model.session().ReadFields([&](const Fields& fields, std::int64_t) {
+      overlays = std::make_unique<PreparedOverlays>(fields, options.overlays);
+    });
+  WritePng(model.session().Render(view, options, overlays.get()), path);
+}
+
+void CpuFrontend::Input(ViewerModel&, const Action& action) {
+  if (action.kind == Action::Kind::kFrames) return;  // nothing to draw
+  throw InputError(action.where, "", "raw input (mouse, key, scroll) needs the window",
+                   "run the script in `pandora view`, not headless");
+}
+
+ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOptions options)
+    : options_(std::move(options)) {
+  session::SessionOptions so;
+  so.rig = options_.rig;
+  so.rig_option = "--rig";
+  so.fields.fields = options_.fields.empty() ? DefaultFields() : options_.fields;
+  so.fields.scene_path = study->scene().path;
+  so.incremental = true;
+  session_ = std::make_unique<session::Session>(study, so);
+  width = options_.width;
+  height = options_.height;
+  const Scene& s = scene();
+  if (!s.views.empty()) {
+    const RenderView v = ViewFromScene(s.views.begin()->second, width, height, 50.0);
+    view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
+  } else {
+    view = OrbitView::Framing(s.Bounds());
+  }
+  display.pixel_sigma = s.study.pixel_sigma;
+  display.layers = false;
+  session_->UpdateFieldsInBackground();
+}
+
+ViewerModel::~ViewerModel() = default;
+
+int ViewerModel::CameraIndex(const std::string& id, const Action& action) const {
+  const int c = rig().FindCamera(id);
+  if (c < 0)
+    throw InputError(action.where, "", "no camera '" + id + "' in rig '" + rig().name + "'",
+                     "cameras: " + rig().CameraIds());
+  return c;
+}
+
+std::vector<int> ViewerModel::CameraIndices(const std::vector<std::string>& ids, const Action& action) const {
+  std::vector<int> out;
+  for (const std::string& id : ids) out.push_back(CameraIndex(id, action));
+  return out;
+}
+
+void ViewerModel::Edited() {
+  session_->UpdateFieldsInBackground();
+  if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
+  if (on_edit) on_edit();
+}
+
+void ViewerModel::Run(const std::vector<Action>& script, Frontend* frontend) {
+  for (const Action& a : script) Do(a, frontend);
+}
+
+void ViewerModel::Do(const Action& a, Frontend* frontend) {
+  using Kind = Action::Kind;
+  session::EditableRig& edit = session_->rig();
+  const std::string& file = scene().path;
+  // Applies camera changes as one undo step.
+  auto apply = [&](const std::vector<int>& cams, const std::string& label, const auto& change) {
+    session::Edit e;
+    e.label = label;
+    for (int c : cams) {
+      session::CameraEdit ce{c, rig().cameras[c], rig().cameras[c]};
+      change(ce.after);
+      e.changes.push_back(std::move(ce));
+    }
+    edit.Apply(std::move(e));
+    Edited();
+  };
+  auto label = [&](const char* verb, const std::vector<int>& cams) {
+    return std::string(verb) + " " +
+           (cams.size() == 1 ? rig().cameras[cams[0]].id : std::to_string(cams.size()) + " cameras");
+  };
+  status.clear();
+  switch (a.kind) {
+    case Kind::kSelect:
+      selection = CameraIndices(a.cameras, a);
+      break;
+    case Kind::kMove: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      for (int c : cams) {
+        const Vec3 target = a.flag ? a.a : rig().cameras[c].center() + a.a;
+        scene().CheckReach(target, a.where, "the camera position");
+      }
+      apply(cams, label("move", cams), [&](Camera& cam) {
+        cam.world_from_camera.translation() = a.flag ? a.a : Vec3(cam.world_from_camera.translation() + a.a);
+      });
+      break;
+    }
+    case Kind::kRotate: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      Vec3 pivot = Vec3::Zero();
+      std::vector<Eigen::Isometry3d> poses;
+      for (int c : cams) {
+        pivot += rig().cameras[c].center() / double(cams.size());
+        poses.push_back(rig().cameras[c].world_from_camera);
+      }
+      const Mat3 R = Eigen::AngleAxisd(a.number * kDeg, a.a.normalized()).toRotationMatrix();
+      const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, pivot, Vec3::Zero(), R);
+      std::size_t i = 0;
+      apply(cams, label("rotate", cams), [&](Camera& cam) { cam.world_from_camera = moved[i++]; });
+      break;
+    }
+    case Kind::kAim: {
+      const int c = CameraIndex(a.cameras[0], a);
+      const Vec3 from = rig().cameras[c].center();
+      const auto pose = LookAt(from, a.a, UpFor(from, a.a));
+      if (!pose) throw InputError(a.where, "", "the camera cannot aim at its own position");
+      apply({c}, label("aim", {c}), [&](Camera& cam) { cam.world_from_camera = *pose; });
+      break;
+    }
+    case Kind::kEnable:
+    case Kind::kDisable: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      const bool on = a.kind == Kind::kEnable;
+      apply(cams, label(on ? "enable" : "disable", cams), [&](Camera& cam) { cam.enabled = on; });
+      break;
+    }
+    case Kind::kHfov: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      apply(cams, label("zoom", cams), [&](Camera& cam) {
+        Intrinsics k = cam.model.intrinsics();
+        const double fx = FocalFromHfov(a.number * kDeg, k.width, k.model);
+        if (k.model != LensModel::kFisheye && a.number >= 180)
+          throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+        k.fy *= fx / k.fx;
+        k.fx = fx;
+        cam.model = CameraModel(k);
+      });
+      break;
+    }
+    case Kind::kUndo:
+      status = edit.can_undo() ? "undo " + edit.undo_label() : "nothing to undo";
+      if (edit.Undo()) Edited();
+      break;
+    case Kind::kRedo:
+      status = edit.can_redo() ? "redo " + edit.redo_label() : "nothing to redo";
+      if (edit.Redo()) Edited();
+      break;
+    case Kind::kSlice:
+    case Kind::kIso: {
+      const bool slice = a.kind == Kind::kSlice;
+      if (!a.flag) {
+        const std::vector<std::string> live = options_.fields.empty() ? DefaultFields() : options_.fields;
+        if (std::find(live.begin(), live.end(), a.text) == live.end()) {
+          std::string list;
+          for (const std::string& f : live) list += (list.empty() ? "" : ", ") + f;
+          throw InputError(a.where, "", "'" + a.text + "' is not a live field of this session", "live: " + list);
+        }
+      }
+      if (slice) {
+        display.overlays.slice_field = a.text;
+        display.overlays.slice_axis = a.text2 == "x" ? 0 : a.text2 == "y" ? 1 : 2;
+        display.overlays.slice_position = a.number;
+      } else {
+        display.overlays.iso_field = a.text;
+        if (!a.flag) display.overlays.iso_value = a.number;
+      }
+      break;
+    }
+    case Kind::kView: {
+      const auto it = scene().views.find(a.text);
+      if (it == scene().views.end()) {
+        std::string names;
+        for (const auto& [name, v] : scene().views) names += (names.empty() ? "" : ", ") + name;
+        throw InputError(a.where, "", "no view '" + a.text + "' in " + file,
+                         names.empty() ? "the scene defines no views" : "views: " + names);
+      }
+      const RenderView v = ViewFromScene(it->second, width, height, 50.0);
+      view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
+      break;
+    }
+    case Kind::kOrbit:
+      view.Orbit(a.a.x(), a.a.y());
+      break;
+    case Kind::kPan:
+      view.Pan(a.a.x(), a.a.y(), width);
+      break;
+    case Kind::kDolly:
+      view.Dolly(a.number);
+      break;
+    case Kind::kEye:
+      view = OrbitView::FromLookAt(a.a, a.b, a.number);
+      break;
+    case Kind::kLight:
+      display.pattern = a.text == "grid" ? Pattern::kGrid : Pattern::kUniform;
+      display.grid_pixels = int(a.number);
+      display.brightness = a.number2;
+      display.surface = a.text2 == "black"         ? Surface::kBlack
+                        : a.text2 == "hidden-line" ? Surface::kHiddenLine
+                        : a.text2 == "contours"    ? Surface::kContours
+                                                   : Surface::kMaterial;
+      break;
+    case Kind::kWait:
+      if (a.text == "fields") {
+        const session::JobStatus s = session_->WaitFields();
+        if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+      } else if (a.text == "suggest") {
+        session::JobStatus s;
+        suggestion = session_->WaitSuggestion(&s);
+        if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+        if (suggestion) status = suggestion->message;
+      } else {
+        session_->jobs().Wait("render");
+      }
+      break;
+    case Kind::kSuggest: {
+      SuggestOptions o;
+      o.scene_path = a.where;
+      o.cameras = CameraIndices(a.cameras, a);
+      CameraLimits limits;
+      limits.max_move = a.number;
+      limits.max_rotate_deg = a.number2;
+      o.limits = {limits};
+      const std::optional<Objective> objective = ParseObjective(a.text);
+      if (!objective)
+        throw InputError(a.where + ".objective", "", "unknown objective '" + a.text + "'",
+                         "use coverage2 (or coverageK), sigma-mean, sigma-p90, resolution or mix");
+      o.objective = *objective;
+      std::vector<TargetPoint> targets = SampleTargets(scene(), int(a.number3), {}, false, a.seed);
+      suggestion.reset();
+      session_->SuggestInBackground(std::move(targets), o);
+      status = "suggesting";
+      break;
+    }
+    case Kind::kAccept: {
+      if (!suggestion) throw InputError(a.where, "", "there is no suggestion to accept", "suggest first, then wait for it");
+      Suggestion take = *suggestion, keep = *suggestion;
+      take.cameras.clear();
+      keep.cameras.clear();
+      for (const CameraChange& c : suggestion->cameras)
+        (a.cameras.empty() || std::count(a.cameras.begin(), a.cameras.end(), c.id) ? take : keep).cameras.push_back(c);
+      for (const std::string& id : a.cameras)
+        if (std::none_of(take.cameras.begin(), take.cameras.end(), [&](const CameraChange& c) { return c.id == id; }))
+          throw InputError(a.where, "", "camera '" + id + "' is not in the suggestion");
+      session_->ApplySuggestion(take);
+      Edited();
+      if (keep.cameras.empty()) suggestion.reset();
+      else suggestion = keep;
+      status = "accepted " + std::to_string(take.cameras.size()) + " cameras (not saved yet)";
+      break;
+    }
+    case Kind::kReject:
+      suggestion.reset();
+      break;
+    case Kind::kSave: {
+      const session::SaveResult r = session_->Save(a.flag);
+      if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
+      status = r.saved.empty() ? "nothing to save" : "saved " + std::to_string(r.saved.size()) + " cameras into " +
+                                                          r.scene_path + " (previous file kept as " + r.backup_path + ")";
+      break;
+    }
+    case Kind::kScreenshot: {
+      if (!frontend) throw InputError(a.where, "", "screenshots need a front end");
+      CheckOutputPath(scene(), a.text, a.where);
+      frontend->Screenshot(*this, a.text, a.text2.empty() ? -1 : CameraIndex(a.text2, a));
+      break;
+    }
+    case Kind::kSize:
+      width = int(a.a.x());
+      height = int(a.a.y());
+      break;
+    case Kind::kGamepad: {
+      const int c = CameraIndex(a.cameras[0], a);
+      GamepadAxes axes;
+      axes.left_x = a.a.x();
+      axes.left_y = a.a.y();
+      axes.right_x = a.b.x();
+      axes.right_y = a.b.y();
+      Eigen::Isometry3d pose = rig().cameras[c].world_from_camera;
+      const int steps = int(std::lround(a.number * 60.0));  // 60 Hz, as the window polls
+      for (int i = 0; i < steps; ++i) pose = GamepadMove(pose, axes, 1.0 / 60.0, 0.5, 45.0);
+      apply({c}, label("gamepad", {c}), [&](Camera& cam) { cam.world_from_camera = pose; });
+      break;
+    }
+    case Kind::kMouse:
+    case Kind::kKey:
+    case Kind::kScroll:
+    case Kind::kFrames:
+      if (frontend) frontend->Input(*this, a);
+      break;
+  }
+}
+
+nlohmann::json ViewerModel::StateJson() const {
+  using nlohmann::json;
+  const session::EditableRig& edit = session_->rig();
+  json cameras = json::array();
+  for (const Camera& c : rig().cameras) {
+    const Vec3 p = c.center();
+    cameras.push_back({{"id", c.id},
+                       {"enabled", c.enabled},
+                       {"position", {p.x(), p.y(), p.z()}},
+                       {"hfov_deg", HfovFromFocal(c.model.intrinsics().fx, c.model.width(), c.model.intrinsics().model) / kDeg}});
+  }
+  json selected = json::array();
+  for (int c : selection) selected.push_back(rig().cameras[c].id);
+  json fields = json::object();
+  session_->ReadFields([&](const Fields& f, std::int64_t version) {
+    fields["rig_version"] = version;
+    // coverage_ge[k - 1]: share of the free region voxels seen by at least k cameras.
+    const auto& h = f.stats.coverage_histogram;
+    std::int64_t total = 0;
+    for (std::int64_t n : h) total += n;
+    json ge = json::array();
+    std::int64_t at_least = total;
+    for (std::size_t k = 1; k < h.size(); ++k) {
+      at_least -= h[k - 1];
+      ge.push_back(total > 0 ? double(at_least) / total : 0.0);
+    }
+    fields["coverage_ge"] = ge;
+    const std::optional<double> p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
+    fields["sigma_max_p50_mm"] = p50 ? json(*p50) : json();
+  });
+  json j = {{"rig", rig().name},
+            {"rig_version", edit.version()},
+            {"undo", edit.undo_label()},
+            {"redo", edit.redo_label()},
+            {"unsaved", edit.Unsaved().size()},
+            {"selection", selected},
+            {"cameras", cameras},
+            {"fields", fields},
+            {"status", status}};
+  if (suggestion) {
+    json ids = json::array();
+    for (const CameraChange& c : suggestion->cameras) ids.push_back(c.id);
+    j["suggestion"] = {{"cameras", ids},
+                       {"objective", ObjectiveName(suggestion->objective)},
+                       {"before", suggestion->before.objective},
+                       {"after", suggestion->after.objective},
+                       {"improved", suggestion->improved}};
+  }
+  return j;
+}
+
+}  // namespace pandora::viewer

@@ -1,0 +1,92 @@
+#pragma once
+/// \file model.h
+/// What the viewer shows and edits, without GL: the session (study, rig being edited with undo,
+/// fields kept up to date in the background, suggest), the selection, the main view, the display
+/// settings, the pending suggestion, and the autosave. Every UI action, from the window or from a
+/// script, is ViewerModel::Do(action): the GL front end draws the model and turns input into
+/// actions; the unit tests run whole sessions through Do with the exact CPU renderer standing in
+/// for the GPU (CpuFrontend).
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "app/session/session.h"
+#include "viewer/core/navigation.h"
+#include "viewer/core/script.h"
+
+namespace pandora::viewer {
+
+class ViewerModel;
+
+/// What a front end does for the actions that need a window: screenshots, raw input, frames.
+class Frontend {
+ public:
+  virtual ~Frontend() = default;
+  /// Writes `path` (PNG): the main view, or camera `camera`'s own view when it is >= 0.
+  virtual void Screenshot(const ViewerModel& model, const std::string& path, int camera) = 0;
+  /// Mouse, key, scroll and frame actions (the GL front end feeds them to GLFW and Dear ImGui).
+  virtual void Input(ViewerModel& model, const Action& action) { (void)model; (void)action; }
+};
+
+/// The exact CPU renderer as a front end: screenshots through Session::Render with the model's view,
+/// settings and slice / isosurface over the current fields. Raw input is refused.
+class CpuFrontend : public Frontend {
+ public:
+  void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;
+  void Input(ViewerModel& model, const Action& action) override;
+};
+
+struct ViewerOptions {
+  std::string rig;                  ///< Empty: the first.
+  std::vector<std::string> fields;  ///< Live fields; empty: coverage, cameras, resolution, sigma_max.
+  std::string autosave_path;        ///< Empty: no autosave.
+  int width = 1280, height = 720;   ///< The main view.
+};
+
+class ViewerModel {
+ public:
+  /// Throws InputError for an unknown rig or field.
+  ViewerModel(std::shared_ptr<const session::Study> study, ViewerOptions options);
+  ~ViewerModel();
+
+  session::Session& session() { return *session_; }
+  const session::Session& session() const { return *session_; }
+  const Rig& rig() const { return session_->rig().rig(); }
+  const Scene& scene() const { return session_->study().scene(); }
+
+  /// Runs one action. Throws InputError naming the script's `where` for an action that cannot
+  /// apply (an unknown camera id, accept without a suggestion, a field that is not live).
+  void Do(const Action& action, Frontend* frontend);
+  /// Runs every action of a script in order.
+  void Run(const std::vector<Action>& script, Frontend* frontend);
+
+  // What the front end draws.
+  OrbitView view;
+  int width = 1280, height = 720;
+  RenderOptions display;                ///< Pattern, surface, brightness, grid, slice and isosurface.
+  std::vector<int> selection;           ///< Rig indices.
+  std::optional<Suggestion> suggestion; ///< Suggested poses waiting for accept or reject (ghosts).
+  std::string status;                   ///< The last action's one-line message.
+
+  /// The main view as the renderer takes it.
+  RenderView MainView() const { return view.ToRenderView(width, height); }
+  /// The state as JSON, for `pandora view --log`: rig version, undo label, selection, cameras'
+  /// poses, fields (version, shares seen by at least 1, 2, ... cameras, sigma_max median), the pending suggestion.
+  nlohmann::json StateJson() const;
+  /// Called after each action that edited the rig (the GL front end re-uploads cameras).
+  std::function<void()> on_edit;
+
+ private:
+  int CameraIndex(const std::string& id, const Action& action) const;
+  std::vector<int> CameraIndices(const std::vector<std::string>& ids, const Action& action) const;
+  void Edited();  // fields in the background, autosave, on_edit
+  ViewerOptions options_;
+  std::unique_ptr<session::Session> session_;
+};
+
+}  // namespace pandora::viewer

@@ -1,0 +1,316 @@
+#include "viewer/core/script.h"
+
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "analysis/error.h"
+#include "analysis/input_file.h"
+
+namespace pandora::viewer {
+namespace {
+
+using nlohmann::json;
+using Kind = Action::Kind;
+
+// One action object: typed reads of its keys, each failing with the file and the JSON path.
+class Entry {
+ public:
+  Entry(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& reason, const std::string& hint = "") const {
+    throw InputError(file_, key.empty() ? path_ : path_ + "." + key, reason, hint);
+  }
+  bool Has(const std::string& key) const { return j_.contains(key); }
+  void Keys(std::initializer_list<const char*> allowed) const {
+    std::set<std::string> ok(allowed.begin(), allowed.end());
+    for (const auto& item : j_.items())
+      if (!ok.count(item.key())) {
+        std::string list;
+        for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);
+        Fail(item.key(), "unknown key for this action", "keys: " + list);
+      }
+  }
+  double Number(const std::string& key, double lo, double hi) const {
+    if (!Has(key)) Fail(key, "missing");
+    const json& v = j_.at(key);
+    if (!v.is_number()) Fail(key, "expected a number");
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+      Fail(key, "expected a number in [" + Short(lo) + ", " + Short(hi) + "], got " + v.dump());
+    return x;
+  }
+  double Number(const std::string& key, double lo, double hi, double fallback) const {
+    return Has(key) ? Number(key, lo, hi) : fallback;
+  }
+  std::string String(const std::string& key, bool allow_empty = false) const {
+    if (!Has(key)) Fail(key, "missing");
+    const json& v = j_.at(key);
+    if (!v.is_string()) Fail(key, "expected a string");
+    std::string s = v.get<std::string>();
+    if (s.empty() && !allow_empty) Fail(key, "must not be empty");
+    if (s.size() > 4096) Fail(key, "longer than 4096 characters");
+    return s;
+  }
+  std::string OneOf(const std::string& key, std::initializer_list<const char*> values) const {
+    const std::string s = String(key);
+    for (const char* v : values)
+      if (s == v) return s;
+    std::string list;
+    for (const char* v : values) list += (list.empty() ? "" : ", ") + std::string(v);
+    Fail(key, "unknown value '" + s + "'", "use one of " + list);
+  }
+  Vec3 Vector(const std::string& key, int n = 3) const {
+    if (!Has(key)) Fail(key, "missing");
+    const json& v = j_.at(key);
+    if (!v.is_array() || int(v.size()) != n) Fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    Vec3 out = Vec3::Zero();
+    for (int i = 0; i < n; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || std::abs(v[i].get<double>()) > 1e7)
+        Fail(key + "[" + std::to_string(i) + "]", "expected a finite number of at most 1e7 in size");
+      out[i] = v[i].get<double>();
+    }
+    return out;
+  }
+  // A camera id or a list of them.
+  std::vector<std::string> Ids(const std::string& key, bool allow_empty) const {
+    const json& v = j_.at(key);
+    std::vector<std::string> out;
+    if (v.is_string()) {
+      out.push_back(String(key));
+    } else if (v.is_array()) {
+      if (v.size() > 10000) Fail(key, "more than 10000 cameras");
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        if (!v[i].is_string() || v[i].get<std::string>().empty())
+          Fail(key + "[" + std::to_string(i) + "]", "expected a camera id (a non-empty string)");
+        out.push_back(v[i].get<std::string>());
+      }
+    } else {
+      Fail(key, "expected a camera id or an array of ids");
+    }
+    if (out.empty() && !allow_empty) Fail(key, "name at least one camera");
+    return out;
+  }
+
+ private:
+  static std::string Short(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+  }
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+};
+
+const std::map<std::string, Kind>& Kinds() {
+  static const std::map<std::string, Kind> kinds = {
+      {"select", Kind::kSelect}, {"move", Kind::kMove},       {"rotate", Kind::kRotate},
+      {"aim", Kind::kAim},       {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
+      {"hfov", Kind::kHfov},     {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
+      {"slice", Kind::kSlice},   {"iso", Kind::kIso},         {"view", Kind::kView},
+      {"orbit", Kind::kOrbit},   {"pan", Kind::kPan},         {"dolly", Kind::kDolly},
+      {"eye", Kind::kEye},       {"light", Kind::kLight},     {"wait", Kind::kWait},
+      {"suggest", Kind::kSuggest}, {"accept", Kind::kAccept}, {"reject", Kind::kReject},
+      {"save", Kind::kSave},     {"screenshot", Kind::kScreenshot}, {"size", Kind::kSize},
+      {"mouse", Kind::kMouse},   {"key", Kind::kKey},         {"scroll", Kind::kScroll},
+      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}};
+  return kinds;
+}
+
+Action ParseAction(const json& j, const std::string& where, const std::string& file) {
+  if (!j.is_object() || j.empty())
+    throw InputError(file, where, "expected an object naming one action, e.g. {\"undo\": 1}");
+  // The action is the first known key present (objects keep their keys sorted; exactly one action).
+  std::string name;
+  for (const auto& item : j.items())
+    if (Kinds().count(item.key())) {
+      if (!name.empty())
+        throw InputError(file, where, "two actions in one object ('" + name + "' and '" + item.key() + "')",
+                         "give each action its own object");
+      name = item.key();
+    }
+  if (name.empty()) {
+    std::string list;
+    for (const auto& [k, v] : Kinds()) list += (list.empty() ? "" : ", ") + k;
+    throw InputError(file, where, "no known action in this object", "actions: " + list);
+  }
+  const Entry e(j, where, file);
+  Action a;
+  a.kind = Kinds().at(name);
+  a.where = where;
+  switch (a.kind) {
+    case Kind::kSelect:
+      e.Keys({"select"});
+      a.cameras = e.Ids("select", true);
+      break;
+    case Kind::kMove:
+      e.Keys({"move", "by", "to"});
+      a.cameras = e.Ids("move", false);
+      if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
+      a.flag = e.Has("to");
+      if (a.flag && a.cameras.size() != 1) e.Fail("to", "'to' places one camera; use 'by' for a group");
+      a.a = e.Vector(a.flag ? "to" : "by");
+      a.has_a = true;
+      break;
+    case Kind::kRotate:
+      e.Keys({"rotate", "axis", "deg"});
+      a.cameras = e.Ids("rotate", false);
+      a.a = e.Vector("axis");
+      if (!(a.a.norm() > 0)) e.Fail("axis", "the axis must be a non-zero vector");
+      a.number = e.Number("deg", -360, 360);
+      break;
+    case Kind::kAim:
+      e.Keys({"aim", "at"});
+      a.cameras = {e.String("aim")};
+      a.a = e.Vector("at");
+      break;
+    case Kind::kEnable:
+    case Kind::kDisable:
+      e.Keys({name.c_str()});
+      a.cameras = e.Ids(name, false);
+      break;
+    case Kind::kHfov:
+      e.Keys({"hfov", "deg"});
+      a.cameras = e.Ids("hfov", false);
+      a.number = e.Number("deg", 1, 359);
+      break;
+    case Kind::kUndo:
+    case Kind::kRedo:
+    case Kind::kReject:
+      e.Keys({name.c_str()});
+      break;
+    case Kind::kSlice:
+      e.Keys({"slice", "axis", "at"});
+      a.text = e.String("slice", true);
+      a.flag = a.text.empty();
+      a.text2 = e.Has("axis") ? e.OneOf("axis", {"x", "y", "z"}) : "z";
+      a.number = e.Has("at") ? e.Number("at", -1e7, 1e7) : NAN;
+      break;
+    case Kind::kIso:
+      e.Keys({"iso", "value"});
+      a.text = e.String("iso", true);
+      a.flag = a.text.empty();
+      if (!a.flag) a.number = e.Number("value", -1e30, 1e30);
+      break;
+    case Kind::kView:
+      e.Keys({"view"});
+      a.text = e.String("view");
+      break;
+    case Kind::kOrbit:
+    case Kind::kPan:
+      e.Keys({name.c_str()});
+      a.a = e.Vector(name, 2);
+      break;
+    case Kind::kDolly:
+      e.Keys({"dolly"});
+      a.number = e.Number("dolly", -100, 100);
+      break;
+    case Kind::kEye:
+      e.Keys({"eye", "at", "fov"});
+      a.a = e.Vector("eye");
+      a.b = e.Vector("at");
+      if ((a.a - a.b).norm() == 0) e.Fail("at", "the eye and the point looked at coincide");
+      a.number = e.Number("fov", 1, 170, 50);
+      break;
+    case Kind::kLight:
+      e.Keys({"light", "grid", "brightness", "surface"});
+      a.text = e.OneOf("light", {"uniform", "grid"});
+      a.number = e.Number("grid", 1, 100000, 32);
+      a.number2 = e.Has("brightness") ? e.Number("brightness", 1e-6, 1e6) : NAN;
+      a.text2 = e.Has("surface") ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"}) : "material";
+      break;
+    case Kind::kWait:
+      e.Keys({"wait"});
+      a.text = e.OneOf("wait", {"fields", "suggest", "render"});
+      break;
+    case Kind::kSuggest:
+      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed"});
+      a.cameras = e.Ids("suggest", false);
+      a.text = e.Has("objective") ? e.String("objective") : "coverage2";
+      a.number = e.Number("max_move", 0, 1e4, 0.3);
+      a.number2 = e.Number("max_rotate", 0, 179.999, 10);
+      a.number3 = e.Number("points", 1, 1e6, 800);
+      a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
+      break;
+    case Kind::kAccept:
+      e.Keys({"accept"});
+      if (j.at("accept").is_string() && j.at("accept") == "all") break;  // every suggested camera
+      a.cameras = e.Ids("accept", false);
+      break;
+    case Kind::kSave:
+      e.Keys({"save"});
+      a.flag = j.at("save").is_string() && j.at("save") == "force";
+      break;
+    case Kind::kScreenshot:
+      e.Keys({"screenshot", "camera"});
+      a.text = e.String("screenshot");
+      if (e.Has("camera")) a.text2 = e.String("camera");
+      break;
+    case Kind::kSize: {
+      e.Keys({"size"});
+      const Vec3 v = e.Vector("size", 2);
+      if (v.x() < 16 || v.y() < 16 || v.x() > 8192 || v.y() > 8192 || v.x() != std::floor(v.x()) ||
+          v.y() != std::floor(v.y()))
+        e.Fail("size", "expected [width, height], whole numbers of pixels from 16 to 8192");
+      a.a = v;
+      break;
+    }
+    case Kind::kMouse:
+      e.Keys({"mouse", "button", "x", "y"});
+      a.text = e.OneOf("mouse", {"press", "release", "move"});
+      a.text2 = e.Has("button") ? e.OneOf("button", {"left", "right", "middle"}) : "left";
+      a.number3 = e.Number("x", -1e5, 1e5);
+      a.number2 = e.Number("y", -1e5, 1e5);
+      break;
+    case Kind::kKey:
+      e.Keys({"key"});
+      a.text = e.String("key");
+      break;
+    case Kind::kScroll:
+      e.Keys({"scroll", "x", "y"});
+      a.number = e.Number("scroll", -100, 100);
+      a.number3 = e.Number("x", -1e5, 1e5, 0);
+      a.number2 = e.Number("y", -1e5, 1e5, 0);
+      break;
+    case Kind::kGamepad:
+      e.Keys({"gamepad", "left", "right", "seconds"});
+      a.cameras = {e.String("gamepad")};
+      a.a = e.Has("left") ? e.Vector("left", 2) : Vec3::Zero();
+      a.b = e.Has("right") ? e.Vector("right", 2) : Vec3::Zero();
+      if (a.a.cwiseAbs().maxCoeff() > 1 || a.b.cwiseAbs().maxCoeff() > 1)
+        e.Fail(a.a.cwiseAbs().maxCoeff() > 1 ? "left" : "right", "stick positions lie in [-1, 1]");
+      a.number = e.Number("seconds", 0, 60);
+      break;
+    case Kind::kFrames:
+      e.Keys({"frames"});
+      a.number = e.Number("frames", 0, 10000);
+      break;
+  }
+  return a;
+}
+
+}  // namespace
+
+std::vector<Action> ParseScript(const std::string& text, const std::string& path) {
+  CheckJsonLimits(text, path);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(path, "$", std::string("malformed JSON: ") + e.what());
+  }
+  if (!j.is_array()) throw InputError(path, "$", "a script is an array of actions", "e.g. [{\"undo\": 1}]");
+  if (j.size() > 100000) throw InputError(path, "$", "more than 100000 actions");
+  std::vector<Action> out;
+  out.reserve(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) out.push_back(ParseAction(j[i], "$[" + std::to_string(i) + "]", path));
+  return out;
+}
+
+std::vector<Action> LoadScript(const std::string& path) {
+  return ParseScript(ReadInputFile(path, InputLimits::kJsonBytes, "script"), path);
+}
+
+}  // namespace pandora::viewer

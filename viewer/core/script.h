@@ -1,0 +1,67 @@
+#pragma once
+/// \file script.h
+/// The viewer's actions as data: every UI action (select, move, rotate, enable, zoom a camera, undo,
+/// slice, suggest, accept, save, navigate, screenshot) is an Action, whether it came from a click or
+/// from a script line, so `pandora view --script FILE` replays what a person does and the unit tests
+/// run sessions without GL (docs/viewer.md, "Scripts").
+///
+/// A script is a JSON array of objects, each naming one action by its first key:
+///     [{"select": ["c03"]},
+///      {"move": ["c03"], "by": [0.2, 0, 0]},           // world metres; "to": [x, y, z] for one camera
+///      {"rotate": ["c03"], "axis": [0, 0, 1], "deg": 10},  // about the cameras' centroid
+///      {"aim": "c03", "at": [0, 0, 1]},                 // turn to look at a point (Z up)
+///      {"enable": ["c01"]}, {"disable": ["c01"]},
+///      {"hfov": ["c03"], "deg": 55},                    // zoom (focal lengths scaled)
+///      {"undo": 1}, {"redo": 1},
+///      {"slice": "coverage", "axis": "z", "at": 1.0},   // "slice": "" hides it
+///      {"iso": "sigma_max", "value": 2.0},              // "iso": "" hides it
+///      {"view": "overview"}, {"orbit": [dx, dy]}, {"pan": [dx, dy]}, {"dolly": 2},
+///      {"eye": [x, y, z], "at": [x, y, z]},
+///      {"light": "grid", "grid": 16, "brightness": 0.5, "surface": "material"},
+///      {"wait": "fields"},                              // or "suggest", "render"
+///      {"suggest": ["c03"], "objective": "coverage2", "max_move": 0.3, "max_rotate": 10,
+///       "points": 600, "seed": 1},
+///      {"accept": ["c03"]}, {"accept": "all"}, {"reject": 1},
+///      {"save": 1},                                     // {"save": "force"} over a changed file
+///      {"screenshot": "out/main.png"}, {"screenshot": "out/c03.png", "camera": "c03"},
+///      {"size": [1280, 720]},                           // the main view's size in pixels
+///      {"mouse": "press", "button": "left", "x": 640, "y": 360},  // raw input, GL front end only
+///      {"key": "ctrl+z"}, {"scroll": 1.0, "x": 640, "y": 360},
+///      {"gamepad": "c03", "left": [0, -1], "right": [0, 0], "seconds": 0.5},
+///      {"frames": 3}]                                   // let the window draw
+/// Unknown actions or keys, wrong types and out-of-range values are refused when the script is
+/// read, before anything runs: InputError naming the file and the JSON path ("$[4].by").
+
+#include <string>
+#include <vector>
+
+#include "analysis/geometry.h"
+
+namespace pandora::viewer {
+
+struct Action {
+  enum class Kind {
+    kSelect, kMove, kRotate, kAim, kEnable, kDisable, kHfov, kUndo, kRedo, kSlice, kIso, kView,
+    kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
+    kMouse, kKey, kScroll, kGamepad, kFrames,
+  };
+  Kind kind = Kind::kFrames;
+  std::string where;                 ///< "$[i]": for messages while running.
+  std::vector<std::string> cameras;  ///< Camera ids (select, move, ... accept; empty accept: all).
+  std::string text;    ///< Field, view, wait target, objective, path, key, mouse action, light pattern.
+  std::string text2;   ///< slice axis "x"/"y"/"z", surface mode, mouse button, screenshot camera.
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  ///< by/to/axis/at/eye; gamepad left (x, y), right (x, y).
+  bool has_a = false, has_b = false;
+  double number = 0;   ///< deg, at, value, dolly steps, seconds, frames, scroll, grid, max_move ...
+  double number2 = 0;  ///< max_rotate, brightness, mouse y ...
+  double number3 = 0;  ///< points, mouse x ...
+  bool flag = false;   ///< save "force"; move "to" (absolute); slice/iso hidden; "at" given.
+  unsigned long long seed = 1;
+};
+
+/// Parses a script (the text of `path`); throws InputError naming `path` and the JSON path.
+std::vector<Action> ParseScript(const std::string& text, const std::string& path);
+/// Reads and parses a script file (64 MiB and nesting limits as for scene files).
+std::vector<Action> LoadScript(const std::string& path);
+
+}  // namespace pandora::viewer

@@ -1,0 +1,329 @@
+// The viewer without GL: navigation and manipulation geometry against closed forms, the stick
+// mapping, scripts refused with file and JSON path, and a whole scripted session (move a camera,
+// the coverage follows, suggest, accept one camera, undo, save, autosave) through ViewerModel with
+// the CPU renderer as front end.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "analysis/error.h"
+#include "app/session/autosave.h"
+#include "tests/fixtures.h"
+#include "viewer/core/manipulate.h"
+#include "viewer/core/model.h"
+#include "viewer/core/navigation.h"
+#include "viewer/core/script.h"
+#include "volume/fields.h"
+
+namespace pandora::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = M_PI / 180.0;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Navigation, OrbitKeepsDistanceAndPitchLimits) {
+  OrbitView v;
+  v.target = Vec3(1, 2, 0.5);
+  v.distance = 4;
+  v.yaw_deg = 0;
+  v.pitch_deg = 0;
+  EXPECT_LT((v.Eye() - Vec3(5, 2, 0.5)).norm(), 1e-12);
+  v.Orbit(-300, 0);  // 90 degrees: the eye goes to +Y of the target
+  EXPECT_LT((v.Eye() - Vec3(1, 6, 0.5)).norm(), 1e-12);
+  v.Orbit(0, 1000);  // pitch clamps at 89
+  EXPECT_EQ(v.pitch_deg, 89.0);
+  EXPECT_NEAR((v.Eye() - v.target).norm(), 4.0, 1e-12);
+  // The view basis is orthonormal and right-handed with screen up.
+  EXPECT_NEAR(v.Forward().dot(v.Right()), 0, 1e-12);
+  EXPECT_NEAR(v.Right().cross(v.Up()).dot(-v.Forward()), 1.0, 1e-12);
+}
+
+TEST(Navigation, PanMovesThePointUnderTheCursorWithIt) {
+  OrbitView v = OrbitView::FromLookAt(Vec3(0, -5, 2), Vec3(0, 0, 1), 60);
+  const RenderView before = v.ToRenderView(800, 600);
+  // The target sits at the image centre; after panning 100 px right it sits 100 px right of centre.
+  const Vec3 target = v.target;
+  v.Pan(100, 0, 800);
+  const RenderView after = v.ToRenderView(800, 600);
+  const auto pose = LookAt(after.from, after.at, after.up);
+  ASSERT_TRUE(pose);
+  const Vec3 local = pose->inverse() * target;
+  const double f = 0.5 * 800 / std::tan(0.5 * 60 * kDeg);
+  EXPECT_NEAR(local.x() / local.z() * f, 100.0, 1e-9);
+  EXPECT_NEAR(local.y() / local.z() * f, 0.0, 1e-9);
+  (void)before;
+  // Dolly by one step multiplies the distance by 0.85; FromLookAt round-trips the eye.
+  const double d = v.distance;
+  v.Dolly(1);
+  EXPECT_NEAR(v.distance, 0.85 * d, 1e-12);
+  const OrbitView w = OrbitView::FromLookAt(Vec3(3, -4, 2), Vec3(0, 0, 2), 40);
+  EXPECT_LT((w.Eye() - Vec3(3, -4, 2)).norm(), 1e-12);
+}
+
+TEST(Navigation, LookTurnsAboutTheEye) {
+  OrbitView v = OrbitView::FromLookAt(Vec3(0, 0, 1), Vec3(3, 0, 1), 50);
+  const Vec3 eye = v.Eye();
+  v.Look(90, 0);  // turn left: now looking along +Y
+  EXPECT_LT((v.Eye() - eye).norm(), 1e-12);
+  EXPECT_LT((v.Forward() - Vec3(0, 1, 0)).norm(), 1e-12);
+  v.Fly(0, 0, 2);  // forward 2 m
+  EXPECT_LT((v.Eye() - (eye + Vec3(0, 2, 0))).norm(), 1e-12);
+}
+
+TEST(Manipulate, AxisDragFollowsTheClosestPoint) {
+  // A ray from (0, -5, 1) towards (2, 0, 1) meets the x axis line through (0, 0, 1) at x = 2.
+  const Ray ray{Vec3(0, -5, 1), Vec3(2, 5, 0).normalized(), 0, 1e30};
+  const auto t = AxisParameter(ray, Vec3(0, 0, 1), Vec3(1, 0, 0));
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 2.0, 1e-12);
+  // Skew lines: the axis z through (1, 0, 0), the ray along x at height 3, y = 0.
+  const auto s = AxisParameter(Ray{Vec3(-4, 0, 3), Vec3(1, 0, 0), 0, 1e30}, Vec3(1, 0, 0), Vec3(0, 0, 1));
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(*s, 3.0, 1e-12);
+  EXPECT_FALSE(AxisParameter(Ray{Vec3(0, 1, 0), Vec3(1, 0, 0), 0, 1}, Vec3::Zero(), Vec3(1, 0, 0)));
+}
+
+TEST(Manipulate, RingDragSweepsTheAngleAboutTheAxis) {
+  // Looking down from (0, 0, 10) at the plane z = 0: from (1, 0, 0) to (0, 1, 0) is +90 about +Z.
+  const Vec3 eye(0, 0, 10);
+  const Ray a{eye, (Vec3(1, 0, 0) - eye).normalized(), 0, 1e30};
+  const Ray b{eye, (Vec3(0, 1, 0) - eye).normalized(), 0, 1e30};
+  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), Vec3::UnitZ()), M_PI / 2, 1e-12);
+  EXPECT_NEAR(*SweptAngle(b, a, Vec3::Zero(), Vec3::UnitZ()), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), -Vec3::UnitZ()), -M_PI / 2, 1e-12);
+  EXPECT_FALSE(SweptAngle(Ray{eye, Vec3(1, 0, 0), 0, 1}, b, Vec3::Zero(), Vec3::UnitZ()));  // parallel
+  EXPECT_EQ(Snap(0.26, 0.1), 0.30000000000000004);
+  EXPECT_EQ(Snap(-0.24, 0.1), -0.2);
+  EXPECT_EQ(Snap(0.26, 0), 0.26);
+}
+
+TEST(Manipulate, GroupsMoveRigidlyAndPickingFindsTheNearestBody) {
+  Rig rig = testing::RingRig(4, 2.0, 1.0);
+  std::vector<Eigen::Isometry3d> poses;
+  for (const Camera& c : rig.cameras) poses.push_back(c.world_from_camera);
+  const Mat3 R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix();
+  const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, Vec3::Zero(), Vec3(0, 0, 0.5), R);
+  // A quarter turn about the ring's axis takes camera i to camera i + 1's place, lifted 0.5 m.
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_LT((moved[i].translation() - (poses[(i + 1) % 4].translation() + Vec3(0, 0, 0.5))).norm(), 1e-12);
+    EXPECT_LT((moved[i].linear() - poses[(i + 1) % 4].linear()).norm(), 1e-12);
+  }
+  // Pairwise distances are kept.
+  EXPECT_NEAR((moved[0].translation() - moved[2].translation()).norm(),
+              (poses[0].translation() - poses[2].translation()).norm(), 1e-12);
+  // A ray from outside through camera 0 (at (2, 0, 1)) and on to camera 2 picks camera 0 first.
+  const Ray ray{Vec3(5, 0, 1), Vec3(-1, 0, 0), 0, 1e30};
+  EXPECT_EQ(PickCamera(rig, ray, 0.1), 0);
+  EXPECT_EQ(PickCamera(rig, Ray{Vec3(5, 0, 1.2), Vec3(-1, 0, 0), 0, 1e30}, 0.1), -1);  // passes above
+  EXPECT_EQ(PickCamera(rig, Ray{Vec3(5, 0, 1.05), Vec3(-1, 0, 0), 0, 1e30}, 0.1), 0);
+}
+
+TEST(Manipulate, FourthPowerStickMapping) {
+  EXPECT_EQ(StickCurve(0.05), 0.0);  // dead zone
+  EXPECT_EQ(StickCurve(1.0), 1.0);
+  EXPECT_EQ(StickCurve(-1.0), -1.0);
+  EXPECT_EQ(StickCurve(2.0), 1.0);  // clamped
+  EXPECT_NEAR(StickCurve(0.55), std::pow(0.5, 4), 1e-15);  // halfway through the travel: 1/16
+  EXPECT_NEAR(StickCurve(-0.55), -std::pow(0.5, 4), 1e-15);
+  // One second full forward at 0.5 m/s moves a level camera 0.5 m along its view; full right stick
+  // for a second at 45 deg/s turns it 45 degrees to the right, keeping it level.
+  const Camera cam = testing::TestCamera("c", Vec3(0, 0, 1), Vec3(1, 0, 1));
+  Eigen::Isometry3d p = cam.world_from_camera;
+  GamepadAxes forward;
+  forward.left_y = -1;
+  for (int i = 0; i < 60; ++i) p = GamepadMove(p, forward, 1.0 / 60, 0.5, 45);
+  EXPECT_LT((p.translation() - Vec3(0.5, 0, 1)).norm(), 1e-12);
+  GamepadAxes turn;
+  turn.right_x = 1;
+  for (int i = 0; i < 60; ++i) p = GamepadMove(p, turn, 1.0 / 60, 0.5, 45);
+  const Vec3 view = p.linear().col(2);
+  EXPECT_NEAR(std::atan2(view.y(), view.x()), -45 * kDeg, 1e-12);
+  EXPECT_NEAR(view.z(), 0, 1e-12);
+}
+
+void ExpectScriptError(const std::string& text, const std::string& json_path) {
+  try {
+    ParseScript(text, "s.json");
+    ADD_FAILURE() << "expected InputError for " << text;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "s.json");
+    EXPECT_EQ(e.json_path(), json_path) << e.what();
+  }
+}
+
+TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
+  const std::vector<Action> s = ParseScript(R"([
+    {"select": ["a"]}, {"move": "a", "by": [0.1, 0, 0]}, {"move": ["a"], "to": [1, 2, 3]},
+    {"rotate": ["a", "b"], "axis": [0, 0, 1], "deg": 15}, {"aim": "a", "at": [0, 0, 0]},
+    {"enable": "a"}, {"disable": ["b"]}, {"hfov": "a", "deg": 40}, {"undo": 1}, {"redo": 1},
+    {"slice": "coverage", "axis": "y", "at": 0.5}, {"slice": ""}, {"iso": "sigma_max", "value": 2},
+    {"view": "overview"}, {"orbit": [10, -5]}, {"pan": [3, 4]}, {"dolly": -1},
+    {"eye": [0, -3, 2], "at": [0, 0, 1], "fov": 45}, {"light": "grid", "grid": 8, "surface": "black"},
+    {"wait": "fields"}, {"suggest": ["a"], "objective": "sigma-p90", "points": 50},
+    {"accept": "all"}, {"accept": ["a"]}, {"reject": 1}, {"save": "force"},
+    {"screenshot": "x.png", "camera": "a"}, {"size": [640, 360]}, {"mouse": "press", "x": 1, "y": 2},
+    {"key": "ctrl+z"}, {"scroll": -1}, {"gamepad": "a", "left": [0, -1], "seconds": 0.5}, {"frames": 2}
+  ])", "s.json");
+  ASSERT_EQ(s.size(), 32u);
+  EXPECT_EQ(s[1].kind, Action::Kind::kMove);
+  EXPECT_FALSE(s[1].flag);
+  EXPECT_TRUE(s[2].flag);
+  EXPECT_EQ(s[3].cameras, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(s[10].text2, "y");
+  EXPECT_EQ(s[10].number, 0.5);
+  EXPECT_TRUE(s[11].flag);
+  EXPECT_TRUE(s[21].cameras.empty());
+  EXPECT_TRUE(s[24].flag);
+  EXPECT_EQ(s[20].number3, 50);
+  EXPECT_EQ(s[30].number, 0.5);
+
+  ExpectScriptError("{", "$");
+  ExpectScriptError("{\"undo\": 1}", "$");
+  ExpectScriptError("[1]", "$[0]");
+  ExpectScriptError("[{\"undo\": 1}, {\"jump\": 1}]", "$[1]");
+  ExpectScriptError("[{\"undo\": 1, \"redo\": 1}]", "$[0]");
+  ExpectScriptError("[{\"move\": \"a\", \"by\": [0, 0]}]", "$[0].by");
+  ExpectScriptError("[{\"move\": \"a\", \"by\": [0, \"x\", 0]}]", "$[0].by[1]");
+  ExpectScriptError("[{\"move\": \"a\"}]", "$[0]");
+  ExpectScriptError("[{\"move\": [\"a\", \"b\"], \"to\": [0, 0, 0]}]", "$[0].to");
+  ExpectScriptError("[{\"move\": [], \"by\": [0, 0, 0]}]", "$[0].move");
+  ExpectScriptError("[{\"rotate\": \"a\", \"axis\": [0, 0, 0], \"deg\": 5}]", "$[0].axis");
+  ExpectScriptError("[{\"hfov\": \"a\", \"deg\": 0}]", "$[0].deg");
+  ExpectScriptError("[{\"slice\": \"coverage\", \"axis\": \"w\"}]", "$[0].axis");
+  ExpectScriptError("[{\"wait\": \"forever\"}]", "$[0].wait");
+  ExpectScriptError("[{\"size\": [10, 10]}]", "$[0].size");
+  ExpectScriptError("[{\"gamepad\": \"a\", \"left\": [2, 0], \"seconds\": 1}]", "$[0].left");
+  ExpectScriptError("[{\"undo\": 1, \"bogus\": 2}]", "$[0].bogus");
+  ExpectScriptError("[{\"eye\": [1, 1, 1], \"at\": [1, 1, 1]}]", "$[0].at");
+  ExpectScriptError("[{\"move\": \"a\", \"by\": [1e300, 0, 0]}]", "$[0].by[0]");
+}
+
+// A copy of the suggest ring scene in a fresh folder (the session saves into it).
+fs::path CopyScene(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("viewer_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file("tests/data/suggest_ring.json", dir / "scene.json");
+  return dir / "scene.json";
+}
+
+// Share of the region seen by all four cameras of the ring.
+double CoverageGe4(const ViewerModel& m) {
+  const nlohmann::json ge = m.StateJson()["fields"]["coverage_ge"];
+  return ge.size() >= 4 ? ge[3].get<double>() : 0.0;
+}
+
+TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
+  const fs::path scene = CopyScene("session");
+  const std::string original_text = Read(scene);
+  ViewerOptions options;
+  options.fields = {"coverage", "cameras", "sigma_max"};
+  options.autosave_path = session::AutosavePath(scene.string());
+  options.width = 160;
+  options.height = 90;
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  CpuFrontend cpu;
+  const std::string c = m.rig().cameras[1].id;
+  const Vec3 start = m.rig().cameras[1].center();
+  const fs::path dir = scene.parent_path();
+  m.Run(ParseScript(R"([{"wait": "fields"}, {"slice": "coverage", "axis": "z", "at": 0.5},
+                        {"screenshot": ")" + (dir / "before.png").string() + R"("}])", "s.json"),
+        &cpu);
+  const double before = CoverageGe4(m);
+  EXPECT_GT(before, 0);
+  // Turn camera 1 partly away from the region: coverage >= 4 drops, the fields follow in the
+  // background.
+  m.Run(ParseScript(R"([{"select": [")" + c + R"("]}, {"rotate": [")" + c + R"("], "axis": [0, 0, 1], "deg": 30},
+                        {"wait": "fields"}, {"screenshot": ")" + (dir / "turned.png").string() + R"("}])", "s.json"),
+        &cpu);
+  EXPECT_EQ(m.StateJson()["undo"], "rotate " + c);
+  EXPECT_EQ(m.StateJson()["selection"], nlohmann::json::array({c}));
+  const double turned = CoverageGe4(m);
+  EXPECT_LT(turned, before);
+  EXPECT_EQ(m.StateJson()["fields"]["rig_version"], m.session().rig().version());
+  // The fields equal a full evaluation of the rig as edited.
+  FieldOptions fo;
+  fo.fields = options.fields;
+  const Fields full = EvaluateFields(m.scene(), m.rig(), m.session().study().caster(), fo);
+  m.session().ReadFields([&](const Fields& f, std::int64_t) {
+    EXPECT_EQ(f.stats.coverage_histogram, full.stats.coverage_histogram);
+  });
+  EXPECT_NE(Read(dir / "before.png"), Read(dir / "turned.png"));  // the slice changed
+  // The autosave holds the turned camera; the scene file is untouched.
+  EXPECT_TRUE(fs::exists(options.autosave_path));
+  EXPECT_EQ(Read(scene), original_text);
+
+  // Suggest for the turned camera, accept it: coverage recovers; undo takes it back.
+  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "objective": "coverage4", "max_move": 0.2, "max_rotate": 45,
+                        "points": 300}, {"wait": "suggest"}])", "s.json"),
+        &cpu);
+  ASSERT_TRUE(m.suggestion);
+  EXPECT_TRUE(m.suggestion->improved) << m.suggestion->message;
+  m.Run(ParseScript(R"([{"accept": [")" + c + R"("]}, {"wait": "fields"}])", "s.json"), &cpu);
+  EXPECT_FALSE(m.suggestion);
+  const double accepted = CoverageGe4(m);
+  EXPECT_GT(accepted, turned);
+  m.Run(ParseScript(R"([{"undo": 1}, {"wait": "fields"}])", "s.json"), &cpu);
+  EXPECT_EQ(CoverageGe4(m), turned);
+  m.Run(ParseScript(R"([{"redo": 1}, {"wait": "fields"}, {"save": 1}])", "s.json"), &cpu);
+  // Saved with a backup; the autosave is gone; the scene file reloads with the accepted pose.
+  EXPECT_NE(Read(scene), original_text);
+  EXPECT_FALSE(fs::exists(options.autosave_path));
+  bool backup = false;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find("scene.json") == 0 && e.path() != scene &&
+        e.path().string().find("autosave") == std::string::npos && Read(e.path()) == original_text)
+      backup = true;
+  EXPECT_TRUE(backup);
+  const Scene reloaded = LoadScene(scene.string());
+  const Camera& saved = reloaded.rigs[0].cameras[1];
+  EXPECT_LT((saved.world_from_camera.matrix() - m.rig().cameras[1].world_from_camera.matrix()).norm(), 1e-6);
+  EXPECT_GT((saved.center() - start).norm() + (saved.world_from_camera.linear() - Mat3::Identity()).norm(), 0);
+
+  // A camera's own view renders too; an output onto the scene file is refused.
+  m.Run(ParseScript(R"([{"screenshot": ")" + (dir / "cam.png").string() + R"(", "camera": ")" + c + R"("}])", "s.json"),
+        &cpu);
+  EXPECT_TRUE(fs::exists(dir / "cam.png"));
+  EXPECT_THROW(m.Run(ParseScript(R"([{"screenshot": ")" + scene.string() + R"("}])", "s.json"), &cpu), InputError);
+  EXPECT_EQ(Read(scene), Read(scene));  // still readable
+  EXPECT_THROW(m.Run(ParseScript(R"([{"select": ["nope"]}])", "s.json"), &cpu), InputError);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"accept": "all"}])", "s.json"), &cpu), InputError);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"slice": "resolution"}])", "s.json"), &cpu), InputError);  // not live
+  EXPECT_THROW(m.Run(ParseScript(R"([{"mouse": "press", "x": 1, "y": 1}])", "s.json"), &cpu), InputError);
+}
+
+TEST(ViewerModel, GroupEditsAreOneUndoStep) {
+  const fs::path scene = CopyScene("group");
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  const Rig original = m.rig();
+  const std::string a = original.cameras[0].id, b = original.cameras[2].id;
+  m.Run(ParseScript(R"([{"move": [")" + a + R"(", ")" + b + R"("], "by": [0, 0, 0.25]},
+                        {"hfov": [")" + a + R"("], "deg": 30}, {"disable": [")" + b + R"("]},
+                        {"gamepad": ")" + a + R"(", "left": [0, -1], "seconds": 1}])", "s.json"),
+        nullptr);
+  EXPECT_NEAR(m.rig().cameras[2].center().z() - original.cameras[2].center().z(), 0.25, 1e-12);
+  EXPECT_NEAR(HfovFromFocal(m.rig().cameras[0].model.intrinsics().fx, m.rig().cameras[0].model.width(),
+                            LensModel::kPinhole) / kDeg, 30, 1e-9);
+  EXPECT_FALSE(m.rig().cameras[2].enabled);
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(m.session().rig().Undo());
+  EXPECT_FALSE(m.session().rig().Undo());
+  for (std::size_t i = 0; i < original.cameras.size(); ++i)
+    EXPECT_TRUE(SameCameraGeometry(m.rig().cameras[i], original.cameras[i])) << i;
+  m.session().WaitFields();
+}
+
+}  // namespace
+}  // namespace pandora::viewer
