@@ -1,0 +1,928 @@
+// The GPU projective-light renderer (viewer/gl_renderer.h). A frame is deferred:
+//  1. G-buffer: the scene from the view; per pixel the surface point (relative to the scene's
+//     centre, float), the triangle index, the normal turned towards the eye and the albedo.
+//  2. Per enabled camera, in rig order: its distance map (one perspective map over the camera's
+//     field, or a cube of six for wide lenses), then a full-screen pass that tests every pixel's
+//     point as VisibilityTester does (range, lens projection, image bounds, facing, the map in
+//     place of the occlusion segment) and adds the camera's term of the light rule into a float
+//     accumulation target (additive blending, rig order) and ORs its bit into an RG32UI mask
+//     (ping-pong between two mask textures: integer targets do not blend).
+//  3. Compose: MaterialColor (or the light alone) and the background, then read back.
+#include "viewer/gl_renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "render/render.h"
+
+namespace pandora {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A camera whose field reaches this far off its axis gets a cube of maps: one perspective map
+// would spend most of its texels at the edges (tan 75 deg = 3.7 times the centre's spacing).
+constexpr double kMaxPerspectiveFieldAngle = 75.0 * kPi / 180.0;
+
+// ------------------------------------------------------------------------------------------
+// Shaders (GLSL 3.30 core).
+
+const char* kGBufferVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;  // relative to the scene's centre
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 albedo;
+uniform mat3 view_R;   // camera_from_world rotation of the eye (OpenCV frame: y down, z forward)
+uniform vec3 view_t;   // camera-frame position of the scene's centre
+uniform vec4 proj;     // 2f/W, 2f/H, A, B: clip = (proj.x x, proj.y y, A z + B, z)
+out vec3 v_position;
+flat out vec3 v_normal;
+flat out vec3 v_albedo;
+void main() {
+  vec3 c = view_R * position + view_t;
+  gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z);
+  v_position = position;
+  v_normal = normal;
+  v_albedo = albedo;
+}
+)";
+
+const char* kGBufferFragment = R"(#version 330 core
+in vec3 v_position;
+flat in vec3 v_normal;
+flat in vec3 v_albedo;
+uniform vec3 eye;
+layout(location = 0) out vec4 g_position;  // xyz, triangle index (-1: no surface)
+layout(location = 1) out vec4 g_normal;    // turned towards the eye
+layout(location = 2) out vec4 g_albedo;
+void main() {
+  vec3 n = v_normal;
+  if (dot(n, v_position - eye) > 0.0) n = -n;
+  g_position = vec4(v_position, float(gl_PrimitiveID));
+  g_normal = vec4(n, 0.0);
+  g_albedo = vec4(v_albedo, 1.0);
+}
+)";
+
+const char* kShadowVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+uniform mat3 face_R;  // face_from_world rotation
+uniform vec3 face_t;  // face-frame position of the scene's centre (the camera at the origin)
+uniform vec4 map;     // sx, sy, ox, oy: ndc = (sx x / z - ox, sy y / z - oy)
+uniform vec2 depth;   // A, B
+out vec3 v_face;
+void main() {
+  vec3 c = face_R * position + face_t;
+  v_face = c;
+  gl_Position = vec4(map.x * c.x - map.z * c.z, map.y * c.y - map.w * c.z,
+                     depth.x * c.z + depth.y, c.z);
+}
+)";
+
+const char* kShadowFragment = R"(#version 330 core
+in vec3 v_face;
+layout(location = 0) out vec2 o_map;  // distance from the camera's centre, triangle index
+void main() { o_map = vec2(length(v_face), float(gl_PrimitiveID)); }
+)";
+
+// A triangle covering the screen, from gl_VertexID alone (no attributes).
+const char* kFullScreenVertex = R"(#version 330 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* kLightFragment = R"(#version 330 core
+uniform sampler2D g_position_tex;
+uniform sampler2D g_normal_tex;
+uniform usampler2D mask_in;
+uniform sampler2DArray shadow_map;
+uniform int map_size;
+uniform int faces;             // 1: one perspective map; 6: a cube
+uniform mat3 face_R[6];        // face_from_camera
+uniform vec4 face_map[6];      // sx, sy, ox, oy as in the shadow pass
+uniform float texel;           // normalized-coordinate size of a texel
+uniform float bias_scale;
+uniform int shadow_mode;      // 0: distance + bias, 1: receiver plane, 2: either
+uniform mat3 cam_R;            // camera_from_world
+uniform vec3 cam_t;            // camera-frame position of the scene's centre
+uniform vec3 cam_center;       // relative to the scene's centre
+uniform int lens;              // 0 pinhole, 1 Brown-Conrady, 2 fisheye
+uniform vec4 K;                // fx fy cx cy
+uniform vec4 D0;               // Brown-Conrady k1 k2 p1 p2; fisheye k1 k2 k3 k4
+uniform float D1;              // Brown-Conrady k3
+uniform float max_radius;      // monotonic domain: normalized radius (BC) or theta (fisheye)
+uniform vec2 image_size;       // camera width, height
+uniform vec2 range;            // near, far (Euclidean, m)
+uniform float lift;
+uniform uvec2 bit;             // the camera's mask bit (zero for cameras 64 and up)
+uniform vec3 light;            // brightness * colour
+uniform int grid;
+uniform float grid_n;
+uniform float grid_fill;
+uniform float line_width;
+uniform vec3 eye;
+uniform mat3 view_Rt;          // world_from_camera rotation of the eye: columns x, y, z
+uniform vec3 view_f;           // f, cx, cy of the eye
+layout(location = 0) out vec4 o_light;
+layout(location = 1) out uvec2 o_mask;
+
+// CameraModel::Project (analysis/camera.cpp) in float: camera-frame point to distorted pixel.
+bool Project(vec3 p, out vec2 px) {
+  px = vec2(0.0);
+  if (lens == 2) {
+    float r = length(p.xy);
+    if (r == 0.0 && p.z == 0.0) return false;
+    float theta = atan(r, p.z);
+    if (!(theta < max_radius)) return false;
+    float t = theta * theta;
+    float poly = 1.0 + t * (D0.x + t * (D0.y + t * (D0.z + t * D0.w)));
+    vec2 q = r > 0.0 ? p.xy * (theta * poly / r) : vec2(0.0);
+    px = K.xy * q + K.zw;
+    return true;
+  }
+  if (!(p.z > 0.0)) return false;
+  vec2 n = p.xy / p.z;
+  vec2 d = n;
+  if (lens == 1) {
+    if (!(length(n) < max_radius)) return false;
+    float x = n.x, y = n.y, s = x * x + y * y;
+    float radial = 1.0 + s * (D0.x + s * (D0.y + s * D1));
+    float dr = 2.0 * (D0.x + s * (2.0 * D0.y + s * 3.0 * D1));
+    d = vec2(x * radial + 2.0 * D0.z * x * y + D0.w * (s + 2.0 * x * x),
+             y * radial + D0.z * (s + 2.0 * y * y) + 2.0 * D0.w * x * y);
+    float c = dr * x * y + 2.0 * D0.z * x + 2.0 * D0.w * y;
+    float j00 = radial + dr * x * x + 2.0 * D0.z * y + 6.0 * D0.w * x;
+    float j11 = radial + dr * y * y + 6.0 * D0.z * y + 2.0 * D0.w * x;
+    if (!(j00 * j11 - c * c > 0.0)) return false;
+  }
+  px = K.xy * d + K.zw;
+  return true;
+}
+
+// GridLineCoverage (render/light.h).
+float GridLine(float u, float g) {
+  if (!(g > 0.0) || isinf(g)) return 0.0;
+  float f = (u + 0.5) / grid_n;
+  float du = abs(f - floor(f + 0.5)) * grid_n;
+  float spacing = grid_n / g;
+  float line = clamp(0.5 * line_width + 0.5 - du / g, 0.0, 1.0);
+  float mean = min(1.0, line_width / spacing);
+  float fade = clamp((3.0 - spacing) / 1.5, 0.0, 1.0);
+  return (1.0 - fade) * line + fade * mean;
+}
+
+void main() {
+  ivec2 ip = ivec2(gl_FragCoord.xy);
+  uvec2 mask = texelFetch(mask_in, ip, 0).xy;
+  o_light = vec4(0.0);
+  o_mask = mask;
+  vec4 g = texelFetch(g_position_tex, ip, 0);
+  if (g.w < 0.0) return;
+  vec3 n = texelFetch(g_normal_tex, ip, 0).xyz;
+  vec3 X = g.xyz + lift * n;
+  vec3 to_point = X - cam_center;
+  float dist = length(to_point);
+  if (dist < range.x || dist > range.y) return;
+  vec3 pc = cam_R * X + cam_t;
+  vec2 px;
+  if (!Project(pc, px)) return;
+  if (!(px.x >= -0.5 && px.y >= -0.5 && px.x <= image_size.x - 0.5 &&
+        px.y <= image_size.y - 0.5)) return;
+  float facing = -dot(n, to_point);
+  if (!(facing > 0.0)) return;
+
+  // Shadow: the distance map's texel that holds the point's direction.
+  int layer = 0;
+  if (faces == 6) {
+    vec3 a = abs(pc);
+    if (a.x >= a.y && a.x >= a.z) layer = pc.x > 0.0 ? 0 : 1;
+    else if (a.y >= a.z) layer = pc.y > 0.0 ? 2 : 3;
+    else layer = pc.z > 0.0 ? 4 : 5;
+  }
+  vec3 pf = face_R[layer] * pc;
+  vec4 fm = face_map[layer];
+  vec2 q = pf.xy / pf.z;
+  vec2 uv = 0.5 * vec2(fm.x * q.x - fm.z, fm.y * q.y - fm.w) + 0.5;
+  ivec2 tc = clamp(ivec2(floor(uv * float(map_size))), ivec2(0), ivec2(map_size - 1));
+  vec2 stored = texelFetch(shadow_map, ivec3(tc, layer), 0).xy;
+  // Tolerance: how much the distance can change between the point and the centre of its texel
+  // on the point's own plane (texel size at that distance times the tangent of the incidence).
+  float cos_i = facing / dist;
+  float tan_i = sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-6);
+  float w = texel * dist * sqrt(1.0 + dot(q, q));
+  float bias = bias_scale * (w * (0.5 + 0.75 * min(tan_i, 10.0)) + 1e-5 * dist);
+  // Receiver plane: the distance at which the texel's centre ray meets the point's own plane. A
+  // planar receiver compares with itself exactly there, at any incidence (no acne).
+  vec2 qc = (((vec2(tc) + 0.5) / float(map_size)) * 2.0 - 1.0 + fm.zw) / fm.xy;
+  vec3 rc = transpose(cam_R) * (transpose(face_R[layer]) * vec3(qc, 1.0));
+  float nr = dot(n, rc);
+  float plane = nr < 0.0 ? dot(n, to_point) / nr * length(rc) : 3e38;
+  bool lit = stored.y == g.w || (shadow_mode != 1 && dist <= stored.x + bias) ||
+             (shadow_mode != 0 && stored.x >= plane - bias_scale * 1e-4 * dist);
+  if (!lit) return;
+
+  float weight = 1.0;
+  if (grid == 1) {
+    // Ray differentials of the hit point on its plane, then the camera pixel's change per output
+    // pixel by central differences of the projection along them.
+    vec2 pp = gl_FragCoord.xy - 0.5;
+    vec3 D = view_Rt[2] + ((pp.x - view_f.y) / view_f.x) * view_Rt[0] +
+             ((pp.y - view_f.z) / view_f.x) * view_Rt[1];
+    float len = length(D);
+    vec3 d = D / len;
+    vec3 Dx = view_Rt[0] / view_f.x, Dy = view_Rt[1] / view_f.x;
+    vec3 ddx = (Dx - d * dot(d, Dx)) / len, ddy = (Dy - d * dot(d, Dy)) / len;
+    float t = length(g.xyz - eye);
+    float nd = dot(n, d);
+    vec3 dXdx = t * (ddx - (dot(n, ddx) / nd) * d);
+    vec3 dXdy = t * (ddy - (dot(n, ddy) / nd) * d);
+    vec2 a, b, c, e;
+    float du = 0.0, dv = 0.0;
+    if (Project(cam_R * (X + 0.5 * dXdx) + cam_t, a) && Project(cam_R * (X - 0.5 * dXdx) + cam_t, b) &&
+        Project(cam_R * (X + 0.5 * dXdy) + cam_t, c) && Project(cam_R * (X - 0.5 * dXdy) + cam_t, e)) {
+      vec2 jx = a - b, jy = c - e;
+      du = length(vec2(jx.x, jy.x));
+      dv = length(vec2(jx.y, jy.y));
+    }
+    float lu = GridLine(px.x, du), lv = GridLine(px.y, dv);
+    weight = grid_fill + (1.0 - grid_fill) * (1.0 - (1.0 - lu) * (1.0 - lv));
+  }
+  o_light = vec4(weight * light, 0.0);
+  o_mask = mask | bit;
+}
+)";
+
+const char* kComposeFragment = R"(#version 330 core
+uniform sampler2D g_position_tex;
+uniform sampler2D g_normal_tex;
+uniform sampler2D g_albedo_tex;
+uniform sampler2D light_tex;
+uniform int material;
+uniform float ambient;
+uniform vec3 background;
+uniform vec3 eye;
+layout(location = 0) out vec4 o_color;
+void main() {
+  ivec2 ip = ivec2(gl_FragCoord.xy);
+  vec4 g = texelFetch(g_position_tex, ip, 0);
+  if (g.w < 0.0) {
+    o_color = vec4(background, 1.0);
+    return;
+  }
+  vec3 L = texelFetch(light_tex, ip, 0).xyz;
+  if (material == 0) {
+    o_color = vec4(L, 1.0);
+    return;
+  }
+  vec3 n = texelFetch(g_normal_tex, ip, 0).xyz;
+  vec3 albedo = texelFetch(g_albedo_tex, ip, 0).xyz;
+  float cos_eye = dot(n, normalize(g.xyz - eye));
+  o_color = vec4(albedo * L + ambient * (0.4 + 0.6 * abs(cos_eye)) * albedo, 1.0);
+}
+)";
+
+// ------------------------------------------------------------------------------------------
+// GL helpers.
+
+GLuint Compile(GLenum type, const char* source, const char* name) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    glDeleteShader(shader);
+    throw std::runtime_error(std::string("GlRenderer: shader ") + name + " does not compile: " + log);
+  }
+  return shader;
+}
+
+GLuint Link(const char* vertex, const char* fragment, const char* name) {
+  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex, name);
+  const GLuint fs = Compile(GL_FRAGMENT_SHADER, fragment, name);
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    glDeleteProgram(program);
+    throw std::runtime_error(std::string("GlRenderer: program ") + name + " does not link: " + log);
+  }
+  return program;
+}
+
+GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+
+void SetMat3(GLuint program, const char* name, const Mat3& m) {
+  float f[9];
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) f[3 * c + r] = float(m(r, c));  // column-major
+  glUniformMatrix3fv(Loc(program, name), 1, GL_FALSE, f);
+}
+void SetVec3(GLuint program, const char* name, const Vec3& v) {
+  glUniform3f(Loc(program, name), float(v.x()), float(v.y()), float(v.z()));
+}
+
+GLuint MakeTexture(GLenum internal, int width, int height, GLenum format, GLenum type) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glTexImage2D(GL_TEXTURE_2D, 0, internal, width, height, 0, format, type, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+void CheckFramebuffer(const char* what) {
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error(std::string("GlRenderer: framebuffer ") + what +
+                             " incomplete (status " + std::to_string(status) + ")");
+}
+
+// Perspective clip coefficients A, B mapping z = near to -1 and z = far to +1.
+Eigen::Vector2d DepthCoefficients(double near, double far) {
+  return Eigen::Vector2d((far + near) / (far - near), -2.0 * far * near / (far - near));
+}
+
+// [near, far] for a depth buffer from the geometry's range: a margin of 1e-3 each way, near kept
+// above 1e-5 of far (closer geometry is clipped: nothing a depth buffer could order anyway).
+std::pair<double, double> PadRange(std::pair<double, double> r) {
+  const double far = std::max(r.second * (1 + 1e-3), 1e-6);
+  const double near = std::max(r.first * (1 - 1e-3), far * 1e-5);
+  return {near, far};
+}
+
+// One distance map of a camera: the face frame (a rotation of the camera frame), the normalized
+// bounds it covers and its depth range.
+struct MapFace {
+  Mat3 face_from_camera = Mat3::Identity();
+  Eigen::Vector4d bounds{-1, 1, -1, 1};
+  bool empty = false;  // no geometry in it: stays cleared
+  double near = 0, far = 1;
+};
+
+// The six cube faces, in the shader's layer order +x, -x, +y, -y, +z, -z: each maps its axis
+// onto +z.
+std::array<Mat3, 6> CubeFaces() {
+  std::array<Mat3, 6> f;
+  auto frame = [](const Vec3& z, const Vec3& up) {
+    const Vec3 x = up.cross(z).normalized();
+    const Vec3 y = z.cross(x);
+    Mat3 m;
+    m.row(0) = x.transpose();
+    m.row(1) = y.transpose();
+    m.row(2) = z.transpose();
+    return m;
+  };
+  f[0] = frame(Vec3::UnitX(), Vec3::UnitY());
+  f[1] = frame(-Vec3::UnitX(), Vec3::UnitY());
+  f[2] = frame(Vec3::UnitY(), Vec3::UnitZ());
+  f[3] = frame(-Vec3::UnitY(), Vec3::UnitZ());
+  f[4] = frame(Vec3::UnitZ(), Vec3::UnitY());
+  f[5] = frame(-Vec3::UnitZ(), Vec3::UnitY());
+  return f;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+
+std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh,
+                                              const Eigen::Isometry3d& camera_from_world,
+                                              const Eigen::Vector4d& bounds) {
+  // Inward plane normals through the apex: x - x_min z >= 0, x_max z - x >= 0, ...
+  const std::array<Vec3, 4> planes = {Vec3(1, 0, -bounds(0)), Vec3(-1, 0, bounds(1)),
+                                      Vec3(0, 1, -bounds(2)), Vec3(0, -1, bounds(3))};
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  std::vector<Vec3> camera_vertices(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    camera_vertices[i] = camera_from_world * mesh.vertices[i];
+  std::array<Vec3, 16> poly, next;
+  for (const Eigen::Vector3i& tri : mesh.triangles) {
+    int count = 3;
+    for (int k = 0; k < 3; ++k) poly[k] = camera_vertices[tri[k]];
+    bool all_inside = true;
+    for (const Vec3& p : planes) {
+      int outside = 0;
+      for (int k = 0; k < 3; ++k) outside += p.dot(poly[k]) < 0;
+      if (outside == 3) {
+        count = 0;
+        break;
+      }
+      all_inside &= outside == 0;
+    }
+    if (count == 0) continue;
+    if (!all_inside) {
+      // Sutherland-Hodgman against the four planes.
+      for (const Vec3& p : planes) {
+        int out = 0;
+        for (int k = 0; k < count; ++k) {
+          const Vec3& a = poly[k];
+          const Vec3& b = poly[(k + 1) % count];
+          const double da = p.dot(a), db = p.dot(b);
+          if (da >= 0) next[out++] = a;
+          if ((da >= 0) != (db >= 0)) next[out++] = a + (da / (da - db)) * (b - a);
+        }
+        count = out;
+        poly = next;
+        if (count == 0) break;
+      }
+    }
+    for (int k = 0; k < count; ++k) {
+      zmin = std::min(zmin, poly[k].z());
+      zmax = std::max(zmax, poly[k].z());
+    }
+  }
+  return {zmin, zmax};
+}
+
+struct GlRenderer::Impl {
+  TriangleMesh mesh;  // world, double: the depth ranges
+  Vec3 origin = Vec3::Zero();
+  double scene_scale = 1.0;
+  GLsizei vertex_count = 0;
+  GLuint vao = 0, vbo = 0;
+  GLuint gbuffer_program = 0, shadow_program = 0, light_program = 0, compose_program = 0;
+  GLuint empty_vao = 0;
+
+  // Per view size.
+  int width = 0, height = 0;
+  GLuint g_fbo = 0, g_position = 0, g_normal = 0, g_albedo = 0, g_depth = 0;
+  GLuint light_fbo[2] = {0, 0}, light_accum = 0, mask[2] = {0, 0};
+  GLuint compose_fbo = 0, compose_color = 0;
+
+  // Distance maps: one perspective layer and the cube's six.
+  int map_size = 0, cube_size = 0;
+  GLuint shadow_fbo = 0, map_single = 0, map_cube = 0, map_depth_single = 0, map_depth_cube = 0;
+
+  void FreeViewTargets() {
+    GLuint textures[] = {g_position, g_normal, g_albedo, light_accum, mask[0], mask[1], compose_color};
+    glDeleteTextures(7, textures);
+    GLuint rbs[] = {g_depth};
+    glDeleteRenderbuffers(1, rbs);
+    GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo};
+    glDeleteFramebuffers(4, fbos);
+    width = height = 0;
+  }
+
+  void EnsureViewTargets(int w, int h) {
+    if (w == width && h == height) return;
+    FreeViewTargets();
+    width = w;
+    height = h;
+    g_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    g_normal = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    g_albedo = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    glGenRenderbuffers(1, &g_depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, g_depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glGenFramebuffers(1, &g_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, g_position, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, g_normal, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_TEXTURE_2D, g_albedo, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g_depth);
+    CheckFramebuffer("G-buffer");
+
+    light_accum = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    for (int k = 0; k < 2; ++k) {
+      mask[k] = MakeTexture(GL_RG32UI, w, h, GL_RG_INTEGER, GL_UNSIGNED_INT);
+      glGenFramebuffers(1, &light_fbo[k]);
+      glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[k]);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, light_accum, 0);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, mask[k], 0);
+      CheckFramebuffer("light");
+    }
+    compose_color = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    glGenFramebuffers(1, &compose_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, compose_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, compose_color, 0);
+    CheckFramebuffer("compose");
+  }
+
+  static GLuint MapArray(int size, int layers) {
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RG32F, size, size, layers, 0, GL_RG, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return tex;
+  }
+  static GLuint DepthBuffer(int size) {
+    GLuint rb = 0;
+    glGenRenderbuffers(1, &rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, size, size);
+    return rb;
+  }
+
+  void EnsureMaps(int size, bool need_cube) {
+    if (size != map_size) {
+      glDeleteTextures(1, &map_single);
+      glDeleteTextures(1, &map_cube);
+      glDeleteRenderbuffers(1, &map_depth_single);
+      glDeleteRenderbuffers(1, &map_depth_cube);
+      map_single = map_cube = map_depth_single = map_depth_cube = 0;
+      map_size = size;
+      cube_size = size / 2;
+    }
+    if (!map_single) {
+      map_single = MapArray(map_size, 1);
+      map_depth_single = DepthBuffer(map_size);
+    }
+    if (need_cube && !map_cube) {
+      map_cube = MapArray(cube_size, 6);
+      map_depth_cube = DepthBuffer(cube_size);
+    }
+    if (!shadow_fbo) glGenFramebuffers(1, &shadow_fbo);
+  }
+
+  ~Impl() {
+    FreeViewTargets();
+    glDeleteTextures(1, &map_single);
+    glDeleteTextures(1, &map_cube);
+    glDeleteRenderbuffers(1, &map_depth_single);
+    glDeleteRenderbuffers(1, &map_depth_cube);
+    glDeleteFramebuffers(1, &shadow_fbo);
+    glDeleteBuffers(1, &vbo);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteVertexArrays(1, &empty_vao);
+    for (GLuint p : {gbuffer_program, shadow_program, light_program, compose_program})
+      glDeleteProgram(p);
+  }
+};
+
+GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  std::vector<int> triangle_object;
+  m.mesh = scene.AllTriangles(&triangle_object);
+  const Aabb content = scene.ContentBounds();
+  m.origin = content.empty() ? Vec3::Zero() : content.center();
+  m.scene_scale = std::max(content.diagonal(), 1e-9);
+  if (m.mesh.triangles.size() >= (std::size_t(1) << 24))
+    throw std::invalid_argument(
+        "GlRenderer: more than 2^24 triangles (the triangle index is kept in a float)");
+
+  std::vector<Vec3> object_color(scene.objects.size(), Material().color);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const int mat = scene.objects[o].material;
+    if (mat >= 0 && mat < int(scene.materials.size())) object_color[o] = scene.materials[mat].color;
+  }
+  std::vector<float> data;
+  data.reserve(m.mesh.triangles.size() * 27);
+  for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& tri = m.mesh.triangles[t];
+    const Vec3 a = m.mesh.vertices[tri[0]], b = m.mesh.vertices[tri[1]], c = m.mesh.vertices[tri[2]];
+    Vec3 n = (b - a).cross(c - a);
+    n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
+    const Vec3& albedo = object_color[triangle_object[t]];
+    for (const Vec3* p : {&a, &b, &c}) {
+      const Vec3 r = *p - m.origin;
+      for (const Vec3* v : std::array<const Vec3*, 3>{&r, &n, &albedo})
+        for (int k = 0; k < 3; ++k) data.push_back(float((*v)(k)));
+    }
+  }
+  m.vertex_count = GLsizei(3 * m.mesh.triangles.size());
+  glGenVertexArrays(1, &m.vao);
+  glBindVertexArray(m.vao);
+  glGenBuffers(1, &m.vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
+  const GLsizei stride = 9 * sizeof(float);
+  for (int k = 0; k < 3; ++k) {
+    glEnableVertexAttribArray(k);
+    glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<const void*>(std::size_t(3 * k) * sizeof(float)));
+  }
+  glGenVertexArrays(1, &m.empty_vao);
+  m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
+  m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
+  m.light_program = Link(kFullScreenVertex, kLightFragment, "light");
+  m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
+}
+
+GlRenderer::~GlRenderer() = default;
+
+std::size_t GlRenderer::triangle_count() const { return impl_->mesh.triangles.size(); }
+
+GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
+                           GlFrameStats* stats) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  Impl& m = *impl_;
+  if (view.camera >= 0)
+    throw std::invalid_argument(
+        "GlRenderer: camera's-eye views (RenderView::camera) are not drawn on the GPU yet; use "
+        "the CPU renderer (render/render.h)");
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  if (view.width <= 0 || view.height <= 0 || view.width > max_size || view.height > max_size)
+    throw std::invalid_argument("GlRenderer: the image size must be 1 .. " +
+                                std::to_string(max_size) + " pixels per side");
+  if (!(view.fov_deg > 0 && view.fov_deg < 180))
+    throw std::invalid_argument("GlRenderer: fov must be in (0, 180) degrees");
+  const auto pose = LookAt(view.from, view.at, view.up);
+  if (!pose)
+    throw std::invalid_argument(
+        "GlRenderer: 'at' equals 'from', or 'up' is parallel to the viewing direction");
+  if (options.shadow_map_size < 512 || options.shadow_map_size > 4096)
+    throw std::invalid_argument("GlRenderer: shadow_map_size must be 512 .. 4096 (is " +
+                                std::to_string(options.shadow_map_size) + ")");
+  const int W = view.width, H = view.height;
+  const std::size_t pixels = std::size_t(W) * H;
+
+  // Which cameras light, and which need a cube of maps.
+  const int camera_count = int(rig.cameras.size());
+  bool need_cube = false;
+  for (const Camera& cam : rig.cameras)
+    if (cam.enabled && cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle) need_cube = true;
+  m.EnsureViewTargets(W, H);
+  m.EnsureMaps(options.shadow_map_size, need_cube);
+
+  // The eye: OpenCV frame (x right, y down, z forward); GL's window row r is the image's row r.
+  const Mat3 eye_R = pose->linear().transpose();  // camera_from_world
+  const double f = 0.5 * W / std::tan(0.5 * view.fov_deg * kPi / 180.0);
+  const Vec3 eye_rel = view.from - m.origin;
+  {
+    const Eigen::Isometry3d cfw = pose->inverse();
+    const Eigen::Vector4d bounds(-0.5 * W / f, 0.5 * W / f, -0.5 * H / f, 0.5 * H / f);
+    auto range = DepthRangeInPyramid(m.mesh, cfw, bounds);
+    if (!(range.first <= range.second)) range = {1.0, 2.0};  // nothing in view: any range
+    const auto [near, far] = PadRange(range);
+    const Eigen::Vector2d ab = DepthCoefficients(near, far);
+    glBindFramebuffer(GL_FRAMEBUFFER, m.g_fbo);
+    const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, buffers);
+    glViewport(0, 0, W, H);
+    const float no_hit[4] = {0, 0, 0, -1}, zero[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, no_hit);
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(m.gbuffer_program);
+    SetMat3(m.gbuffer_program, "view_R", eye_R);
+    SetVec3(m.gbuffer_program, "view_t", eye_R * (m.origin - view.from));
+    glUniform4f(Loc(m.gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
+                float(ab(1)));
+    SetVec3(m.gbuffer_program, "eye", eye_rel);
+    glBindVertexArray(m.vao);
+    glDrawArrays(GL_TRIANGLES, 0, m.vertex_count);
+  }
+
+  // Clear the light and the first mask.
+  glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[0]);
+  {
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    const float zero[4] = {0, 0, 0, 0};
+    const GLuint zero_u[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glClearBufferuiv(GL_COLOR, 1, zero_u);
+  }
+
+  LightRule rule;
+  rule.brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
+                                                   : options.brightness;
+  const double lift = 0.1 * 1e-5 * m.scene_scale;  // as the CPU renderer: a tenth of epsilon
+  const std::array<Mat3, 6> cube = CubeFaces();
+  int src = 0;
+  double shadow_seconds = 0;
+  int maps_drawn = 0;
+  for (int c = 0; c < camera_count; ++c) {
+    const Camera& cam = rig.cameras[c];
+    if (!cam.enabled) continue;
+    const Intrinsics& k = cam.model.intrinsics();
+    const Eigen::Isometry3d cfw = cam.camera_from_world();
+    const Mat3 R = cfw.linear();
+    const Vec3 cam_t = R * (m.origin - cam.center());
+    const bool is_cube = cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle;
+
+    // 1. The camera's distance map(s).
+    const auto shadow_start = Clock::now();
+    std::vector<MapFace> faces;
+    if (!is_cube) {
+      MapFace face;
+      face.bounds = cam.model.normalized_bounds();
+      faces.push_back(face);
+    } else {
+      const double field = cam.model.max_field_angle();
+      for (int i = 0; i < 6; ++i) {
+        MapFace face;
+        face.face_from_camera = cube[i];
+        // The face's pyramid reaches atan(sqrt 2) = 54.7 deg around its axis; skip faces the
+        // camera's field cannot reach.
+        const double axis_angle = std::acos(std::clamp(cube[i].row(2).z(), -1.0, 1.0));
+        face.empty = axis_angle - std::atan(std::sqrt(2.0)) >= field;
+        faces.push_back(face);
+      }
+    }
+    const int size = is_cube ? m.cube_size : m.map_size;
+    glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              is_cube ? m.map_depth_cube : m.map_depth_single);
+    glViewport(0, 0, size, size);
+    glUseProgram(m.shadow_program);
+    glBindVertexArray(m.vao);
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer0);
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      MapFace& face = faces[i];
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                                is_cube ? m.map_cube : m.map_single, 0, GLint(i));
+      CheckFramebuffer("distance map");
+      const float cleared[4] = {3e38f, -1.0f, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, cleared);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      if (face.empty) continue;
+      Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
+      face_from_world.linear() = face.face_from_camera * R;
+      face_from_world.translation() = face.face_from_camera * cfw.translation();
+      auto range = DepthRangeInPyramid(m.mesh, face_from_world, face.bounds);
+      range.second = std::min(range.second, cam.far);  // occluders lie nearer than the point
+      if (!(range.first <= range.second)) {
+        face.empty = true;
+        continue;
+      }
+      const auto [near, far] = PadRange(range);
+      const Eigen::Vector2d ab = DepthCoefficients(near, far);
+      const Eigen::Vector4d& b = face.bounds;
+      SetMat3(m.shadow_program, "face_R", face_from_world.linear());
+      SetVec3(m.shadow_program, "face_t", face_from_world * m.origin);
+      glUniform4f(Loc(m.shadow_program, "map"), float(2 / (b(1) - b(0))), float(2 / (b(3) - b(2))),
+                  float((b(0) + b(1)) / (b(1) - b(0))), float((b(2) + b(3)) / (b(3) - b(2))));
+      glUniform2f(Loc(m.shadow_program, "depth"), float(ab(0)), float(ab(1)));
+      glDrawArrays(GL_TRIANGLES, 0, m.vertex_count);
+      ++maps_drawn;
+    }
+    if (stats) {
+      glFinish();
+      shadow_seconds += std::chrono::duration<double>(Clock::now() - shadow_start).count();
+    }
+
+    // 2. The camera's light over the G-buffer.
+    const int dst = 1 - src;
+    glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[dst]);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    glViewport(0, 0, W, H);
+    glDisable(GL_DEPTH_TEST);
+    glEnablei(GL_BLEND, 0);
+    glDisablei(GL_BLEND, 1);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    const GLuint p = m.light_program;
+    glUseProgram(p);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, m.g_position);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, m.g_normal);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, m.mask[src]);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, is_cube ? m.map_cube : m.map_single);
+    glUniform1i(Loc(p, "g_position_tex"), 0);
+    glUniform1i(Loc(p, "g_normal_tex"), 1);
+    glUniform1i(Loc(p, "mask_in"), 2);
+    glUniform1i(Loc(p, "shadow_map"), 3);
+    glUniform1i(Loc(p, "map_size"), size);
+    glUniform1i(Loc(p, "faces"), is_cube ? 6 : 1);
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      const std::string index = "[" + std::to_string(i) + "]";
+      SetMat3(p, ("face_R" + index).c_str(), faces[i].face_from_camera);
+      const Eigen::Vector4d& b = faces[i].bounds;
+      glUniform4f(Loc(p, ("face_map" + index).c_str()), float(2 / (b(1) - b(0))),
+                  float(2 / (b(3) - b(2))), float((b(0) + b(1)) / (b(1) - b(0))),
+                  float((b(2) + b(3)) / (b(3) - b(2))));
+    }
+    const Eigen::Vector4d& b0 = faces[0].bounds;
+    glUniform1f(Loc(p, "texel"), float(std::max(b0(1) - b0(0), b0(3) - b0(2)) / size));
+    glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
+    glUniform1i(Loc(p, "shadow_mode"), options.shadow_mode);
+    SetMat3(p, "cam_R", R);
+    SetVec3(p, "cam_t", cam_t);
+    SetVec3(p, "cam_center", cam.center() - m.origin);
+    glUniform1i(Loc(p, "lens"), k.model == LensModel::kPinhole        ? 0
+                                : k.model == LensModel::kBrownConrady ? 1
+                                                                      : 2);
+    glUniform4f(Loc(p, "K"), float(k.fx), float(k.fy), float(k.cx), float(k.cy));
+    if (k.model == LensModel::kFisheye)
+      glUniform4f(Loc(p, "D0"), float(k.k1), float(k.k2), float(k.k3), float(k.k4));
+    else
+      glUniform4f(Loc(p, "D0"), float(k.k1), float(k.k2), float(k.p1), float(k.p2));
+    glUniform1f(Loc(p, "D1"), float(k.k3));
+    const double max_radius = cam.model.max_radius();
+    glUniform1f(Loc(p, "max_radius"), std::isfinite(max_radius) ? float(max_radius) : 3e38f);
+    glUniform2f(Loc(p, "image_size"), float(k.width), float(k.height));
+    glUniform2f(Loc(p, "range"), float(cam.near), std::isfinite(cam.far) ? float(cam.far) : 3e38f);
+    glUniform1f(Loc(p, "lift"), float(lift));
+    const GLuint lo = c < 32 ? (1u << c) : 0u, hi = c >= 32 && c < 64 ? (1u << (c - 32)) : 0u;
+    glUniform2ui(Loc(p, "bit"), lo, hi);
+    SetVec3(p, "light", rule.brightness * cam.color);
+    glUniform1i(Loc(p, "grid"), options.pattern == Pattern::kGrid ? 1 : 0);
+    glUniform1f(Loc(p, "grid_n"), float(std::max(1, options.grid_pixels)));
+    glUniform1f(Loc(p, "grid_fill"), float(options.grid_fill));
+    glUniform1f(Loc(p, "line_width"), float(options.line_width_px));
+    SetVec3(p, "eye", eye_rel);
+    SetMat3(p, "view_Rt", pose->linear());
+    glUniform3f(Loc(p, "view_f"), float(f), float(0.5 * W - 0.5), float(0.5 * H - 0.5));
+    glBindVertexArray(m.empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisablei(GL_BLEND, 0);
+    src = dst;
+  }
+
+  // 3. Compose.
+  glBindFramebuffer(GL_FRAMEBUFFER, m.compose_fbo);
+  const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &buffer0);
+  glViewport(0, 0, W, H);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  const GLuint p = m.compose_program;
+  glUseProgram(p);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, m.g_position);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, m.g_normal);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D, m.g_albedo);
+  glActiveTexture(GL_TEXTURE3);
+  glBindTexture(GL_TEXTURE_2D, m.light_accum);
+  glUniform1i(Loc(p, "g_position_tex"), 0);
+  glUniform1i(Loc(p, "g_normal_tex"), 1);
+  glUniform1i(Loc(p, "g_albedo_tex"), 2);
+  glUniform1i(Loc(p, "light_tex"), 3);
+  glUniform1i(Loc(p, "material"), options.material ? 1 : 0);
+  glUniform1f(Loc(p, "ambient"), float(options.ambient));
+  SetVec3(p, "background", options.background);
+  SetVec3(p, "eye", eye_rel);
+  glBindVertexArray(m.empty_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  if (stats) glFinish();
+  const auto drawn = Clock::now();
+
+  // 4. Read back (GL's row r is the image's row r: no flip).
+  GlImage image;
+  image.width = W;
+  image.height = H;
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  std::vector<float> rgba(4 * pixels);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+  image.rgb.resize(3 * pixels);
+  for (std::size_t i = 0; i < pixels; ++i)
+    for (int ch = 0; ch < 3; ++ch) image.rgb[3 * i + ch] = rgba[4 * i + ch];
+  glBindFramebuffer(GL_FRAMEBUFFER, m.g_fbo);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+  image.hit.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) image.hit[i] = rgba[4 * i + 3] >= 0;
+  if (camera_count <= 64) {
+    std::vector<GLuint> bits(2 * pixels);
+    glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[src]);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glReadPixels(0, 0, W, H, GL_RG_INTEGER, GL_UNSIGNED_INT, bits.data());
+    image.cameras.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      image.cameras[i] = uint64_t(bits[2 * i]) | (uint64_t(bits[2 * i + 1]) << 32);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR)
+    throw std::runtime_error("GlRenderer: GL error " + std::to_string(error) + " in a frame");
+  if (stats) {
+    stats->shadow_seconds = shadow_seconds;
+    stats->total_seconds = std::chrono::duration<double>(drawn - start).count();
+    stats->readback_seconds = std::chrono::duration<double>(Clock::now() - drawn).count();
+    stats->shadow_maps = maps_drawn;
+  }
+  return image;
+}
+
+}  // namespace pandora
