@@ -710,7 +710,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   const double lift = 0.1 * 1e-5 * m.scene_scale;  // as the CPU renderer: a tenth of epsilon
   const std::array<Mat3, 6> cube = CubeFaces();
   int src = 0;
-  double shadow_seconds = 0;
+  double shadow_seconds = 0, light_seconds = 0;
   int maps_drawn = 0;
   for (int c = 0; c < camera_count; ++c) {
     const Camera& cam = rig.cameras[c];
@@ -722,6 +722,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     const bool is_cube = cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle;
 
     // 1. The camera's distance map(s).
+    if (stats) glFinish();  // the previous camera's light pass is not the map's time
     const auto shadow_start = Clock::now();
     std::vector<MapFace> faces;
     if (!is_cube) {
@@ -784,6 +785,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
       glFinish();
       shadow_seconds += std::chrono::duration<double>(Clock::now() - shadow_start).count();
     }
+    const auto light_start = Clock::now();
 
     // 2. The camera's light over the G-buffer.
     const int dst = 1 - src;
@@ -823,7 +825,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     const Eigen::Vector4d& b0 = faces[0].bounds;
     glUniform1f(Loc(p, "texel"), float(std::max(b0(1) - b0(0), b0(3) - b0(2)) / size));
     glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
-    glUniform1i(Loc(p, "shadow_mode"), options.shadow_mode);
+    glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
     SetMat3(p, "cam_R", R);
     SetVec3(p, "cam_t", cam_t);
     SetVec3(p, "cam_center", cam.center() - m.origin);
@@ -855,6 +857,10 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDisablei(GL_BLEND, 0);
     src = dst;
+    if (stats) {
+      glFinish();
+      light_seconds += std::chrono::duration<double>(Clock::now() - light_start).count();
+    }
   }
 
   // 3. Compose.
@@ -918,6 +924,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     throw std::runtime_error("GlRenderer: GL error " + std::to_string(error) + " in a frame");
   if (stats) {
     stats->shadow_seconds = shadow_seconds;
+    stats->light_seconds = light_seconds;
     stats->total_seconds = std::chrono::duration<double>(drawn - start).count();
     stats->readback_seconds = std::chrono::duration<double>(Clock::now() - drawn).count();
     stats->shadow_maps = maps_drawn;

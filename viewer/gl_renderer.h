@@ -45,7 +45,15 @@ struct GlRenderOptions {
   int shadow_map_size = 2048;
   /// Multiplies the shadow test's tolerance (docs/viewer.md, "Shadows"); 1 is what was measured.
   double shadow_bias_scale = 1.0;
-  int shadow_mode = 2;
+  /// Which test decides that a point is lit besides the texel holding its own triangle
+  /// (docs/viewer.md, "Shadows"). kBoth, the default, is what the thresholds were measured with;
+  /// the others are there to measure each alone.
+  enum class ShadowTest {
+    kDistance = 0,       ///< Distance to the camera within the stored one plus a texel-size bias.
+    kReceiverPlane = 1,  ///< The stored distance not nearer than the point's plane on the texel ray.
+    kBoth = 2,           ///< Either.
+  };
+  ShadowTest shadow_test = ShadowTest::kBoth;
 };
 
 /// A GPU frame read back to the CPU. Row-major, y down, index y * width + x, as render's Image.
@@ -59,9 +67,11 @@ struct GlImage {
   std::vector<uint8_t> hit;
 };
 
-/// Timing of the last frame, seconds (GPU work waited for with glFinish).
+/// Timing of a frame, seconds. With stats requested the renderer waits for the GPU (glFinish)
+/// after each part, so the parts do not overlap.
 struct GlFrameStats {
   double shadow_seconds = 0;  ///< Distance maps of every enabled camera.
+  double light_seconds = 0;   ///< The per-camera light passes over the G-buffer.
   double total_seconds = 0;   ///< The whole frame up to the read-back (not included).
   double readback_seconds = 0;
   int shadow_maps = 0;        ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
