@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <optional>
 #include <string>
 
 #include "render/render.h"
@@ -97,31 +98,26 @@ void main() {
 }
 )";
 
+// The light of a batch of cameras over the G-buffer, in one pass: for each pixel, each camera of
+// the batch in rig order. A camera's parameters are kCameraVec4 vec4s of the uniform block (see
+// PackCamera); its distance map is layer `layer` of `maps` (one perspective map) or layers
+// layer .. layer + 5 of `cubes` (a cube).
 const char* kLightFragment = R"(#version 330 core
+#define CAMERA_VEC4 10
+#define MAX_BATCH 64
+layout(std140) uniform CameraBlock { vec4 cams[CAMERA_VEC4 * MAX_BATCH]; };
+uniform int camera_count;
 uniform sampler2D g_position_tex;
 uniform sampler2D g_normal_tex;
 uniform usampler2D mask_in;
-uniform sampler2DArray shadow_map;
+uniform sampler2DArray maps;
+uniform sampler2DArray cubes;
 uniform int map_size;
-uniform int faces;             // 1: one perspective map; 6: a cube
-uniform mat3 face_R[6];        // face_from_camera
-uniform vec4 face_map[6];      // sx, sy, ox, oy as in the shadow pass
-uniform float texel;           // normalized-coordinate size of a texel
+uniform int cube_size;
+uniform mat3 face_R[6];        // cube faces: face_from_camera
 uniform float bias_scale;
-uniform int shadow_mode;      // 0: distance + bias, 1: receiver plane, 2: either
-uniform mat3 cam_R;            // camera_from_world
-uniform vec3 cam_t;            // camera-frame position of the scene's centre
-uniform vec3 cam_center;       // relative to the scene's centre
-uniform int lens;              // 0 pinhole, 1 Brown-Conrady, 2 fisheye
-uniform vec4 K;                // fx fy cx cy
-uniform vec4 D0;               // Brown-Conrady k1 k2 p1 p2; fisheye k1 k2 k3 k4
-uniform float D1;              // Brown-Conrady k3
-uniform float max_radius;      // monotonic domain: normalized radius (BC) or theta (fisheye)
-uniform vec2 image_size;       // camera width, height
-uniform vec2 range;            // near, far (Euclidean, m)
+uniform int shadow_mode;       // 0: distance + bias, 1: receiver plane, 2: either
 uniform float lift;
-uniform uvec2 bit;             // the camera's mask bit (zero for cameras 64 and up)
-uniform vec3 light;            // brightness * colour
 uniform int grid;
 uniform float grid_n;
 uniform float grid_fill;
@@ -132,36 +128,45 @@ uniform vec3 view_f;           // f, cx, cy of the eye
 layout(location = 0) out vec4 o_light;
 layout(location = 1) out uvec2 o_mask;
 
+struct Lens {
+  int model;      // 0 pinhole, 1 Brown-Conrady, 2 fisheye
+  vec4 K;         // fx fy cx cy
+  vec4 D0;        // Brown-Conrady k1 k2 p1 p2; fisheye k1 k2 k3 k4
+  float D1;       // Brown-Conrady k3
+  float max_radius;
+};
+
 // CameraModel::Project (analysis/camera.cpp) in float: camera-frame point to distorted pixel.
-bool Project(vec3 p, out vec2 px) {
+bool Project(Lens L, vec3 p, out vec2 px) {
   px = vec2(0.0);
-  if (lens == 2) {
+  if (L.model == 2) {
     float r = length(p.xy);
     if (r == 0.0 && p.z == 0.0) return false;
     float theta = atan(r, p.z);
-    if (!(theta < max_radius)) return false;
+    if (!(theta < L.max_radius)) return false;
     float t = theta * theta;
-    float poly = 1.0 + t * (D0.x + t * (D0.y + t * (D0.z + t * D0.w)));
+    float poly = 1.0 + t * (L.D0.x + t * (L.D0.y + t * (L.D0.z + t * L.D0.w)));
     vec2 q = r > 0.0 ? p.xy * (theta * poly / r) : vec2(0.0);
-    px = K.xy * q + K.zw;
+    px = L.K.xy * q + L.K.zw;
     return true;
   }
   if (!(p.z > 0.0)) return false;
   vec2 n = p.xy / p.z;
   vec2 d = n;
-  if (lens == 1) {
-    if (!(length(n) < max_radius)) return false;
+  if (L.model == 1) {
+    if (!(length(n) < L.max_radius)) return false;
+    vec4 D = L.D0;
     float x = n.x, y = n.y, s = x * x + y * y;
-    float radial = 1.0 + s * (D0.x + s * (D0.y + s * D1));
-    float dr = 2.0 * (D0.x + s * (2.0 * D0.y + s * 3.0 * D1));
-    d = vec2(x * radial + 2.0 * D0.z * x * y + D0.w * (s + 2.0 * x * x),
-             y * radial + D0.z * (s + 2.0 * y * y) + 2.0 * D0.w * x * y);
-    float c = dr * x * y + 2.0 * D0.z * x + 2.0 * D0.w * y;
-    float j00 = radial + dr * x * x + 2.0 * D0.z * y + 6.0 * D0.w * x;
-    float j11 = radial + dr * y * y + 6.0 * D0.z * y + 2.0 * D0.w * x;
+    float radial = 1.0 + s * (D.x + s * (D.y + s * L.D1));
+    float dr = 2.0 * (D.x + s * (2.0 * D.y + s * 3.0 * L.D1));
+    d = vec2(x * radial + 2.0 * D.z * x * y + D.w * (s + 2.0 * x * x),
+             y * radial + D.z * (s + 2.0 * y * y) + 2.0 * D.w * x * y);
+    float c = dr * x * y + 2.0 * D.z * x + 2.0 * D.w * y;
+    float j00 = radial + dr * x * x + 2.0 * D.z * y + 6.0 * D.w * x;
+    float j11 = radial + dr * y * y + 6.0 * D.z * y + 2.0 * D.w * x;
     if (!(j00 * j11 - c * c > 0.0)) return false;
   }
-  px = K.xy * d + K.zw;
+  px = L.K.xy * d + L.K.zw;
   return true;
 }
 
@@ -186,75 +191,106 @@ void main() {
   if (g.w < 0.0) return;
   vec3 n = texelFetch(g_normal_tex, ip, 0).xyz;
   vec3 X = g.xyz + lift * n;
-  vec3 to_point = X - cam_center;
-  float dist = length(to_point);
-  if (dist < range.x || dist > range.y) return;
-  vec3 pc = cam_R * X + cam_t;
-  vec2 px;
-  if (!Project(pc, px)) return;
-  if (!(px.x >= -0.5 && px.y >= -0.5 && px.x <= image_size.x - 0.5 &&
-        px.y <= image_size.y - 0.5)) return;
-  float facing = -dot(n, to_point);
-  if (!(facing > 0.0)) return;
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < camera_count; ++i) {
+    int b = CAMERA_VEC4 * i;
+    vec4 c0 = cams[b], c1 = cams[b + 1], c2 = cams[b + 2], c3 = cams[b + 3], c4 = cams[b + 4];
+    vec4 c7 = cams[b + 7];
+    // c0..c2: rows of camera_from_world and (lens, first map layer, cube); c3: translation of
+    // the scene's centre, k3; c4: centre, monotonic radius; c5: K; c6: D0; c7: image size, range;
+    // c8: light, bit index; c9: perspective map's (sx, sy, ox, oy).
+    vec3 to_point = X - c4.xyz;
+    float dist = length(to_point);
+    if (dist < c7.z || dist > c7.w) continue;
+    mat3 R = transpose(mat3(c0.xyz, c1.xyz, c2.xyz));  // rows -> camera_from_world
+    vec3 pc = R * X + c3.xyz;
+    Lens L = Lens(int(c0.w), cams[b + 5], cams[b + 6], c3.w, c4.w);
+    vec2 px;
+    if (!Project(L, pc, px)) continue;
+    if (!(px.x >= -0.5 && px.y >= -0.5 && px.x <= c7.x - 0.5 && px.y <= c7.y - 0.5)) continue;
+    float facing = -dot(n, to_point);
+    if (!(facing > 0.0)) continue;
 
-  // Shadow: the distance map's texel that holds the point's direction.
-  int layer = 0;
-  if (faces == 6) {
-    vec3 a = abs(pc);
-    if (a.x >= a.y && a.x >= a.z) layer = pc.x > 0.0 ? 0 : 1;
-    else if (a.y >= a.z) layer = pc.y > 0.0 ? 2 : 3;
-    else layer = pc.z > 0.0 ? 4 : 5;
-  }
-  vec3 pf = face_R[layer] * pc;
-  vec4 fm = face_map[layer];
-  vec2 q = pf.xy / pf.z;
-  vec2 uv = 0.5 * vec2(fm.x * q.x - fm.z, fm.y * q.y - fm.w) + 0.5;
-  ivec2 tc = clamp(ivec2(floor(uv * float(map_size))), ivec2(0), ivec2(map_size - 1));
-  vec2 stored = texelFetch(shadow_map, ivec3(tc, layer), 0).xy;
-  // Tolerance: how much the distance can change between the point and the centre of its texel
-  // on the point's own plane (texel size at that distance times the tangent of the incidence).
-  float cos_i = facing / dist;
-  float tan_i = sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-6);
-  float w = texel * dist * sqrt(1.0 + dot(q, q));
-  float bias = bias_scale * (w * (0.5 + 0.75 * min(tan_i, 10.0)) + 1e-5 * dist);
-  // Receiver plane: the distance at which the texel's centre ray meets the point's own plane. A
-  // planar receiver compares with itself exactly there, at any incidence (no acne).
-  vec2 qc = (((vec2(tc) + 0.5) / float(map_size)) * 2.0 - 1.0 + fm.zw) / fm.xy;
-  vec3 rc = transpose(cam_R) * (transpose(face_R[layer]) * vec3(qc, 1.0));
-  float nr = dot(n, rc);
-  float plane = nr < 0.0 ? dot(n, to_point) / nr * length(rc) : 3e38;
-  bool lit = stored.y == g.w || (shadow_mode != 1 && dist <= stored.x + bias) ||
-             (shadow_mode != 0 && stored.x >= plane - bias_scale * 1e-4 * dist);
-  if (!lit) return;
-
-  float weight = 1.0;
-  if (grid == 1) {
-    // Ray differentials of the hit point on its plane, then the camera pixel's change per output
-    // pixel by central differences of the projection along them.
-    vec2 pp = gl_FragCoord.xy - 0.5;
-    vec3 D = view_Rt[2] + ((pp.x - view_f.y) / view_f.x) * view_Rt[0] +
-             ((pp.y - view_f.z) / view_f.x) * view_Rt[1];
-    float len = length(D);
-    vec3 d = D / len;
-    vec3 Dx = view_Rt[0] / view_f.x, Dy = view_Rt[1] / view_f.x;
-    vec3 ddx = (Dx - d * dot(d, Dx)) / len, ddy = (Dy - d * dot(d, Dy)) / len;
-    float t = length(g.xyz - eye);
-    float nd = dot(n, d);
-    vec3 dXdx = t * (ddx - (dot(n, ddx) / nd) * d);
-    vec3 dXdy = t * (ddy - (dot(n, ddy) / nd) * d);
-    vec2 a, b, c, e;
-    float du = 0.0, dv = 0.0;
-    if (Project(cam_R * (X + 0.5 * dXdx) + cam_t, a) && Project(cam_R * (X - 0.5 * dXdx) + cam_t, b) &&
-        Project(cam_R * (X + 0.5 * dXdy) + cam_t, c) && Project(cam_R * (X - 0.5 * dXdy) + cam_t, e)) {
-      vec2 jx = a - b, jy = c - e;
-      du = length(vec2(jx.x, jy.x));
-      dv = length(vec2(jx.y, jy.y));
+    // Shadow: the texel of the camera's distance map that holds the point's direction.
+    bool cube = c2.w > 0.5;
+    int layer = int(c1.w);
+    mat3 F = mat3(1.0);
+    vec4 fm = cams[b + 9];
+    int size = map_size;
+    if (cube) {
+      vec3 a = abs(pc);
+      int face = a.x >= a.y && a.x >= a.z ? (pc.x > 0.0 ? 0 : 1)
+               : a.y >= a.z              ? (pc.y > 0.0 ? 2 : 3)
+                                         : (pc.z > 0.0 ? 4 : 5);
+      F = face_R[face];
+      layer += face;
+      fm = vec4(1.0, 1.0, 0.0, 0.0);
+      size = cube_size;
     }
-    float lu = GridLine(px.x, du), lv = GridLine(px.y, dv);
-    weight = grid_fill + (1.0 - grid_fill) * (1.0 - (1.0 - lu) * (1.0 - lv));
+    vec3 pf = F * pc;
+    vec2 q = pf.xy / pf.z;
+    vec2 uv = 0.5 * vec2(fm.x * q.x - fm.z, fm.y * q.y - fm.w) + 0.5;
+    ivec2 tc = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
+    vec2 stored = cube ? texelFetch(cubes, ivec3(tc, layer), 0).xy
+                       : texelFetch(maps, ivec3(tc, layer), 0).xy;
+    bool lit = stored.y == g.w;  // the texel holds the point's own triangle
+    if (!lit && shadow_mode != 1) {
+      // Distance within how much it can change between the point and its texel's centre on the
+      // point's own plane: the texel's size there times the tangent of the incidence.
+      float texel = 2.0 / (min(fm.x, fm.y) * float(size));
+      float cos_i = facing / dist;
+      float tan_i = sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-6);
+      float w = texel * dist * sqrt(1.0 + dot(q, q));
+      float bias = bias_scale * (w * (0.5 + 0.75 * min(tan_i, 10.0)) + 1e-5 * dist);
+      lit = dist <= stored.x + bias;
+    }
+    if (!lit && shadow_mode != 0) {
+      // Receiver plane: where the texel's centre ray meets the point's own plane. A planar
+      // receiver compares with itself exactly there, at any incidence (no acne).
+      vec2 qc = (((vec2(tc) + 0.5) / float(size)) * 2.0 - 1.0 + fm.zw) / fm.xy;
+      vec3 rc = transpose(R) * (transpose(F) * vec3(qc, 1.0));
+      float nr = dot(n, rc);
+      float plane = nr < 0.0 ? dot(n, to_point) / nr * length(rc) : 3e38;
+      lit = stored.x >= plane - bias_scale * 1e-4 * dist;
+    }
+    if (!lit) continue;
+
+    float weight = 1.0;
+    if (grid == 1) {
+      // Ray differentials of the hit point on its plane, then the camera pixel's change per
+      // output pixel by central differences of the projection along them.
+      vec2 pp = gl_FragCoord.xy - 0.5;
+      vec3 D = view_Rt[2] + ((pp.x - view_f.y) / view_f.x) * view_Rt[0] +
+               ((pp.y - view_f.z) / view_f.x) * view_Rt[1];
+      float len = length(D);
+      vec3 d = D / len;
+      vec3 Dx = view_Rt[0] / view_f.x, Dy = view_Rt[1] / view_f.x;
+      vec3 ddx = (Dx - d * dot(d, Dx)) / len, ddy = (Dy - d * dot(d, Dy)) / len;
+      float t = length(g.xyz - eye);
+      float nd = dot(n, d);
+      vec3 dXdx = t * (ddx - (dot(n, ddx) / nd) * d);
+      vec3 dXdy = t * (ddy - (dot(n, ddy) / nd) * d);
+      vec2 pa, pb, pc2, pd;
+      float du = 0.0, dv = 0.0;
+      if (Project(L, R * (X + 0.5 * dXdx) + c3.xyz, pa) &&
+          Project(L, R * (X - 0.5 * dXdx) + c3.xyz, pb) &&
+          Project(L, R * (X + 0.5 * dXdy) + c3.xyz, pc2) &&
+          Project(L, R * (X - 0.5 * dXdy) + c3.xyz, pd)) {
+        vec2 jx = pa - pb, jy = pc2 - pd;
+        du = length(vec2(jx.x, jy.x));
+        dv = length(vec2(jx.y, jy.y));
+      }
+      float lu = GridLine(px.x, du), lv = GridLine(px.y, dv);
+      weight = grid_fill + (1.0 - grid_fill) * (1.0 - (1.0 - lu) * (1.0 - lv));
+    }
+    vec4 c8 = cams[b + 8];
+    sum += weight * c8.xyz;
+    int bit = int(c8.w);
+    if (bit < 32) mask.x |= 1u << uint(bit);
+    else if (bit < 64) mask.y |= 1u << uint(bit - 32);
   }
-  o_light = vec4(weight * light, 0.0);
-  o_mask = mask | bit;
+  o_light = vec4(sum, 0.0);
+  o_mask = mask;
 }
 )";
 
@@ -369,15 +405,6 @@ std::pair<double, double> PadRange(std::pair<double, double> r) {
   return {near, far};
 }
 
-// One distance map of a camera: the face frame (a rotation of the camera frame), the normalized
-// bounds it covers and its depth range.
-struct MapFace {
-  Mat3 face_from_camera = Mat3::Identity();
-  Eigen::Vector4d bounds{-1, 1, -1, 1};
-  bool empty = false;  // no geometry in it: stays cleared
-  double near = 0, far = 1;
-};
-
 // The six cube faces, in the shader's layer order +x, -x, +y, -y, +z, -z: each maps its axis
 // onto +z.
 std::array<Mat3, 6> CubeFaces() {
@@ -398,6 +425,49 @@ std::array<Mat3, 6> CubeFaces() {
   f[4] = frame(Vec3::UnitZ(), Vec3::UnitY());
   f[5] = frame(-Vec3::UnitZ(), Vec3::UnitY());
   return f;
+}
+
+// Cameras per light pass: the uniform block holds kCameraVec4 vec4s per camera (16 KiB, the
+// least GL 3.3 guarantees, fits 64 x 10 x 16 bytes).
+constexpr int kCameraVec4 = 10;
+constexpr int kMaxBatch = 64;
+
+bool IsCube(const Camera& cam) { return cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle; }
+
+// (sx, sy, ox, oy) with ndc = (sx x / z - ox, sy y / z - oy) mapping `bounds` onto [-1, 1]^2.
+Eigen::Vector4d MapCoefficients(const Eigen::Vector4d& b) {
+  return Eigen::Vector4d(2 / (b(1) - b(0)), 2 / (b(3) - b(2)), (b(0) + b(1)) / (b(1) - b(0)),
+                         (b(2) + b(3)) / (b(3) - b(2)));
+}
+
+// Camera `index` of the rig as the light shader reads it (kLightFragment's c0 .. c9).
+void PackCamera(const Camera& cam, int index, bool cube, int layer, const Vec3& origin,
+                double brightness, float* out) {
+  const Intrinsics& k = cam.model.intrinsics();
+  const Eigen::Isometry3d cfw = cam.camera_from_world();
+  const Mat3 R = cfw.linear();
+  const Vec3 t = R * (origin - cam.center());
+  const double max_radius = cam.model.max_radius();
+  const int lens = k.model == LensModel::kPinhole ? 0 : k.model == LensModel::kBrownConrady ? 1 : 2;
+  const Eigen::Vector4d map =
+      cube ? Eigen::Vector4d(1, 1, 0, 0) : MapCoefficients(cam.model.normalized_bounds());
+  const Vec3 light = brightness * cam.color;
+  const double v[kCameraVec4][4] = {
+      {R(0, 0), R(0, 1), R(0, 2), double(lens)},
+      {R(1, 0), R(1, 1), R(1, 2), double(cube ? 6 * layer : layer)},
+      {R(2, 0), R(2, 1), R(2, 2), cube ? 1.0 : 0.0},
+      {t.x(), t.y(), t.z(), k.k3},
+      {cam.center().x() - origin.x(), cam.center().y() - origin.y(), cam.center().z() - origin.z(),
+       std::isfinite(max_radius) ? max_radius : 3e38},
+      {k.fx, k.fy, k.cx, k.cy},
+      {k.k1, k.k2, k.model == LensModel::kFisheye ? k.k3 : k.p1,
+       k.model == LensModel::kFisheye ? k.k4 : k.p2},
+      {double(k.width), double(k.height), cam.near, std::isfinite(cam.far) ? cam.far : 3e38},
+      {light.x(), light.y(), light.z(), double(std::min(index, 64))},
+      {map(0), map(1), map(2), map(3)},
+  };
+  for (int i = 0; i < kCameraVec4; ++i)
+    for (int j = 0; j < 4; ++j) out[4 * i + j] = float(v[i][j]);
 }
 
 }  // namespace
@@ -460,7 +530,7 @@ struct GlRenderer::Impl {
   GLsizei vertex_count = 0;
   GLuint vao = 0, vbo = 0;
   GLuint gbuffer_program = 0, shadow_program = 0, light_program = 0, compose_program = 0;
-  GLuint empty_vao = 0;
+  GLuint empty_vao = 0, camera_ubo = 0;
 
   // Per view size.
   int width = 0, height = 0;
@@ -468,15 +538,17 @@ struct GlRenderer::Impl {
   GLuint light_fbo[2] = {0, 0}, light_accum = 0, mask[2] = {0, 0};
   GLuint compose_fbo = 0, compose_color = 0;
 
-  // Distance maps: one perspective layer and the cube's six.
+  // Distance maps: perspective maps (one layer per camera) and cubes (six layers per camera),
+  // with the camera each layer group was last drawn for (reused while it stays the same).
   int map_size = 0, cube_size = 0;
-  GLuint shadow_fbo = 0, map_single = 0, map_cube = 0, map_depth_single = 0, map_depth_cube = 0;
+  int map_layers = 0, cube_layers = 0;
+  GLuint shadow_fbo = 0, maps = 0, cubes = 0, map_depth = 0, cube_depth = 0;
+  std::vector<std::optional<Camera>> map_camera, cube_camera;
 
   void FreeViewTargets() {
     GLuint textures[] = {g_position, g_normal, g_albedo, light_accum, mask[0], mask[1], compose_color};
     glDeleteTextures(7, textures);
-    GLuint rbs[] = {g_depth};
-    glDeleteRenderbuffers(1, rbs);
+    glDeleteRenderbuffers(1, &g_depth);
     GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo};
     glDeleteFramebuffers(4, fbos);
     width = height = 0;
@@ -536,39 +608,108 @@ struct GlRenderer::Impl {
     return rb;
   }
 
-  void EnsureMaps(int size, bool need_cube) {
+  // At least `perspective` map layers and `cube` cubes of map size `size`; (re)allocating forgets
+  // what the layers held.
+  void EnsureMaps(int size, int perspective, int cube) {
     if (size != map_size) {
-      glDeleteTextures(1, &map_single);
-      glDeleteTextures(1, &map_cube);
-      glDeleteRenderbuffers(1, &map_depth_single);
-      glDeleteRenderbuffers(1, &map_depth_cube);
-      map_single = map_cube = map_depth_single = map_depth_cube = 0;
+      glDeleteTextures(1, &maps);
+      glDeleteTextures(1, &cubes);
+      glDeleteRenderbuffers(1, &map_depth);
+      glDeleteRenderbuffers(1, &cube_depth);
+      maps = cubes = map_depth = cube_depth = 0;
+      map_layers = cube_layers = 0;
+      map_camera.clear();
+      cube_camera.clear();
       map_size = size;
       cube_size = size / 2;
+      map_depth = DepthBuffer(map_size);
+      cube_depth = DepthBuffer(cube_size);
     }
-    if (!map_single) {
-      map_single = MapArray(map_size, 1);
-      map_depth_single = DepthBuffer(map_size);
+    // Texture arrays need at least one layer to be complete, also when no camera uses them.
+    perspective = std::max(perspective, 1);
+    cube = std::max(cube, 1);
+    if (perspective > map_layers) {
+      glDeleteTextures(1, &maps);
+      maps = MapArray(map_size, perspective);
+      map_layers = perspective;
+      map_camera.assign(perspective, std::nullopt);
     }
-    if (need_cube && !map_cube) {
-      map_cube = MapArray(cube_size, 6);
-      map_depth_cube = DepthBuffer(cube_size);
+    if (6 * cube > cube_layers) {
+      glDeleteTextures(1, &cubes);
+      cubes = MapArray(cube_size, 6 * cube);
+      cube_layers = 6 * cube;
+      cube_camera.assign(cube, std::nullopt);
     }
     if (!shadow_fbo) glGenFramebuffers(1, &shadow_fbo);
   }
 
   ~Impl() {
     FreeViewTargets();
-    glDeleteTextures(1, &map_single);
-    glDeleteTextures(1, &map_cube);
-    glDeleteRenderbuffers(1, &map_depth_single);
-    glDeleteRenderbuffers(1, &map_depth_cube);
+    glDeleteTextures(1, &maps);
+    glDeleteTextures(1, &cubes);
+    glDeleteRenderbuffers(1, &map_depth);
+    glDeleteRenderbuffers(1, &cube_depth);
     glDeleteFramebuffers(1, &shadow_fbo);
     glDeleteBuffers(1, &vbo);
+    glDeleteBuffers(1, &camera_ubo);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
     for (GLuint p : {gbuffer_program, shadow_program, light_program, compose_program})
       glDeleteProgram(p);
+  }
+
+  // Draws camera `cam`'s distance map(s): one perspective map into layer `layer` of `maps`, or a
+  // cube into layers 6 layer .. 6 layer + 5 of `cubes`. Returns the maps drawn.
+  int DrawMaps(const Camera& cam, bool cube, int layer) {
+    const Eigen::Isometry3d cfw = cam.camera_from_world();
+    static const std::array<Mat3, 6> kCube = CubeFaces();
+    const int faces = cube ? 6 : 1;
+    const int size = cube ? cube_size : map_size;
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              cube ? cube_depth : map_depth);
+    glViewport(0, 0, size, size);
+    glUseProgram(shadow_program);
+    glBindVertexArray(vao);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer0);
+    int drawn = 0;
+    for (int i = 0; i < faces; ++i) {
+      const Mat3 face_from_camera = cube ? kCube[i] : Mat3::Identity();
+      const Eigen::Vector4d bounds =
+          cube ? Eigen::Vector4d(-1, 1, -1, 1) : cam.model.normalized_bounds();
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, cube ? cubes : maps, 0,
+                                cube ? 6 * layer + i : layer);
+      CheckFramebuffer("distance map");
+      const float cleared[4] = {3e38f, -1.0f, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, cleared);
+      // A cube face whose pyramid (54.7 degrees around its axis) the field cannot reach stays
+      // cleared.
+      if (cube) {
+        const double axis_angle = std::acos(std::clamp(kCube[i].row(2).z(), -1.0, 1.0));
+        if (axis_angle - std::atan(std::sqrt(2.0)) >= cam.model.max_field_angle()) continue;
+      }
+      Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
+      face_from_world.linear() = face_from_camera * cfw.linear();
+      face_from_world.translation() = face_from_camera * cfw.translation();
+      auto range = DepthRangeInPyramid(mesh, face_from_world, bounds);
+      range.second = std::min(range.second, cam.far);  // occluders lie nearer than the point
+      if (!(range.first <= range.second)) continue;
+      const auto [near, far] = PadRange(range);
+      const Eigen::Vector2d ab = DepthCoefficients(near, far);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      SetMat3(shadow_program, "face_R", face_from_world.linear());
+      SetVec3(shadow_program, "face_t", face_from_world * origin);
+      const Eigen::Vector4d m = MapCoefficients(bounds);
+      glUniform4f(Loc(shadow_program, "map"), float(m(0)), float(m(1)), float(m(2)), float(m(3)));
+      glUniform2f(Loc(shadow_program, "depth"), float(ab(0)), float(ab(1)));
+      glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+      ++drawn;
+    }
+    return drawn;
   }
 };
 
@@ -619,6 +760,11 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
   m.light_program = Link(kFullScreenVertex, kLightFragment, "light");
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
+  glUniformBlockBinding(m.light_program, glGetUniformBlockIndex(m.light_program, "CameraBlock"), 0);
+  glGenBuffers(1, &m.camera_ubo);
+  glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
+  glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(kCameraVec4 * kMaxBatch * 4 * sizeof(float)), nullptr,
+               GL_DYNAMIC_DRAW);
 }
 
 GlRenderer::~GlRenderer() = default;
@@ -650,16 +796,50 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
                                 std::to_string(options.shadow_map_size) + ")");
   const int W = view.width, H = view.height;
   const std::size_t pixels = std::size_t(W) * H;
-
-  // Which cameras light, and which need a cube of maps.
   const int camera_count = int(rig.cameras.size());
-  bool need_cube = false;
-  for (const Camera& cam : rig.cameras)
-    if (cam.enabled && cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle) need_cube = true;
-  m.EnsureViewTargets(W, H);
-  m.EnsureMaps(options.shadow_map_size, need_cube);
 
-  // The eye: OpenCV frame (x right, y down, z forward); GL's window row r is the image's row r.
+  // Batches of enabled cameras in rig order, each within the map memory budget and the uniform
+  // block; each batch is one light pass over the G-buffer with all its maps bound.
+  struct Batch {
+    std::vector<int> cameras;
+    int perspective = 0, cube = 0;
+  };
+  std::vector<Batch> batches;
+  {
+    const double map_bytes = 8.0 * options.shadow_map_size * options.shadow_map_size;
+    const double budget = std::max(options.map_memory_mib, 1.0) * 1024.0 * 1024.0;
+    double bytes = 0;
+    for (int c = 0; c < camera_count; ++c) {
+      const Camera& cam = rig.cameras[c];
+      if (!cam.enabled) continue;
+      const bool cube = IsCube(cam);
+      const double need = cube ? 1.5 * map_bytes : map_bytes;
+      if (batches.empty() || int(batches.back().cameras.size()) == kMaxBatch ||
+          (bytes + need > budget && !batches.back().cameras.empty())) {
+        batches.emplace_back();
+        bytes = 0;
+      }
+      batches.back().cameras.push_back(c);
+      (cube ? batches.back().cube : batches.back().perspective) += 1;
+      bytes += need;
+    }
+  }
+  int perspective_layers = 0, cube_count = 0;
+  for (const Batch& b : batches) {
+    perspective_layers = std::max(perspective_layers, b.perspective);
+    cube_count = std::max(cube_count, b.cube);
+  }
+  m.EnsureViewTargets(W, H);
+  m.EnsureMaps(options.shadow_map_size, perspective_layers, cube_count);
+  // Maps are kept for the next frame only when every camera has its own layers.
+  const bool keep = batches.size() <= 1;
+  if (!keep || !options.reuse_maps) {
+    std::fill(m.map_camera.begin(), m.map_camera.end(), std::nullopt);
+    std::fill(m.cube_camera.begin(), m.cube_camera.end(), std::nullopt);
+  }
+
+  // 1. G-buffer. The eye: OpenCV frame (x right, y down, z forward); GL's window row r is the
+  // image's row r.
   const Mat3 eye_R = pose->linear().transpose();  // camera_from_world
   const double f = 0.5 * W / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   const Vec3 eye_rel = view.from - m.origin;
@@ -704,90 +884,47 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glClearBufferuiv(GL_COLOR, 1, zero_u);
   }
 
-  LightRule rule;
-  rule.brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
-                                                   : options.brightness;
+  const double brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
+                                                           : options.brightness;
   const double lift = 0.1 * 1e-5 * m.scene_scale;  // as the CPU renderer: a tenth of epsilon
-  const std::array<Mat3, 6> cube = CubeFaces();
   int src = 0;
   double shadow_seconds = 0, light_seconds = 0;
   int maps_drawn = 0;
-  for (int c = 0; c < camera_count; ++c) {
-    const Camera& cam = rig.cameras[c];
-    if (!cam.enabled) continue;
-    const Intrinsics& k = cam.model.intrinsics();
-    const Eigen::Isometry3d cfw = cam.camera_from_world();
-    const Mat3 R = cfw.linear();
-    const Vec3 cam_t = R * (m.origin - cam.center());
-    const bool is_cube = cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle;
-
-    // 1. The camera's distance map(s).
-    if (stats) glFinish();  // the previous camera's light pass is not the map's time
+  std::vector<float> block(4 * kCameraVec4 * kMaxBatch, 0.0f);
+  for (const Batch& batch : batches) {
+    // 2. The batch's distance maps (those not kept from the last frame).
+    if (stats) glFinish();
     const auto shadow_start = Clock::now();
-    std::vector<MapFace> faces;
-    if (!is_cube) {
-      MapFace face;
-      face.bounds = cam.model.normalized_bounds();
-      faces.push_back(face);
-    } else {
-      const double field = cam.model.max_field_angle();
-      for (int i = 0; i < 6; ++i) {
-        MapFace face;
-        face.face_from_camera = cube[i];
-        // The face's pyramid reaches atan(sqrt 2) = 54.7 deg around its axis; skip faces the
-        // camera's field cannot reach.
-        const double axis_angle = std::acos(std::clamp(cube[i].row(2).z(), -1.0, 1.0));
-        face.empty = axis_angle - std::atan(std::sqrt(2.0)) >= field;
-        faces.push_back(face);
-      }
-    }
-    const int size = is_cube ? m.cube_size : m.map_size;
-    glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                              is_cube ? m.map_depth_cube : m.map_depth_single);
-    glViewport(0, 0, size, size);
-    glUseProgram(m.shadow_program);
-    glBindVertexArray(m.vao);
-    glEnable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
-    glDrawBuffers(1, &buffer0);
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      MapFace& face = faces[i];
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
-                                is_cube ? m.map_cube : m.map_single, 0, GLint(i));
-      CheckFramebuffer("distance map");
-      const float cleared[4] = {3e38f, -1.0f, 0, 0};
-      glClearBufferfv(GL_COLOR, 0, cleared);
-      glClear(GL_DEPTH_BUFFER_BIT);
-      if (face.empty) continue;
-      Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
-      face_from_world.linear() = face.face_from_camera * R;
-      face_from_world.translation() = face.face_from_camera * cfw.translation();
-      auto range = DepthRangeInPyramid(m.mesh, face_from_world, face.bounds);
-      range.second = std::min(range.second, cam.far);  // occluders lie nearer than the point
-      if (!(range.first <= range.second)) {
-        face.empty = true;
-        continue;
-      }
-      const auto [near, far] = PadRange(range);
-      const Eigen::Vector2d ab = DepthCoefficients(near, far);
-      const Eigen::Vector4d& b = face.bounds;
-      SetMat3(m.shadow_program, "face_R", face_from_world.linear());
-      SetVec3(m.shadow_program, "face_t", face_from_world * m.origin);
-      glUniform4f(Loc(m.shadow_program, "map"), float(2 / (b(1) - b(0))), float(2 / (b(3) - b(2))),
-                  float((b(0) + b(1)) / (b(1) - b(0))), float((b(2) + b(3)) / (b(3) - b(2))));
-      glUniform2f(Loc(m.shadow_program, "depth"), float(ab(0)), float(ab(1)));
-      glDrawArrays(GL_TRIANGLES, 0, m.vertex_count);
-      ++maps_drawn;
+    int next_map = 0, next_cube = 0;
+    std::vector<int> layer(batch.cameras.size());
+    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
+      const Camera& cam = rig.cameras[batch.cameras[i]];
+      const bool cube = IsCube(cam);
+      layer[i] = cube ? next_cube++ : next_map++;
+      std::optional<Camera>& held = cube ? m.cube_camera[layer[i]] : m.map_camera[layer[i]];
+      if (held && SameCameraGeometry(*held, cam)) continue;
+      maps_drawn += m.DrawMaps(cam, cube, layer[i]);
+      if (keep && options.reuse_maps)
+        held = cam;
+      else
+        held.reset();
     }
     if (stats) {
       glFinish();
       shadow_seconds += std::chrono::duration<double>(Clock::now() - shadow_start).count();
     }
-    const auto light_start = Clock::now();
 
-    // 2. The camera's light over the G-buffer.
+    // 3. The batch's light over the G-buffer, in one pass.
+    const auto light_start = Clock::now();
+    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
+      const int c = batch.cameras[i];
+      PackCamera(rig.cameras[c], c, IsCube(rig.cameras[c]), layer[i], m.origin, brightness,
+                 &block[4 * kCameraVec4 * i]);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, GLsizeiptr(4 * kCameraVec4 * batch.cameras.size() * sizeof(float)),
+                    block.data());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, m.camera_ubo);
     const int dst = 1 - src;
     glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[dst]);
     const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
@@ -795,7 +932,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glViewport(0, 0, W, H);
     glDisable(GL_DEPTH_TEST);
     glEnablei(GL_BLEND, 0);
-    glDisablei(GL_BLEND, 1);
+    glDisablei(GL_BLEND, 1);  // integer: the shader ORs the previous mask in
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
     const GLuint p = m.light_program;
@@ -807,45 +944,23 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D, m.mask[src]);
     glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, is_cube ? m.map_cube : m.map_single);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, m.maps);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, m.cubes);
     glUniform1i(Loc(p, "g_position_tex"), 0);
     glUniform1i(Loc(p, "g_normal_tex"), 1);
     glUniform1i(Loc(p, "mask_in"), 2);
-    glUniform1i(Loc(p, "shadow_map"), 3);
-    glUniform1i(Loc(p, "map_size"), size);
-    glUniform1i(Loc(p, "faces"), is_cube ? 6 : 1);
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      const std::string index = "[" + std::to_string(i) + "]";
-      SetMat3(p, ("face_R" + index).c_str(), faces[i].face_from_camera);
-      const Eigen::Vector4d& b = faces[i].bounds;
-      glUniform4f(Loc(p, ("face_map" + index).c_str()), float(2 / (b(1) - b(0))),
-                  float(2 / (b(3) - b(2))), float((b(0) + b(1)) / (b(1) - b(0))),
-                  float((b(2) + b(3)) / (b(3) - b(2))));
-    }
-    const Eigen::Vector4d& b0 = faces[0].bounds;
-    glUniform1f(Loc(p, "texel"), float(std::max(b0(1) - b0(0), b0(3) - b0(2)) / size));
+    glUniform1i(Loc(p, "maps"), 3);
+    glUniform1i(Loc(p, "cubes"), 4);
+    glUniform1i(Loc(p, "camera_count"), int(batch.cameras.size()));
+    glUniform1i(Loc(p, "map_size"), m.map_size);
+    glUniform1i(Loc(p, "cube_size"), m.cube_size);
+    static const std::array<Mat3, 6> kCube = CubeFaces();
+    for (int i = 0; i < 6; ++i)
+      SetMat3(p, ("face_R[" + std::to_string(i) + "]").c_str(), kCube[i]);
     glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
     glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
-    SetMat3(p, "cam_R", R);
-    SetVec3(p, "cam_t", cam_t);
-    SetVec3(p, "cam_center", cam.center() - m.origin);
-    glUniform1i(Loc(p, "lens"), k.model == LensModel::kPinhole        ? 0
-                                : k.model == LensModel::kBrownConrady ? 1
-                                                                      : 2);
-    glUniform4f(Loc(p, "K"), float(k.fx), float(k.fy), float(k.cx), float(k.cy));
-    if (k.model == LensModel::kFisheye)
-      glUniform4f(Loc(p, "D0"), float(k.k1), float(k.k2), float(k.k3), float(k.k4));
-    else
-      glUniform4f(Loc(p, "D0"), float(k.k1), float(k.k2), float(k.p1), float(k.p2));
-    glUniform1f(Loc(p, "D1"), float(k.k3));
-    const double max_radius = cam.model.max_radius();
-    glUniform1f(Loc(p, "max_radius"), std::isfinite(max_radius) ? float(max_radius) : 3e38f);
-    glUniform2f(Loc(p, "image_size"), float(k.width), float(k.height));
-    glUniform2f(Loc(p, "range"), float(cam.near), std::isfinite(cam.far) ? float(cam.far) : 3e38f);
     glUniform1f(Loc(p, "lift"), float(lift));
-    const GLuint lo = c < 32 ? (1u << c) : 0u, hi = c >= 32 && c < 64 ? (1u << (c - 32)) : 0u;
-    glUniform2ui(Loc(p, "bit"), lo, hi);
-    SetVec3(p, "light", rule.brightness * cam.color);
     glUniform1i(Loc(p, "grid"), options.pattern == Pattern::kGrid ? 1 : 0);
     glUniform1f(Loc(p, "grid_n"), float(std::max(1, options.grid_pixels)));
     glUniform1f(Loc(p, "grid_fill"), float(options.grid_fill));
@@ -863,7 +978,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     }
   }
 
-  // 3. Compose.
+  // 4. Compose.
   glBindFramebuffer(GL_FRAMEBUFFER, m.compose_fbo);
   const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
   glDrawBuffers(1, &buffer0);
@@ -893,7 +1008,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   if (stats) glFinish();
   const auto drawn = Clock::now();
 
-  // 4. Read back (GL's row r is the image's row r: no flip).
+  // 5. Read back (GL's row r is the image's row r: no flip).
   GlImage image;
   image.width = W;
   image.height = H;
@@ -928,6 +1043,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     stats->total_seconds = std::chrono::duration<double>(drawn - start).count();
     stats->readback_seconds = std::chrono::duration<double>(Clock::now() - drawn).count();
     stats->shadow_maps = maps_drawn;
+    stats->light_passes = int(batches.size());
   }
   return image;
 }

@@ -54,6 +54,14 @@ struct GlRenderOptions {
     kBoth = 2,           ///< Either.
   };
   ShadowTest shadow_test = ShadowTest::kBoth;
+  /// Keep each camera's maps for the next frame and draw them again only for cameras whose
+  /// geometry changed (SameCameraGeometry): a frame that moves only the eye draws no maps. Only
+  /// when the whole rig fits one light pass (see map_memory_mib).
+  bool reuse_maps = true;
+  /// Memory for the maps of one light pass, MiB. All maps of a pass are bound at once; a rig whose
+  /// maps need more is lit in several passes (and its maps are drawn every frame). A map takes
+  /// 8 map_size^2 bytes (32 MiB at 2048, 128 MiB at 4096), a cube 1.5 times that.
+  double map_memory_mib = 1024;
 };
 
 /// A GPU frame read back to the CPU. Row-major, y down, index y * width + x, as render's Image.
@@ -75,6 +83,7 @@ struct GlFrameStats {
   double total_seconds = 0;   ///< The whole frame up to the read-back (not included).
   double readback_seconds = 0;
   int shadow_maps = 0;        ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
+  int light_passes = 0;       ///< Passes over the G-buffer (batches of cameras).
 };
 
 /// The scene's triangles on the GPU and the programs; renders frames of any rig and view.
