@@ -41,10 +41,11 @@ struct GlComparison {
 };
 
 /// Compares `gpu` with `cpu` (same size; `cpu` rendered with layers: cameras, object, depth).
-/// A pixel is excluded when a pixel within `band` pixels of it (Chebyshev distance) in the CPU
-/// image has another camera set (footprint and shadow edges), another object, or a depth more than
-/// 5 % away from its own (silhouettes), or when the two renderers disagree on whether it shows a
-/// surface and a neighbour within `band` shows none (the silhouette against the background).
+/// Edges: between horizontally or vertically adjacent pixels of the CPU image with another camera
+/// set (footprint and shadow edges), another object, or depths more than 5 % apart (silhouettes);
+/// both pixels of such a pair are edge pixels, and so is a pixel where the two renderers disagree
+/// on whether it shows a surface. Excluded: the pixels within `band` - 1 pixels (Chebyshev) of an
+/// edge pixel; band 1 excludes the edge pixels themselves, the one-pixel band either side.
 /// Throws std::invalid_argument when the sizes differ or `cpu` has no camera sets.
 GlComparison Compare(const Image& cpu, const GlImage& gpu, int band = 1);
 

@@ -84,10 +84,12 @@ constexpr double kMaxMaskShareAll = 0.005;   // of all pixels, edges included
 constexpr double kMaxRgbMean = 1e-5;         // mean channel difference, agreeing pixels
 constexpr double kMaxRgbOverShare = 0.0005;  // agreeing pixels with a channel off by > 1e-3
 
-void ExpectAgreement(const GlComparison& c, double min_compared = 0.5) {
+// `edges`: scenes with many more edges (40 footprints) get `edges` times the all-pixel bound and
+// may exclude more.
+void ExpectAgreement(const GlComparison& c, double min_compared = 0.5, double edges = 1.0) {
   EXPECT_GT(c.compared, min_compared * c.pixels);  // the band does not swallow the image
   EXPECT_LE(c.mask_share(), kMaxMaskShare);
-  EXPECT_LE(c.mask_share_all(), kMaxMaskShareAll);
+  EXPECT_LE(c.mask_share_all(), edges * kMaxMaskShareAll);
   EXPECT_LE(c.rgb_mean, kMaxRgbMean);
   EXPECT_LE(c.rgb_over_share(), kMaxRgbOverShare);
 }
@@ -177,7 +179,7 @@ TEST(GlRenderer, FortyCamerasFillBothMaskWords) {
   view.width = 240;
   view.height = 180;
   const Result r = RenderBoth(scene, scene.rigs[0], view, "forty_cameras");
-  ExpectAgreement(r.comparison, 0.3);  // 40 footprints and their shadows: edges everywhere
+  ExpectAgreement(r.comparison, 0.3, 2.0);  // 40 footprints and their shadows: edges everywhere
   uint64_t any = 0;
   for (uint64_t m : r.gpu.cameras) any |= m;
   EXPECT_NE(any >> 32, 0u);
