@@ -98,6 +98,28 @@ void main() {
 }
 )";
 
+// The light rule of render/light.h in GLSL (shared by the light pass and GlCameraLightWeights).
+const char* kLightRuleGlsl = R"(
+// GridLineCoverage: one family of grid lines (camera pixel borders u = k n - 1/2) at camera
+// coordinate u, g camera pixels per output pixel, lines `width` output pixels wide.
+float GridLineCoverage(float u, float g, float n, float width) {
+  if (!(g > 0.0) || isinf(g)) return 0.0;
+  float f = (u + 0.5) / n;
+  float du = abs(f - floor(f + 0.5)) * n;
+  float spacing = n / g;
+  float line = clamp(0.5 * width + 0.5 - du / g, 0.0, 1.0);
+  float mean = min(1.0, width / spacing);
+  float fade = clamp((3.0 - spacing) / 1.5, 0.0, 1.0);
+  return (1.0 - fade) * line + fade * mean;
+}
+// CameraLightWeight of a camera that sees the point, grid pattern (n = max(1, grid_pixels)).
+float GridLightWeight(bool projects, vec2 uv, vec2 duv, float n, float fill, float width) {
+  float lu = projects ? GridLineCoverage(uv.x, duv.x, n, width) : 0.0;
+  float lv = projects ? GridLineCoverage(uv.y, duv.y, n, width) : 0.0;
+  return fill + (1.0 - fill) * (1.0 - (1.0 - lu) * (1.0 - lv));
+}
+)";
+
 // The light of a batch of cameras over the G-buffer, in one pass: for each pixel, each camera of
 // the batch in rig order. A camera's parameters are kCameraVec4 vec4s of the uniform block (see
 // PackCamera); its distance map is layer `layer` of `maps` (one perspective map) or layers
@@ -170,17 +192,7 @@ bool Project(Lens L, vec3 p, out vec2 px) {
   return true;
 }
 
-// GridLineCoverage (render/light.h).
-float GridLine(float u, float g) {
-  if (!(g > 0.0) || isinf(g)) return 0.0;
-  float f = (u + 0.5) / grid_n;
-  float du = abs(f - floor(f + 0.5)) * grid_n;
-  float spacing = grid_n / g;
-  float line = clamp(0.5 * line_width + 0.5 - du / g, 0.0, 1.0);
-  float mean = min(1.0, line_width / spacing);
-  float fade = clamp((3.0 - spacing) / 1.5, 0.0, 1.0);
-  return (1.0 - fade) * line + fade * mean;
-}
+// @LIGHT_RULE@
 
 void main() {
   ivec2 ip = ivec2(gl_FragCoord.xy);
@@ -280,8 +292,7 @@ void main() {
         du = length(vec2(jx.x, jy.x));
         dv = length(vec2(jx.y, jy.y));
       }
-      float lu = GridLine(px.x, du), lv = GridLine(px.y, dv);
-      weight = grid_fill + (1.0 - grid_fill) * (1.0 - (1.0 - lu) * (1.0 - lv));
+      weight = GridLightWeight(true, px, vec2(du, dv), grid_n, grid_fill, line_width);
     }
     vec4 c8 = cams[b + 8];
     sum += weight * c8.xyz;
@@ -322,6 +333,14 @@ void main() {
   o_color = vec4(albedo * L + ambient * (0.4 + 0.6 * abs(cos_eye)) * albedo, 1.0);
 }
 )";
+
+// `source` with the light rule's GLSL in place of its "// @LIGHT_RULE@" line.
+std::string WithLightRule(const char* source) {
+  std::string s = source;
+  const std::string marker = "// @LIGHT_RULE@";
+  s.replace(s.find(marker), marker.size(), kLightRuleGlsl);
+  return s;
+}
 
 // ------------------------------------------------------------------------------------------
 // GL helpers.
@@ -758,7 +777,7 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   glGenVertexArrays(1, &m.empty_vao);
   m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
   m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
-  m.light_program = Link(kFullScreenVertex, kLightFragment, "light");
+  m.light_program = Link(kFullScreenVertex, WithLightRule(kLightFragment).c_str(), "light");
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
   glUniformBlockBinding(m.light_program, glGetUniformBlockIndex(m.light_program, "CameraBlock"), 0);
   glGenBuffers(1, &m.camera_ubo);
@@ -1046,6 +1065,85 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     stats->light_passes = int(batches.size());
   }
   return image;
+}
+
+std::vector<double> GlCameraLightWeights(const LightRule& rule,
+                                         const std::vector<CameraAtPoint>& points) {
+  // One fragment per input: (u, v, du, dv) and (sees, projects) from two float textures, the
+  // weight into a float target.
+  static const char* kFragment = R"(#version 330 core
+uniform sampler2D coords;
+uniform sampler2D flags;
+uniform int grid;
+uniform float n;
+uniform float fill;
+uniform float width;
+layout(location = 0) out vec4 o_weight;
+// @LIGHT_RULE@
+void main() {
+  ivec2 ip = ivec2(gl_FragCoord.xy);
+  vec4 c = texelFetch(coords, ip, 0);
+  vec4 f = texelFetch(flags, ip, 0);
+  float w = 0.0;
+  if (f.x > 0.5) w = grid == 1 ? GridLightWeight(f.y > 0.5, c.xy, c.zw, n, fill, width) : 1.0;
+  o_weight = vec4(w, 0.0, 0.0, 1.0);
+}
+)";
+  const int count = int(points.size());
+  if (count == 0) return {};
+  std::vector<float> coords(4 * points.size()), flags(4 * points.size(), 0.0f);
+  for (int i = 0; i < count; ++i) {
+    const CameraAtPoint& p = points[i];
+    coords[4 * i] = float(p.u);
+    coords[4 * i + 1] = float(p.v);
+    coords[4 * i + 2] = float(p.du);
+    coords[4 * i + 3] = float(p.dv);
+    flags[4 * i] = p.sees ? 1.0f : 0.0f;
+    flags[4 * i + 1] = p.projects ? 1.0f : 0.0f;
+  }
+  const GLuint program = Link(kFullScreenVertex, WithLightRule(kFragment).c_str(), "light rule");
+  const GLuint coord_tex = MakeTexture(GL_RGBA32F, count, 1, GL_RGBA, GL_FLOAT);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, count, 1, GL_RGBA, GL_FLOAT, coords.data());
+  const GLuint flag_tex = MakeTexture(GL_RGBA32F, count, 1, GL_RGBA, GL_FLOAT);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, count, 1, GL_RGBA, GL_FLOAT, flags.data());
+  const GLuint out_tex = MakeTexture(GL_RGBA32F, count, 1, GL_RGBA, GL_FLOAT);
+  GLuint fbo = 0, vao = 0;
+  glGenFramebuffers(1, &fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out_tex, 0);
+  CheckFramebuffer("light rule");
+  const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &buffer0);
+  glViewport(0, 0, count, 1);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glUseProgram(program);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, coord_tex);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, flag_tex);
+  glUniform1i(Loc(program, "coords"), 0);
+  glUniform1i(Loc(program, "flags"), 1);
+  glUniform1i(Loc(program, "grid"), rule.pattern == Pattern::kGrid ? 1 : 0);
+  glUniform1f(Loc(program, "n"), float(std::max(1, rule.grid_pixels)));
+  glUniform1f(Loc(program, "fill"), float(rule.grid_fill));
+  glUniform1f(Loc(program, "width"), float(rule.line_width_px));
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  std::vector<float> rgba(4 * points.size());
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, count, 1, GL_RGBA, GL_FLOAT, rgba.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteFramebuffers(1, &fbo);
+  const GLuint textures[3] = {coord_tex, flag_tex, out_tex};
+  glDeleteTextures(3, textures);
+  glDeleteProgram(program);
+  std::vector<double> weights(points.size());
+  for (int i = 0; i < count; ++i) weights[i] = rgba[4 * i];
+  return weights;
 }
 
 }  // namespace pandora

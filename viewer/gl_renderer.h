@@ -119,4 +119,11 @@ std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh,
                                               const Eigen::Isometry3d& camera_from_world,
                                               const Eigen::Vector4d& bounds);
 
+/// The light rule's weight as the renderer's GLSL computes it (render/light.h CameraLightWeight
+/// for `rule`'s pattern, grid spacing, fill and line width; brightness and colour aside), one
+/// fragment per input, on the current context: what the tests compare with the CPU rule at the
+/// inputs of render/light_test.cpp. Inputs are rounded to float.
+std::vector<double> GlCameraLightWeights(const LightRule& rule,
+                                         const std::vector<CameraAtPoint>& points);
+
 }  // namespace pandora

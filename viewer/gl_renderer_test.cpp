@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include "analysis/primitives.h"
@@ -92,6 +93,58 @@ void ExpectAgreement(const GlComparison& c, double min_compared = 0.5, double ed
   EXPECT_LE(c.mask_share_all(), edges * kMaxMaskShareAll);
   EXPECT_LE(c.rgb_mean, kMaxRgbMean);
   EXPECT_LE(c.rgb_over_share(), kMaxRgbOverShare);
+}
+
+CameraAtPoint OnGrid(double u, double v, double du, double dv) {
+  CameraAtPoint c;
+  c.sees = true;
+  c.projects = true;
+  c.u = u;
+  c.v = v;
+  c.du = du;
+  c.dv = dv;
+  return c;
+}
+
+TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
+  // render/light_test.cpp's inputs (lines on pixel borders, half a pixel off, both families,
+  // fading at spacings 1.5, 2.25 and 3 output pixels, degenerate gradients, unprojectable points,
+  // grid spacing 0), plus a sweep across a line period at several gradients: the GLSL weight
+  // equals CameraLightWeight within float round-off.
+  Context();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<CameraAtPoint> points = {
+      OnGrid(15.5, 3.0, 1, 1),         OnGrid(-0.5, 3.0, 1, 1),        OnGrid(16.0, 3.0, 1, 1),
+      OnGrid(16.0, 7.0, 1, 1),         OnGrid(11.5, 3.5, 1, 1),        OnGrid(16.5, 3.5, 2, 2),
+      OnGrid(15.75, 3.5, 0.5, 0.5),    OnGrid(7.5, 7.5, 16.0 / 3, 16.0 / 3),
+      OnGrid(9.0, 11.5, 16.0 / 3, 16.0 / 3), OnGrid(7.5, 11.5, 32.0 / 9, 32.0 / 9),
+      OnGrid(7.5, 3.0, 8.0 / 3, 8.0 / 3), OnGrid(7.5, 7.5, 0, 0),     OnGrid(7.5, 7.5, -1, -1),
+      OnGrid(7.5, 7.5, inf, inf),      OnGrid(7.5, 7.5, nan, nan),     OnGrid(0.5, 0.0, 0.25, 0.25)};
+  CameraAtPoint unprojectable = OnGrid(7.5, 7.5, 1, 1);
+  unprojectable.projects = false;
+  points.push_back(unprojectable);
+  CameraAtPoint shadowed = OnGrid(7.5, 7.5, 1, 1);
+  shadowed.sees = false;
+  points.push_back(shadowed);
+  for (double g : {0.3, 1.0, 2.7, 4.0, 6.0})
+    for (int i = 0; i <= 64; ++i) points.push_back(OnGrid(-3.0 + i * 0.37, 5.0 - i * 0.11, g, 1.3 * g));
+  for (int grid_pixels : {8, 32, 0}) {
+    LightRule rule;
+    rule.pattern = Pattern::kGrid;
+    rule.grid_pixels = grid_pixels;
+    rule.grid_fill = 0.15;
+    rule.line_width_px = 1.2;
+    const std::vector<double> gpu = GlCameraLightWeights(rule, points);
+    ASSERT_EQ(gpu.size(), points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      EXPECT_NEAR(gpu[i], CameraLightWeight(rule, points[i]), 2e-6)
+          << "input " << i << " u " << points[i].u << " du " << points[i].du << " n " << grid_pixels;
+  }
+  LightRule uniform;
+  const std::vector<double> gpu = GlCameraLightWeights(uniform, points);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(gpu[i], CameraLightWeight(uniform, points[i])) << i;
 }
 
 TEST(DepthRangeInPyramid, MatchesDenseSamplingOfClippedTriangles) {
