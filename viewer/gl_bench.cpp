@@ -4,7 +4,6 @@
 //   pandora_gl_bench examples/trauma_room/scene.json --rig octagon --view overview --size 1280x720
 //   pandora_gl_bench lens_room --size 1280x720       (the generated scene of gl_test_scenes.h)
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -51,8 +50,7 @@ int main(int argc, char** argv) {
   app.add_option("--png", png_dir, "write CPU | GPU comparison PNGs into this folder");
   CLI11_PARSE(app, argc, argv);
   try {
-    const Scene scene =
-        scene_path == "lens_room" ? testing::LensRoom() : LoadScene(scene_path);
+    const Scene scene = scene_path == "lens_room" ? testing::LensRoom() : LoadScene(scene_path);
     const Rig& rig = scene.FindRig(rig_name);
     if (scene.views.empty()) throw std::runtime_error("the scene has no views");
     const View& named = view_name.empty() ? scene.views.begin()->second : scene.views.at(view_name);
@@ -84,9 +82,12 @@ int main(int argc, char** argv) {
     std::printf("scene: %s (%zu triangles), rig %s (%d enabled cameras), %dx%d, pattern %s\n",
                 scene_path.c_str(), renderer.triangle_count(), rig.name.c_str(),
                 rig.enabled_count(), width, height, pattern.c_str());
-    std::printf("CPU exact renderer: %.1f ms per frame (median of %d)\n\n",
-                1e3 * Median(cpu_times), cpu_frames);
-    std::printf("| Map | GPU frame ms | maps ms | light ms | eye-only frame ms | read-back ms | CPU / GPU | differ (compared) | differ (all) | excluded | RGB max | RGB > 1e-3 | RGB mean | RGB mean all |\n");
+    std::printf("CPU exact renderer: %.1f ms per frame (median of %d)\n\n", 1e3 * Median(cpu_times),
+                cpu_frames);
+    std::printf(
+        "| Map | GPU frame ms | maps ms | light ms | eye-only frame ms | read-back ms | CPU / GPU "
+        "| differ (compared) | differ (all) | excluded | RGB max | RGB > 1e-3 | RGB mean | RGB "
+        "mean all |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int map : maps) {
       GlRenderOptions options;
@@ -120,10 +121,13 @@ int main(int argc, char** argv) {
         }
       }
       const GlComparison c = Compare(cpu, gpu);
-      std::printf("| %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.4f %% | %.3f %% | %.2f %% | %.2e | %.4f %% | %.2e | %.2e |\n",
-                  map, 1e3 * Median(total), 1e3 * Median(shadow), 1e3 * Median(light), 1e3 * Median(eye_only), 1e3 * Median(readback),
-                  Median(cpu_times) / Median(total), 100 * c.mask_share(), 100 * c.mask_share_all(),
-                  100 * c.excluded_share(), c.rgb_max, 100 * c.rgb_over_share(), c.rgb_mean, c.rgb_mean_all);
+      std::printf(
+          "| %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.4f %% | %.3f %% | %.2f %% | %.2e | "
+          "%.4f %% | %.2e | %.2e |\n",
+          map, 1e3 * Median(total), 1e3 * Median(shadow), 1e3 * Median(light),
+          1e3 * Median(eye_only), 1e3 * Median(readback), Median(cpu_times) / Median(total),
+          100 * c.mask_share(), 100 * c.mask_share_all(), 100 * c.excluded_share(), c.rgb_max,
+          100 * c.rgb_over_share(), c.rgb_mean, c.rgb_mean_all);
       if (verbose) {
         std::printf("   per camera, compared pixels where the GPU misses / adds it:");
         for (std::size_t k = 0; k < rig.cameras.size() && k < 64; ++k)
@@ -131,9 +135,10 @@ int main(int argc, char** argv) {
         std::printf("\n");
         if (c.rgb_max_x >= 0) {
           const std::size_t q = std::size_t(c.rgb_max_y) * width + c.rgb_max_x;
-          std::printf("   largest colour difference at (%d, %d): CPU %g %g %g, GPU %g %g %g, object %d\n",
-                      c.rgb_max_x, c.rgb_max_y, cpu.rgb[3 * q], cpu.rgb[3 * q + 1], cpu.rgb[3 * q + 2],
-                      gpu.rgb[3 * q], gpu.rgb[3 * q + 1], gpu.rgb[3 * q + 2], cpu.object[q]);
+          std::printf(
+              "   largest colour difference at (%d, %d): CPU %g %g %g, GPU %g %g %g, object %d\n",
+              c.rgb_max_x, c.rgb_max_y, cpu.rgb[3 * q], cpu.rgb[3 * q + 1], cpu.rgb[3 * q + 2],
+              gpu.rgb[3 * q], gpu.rgb[3 * q + 1], gpu.rgb[3 * q + 2], cpu.object[q]);
         }
       }
       if (!png_dir.empty())

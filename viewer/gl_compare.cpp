@@ -114,7 +114,8 @@ void WriteComparisonPng(const Image& cpu, const GlImage& gpu, const std::string&
       put(W + x, y, gpu.rgb[3 * p], gpu.rgb[3 * p + 1], gpu.rgb[3 * p + 2]);
       const bool differs = cpu.cameras[p] != gpu.cameras[p];
       const float v = !differs ? 0.0f : excluded[p] ? 0.05f : 1.0f;
-      put(W / 2 + x, H + y, v, excluded[p] && differs ? v : 0.0f, excluded[p] && differs ? v : 0.0f);
+      put(W / 2 + x, H + y, v, excluded[p] && differs ? v : 0.0f,
+          excluded[p] && differs ? v : 0.0f);
     }
   WritePng(out, path);
 }

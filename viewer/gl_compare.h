@@ -15,9 +15,9 @@
 namespace pandora {
 
 struct GlComparison {
-  std::size_t pixels = 0;    ///< width * height.
-  std::size_t excluded = 0;  ///< In the band around an edge of the CPU image (see Compare).
-  std::size_t compared = 0;  ///< pixels - excluded.
+  std::size_t pixels = 0;           ///< width * height.
+  std::size_t excluded = 0;         ///< In the band around an edge of the CPU image (see Compare).
+  std::size_t compared = 0;         ///< pixels - excluded.
   std::size_t mask_differ = 0;      ///< Compared pixels whose camera sets differ.
   std::size_t mask_differ_all = 0;  ///< The same over every pixel, edges included.
   /// Colour over the compared pixels whose camera sets agree: largest and mean absolute difference
@@ -52,6 +52,7 @@ GlComparison Compare(const Image& cpu, const GlImage& gpu, int band = 1);
 /// Writes `cpu` and `gpu` side by side (CPU left) above a map of where their camera sets differ
 /// (red: differs, compared; dark grey: differs, excluded band; black otherwise), as an 8-bit sRGB
 /// PNG at `path`.
-void WriteComparisonPng(const Image& cpu, const GlImage& gpu, const std::string& path, int band = 1);
+void WriteComparisonPng(const Image& cpu, const GlImage& gpu, const std::string& path,
+                        int band = 1);
 
 }  // namespace pandora

@@ -16,8 +16,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "render/render.h"
@@ -355,7 +355,8 @@ GLuint Compile(GLenum type, const char* source, const char* name) {
     char log[4096];
     glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
     glDeleteShader(shader);
-    throw std::runtime_error(std::string("GlRenderer: shader ") + name + " does not compile: " + log);
+    throw std::runtime_error(std::string("GlRenderer: shader ") + name +
+                             " does not compile: " + log);
   }
   return shader;
 }
@@ -565,7 +566,8 @@ struct GlRenderer::Impl {
   std::vector<std::optional<Camera>> map_camera, cube_camera;
 
   void FreeViewTargets() {
-    GLuint textures[] = {g_position, g_normal, g_albedo, light_accum, mask[0], mask[1], compose_color};
+    GLuint textures[] = {g_position, g_normal, g_albedo,     light_accum,
+                         mask[0],    mask[1],  compose_color};
     glDeleteTextures(7, textures);
     glDeleteRenderbuffers(1, &g_depth);
     GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo};
@@ -752,7 +754,8 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   data.reserve(m.mesh.triangles.size() * 27);
   for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
     const Eigen::Vector3i& tri = m.mesh.triangles[t];
-    const Vec3 a = m.mesh.vertices[tri[0]], b = m.mesh.vertices[tri[1]], c = m.mesh.vertices[tri[2]];
+    const Vec3 a = m.mesh.vertices[tri[0]], b = m.mesh.vertices[tri[1]],
+               c = m.mesh.vertices[tri[2]];
     Vec3 n = (b - a).cross(c - a);
     n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
     const Vec3& albedo = object_color[triangle_object[t]];
@@ -767,7 +770,8 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   glBindVertexArray(m.vao);
   glGenBuffers(1, &m.vbo);
   glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
+               GL_STATIC_DRAW);
   const GLsizei stride = 9 * sizeof(float);
   for (int k = 0; k < 3; ++k) {
     glEnableVertexAttribArray(k);
@@ -903,8 +907,8 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glClearBufferuiv(GL_COLOR, 1, zero_u);
   }
 
-  const double brightness = std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count())
-                                                           : options.brightness;
+  const double brightness =
+      std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
   const double lift = 0.1 * 1e-5 * m.scene_scale;  // as the CPU renderer: a tenth of epsilon
   int src = 0;
   double shadow_seconds = 0, light_seconds = 0;
@@ -941,7 +945,8 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
                  &block[4 * kCameraVec4 * i]);
     }
     glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
-    glBufferSubData(GL_UNIFORM_BUFFER, 0, GLsizeiptr(4 * kCameraVec4 * batch.cameras.size() * sizeof(float)),
+    glBufferSubData(GL_UNIFORM_BUFFER, 0,
+                    GLsizeiptr(4 * kCameraVec4 * batch.cameras.size() * sizeof(float)),
                     block.data());
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, m.camera_ubo);
     const int dst = 1 - src;
@@ -975,8 +980,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glUniform1i(Loc(p, "map_size"), m.map_size);
     glUniform1i(Loc(p, "cube_size"), m.cube_size);
     static const std::array<Mat3, 6> kCube = CubeFaces();
-    for (int i = 0; i < 6; ++i)
-      SetMat3(p, ("face_R[" + std::to_string(i) + "]").c_str(), kCube[i]);
+    for (int i = 0; i < 6; ++i) SetMat3(p, ("face_R[" + std::to_string(i) + "]").c_str(), kCube[i]);
     glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
     glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
     glUniform1f(Loc(p, "lift"), float(lift));

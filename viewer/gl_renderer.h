@@ -49,9 +49,10 @@ struct GlRenderOptions {
   /// (docs/viewer.md, "Shadows"). kBoth, the default, is what the thresholds were measured with;
   /// the others are there to measure each alone.
   enum class ShadowTest {
-    kDistance = 0,       ///< Distance to the camera within the stored one plus a texel-size bias.
-    kReceiverPlane = 1,  ///< The stored distance not nearer than the point's plane on the texel ray.
-    kBoth = 2,           ///< Either.
+    kDistance = 0,  ///< Distance to the camera within the stored one plus a texel-size bias.
+    kReceiverPlane =
+        1,      ///< The stored distance not nearer than the point's plane on the texel ray.
+    kBoth = 2,  ///< Either.
   };
   ShadowTest shadow_test = ShadowTest::kBoth;
   /// Keep each camera's maps for the next frame and draw them again only for cameras whose
@@ -82,8 +83,8 @@ struct GlFrameStats {
   double light_seconds = 0;   ///< The per-camera light passes over the G-buffer.
   double total_seconds = 0;   ///< The whole frame up to the read-back (not included).
   double readback_seconds = 0;
-  int shadow_maps = 0;        ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
-  int light_passes = 0;       ///< Passes over the G-buffer (batches of cameras).
+  int shadow_maps = 0;   ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
+  int light_passes = 0;  ///< Passes over the G-buffer (batches of cameras).
 };
 
 /// The scene's triangles on the GPU and the programs; renders frames of any rig and view.

@@ -2,6 +2,8 @@
 // `xvfb-run -a` with Mesa's llvmpipe (ctest sets LIBGL_ALWAYS_SOFTWARE=1); each case renders the
 // same rig, view and size on both and compares the per-pixel camera sets away from the one-pixel
 // band around the CPU image's edges (footprint and shadow edges, silhouettes), and the colours.
+#include "viewer/gl_renderer.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -16,7 +18,6 @@
 #include "tests/fixtures.h"
 #include "viewer/gl_compare.h"
 #include "viewer/gl_context.h"
-#include "viewer/gl_renderer.h"
 #include "viewer/gl_test_scenes.h"
 
 namespace pandora {
@@ -114,13 +115,22 @@ TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
   Context();
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<CameraAtPoint> points = {
-      OnGrid(15.5, 3.0, 1, 1),         OnGrid(-0.5, 3.0, 1, 1),        OnGrid(16.0, 3.0, 1, 1),
-      OnGrid(16.0, 7.0, 1, 1),         OnGrid(11.5, 3.5, 1, 1),        OnGrid(16.5, 3.5, 2, 2),
-      OnGrid(15.75, 3.5, 0.5, 0.5),    OnGrid(7.5, 7.5, 16.0 / 3, 16.0 / 3),
-      OnGrid(9.0, 11.5, 16.0 / 3, 16.0 / 3), OnGrid(7.5, 11.5, 32.0 / 9, 32.0 / 9),
-      OnGrid(7.5, 3.0, 8.0 / 3, 8.0 / 3), OnGrid(7.5, 7.5, 0, 0),     OnGrid(7.5, 7.5, -1, -1),
-      OnGrid(7.5, 7.5, inf, inf),      OnGrid(7.5, 7.5, nan, nan),     OnGrid(0.5, 0.0, 0.25, 0.25)};
+  std::vector<CameraAtPoint> points = {OnGrid(15.5, 3.0, 1, 1),
+                                       OnGrid(-0.5, 3.0, 1, 1),
+                                       OnGrid(16.0, 3.0, 1, 1),
+                                       OnGrid(16.0, 7.0, 1, 1),
+                                       OnGrid(11.5, 3.5, 1, 1),
+                                       OnGrid(16.5, 3.5, 2, 2),
+                                       OnGrid(15.75, 3.5, 0.5, 0.5),
+                                       OnGrid(7.5, 7.5, 16.0 / 3, 16.0 / 3),
+                                       OnGrid(9.0, 11.5, 16.0 / 3, 16.0 / 3),
+                                       OnGrid(7.5, 11.5, 32.0 / 9, 32.0 / 9),
+                                       OnGrid(7.5, 3.0, 8.0 / 3, 8.0 / 3),
+                                       OnGrid(7.5, 7.5, 0, 0),
+                                       OnGrid(7.5, 7.5, -1, -1),
+                                       OnGrid(7.5, 7.5, inf, inf),
+                                       OnGrid(7.5, 7.5, nan, nan),
+                                       OnGrid(0.5, 0.0, 0.25, 0.25)};
   CameraAtPoint unprojectable = OnGrid(7.5, 7.5, 1, 1);
   unprojectable.projects = false;
   points.push_back(unprojectable);
@@ -128,7 +138,8 @@ TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
   shadowed.sees = false;
   points.push_back(shadowed);
   for (double g : {0.3, 1.0, 2.7, 4.0, 6.0})
-    for (int i = 0; i <= 64; ++i) points.push_back(OnGrid(-3.0 + i * 0.37, 5.0 - i * 0.11, g, 1.3 * g));
+    for (int i = 0; i <= 64; ++i)
+      points.push_back(OnGrid(-3.0 + i * 0.37, 5.0 - i * 0.11, g, 1.3 * g));
   for (int grid_pixels : {8, 32, 0}) {
     LightRule rule;
     rule.pattern = Pattern::kGrid;
@@ -139,7 +150,8 @@ TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
     ASSERT_EQ(gpu.size(), points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
       EXPECT_NEAR(gpu[i], CameraLightWeight(rule, points[i]), 2e-6)
-          << "input " << i << " u " << points[i].u << " du " << points[i].du << " n " << grid_pixels;
+          << "input " << i << " u " << points[i].u << " du " << points[i].du << " n "
+          << grid_pixels;
   }
   LightRule uniform;
   const std::vector<double> gpu = GlCameraLightWeights(uniform, points);
@@ -150,8 +162,10 @@ TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
 TEST(DepthRangeInPyramid, MatchesDenseSamplingOfClippedTriangles) {
   // A floor crossing a camera's pyramid obliquely and a small triangle wholly inside it.
   TriangleMesh mesh = MakePlane(Vec2(10, 10));
-  mesh.Append(TriangleMesh{{Vec3(0.1, 0.1, 1.5), Vec3(0.2, 0.1, 1.5), Vec3(0.1, 0.2, 1.6)}, {{0, 1, 2}}, {}});
-  const Eigen::Isometry3d world_from_camera = *LookAt(Vec3(0, -3, 2), Vec3(0, 0, 0.5), Vec3::UnitZ());
+  mesh.Append(TriangleMesh{
+      {Vec3(0.1, 0.1, 1.5), Vec3(0.2, 0.1, 1.5), Vec3(0.1, 0.2, 1.6)}, {{0, 1, 2}}, {}});
+  const Eigen::Isometry3d world_from_camera =
+      *LookAt(Vec3(0, -3, 2), Vec3(0, 0, 0.5), Vec3::UnitZ());
   const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
   const Eigen::Vector4d bounds(-0.4, 0.5, -0.3, 0.35);
   const auto [near, far] = DepthRangeInPyramid(mesh, camera_from_world, bounds);
@@ -159,7 +173,8 @@ TEST(DepthRangeInPyramid, MatchesDenseSamplingOfClippedTriangles) {
   for (const Eigen::Vector3i& t : mesh.triangles)
     for (int i = 0; i <= 400; ++i)
       for (int j = 0; i + j <= 400; ++j) {
-        const Vec3 p = mesh.vertices[t[0]] + (i / 400.0) * (mesh.vertices[t[1]] - mesh.vertices[t[0]]) +
+        const Vec3 p = mesh.vertices[t[0]] +
+                       (i / 400.0) * (mesh.vertices[t[1]] - mesh.vertices[t[0]]) +
                        (j / 400.0) * (mesh.vertices[t[2]] - mesh.vertices[t[0]]);
         const Vec3 c = camera_from_world * p;
         if (c.z() <= 0) continue;
@@ -223,7 +238,8 @@ TEST(GlRenderer, StrongBarrelLabMatchesCpu) {
 TEST(GlRenderer, FortyCamerasFillBothMaskWords) {
   // Cameras 32..39 land in the mask's second word, as render's Image::cameras has them.
   Scene scene = testing::BoxRoom(Vec3(6, 6, 3));
-  scene.objects.push_back(testing::TestObject("box", MakeBox(Vec3(0.6, 0.6, 1.0)), Vec3(0, 0, 0.5)));
+  scene.objects.push_back(
+      testing::TestObject("box", MakeBox(Vec3(0.6, 0.6, 1.0)), Vec3(0, 0, 0.5)));
   scene.rigs.push_back(testing::RingRig(40, 2.5, 2.0, Vec3(0, 0, 0.3), 70, 320, 240));
   RenderView view;
   view.from = Vec3(-2.8, -2.8, 2.8);

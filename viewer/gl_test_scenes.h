@@ -35,40 +35,40 @@ inline Scene LensRoom() {
     c.color = CameraPaletteColor(int(rig.cameras.size()));
     rig.cameras.push_back(c);
   };
-  add(WithIntrinsics(TestCamera("bc1", Vec3(2.7, -2.6, 2.6), middle, 75, 1280, 960,
-                                LensModel::kBrownConrady),
-                     [](Intrinsics& k) {
-                       k.k1 = -0.32;
-                       k.k2 = 0.09;
-                       k.k3 = -0.01;
-                       k.p1 = 0.002;
-                       k.p2 = -0.003;
-                       k.cx += 20;
-                     }));
-  add(WithIntrinsics(TestCamera("bc2", Vec3(-2.7, 2.6, 2.2), middle, 70, 1024, 768,
-                                LensModel::kBrownConrady),
-                     [](Intrinsics& k) {
-                       k.k1 = 0.12;
-                       k.k2 = -0.05;
-                       k.p1 = -0.004;
-                     }));
-  add(WithIntrinsics(TestCamera("fe100", Vec3(-2.8, -2.7, 2.5), middle, 100, 1024, 768,
-                                LensModel::kFisheye),
-                     [](Intrinsics& k) {
-                       k.k1 = -0.02;
-                       k.k2 = 0.004;
-                     }));
-  add(WithIntrinsics(TestCamera("fe160a", Vec3(2.8, 2.0, 2.0), middle, 160, 1280, 1024,
-                                LensModel::kFisheye),
-                     [](Intrinsics& k) {
-                       k.k1 = 0.03;
-                       k.k2 = -0.01;
-                       k.k3 = 0.001;
-                     }));
+  add(WithIntrinsics(
+      TestCamera("bc1", Vec3(2.7, -2.6, 2.6), middle, 75, 1280, 960, LensModel::kBrownConrady),
+      [](Intrinsics& k) {
+        k.k1 = -0.32;
+        k.k2 = 0.09;
+        k.k3 = -0.01;
+        k.p1 = 0.002;
+        k.p2 = -0.003;
+        k.cx += 20;
+      }));
+  add(WithIntrinsics(
+      TestCamera("bc2", Vec3(-2.7, 2.6, 2.2), middle, 70, 1024, 768, LensModel::kBrownConrady),
+      [](Intrinsics& k) {
+        k.k1 = 0.12;
+        k.k2 = -0.05;
+        k.p1 = -0.004;
+      }));
+  add(WithIntrinsics(
+      TestCamera("fe100", Vec3(-2.8, -2.7, 2.5), middle, 100, 1024, 768, LensModel::kFisheye),
+      [](Intrinsics& k) {
+        k.k1 = -0.02;
+        k.k2 = 0.004;
+      }));
+  add(WithIntrinsics(
+      TestCamera("fe160a", Vec3(2.8, 2.0, 2.0), middle, 160, 1280, 1024, LensModel::kFisheye),
+      [](Intrinsics& k) {
+        k.k1 = 0.03;
+        k.k2 = -0.01;
+        k.k3 = 0.001;
+      }));
   add(TestCamera("fe160b", Vec3(0.0, -2.85, 1.2), Vec3(0, 0, 1.0), 160, 1280, 1024,
                  LensModel::kFisheye));
-  add(WithIntrinsics(TestCamera("fe220", Vec3(0.4, 0.3, 2.9), Vec3(0.4, 0.3, 0.0), 220, 1024,
-                                1024, LensModel::kFisheye, Vec3(0, 1, 0)),
+  add(WithIntrinsics(TestCamera("fe220", Vec3(0.4, 0.3, 2.9), Vec3(0.4, 0.3, 0.0), 220, 1024, 1024,
+                                LensModel::kFisheye, Vec3(0, 1, 0)),
                      [](Intrinsics& k) { k.k1 = 0.01; }));
   for (Camera& c : rig.cameras) c.far = 12.0;
   rig.cameras[0].near = 0.3;
