@@ -817,6 +817,12 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   if (options.shadow_map_size < 512 || options.shadow_map_size > 4096)
     throw std::invalid_argument("GlRenderer: shadow_map_size must be 512 .. 4096 (is " +
                                 std::to_string(options.shadow_map_size) + ")");
+  if (options.shadow_map_size > max_size)
+    throw std::invalid_argument("GlRenderer: this GL's textures are at most " +
+                                std::to_string(max_size) + " texels per side; shadow_map_size is " +
+                                std::to_string(options.shadow_map_size));
+  GLint max_layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   const int W = view.width, H = view.height;
   const std::size_t pixels = std::size_t(W) * H;
   const int camera_count = int(rig.cameras.size());
@@ -837,8 +843,11 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
       if (!cam.enabled) continue;
       const bool cube = IsCube(cam);
       const double need = cube ? 1.5 * map_bytes : map_bytes;
+      // A new batch when this one is full: the uniform block, the map budget, or the layers a
+      // texture array may have (GL_MAX_ARRAY_TEXTURE_LAYERS, at least 256 in GL 3.3).
       if (batches.empty() || int(batches.back().cameras.size()) == kMaxBatch ||
-          (bytes + need > budget && !batches.back().cameras.empty())) {
+          (bytes + need > budget && !batches.back().cameras.empty()) ||
+          (cube ? 6 * (batches.back().cube + 1) : batches.back().perspective + 1) > max_layers) {
         batches.emplace_back();
         bytes = 0;
       }

@@ -100,7 +100,8 @@ class GlRenderer {
 
   /// Renders `rig` lit scene seen from `view` (a main view: from/at/up/fov_deg, width x height)
   /// and reads it back. Throws std::invalid_argument for a camera's-eye view (view.camera >= 0:
-  /// not drawn on the GPU yet), a bad size, fov or look-at, or a map size outside 512 .. 4096.
+  /// not drawn on the GPU yet), a bad size, fov or look-at, or a map size outside 512 .. 4096 or
+  /// beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for a GL error in the frame.
   GlImage Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                  GlFrameStats* stats = nullptr);
 
