@@ -16,6 +16,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -124,6 +125,10 @@ float GridLightWeight(bool projects, vec2 uv, vec2 duv, float n, float fill, flo
 // the batch in rig order. A camera's parameters are kCameraVec4 vec4s of the uniform block (see
 // PackCamera); its distance map is layer `layer` of `maps` (one perspective map) or layers
 // layer .. layer + 5 of `cubes` (a cube).
+// Compiled in variants (Impl::LightProgram): GRID for the grid pattern, FISHEYE, DISTORTION
+// (Brown-Conrady) and CUBE only when a camera of the batch needs them. Software GL (llvmpipe)
+// runs every branch of a loop body under a mask whether or not a lane takes it, so code a batch
+// cannot need would cost as much as code it runs.
 const char* kLightFragment = R"(#version 330 core
 #define CAMERA_VEC4 10
 #define MAX_BATCH 64
@@ -140,7 +145,6 @@ uniform mat3 face_R[6];        // cube faces: face_from_camera
 uniform float bias_scale;
 uniform int shadow_mode;       // 0: distance + bias, 1: receiver plane, 2: either
 uniform float lift;
-uniform int grid;
 uniform float grid_n;
 uniform float grid_fill;
 uniform float line_width;
@@ -161,6 +165,7 @@ struct Lens {
 // CameraModel::Project (analysis/camera.cpp) in float: camera-frame point to distorted pixel.
 bool Project(Lens L, vec3 p, out vec2 px) {
   px = vec2(0.0);
+#if FISHEYE
   if (L.model == 2) {
     float r = length(p.xy);
     if (r == 0.0 && p.z == 0.0) return false;
@@ -172,9 +177,11 @@ bool Project(Lens L, vec3 p, out vec2 px) {
     px = L.K.xy * q + L.K.zw;
     return true;
   }
+#endif
   if (!(p.z > 0.0)) return false;
   vec2 n = p.xy / p.z;
   vec2 d = n;
+#if DISTORTION
   if (L.model == 1) {
     if (!(length(n) < L.max_radius)) return false;
     vec4 D = L.D0;
@@ -188,6 +195,7 @@ bool Project(Lens L, vec3 p, out vec2 px) {
     float j11 = radial + dr * y * y + 6.0 * D.z * y + 2.0 * D.w * x;
     if (!(j00 * j11 - c * c > 0.0)) return false;
   }
+#endif
   px = L.K.xy * d + L.K.zw;
   return true;
 }
@@ -229,6 +237,7 @@ void main() {
     mat3 F = mat3(1.0);
     vec4 fm = cams[b + 9];
     int size = map_size;
+#if CUBE
     if (cube) {
       vec3 a = abs(pc);
       int face = a.x >= a.y && a.x >= a.z ? (pc.x > 0.0 ? 0 : 1)
@@ -239,12 +248,17 @@ void main() {
       fm = vec4(1.0, 1.0, 0.0, 0.0);
       size = cube_size;
     }
+#endif
     vec3 pf = F * pc;
     vec2 q = pf.xy / pf.z;
     vec2 uv = 0.5 * vec2(fm.x * q.x - fm.z, fm.y * q.y - fm.w) + 0.5;
     ivec2 tc = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
+#if CUBE
     vec2 stored = cube ? texelFetch(cubes, ivec3(tc, layer), 0).xy
                        : texelFetch(maps, ivec3(tc, layer), 0).xy;
+#else
+    vec2 stored = texelFetch(maps, ivec3(tc, layer), 0).xy;
+#endif
     bool lit = stored.y == g.w;  // the texel holds the point's own triangle
     if (!lit && shadow_mode != 1) {
       // Distance within how much it can change between the point and its texel's centre on the
@@ -268,7 +282,8 @@ void main() {
     if (!lit) continue;
 
     float weight = 1.0;
-    if (grid == 1) {
+#if GRID
+    {
       // Ray differentials of the hit point on its plane, then the camera pixel's change per
       // output pixel by central differences of the projection along them.
       vec2 pp = gl_FragCoord.xy - 0.5;
@@ -294,6 +309,7 @@ void main() {
       }
       weight = GridLightWeight(true, px, vec2(du, dv), grid_n, grid_fill, line_width);
     }
+#endif
     vec4 c8 = cams[b + 8];
     sum += weight * c8.xyz;
     int bit = int(c8.w);
@@ -549,7 +565,23 @@ struct GlRenderer::Impl {
   double scene_scale = 1.0;
   GLsizei vertex_count = 0;
   GLuint vao = 0, vbo = 0;
-  GLuint gbuffer_program = 0, shadow_program = 0, light_program = 0, compose_program = 0;
+  GLuint gbuffer_program = 0, shadow_program = 0, compose_program = 0;
+  std::map<int, GLuint> light_programs;  // by variant bits: 1 grid, 2 fisheye, 4 distortion, 8 cube
+
+  GLuint LightProgram(int variant) {
+    auto it = light_programs.find(variant);
+    if (it != light_programs.end()) return it->second;
+    std::string source = WithLightRule(kLightFragment);
+    const std::string defines = "#define GRID " + std::to_string(variant & 1) +
+                                "\n#define FISHEYE " + std::to_string((variant >> 1) & 1) +
+                                "\n#define DISTORTION " + std::to_string((variant >> 2) & 1) +
+                                "\n#define CUBE " + std::to_string((variant >> 3) & 1) + "\n";
+    source.insert(source.find('\n') + 1, defines);  // after #version
+    const GLuint program = Link(kFullScreenVertex, source.c_str(), "light");
+    glUniformBlockBinding(program, glGetUniformBlockIndex(program, "CameraBlock"), 0);
+    light_programs[variant] = program;
+    return program;
+  }
   GLuint empty_vao = 0, camera_ubo = 0;
 
   // Per view size.
@@ -675,8 +707,8 @@ struct GlRenderer::Impl {
     glDeleteBuffers(1, &camera_ubo);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
-    for (GLuint p : {gbuffer_program, shadow_program, light_program, compose_program})
-      glDeleteProgram(p);
+    for (GLuint p : {gbuffer_program, shadow_program, compose_program}) glDeleteProgram(p);
+    for (const auto& [variant, program] : light_programs) glDeleteProgram(program);
   }
 
   // Draws camera `cam`'s distance map(s): one perspective map into layer `layer` of `maps`, or a
@@ -781,9 +813,8 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   glGenVertexArrays(1, &m.empty_vao);
   m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
   m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
-  m.light_program = Link(kFullScreenVertex, WithLightRule(kLightFragment).c_str(), "light");
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
-  glUniformBlockBinding(m.light_program, glGetUniformBlockIndex(m.light_program, "CameraBlock"), 0);
+  m.LightProgram(15);  // every branch compiled once now: a shader error shows at construction
   glGenBuffers(1, &m.camera_ubo);
   glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
   glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(kCameraVec4 * kMaxBatch * 4 * sizeof(float)), nullptr,
@@ -968,7 +999,13 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glDisablei(GL_BLEND, 1);  // integer: the shader ORs the previous mask in
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    const GLuint p = m.light_program;
+    int variant = options.pattern == Pattern::kGrid ? 1 : 0;
+    for (int c : batch.cameras) {
+      const LensModel lens = rig.cameras[c].model.intrinsics().model;
+      variant |= lens == LensModel::kFisheye ? 2 : lens == LensModel::kBrownConrady ? 4 : 0;
+      variant |= IsCube(rig.cameras[c]) ? 8 : 0;
+    }
+    const GLuint p = m.LightProgram(variant);
     glUseProgram(p);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, m.g_position);
@@ -993,7 +1030,6 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
     glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
     glUniform1f(Loc(p, "lift"), float(lift));
-    glUniform1i(Loc(p, "grid"), options.pattern == Pattern::kGrid ? 1 : 0);
     glUniform1f(Loc(p, "grid_n"), float(std::max(1, options.grid_pixels)));
     glUniform1f(Loc(p, "grid_fill"), float(options.grid_fill));
     glUniform1f(Loc(p, "line_width"), float(options.line_width_px));
