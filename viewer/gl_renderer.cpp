@@ -1,6 +1,6 @@
 // The GPU projective-light renderer (viewer/gl_renderer.h). A frame is deferred:
 //  1. G-buffer: the scene from the view; per pixel the surface point (relative to the scene's
-//     centre, float), the triangle index, the normal turned towards the eye and the albedo.
+//     centre, float), the normal turned towards the eye and the albedo.
 //  2. Per enabled camera, in rig order: its distance map (one perspective map over the camera's
 //     field, or a cube of six for wide lenses), then a full-screen pass that tests every pixel's
 //     point as VisibilityTester does (range, lens projection, image bounds, facing, the map in
@@ -58,13 +58,13 @@ in vec3 v_position;
 flat in vec3 v_normal;
 flat in vec3 v_albedo;
 uniform vec3 eye;
-layout(location = 0) out vec4 g_position;  // xyz, triangle index (-1: no surface)
+layout(location = 0) out vec4 g_position;  // xyz, 1 (-1: no surface)
 layout(location = 1) out vec4 g_normal;    // turned towards the eye
 layout(location = 2) out vec4 g_albedo;
 void main() {
   vec3 n = v_normal;
   if (dot(n, v_position - eye) > 0.0) n = -n;
-  g_position = vec4(v_position, float(gl_PrimitiveID));
+  g_position = vec4(v_position, 1.0);
   g_normal = vec4(n, 0.0);
   g_albedo = vec4(v_albedo, 1.0);
 }
@@ -87,8 +87,8 @@ void main() {
 
 const char* kShadowFragment = R"(#version 330 core
 in vec3 v_face;
-layout(location = 0) out vec2 o_map;  // distance from the camera's centre, triangle index
-void main() { o_map = vec2(length(v_face), float(gl_PrimitiveID)); }
+layout(location = 0) out float o_map;  // distance from the camera's centre
+void main() { o_map = length(v_face); }
 )";
 
 // A triangle covering the screen, from gl_VertexID alone (no attributes).
@@ -254,13 +254,13 @@ void main() {
     vec2 uv = 0.5 * vec2(fm.x * q.x - fm.z, fm.y * q.y - fm.w) + 0.5;
     ivec2 tc = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
 #if CUBE
-    vec2 stored = cube ? texelFetch(cubes, ivec3(tc, layer), 0).xy
-                       : texelFetch(maps, ivec3(tc, layer), 0).xy;
+    float stored = cube ? texelFetch(cubes, ivec3(tc, layer), 0).x
+                        : texelFetch(maps, ivec3(tc, layer), 0).x;
 #else
-    vec2 stored = texelFetch(maps, ivec3(tc, layer), 0).xy;
+    float stored = texelFetch(maps, ivec3(tc, layer), 0).x;
 #endif
-    bool lit = stored.y == g.w;  // the texel holds the point's own triangle
-    if (!lit && shadow_mode != 1) {
+    bool lit = false;
+    if (shadow_mode != 1) {
       // Distance within how much it can change between the point and its texel's centre on the
       // point's own plane: the texel's size there times the tangent of the incidence.
       float texel = 2.0 / (min(fm.x, fm.y) * float(size));
@@ -268,7 +268,7 @@ void main() {
       float tan_i = sqrt(max(1.0 - cos_i * cos_i, 0.0)) / max(cos_i, 1e-6);
       float w = texel * dist * sqrt(1.0 + dot(q, q));
       float bias = bias_scale * (w * (0.5 + 0.75 * min(tan_i, 10.0)) + 1e-5 * dist);
-      lit = dist <= stored.x + bias;
+      lit = dist <= stored + bias;
     }
     if (!lit && shadow_mode != 0) {
       // Receiver plane: where the texel's centre ray meets the point's own plane. A planar
@@ -277,7 +277,7 @@ void main() {
       vec3 rc = transpose(R) * (transpose(F) * vec3(qc, 1.0));
       float nr = dot(n, rc);
       float plane = nr < 0.0 ? dot(n, to_point) / nr * length(rc) : 3e38;
-      lit = stored.x >= plane - bias_scale * 1e-4 * dist;
+      lit = stored >= plane - bias_scale * 1e-4 * dist;
     }
     if (!lit) continue;
 
@@ -646,7 +646,7 @@ struct GlRenderer::Impl {
     GLuint tex = 0;
     glGenTextures(1, &tex);
     glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
-    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RG32F, size, size, layers, 0, GL_RG, GL_FLOAT, nullptr);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, layers, 0, GL_RED, GL_FLOAT, nullptr);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -737,7 +737,7 @@ struct GlRenderer::Impl {
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, cube ? cubes : maps, 0,
                                 cube ? 6 * layer + i : layer);
       CheckFramebuffer("distance map");
-      const float cleared[4] = {3e38f, -1.0f, 0, 0};
+      const float cleared[4] = {3e38f, 0, 0, 0};
       glClearBufferfv(GL_COLOR, 0, cleared);
       // A cube face whose pyramid (54.7 degrees around its axis) the field cannot reach stays
       // cleared.
@@ -773,9 +773,6 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   const Aabb content = scene.ContentBounds();
   m.origin = content.empty() ? Vec3::Zero() : content.center();
   m.scene_scale = std::max(content.diagonal(), 1e-9);
-  if (m.mesh.triangles.size() >= (std::size_t(1) << 24))
-    throw std::invalid_argument(
-        "GlRenderer: more than 2^24 triangles (the triangle index is kept in a float)");
 
   std::vector<Vec3> object_color(scene.objects.size(), Material().color);
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -866,7 +863,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   };
   std::vector<Batch> batches;
   {
-    const double map_bytes = 8.0 * options.shadow_map_size * options.shadow_map_size;
+    const double map_bytes = 4.0 * options.shadow_map_size * options.shadow_map_size;
     const double budget = std::max(options.map_memory_mib, 1.0) * 1024.0 * 1024.0;
     double bytes = 0;
     for (int c = 0; c < camera_count; ++c) {

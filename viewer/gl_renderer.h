@@ -45,9 +45,8 @@ struct GlRenderOptions {
   int shadow_map_size = 2048;
   /// Multiplies the shadow test's tolerance (docs/viewer.md, "Shadows"); 1 is what was measured.
   double shadow_bias_scale = 1.0;
-  /// Which test decides that a point is lit besides the texel holding its own triangle
-  /// (docs/viewer.md, "Shadows"). kBoth, the default, is what the thresholds were measured with;
-  /// the others are there to measure each alone.
+  /// Which test decides that a point is lit (docs/viewer.md, "Shadows"). kBoth, the default, is
+  /// what the thresholds were measured with; the others are there to measure each alone.
   enum class ShadowTest {
     kDistance = 0,  ///< Distance to the camera within the stored one plus a texel-size bias.
     kReceiverPlane =
@@ -61,7 +60,7 @@ struct GlRenderOptions {
   bool reuse_maps = true;
   /// Memory for the maps of one light pass, MiB. All maps of a pass are bound at once; a rig whose
   /// maps need more is lit in several passes (and its maps are drawn every frame). A map takes
-  /// 8 map_size^2 bytes (32 MiB at 2048, 128 MiB at 4096), a cube 1.5 times that.
+  /// 4 map_size^2 bytes (16 MiB at 2048, 64 MiB at 4096), a cube 1.5 times that.
   double map_memory_mib = 1024;
 };
 

@@ -306,7 +306,7 @@ TEST(GlRenderer, KeepsMapsWhileCamerasStayAndRedrawsOnlyMovedOnes) {
   EXPECT_EQ(stats.shadow_maps, 1);
   // A small budget splits the rig into several passes (maps drawn every frame), same picture.
   GlRenderOptions split = options;
-  split.map_memory_mib = 6;  // three 2 MiB maps per pass
+  split.map_memory_mib = 3;  // three 1 MiB maps per pass
   const GlImage a = renderer.Render(rig, view, split, &stats);
   EXPECT_EQ(stats.light_passes, 3);
   EXPECT_EQ(stats.shadow_maps, 8);
