@@ -1,0 +1,130 @@
+#pragma once
+/// \file gl_renderer.h
+/// The GPU projective-light renderer of the viewer: the same picture as the exact CPU renderer
+/// (render/render.h) drawn with OpenGL 3.3 core into offscreen framebuffers, with shadow maps in
+/// place of the occlusion rays. Every enabled camera is a projector of its colour; lights add in
+/// rig order with the brightness and pattern of render/light.h, whose formulas the shaders follow
+/// (docs/rendering.md, "The light rule"). Per camera, a fragment's surface point is tested as
+/// VisibilityTester does: working range, projection through the camera's lens model in the
+/// fragment shader (pinhole, Brown-Conrady k1 k2 p1 p2 k3 with its monotonic domain and Jacobian
+/// test, fisheye k1..k4: the formulas of analysis/camera.cpp), the image bounds, facing, and, in
+/// place of the occlusion segment, one distance map per camera (docs/viewer.md).
+///
+/// Light header: no GL. Every call needs a current GL 3.3 context (viewer/gl_context.h) on the
+/// calling thread, the one the renderer was created on.
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "analysis/geometry.h"
+#include "analysis/scene.h"
+#include "render/light.h"
+
+namespace pandora {
+
+struct RenderView;
+
+/// How a GPU frame is drawn: the CPU renderer's RenderOptions that apply, and the shadow maps.
+struct GlRenderOptions {
+  Pattern pattern = Pattern::kUniform;
+  /// false: Surface::kBlack (the light only); true: Surface::kMaterial, albedo * light plus the
+  /// ambient term of MaterialColor. Material colours only: textures are not drawn yet.
+  bool material = true;
+  /// NaN (the default): DefaultBrightness of the rig's enabled cameras.
+  double brightness = std::numeric_limits<double>::quiet_NaN();
+  double ambient = 0.15;
+  int grid_pixels = 32;
+  double grid_fill = 0.15;
+  double line_width_px = 1.2;
+  Vec3 background{0.02, 0.02, 0.03};
+  /// Texels per side of each camera's distance map, 512 .. 4096 (std::invalid_argument outside).
+  /// A camera whose field reaches 75 degrees off its axis or more (wide fisheyes) gets a cube of
+  /// six maps of map_size / 2 texels around its centre instead of one.
+  int shadow_map_size = 2048;
+  /// Multiplies the shadow test's tolerance (docs/viewer.md, "Shadows"); 1 is what was measured.
+  double shadow_bias_scale = 1.0;
+  /// Which test decides that a point is lit (docs/viewer.md, "Shadows"). kBoth, the default, is
+  /// what the thresholds were measured with; the others are there to measure each alone.
+  enum class ShadowTest {
+    kDistance = 0,  ///< Distance to the camera within the stored one plus a texel-size bias.
+    kReceiverPlane =
+        1,      ///< The stored distance not nearer than the point's plane on the texel ray.
+    kBoth = 2,  ///< Either.
+  };
+  ShadowTest shadow_test = ShadowTest::kBoth;
+  /// Keep each camera's maps for the next frame and draw them again only for cameras whose
+  /// geometry changed (SameCameraGeometry): a frame that moves only the eye draws no maps. Only
+  /// when the whole rig fits one light pass (see map_memory_mib).
+  bool reuse_maps = true;
+  /// Memory for the maps of one light pass, MiB. All maps of a pass are bound at once; a rig whose
+  /// maps need more is lit in several passes (and its maps are drawn every frame). A map takes
+  /// 4 map_size^2 bytes (16 MiB at 2048, 64 MiB at 4096), a cube 1.5 times that.
+  double map_memory_mib = 1024;
+};
+
+/// A GPU frame read back to the CPU. Row-major, y down, index y * width + x, as render's Image.
+struct GlImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  ///< Linear RGB, 3 per pixel, unclamped.
+  /// Bit c set when rig camera c lights the pixel's surface point: render's Image::cameras layout.
+  /// Empty for rigs of more than 64 cameras (their light is still drawn).
+  std::vector<uint64_t> cameras;
+  /// true where the pixel shows a surface.
+  std::vector<uint8_t> hit;
+};
+
+/// Timing of a frame, seconds. With stats requested the renderer waits for the GPU (glFinish)
+/// after each part, so the parts do not overlap.
+struct GlFrameStats {
+  double shadow_seconds = 0;  ///< Distance maps of every enabled camera.
+  double light_seconds = 0;   ///< The per-camera light passes over the G-buffer.
+  double total_seconds = 0;   ///< The whole frame up to the read-back (not included).
+  double readback_seconds = 0;
+  int shadow_maps = 0;   ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
+  int light_passes = 0;  ///< Passes over the G-buffer (batches of cameras).
+};
+
+/// The scene's triangles on the GPU and the programs; renders frames of any rig and view.
+class GlRenderer {
+ public:
+  /// Uploads scene.AllTriangles() (positions relative to the centre of Scene::ContentBounds(), in
+  /// float), each triangle's geometric normal and its object's material colour, and compiles the
+  /// shaders. Throws std::runtime_error with the GL info log when a shader does not compile.
+  explicit GlRenderer(const Scene& scene);
+  ~GlRenderer();
+  GlRenderer(const GlRenderer&) = delete;
+  GlRenderer& operator=(const GlRenderer&) = delete;
+
+  /// Renders `rig` lit scene seen from `view` (a main view: from/at/up/fov_deg, width x height)
+  /// and reads it back. Throws std::invalid_argument for a camera's-eye view (view.camera >= 0:
+  /// not drawn on the GPU yet), a bad size, fov or look-at, or a map size outside 512 .. 4096 or
+  /// beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for a GL error in the frame.
+  GlImage Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
+                 GlFrameStats* stats = nullptr);
+
+  std::size_t triangle_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The tightest [near, far] of camera-frame depth z that the scene's triangles reach inside the
+/// pyramid {|x| / z, |y| / z within `bounds`} (x_min, x_max, y_min, y_max of normalized image
+/// coordinates) of the frame `camera_from_world`: each triangle is clipped to the pyramid's four
+/// side planes (double precision). Empty (near > far) when no triangle enters it. The shadow
+/// maps' near and far planes (the Pandora paper's trick), exposed for tests.
+std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh,
+                                              const Eigen::Isometry3d& camera_from_world,
+                                              const Eigen::Vector4d& bounds);
+
+/// The light rule's weight as the renderer's GLSL computes it (render/light.h CameraLightWeight
+/// for `rule`'s pattern, grid spacing, fill and line width; brightness and colour aside), one
+/// fragment per input, on the current context: what the tests compare with the CPU rule at the
+/// inputs of render/light_test.cpp. Inputs are rounded to float.
+std::vector<double> GlCameraLightWeights(const LightRule& rule,
+                                         const std::vector<CameraAtPoint>& points);
+
+}  // namespace pandora

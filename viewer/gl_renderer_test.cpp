@@ -1,0 +1,337 @@
+// The GPU renderer against the exact CPU renderer (docs/viewer.md, "Tests"). Runs under
+// `xvfb-run -a` with Mesa's llvmpipe (ctest sets LIBGL_ALWAYS_SOFTWARE=1); each case renders the
+// same rig, view and size on both and compares the per-pixel camera sets away from the one-pixel
+// band around the CPU image's edges (footprint and shadow edges, silhouettes), and the colours.
+#include "viewer/gl_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <memory>
+
+#include "analysis/primitives.h"
+#include "render/prepared_scene.h"
+#include "render/render.h"
+#include "tests/fixtures.h"
+#include "viewer/gl_compare.h"
+#include "viewer/gl_context.h"
+#include "viewer/gl_test_scenes.h"
+
+namespace pandora {
+namespace {
+
+// One context for the whole test program.
+GlContext& Context() {
+  static GlContext context;
+  return context;
+}
+
+RenderOptions CpuOptions(Pattern pattern = Pattern::kUniform) {
+  RenderOptions o;
+  o.surface = Surface::kMaterial;
+  o.pattern = pattern;
+  o.layers = false;  // cameras, object and depth are always filled
+  o.overlays.cameras = false;
+  o.overlays.key = false;
+  return o;
+}
+
+struct Result {
+  Image cpu;
+  GlImage gpu;
+  GlComparison comparison;
+};
+
+// Renders `rig` from `view` on both renderers and compares; writes the side-by-side PNG to
+// $PANDORA_TEST_OUT/<name>.png when that is set.
+Result RenderBoth(const Scene& scene, const Rig& rig, const RenderView& view, const char* name,
+                  int map_size = 2048, Pattern pattern = Pattern::kUniform) {
+  Context();
+  Result r;
+  const PreparedScene prepared(scene);
+  r.cpu = Render(prepared, rig, view, CpuOptions(pattern));
+  GlRenderer renderer(scene);
+  GlRenderOptions options;
+  options.pattern = pattern;
+  options.shadow_map_size = map_size;
+  r.gpu = renderer.Render(rig, view, options);
+  r.comparison = Compare(r.cpu, r.gpu);
+  const GlComparison& c = r.comparison;
+  std::printf(
+      "%s (map %d): camera sets differ on %.4f %% of the compared pixels (%.3f %% of all, %.2f %% "
+      "excluded); colour where they agree: max %.2e, mean %.2e, %.4f %% over 1e-3; mean over "
+      "all pixels %.2e\n",
+      name, map_size, 100 * c.mask_share(), 100 * c.mask_share_all(), 100 * c.excluded_share(),
+      c.rgb_max, c.rgb_mean, 100 * c.rgb_over_share(), c.rgb_mean_all);
+  if (const char* out = std::getenv("PANDORA_TEST_OUT")) {
+    std::filesystem::create_directories(out);
+    WriteComparisonPng(r.cpu, r.gpu, std::string(out) + "/" + name + ".png");
+  }
+  return r;
+}
+
+// The thresholds (docs/viewer.md, "Thresholds"). Measured here with 2048 maps (llvmpipe): camera
+// sets differ on at most 0.006 % of the compared pixels of these scenes, colours of agreeing
+// pixels by 1e-7 on average with at most 0.002 % of them over 1e-3 (pixel centres on an edge
+// between two triangles of one object, resolved to the other one: another normal, another ambient
+// shade). The bounds leave room for other GL implementations' rasterisation and float rounding
+// while a real fault fails them by orders of magnitude: without the receiver-plane test, acne made
+// 1.4 % of the trauma room's `neck` view differ; a lens model off by its k1 moves whole footprint
+// edges.
+constexpr double kMaxMaskShare = 0.0005;     // of the compared pixels
+constexpr double kMaxMaskShareAll = 0.005;   // of all pixels, edges included
+constexpr double kMaxRgbMean = 1e-5;         // mean channel difference, agreeing pixels
+constexpr double kMaxRgbOverShare = 0.0005;  // agreeing pixels with a channel off by > 1e-3
+
+// `edges`: scenes with many more edges (40 footprints) get `edges` times the all-pixel bound and
+// may exclude more.
+void ExpectAgreement(const GlComparison& c, double min_compared = 0.5, double edges = 1.0) {
+  EXPECT_GT(c.compared, min_compared * c.pixels);  // the band does not swallow the image
+  EXPECT_LE(c.mask_share(), kMaxMaskShare);
+  EXPECT_LE(c.mask_share_all(), edges * kMaxMaskShareAll);
+  EXPECT_LE(c.rgb_mean, kMaxRgbMean);
+  EXPECT_LE(c.rgb_over_share(), kMaxRgbOverShare);
+}
+
+CameraAtPoint OnGrid(double u, double v, double du, double dv) {
+  CameraAtPoint c;
+  c.sees = true;
+  c.projects = true;
+  c.u = u;
+  c.v = v;
+  c.du = du;
+  c.dv = dv;
+  return c;
+}
+
+TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
+  // render/light_test.cpp's inputs (lines on pixel borders, half a pixel off, both families,
+  // fading at spacings 1.5, 2.25 and 3 output pixels, degenerate gradients, unprojectable points,
+  // grid spacing 0), plus a sweep across a line period at several gradients: the GLSL weight
+  // equals CameraLightWeight within float round-off.
+  Context();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<CameraAtPoint> points = {OnGrid(15.5, 3.0, 1, 1),
+                                       OnGrid(-0.5, 3.0, 1, 1),
+                                       OnGrid(16.0, 3.0, 1, 1),
+                                       OnGrid(16.0, 7.0, 1, 1),
+                                       OnGrid(11.5, 3.5, 1, 1),
+                                       OnGrid(16.5, 3.5, 2, 2),
+                                       OnGrid(15.75, 3.5, 0.5, 0.5),
+                                       OnGrid(7.5, 7.5, 16.0 / 3, 16.0 / 3),
+                                       OnGrid(9.0, 11.5, 16.0 / 3, 16.0 / 3),
+                                       OnGrid(7.5, 11.5, 32.0 / 9, 32.0 / 9),
+                                       OnGrid(7.5, 3.0, 8.0 / 3, 8.0 / 3),
+                                       OnGrid(7.5, 7.5, 0, 0),
+                                       OnGrid(7.5, 7.5, -1, -1),
+                                       OnGrid(7.5, 7.5, inf, inf),
+                                       OnGrid(7.5, 7.5, nan, nan),
+                                       OnGrid(0.5, 0.0, 0.25, 0.25)};
+  CameraAtPoint unprojectable = OnGrid(7.5, 7.5, 1, 1);
+  unprojectable.projects = false;
+  points.push_back(unprojectable);
+  CameraAtPoint shadowed = OnGrid(7.5, 7.5, 1, 1);
+  shadowed.sees = false;
+  points.push_back(shadowed);
+  for (double g : {0.3, 1.0, 2.7, 4.0, 6.0})
+    for (int i = 0; i <= 64; ++i)
+      points.push_back(OnGrid(-3.0 + i * 0.37, 5.0 - i * 0.11, g, 1.3 * g));
+  for (int grid_pixels : {8, 32, 0}) {
+    LightRule rule;
+    rule.pattern = Pattern::kGrid;
+    rule.grid_pixels = grid_pixels;
+    rule.grid_fill = 0.15;
+    rule.line_width_px = 1.2;
+    const std::vector<double> gpu = GlCameraLightWeights(rule, points);
+    ASSERT_EQ(gpu.size(), points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      EXPECT_NEAR(gpu[i], CameraLightWeight(rule, points[i]), 2e-6)
+          << "input " << i << " u " << points[i].u << " du " << points[i].du << " n "
+          << grid_pixels;
+  }
+  LightRule uniform;
+  const std::vector<double> gpu = GlCameraLightWeights(uniform, points);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(gpu[i], CameraLightWeight(uniform, points[i])) << i;
+}
+
+TEST(DepthRangeInPyramid, MatchesDenseSamplingOfClippedTriangles) {
+  // A floor crossing a camera's pyramid obliquely and a small triangle wholly inside it.
+  TriangleMesh mesh = MakePlane(Vec2(10, 10));
+  mesh.Append(TriangleMesh{
+      {Vec3(0.1, 0.1, 1.5), Vec3(0.2, 0.1, 1.5), Vec3(0.1, 0.2, 1.6)}, {{0, 1, 2}}, {}});
+  const Eigen::Isometry3d world_from_camera =
+      *LookAt(Vec3(0, -3, 2), Vec3(0, 0, 0.5), Vec3::UnitZ());
+  const Eigen::Isometry3d camera_from_world = world_from_camera.inverse();
+  const Eigen::Vector4d bounds(-0.4, 0.5, -0.3, 0.35);
+  const auto [near, far] = DepthRangeInPyramid(mesh, camera_from_world, bounds);
+  double lo = 1e300, hi = -1e300;
+  for (const Eigen::Vector3i& t : mesh.triangles)
+    for (int i = 0; i <= 400; ++i)
+      for (int j = 0; i + j <= 400; ++j) {
+        const Vec3 p = mesh.vertices[t[0]] +
+                       (i / 400.0) * (mesh.vertices[t[1]] - mesh.vertices[t[0]]) +
+                       (j / 400.0) * (mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+        const Vec3 c = camera_from_world * p;
+        if (c.z() <= 0) continue;
+        const double x = c.x() / c.z(), y = c.y() / c.z();
+        if (x < bounds(0) || x > bounds(1) || y < bounds(2) || y > bounds(3)) continue;
+        lo = std::min(lo, c.z());
+        hi = std::max(hi, c.z());
+      }
+  EXPECT_LE(near, lo + 1e-12);  // a bound, never inside the geometry's range
+  EXPECT_GE(far + 1e-12, hi);
+  EXPECT_NEAR(near, lo, 0.02);  // and tight: within the sampling's spacing
+  EXPECT_NEAR(far, hi, 0.1);
+  // Nothing in the pyramid (a camera above everything, looking up): empty.
+  const auto behind = DepthRangeInPyramid(
+      mesh, LookAt(Vec3(0, 0, 2), Vec3(0, 0, 5), Vec3::UnitY())->inverse(), bounds);
+  EXPECT_GT(behind.first, behind.second);
+}
+
+TEST(GlRenderer, TraumaRoomOctagonMatchesCpu) {
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const Rig& rig = scene.FindRig("octagon");
+  ASSERT_EQ(rig.enabled_count(), 8);
+  const RenderView view = ViewFromScene(scene.views.at("overview"), 640, 360);
+  const Result r = RenderBoth(scene, rig, view, "trauma_room_overview");
+  ExpectAgreement(r.comparison);
+  // The picture is not empty: most pixels show a surface, many of them lit by 2+ cameras.
+  std::size_t lit2 = 0;
+  for (uint64_t m : r.gpu.cameras) lit2 += __builtin_popcountll(m) >= 2;
+  EXPECT_GT(lit2, r.gpu.cameras.size() / 20);
+}
+
+TEST(GlRenderer, TraumaRoomCloseUpMatchesCpu) {
+  // The close view where acne showed before the receiver-plane test (capsules at grazing light).
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const RenderView view = ViewFromScene(scene.views.at("neck"), 640, 360);
+  ExpectAgreement(RenderBoth(scene, scene.FindRig("octagon"), view, "trauma_room_neck").comparison);
+}
+
+TEST(GlRenderer, DistortedLensesMatchCpu) {
+  // Brown-Conrady with tangential terms and k3, fisheyes of 100, 160 and 220 degrees (one
+  // perspective map, cubes, a cube with its back face).
+  const Scene scene = testing::LensRoom();
+  const RenderView view = ViewFromScene(scene.views.at("room"), 640, 480);
+  const Result r = RenderBoth(scene, scene.rigs[0], view, "lens_room");
+  ExpectAgreement(r.comparison);
+  // Every camera lights a good share of the image.
+  for (std::size_t c = 0; c < scene.rigs[0].cameras.size(); ++c) {
+    std::size_t n = 0;
+    for (uint64_t m : r.gpu.cameras) n += (m >> c) & 1;
+    EXPECT_GT(n, r.gpu.cameras.size() / 20) << scene.rigs[0].cameras[c].id;
+  }
+}
+
+TEST(GlRenderer, StrongBarrelLabMatchesCpu) {
+  // tests/data/lab_7x5.json, rig "lab": 14 cameras, some with k1 = -0.38.
+  const Scene scene = LoadScene("tests/data/lab_7x5.json");
+  const RenderView view = ViewFromScene(scene.views.at("corner"), 480, 270);
+  ExpectAgreement(RenderBoth(scene, scene.FindRig("lab"), view, "lab_corner").comparison);
+}
+
+TEST(GlRenderer, FortyCamerasFillBothMaskWords) {
+  // Cameras 32..39 land in the mask's second word, as render's Image::cameras has them.
+  Scene scene = testing::BoxRoom(Vec3(6, 6, 3));
+  scene.objects.push_back(
+      testing::TestObject("box", MakeBox(Vec3(0.6, 0.6, 1.0)), Vec3(0, 0, 0.5)));
+  scene.rigs.push_back(testing::RingRig(40, 2.5, 2.0, Vec3(0, 0, 0.3), 70, 320, 240));
+  RenderView view;
+  view.from = Vec3(-2.8, -2.8, 2.8);
+  view.at = Vec3(0, 0, 0.3);
+  view.fov_deg = 70;
+  view.width = 240;
+  view.height = 180;
+  const Result r = RenderBoth(scene, scene.rigs[0], view, "forty_cameras");
+  ExpectAgreement(r.comparison, 0.3, 2.0);  // 40 footprints and their shadows: edges everywhere
+  uint64_t any = 0;
+  for (uint64_t m : r.gpu.cameras) any |= m;
+  EXPECT_NE(any >> 32, 0u);
+}
+
+TEST(GlRenderer, GridPatternMatchesCpuLight) {
+  // The grid's line coverage uses the camera pixel's change per output pixel: the CPU from the
+  // projection Jacobian and ray differentials, the GPU by central differences of the projection
+  // along the same differentials. Camera sets are as for uniform light; colours agree to 4.5e-6
+  // on average, 0.009 % of the pixels by more than 1e-3 (docs/viewer.md).
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const RenderView view = ViewFromScene(scene.views.at("overview"), 640, 360);
+  const Result r =
+      RenderBoth(scene, scene.FindRig("octagon"), view, "trauma_room_grid", 2048, Pattern::kGrid);
+  const GlComparison& c = r.comparison;
+  EXPECT_LE(c.mask_share(), kMaxMaskShare);
+  EXPECT_LE(c.rgb_mean, 5e-5);
+  EXPECT_LE(c.rgb_over_share(), 0.001);
+}
+
+TEST(GlRenderer, SmallerMapsDisagreeMoreButStayClose) {
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const RenderView view = ViewFromScene(scene.views.at("overview"), 640, 360);
+  const Result small = RenderBoth(scene, scene.FindRig("octagon"), view, "trauma_room_512", 512);
+  EXPECT_LE(small.comparison.mask_share(), 0.002);
+  EXPECT_LE(small.comparison.mask_share_all(), 0.01);
+}
+
+TEST(GlRenderer, KeepsMapsWhileCamerasStayAndRedrawsOnlyMovedOnes) {
+  Context();
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  Rig rig = scene.FindRig("octagon");
+  GlRenderer renderer(scene);
+  RenderView view = ViewFromScene(scene.views.at("overview"), 160, 90);
+  GlRenderOptions options;
+  options.shadow_map_size = 512;
+  GlFrameStats stats;
+  renderer.Render(rig, view, options, &stats);
+  EXPECT_EQ(stats.shadow_maps, 8);
+  EXPECT_EQ(stats.light_passes, 1);
+  // The eye moves: no map is drawn, and the frame equals one drawn from scratch.
+  view.from += Vec3(0.3, -0.2, 0.1);
+  const GlImage kept = renderer.Render(rig, view, options, &stats);
+  EXPECT_EQ(stats.shadow_maps, 0);
+  GlRenderOptions fresh_options = options;
+  fresh_options.reuse_maps = false;
+  const GlImage fresh = renderer.Render(rig, view, fresh_options, &stats);
+  EXPECT_EQ(stats.shadow_maps, 8);
+  EXPECT_EQ(kept.cameras, fresh.cameras);
+  EXPECT_EQ(kept.rgb, fresh.rgb);
+  // One camera moves: only its map is drawn again.
+  renderer.Render(rig, view, options, &stats);
+  rig.cameras[3].world_from_camera.translation() += Vec3(0, 0, 0.05);
+  renderer.Render(rig, view, options, &stats);
+  EXPECT_EQ(stats.shadow_maps, 1);
+  // A small budget splits the rig into several passes (maps drawn every frame), same picture.
+  GlRenderOptions split = options;
+  split.map_memory_mib = 3;  // three 1 MiB maps per pass
+  const GlImage a = renderer.Render(rig, view, split, &stats);
+  EXPECT_EQ(stats.light_passes, 3);
+  EXPECT_EQ(stats.shadow_maps, 8);
+  const GlImage b = renderer.Render(rig, view, fresh_options, &stats);
+  EXPECT_EQ(a.cameras, b.cameras);
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) ASSERT_NEAR(a.rgb[i], b.rgb[i], 1e-6);
+}
+
+TEST(GlRenderer, RefusesWhatItCannotDraw) {
+  Context();
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  GlRenderer renderer(scene);
+  RenderView view = ViewFromScene(scene.views.at("overview"), 64, 36);
+  GlRenderOptions options;
+  view.camera = 0;  // camera's-eye view: CPU only for now
+  EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
+  view.camera = -1;
+  options.shadow_map_size = 256;
+  EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
+  options.shadow_map_size = 8192;
+  EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
+  options.shadow_map_size = 512;
+  view.fov_deg = 180;
+  EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pandora
