@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,10 @@
 #include <new>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "analysis/error.h"
 #include "app/commands.h"
@@ -128,6 +133,20 @@ int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // `pandora view`: the interactive viewer is its own program (the only one that links GL),
+  // pandora-view beside this one; it gets the remaining arguments.
+  if (argc >= 2 && std::string(argv[1]) == "view") {
+    std::error_code ec;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const std::string viewer = (self.parent_path() / "pandora-view").string();
+    std::vector<char*> args{const_cast<char*>(viewer.c_str())};
+    for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+    args.push_back(nullptr);
+    execv(viewer.c_str(), args.data());
+    std::fprintf(stderr, "pandora: error: cannot start the viewer %s: %s (hint: build the pandora-view target)\n",
+                 viewer.c_str(), std::strerror(errno));
+    return 2;
+  }
   using namespace pandora::app;
   CLI::App app{"Pandora: design multi-camera setups (coverage, resolution and uncertainty fields)"};
   app.set_version_flag("--version", PANDORA_VERSION);

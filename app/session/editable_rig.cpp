@@ -38,6 +38,26 @@ void EditableRig::Apply(Edit edit) {
   redo_.clear();
 }
 
+bool EditableRig::CanAmend(const std::vector<int>& cameras) const {
+  if (undo_.empty() || undo_.back().changes.size() != cameras.size()) return false;
+  for (std::size_t i = 0; i < cameras.size(); ++i)
+    if (undo_.back().changes[i].index != cameras[i]) return false;
+  return true;
+}
+
+void EditableRig::Amend(const Edit& edit) {
+  std::vector<int> cameras;
+  for (const CameraEdit& c : edit.changes) cameras.push_back(c.index);
+  if (!CanAmend(cameras)) throw std::logic_error("edit '" + edit.label + "': not the cameras of the last edit");
+  for (const CameraEdit& c : edit.changes)
+    if (!SameCamera(rig_.cameras[c.index], c.before))
+      throw std::logic_error("edit '" + edit.label + "': camera " + rig_.cameras[c.index].id +
+                             " changed since the edit was made");
+  Set(edit.changes, true);
+  for (std::size_t i = 0; i < edit.changes.size(); ++i) undo_.back().changes[i].after = edit.changes[i].after;
+  redo_.clear();
+}
+
 bool EditableRig::Undo() {
   if (undo_.empty()) return false;
   Set(undo_.back().changes, false);

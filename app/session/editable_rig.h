@@ -38,6 +38,14 @@ class EditableRig {
   /// Applies `edit` (each change's `before` must be the camera as it is now: a stale edit throws
   /// std::logic_error), pushes it on the undo stack and clears the redo stack.
   void Apply(Edit edit);
+  /// Continues the last edit instead of adding one: `edit`'s cameras must be the last edit's (same
+  /// indices, same order) and each `before` the camera as it is now; the last edit keeps its own
+  /// `before` states and takes `edit`'s `after` states (std::logic_error otherwise). A drag or a
+  /// gamepad gesture stays one undo step while the rig, its versions and the fields follow every
+  /// step. Clears the redo stack.
+  void Amend(const Edit& edit);
+  /// Whether Amend would accept an edit of `cameras` (indices, in order) now.
+  bool CanAmend(const std::vector<int>& cameras) const;
   bool Undo();  ///< False when there is nothing to undo.
   bool Redo();  ///< False when there is nothing to redo.
   bool can_undo() const { return !undo_.empty(); }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/error.h"
+#include "analysis/pose.h"
 #include "app/session/autosave.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
@@ -79,7 +80,9 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   height = options_.height;
   const Scene& s = scene();
   if (!s.views.empty()) {
-    const RenderView v = ViewFromScene(s.views.begin()->second, width, height, 50.0);
+    // The scene's "overview" when it has one, else its first view (by name).
+    const auto named = s.views.find("overview");
+    const RenderView v = ViewFromScene((named != s.views.end() ? named : s.views.begin())->second, width, height, 50.0);
     view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
   } else {
     view = OrbitView::Framing(s.Bounds());
@@ -119,7 +122,9 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
   using Kind = Action::Kind;
   session::EditableRig& edit = session_->rig();
   const std::string& file = scene().path;
-  // Applies camera changes as one undo step.
+  // Applies camera changes as one undo step (a drag's later steps amend its first).
+  const std::string drag = a.drag ? drag_label_ : std::string();
+  drag_label_.clear();
   auto apply = [&](const std::vector<int>& cams, const std::string& label, const auto& change) {
     session::Edit e;
     e.label = label;
@@ -128,7 +133,9 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       change(ce.after);
       e.changes.push_back(std::move(ce));
     }
-    edit.Apply(std::move(e));
+    if (a.drag && drag == label && edit.CanAmend(cams)) edit.Amend(e);
+    else edit.Apply(std::move(e));
+    if (a.drag) drag_label_ = label;
     Edited();
   };
   auto label = [&](const char* verb, const std::vector<int>& cams) {
@@ -171,6 +178,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       const auto pose = LookAt(from, a.a, UpFor(from, a.a));
       if (!pose) throw InputError(a.where, "", "the camera cannot aim at its own position");
       apply({c}, label("aim", {c}), [&](Camera& cam) { cam.world_from_camera = *pose; });
+      break;
+    }
+    case Kind::kOrient: {
+      const int c = CameraIndex(a.cameras[0], a);
+      const Mat3 R = RotationFromYawPitchRollDeg(a.a);
+      apply({c}, label("turn", {c}), [&](Camera& cam) { cam.world_from_camera.linear() = R; });
       break;
     }
     case Kind::kEnable:

@@ -85,6 +85,7 @@ class ViewerModel {
   int CameraIndex(const std::string& id, const Action& action) const;
   std::vector<int> CameraIndices(const std::vector<std::string>& ids, const Action& action) const;
   void Edited();  // fields in the background, autosave, on_edit
+  std::string drag_label_;  // the drag in progress (its steps amend one edit), empty: none
   ViewerOptions options_;
   std::unique_ptr<session::Session> session_;
 };

@@ -107,7 +107,7 @@ class Entry {
 const std::map<std::string, Kind>& Kinds() {
   static const std::map<std::string, Kind> kinds = {
       {"select", Kind::kSelect}, {"move", Kind::kMove},       {"rotate", Kind::kRotate},
-      {"aim", Kind::kAim},       {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
+      {"aim", Kind::kAim},       {"orient", Kind::kOrient},   {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
       {"hfov", Kind::kHfov},     {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
       {"slice", Kind::kSlice},   {"iso", Kind::kIso},         {"view", Kind::kView},
       {"orbit", Kind::kOrbit},   {"pan", Kind::kPan},         {"dolly", Kind::kDolly},
@@ -146,7 +146,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.cameras = e.Ids("select", true);
       break;
     case Kind::kMove:
-      e.Keys({"move", "by", "to"});
+      e.Keys({"move", "by", "to", "drag"});
+      a.drag = e.Has("drag") && j.at("drag") == true;
       a.cameras = e.Ids("move", false);
       if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
       a.flag = e.Has("to");
@@ -155,7 +156,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.has_a = true;
       break;
     case Kind::kRotate:
-      e.Keys({"rotate", "axis", "deg"});
+      e.Keys({"rotate", "axis", "deg", "drag"});
+      a.drag = e.Has("drag") && j.at("drag") == true;
       a.cameras = e.Ids("rotate", false);
       a.a = e.Vector("axis");
       if (!(a.a.norm() > 0)) e.Fail("axis", "the axis must be a non-zero vector");
@@ -165,6 +167,13 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       e.Keys({"aim", "at"});
       a.cameras = {e.String("aim")};
       a.a = e.Vector("at");
+      break;
+    case Kind::kOrient:
+      e.Keys({"orient", "ypr_deg", "drag"});
+      a.drag = e.Has("drag") && j.at("drag") == true;
+      a.cameras = {e.String("orient")};
+      a.a = e.Vector("ypr_deg");
+      if (std::abs(a.a.y()) > 90) e.Fail("ypr_deg[1]", "the pitch lies in [-90, 90] degrees");
       break;
     case Kind::kEnable:
     case Kind::kDisable:
@@ -275,7 +284,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.number2 = e.Number("y", -1e5, 1e5, 0);
       break;
     case Kind::kGamepad:
-      e.Keys({"gamepad", "left", "right", "seconds"});
+      e.Keys({"gamepad", "left", "right", "seconds", "drag"});
+      a.drag = e.Has("drag") && j.at("drag") == true;
       a.cameras = {e.String("gamepad")};
       a.a = e.Has("left") ? e.Vector("left", 2) : Vec3::Zero();
       a.b = e.Has("right") ? e.Vector("right", 2) : Vec3::Zero();

@@ -8,8 +8,10 @@
 /// A script is a JSON array of objects, each naming one action by its first key:
 ///     [{"select": ["c03"]},
 ///      {"move": ["c03"], "by": [0.2, 0, 0]},           // world metres; "to": [x, y, z] for one camera
+///                                                      // "drag": true continues the last drag step
 ///      {"rotate": ["c03"], "axis": [0, 0, 1], "deg": 10},  // about the cameras' centroid
 ///      {"aim": "c03", "at": [0, 0, 1]},                 // turn to look at a point (Z up)
+///      {"orient": "c03", "ypr_deg": [30, -10, 0]},      // the scene file's yaw, pitch, roll
 ///      {"enable": ["c01"]}, {"disable": ["c01"]},
 ///      {"hfov": ["c03"], "deg": 55},                    // zoom (focal lengths scaled)
 ///      {"undo": 1}, {"redo": 1},
@@ -41,7 +43,7 @@ namespace pandora::viewer {
 
 struct Action {
   enum class Kind {
-    kSelect, kMove, kRotate, kAim, kEnable, kDisable, kHfov, kUndo, kRedo, kSlice, kIso, kView,
+    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kUndo, kRedo, kSlice, kIso, kView,
     kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
     kMouse, kKey, kScroll, kGamepad, kFrames,
   };
@@ -56,6 +58,9 @@ struct Action {
   double number2 = 0;  ///< max_rotate, brightness, mouse y ...
   double number3 = 0;  ///< points, mouse x ...
   bool flag = false;   ///< save "force"; move "to" (absolute); slice/iso hidden; "at" given.
+  /// move, rotate, gamepad: part of a drag ("drag": true): continues the previous step of the same
+  /// drag (same cameras) as one undo step.
+  bool drag = false;
   unsigned long long seed = 1;
 };
 

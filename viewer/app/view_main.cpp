@@ -1,0 +1,131 @@
+// `pandora view SCENE` (the `pandora` command runs this program, pandora-view, beside it): the
+// interactive simulator (docs/viewer.md). With --script it replays actions (viewer/core/script.h)
+// in a window, writes --screenshot and --log, and exits: what the CI's scripted session does.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "analysis/atomic_file.h"
+#include "analysis/error.h"
+#include "app/session/autosave.h"
+#include "app/session/study.h"
+#include "viewer/app/viewer_app.h"
+#include "viewer/core/model.h"
+#include "viewer/core/script.h"
+
+namespace {
+
+std::pair<int, int> ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, rest = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X') || w < 320 ||
+      h < 240 || w > 8192 || h > 8192)
+    throw pandora::InputError("--size", "", "expected WxH, each from 320x240 to 8192", "e.g. --size 1280x720");
+  return {w, h};
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{"Pandora's interactive simulator: move cameras, watch their light, fields and suggestions"};
+  app.name("pandora view");
+  std::string scene, rig, fields, script, screenshot, log, size = "1280x720";
+  bool hidden = false, recover = false, discard = false, no_autosave = false;
+  int shadow_map = 2048;
+  app.add_option("scene", scene, "Scene file (JSON)")->required();
+  app.add_option("--rig", rig, "Rig to edit (default: the first)");
+  app.add_option("--fields", fields, "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
+  app.add_option("--script", script, "Replay these actions (a JSON array; docs/viewer.md), then exit");
+  app.add_option("--screenshot", screenshot, "With --script: the window at the end, as PNG");
+  app.add_option("--log", log, "With --script: the state after each action, as JSON");
+  app.add_option("--size", size, "Window size WxH")->capture_default_str();
+  app.add_option("--shadow-map", shadow_map, "Shadow map size per camera, 512 to 4096")->capture_default_str()
+      ->check(CLI::Range(512, 4096));
+  app.add_flag("--hidden", hidden, "No visible window (scripts, tests)");
+  app.add_flag("--recover", recover, "Apply the autosave of a session that ended without saving");
+  app.add_flag("--discard-autosave", discard, "Delete that autosave and start from the scene file");
+  app.add_flag("--no-autosave", no_autosave, "Do not write the autosave file");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "pandora view: error: %s\n", e.what());
+    return 2;
+  }
+  const auto [width, height] = ParseSize(size);
+  if ((!screenshot.empty() || !log.empty()) && script.empty())
+    throw pandora::InputError(screenshot.empty() ? "--log" : "--screenshot", "", "needs --script");
+  std::vector<pandora::viewer::Action> actions;
+  if (!script.empty()) actions = pandora::viewer::LoadScript(script);  // refused before any window
+
+  const auto study = pandora::session::Study::Load(scene);
+  pandora::viewer::ViewerOptions vo;
+  vo.rig = rig;
+  vo.width = width;
+  vo.height = height;
+  if (!fields.empty()) {
+    std::stringstream ss(fields);
+    for (std::string f; std::getline(ss, f, ',');)
+      if (!f.empty()) vo.fields.push_back(f);
+  }
+  const std::string autosave = pandora::session::AutosavePath(study->scene().path);
+  if (!no_autosave) vo.autosave_path = autosave;
+  const auto saved = pandora::session::ReadAutosave(autosave, *study);
+  if (saved && !recover && !discard)
+    throw pandora::InputError(autosave, "", "unsaved edits of an earlier session are kept here",
+                              "start with --recover to apply them, or --discard-autosave to delete them");
+  pandora::viewer::ViewerModel model(study, vo);
+  if (saved && recover) {
+    const auto ids = pandora::session::RecoverAutosave(model.session(), *saved, autosave);
+    model.status = "recovered " + std::to_string(ids.size()) + " cameras from " + autosave;
+  }
+  if (saved && discard) std::filesystem::remove(autosave);
+
+  pandora::viewer::AppOptions ao;
+  ao.width = width;
+  ao.height = height;
+  ao.visible = !hidden;
+  ao.shadow_map_size = shadow_map;
+  ao.show_timing = script.empty();
+  pandora::viewer::ViewerApp window(model, ao);
+  if (script.empty()) {
+    window.Loop();
+    return 0;
+  }
+  nlohmann::json states = nlohmann::json::array();
+  auto write_log = [&] {
+    if (!log.empty()) pandora::WriteFileAtomically(log, states.dump(1) + "\n");
+  };
+  try {
+    window.Frame();
+    for (const auto& a : actions) {
+      model.Do(a, &window);
+      window.Frame();
+      nlohmann::json s = model.StateJson();
+      s["action"] = a.where;
+      states.push_back(std::move(s));
+    }
+    model.session().WaitFields();
+    if (!screenshot.empty()) window.Screenshot(model, screenshot, -1);
+  } catch (...) {
+    write_log();
+    throw;
+  }
+  write_log();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const pandora::InputError& e) {
+    std::fprintf(stderr, "pandora view: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pandora view: error: %s\n", e.what());
+    return 1;
+  }
+}

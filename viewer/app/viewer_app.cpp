@@ -1,0 +1,1027 @@
+// The window of `pandora view` (viewer/app/viewer_app.h). Input from GLFW and from scripts lands in
+// one InputState; each frame feeds it to Dear ImGui (no platform backend: the state is ours, so a
+// script drives the panels exactly as a mouse does), then to the 3D handlers (orbit, pan, dolly,
+// pick, gizmo), which turn it into the model's actions.
+#include "viewer/app/viewer_app.h"
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+
+#include "analysis/error.h"
+#include "analysis/pose.h"
+#include "analysis/color.h"
+#include "render/prepared_scene.h"
+#include "viewer/core/manipulate.h"
+#include "viewer/gl_renderer.h"
+#include "volume/fields.h"
+#include "volume/slice.h"
+#include "volume/summary.h"
+
+namespace pandora::viewer {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+std::string g_glfw_error;
+void OnGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (" + std::to_string(code) + ")"; }
+
+unsigned char ToSrgb8(double linear) {
+  const double c = std::clamp(linear, 0.0, 1.0);
+  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  return static_cast<unsigned char>(std::lround(255.0 * s));
+}
+
+ImU32 Color(const Vec3& rgb, double alpha = 1.0) {
+  return IM_COL32(ToSrgb8(rgb.x()), ToSrgb8(rgb.y()), ToSrgb8(rgb.z()), int(255 * alpha));
+}
+
+// What the mouse, the keys and the scroll wheel did: filled by GLFW callbacks or by a script.
+struct InputState {
+  double x = 0, y = 0;
+  bool down[3] = {false, false, false};
+  double wheel = 0;
+  bool ctrl = false, shift = false, alt = false;
+  bool keys[GLFW_KEY_LAST + 1] = {};
+  std::vector<unsigned> chars;
+  std::vector<int> pressed;  // keys pressed since the last frame
+};
+
+// The main view's projection for overlays (the renderer's convention: pixel centres at integers).
+struct Projector {
+  Eigen::Isometry3d camera_from_world;
+  double f = 1, cx = 0, cy = 0;
+  explicit Projector(const RenderView& v) {
+    camera_from_world = LookAt(v.from, v.at, v.up)->inverse();
+    f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * kDeg);
+    cx = 0.5 * v.width - 0.5;
+    cy = 0.5 * v.height - 0.5;
+  }
+  ImVec2 Pixel(const Vec3& c) const { return ImVec2(float(cx + f * c.x() / c.z() + 0.5), float(cy + f * c.y() / c.z() + 0.5)); }
+  // The segment a-b clipped to the half space in front of the eye; false when none of it is.
+  bool Segment(const Vec3& a, const Vec3& b, ImVec2* pa, ImVec2* pb) const {
+    Vec3 p = camera_from_world * a, q = camera_from_world * b;
+    const double near = 1e-3;
+    if (p.z() < near && q.z() < near) return false;
+    if (p.z() < near) p = p + (q - p) * ((near - p.z()) / (q.z() - p.z()));
+    if (q.z() < near) q = q + (p - q) * ((near - q.z()) / (p.z() - q.z()));
+    *pa = Pixel(p);
+    *pb = Pixel(q);
+    return true;
+  }
+  std::optional<ImVec2> Point(const Vec3& w) const {
+    const Vec3 c = camera_from_world * w;
+    if (c.z() < 1e-3) return std::nullopt;
+    return Pixel(c);
+  }
+};
+
+double SegmentDistance(const ImVec2& p, const ImVec2& a, const ImVec2& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  const double ex = a.x + t * dx - p.x, ey = a.y + t * dy - p.y;
+  return std::sqrt(ex * ex + ey * ey);
+}
+
+// A camera's frustum outline: rays through its image border (distortion included), `length` metres.
+std::vector<Vec3> FrustumBorder(const Camera& cam, double length) {
+  std::vector<Vec3> out;
+  const CameraModel& m = cam.model;
+  const double w = m.width() - 0.5, h = m.height() - 0.5;
+  const int n = m.intrinsics().model == LensModel::kPinhole ? 1 : 8;
+  auto add = [&](double u, double v) {
+    if (const auto d = m.Unproject(Vec2(u, v))) out.push_back(cam.world_from_camera * (*d * length));
+  };
+  for (int i = 0; i < n; ++i) add(-0.5 + (w + 0.5) * i / n, -0.5);
+  for (int i = 0; i < n; ++i) add(w, -0.5 + (h + 0.5) * i / n);
+  for (int i = 0; i < n; ++i) add(w - (w + 0.5) * i / n, h);
+  for (int i = 0; i < n; ++i) add(-0.5, h - (h + 0.5) * i / n);
+  return out;
+}
+
+enum class Drag { kNone, kOrbit, kPan, kAxis, kRing, kClick };
+
+}  // namespace
+
+struct ViewerApp::Impl {
+  ViewerModel& model;
+  AppOptions options;
+  GLFWwindow* window = nullptr;
+  std::unique_ptr<GlRenderer> gl;
+  GlRenderOptions gl_options;
+  GLuint main_texture = 0;
+  std::string main_key;  // what the main texture shows
+  InputState input;
+  ImGuiContext* imgui = nullptr;
+  std::chrono::steady_clock::time_point last_frame = std::chrono::steady_clock::now();
+  double frame_seconds = 0, gl_seconds = 0;
+
+  // 3D interaction.
+  Drag drag = Drag::kNone;
+  int drag_handle = -1;   // axis 0..2
+  double press_x = 0, press_y = 0, last_x = 0, last_y = 0;
+  Ray drag_ray;
+  double applied = 0;     // metres or degrees already applied in this drag
+  int hover_handle = -1;  // 0..2 axes, 3..5 rings
+  bool hover_ring = false;
+  float move_step = 0.0f, rotate_step = 0.0f;  // snap steps (0: off)
+
+  // Camera views (exact, CPU) of the selected cameras.
+  struct CameraView {
+    GLuint texture = 0;
+    std::int64_t version = -1;
+    int width = 0, height = 0;
+  };
+  std::map<int, CameraView> camera_views;
+
+  // Field panel cache.
+  std::int64_t slice_version = -2;
+  std::string slice_key;
+  FieldSlice slice;
+
+  // Suggest panel settings.
+  int objective = 0;
+  float max_move = 0.3f, max_rotate = 10.0f;
+  int points = 800;
+  std::string error;  // the last action's error, shown in the status bar
+
+  Impl(ViewerModel& m, AppOptions o) : model(m), options(o) {}
+
+  void Do(const Action& a) {
+    try {
+      error.clear();
+      model.Do(a, nullptr);
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+  }
+  Action Make(Action::Kind kind, std::vector<std::string> cameras = {}) const {
+    Action a;
+    a.kind = kind;
+    a.where = "the window";
+    a.cameras = std::move(cameras);
+    return a;
+  }
+  int Primary() const { return model.selection.empty() ? -1 : model.selection.front(); }
+  std::vector<std::string> SelectedIds() const {
+    std::vector<std::string> ids;
+    for (int c : model.selection) ids.push_back(model.rig().cameras[c].id);
+    return ids;
+  }
+  std::optional<Ray> MouseRay(double x, double y) const {
+    return PixelRay(model.rig(), model.MainView(), x, y);
+  }
+  double GizmoLength() const {
+    const int c = Primary();
+    if (c < 0) return 0.3;
+    return 0.12 * (model.rig().cameras[c].center() - model.view.Eye()).norm();
+  }
+
+  void RenderMain() {
+    const RenderView view = model.MainView();
+    char key[512];
+    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d",
+                  static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
+                  view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
+                  int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
+                  int(model.display.surface), gl_options.shadow_map_size);
+    if (key == main_key && main_texture) return;
+    main_key = key;
+    gl_options.pattern = model.display.pattern;
+    gl_options.material = model.display.surface == Surface::kMaterial;
+    gl_options.brightness = model.display.brightness;
+    gl_options.grid_pixels = model.display.grid_pixels;
+    const auto t0 = std::chrono::steady_clock::now();
+    const GlImage image = gl->Render(model.rig(), view, gl_options);
+    gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
+    for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
+      for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
+      rgba[4 * i + 3] = 255;
+    }
+    Upload(&main_texture, image.width, image.height, rgba);
+  }
+
+  static void Upload(GLuint* texture, int w, int h, const std::vector<unsigned char>& rgba) {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!*texture) glGenTextures(1, texture);
+    glBindTexture(GL_TEXTURE_2D, *texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  }
+
+  void RenderCameraView(int c) {
+    CameraView& v = camera_views[c];
+    const std::int64_t version = model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
+    if (v.texture && v.version == version) return;
+    const CameraModel& m = model.rig().cameras[c].model;
+    const double scale = std::min(1.0, 320.0 / m.width());
+    RenderView view;
+    view.camera = c;
+    view.width = std::max(16, int(std::lround(m.width() * scale)));
+    view.height = std::max(16, int(std::lround(m.height() * scale)));
+    RenderOptions o = model.display;
+    o.layers = false;
+    o.overlays.slice_field.clear();
+    o.overlays.iso_field.clear();
+    o.overlays.key = false;
+    const Image image = model.session().Render(view, o);
+    std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
+    for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
+      for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
+      rgba[4 * i + 3] = 255;
+    }
+    Upload(&v.texture, image.width, image.height, rgba);
+    v.version = version;
+    v.width = image.width;
+    v.height = image.height;
+  }
+
+  // Camera bodies, frusta, the selection, the suggestion's ghosts, the slice, the gizmo.
+  void DrawOverlays(ImDrawList* dl) {
+    const Projector P(model.MainView());
+    const Rig& rig = model.rig();
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
+      ImVec2 pa, pb;
+      if (P.Segment(a, b, &pa, &pb)) dl->AddLine(pa, pb, col, width);
+    };
+    // The slice: its voxels as translucent quads in the plane.
+    if (!model.display.overlays.slice_field.empty()) DrawSlice(dl, P);
+    auto frustum = [&](const Camera& cam, ImU32 col, float width) {
+      const std::vector<Vec3> border = FrustumBorder(cam, 0.6);
+      const Vec3 o = cam.center();
+      const std::size_t n = border.size();
+      for (std::size_t i = 0; i < n; ++i) line(border[i], border[(i + 1) % n], col, width);
+      if (n >= 4)
+        for (std::size_t i = 0; i < n; i += n / 4) line(o, border[i], col, width);
+    };
+    for (int c = 0; c < int(rig.cameras.size()); ++c) {
+      const Camera& cam = rig.cameras[c];
+      const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
+      const ImU32 col = cam.enabled ? Color(cam.color, selected ? 1.0 : 0.8) : IM_COL32(110, 110, 110, 160);
+      frustum(cam, col, selected ? 2.5f : 1.2f);
+      if (const auto p = P.Point(cam.center())) {
+        dl->AddCircleFilled(*p, selected ? 6.0f : 4.0f, col);
+        if (selected) dl->AddCircle(*p, 9.0f, IM_COL32(255, 255, 255, 230), 0, 1.5f);
+        dl->AddText(ImVec2(p->x + 7, p->y - 7), col, cam.id.c_str());
+      }
+    }
+    if (model.suggestion)
+      for (const CameraChange& ch : model.suggestion->cameras) {
+        Camera ghost = rig.cameras[ch.index];
+        ghost.world_from_camera = ch.after;
+        frustum(ghost, IM_COL32(255, 255, 255, 200), 1.5f);
+        line(ch.before.translation(), ch.after.translation(), IM_COL32(255, 255, 255, 160), 1.0f);
+      }
+    DrawGizmo(dl, P);
+  }
+
+  void DrawSlice(ImDrawList* dl, const Projector& P) {
+    const OverlayOptions& ov = model.display.overlays;
+    std::int64_t version = -1;
+    char key[256];
+    std::snprintf(key, sizeof key, "%s %d %.17g", ov.slice_field.c_str(), ov.slice_axis, ov.slice_position);
+    model.session().ReadFields([&](const Fields& f, std::int64_t v) {
+      version = v;
+      if (v == slice_version && key == slice_key) return;
+      try {
+        slice = SliceField(f, ov.slice_field, ov.slice_axis, std::isnan(ov.slice_position) ? f.lattice.origin[ov.slice_axis] + 0.5 * f.lattice.voxel_size * (f.lattice.dims[ov.slice_axis] - 1) : ov.slice_position, false);
+      } catch (const std::exception&) {
+        slice = FieldSlice();
+      }
+    });
+    slice_version = version;
+    slice_key = key;
+    if (slice.index < 0 || slice.width == 0) return;
+    const double h = slice.voxel_size;
+    const int ua = slice.u_axis(), va = slice.v_axis();
+    const double lo = std::isfinite(ov.slice_min) ? ov.slice_min : slice.min;
+    const double hi = std::isfinite(ov.slice_max) ? ov.slice_max : slice.max;
+    for (int row = 0; row < slice.height; ++row)
+      for (int col = 0; col < slice.width; ++col) {
+        const std::size_t o = std::size_t(row) * slice.width + col;
+        if (!slice.has_value[o]) continue;
+        const double t = hi > lo ? (slice.values[o] - lo) / (hi - lo) : 0.5;
+        const Vec3 rgb = ViridisLinear(t);
+        Vec3 c = Vec3::Zero();
+        c[slice.axis] = slice.coordinate;
+        c[ua] = slice.u_min + h * col;
+        c[va] = slice.v_max - h * row;
+        Vec3 corners[4];
+        for (int k = 0; k < 4; ++k) {
+          corners[k] = c;
+          corners[k][ua] += (k == 1 || k == 2 ? 0.5 : -0.5) * h;
+          corners[k][va] += (k >= 2 ? 0.5 : -0.5) * h;
+        }
+        std::optional<ImVec2> q[4];
+        bool ok = true;
+        for (int k = 0; k < 4 && ok; ++k) ok = bool(q[k] = P.Point(corners[k]));
+        if (ok) dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3], Color(rgb, ov.slice_opacity));
+      }
+  }
+
+  // Translate handles along world X, Y, Z and rotation rings about them, at the primary camera.
+  void DrawGizmo(ImDrawList* dl, const Projector& P) {
+    const int c = Primary();
+    if (c < 0) return;
+    const Vec3 o = model.rig().cameras[c].center();
+    const double len = GizmoLength();
+    const ImU32 axis_col[3] = {IM_COL32(230, 60, 60, 255), IM_COL32(60, 200, 60, 255), IM_COL32(70, 110, 240, 255)};
+    for (int k = 0; k < 3; ++k) {
+      ImVec2 a, b;
+      const bool hot = (drag == Drag::kAxis && drag_handle == k) || (drag == Drag::kNone && hover_handle == k);
+      if (P.Segment(o, o + len * Vec3::Unit(k), &a, &b)) dl->AddLine(a, b, axis_col[k], hot ? 4.0f : 2.5f);
+      // The ring in the plane normal to axis k.
+      const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
+      const bool ring_hot = (drag == Drag::kRing && drag_handle == k) || (drag == Drag::kNone && hover_handle == k + 3);
+      for (int i = 0; i < 48; ++i) {
+        const double t0 = 2 * M_PI * i / 48, t1 = 2 * M_PI * (i + 1) / 48;
+        const Vec3 p0 = o + 0.8 * len * (std::cos(t0) * u + std::sin(t0) * v);
+        const Vec3 p1 = o + 0.8 * len * (std::cos(t1) * u + std::sin(t1) * v);
+        if (P.Segment(p0, p1, &a, &b)) dl->AddLine(a, b, axis_col[k] & 0xB0FFFFFF, ring_hot ? 3.5f : 1.5f);
+      }
+    }
+  }
+
+  // Which gizmo handle is under the mouse: 0..2 axes, 3..5 rings, -1 none.
+  int HandleAt(double x, double y) const {
+    const int c = Primary();
+    if (c < 0) return -1;
+    const Projector P(model.MainView());
+    const Vec3 o = model.rig().cameras[c].center();
+    const double len = GizmoLength();
+    const ImVec2 m{float(x), float(y)};
+    int best = -1;
+    double best_d = 7.0;
+    for (int k = 0; k < 3; ++k) {
+      ImVec2 a, b;
+      if (P.Segment(o + 0.15 * len * Vec3::Unit(k), o + len * Vec3::Unit(k), &a, &b)) {
+        const double d = SegmentDistance(m, a, b);
+        if (d < best_d) best_d = d, best = k;
+      }
+      const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
+      for (int i = 0; i < 48; ++i) {
+        const double t0 = 2 * M_PI * i / 48, t1 = 2 * M_PI * (i + 1) / 48;
+        if (P.Segment(o + 0.8 * len * (std::cos(t0) * u + std::sin(t0) * v),
+                      o + 0.8 * len * (std::cos(t1) * u + std::sin(t1) * v), &a, &b)) {
+          const double d = SegmentDistance(m, a, b);
+          if (d < best_d) best_d = d, best = k + 3;
+        }
+      }
+    }
+    return best;
+  }
+
+  // The 3D view's handling of the mouse when no panel wants it.
+  void Handle3d(bool mouse_free) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const double x = input.x, y = input.y;
+    if (drag == Drag::kNone) hover_handle = mouse_free ? HandleAt(x, y) : -1;
+    if (mouse_free && io.MouseWheel != 0) model.view.Dolly(io.MouseWheel);
+    const bool left = input.down[0], right = input.down[1] || input.down[2];
+    if (drag == Drag::kNone && mouse_free && (left || right)) {
+      press_x = last_x = x;
+      press_y = last_y = y;
+      if (right) {
+        drag = Drag::kPan;
+      } else if (hover_handle >= 0) {
+        drag = hover_handle < 3 ? Drag::kAxis : Drag::kRing;
+        drag_handle = hover_handle % 3;
+        applied = 0;
+        if (const auto r = MouseRay(x, y)) drag_ray = *r;
+      } else {
+        drag = Drag::kClick;  // becomes an orbit once the mouse moves
+      }
+      return;
+    }
+    if (drag == Drag::kNone) return;
+    const double dx = x - last_x, dy = y - last_y;
+    last_x = x;
+    last_y = y;
+    if (drag == Drag::kClick && std::hypot(x - press_x, y - press_y) > 3) drag = Drag::kOrbit;
+    if (drag == Drag::kOrbit) model.view.Orbit(dx, dy);
+    if (drag == Drag::kPan) model.view.Pan(dx, dy, model.width);
+    if ((drag == Drag::kAxis || drag == Drag::kRing) && (dx != 0 || dy != 0)) DragGizmo(x, y);
+    if (!left && !right) {  // released
+      if (drag == Drag::kClick) Click(x, y);
+      drag = Drag::kNone;
+    }
+  }
+
+  void DragGizmo(double x, double y) {
+    const int c = Primary();
+    const auto ray = MouseRay(x, y);
+    if (c < 0 || !ray) return;
+    const Vec3 o = model.rig().cameras[c].center();
+    const Vec3 axis = Vec3::Unit(drag_handle);
+    if (drag == Drag::kAxis) {
+      // The start's parameter against the camera's start position: the handle follows the mouse.
+      const Vec3 start_origin = o - applied * axis;
+      const auto t0 = AxisParameter(drag_ray, start_origin, axis);
+      const auto t1 = AxisParameter(*ray, start_origin, axis);
+      if (!t0 || !t1) return;
+      const double total = Snap(*t1 - *t0, move_step);
+      if (total == applied) return;
+      Action a = Make(Action::Kind::kMove, SelectedIds());
+      a.a = (total - applied) * axis;
+      a.drag = true;
+      Do(a);
+      applied = total;
+    } else {
+      const auto angle = SweptAngle(drag_ray, *ray, o, axis);
+      if (!angle) return;
+      const double total = Snap(*angle / kDeg, rotate_step);
+      if (total == applied) return;
+      Action a = Make(Action::Kind::kRotate, SelectedIds());
+      a.a = axis;
+      a.number = total - applied;
+      a.drag = true;
+      Do(a);
+      applied = total;
+    }
+  }
+
+  void Click(double x, double y) {
+    const auto ray = MouseRay(x, y);
+    if (!ray) return;
+    const double radius = 0.02 * (model.view.Eye() - model.view.target).norm() + 0.02;
+    const int c = PickCamera(model.rig(), *ray, radius);
+    std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
+    if (c >= 0) {
+      const std::string& id = model.rig().cameras[c].id;
+      const auto it = std::find(ids.begin(), ids.end(), id);
+      if (it != ids.end()) ids.erase(it);
+      else ids.push_back(id);
+    } else {
+      PixelPicker picker(model.session().study().prepared(), model.rig(), model.MainView());
+      const int px = std::clamp(int(std::lround(x)), 0, model.width - 1);
+      const int py = std::clamp(int(std::lround(y)), 0, model.height - 1);
+      if (const auto pick = picker.Pick(px, py)) {
+        std::string seen;
+        for (int k : pick->cameras) seen += (seen.empty() ? "" : ", ") + model.rig().cameras[k].id;
+        model.status = "object '" + model.scene().objects[pick->object].name + "' at (" +
+                       std::to_string(pick->point.x()).substr(0, 6) + ", " + std::to_string(pick->point.y()).substr(0, 6) +
+                       ", " + std::to_string(pick->point.z()).substr(0, 6) + "), seen by " +
+                       (seen.empty() ? "no camera" : seen);
+      }
+    }
+    Action a = Make(Action::Kind::kSelect, ids);
+    Do(a);
+  }
+
+  void Keys() {
+    for (int key : input.pressed) {
+      if (ImGui::GetIO().WantCaptureKeyboard) break;
+      if (input.ctrl && key == GLFW_KEY_Z) Do(Make(input.shift ? Action::Kind::kRedo : Action::Kind::kUndo));
+      else if (input.ctrl && key == GLFW_KEY_Y) Do(Make(Action::Kind::kRedo));
+      else if (input.ctrl && key == GLFW_KEY_S) Do(Make(Action::Kind::kSave));
+      else if (key == GLFW_KEY_ESCAPE) Do(Make(Action::Kind::kSelect));
+      else if (key == GLFW_KEY_F) model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
+    }
+    input.pressed.clear();
+    // Fly with W A S D Q E while the right button is held.
+    if (input.down[1] && !ImGui::GetIO().WantCaptureKeyboard) {
+      const double step = 0.02 * model.view.distance;
+      model.view.Fly(step * (input.keys[GLFW_KEY_D] - input.keys[GLFW_KEY_A]),
+                     step * (input.keys[GLFW_KEY_E] - input.keys[GLFW_KEY_Q]),
+                     step * (input.keys[GLFW_KEY_W] - input.keys[GLFW_KEY_S]));
+    }
+  }
+
+  // A connected gamepad moves the primary camera (or, with none selected, flies the view).
+  void Gamepad() {
+    GLFWgamepadstate s;
+    if (!glfwJoystickIsGamepad(GLFW_JOYSTICK_1) || !glfwGetGamepadState(GLFW_JOYSTICK_1, &s)) return;
+    GamepadAxes g;
+    g.left_x = s.axes[GLFW_GAMEPAD_AXIS_LEFT_X];
+    g.left_y = s.axes[GLFW_GAMEPAD_AXIS_LEFT_Y];
+    g.right_x = s.axes[GLFW_GAMEPAD_AXIS_RIGHT_X];
+    g.right_y = s.axes[GLFW_GAMEPAD_AXIS_RIGHT_Y];
+    g.left_trigger = s.axes[GLFW_GAMEPAD_AXIS_LEFT_TRIGGER];
+    g.right_trigger = s.axes[GLFW_GAMEPAD_AXIS_RIGHT_TRIGGER];
+    const bool active = StickCurve(g.left_x) != 0 || StickCurve(g.left_y) != 0 || StickCurve(g.right_x) != 0 ||
+                        StickCurve(g.right_y) != 0 || g.left_trigger > -0.9 || g.right_trigger > -0.9;
+    if (!active) return;
+    const double dt = std::clamp(frame_seconds, 1e-3, 0.1);
+    if (Primary() < 0) {
+      model.view.Fly(dt * 1.5 * StickCurve(g.left_x), 0, -dt * 1.5 * StickCurve(g.left_y));
+      model.view.Look(-dt * 60 * StickCurve(g.right_x), -dt * 60 * StickCurve(g.right_y));
+      return;
+    }
+    Action a = Make(Action::Kind::kGamepad, {model.rig().cameras[Primary()].id});
+    a.a = Vec3(g.left_x, g.left_y, 0);
+    a.b = Vec3(g.right_x, g.right_y, 0);
+    a.number = dt;
+    a.drag = true;
+    Do(a);
+  }
+
+  void Panels() {
+    const Rig& rig = model.rig();
+    session::EditableRig& edit = model.session().rig();
+    ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250, 300), ImGuiCond_FirstUseEver);
+    ImGui::Begin("Rig");
+    ImGui::Text("%s: %d of %zu cameras on", rig.name.c_str(), rig.enabled_count(), rig.cameras.size());
+    if (ImGui::Button("Undo")) Do(Make(Action::Kind::kUndo));
+    ImGui::SameLine();
+    if (ImGui::Button("Redo")) Do(Make(Action::Kind::kRedo));
+    ImGui::SameLine();
+    if (ImGui::Button("Save")) Do(Make(Action::Kind::kSave));
+    ImGui::SameLine();
+    ImGui::TextDisabled("%zu unsaved", edit.Unsaved().size());
+    ImGui::Separator();
+    for (int c = 0; c < int(rig.cameras.size()); ++c) {
+      const Camera& cam = rig.cameras[c];
+      ImGui::PushID(c);
+      bool on = cam.enabled;
+      if (ImGui::Checkbox("##on", &on)) Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
+      ImGui::SameLine();
+      ImGui::ColorButton("##col", ImVec4(float(cam.color.x()), float(cam.color.y()), float(cam.color.z()), 1.0f),
+                         ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+      ImGui::SameLine();
+      const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
+      if (ImGui::Selectable(cam.id.c_str(), selected)) {
+        std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
+        const auto it = std::find(ids.begin(), ids.end(), cam.id);
+        if (it != ids.end()) ids.erase(it);
+        else ids.push_back(cam.id);
+        Do(Make(Action::Kind::kSelect, ids));
+      }
+      ImGui::PopID();
+    }
+    ImGui::End();
+
+    CameraPanel();
+    FieldsPanel();
+    SuggestPanel();
+    DisplayPanel();
+
+    // Camera's-eye views of up to four selected cameras, exact (CPU), distortion included.
+    for (std::size_t i = 0; i < model.selection.size() && i < 4; ++i) {
+      const int c = model.selection[i];
+      RenderCameraView(c);
+      const CameraView& v = camera_views[c];
+      ImGui::SetNextWindowPos(ImVec2(float(model.width - v.width - 24), float(8 + i * (v.height + 44))),
+                              ImGuiCond_FirstUseEver);
+      ImGui::Begin(("View " + rig.cameras[c].id).c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+      ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)), ImVec2(float(v.width), float(v.height)));
+      ImGui::End();
+    }
+
+    // Status bar.
+    ImGui::SetNextWindowPos(ImVec2(0, float(model.height - 28)));
+    ImGui::SetNextWindowSize(ImVec2(float(model.width), 28));
+    ImGui::Begin("##status", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
+    const session::JobStatus f = model.session().jobs().Status("fields");
+    const std::string undo = edit.can_undo() ? "undo: " + edit.undo_label() : "nothing to undo";
+    const std::string timing = options.show_timing ? " | GPU frame " + std::to_string(int(1000 * gl_seconds)) + " ms" : "";
+    ImGui::Text("%s | fields %s%s%s | %s", undo.c_str(), session::JobStateName(f.state),
+                f.state == session::JobState::kRunning ? (" " + std::to_string(int(100 * f.progress)) + "%").c_str() : "",
+                timing.c_str(), error.empty() ? model.status.c_str() : error.c_str());
+    ImGui::End();
+  }
+
+  void CameraPanel() {
+    const int c = Primary();
+    ImGui::SetNextWindowPos(ImVec2(8, 316), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250, 210), ImGuiCond_FirstUseEver);
+    ImGui::Begin("Camera");
+    if (c < 0) {
+      ImGui::TextDisabled("click a camera to select it");
+      ImGui::End();
+      return;
+    }
+    const Camera& cam = model.rig().cameras[c];
+    ImGui::Text("%s (%s), %dx%d %s", cam.id.c_str(), cam.name.c_str(), cam.model.width(), cam.model.height(),
+                LensModelName(cam.model.intrinsics().model));
+    float p[3] = {float(cam.center().x()), float(cam.center().y()), float(cam.center().z())};
+    if (ImGui::DragFloat3("position m", p, 0.005f, -1e4f, 1e4f, "%.3f")) {
+      Action a = Make(Action::Kind::kMove, {cam.id});
+      a.flag = true;
+      a.a = Vec3(p[0], p[1], p[2]);
+      a.drag = true;
+      Do(a);
+    }
+    const Vec3 ypr = YawPitchRollDeg(cam.world_from_camera.linear());
+    float e[3] = {float(ypr.x()), float(ypr.y()), float(ypr.z())};
+    if (ImGui::DragFloat3("yaw pitch roll", e, 0.2f, -180.0f, 180.0f, "%.1f")) {
+      Action a = Make(Action::Kind::kOrient, {cam.id});
+      a.a = Vec3(e[0], std::clamp(e[1], -90.0f, 90.0f), e[2]);
+      a.drag = true;
+      Do(a);
+    }
+    const Intrinsics& k = cam.model.intrinsics();
+    float hfov = float(HfovFromFocal(k.fx, k.width, k.model) / kDeg);
+    if (ImGui::DragFloat("hfov deg", &hfov, 0.1f, 1.0f, k.model == LensModel::kFisheye ? 359.0f : 179.0f, "%.1f")) {
+      Action a = Make(Action::Kind::kHfov, {cam.id});
+      a.number = hfov;
+      Do(a);
+    }
+    ImGui::Text("range %.2f .. %s m", cam.near, std::isfinite(cam.far) ? std::to_string(cam.far).substr(0, 5).c_str() : "inf");
+    ImGui::DragFloat("snap move m", &move_step, 0.005f, 0.0f, 1.0f, "%.3f");
+    ImGui::DragFloat("snap turn deg", &rotate_step, 0.5f, 0.0f, 45.0f, "%.1f");
+    ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)", model.selection.size());
+    ImGui::End();
+  }
+
+  void FieldsPanel() {
+    ImGui::SetNextWindowPos(ImVec2(8, 534), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250, 150), ImGuiCond_FirstUseEver);
+    ImGui::Begin("Fields");
+    VoxelLattice lattice;
+    std::string numbers;
+    model.session().ReadFields([&](const Fields& f, std::int64_t version) {
+      lattice = f.lattice;
+      const auto& h = f.stats.coverage_histogram;
+      std::int64_t total = 0;
+      for (auto n : h) total += n;
+      std::int64_t at_least = total;
+      for (std::size_t k = 1; k < h.size() && k <= 3; ++k) {
+        at_least -= h[k - 1];
+        char cell[48];
+        std::snprintf(cell, sizeof cell, ">=%zu %.1f%%  ", k, total ? 100.0 * at_least / total : 0.0);
+        numbers += cell;
+      }
+      const auto p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
+      if (p50) numbers += "\nsigma_max p50 " + std::to_string(*p50).substr(0, 5) + " mm";
+      numbers += version == model.session().rig().version() ? "" : "\n(updating)";
+    });
+    ImGui::TextUnformatted(numbers.empty() ? "evaluating..." : numbers.c_str());
+    const char* fields[] = {"", "coverage", "resolution", "sigma_max"};
+    const OverlayOptions& ov = model.display.overlays;
+    int current = 0;
+    for (int i = 1; i < 4; ++i)
+      if (ov.slice_field == fields[i]) current = i;
+    int axis = ov.slice_axis;
+    float at = std::isnan(ov.slice_position) ? float(lattice.origin[axis] + 0.5 * lattice.voxel_size * (lattice.dims[axis] - 1))
+                                              : float(ov.slice_position);
+    bool changed = ImGui::Combo("slice", &current, "off\0coverage\0resolution\0sigma_max\0");
+    changed |= ImGui::RadioButton("x", &axis, 0);
+    ImGui::SameLine();
+    changed |= ImGui::RadioButton("y", &axis, 1);
+    ImGui::SameLine();
+    changed |= ImGui::RadioButton("z", &axis, 2);
+    const float lo = float(lattice.origin[axis]), hi = float(lattice.origin[axis] + lattice.voxel_size * std::max(0, lattice.dims[axis] - 1));
+    changed |= ImGui::SliderFloat("at m", &at, lo, std::max(hi, lo + 1e-3f), "%.3f");
+    if (changed) {
+      Action a = Make(Action::Kind::kSlice);
+      a.text = fields[current];
+      a.flag = a.text.empty();
+      a.text2 = axis == 0 ? "x" : axis == 1 ? "y" : "z";
+      a.number = at;
+      Do(a);
+    }
+    ImGui::End();
+  }
+
+  void SuggestPanel() {
+    ImGui::SetNextWindowPos(ImVec2(float(model.width - 290), float(model.height - 290)), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(280, 250), ImGuiCond_FirstUseEver);
+    ImGui::Begin("Suggest");
+    const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution"};
+    ImGui::Combo("objective", &objective, objectives, 5);
+    ImGui::DragFloat("max move m", &max_move, 0.01f, 0.0f, 10.0f, "%.2f");
+    ImGui::DragFloat("max turn deg", &max_rotate, 0.5f, 0.0f, 179.0f, "%.1f");
+    ImGui::DragInt("points", &points, 10, 50, 20000);
+    const session::JobStatus s = model.session().jobs().Status("suggest");
+    const bool running = s.state == session::JobState::kRunning || s.state == session::JobState::kQueued;
+    if (model.selection.empty()) {
+      ImGui::TextDisabled("select the cameras that may move");
+    } else if (running) {
+      ImGui::Text("suggesting...");
+      ImGui::SameLine();
+      if (ImGui::Button("Cancel")) model.session().jobs().Cancel("suggest");
+    } else if (ImGui::Button(("Suggest for " + std::to_string(model.selection.size()) + " cameras").c_str())) {
+      Action a = Make(Action::Kind::kSuggest, SelectedIds());
+      a.text = objectives[objective];
+      a.number = max_move;
+      a.number2 = max_rotate;
+      a.number3 = points;
+      Do(a);
+      waiting_for_suggestion = true;
+    }
+    if (waiting_for_suggestion && !running) {
+      waiting_for_suggestion = false;
+      Action a = Make(Action::Kind::kWait);
+      a.text = "suggest";
+      Do(a);
+    }
+    if (model.suggestion) {
+      const Suggestion& g = *model.suggestion;
+      ImGui::Separator();
+      ImGui::Text("%s: %.4g -> %.4g%s", ObjectiveName(g.objective).c_str(), g.before.objective, g.after.objective,
+                  g.improved ? "" : " (no improvement)");
+      for (const CameraChange& ch : g.cameras) {
+        ImGui::PushID(ch.index);
+        ImGui::Text("%s: %.3f m, %.1f deg", ch.id.c_str(), ch.move_m, ch.rotate_deg);
+        ImGui::SameLine();
+        if (ImGui::SmallButton("accept")) {
+          Do(Make(Action::Kind::kAccept, {ch.id}));
+          ImGui::PopID();
+          break;
+        }
+        ImGui::PopID();
+      }
+      if (model.suggestion && ImGui::Button("Accept all")) Do(Make(Action::Kind::kAccept));
+      ImGui::SameLine();
+      if (model.suggestion && ImGui::Button("Reject")) Do(Make(Action::Kind::kReject));
+    }
+    ImGui::End();
+  }
+  bool waiting_for_suggestion = false;
+
+  void DisplayPanel() {
+    ImGui::SetNextWindowPos(ImVec2(266, 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(230, 130), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+    ImGui::Begin("Display");
+    int pattern = model.display.pattern == Pattern::kGrid ? 1 : 0;
+    bool changed = ImGui::Combo("light", &pattern, "uniform\0grid\0");
+    int grid = model.display.grid_pixels;
+    changed |= ImGui::DragInt("grid px", &grid, 1, 1, 1000);
+    bool material = model.display.surface == Surface::kMaterial;
+    changed |= ImGui::Checkbox("material", &material);
+    bool automatic = std::isnan(model.display.brightness);
+    float brightness = automatic ? float(DefaultBrightness(model.rig().enabled_count())) : float(model.display.brightness);
+    changed |= ImGui::Checkbox("auto brightness", &automatic);
+    if (!automatic) changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f");
+    int map = gl_options.shadow_map_size;
+    if (ImGui::Combo("shadow map", &map_index, "512\0" "1024\0" "2048\0" "4096\0")) map = 512 << map_index;
+    gl_options.shadow_map_size = map;
+    if (changed) {
+      Action a = Make(Action::Kind::kLight);
+      a.text = pattern ? "grid" : "uniform";
+      a.number = grid;
+      a.number2 = automatic ? NAN : brightness;
+      a.text2 = material ? "material" : "black";
+      Do(a);
+    }
+    ImGui::End();
+  }
+  int map_index = 2;
+
+  void Draw() {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    int fw = 0, fh = 0;
+    glfwGetFramebufferSize(window, &fw, &fh);
+    glViewport(0, 0, fw, fh);
+    glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  }
+
+  void FeedImGui() {
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(float(model.width), float(model.height));
+    io.DeltaTime = float(std::clamp(frame_seconds, 1e-3, 0.25));
+    io.MousePos = ImVec2(float(input.x), float(input.y));
+    for (int b = 0; b < 3; ++b) io.MouseDown[b] = input.down[b];
+    io.MouseWheel = float(input.wheel);
+    input.wheel = 0;
+    io.KeyCtrl = input.ctrl;
+    io.KeyShift = input.shift;
+    io.KeyAlt = input.alt;
+    for (int k = 0; k <= GLFW_KEY_LAST && k < int(IM_ARRAYSIZE(io.KeysDown)); ++k) io.KeysDown[k] = input.keys[k];
+    for (unsigned ch : input.chars) io.AddInputCharacter(ch);
+    input.chars.clear();
+  }
+
+  bool OneFrame() {
+    const auto now = std::chrono::steady_clock::now();
+    frame_seconds = std::chrono::duration<double>(now - last_frame).count();
+    last_frame = now;
+    int w = 0, h = 0;
+    glfwGetWindowSize(window, &w, &h);
+    if (w > 0 && h > 0 && (w != model.width || h != model.height) && options.visible) {
+      model.width = w;
+      model.height = h;
+    }
+    FeedImGui();
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui::NewFrame();
+    const bool mouse_free = !ImGui::GetIO().WantCaptureMouse;
+    Keys();
+    Gamepad();
+    Handle3d(mouse_free);
+    RenderMain();
+    ImDrawList* bg = ImGui::GetBackgroundDrawList();
+    bg->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(main_texture)), ImVec2(0, 0),
+                 ImVec2(float(model.width), float(model.height)));
+    DrawOverlays(bg);
+    Panels();
+    Draw();
+    return !glfwWindowShouldClose(window);
+  }
+};
+
+namespace {
+
+ViewerApp::Impl* g_app = nullptr;  // GLFW's callbacks reach the one window through it
+
+void OnCursor(GLFWwindow*, double x, double y) {
+  g_app->input.x = x;
+  g_app->input.y = y;
+}
+void OnButton(GLFWwindow*, int button, int action, int mods) {
+  if (button >= 0 && button < 3) g_app->input.down[button] = action == GLFW_PRESS;
+  g_app->input.ctrl = mods & GLFW_MOD_CONTROL;
+  g_app->input.shift = mods & GLFW_MOD_SHIFT;
+}
+void OnScroll(GLFWwindow*, double, double dy) { g_app->input.wheel += dy; }
+void OnKey(GLFWwindow*, int key, int, int action, int mods) {
+  if (key >= 0 && key <= GLFW_KEY_LAST) g_app->input.keys[key] = action != GLFW_RELEASE;
+  if (action == GLFW_PRESS) g_app->input.pressed.push_back(key);
+  g_app->input.ctrl = mods & GLFW_MOD_CONTROL;
+  g_app->input.shift = mods & GLFW_MOD_SHIFT;
+  g_app->input.alt = mods & GLFW_MOD_ALT;
+}
+void OnChar(GLFWwindow*, unsigned c) { g_app->input.chars.push_back(c); }
+
+}  // namespace
+
+ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_unique<Impl>(model, options)) {
+  Impl& m = *impl_;
+  glfwSetErrorCallback(OnGlfwError);
+  if (!glfwInit())
+    throw std::runtime_error("pandora view: no display (" + g_glfw_error +
+                             "); on a machine without one run under `xvfb-run -a`");
+  glfwWindowHint(GLFW_VISIBLE, options.visible ? GLFW_TRUE : GLFW_FALSE);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  model.width = options.width;
+  model.height = options.height;
+  m.window = glfwCreateWindow(options.width, options.height, ("Pandora: " + model.scene().path).c_str(), nullptr, nullptr);
+  if (!m.window) {
+    glfwTerminate();
+    throw std::runtime_error("pandora view: no OpenGL 3.3 core context (" + g_glfw_error +
+                             "); install Mesa (libgl1-mesa-dri) or a GPU driver");
+  }
+  glfwMakeContextCurrent(m.window);
+  glfwSwapInterval(1);
+  g_app = &m;
+  glfwSetCursorPosCallback(m.window, OnCursor);
+  glfwSetMouseButtonCallback(m.window, OnButton);
+  glfwSetScrollCallback(m.window, OnScroll);
+  glfwSetKeyCallback(m.window, OnKey);
+  glfwSetCharCallback(m.window, OnChar);
+  IMGUI_CHECKVERSION();
+  m.imgui = ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // the same layout every start (and in tests)
+  io.KeyMap[ImGuiKey_Tab] = GLFW_KEY_TAB;
+  io.KeyMap[ImGuiKey_LeftArrow] = GLFW_KEY_LEFT;
+  io.KeyMap[ImGuiKey_RightArrow] = GLFW_KEY_RIGHT;
+  io.KeyMap[ImGuiKey_UpArrow] = GLFW_KEY_UP;
+  io.KeyMap[ImGuiKey_DownArrow] = GLFW_KEY_DOWN;
+  io.KeyMap[ImGuiKey_Backspace] = GLFW_KEY_BACKSPACE;
+  io.KeyMap[ImGuiKey_Delete] = GLFW_KEY_DELETE;
+  io.KeyMap[ImGuiKey_Enter] = GLFW_KEY_ENTER;
+  io.KeyMap[ImGuiKey_Escape] = GLFW_KEY_ESCAPE;
+  io.KeyMap[ImGuiKey_Home] = GLFW_KEY_HOME;
+  io.KeyMap[ImGuiKey_End] = GLFW_KEY_END;
+  io.KeyMap[ImGuiKey_A] = GLFW_KEY_A;
+  io.KeyMap[ImGuiKey_C] = GLFW_KEY_C;
+  io.KeyMap[ImGuiKey_V] = GLFW_KEY_V;
+  io.KeyMap[ImGuiKey_X] = GLFW_KEY_X;
+  io.KeyMap[ImGuiKey_Z] = GLFW_KEY_Z;
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().WindowRounding = 3.0f;
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+  m.gl = std::make_unique<GlRenderer>(model.scene());
+  m.gl_options.shadow_map_size = options.shadow_map_size;
+  m.map_index = options.shadow_map_size >= 4096 ? 3 : options.shadow_map_size >= 2048 ? 2 : options.shadow_map_size >= 1024 ? 1 : 0;
+}
+
+ViewerApp::~ViewerApp() {
+  Impl& m = *impl_;
+  glfwMakeContextCurrent(m.window);
+  m.gl.reset();
+  if (m.main_texture) glDeleteTextures(1, &m.main_texture);
+  for (auto& [c, v] : m.camera_views)
+    if (v.texture) glDeleteTextures(1, &v.texture);
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui::DestroyContext(m.imgui);
+  glfwDestroyWindow(m.window);
+  glfwTerminate();
+  g_app = nullptr;
+}
+
+bool ViewerApp::Frame() {
+  glfwPollEvents();
+  const bool open = impl_->OneFrame();
+  glfwSwapBuffers(impl_->window);
+  return open;
+}
+
+void ViewerApp::Loop() {
+  while (Frame()) {
+  }
+}
+
+void ViewerApp::Screenshot(const ViewerModel& model, const std::string& path, int camera) {
+  if (camera >= 0) {
+    CpuFrontend().Screenshot(model, path, camera);
+    return;
+  }
+  // Two frames, so that panels placed in the first are drawn in place in the second; then the back
+  // buffer as it would be shown.
+  Impl& m = *impl_;
+  m.OneFrame();
+  glfwSwapBuffers(m.window);
+  m.OneFrame();
+  int fw = 0, fh = 0;
+  glfwGetFramebufferSize(m.window, &fw, &fh);
+  std::vector<unsigned char> pixels(std::size_t(fw) * fh * 4);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  glfwSwapBuffers(m.window);
+  // To linear RGB for WritePng (which applies the sRGB curve again), rows flipped to y down.
+  Image image;
+  image.width = fw;
+  image.height = fh;
+  image.rgb.resize(std::size_t(fw) * fh * 3);
+  for (int y = 0; y < fh; ++y)
+    for (int x = 0; x < fw; ++x)
+      for (int k = 0; k < 3; ++k) {
+        const double s = pixels[(std::size_t(fh - 1 - y) * fw + x) * 4 + k] / 255.0;
+        image.rgb[(std::size_t(y) * fw + x) * 3 + k] =
+            float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
+      }
+  WritePng(image, path);
+}
+
+void ViewerApp::Input(ViewerModel&, const Action& a) {
+  Impl& m = *impl_;
+  using Kind = Action::Kind;
+  const int button = a.text2 == "right" ? 1 : a.text2 == "middle" ? 2 : 0;
+  switch (a.kind) {
+    case Kind::kMouse:
+      m.input.x = a.number3;
+      m.input.y = a.number2;
+      if (a.text == "press") m.input.down[button] = true;
+      if (a.text == "release") m.input.down[button] = false;
+      Frame();
+      break;
+    case Kind::kScroll:
+      m.input.x = a.number3;
+      m.input.y = a.number2;
+      m.input.wheel += a.number;
+      Frame();
+      break;
+    case Kind::kKey: {
+      // "ctrl+shift+z": modifiers, then one key (a letter, a digit, or escape/enter/tab/delete).
+      std::string key = a.text;
+      m.input.ctrl = m.input.shift = m.input.alt = false;
+      for (;;) {
+        const auto plus = key.find('+');
+        if (plus == std::string::npos) break;
+        const std::string mod = key.substr(0, plus);
+        if (mod == "ctrl") m.input.ctrl = true;
+        else if (mod == "shift") m.input.shift = true;
+        else if (mod == "alt") m.input.alt = true;
+        else throw InputError(a.where, "", "unknown modifier '" + mod + "'", "use ctrl, shift, alt");
+        key = key.substr(plus + 1);
+      }
+      static const std::map<std::string, int> named = {{"escape", GLFW_KEY_ESCAPE}, {"enter", GLFW_KEY_ENTER},
+                                                       {"tab", GLFW_KEY_TAB}, {"delete", GLFW_KEY_DELETE}};
+      int code = -1;
+      if (key.size() == 1 && std::isalpha(static_cast<unsigned char>(key[0]))) code = GLFW_KEY_A + (std::tolower(key[0]) - 'a');
+      else if (key.size() == 1 && std::isdigit(static_cast<unsigned char>(key[0]))) code = GLFW_KEY_0 + (key[0] - '0');
+      else if (named.count(key)) code = named.at(key);
+      if (code < 0) throw InputError(a.where, "", "unknown key '" + key + "'", "a letter, a digit, escape, enter, tab or delete");
+      m.input.keys[code] = true;
+      m.input.pressed.push_back(code);
+      Frame();
+      m.input.keys[code] = false;
+      m.input.ctrl = m.input.shift = m.input.alt = false;
+      Frame();
+      break;
+    }
+    case Kind::kFrames:
+      for (int i = 0; i < int(a.number); ++i) Frame();
+      break;
+    default:
+      break;
+  }
+}
+
+}  // namespace pandora::viewer

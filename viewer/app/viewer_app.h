@@ -1,0 +1,46 @@
+#pragma once
+/// \file viewer_app.h
+/// The window of `pandora view`: GLFW + OpenGL 3.3 core + Dear ImGui over a ViewerModel
+/// (viewer/core/model.h). It draws the model (the GPU projective light of viewer/gl_renderer.h,
+/// camera bodies and frusta, the gizmo, the slice, the suggestion's ghosts, the panels) and turns
+/// mouse, keyboard and gamepad input into the model's actions; scripted input goes through the same
+/// handlers. Light header: no GL, GLFW or ImGui in it.
+
+#include <memory>
+#include <string>
+
+#include "viewer/core/model.h"
+
+namespace pandora::viewer {
+
+struct AppOptions {
+  int width = 1280, height = 720;  ///< Window size (the main view fills it).
+  bool visible = true;             ///< false: a hidden window (scripts, tests).
+  int shadow_map_size = 2048;
+  /// Frame times in the status bar (off in scripts, whose screenshots are compared with references).
+  bool show_timing = true;
+};
+
+class ViewerApp : public Frontend {
+ public:
+  /// Opens the window and its GL context. Throws std::runtime_error naming the cause (no display:
+  /// run under `xvfb-run -a`; no GL 3.3 core).
+  ViewerApp(ViewerModel& model, AppOptions options);
+  ~ViewerApp() override;
+
+  /// One frame: input, panels, drawing, swap. False once the window was asked to close.
+  bool Frame();
+  /// Frames until the window closes.
+  void Loop();
+
+  // Frontend: the window's own picture (after a frame is drawn), or a camera's exact view.
+  void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;
+  void Input(ViewerModel& model, const Action& action) override;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pandora::viewer
