@@ -228,7 +228,7 @@ struct ViewerApp::Impl {
     const std::int64_t version = model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
     if (v.texture && v.version == version) return;
     const CameraModel& m = model.rig().cameras[c].model;
-    const double scale = std::min(1.0, 320.0 / m.width());
+    const double scale = std::min(1.0, 256.0 / m.width());
     RenderView view;
     view.camera = c;
     view.width = std::max(16, int(std::lround(m.width() * scale)));
