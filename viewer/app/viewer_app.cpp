@@ -694,6 +694,9 @@ struct ViewerApp::Impl {
     ImGui::SetNextWindowSize(ImVec2(280, 250), ImGuiCond_FirstUseEver);
     ImGui::Begin("Suggest");
     const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution"};
+    if (model.suggestion)  // the panel shows what the suggestion on screen was asked for
+      for (int i = 0; i < 5; ++i)
+        if (ObjectiveName(model.suggestion->objective) == objectives[i]) objective = i;
     ImGui::Combo("objective", &objective, objectives, 5);
     ImGui::DragFloat("max move m", &max_move, 0.01f, 0.0f, 10.0f, "%.2f");
     ImGui::DragFloat("max turn deg", &max_rotate, 0.5f, 0.0f, 179.0f, "%.1f");
