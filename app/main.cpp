@@ -135,12 +135,28 @@ int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
 int main(int argc, char** argv) {
   // `pandora view`: the interactive viewer is its own program (the only one that links GL),
   // pandora-view beside this one; it gets the remaining arguments.
-  if (argc >= 2 && std::string(argv[1]) == "view") {
+  // `pandora bench --viewer SCENE [--repeat N]` is `pandora-view SCENE --bench N` (frame rates).
+  bool viewer_bench = false;
+  if (argc >= 2 && std::string(argv[1]) == "bench")
+    for (int i = 2; i < argc; ++i) viewer_bench |= std::string(argv[i]) == "--viewer";
+  if (argc >= 2 && (std::string(argv[1]) == "view" || viewer_bench)) {
     std::error_code ec;
     const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
     const std::string viewer = (self.parent_path() / "pandora-view").string();
+    std::vector<std::string> kept;
+    std::string frames = "20";
+    for (int i = 2; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (viewer_bench && arg == "--viewer") continue;
+      if (viewer_bench && arg == "--repeat" && i + 1 < argc) {
+        frames = argv[++i];
+        continue;
+      }
+      kept.push_back(arg);
+    }
+    if (viewer_bench) kept.insert(kept.end(), {"--bench", frames, "--no-autosave"});
     std::vector<char*> args{const_cast<char*>(viewer.c_str())};
-    for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+    for (std::string& k : kept) args.push_back(k.data());
     args.push_back(nullptr);
     execv(viewer.c_str(), args.data());
     std::fprintf(stderr, "pandora: error: cannot start the viewer %s: %s (hint: build the pandora-view target)\n",
@@ -181,6 +197,8 @@ int main(int argc, char** argv) {
               "Time `pandora render` (1280x720) against raw Embree loops over the same primary and shadow rays");
   b->add_option("--view", bench.view, "With --render: the named view (default: the scene's first view)");
   b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
+  bool viewer_flag = false;  // handled above (pandora-view); listed for --help
+  b->add_flag("--viewer", viewer_flag, "Frame rates of `pandora view` (navigating, all cameras moving) against the exact CPU renderer");
   b->add_flag("--incremental", bench.incremental,
               "Time the field update after moving one camera against a full evaluation");
   b->add_option("--move", bench.move, "With --incremental: how far each camera moves, metres")

@@ -3,6 +3,8 @@
 // in a window, writes --screenshot and --log, and exits: what the CI's scripted session does.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,12 +29,68 @@ std::pair<int, int> ParseSize(const std::string& text) {
   return {w, h};
 }
 
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// `pandora bench --viewer`: whole frames of the window (GPU light, overlays, panels, swap) while the
+// eye orbits (each camera's shadow maps reused) and while every camera moves (maps redrawn each
+// frame, the fields updating in the background), against the exact CPU renderer of the same view.
+int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& window, int frames, double scale) {
+  using pandora::viewer::Action;
+  model.session().WaitFields();
+  window.Frame();  // first frame: programs, maps
+  auto run = [&](bool move_cameras) {
+    std::vector<double> times;
+    for (int i = 0; i < frames; ++i) {
+      if (move_cameras) {
+        Action a;
+        a.kind = Action::Kind::kMove;
+        a.where = "bench";
+        for (const auto& c : model.rig().cameras) a.cameras.push_back(c.id);
+        a.a = pandora::Vec3(i % 2 ? -0.002 : 0.002, 0, 0);
+        a.drag = true;
+        model.Do(a, nullptr);
+      } else {
+        model.view.Orbit(2.0, 0.0);
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      window.Frame();
+      times.push_back(Seconds(t0));
+    }
+    std::sort(times.begin(), times.end());
+    return times[times.size() / 2];
+  };
+  const double navigate = run(false);
+  const double moving = run(true);
+  model.session().WaitFields();
+  pandora::RenderOptions options = model.display;
+  options.layers = false;
+  double cpu = 1e300;
+  for (int i = 0; i < 3; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    model.session().Render(model.MainView(), options);
+    cpu = std::min(cpu, Seconds(t0));
+  }
+  std::printf("pandora bench --viewer: %s, rig %s (%d enabled cameras), %dx%d, %d frames each (median); "
+              "while moving drawn at %.2f of the resolution\n",
+              model.scene().path.c_str(), model.rig().name.c_str(), model.rig().enabled_count(), model.width,
+              model.height, frames, scale);
+  std::printf("  navigating (eye orbits, shadow maps reused)       %8.1f ms  %6.2f frames/s\n", 1000 * navigate,
+              1 / navigate);
+  std::printf("  all cameras moving (maps redrawn, fields live)    %8.1f ms  %6.2f frames/s\n", 1000 * moving,
+              1 / moving);
+  std::printf("  exact CPU renderer, same view (best of 3)         %8.1f ms  %6.2f frames/s\n", 1000 * cpu, 1 / cpu);
+  std::printf("  ratio window frame / CPU frame: navigating %.3f, cameras moving %.3f\n", navigate / cpu, moving / cpu);
+  return 0;
+}
+
 int Run(int argc, char** argv) {
   CLI::App app{"Pandora's interactive simulator: move cameras, watch their light, fields and suggestions"};
   app.name("pandora view");
   std::string scene, rig, fields, script, screenshot, log, size = "1280x720";
   bool hidden = false, recover = false, discard = false, no_autosave = false;
-  int shadow_map = 2048;
+  int shadow_map = 2048, bench_frames = 0;
   app.add_option("scene", scene, "Scene file (JSON)")->required();
   app.add_option("--rig", rig, "Rig to edit (default: the first)");
   app.add_option("--fields", fields, "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
@@ -43,6 +101,9 @@ int Run(int argc, char** argv) {
   app.add_option("--shadow-map", shadow_map, "Shadow map size per camera, 512 to 4096")->capture_default_str()
       ->check(CLI::Range(512, 4096));
   app.add_flag("--hidden", hidden, "No visible window (scripts, tests)");
+  app.add_option("--bench", bench_frames, "Measure frame rates over this many frames (navigating; all cameras moving) "
+                                          "against the exact CPU renderer, print them and exit")
+      ->check(CLI::Range(2, 10000));
   app.add_flag("--recover", recover, "Apply the autosave of a session that ended without saving");
   app.add_flag("--discard-autosave", discard, "Delete that autosave and start from the scene file");
   app.add_flag("--no-autosave", no_autosave, "Do not write the autosave file");
@@ -88,6 +149,16 @@ int Run(int argc, char** argv) {
   ao.visible = !hidden;
   ao.shadow_map_size = shadow_map;
   ao.show_timing = script.empty();
+  if (bench_frames > 0) ao.visible = false, ao.show_timing = false, ao.motion_scale = 1.0;
+  if (bench_frames > 0) {
+    // Full resolution throughout, then as interaction draws it (reduced while moving).
+    for (const double scale : {1.0, 0.5}) {
+      ao.motion_scale = scale;
+      pandora::viewer::ViewerApp window(model, ao);
+      Bench(model, window, bench_frames, scale);
+    }
+    return 0;
+  }
   pandora::viewer::ViewerApp window(model, ao);
   if (script.empty()) {
     window.Loop();

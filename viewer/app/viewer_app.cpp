@@ -122,6 +122,9 @@ struct ViewerApp::Impl {
   GlRenderOptions gl_options;
   GLuint main_texture = 0;
   std::string main_key;  // what the main texture shows
+  bool main_full = false;  // ... at full resolution
+  std::chrono::steady_clock::time_point last_change;
+  int shadow_map_size = 2048;
   InputState input;
   ImGuiContext* imgui = nullptr;
   std::chrono::steady_clock::time_point last_frame = std::chrono::steady_clock::now();
@@ -189,15 +192,26 @@ struct ViewerApp::Impl {
   }
 
   void RenderMain() {
-    const RenderView view = model.MainView();
+    RenderView view = model.MainView();
     char key[512];
     std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d",
                   static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
                   view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
                   int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
-                  int(model.display.surface), gl_options.shadow_map_size);
-    if (key == main_key && main_texture) return;
+                  int(model.display.surface), shadow_map_size);
+    const auto now = std::chrono::steady_clock::now();
+    if (key != main_key) last_change = now;
+    // Reduced while things move, full once idle.
+    const bool moving = options.motion_scale < 1 &&
+                        (drag != Drag::kNone || std::chrono::duration<double>(now - last_change).count() < 0.3);
+    if (key == main_key && main_texture && (moving || main_full)) return;
     main_key = key;
+    main_full = !moving;
+    if (moving) {
+      view.width = std::max(16, int(std::lround(view.width * options.motion_scale)));
+      view.height = std::max(16, int(std::lround(view.height * options.motion_scale)));
+    }
+    gl_options.shadow_map_size = moving ? std::min(shadow_map_size, 1024) : shadow_map_size;
     gl_options.pattern = model.display.pattern;
     gl_options.material = model.display.surface == Surface::kMaterial;
     gl_options.brightness = model.display.brightness;
@@ -763,9 +777,7 @@ struct ViewerApp::Impl {
     float brightness = automatic ? float(DefaultBrightness(model.rig().enabled_count())) : float(model.display.brightness);
     changed |= ImGui::Checkbox("auto brightness", &automatic);
     if (!automatic) changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f");
-    int map = gl_options.shadow_map_size;
-    if (ImGui::Combo("shadow map", &map_index, "512\0" "1024\0" "2048\0" "4096\0")) map = 512 << map_index;
-    gl_options.shadow_map_size = map;
+    if (ImGui::Combo("shadow map", &map_index, "512\0" "1024\0" "2048\0" "4096\0")) shadow_map_size = 512 << map_index;
     if (changed) {
       Action a = Make(Action::Kind::kLight);
       a.text = pattern ? "grid" : "uniform";
@@ -909,7 +921,7 @@ ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_u
   ImGui::GetStyle().WindowRounding = 3.0f;
   ImGui_ImplOpenGL3_Init("#version 330 core");
   m.gl = std::make_unique<GlRenderer>(model.scene());
-  m.gl_options.shadow_map_size = options.shadow_map_size;
+  m.shadow_map_size = options.shadow_map_size;
   m.map_index = options.shadow_map_size >= 4096 ? 3 : options.shadow_map_size >= 2048 ? 2 : options.shadow_map_size >= 1024 ? 1 : 0;
 }
 

@@ -19,6 +19,11 @@ struct AppOptions {
   int shadow_map_size = 2048;
   /// Frame times in the status bar (off in scripts, whose screenshots are compared with references).
   bool show_timing = true;
+  /// While the view or the rig changes (and for 0.3 s after), the main view is drawn at this
+  /// fraction of the window's resolution and with shadow maps of at most 1024 texels, then again
+  /// in full once idle: interaction stays responsive on software GL (docs/viewer.md, "Frame rate").
+  /// 1: always full.
+  double motion_scale = 0.5;
 };
 
 class ViewerApp : public Frontend {
