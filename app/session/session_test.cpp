@@ -94,6 +94,34 @@ TEST(EditableRig, UndoAndRedoRestoreEveryCameraExactly) {
                InputError);
 }
 
+TEST(EditableRig, AmendKeepsADragOneUndoStep) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  EditableRig rig(study->FindRig(""));
+  const Rig original = rig.rig();
+  // A drag in three steps: the first applies, the others amend it.
+  for (int step = 1; step <= 3; ++step) {
+    const Camera now = rig.rig().cameras[0];
+    Camera after = now;
+    after.world_from_camera = Moved(original.cameras[0], Vec3(0.01 * step, 0, 0));
+    Edit e{"move a", {{0, now, after}}};
+    if (step == 1) rig.Apply(e);
+    else rig.Amend(e);
+  }
+  EXPECT_EQ(rig.version(), 3);
+  EXPECT_EQ(rig.camera_version(0), 3);
+  EXPECT_LT((rig.rig().cameras[0].center() - (original.cameras[0].center() + Vec3(0.03, 0, 0))).norm(), 1e-12);
+  ASSERT_TRUE(rig.Undo());
+  EXPECT_TRUE(SameRig(rig.rig(), original));  // one step back to the start of the drag
+  EXPECT_FALSE(rig.Undo());
+  // Amending another camera than the last edit's, or with nothing to amend, is refused.
+  EXPECT_FALSE(rig.CanAmend({1}));
+  ASSERT_TRUE(rig.Redo());
+  EXPECT_FALSE(rig.CanAmend({1}));
+  EXPECT_TRUE(rig.CanAmend({0}));
+  Edit other{"move b", {{1, rig.rig().cameras[1], rig.rig().cameras[1]}}};
+  EXPECT_THROW(rig.Amend(other), std::logic_error);
+}
+
 TEST(Jobs, LatestWinsAndFailuresAreReported) {
   Jobs jobs;
   std::atomic<int> started{0}, finished{0};

@@ -318,6 +318,14 @@ TEST(ViewerModel, GroupEditsAreOneUndoStep) {
   EXPECT_NEAR(HfovFromFocal(m.rig().cameras[0].model.intrinsics().fx, m.rig().cameras[0].model.width(),
                             LensModel::kPinhole) / kDeg, 30, 1e-9);
   EXPECT_FALSE(m.rig().cameras[2].enabled);
+  // A drag of three steps on one camera is one undo step; a new drag starts a new one.
+  m.Run(ParseScript(R"([{"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true},
+                        {"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true},
+                        {"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true}])", "s.json"),
+        nullptr);
+  EXPECT_NEAR(m.rig().cameras[2].center().x() - original.cameras[2].center().x(), 0.3, 1e-12);
+  ASSERT_TRUE(m.session().rig().Undo());
+  EXPECT_NEAR(m.rig().cameras[2].center().x() - original.cameras[2].center().x(), 0.0, 1e-12);
   for (int i = 0; i < 4; ++i) ASSERT_TRUE(m.session().rig().Undo());
   EXPECT_FALSE(m.session().rig().Undo());
   for (std::size_t i = 0; i < original.cameras.size(); ++i)
