@@ -149,6 +149,7 @@ int Run(int argc, char** argv) {
   ao.visible = !hidden;
   ao.shadow_map_size = shadow_map;
   ao.show_timing = script.empty();
+  if (!script.empty()) ao.motion_scale = 1.0;  // every scripted frame in full: reproducible pictures
   if (bench_frames > 0) ao.visible = false, ao.show_timing = false, ao.motion_scale = 1.0;
   if (bench_frames > 0) {
     // Full resolution throughout, then as interaction draws it (reduced while moving).

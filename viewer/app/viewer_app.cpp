@@ -123,6 +123,7 @@ struct ViewerApp::Impl {
   GLuint main_texture = 0;
   std::string main_key;  // what the main texture shows
   bool main_full = false;  // ... at full resolution
+  bool full_now = false;   // a screenshot: draw in full whatever moved just before
   std::chrono::steady_clock::time_point last_change;
   int shadow_map_size = 2048;
   InputState input;
@@ -202,7 +203,7 @@ struct ViewerApp::Impl {
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
     // Reduced while things move, full once idle.
-    const bool moving = options.motion_scale < 1 &&
+    const bool moving = options.motion_scale < 1 && !full_now &&
                         (drag != Drag::kNone || std::chrono::duration<double>(now - last_change).count() < 0.3);
     if (key == main_key && main_texture && (moving || main_full)) return;
     main_key = key;
@@ -959,9 +960,11 @@ void ViewerApp::Screenshot(const ViewerModel& model, const std::string& path, in
   // Two frames, so that panels placed in the first are drawn in place in the second; then the back
   // buffer as it would be shown.
   Impl& m = *impl_;
+  m.full_now = true;
   m.OneFrame();
   glfwSwapBuffers(m.window);
   m.OneFrame();
+  m.full_now = false;
   int fw = 0, fh = 0;
   glfwGetFramebufferSize(m.window, &fw, &fh);
   std::vector<unsigned char> pixels(std::size_t(fw) * fh * 4);
