@@ -18,6 +18,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 
 #include "analysis/error.h"
 #include "analysis/inside_mesh.h"
@@ -431,15 +432,19 @@ struct RigData {
 };
 
 // A block's new leaves, made in the parallel phase and put into the grids in the serial one.
+// An update rewrites the grids' own leaves in place where they exist (not owned here).
 struct BlockLeaves {
   openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
+  bool coverage_owned = false;
   bool coverage_tile = false;
   std::array<FloatLeaf*, kFloatFieldCount> floats{};
+  std::array<bool, kFloatFieldCount> float_owned{};
   std::array<bool, kFloatFieldCount> remove_float{};
   std::vector<std::pair<int, openvdb::BoolTree::LeafNodeType*>> visible;  // changed cameras
   void Free() {
-    delete coverage;
-    for (FloatLeaf* f : floats) delete f;
+    if (coverage_owned) delete coverage;
+    for (int f = 0; f < kFloatFieldCount; ++f)
+      if (float_owned[f]) delete floats[f];
     for (auto& v : visible) delete v.second;
   }
 };
@@ -459,6 +464,7 @@ struct FieldEvaluator::State {
   ActiveSetStats active_stats;
   double active_set_seconds = 0;
   Rig rig;  // as of the last update
+  std::array<openvdb::FloatGrid*, kFloatFieldCount> float_grids{};  // in fields, by FloatField
   bool evaluated = false;
   Fields fields;
 
@@ -476,7 +482,8 @@ struct FieldEvaluator::State {
             std::vector<Ray>* rays) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
-              const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves) const;
+              const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
+              bool in_place);
   void Totals(FieldStats* stats, int camera_count, int enabled) const;
   void ResetGrids(int camera_count);
 };
@@ -507,6 +514,7 @@ void FieldEvaluator::State::ResetGrids(int camera_count) {
     openvdb::FloatGrid::Ptr grid;
     MakeGrid(grid, kFloatFieldNames[f], g.transform);
     g.floats[kFloatFieldNames[f]] = grid;
+    float_grids[f] = grid.get();
   }
   if (want_cameras) {
     g.visible.resize(camera_count);
@@ -586,23 +594,26 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
 }
 
 // Recomputes the voxels in `dirty` from the block's camera entries (`view`, ascending camera:
-// the kept ones and the re-cast ones), summing in rig order, and makes the block's new leaves:
-// copies of the current ones with the dirty voxels rewritten. The same arithmetic for a full
-// evaluation (every voxel dirty) and an update, so both give the same bits.
+// the kept ones and the re-cast ones) and the kept caches, and makes the block's new leaves:
+// copies of the current ones with the dirty voxels rewritten, or (`in_place`, an update that can
+// no longer be cancelled; `next` is then `old`) the grids' own leaves rewritten in place, new
+// leaves only where the grid has none. The same arithmetic for a full evaluation (every voxel
+// dirty) and an update, so both give the same bits.
 void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
                                    std::vector<const CameraEntry*> view, const Bits& dirty,
                                    const std::vector<std::uint8_t>& is_changed,
                                    const std::vector<Vec3>& centres, BlockState* next,
-                                   BlockLeaves* leaves) const {
+                                   BlockLeaves* leaves, bool in_place) {
   // Entries that see nothing take no part.
   view.erase(std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
              view.end());
-  const Fields::Impl& g = fields.impl();
+  Fields::Impl& g = fields.impl();
   const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
   const VoxelLattice& lattice = fields.lattice;
 
   // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
   const bool fresh = old.coverage.empty();
+  if (in_place && next != &old) throw std::logic_error("Derive in place: next must be old");
   if (fresh) {
     next->coverage.assign(512, 0);
     next->status.assign(512, kUnseen);
@@ -613,7 +624,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       next->pair_a.assign(512, -1);
       next->pair_b.assign(512, -1);
     }
-  } else {
+  } else if (!in_place) {
     next->coverage = old.coverage;
     next->status = old.status;
     next->sigma_max = old.sigma_max;
@@ -632,7 +643,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       next->sum_band.assign(512, kNotExact);
       next->band_count.assign(512, 0);
     }
-  } else {
+  } else if (!in_place) {
     next->best_density = old.best_density;
     next->best_camera = old.best_camera;
     next->sums = old.sums;
@@ -641,20 +652,31 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   }
 
   // Leaves to rewrite: copies of the grids' current ones, or new ones.
+  // (probeLeaf changes no tree structure, and every block has leaves of its own: the threads
+  // never write the same leaf.)
   if (want_coverage) {
-    const auto* current = g.coverage->tree().probeConstLeaf(origin);
-    if (current) {
+    auto* current = g.coverage->tree().probeLeaf(origin);
+    if (current && in_place) {
+      leaves->coverage = current;
+    } else if (current) {
       leaves->coverage = new openvdb::Int32Tree::LeafNodeType(*current);
+      leaves->coverage_owned = true;
     } else {
       // None yet, or a tile of zeros (a full block nobody saw): every voxel active at 0.
       const bool tile = g.coverage->tree().isValueOn(origin);
       leaves->coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, tile);
+      leaves->coverage_owned = true;
     }
   }
   for (int f = 0; f < kFloatFieldCount; ++f) {
     if (!want_float[f]) continue;
-    const auto* current = g.floats.at(kFloatFieldNames[f])->tree().probeConstLeaf(origin);
-    leaves->floats[f] = current ? new FloatLeaf(*current) : new FloatLeaf(origin, 0.0f, false);
+    FloatLeaf* current = float_grids[f]->tree().probeLeaf(origin);
+    if (current && in_place) {
+      leaves->floats[f] = current;
+    } else {
+      leaves->floats[f] = current ? new FloatLeaf(*current) : new FloatLeaf(origin, 0.0f, false);
+      leaves->float_owned[f] = true;
+    }
   }
 
   // Per dirty voxel: coverage, density, information in rig order.
@@ -981,14 +1003,16 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
 
   // Leaves: a full block nobody sees keeps its coverage as a tile; empty float leaves go.
   if (leaves->coverage && block.full && next->seen == 0) {
-    delete leaves->coverage;
+    if (leaves->coverage_owned) delete leaves->coverage;
     leaves->coverage = nullptr;
+    leaves->coverage_owned = false;
     leaves->coverage_tile = true;
   }
   for (int f = 0; f < kFloatFieldCount; ++f)
     if (leaves->floats[f] && leaves->floats[f]->isEmpty()) {
-      delete leaves->floats[f];
+      if (leaves->float_owned[f]) delete leaves->floats[f];
       leaves->floats[f] = nullptr;
+      leaves->float_owned[f] = false;
       leaves->remove_float[f] = true;
     }
 }
@@ -1218,7 +1242,11 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     }
   }
 
-  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves.
+  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves. A full
+  // evaluation does both per block (the per-pair data is dropped block by block without kept
+  // state). An update casts every changed camera first, where it can still be cancelled, then
+  // derives in place: into the kept caches and the grids' own leaves, no copies.
+  const bool in_place = S.evaluated;
   std::vector<BlockState> next(dirty.size());
   std::vector<std::vector<CameraEntry>> cast(dirty.size());
   std::vector<BlockLeaves> leaves(dirty.size());
@@ -1226,6 +1254,75 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   std::atomic<std::int64_t> dirty_voxels{0};
   std::atomic<bool> cancelled{false};
   const std::size_t report_every = std::max<std::size_t>(1, dirty.size() / 200);
+  const double phases = in_place ? 2.0 : 1.0;
+  const auto derive = [&](std::size_t i) {
+    const std::size_t b = dirty[i];
+    const Block& block = S.blocks[b];
+    BlockState& old = S.states[b];
+    // Dirty voxels: where a changed camera saw or sees.
+    Bits voxels{};
+    if (old.coverage.empty()) {
+      for (int x = 0; x < block.extent.x(); ++x)
+        for (int y = 0; y < block.extent.y(); ++y)
+          for (int z = 0; z < block.extent.z(); ++z)
+            if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
+    } else {
+      for (const CameraEntry& e : old.entries)
+        if (is_changed[e.camera])
+          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+      for (const CameraEntry& e : cast[i])
+        for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+    }
+    std::int64_t count = 0;
+    for (std::uint64_t w : voxels) count += PopcountInline(w);
+    dirty_voxels += count;
+    std::vector<const CameraEntry*> view;
+    view.reserve(old.entries.size() + cast[i].size());
+    for (const CameraEntry& e : old.entries)
+      if (!is_changed[e.camera]) view.push_back(&e);
+    for (const CameraEntry& e : cast[i]) view.push_back(&e);
+    std::sort(view.begin(), view.end(),
+              [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
+    if (count > 0 || old.coverage.empty())
+      S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
+               in_place ? &old : &next[i], &leaves[i], in_place);
+    // Camera grids: a leaf per re-cast camera that sees part of the block.
+    if (S.want_cameras)
+      for (const CameraEntry& e : cast[i]) {
+        if (e.seen == 0) continue;
+        const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+        auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
+        for (int w = 0; w < kWords; ++w)
+          for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
+            leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
+        leaves[i].visible.emplace_back(e.camera, leaf);
+      }
+    if (!S.keep) {
+      // One evaluation only: keep the summary, drop per-pair data and caches.
+      for (CameraEntry& e : cast[i]) {
+        std::vector<double>().swap(e.information);
+        std::vector<std::uint8_t>().swap(e.band);
+        std::vector<float>().swap(e.density);
+      }
+      std::vector<std::int32_t>().swap(next[i].coverage);
+      std::vector<std::uint8_t>().swap(next[i].status);
+      std::vector<float>().swap(next[i].sigma_max);
+      std::vector<float>().swap(next[i].sigma_steady);
+      std::vector<double>().swap(next[i].pair_dot);
+      std::vector<std::int32_t>().swap(next[i].pair_a);
+      std::vector<std::int32_t>().swap(next[i].pair_b);
+      std::vector<float>().swap(next[i].best_density);
+      std::vector<std::int32_t>().swap(next[i].best_camera);
+      std::vector<Sum6>().swap(next[i].sums);
+      std::vector<std::uint8_t>().swap(next[i].sum_band);
+      std::vector<std::int32_t>().swap(next[i].band_count);
+    }
+  };
+  const auto report = [&](double base) {
+    const std::size_t n = done.fetch_add(1) + 1;
+    if (opt.progress && (n % report_every == 0 || n == dirty.size()))
+      opt.progress((base + double(n) / double(dirty.size())) / phases);
+  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       if (cancelled.load(std::memory_order_relaxed)) return;
@@ -1234,73 +1331,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         return;
       }
       const std::size_t b = dirty[i];
-      const Block& block = S.blocks[b];
-      const BlockState& old = S.states[b];
       // The changed cameras that may see the block now.
       for (int c : changed)
         if (std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
           cast[i].emplace_back();
-          S.Cast(block, c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
+          S.Cast(S.blocks[b], c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
         }
-      // Dirty voxels: where a changed camera saw or sees.
-      Bits voxels{};
-      if (old.coverage.empty()) {
-        for (int x = 0; x < block.extent.x(); ++x)
-          for (int y = 0; y < block.extent.y(); ++y)
-            for (int z = 0; z < block.extent.z(); ++z)
-              if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
-      } else {
-        for (const CameraEntry& e : old.entries)
-          if (is_changed[e.camera])
-            for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-        for (const CameraEntry& e : cast[i])
-          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-      }
-      std::int64_t count = 0;
-      for (std::uint64_t w : voxels) count += __builtin_popcountll(w);
-      dirty_voxels += count;
-      std::vector<const CameraEntry*> view;
-      view.reserve(old.entries.size() + cast[i].size());
-      for (const CameraEntry& e : old.entries)
-        if (!is_changed[e.camera]) view.push_back(&e);
-      for (const CameraEntry& e : cast[i]) view.push_back(&e);
-      std::sort(view.begin(), view.end(),
-                [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
-      if (count > 0 || old.coverage.empty())
-        S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres, &next[i], &leaves[i]);
-      // Camera grids: a leaf per re-cast camera that sees part of the block.
-      if (S.want_cameras)
-        for (const CameraEntry& e : cast[i]) {
-          if (e.seen == 0) continue;
-          const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
-          auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
-          for (int w = 0; w < kWords; ++w)
-            for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
-              leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
-          leaves[i].visible.emplace_back(e.camera, leaf);
-        }
-      if (!S.keep) {
-        // One evaluation only: keep the summary, drop per-pair data and caches.
-        for (CameraEntry& e : cast[i]) {
-          std::vector<double>().swap(e.information);
-          std::vector<float>().swap(e.density);
-        }
-        std::vector<std::int32_t>().swap(next[i].coverage);
-        std::vector<std::uint8_t>().swap(next[i].status);
-        std::vector<float>().swap(next[i].sigma_max);
-        std::vector<float>().swap(next[i].sigma_steady);
-        std::vector<double>().swap(next[i].pair_dot);
-        std::vector<std::int32_t>().swap(next[i].pair_a);
-        std::vector<std::int32_t>().swap(next[i].pair_b);
-        std::vector<float>().swap(next[i].best_density);
-        std::vector<std::int32_t>().swap(next[i].best_camera);
-        std::vector<Sum6>().swap(next[i].sums);
-        std::vector<std::uint8_t>().swap(next[i].sum_band);
-        std::vector<std::int32_t>().swap(next[i].band_count);
-      }
-      const std::size_t n = done.fetch_add(1) + 1;
-      if (opt.progress && (n % report_every == 0 || n == dirty.size()))
-        opt.progress(double(n) / double(dirty.size()));
+      if (!in_place) derive(i);
+      report(0.0);
     }
   });
   if (cancelled) {
@@ -1312,6 +1350,15 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     update.cancelled = true;
     update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return update;
+  }
+  if (in_place) {
+    done = 0;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        derive(i);
+        report(1.0);
+      }
+    });
   }
 
   // The serial phase: the new leaves into the grids, the new entries and caches into the state.
@@ -1329,12 +1376,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     BlockState& s = S.states[b];
     BlockLeaves& l = leaves[i];
     if (l.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
-    if (l.coverage) g.coverage->tree().addLeaf(l.coverage);
+    if (l.coverage && l.coverage_owned) g.coverage->tree().addLeaf(l.coverage);
     for (int f = 0; f < kFloatFieldCount; ++f) {
       if (!S.want_float[f]) continue;
-      openvdb::FloatTree& tree = g.floats[kFloatFieldNames[f]]->tree();
-      if (l.floats[f])
+      openvdb::FloatTree& tree = S.float_grids[f]->tree();
+      if (l.floats[f] && l.float_owned[f])
         tree.addLeaf(l.floats[f]);
+      else if (l.floats[f])
+        ;  // rewritten in place
       else if (l.remove_float[f] && tree.probeConstLeaf(origin))
         tree.addTile(1, origin, 0.0f, false);
     }
