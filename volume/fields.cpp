@@ -927,13 +927,14 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
           pb[g][k] = entry_of(cb);
         }
       }
-      std::vector<double> directions(3 * 64 * view.size());
+      // Scratch, every entry written before it is read: no zero fill (36 KiB for 24 cameras).
+      const std::unique_ptr<double[]> directions(new double[3 * 64 * view.size()]);
       for (int g = 0; g < 2; ++g)
         if (size[g] > 0)
           TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
                               static_cast<int>(view.size()), sees.data(), entry_centres.data(),
                               g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
-                              pb[g].data(), directions.data(), degrees[g].data());
+                              pb[g].data(), directions.get(), degrees[g].data());
       for (int m = 0; m < candidate_count; ++m) {
         const int g = which[m], k = group_of[m], o = candidate[m];
         angle_deg[m] = degrees[g][k];
