@@ -4,9 +4,6 @@
 #include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#if defined(__x86_64__) && defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -312,9 +309,10 @@ inline std::uint8_t Band(const double* c) {
   return static_cast<std::uint8_t>(e >> kBandShift);
 }
 
-// Per band k < 63: 2^-q as two factors (2^-q itself may overflow), and 2^q likewise.
+// Per band k < 63: its q, and 2^q as two factors (2^q itself may underflow).
 struct BandScale {
-  double down[2], up[2];
+  int q;
+  double up[2];
 };
 const std::array<BandScale, 64>& BandScales() {
   static const std::array<BandScale, 64> table = [] {
@@ -322,8 +320,7 @@ const std::array<BandScale, 64>& BandScales() {
     for (int k = 0; k < 63; ++k) {
       const int q = 32 * (k + 1) - 1129;
       const int half = q / 2;
-      t[k].down[0] = std::ldexp(1.0, -half);
-      t[k].down[1] = std::ldexp(1.0, -(q - half));
+      t[k].q = q;
       t[k].up[0] = std::ldexp(1.0, half);
       t[k].up[1] = std::ldexp(1.0, q - half);
     }
@@ -332,20 +329,29 @@ const std::array<BandScale, 64>& BandScales() {
   return table;
 }
 
-// Round to the nearest integer (ties to even) of x, |x| < 2^107.
-inline Int128 ToFixed(double x) {
-  if (std::fabs(x) < 0x1p62) {
-#if defined(__x86_64__) && defined(__SSE2__)
-    return static_cast<Int128>(_mm_cvtsd_si64(_mm_set_sd(x)));  // MXCSR: round to nearest
-#else
-    return static_cast<Int128>(std::llrint(x));
-#endif
+// c / 2^q rounded to the nearest integer (ties to even), from c's bits: no multiplication, no
+// library call. For a contribution in band k or below with q = 32 (k + 1) - 1129 the result is
+// below 2^106 in magnitude, so the left shift is at most 54.
+inline Int128 ToFixed(double c, int q) {
+  const std::uint64_t b = DoubleBits(c);
+  int e = static_cast<int>((b >> 52) & 0x7ff);
+  std::uint64_t m = b & ((std::uint64_t{1} << 52) - 1);
+  if (e != 0)
+    m |= std::uint64_t{1} << 52;
+  else
+    e = 1;  // subnormal
+  const int shift = e - 1075 - q;  // |c| / 2^q = m 2^shift
+  Int128 v;
+  if (shift >= 0) {
+    v = static_cast<Int128>(static_cast<unsigned __int128>(m) << shift);
+  } else if (shift < -63) {
+    v = 0;  // m < 2^53: below one half
+  } else {
+    const int r = -shift;
+    const std::uint64_t t = m >> r, rest = m & ((std::uint64_t{1} << r) - 1),
+                        half = std::uint64_t{1} << (r - 1);
+    v = static_cast<Int128>(t + ((rest > half) | ((rest == half) & (t & 1))));
   }
-  // |x| >= 2^62 is an integer: its 53-bit significand shifted left.
-  const std::uint64_t b = DoubleBits(x);
-  const int e = static_cast<int>((b >> 52) & 0x7ff);
-  const std::uint64_t m = (b & ((std::uint64_t{1} << 52) - 1)) | (std::uint64_t{1} << 52);
-  const Int128 v = static_cast<Int128>(static_cast<unsigned __int128>(m) << (e - 1075));
   return (b >> 63) ? -v : v;
 }
 
@@ -369,10 +375,10 @@ inline double ToDouble(Int128 s) {
   return negative ? -d : d;
 }
 
-// Adds (sign +1) or subtracts (-1) contribution c rounded on band k's grid.
+// Adds (`add`) or subtracts contribution c rounded on its band's grid.
 inline void Accumulate(Sum6& sum, const double* c, const BandScale& scale, bool add) {
   for (int k = 0; k < 6; ++k) {
-    const Int128 v = ToFixed(c[k] * scale.down[0] * scale.down[1]);
+    const Int128 v = ToFixed(c[k], scale.q);
     sum.v[k] = add ? sum.v[k] + v : sum.v[k] - v;
   }
 }
@@ -703,7 +709,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   std::array<std::int32_t, 512> cover;
   Bits rescan_density{}, rescan_info{};
   const std::array<BandScale, 64>& scales = BandScales();
-  const auto walk = [](const CameraEntry& e, auto&& f) {  // every seen voxel, with its index
+  const auto walk = [](const CameraEntry& e, auto&& f) __attribute__((always_inline)) {  // every seen voxel, with its index
     int index = 0;
     for (int w = 0; w < kWords; ++w)
       for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
@@ -717,7 +723,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
     for (const CameraEntry* e : view) {
       if (!is_changed[e->camera]) continue;
-      walk(*e, [&](int o, int index) {  // a changed camera's new view
+      walk(*e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
         ++cover[o];
         if (want_resolution && e->density[index] > next->best_density[o]) {
           next->best_density[o] = e->density[index];
@@ -736,7 +742,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     }
     for (const CameraEntry& e : old.entries) {
       if (!is_changed[e.camera] || e.seen == 0) continue;
-      walk(e, [&](int o, int index) {  // a changed camera's old view
+      walk(e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
         --cover[o];
         if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
         if (want_information && !TestBit(rescan_info, o)) {
@@ -762,7 +768,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   Bits rescan = rescan_density;
   for (int w = 0; w < kWords; ++w) rescan[w] |= rescan_info[w];
   if (fresh) rescan = dirty;
-  const auto walk_masked = [](const CameraEntry& e, const Bits& mask, auto&& f) {
+  const auto walk_masked = [](const CameraEntry& e, const Bits& mask, auto&& f) __attribute__((always_inline)) {
     for (int w = 0; w < kWords; ++w) {
       const std::uint64_t seen = e.bits[w], wanted = seen & mask[w];
       if (!wanted) continue;
@@ -798,7 +804,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       }
     }
     for (const CameraEntry* e : view)
-      walk_masked(*e, rescan, [&](int o, int index) {
+      walk_masked(*e, rescan, [&](int o, int index) __attribute__((always_inline)) {
         if (fresh) ++cover[o];
         if (TestBit(rescan_density, o) && e->density[index] > next->best_density[o]) {
           next->best_density[o] = e->density[index];
@@ -832,7 +838,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     }
     if (any_info)
       for (const CameraEntry* e : view)
-        walk_masked(*e, rescan_info, [&](int o, int index) {
+        walk_masked(*e, rescan_info, [&](int o, int index) __attribute__((always_inline)) {
           const double* c = &e->information[6 * index];
           if (TestBit(in_double, o)) {
             std::array<double, 6>& d = double_sum[double_index[o]];
