@@ -11,9 +11,11 @@
 #include <chrono>
 #include <ctime>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 
 #include "analysis/error.h"
 #include "analysis/inside_mesh.h"
@@ -176,11 +178,14 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
       const double cx = centres[c].x(), cy = centres[c].y(), cz = centres[c].z();
       const std::uint64_t* mask = sees[c];
       double* d = dirs + 3 * kTile * c;
+      // The mask bits first, as 0 or NaN to add (GCC vectorises neither the bit gather nor a
+      // select after the square root), then the directions in SIMD: 1/|v| + 0 is 1/|v|.
+      double unseen[kTile];
+      for (int m = 0; m < n; ++m) unseen[m] = (mask[to[m] >> 6] >> (to[m] & 63) & 1) ? 0.0 : nan;
 #pragma omp simd
       for (int m = 0; m < n; ++m) {
         const double vx = tx[m] - cx, vy = ty[m] - cy, vz = tz[m] - cz;
-        const bool seen = (mask[to[m] >> 6] >> (to[m] & 63) & 1) != 0;
-        const double inv = seen ? 1.0 / std::sqrt(vx * vx + vy * vy + vz * vz) : nan;
+        const double inv = 1.0 / std::sqrt(vx * vx + vy * vy + vz * vz) + unseen[m];
         d[m] = vx * inv;
         d[m + kTile] = vy * inv;
         d[m + 2 * kTile] = vz * inv;
@@ -248,19 +253,135 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
 
 constexpr int kWords = 8;  // 512 voxels of a block as bits
 
-// The hardware population count where the CPU has one (every x86-64 since 2008); GCC's generic
-// __builtin_popcountll is a library call without -mpopcnt.
-#if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("popcnt"))) inline int PopcountHw(std::uint64_t x) { return __builtin_popcountll(x); }
-inline int Popcount(std::uint64_t x) {
-  static const bool hw = __builtin_cpu_supports("popcnt");
-  return hw ? PopcountHw(x) : __builtin_popcountll(x);
-}
-#else
-inline int Popcount(std::uint64_t x) { return __builtin_popcountll(x); }
-#endif
 using Bits = std::array<std::uint64_t, kWords>;
 inline void SetBit(Bits& b, int o) { b[o >> 6] |= std::uint64_t{1} << (o & 63); }
+inline bool TestBit(const Bits& b, int o) { return (b[o >> 6] >> (o & 63) & 1) != 0; }
+// Inline population count (no library call, no CPU dispatch) for sparse masked walks.
+inline int PopcountInline(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ULL);
+  x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
+  return static_cast<int>((x * 0x0101010101010101ULL) >> 56);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The exact information sum. A voxel's information J is the sum of its cameras' contributions
+// (six doubles each). Summed in double, the bits depend on the order, so an update would have to
+// re-read every camera's contribution. Instead each contribution is rounded once to a fixed-point
+// integer (int128) on a grid of spacing 2^q and the integers are summed: exact, so in any order
+// and by subtracting one camera's old contribution and adding its new one, with the same bits.
+// The grid depends on the voxel's largest contribution: its "band" is the largest IEEE exponent
+// field e (biased, 0..2047) of the contribution's six entries, shifted right by 5 (bands of 32
+// binades). A voxel's band k is the largest band of its contributions; then every entry is below
+// 2^(32 (k + 1) - 1023), q = 32 (k + 1) - 1129, every rounded entry is below 2^106 in magnitude and
+// the sum of up to 2^20 of them below 2^126: no overflow. The spacing is 2^-74 .. 2^-106 of the
+// largest entry of the largest contribution, itself at most the largest eigenvalue of J (J is a
+// sum of positive semi-definite matrices, so its largest entry is on the diagonal), so the
+// rounding moves every eigenvalue by at most 2^-75 N lambda_max (Weyl), far below the 2^-53
+// lambda_max of the double sum and of the eigenvalue solver. The integer sum is then rounded to
+// double once (correctly rounded), so J is at least as accurate as a double sum in rig order.
+// Voxels with a contribution in band 63 (an entry >= 2^993, inf or NaN) or more than 2^20 cameras
+// are summed in double in rig order as before (a function of the contributions only, so a full
+// evaluation and an update choose alike). Per voxel the evaluator keeps the sums, the band and how
+// many contributions are in it; an update that removes the last one of the top band, or adds one
+// above it, re-sums that voxel from every camera.
+constexpr int kBandShift = 5;
+constexpr std::uint8_t kNotExact = 63;  // also: a voxel without contributions
+constexpr int kMaxExactCameras = 1 << 20;
+using Int128 = __int128;
+struct Sum6 {
+  Int128 v[6];
+};
+
+inline std::uint64_t DoubleBits(double x) {
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof(b));
+  return b;
+}
+inline double BitsDouble(std::uint64_t b) {
+  double x;
+  std::memcpy(&x, &b, sizeof(x));
+  return x;
+}
+inline std::uint8_t Band(const double* c) {
+  std::uint64_t e = 0;
+  for (int k = 0; k < 6; ++k) e = std::max(e, (DoubleBits(c[k]) >> 52) & 0x7ff);
+  return static_cast<std::uint8_t>(e >> kBandShift);
+}
+
+// Per band k < 63: its q, and 2^q as two factors (2^q itself may underflow).
+struct BandScale {
+  int q;
+  double up[2];
+};
+const std::array<BandScale, 64>& BandScales() {
+  static const std::array<BandScale, 64> table = [] {
+    std::array<BandScale, 64> t{};
+    for (int k = 0; k < 63; ++k) {
+      const int q = 32 * (k + 1) - 1129;
+      const int half = q / 2;
+      t[k].q = q;
+      t[k].up[0] = std::ldexp(1.0, half);
+      t[k].up[1] = std::ldexp(1.0, q - half);
+    }
+    return t;
+  }();
+  return table;
+}
+
+// c / 2^q rounded to the nearest integer (ties to even), from c's bits: no multiplication, no
+// library call. For a contribution in band k or below with q = 32 (k + 1) - 1129 the result is
+// below 2^106 in magnitude, so the left shift is at most 54.
+inline Int128 ToFixed(double c, int q) {
+  const std::uint64_t b = DoubleBits(c);
+  int e = static_cast<int>((b >> 52) & 0x7ff);
+  std::uint64_t m = b & ((std::uint64_t{1} << 52) - 1);
+  if (e != 0)
+    m |= std::uint64_t{1} << 52;
+  else
+    e = 1;  // subnormal
+  const int shift = e - 1075 - q;  // |c| / 2^q = m 2^shift
+  Int128 v;
+  if (shift >= 0) {
+    v = static_cast<Int128>(static_cast<unsigned __int128>(m) << shift);
+  } else if (shift < -63) {
+    v = 0;  // m < 2^53: below one half
+  } else {
+    const int r = -shift;
+    const std::uint64_t t = m >> r, rest = m & ((std::uint64_t{1} << r) - 1),
+                        half = std::uint64_t{1} << (r - 1);
+    v = static_cast<Int128>(t + ((rest > half) | ((rest == half) & (t & 1))));
+  }
+  return (b >> 63) ? -v : v;
+}
+
+// The int128 as the nearest double (ties to even), without a library call.
+inline double ToDouble(Int128 s) {
+  const bool negative = s < 0;
+  const unsigned __int128 u = negative ? -static_cast<unsigned __int128>(s) : s;
+  double d;
+  if ((u >> 63) == 0) {
+    d = static_cast<double>(static_cast<std::int64_t>(u));
+  } else {
+    // Keep the top 63 bits, the dropped ones as a sticky bit: one correct rounding to 53 bits.
+    const std::uint64_t hi = static_cast<std::uint64_t>(u >> 64);
+    const int bits = hi ? 128 - __builtin_clzll(hi) : 64;
+    const int shift = bits - 63;
+    std::uint64_t t = static_cast<std::uint64_t>(u >> shift);
+    if (static_cast<std::uint64_t>(u) & ((std::uint64_t{1} << shift) - 1)) t |= 1;
+    d = static_cast<double>(static_cast<std::int64_t>(t)) *
+        BitsDouble(static_cast<std::uint64_t>(1023 + shift) << 52);
+  }
+  return negative ? -d : d;
+}
+
+// Adds (`add`) or subtracts contribution c rounded on its band's grid.
+inline void Accumulate(Sum6& sum, const double* c, const BandScale& scale, bool add) {
+  for (int k = 0; k < 6; ++k) {
+    const Int128 v = ToFixed(c[k], scale.q);
+    sum.v[k] = add ? sum.v[k] + v : sum.v[k] - v;
+  }
+}
 
 // What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,
 // its information contribution A^T A (six doubles, AddCameraInformation on zeros) and pixel density.
@@ -271,9 +392,10 @@ struct CameraEntry {
   Bits bits{};
   std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
   std::vector<double> information;  // with an information field
+  std::vector<std::uint8_t> band;   // with an information field: Band() of each contribution
   std::vector<float> density;       // with resolution
   double Bytes() const {
-    return sizeof(CameraEntry) + information.capacity() * sizeof(double) +
+    return sizeof(CameraEntry) + information.capacity() * sizeof(double) + band.capacity() +
            density.capacity() * sizeof(float);
   }
 };
@@ -291,6 +413,14 @@ struct BlockState {
   // cameras' rig indices; a = -1 where none), with triangulation_angle.
   std::vector<double> pair_dot;
   std::vector<std::int32_t> pair_a, pair_b;
+  // With resolution: the best pixel density and a camera that has it (-1: none).
+  std::vector<float> best_density;
+  std::vector<std::int32_t> best_camera;
+  // With an information field: the exact sums, their band (kNotExact: summed in double, or no
+  // camera) and how many contributions lie in that band.
+  std::vector<Sum6> sums;
+  std::vector<std::uint8_t> sum_band;
+  std::vector<std::int32_t> band_count;
   // Summary.
   std::vector<std::int64_t> histogram;  // [k] = free voxels seen by k cameras
   std::int64_t seen = 0, triangulable = 0, unobservable = 0;
@@ -308,15 +438,19 @@ struct RigData {
 };
 
 // A block's new leaves, made in the parallel phase and put into the grids in the serial one.
+// An update rewrites the grids' own leaves in place where they exist (not owned here).
 struct BlockLeaves {
   openvdb::Int32Tree::LeafNodeType* coverage = nullptr;
+  bool coverage_owned = false;
   bool coverage_tile = false;
   std::array<FloatLeaf*, kFloatFieldCount> floats{};
+  std::array<bool, kFloatFieldCount> float_owned{};
   std::array<bool, kFloatFieldCount> remove_float{};
   std::vector<std::pair<int, openvdb::BoolTree::LeafNodeType*>> visible;  // changed cameras
   void Free() {
-    delete coverage;
-    for (FloatLeaf* f : floats) delete f;
+    if (coverage_owned) delete coverage;
+    for (int f = 0; f < kFloatFieldCount; ++f)
+      if (float_owned[f]) delete floats[f];
     for (auto& v : visible) delete v.second;
   }
 };
@@ -336,6 +470,7 @@ struct FieldEvaluator::State {
   ActiveSetStats active_stats;
   double active_set_seconds = 0;
   Rig rig;  // as of the last update
+  std::array<openvdb::FloatGrid*, kFloatFieldCount> float_grids{};  // in fields, by FloatField
   bool evaluated = false;
   Fields fields;
 
@@ -353,7 +488,8 @@ struct FieldEvaluator::State {
             std::vector<Ray>* rays) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
-              const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves) const;
+              const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
+              bool in_place);
   void Totals(FieldStats* stats, int camera_count, int enabled) const;
   void ResetGrids(int camera_count);
 };
@@ -384,6 +520,7 @@ void FieldEvaluator::State::ResetGrids(int camera_count) {
     openvdb::FloatGrid::Ptr grid;
     MakeGrid(grid, kFloatFieldNames[f], g.transform);
     g.floats[kFloatFieldNames[f]] = grid;
+    float_grids[f] = grid.get();
   }
   if (want_cameras) {
     g.visible.resize(camera_count);
@@ -435,6 +572,13 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
   if (rays) rays->insert(rays->end(), segments.begin(), segments.begin() + n);
   entry->camera = camera;
   entry->rays = static_cast<std::int32_t>(n);
+  std::size_t visible = 0;
+  for (std::size_t i = 0; i < n; ++i) visible += occluded[i] ? 0 : 1;
+  if (want_resolution) entry->density.reserve(visible);
+  if (want_information) {
+    entry->information.reserve(6 * visible);
+    entry->band.reserve(visible);
+  }
   // Offsets come in ascending order (x, y, z loops, Offset = 64 x + 8 y + z).
   for (std::size_t i = 0; i < n; ++i) {
     if (occluded[i]) continue;
@@ -445,6 +589,7 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
       double contribution[6] = {0, 0, 0, 0, 0, 0};
       AddCameraInformation(jacobian[i], rd.whitened[camera].data(), contribution);
       entry->information.insert(entry->information.end(), contribution, contribution + 6);
+      entry->band.push_back(Band(contribution));
     }
   }
   int before = 0;
@@ -455,23 +600,26 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
 }
 
 // Recomputes the voxels in `dirty` from the block's camera entries (`view`, ascending camera:
-// the kept ones and the re-cast ones), summing in rig order, and makes the block's new leaves:
-// copies of the current ones with the dirty voxels rewritten. The same arithmetic for a full
-// evaluation (every voxel dirty) and an update, so both give the same bits.
+// the kept ones and the re-cast ones) and the kept caches, and makes the block's new leaves:
+// copies of the current ones with the dirty voxels rewritten, or (`in_place`, an update that can
+// no longer be cancelled; `next` is then `old`) the grids' own leaves rewritten in place, new
+// leaves only where the grid has none. The same arithmetic for a full evaluation (every voxel
+// dirty) and an update, so both give the same bits.
 void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
                                    std::vector<const CameraEntry*> view, const Bits& dirty,
                                    const std::vector<std::uint8_t>& is_changed,
                                    const std::vector<Vec3>& centres, BlockState* next,
-                                   BlockLeaves* leaves) const {
+                                   BlockLeaves* leaves, bool in_place) {
   // Entries that see nothing take no part.
   view.erase(std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
              view.end());
-  const Fields::Impl& g = fields.impl();
+  Fields::Impl& g = fields.impl();
   const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
   const VoxelLattice& lattice = fields.lattice;
 
   // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
   const bool fresh = old.coverage.empty();
+  if (in_place && next != &old) throw std::logic_error("Derive in place: next must be old");
   if (fresh) {
     next->coverage.assign(512, 0);
     next->status.assign(512, kUnseen);
@@ -482,7 +630,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       next->pair_a.assign(512, -1);
       next->pair_b.assign(512, -1);
     }
-  } else {
+  } else if (!in_place) {
     next->coverage = old.coverage;
     next->status = old.status;
     next->sigma_max = old.sigma_max;
@@ -491,22 +639,50 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     next->pair_a = old.pair_a;
     next->pair_b = old.pair_b;
   }
+  if (fresh) {
+    if (want_resolution) {
+      next->best_density.assign(512, 0.0f);
+      next->best_camera.assign(512, -1);
+    }
+    if (want_information) {
+      next->sums.assign(512, Sum6{});
+      next->sum_band.assign(512, kNotExact);
+      next->band_count.assign(512, 0);
+    }
+  } else if (!in_place) {
+    next->best_density = old.best_density;
+    next->best_camera = old.best_camera;
+    next->sums = old.sums;
+    next->sum_band = old.sum_band;
+    next->band_count = old.band_count;
+  }
 
   // Leaves to rewrite: copies of the grids' current ones, or new ones.
+  // (probeLeaf changes no tree structure, and every block has leaves of its own: the threads
+  // never write the same leaf.)
   if (want_coverage) {
-    const auto* current = g.coverage->tree().probeConstLeaf(origin);
-    if (current) {
+    auto* current = g.coverage->tree().probeLeaf(origin);
+    if (current && in_place) {
+      leaves->coverage = current;
+    } else if (current) {
       leaves->coverage = new openvdb::Int32Tree::LeafNodeType(*current);
+      leaves->coverage_owned = true;
     } else {
       // None yet, or a tile of zeros (a full block nobody saw): every voxel active at 0.
       const bool tile = g.coverage->tree().isValueOn(origin);
       leaves->coverage = new openvdb::Int32Tree::LeafNodeType(origin, 0, tile);
+      leaves->coverage_owned = true;
     }
   }
   for (int f = 0; f < kFloatFieldCount; ++f) {
     if (!want_float[f]) continue;
-    const auto* current = g.floats.at(kFloatFieldNames[f])->tree().probeConstLeaf(origin);
-    leaves->floats[f] = current ? new FloatLeaf(*current) : new FloatLeaf(origin, 0.0f, false);
+    FloatLeaf* current = float_grids[f]->tree().probeLeaf(origin);
+    if (current && in_place) {
+      leaves->floats[f] = current;
+    } else {
+      leaves->floats[f] = current ? new FloatLeaf(*current) : new FloatLeaf(origin, 0.0f, false);
+      leaves->float_owned[f] = true;
+    }
   }
 
   // Per dirty voxel: coverage, density, information in rig order.
@@ -524,31 +700,153 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
   FloatLeaf* resolution = leaves->floats[kResolution];
 
-  // Sums camera by camera in rig order (entry-major: each entry's seen voxels are walked once,
-  // with a running index into its contributions), the same order for every voxel.
-  std::array<std::int32_t, 512> cover{};
-  std::array<float, 512> best_density{};
-  // Per voxel, its six sums side by side (rows of 512 would put them 4 KiB apart: cache aliasing).
-  std::array<std::array<double, 6>, 512> sum;
-  if (want_information)
-    for (auto& row : sum) row.fill(0.0);
-  for (const CameraEntry* e : view) {
-    for (int w = 0; w < kWords; ++w) {
-      const std::uint64_t seen = e->bits[w];
-      const std::uint64_t wanted = seen & dirty[w];
-      if (!wanted) continue;
-      for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
-        const int bit = __builtin_ctzll(bits);
-        const int index = e->before[w] + Popcount(seen & ((std::uint64_t{1} << bit) - 1));
-        const int o = 64 * w + bit;
+  // Coverage, best density and information of the dirty voxels. A full evaluation sums every
+  // camera of every voxel. An update starts from the cached values and takes out the changed
+  // cameras' old contributions and puts in their new ones: coverage is a count, the density a
+  // maximum and the information an exact fixed-point sum (see Sum6), so the result has the bits of
+  // a full evaluation. A voxel whose best density came from a changed camera, or whose sum's band
+  // changes (or that is summed in double), is re-summed from every camera ("rescan").
+  std::array<std::int32_t, 512> cover;
+  Bits rescan_density{}, rescan_info{};
+  const std::array<BandScale, 64>& scales = BandScales();
+  const auto walk = [](const CameraEntry& e, auto&& f) __attribute__((always_inline)) {  // every seen voxel, with its index
+    int index = 0;
+    for (int w = 0; w < kWords; ++w)
+      for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
+        f(64 * w + __builtin_ctzll(bits), index++);
+  };
+  if (fresh) {
+    cover.fill(0);
+    if (want_resolution) rescan_density = dirty;
+    if (want_information) rescan_info = dirty;
+  } else {
+    for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
+    for (const CameraEntry* e : view) {
+      if (!is_changed[e->camera]) continue;
+      walk(*e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
         ++cover[o];
-        if (want_resolution) best_density[o] = std::max(best_density[o], e->density[index]);
-        if (want_information) {
-          const double* c = &e->information[6 * index];
-          for (int k = 0; k < 6; ++k) sum[o][k] += c[k];
+        if (want_resolution && e->density[index] > next->best_density[o]) {
+          next->best_density[o] = e->density[index];
+          next->best_camera[o] = e->camera;
+        }
+        if (want_information && !TestBit(rescan_info, o)) {
+          const std::uint8_t b = e->band[index], k = next->sum_band[o];
+          if (k == kNotExact || b > k) {
+            SetBit(rescan_info, o);
+          } else {
+            if (b == k) ++next->band_count[o];
+            Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
+          }
+        }
+      });
+    }
+    for (const CameraEntry& e : old.entries) {
+      if (!is_changed[e.camera] || e.seen == 0) continue;
+      walk(e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
+        --cover[o];
+        if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
+        if (want_information && !TestBit(rescan_info, o)) {
+          const std::uint8_t b = e.band[index], k = next->sum_band[o];
+          if (k == kNotExact || b > k) {
+            SetBit(rescan_info, o);
+          } else {
+            if (b == k) --next->band_count[o];
+            Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
+          }
+        }
+      });
+    }
+    if (want_information)
+      for (int w = 0; w < kWords; ++w)
+        for (std::uint64_t bits = dirty[w] & ~rescan_info[w]; bits; bits &= bits - 1) {
+          const int o = 64 * w + __builtin_ctzll(bits);
+          if (next->band_count[o] <= 0 || cover[o] > kMaxExactCameras) SetBit(rescan_info, o);
+        }
+  }
+  // Rescans, camera by camera in rig order: coverage (a full evaluation), best density, the band
+  // of the information sum and its count.
+  Bits rescan = rescan_density;
+  for (int w = 0; w < kWords; ++w) rescan[w] |= rescan_info[w];
+  if (fresh) rescan = dirty;
+  const auto walk_masked = [](const CameraEntry& e, const Bits& mask, auto&& f) __attribute__((always_inline)) {
+    for (int w = 0; w < kWords; ++w) {
+      const std::uint64_t seen = e.bits[w], wanted = seen & mask[w];
+      if (!wanted) continue;
+      if (wanted == seen) {
+        int index = e.before[w];
+        for (std::uint64_t bits = seen; bits; bits &= bits - 1) f(64 * w + __builtin_ctzll(bits), index++);
+      } else {
+        for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
+          const int bit = __builtin_ctzll(bits);
+          f(64 * w + bit, e.before[w] + PopcountInline(seen & ((std::uint64_t{1} << bit) - 1)));
         }
       }
     }
+  };
+  bool any_rescan = false;
+  for (std::uint64_t word : rescan) any_rescan |= word != 0;
+  // Voxels summed in double (rig order), by offset; rarely any.
+  Bits in_double{};
+  std::vector<std::array<double, 6>> double_sum;
+  std::array<std::int16_t, 512> double_index;
+  if (any_rescan) {
+    for (int w = 0; w < kWords; ++w) {
+      for (std::uint64_t bits = rescan_density[w]; bits; bits &= bits - 1) {
+        const int o = 64 * w + __builtin_ctzll(bits);
+        next->best_density[o] = 0.0f;
+        next->best_camera[o] = -1;
+      }
+      for (std::uint64_t bits = rescan_info[w]; bits; bits &= bits - 1) {
+        const int o = 64 * w + __builtin_ctzll(bits);
+        next->sums[o] = Sum6{};
+        next->sum_band[o] = 0;
+        next->band_count[o] = 0;
+      }
+    }
+    for (const CameraEntry* e : view)
+      walk_masked(*e, rescan, [&](int o, int index) __attribute__((always_inline)) {
+        if (fresh) ++cover[o];
+        if (TestBit(rescan_density, o) && e->density[index] > next->best_density[o]) {
+          next->best_density[o] = e->density[index];
+          next->best_camera[o] = e->camera;
+        }
+        if (TestBit(rescan_info, o)) {
+          const std::uint8_t b = e->band[index];
+          if (b > next->sum_band[o]) {
+            next->sum_band[o] = b;
+            next->band_count[o] = 1;
+          } else if (b == next->sum_band[o]) {
+            ++next->band_count[o];
+          }
+        }
+      });
+    bool any_info = false;
+    for (int w = 0; w < kWords; ++w) {
+      for (std::uint64_t bits = rescan_info[w]; bits; bits &= bits - 1) {
+        const int o = 64 * w + __builtin_ctzll(bits);
+        any_info = true;
+        if (cover[o] == 0 || cover[o] > kMaxExactCameras || next->sum_band[o] == kNotExact) {
+          next->sum_band[o] = kNotExact;
+          next->band_count[o] = 0;
+          if (cover[o] > 0) {
+            SetBit(in_double, o);
+            double_index[o] = static_cast<std::int16_t>(double_sum.size());
+            double_sum.push_back({0, 0, 0, 0, 0, 0});
+          }
+        }
+      }
+    }
+    if (any_info)
+      for (const CameraEntry* e : view)
+        walk_masked(*e, rescan_info, [&](int o, int index) __attribute__((always_inline)) {
+          const double* c = &e->information[6 * index];
+          if (TestBit(in_double, o)) {
+            std::array<double, 6>& d = double_sum[double_index[o]];
+            for (int k = 0; k < 6; ++k) d[k] += c[k];
+          } else {
+            Accumulate(next->sums[o], c, scales[next->sum_band[o]], true);
+          }
+        });
   }
 
   int candidate_count = 0;
@@ -556,7 +854,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     for (std::uint64_t bits = dirty[w]; bits; bits &= bits - 1) {
       const int o = 64 * w + __builtin_ctzll(bits);
       const int coverage = cover[o];
-      const float density = best_density[o];
+      const float density = want_resolution ? next->best_density[o] : 0.0f;
       next->coverage[o] = coverage;
       next->status[o] = coverage == 0 ? kUnseen : kSeenOnly;
       if (leaves->coverage) leaves->coverage->setValueOn(o, coverage);
@@ -572,7 +870,13 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
         if (want_angle) next->pair_a[o] = next->pair_b[o] = -1;
         continue;
       }
-      for (int k = 0; k < 6; ++k) upper[k][candidate_count] = sum[o][k];
+      if (TestBit(in_double, o)) {
+        for (int k = 0; k < 6; ++k) upper[k][candidate_count] = double_sum[double_index[o]][k];
+      } else {
+        const BandScale& scale = scales[next->sum_band[o]];
+        for (int k = 0; k < 6; ++k)
+          upper[k][candidate_count] = ToDouble(next->sums[o].v[k]) * scale.up[0] * scale.up[1];
+      }
       if (want_angle) {
         const int x = o >> 6, y = (o >> 3) & 7, z = o & 7;
         const Vec3 p =
@@ -629,13 +933,14 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
           pb[g][k] = entry_of(cb);
         }
       }
-      std::vector<double> directions(3 * 64 * view.size());
+      // Scratch, every entry written before it is read: no zero fill (36 KiB for 24 cameras).
+      const std::unique_ptr<double[]> directions(new double[3 * 64 * view.size()]);
       for (int g = 0; g < 2; ++g)
         if (size[g] > 0)
           TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
                               static_cast<int>(view.size()), sees.data(), entry_centres.data(),
                               g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
-                              pb[g].data(), directions.data(), degrees[g].data());
+                              pb[g].data(), directions.get(), degrees[g].data());
       for (int m = 0; m < candidate_count; ++m) {
         const int g = which[m], k = group_of[m], o = candidate[m];
         angle_deg[m] = degrees[g][k];
@@ -681,6 +986,12 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   next->seen = next->triangulable = next->unobservable = 0;
   next->sigma_list.clear();
   next->steady_list.clear();
+  {
+    int triangulable = 0;
+    for (int o = 0; o < 512; ++o) triangulable += next->status[o] == kTriangulable ? 1 : 0;
+    next->sigma_list.reserve(triangulable);
+    if (want_steady) next->steady_list.reserve(triangulable);
+  }
   for (int x = 0; x < block.extent.x(); ++x)
     for (int y = 0; y < block.extent.y(); ++y)
       for (int z = 0; z < block.extent.z(); ++z) {
@@ -699,14 +1010,16 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
 
   // Leaves: a full block nobody sees keeps its coverage as a tile; empty float leaves go.
   if (leaves->coverage && block.full && next->seen == 0) {
-    delete leaves->coverage;
+    if (leaves->coverage_owned) delete leaves->coverage;
     leaves->coverage = nullptr;
+    leaves->coverage_owned = false;
     leaves->coverage_tile = true;
   }
   for (int f = 0; f < kFloatFieldCount; ++f)
     if (leaves->floats[f] && leaves->floats[f]->isEmpty()) {
-      delete leaves->floats[f];
+      if (leaves->float_owned[f]) delete leaves->floats[f];
       leaves->floats[f] = nullptr;
+      leaves->float_owned[f] = false;
       leaves->remove_float[f] = true;
     }
 }
@@ -838,7 +1151,10 @@ double FieldEvaluator::state_bytes() const {
   for (const BlockState& s : S.states) {
     bytes += s.candidates.capacity() * sizeof(std::int32_t) + s.coverage.capacity() * 4 +
              s.status.capacity() + (s.sigma_max.capacity() + s.sigma_steady.capacity()) * 4 +
-             s.histogram.capacity() * 8 + (s.sigma_list.capacity() + s.steady_list.capacity()) * 4;
+             s.histogram.capacity() * 8 + (s.sigma_list.capacity() + s.steady_list.capacity()) * 4 +
+             s.pair_dot.capacity() * 8 + (s.pair_a.capacity() + s.pair_b.capacity()) * 4 +
+             (s.best_density.capacity() + s.best_camera.capacity()) * 4 +
+             s.sums.capacity() * sizeof(Sum6) + s.sum_band.capacity() + s.band_count.capacity() * 4;
     for (const CameraEntry& e : s.entries) bytes += e.Bytes();
   }
   return bytes;
@@ -912,10 +1228,13 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
 
   // Kept state: an upper bound (every candidate camera sees every free voxel) against the budget.
   if (S.keep) {
-    const double per_pair = (S.want_information ? 48.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
+    const double per_pair = (S.want_information ? 49.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
+    // Per voxel caches: coverage, status, sigmas, best pair, best density, exact sums.
+    const double per_voxel = 13 + (S.want_angle ? 16 : 0) + (S.want_resolution ? 8 : 0) +
+                             (S.want_information ? sizeof(Sum6) + 5 : 0);
     double bytes = 0;
     for (std::size_t b = 0; b < S.blocks.size(); ++b)
-      bytes += 512.0 * 13 + double(candidates[b].size()) *
+      bytes += 512.0 * per_voxel + double(candidates[b].size()) *
                                 (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
     const double total = bytes + S.fields.stats.estimated_bytes;
     if (total > opt.memory_budget_bytes) {
@@ -930,7 +1249,11 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     }
   }
 
-  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves.
+  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves. A full
+  // evaluation does both per block (the per-pair data is dropped block by block without kept
+  // state). An update casts every changed camera first, where it can still be cancelled, then
+  // derives in place: into the kept caches and the grids' own leaves, no copies.
+  const bool in_place = S.evaluated;
   std::vector<BlockState> next(dirty.size());
   std::vector<std::vector<CameraEntry>> cast(dirty.size());
   std::vector<BlockLeaves> leaves(dirty.size());
@@ -938,6 +1261,75 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   std::atomic<std::int64_t> dirty_voxels{0};
   std::atomic<bool> cancelled{false};
   const std::size_t report_every = std::max<std::size_t>(1, dirty.size() / 200);
+  const double phases = in_place ? 2.0 : 1.0;
+  const auto derive = [&](std::size_t i) {
+    const std::size_t b = dirty[i];
+    const Block& block = S.blocks[b];
+    BlockState& old = S.states[b];
+    // Dirty voxels: where a changed camera saw or sees.
+    Bits voxels{};
+    if (old.coverage.empty()) {
+      for (int x = 0; x < block.extent.x(); ++x)
+        for (int y = 0; y < block.extent.y(); ++y)
+          for (int z = 0; z < block.extent.z(); ++z)
+            if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
+    } else {
+      for (const CameraEntry& e : old.entries)
+        if (is_changed[e.camera])
+          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+      for (const CameraEntry& e : cast[i])
+        for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+    }
+    std::int64_t count = 0;
+    for (std::uint64_t w : voxels) count += PopcountInline(w);
+    dirty_voxels += count;
+    std::vector<const CameraEntry*> view;
+    view.reserve(old.entries.size() + cast[i].size());
+    for (const CameraEntry& e : old.entries)
+      if (!is_changed[e.camera]) view.push_back(&e);
+    for (const CameraEntry& e : cast[i]) view.push_back(&e);
+    std::sort(view.begin(), view.end(),
+              [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
+    if (count > 0 || old.coverage.empty())
+      S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
+               in_place ? &old : &next[i], &leaves[i], in_place);
+    // Camera grids: a leaf per re-cast camera that sees part of the block.
+    if (S.want_cameras)
+      for (const CameraEntry& e : cast[i]) {
+        if (e.seen == 0) continue;
+        const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+        auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
+        for (int w = 0; w < kWords; ++w)
+          for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
+            leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
+        leaves[i].visible.emplace_back(e.camera, leaf);
+      }
+    if (!S.keep) {
+      // One evaluation only: keep the summary, drop per-pair data and caches.
+      for (CameraEntry& e : cast[i]) {
+        std::vector<double>().swap(e.information);
+        std::vector<std::uint8_t>().swap(e.band);
+        std::vector<float>().swap(e.density);
+      }
+      std::vector<std::int32_t>().swap(next[i].coverage);
+      std::vector<std::uint8_t>().swap(next[i].status);
+      std::vector<float>().swap(next[i].sigma_max);
+      std::vector<float>().swap(next[i].sigma_steady);
+      std::vector<double>().swap(next[i].pair_dot);
+      std::vector<std::int32_t>().swap(next[i].pair_a);
+      std::vector<std::int32_t>().swap(next[i].pair_b);
+      std::vector<float>().swap(next[i].best_density);
+      std::vector<std::int32_t>().swap(next[i].best_camera);
+      std::vector<Sum6>().swap(next[i].sums);
+      std::vector<std::uint8_t>().swap(next[i].sum_band);
+      std::vector<std::int32_t>().swap(next[i].band_count);
+    }
+  };
+  const auto report = [&](double base) {
+    const std::size_t n = done.fetch_add(1) + 1;
+    if (opt.progress && (n % report_every == 0 || n == dirty.size()))
+      opt.progress((base + double(n) / double(dirty.size())) / phases);
+  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       if (cancelled.load(std::memory_order_relaxed)) return;
@@ -946,64 +1338,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         return;
       }
       const std::size_t b = dirty[i];
-      const Block& block = S.blocks[b];
-      const BlockState& old = S.states[b];
       // The changed cameras that may see the block now.
       for (int c : changed)
         if (std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
           cast[i].emplace_back();
-          S.Cast(block, c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
+          S.Cast(S.blocks[b], c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
         }
-      // Dirty voxels: where a changed camera saw or sees.
-      Bits voxels{};
-      if (old.coverage.empty()) {
-        for (int x = 0; x < block.extent.x(); ++x)
-          for (int y = 0; y < block.extent.y(); ++y)
-            for (int z = 0; z < block.extent.z(); ++z)
-              if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
-      } else {
-        for (const CameraEntry& e : old.entries)
-          if (is_changed[e.camera])
-            for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-        for (const CameraEntry& e : cast[i])
-          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-      }
-      std::int64_t count = 0;
-      for (std::uint64_t w : voxels) count += __builtin_popcountll(w);
-      dirty_voxels += count;
-      std::vector<const CameraEntry*> view;
-      for (const CameraEntry& e : old.entries)
-        if (!is_changed[e.camera]) view.push_back(&e);
-      for (const CameraEntry& e : cast[i]) view.push_back(&e);
-      std::sort(view.begin(), view.end(),
-                [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
-      if (count > 0 || old.coverage.empty())
-        S.Derive(block, old, view, voxels, is_changed, rd.centres, &next[i], &leaves[i]);
-      // Camera grids: a leaf per re-cast camera that sees part of the block.
-      if (S.want_cameras)
-        for (const CameraEntry& e : cast[i]) {
-          if (e.seen == 0) continue;
-          const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
-          auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
-          for (int w = 0; w < kWords; ++w)
-            for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
-              leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
-          leaves[i].visible.emplace_back(e.camera, leaf);
-        }
-      if (!S.keep) {
-        // One evaluation only: keep the summary, drop per-pair data and caches.
-        for (CameraEntry& e : cast[i]) {
-          std::vector<double>().swap(e.information);
-          std::vector<float>().swap(e.density);
-        }
-        std::vector<std::int32_t>().swap(next[i].coverage);
-        std::vector<std::uint8_t>().swap(next[i].status);
-        std::vector<float>().swap(next[i].sigma_max);
-        std::vector<float>().swap(next[i].sigma_steady);
-      }
-      const std::size_t n = done.fetch_add(1) + 1;
-      if (opt.progress && (n % report_every == 0 || n == dirty.size()))
-        opt.progress(double(n) / double(dirty.size()));
+      if (!in_place) derive(i);
+      report(0.0);
     }
   });
   if (cancelled) {
@@ -1015,6 +1357,15 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     update.cancelled = true;
     update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return update;
+  }
+  if (in_place) {
+    done = 0;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        derive(i);
+        report(1.0);
+      }
+    });
   }
 
   // The serial phase: the new leaves into the grids, the new entries and caches into the state.
@@ -1032,12 +1383,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     BlockState& s = S.states[b];
     BlockLeaves& l = leaves[i];
     if (l.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
-    if (l.coverage) g.coverage->tree().addLeaf(l.coverage);
+    if (l.coverage && l.coverage_owned) g.coverage->tree().addLeaf(l.coverage);
     for (int f = 0; f < kFloatFieldCount; ++f) {
       if (!S.want_float[f]) continue;
-      openvdb::FloatTree& tree = g.floats[kFloatFieldNames[f]]->tree();
-      if (l.floats[f])
+      openvdb::FloatTree& tree = S.float_grids[f]->tree();
+      if (l.floats[f] && l.float_owned[f])
         tree.addLeaf(l.floats[f]);
+      else if (l.floats[f])
+        ;  // rewritten in place
       else if (l.remove_float[f] && tree.probeConstLeaf(origin))
         tree.addTile(1, origin, 0.0f, false);
     }
@@ -1052,6 +1405,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     }
     // Entries: the kept ones and the re-cast ones, in camera order.
     std::vector<CameraEntry> entries;
+    entries.reserve(s.entries.size() + cast[i].size());
     for (CameraEntry& e : s.entries)
       if (!is_changed[e.camera]) entries.push_back(std::move(e));
     for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));

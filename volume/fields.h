@@ -112,8 +112,10 @@ struct FieldUpdate {
 /// 512-bit mask per camera that sees the block: sparse, any number of cameras) and each seen
 /// (voxel, camera) pair's information contribution and pixel density. When cameras change it
 /// re-casts only those cameras, only inside their old and new frusta, and re-derives only the
-/// voxels whose camera set or contributions changed, summing contributions in rig order exactly as
-/// a full evaluation does: the fields equal a full recompute voxel for voxel, bit for bit
+/// voxels whose camera set or contributions changed. Coverage (a count), the best density (a
+/// maximum) and the information (an exact fixed-point sum, so independent of order) are updated
+/// from the changed cameras alone and equal what a full evaluation computes from all of them: the
+/// fields equal a full recompute voxel for voxel, bit for bit
 /// (docs/architecture.md; test volume/field_evaluator_test.cpp). The scene and the ray caster must
 /// outlive the evaluator.
 class FieldEvaluator {
