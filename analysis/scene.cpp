@@ -997,6 +997,68 @@ View ReadView(const Node& node) {
   return view;
 }
 
+// "stations": {"NAME": {"display": {"center", "facing", "up", "size", "pixels"}, "eye",
+//                        "tracker": {"position", "look_at", "up", "hfov_deg", "vfov_deg", "range"}}}
+ViewingStation ReadStation(const Node& node) {
+  node.CheckKeys({"display", "eye", "tracker"});
+  ViewingStation s;
+  const Node display = node.Get("display");
+  display.CheckKeys({"center", "facing", "up", "size", "pixels"});
+  s.display_center = display.Get("center").Point();
+  const Node facing = display.Get("facing");
+  const Vec3 toward = facing.Point() - s.display_center;
+  if (!(toward.norm() > 0)) facing.Fail("'facing' (a point on the viewer's side) equals the display's center");
+  s.display_normal = toward.normalized();
+  if (auto n = display.Find("up")) {
+    const Vec3 up = n->Vector3();
+    const Vec3 in_plane = up - up.dot(s.display_normal) * s.display_normal;
+    if (!(in_plane.norm() > 1e-9 * std::max(up.norm(), 1e-300))) n->Fail("'up' is parallel to the display's normal");
+    s.display_up = in_plane.normalized();
+  } else {
+    const Vec3 in_plane = Vec3::UnitZ() - s.display_normal.z() * s.display_normal;
+    if (!(in_plane.norm() > 1e-9)) display.Fail("the display faces straight up or down", "give its 'up'");
+    s.display_up = in_plane.normalized();
+  }
+  const Node size = display.Get("size");
+  if (size.ArraySize("[width, height] in metres") != 2) size.Fail("expected [width, height] in metres");
+  s.display_width = size.At(0).PositiveLength();
+  s.display_height = size.At(1).PositiveLength();
+  if (auto n = display.Find("pixels")) {
+    if (n->ArraySize("[width, height] in pixels") != 2) n->Fail("expected [width, height] in pixels");
+    s.pixels_wide = n->At(0).Integer(16, 8192);
+    s.pixels_high = n->At(1).Integer(16, 8192);
+  } else {
+    s.pixels_wide = 640;
+    s.pixels_high = std::clamp(int(std::lround(640 * s.display_height / s.display_width)), 16, 8192);
+  }
+  const Node eye = node.Get("eye");
+  s.eye = eye.Point();
+  if (!((s.eye - s.display_center).dot(s.display_normal) > 0))
+    eye.Fail("the eye is behind the display or in its plane", "put it on the side 'facing' points to");
+  if (auto t = node.Find("tracker")) {
+    t->CheckKeys({"position", "look_at", "up", "hfov_deg", "vfov_deg", "range"});
+    s.has_tracker = true;
+    const Vec3 position = t->Get("position").Point();
+    const Node look = t->Get("look_at");
+    const Vec3 up = t->Find("up") ? t->Get("up").Vector3() : Vec3::UnitZ();
+    const auto pose = LookAt(position, look.Point(), up);
+    if (!pose) look.Fail("'look_at' equals 'position', or 'up' is parallel to the tracker's axis");
+    s.tracker_pose = *pose;
+    for (const char* key : {"hfov_deg", "vfov_deg"}) {
+      const Node n = t->Get(key);
+      const double v = n.Number();
+      if (!(v > 0 && v < 180)) n.Fail("must be in (0, 180) degrees, got " + FormatNumber(v));
+      (std::string(key) == "hfov_deg" ? s.tracker_hfov_deg : s.tracker_vfov_deg) = v;
+    }
+    const Node range = t->Get("range");
+    if (range.ArraySize("[near, far] in metres") != 2) range.Fail("expected [near, far] in metres");
+    s.tracker_near = range.At(0).PositiveLength();
+    s.tracker_far = range.At(1).PositiveLength();
+    if (!(s.tracker_near < s.tracker_far)) range.Fail("near must be less than far");
+  }
+  return s;
+}
+
 double ReadUnit(const Node& node) {
   const std::string unit = node.String();
   struct UnitScale {
@@ -1118,7 +1180,7 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   context.options = options;
   const json root_value = ParseJson(json_text, path);
   const Node root(&root_value, "$", &context);
-  root.CheckKeys({"pandora", "units", "materials", "objects", "rigs", "study", "views"});
+  root.CheckKeys({"pandora", "units", "materials", "objects", "rigs", "study", "views", "stations"});
 
   Scene scene;
   scene.path = path;
@@ -1163,6 +1225,14 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
       scene.views[item.key()] = ReadView(v);
     }
   }
+  if (auto stations = root.Find("stations")) {
+    stations->ExpectObject("an object of named viewing stations");
+    for (const auto& item : stations->value().items()) {
+      const Node v(&item.value(), MemberPath(stations->path(), item.key()), &context);
+      if (item.key().empty()) v.Fail("station names must not be empty");
+      scene.stations[item.key()] = ReadStation(v);
+    }
+  }
 
   // Cameras and viewpoints within reach of the scene: beyond it, single-precision ray casting has
   // no digits left for the scene (docs/robustness.md).
@@ -1183,6 +1253,11 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto views = root.Find("views"))
     for (const auto& [name, view] : scene.views)
       check_reach(views->Get(name).Get("from"), view.from, "the viewpoint");
+  if (auto stations = root.Find("stations"))
+    for (const auto& [name, station] : scene.stations) {
+      check_reach(stations->Get(name).Get("eye"), station.eye, "the station's eye");
+      check_reach(stations->Get(name).Get("display").Get("center"), station.display_center, "the display");
+    }
   return scene;
 }
 

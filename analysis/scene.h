@@ -121,6 +121,24 @@ struct View {
   std::optional<double> fov_deg;
 };
 
+/// A viewing station (the Pandora paper's Section 5): a flat display placed in the scene that shows
+/// the scene as a viewer's eye would see it through the display (a head-tracked window), and
+/// optionally a head tracker with its angular range. The display's image is an off-axis perspective
+/// from `eye` through the display rectangle (viewer/core/station.h).
+struct ViewingStation {
+  Vec3 display_center = Vec3::Zero();
+  Vec3 display_normal = Vec3::UnitX();  ///< Unit; points to the side the viewer stands on.
+  Vec3 display_up = Vec3::UnitZ();      ///< Unit, in the display's plane.
+  double display_width = 0.5, display_height = 0.3;  ///< Metres.
+  int pixels_wide = 640, pixels_high = 384;           ///< The simulated display image.
+  Vec3 eye = Vec3::Zero();  ///< The viewer's eye, in front of the display.
+  /// The head tracker (world_from_tracker: z along its axis, y down as a camera), its full
+  /// angular range and working distances; absent when `has_tracker` is false.
+  bool has_tracker = false;
+  Eigen::Isometry3d tracker_pose = Eigen::Isometry3d::Identity();
+  double tracker_hfov_deg = 0, tracker_vfov_deg = 0, tracker_near = 0, tracker_far = 0;
+};
+
 /// Limits on coordinates and lengths, checked when a scene is loaded and on every length given as an
 /// option (docs/robustness.md). Embree casts rays in single precision, and OpenVDB indexes voxels
 /// with 32-bit integers: beyond these a finite number can still abort a library or mean nothing.
@@ -145,6 +163,7 @@ struct Scene {
   std::vector<Rig> rigs;    ///< In file order; at least one.
   Study study;
   std::map<std::string, View> views;  ///< Named viewpoints, by name.
+  std::map<std::string, ViewingStation> stations;  ///< Viewing stations, by name.
 
   /// All triangles of all objects, for ray casting. Also returns, per triangle, its object index.
   TriangleMesh AllTriangles(std::vector<int>* triangle_object = nullptr) const;

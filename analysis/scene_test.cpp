@@ -1687,3 +1687,57 @@ TEST(SceneStudyTest, BadMotionAndSigmas) {
 
 }  // namespace
 }  // namespace pandora
+
+namespace pandora {
+namespace {
+
+TEST(SceneStationTest, DisplayEyeAndTrackerInMillimetres) {
+  json scene = BaseScene();
+  scene["units"] = "mm";
+  scene["stations"] = json::parse(R"({"remote": {
+    "display": {"center": [1000, 0, 1200], "facing": [0, 0, 1200], "size": [600, 400], "pixels": [300, 200]},
+    "eye": [200, 150, 1300],
+    "tracker": {"position": [1000, 0, 1450], "look_at": [0, 0, 1300], "hfov_deg": 75, "vfov_deg": 60,
+                "range": [300, 1500]}}})");
+  FirstCamera(scene)["position"] = {0, 0, 1000};
+  FirstCamera(scene)["look_at"] = {1000, 0, 1000};
+  const Scene s = Parse(scene);
+  ASSERT_EQ(s.stations.count("remote"), 1u);
+  const ViewingStation& st = s.stations.at("remote");
+  ExpectVecNear(st.display_center, Vec3(1, 0, 1.2), 1e-12);
+  ExpectVecNear(st.display_normal, Vec3(-1, 0, 0), 1e-12);
+  ExpectVecNear(st.display_up, Vec3(0, 0, 1), 1e-12);  // the default up, made perpendicular
+  EXPECT_DOUBLE_EQ(st.display_width, 0.6);
+  EXPECT_DOUBLE_EQ(st.display_height, 0.4);
+  EXPECT_EQ(st.pixels_wide, 300);
+  ExpectVecNear(st.eye, Vec3(0.2, 0.15, 1.3), 1e-12);
+  EXPECT_TRUE(st.has_tracker);
+  EXPECT_DOUBLE_EQ(st.tracker_near, 0.3);
+  ExpectVecNear(st.tracker_pose.translation(), Vec3(1, 0, 1.45), 1e-12);
+}
+
+TEST(SceneStationTest, BadStationsNameTheirPath) {
+  auto with = [](const char* station) {
+    json scene = BaseScene();
+    scene["stations"] = json::parse(std::string(R"({"s": )") + station + "}");
+    return scene;
+  };
+  const char* ok_display = R"("display": {"center": [1, 0, 1], "facing": [0, 0, 1], "size": [0.6, 0.4]})";
+  EXPECT_INPUT_ERROR(ErrorFor(with(R"({"display": {"center": [1, 0, 1], "facing": [1, 0, 1], "size": [0.6, 0.4]}, "eye": [0, 0, 1]})")),
+                     "$.stations.s.display.facing", "equals the display's center");
+  EXPECT_INPUT_ERROR(ErrorFor(with((std::string("{") + ok_display + R"(, "eye": [2, 0, 1]})").c_str())),
+                     "$.stations.s.eye", "behind the display");
+  EXPECT_INPUT_ERROR(ErrorFor(with(R"({"display": {"center": [1, 0, 1], "facing": [0, 0, 1], "size": [0.6, -1]}, "eye": [0, 0, 1]})")),
+                     "$.stations.s.display.size[1]", "");
+  EXPECT_INPUT_ERROR(ErrorFor(with((std::string("{") + ok_display +
+                                    R"(, "eye": [0, 0, 1], "tracker": {"position": [1, 0, 2], "look_at": [0, 0, 2], "hfov_deg": 190, "vfov_deg": 60, "range": [0.3, 1]}})").c_str())),
+                     "$.stations.s.tracker.hfov_deg", "(0, 180)");
+  EXPECT_INPUT_ERROR(ErrorFor(with((std::string("{") + ok_display +
+                                    R"(, "eye": [0, 0, 1], "tracker": {"position": [1, 0, 2], "look_at": [0, 0, 2], "hfov_deg": 90, "vfov_deg": 60, "range": [2, 1]}})").c_str())),
+                     "$.stations.s.tracker.range", "near must be less than far");
+  EXPECT_INPUT_ERROR(ErrorFor(with((std::string("{") + ok_display + R"(, "eye": [0, 0, 1], "screen": 1})").c_str())),
+                     "$.stations.s.screen", "");
+}
+
+}  // namespace
+}  // namespace pandora

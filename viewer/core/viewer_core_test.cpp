@@ -17,6 +17,7 @@
 #include "viewer/core/model.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
+#include "viewer/core/station.h"
 #include "volume/fields.h"
 
 namespace pandora::viewer {
@@ -150,6 +151,54 @@ TEST(Manipulate, FourthPowerStickMapping) {
   const Vec3 view = p.linear().col(2);
   EXPECT_NEAR(std::atan2(view.y(), view.x()), -45 * kDeg, 1e-12);
   EXPECT_NEAR(view.z(), 0, 1e-12);
+}
+
+TEST(Station, TheDisplayImageIsTheViewThroughTheDisplay) {
+  // A 0.6 x 0.4 m display at (1, 0, 1.2) facing -X (the viewer stands at smaller x), eye off-axis.
+  ViewingStation s;
+  s.display_center = Vec3(1, 0, 1.2);
+  s.display_normal = Vec3(-1, 0, 0);
+  s.display_up = Vec3(0, 0, 1);
+  s.display_width = 0.6;
+  s.display_height = 0.4;
+  s.pixels_wide = 300;
+  s.pixels_high = 200;
+  s.eye = Vec3(0.2, 0.15, 1.3);
+  const Camera cam = DisplayCamera(s);
+  EXPECT_FALSE(cam.enabled);
+  const std::array<Vec3, 4> corners = DisplayCorners(s);
+  // Top left as the viewer sees it: the viewer looks along +X with +Z up, so left is +Y.
+  EXPECT_LT((corners[0] - Vec3(1, 0.3, 1.4)).norm(), 1e-12);
+  // Every corner projects onto the matching image corner; so does any point on the eye's ray
+  // through a display point, wherever it lies in the scene.
+  const Vec2 expected[4] = {Vec2(-0.5, -0.5), Vec2(299.5, -0.5), Vec2(299.5, 199.5), Vec2(-0.5, 199.5)};
+  for (int i = 0; i < 4; ++i) {
+    const auto p = cam.model.Project(cam.world_from_camera.inverse() * corners[i]);
+    ASSERT_TRUE(p);
+    EXPECT_LT((*p - expected[i]).norm(), 1e-9) << i;
+  }
+  const Vec3 on_display = s.display_center + Vec3(0, -0.1, 0.05);
+  const Vec3 beyond = s.eye + 3.7 * (on_display - s.eye);
+  const auto a = cam.model.Project(cam.world_from_camera.inverse() * on_display);
+  const auto b = cam.model.Project(cam.world_from_camera.inverse() * beyond);
+  ASSERT_TRUE(a && b);
+  EXPECT_LT((*a - *b).norm(), 1e-9);
+  // (0, -0.1, +0.05) from the centre: right of centre by 0.1 m = 50 px, up 0.05 m = 25 px.
+  EXPECT_LT((*a - Vec2(149.5 + 50, 99.5 - 25)).norm(), 1e-9);
+}
+
+TEST(Station, TrackerRangeCorners) {
+  ViewingStation s;
+  s.has_tracker = true;
+  s.tracker_pose = *LookAt(Vec3(0, 0, 2), Vec3(1, 0, 2), Vec3(0, 0, 1));
+  s.tracker_hfov_deg = 90;
+  s.tracker_vfov_deg = 60;
+  s.tracker_near = 0.5;
+  s.tracker_far = 2.0;
+  const std::array<Vec3, 8> c = TrackerCorners(s);
+  // Far top left: 2 m along +X, left (+Y) by 2 tan 45 = 2, up by 2 tan 30.
+  EXPECT_LT((c[4] - Vec3(2, 2, 2 + 2 * std::tan(30 * kDeg))).norm(), 1e-12);
+  EXPECT_LT((c[2] - Vec3(0.5, -0.5, 2 - 0.5 * std::tan(30 * kDeg))).norm(), 1e-12);
 }
 
 void ExpectScriptError(const std::string& text, const std::string& json_path) {
