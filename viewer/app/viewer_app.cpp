@@ -11,6 +11,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "analysis/color.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
+#include "viewer/core/station.h"
 #include "viewer/gl_renderer.h"
 #include "volume/fields.h"
 #include "volume/slice.h"
@@ -148,6 +150,7 @@ struct ViewerApp::Impl {
     int width = 0, height = 0;
   };
   std::map<int, CameraView> camera_views;
+  std::map<std::string, CameraView> station_views;  // each display's image
 
   // Field panel cache.
   std::int64_t slice_version = -2;
@@ -301,7 +304,71 @@ struct ViewerApp::Impl {
         frustum(ghost, IM_COL32(255, 255, 255, 200), 1.5f);
         line(ch.before.translation(), ch.after.translation(), IM_COL32(255, 255, 255, 160), 1.0f);
       }
+    DrawStations(dl, P);
     DrawGizmo(dl, P);
+  }
+
+  // Viewing stations: each display textured with the scene as its viewer's eye sees it through the
+  // display (exact CPU renderer, the display's off-axis camera), the eye's lines to the display's
+  // corners, and the tracker's range as a red wireframe.
+  void DrawStations(ImDrawList* dl, const Projector& P) {
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
+      ImVec2 pa, pb;
+      if (P.Segment(a, b, &pa, &pb)) dl->AddLine(pa, pb, col, width);
+    };
+    for (const auto& [name, st] : model.stations) {
+      CameraView& v = station_views[name];
+      const std::int64_t version = model.session().rig().version() * 1000003 + model.stations_version;
+      if (!v.texture || v.version != version) {
+        Rig rig = model.rig();
+        rig.cameras.push_back(DisplayCamera(st));
+        RenderView view;
+        view.camera = int(rig.cameras.size()) - 1;
+        const double scale = std::min(1.0, 320.0 / st.pixels_wide);
+        view.width = std::max(16, int(std::lround(st.pixels_wide * scale)));
+        view.height = std::max(16, int(std::lround(st.pixels_high * scale)));
+        RenderOptions o = model.display;
+        o.layers = false;
+        o.overlays.slice_field.clear();
+        o.overlays.iso_field.clear();
+        o.overlays.key = false;
+        o.overlays.cameras = false;
+        const Image image = pandora::Render(model.session().study().prepared(), rig, view, o);
+        std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
+        for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
+          for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
+          rgba[4 * i + 3] = 255;
+        }
+        Upload(&v.texture, image.width, image.height, rgba);
+        v.version = version;
+      }
+      const std::array<Vec3, 4> c = DisplayCorners(st);
+      std::optional<ImVec2> q[4];
+      bool visible = true;
+      for (int k = 0; k < 4; ++k) visible &= bool(q[k] = P.Point(c[k]));
+      // The textured face only when its front (the viewer's side) faces the main view's eye.
+      if (visible && (model.view.Eye() - st.display_center).dot(st.display_normal) > 0)
+        dl->AddImageQuad(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)), *q[0], *q[1], *q[2], *q[3],
+                         ImVec2(0, 0), ImVec2(1, 0), ImVec2(1, 1), ImVec2(0, 1));
+      for (int k = 0; k < 4; ++k) {
+        line(c[k], c[(k + 1) % 4], IM_COL32(230, 230, 230, 255), 2.0f);
+        line(st.eye, c[k], IM_COL32(230, 230, 230, 90), 1.0f);
+      }
+      if (const auto e = P.Point(st.eye)) {
+        dl->AddCircleFilled(*e, 4.0f, IM_COL32(255, 255, 255, 255));
+        dl->AddText(ImVec2(e->x + 6, e->y - 7), IM_COL32(255, 255, 255, 255), (name + " eye").c_str());
+      }
+      if (st.has_tracker) {
+        const std::array<Vec3, 8> t = TrackerCorners(st);
+        const ImU32 red = IM_COL32(235, 50, 50, 220);
+        for (int k = 0; k < 4; ++k) {
+          line(t[k], t[(k + 1) % 4], red, 1.2f);
+          line(t[4 + k], t[4 + (k + 1) % 4], red, 1.2f);
+          line(t[k], t[4 + k], red, 1.2f);
+        }
+        line(st.tracker_pose.translation(), t[0], red, 1.0f);
+      }
+    }
   }
 
   void DrawSlice(ImDrawList* dl, const Projector& P) {
@@ -932,6 +999,8 @@ ViewerApp::~ViewerApp() {
   m.gl.reset();
   if (m.main_texture) glDeleteTextures(1, &m.main_texture);
   for (auto& [c, v] : m.camera_views)
+    if (v.texture) glDeleteTextures(1, &v.texture);
+  for (auto& [name, v] : m.station_views)
     if (v.texture) glDeleteTextures(1, &v.texture);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui::DestroyContext(m.imgui);

@@ -89,6 +89,7 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   }
   display.pixel_sigma = s.study.pixel_sigma;
   display.layers = false;
+  stations = s.stations;
   session_->UpdateFieldsInBackground();
 }
 
@@ -348,6 +349,24 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       const int steps = int(std::lround(a.number * 60.0));  // 60 Hz, as the window polls
       for (int i = 0; i < steps; ++i) pose = GamepadMove(pose, axes, 1.0 / 60.0, 0.5, 45.0);
       apply({c}, label("gamepad", {c}), [&](Camera& cam) { cam.world_from_camera = pose; });
+      break;
+    }
+    case Kind::kStation: {
+      auto it = stations.find(a.text);
+      if (it == stations.end()) {
+        std::string names;
+        for (const auto& [name, st] : stations) names += (names.empty() ? "" : ", ") + name;
+        throw InputError(a.where, "", "no viewing station '" + a.text + "' in " + file,
+                         names.empty() ? "the scene defines no stations" : "stations: " + names);
+      }
+      ViewingStation moved = it->second;
+      scene().CheckReach(a.a, a.where, a.flag ? "the display" : "the eye");
+      if (a.flag) moved.display_center = a.a;
+      else moved.eye = a.a;
+      if (!((moved.eye - moved.display_center).dot(moved.display_normal) > 0))
+        throw InputError(a.where, "", "the eye would be behind the display or in its plane");
+      it->second = moved;
+      ++stations_version;
       break;
     }
     case Kind::kMouse:

@@ -8,6 +8,7 @@
 /// for the GPU (CpuFrontend).
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -72,6 +73,9 @@ class ViewerModel {
   std::vector<int> selection;           ///< Rig indices.
   std::optional<Suggestion> suggestion; ///< Suggested poses waiting for accept or reject (ghosts).
   std::string status;                   ///< The last action's one-line message.
+  /// The scene's viewing stations as placed in this session (not saved into the scene file).
+  std::map<std::string, ViewingStation> stations;
+  std::int64_t stations_version = 0;    ///< Bumps when a station moves.
 
   /// The main view as the renderer takes it.
   RenderView MainView() const { return view.ToRenderView(width, height); }

@@ -115,7 +115,7 @@ const std::map<std::string, Kind>& Kinds() {
       {"suggest", Kind::kSuggest}, {"accept", Kind::kAccept}, {"reject", Kind::kReject},
       {"save", Kind::kSave},     {"screenshot", Kind::kScreenshot}, {"size", Kind::kSize},
       {"mouse", Kind::kMouse},   {"key", Kind::kKey},         {"scroll", Kind::kScroll},
-      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}};
+      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}, {"station", Kind::kStation}};
   return kinds;
 }
 
@@ -292,6 +292,13 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       if (a.a.cwiseAbs().maxCoeff() > 1 || a.b.cwiseAbs().maxCoeff() > 1)
         e.Fail(a.a.cwiseAbs().maxCoeff() > 1 ? "left" : "right", "stick positions lie in [-1, 1]");
       a.number = e.Number("seconds", 0, 60);
+      break;
+    case Kind::kStation:
+      e.Keys({"station", "eye_at", "display_at"});
+      a.text = e.String("station");
+      if (e.Has("eye_at") == e.Has("display_at")) e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
+      a.flag = e.Has("display_at");
+      a.a = e.Vector(a.flag ? "display_at" : "eye_at");
       break;
     case Kind::kFrames:
       e.Keys({"frames"});

@@ -30,7 +30,9 @@
 ///      {"mouse": "press", "button": "left", "x": 640, "y": 360},  // raw input, GL front end only
 ///      {"key": "ctrl+z"}, {"scroll": 1.0, "x": 640, "y": 360},
 ///      {"gamepad": "c03", "left": [0, -1], "right": [0, 0], "seconds": 0.5},
-///      {"frames": 3}]                                   // let the window draw
+///      {"frames": 3},                                   // let the window draw
+///      {"station": "remote", "eye_at": [x, y, z]}]      // move a viewing station's eye
+///                                                      // ("display_at": its display's centre)
 /// Unknown actions or keys, wrong types and out-of-range values are refused when the script is
 /// read, before anything runs: InputError naming the file and the JSON path ("$[4].by").
 
@@ -45,7 +47,7 @@ struct Action {
   enum class Kind {
     kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kUndo, kRedo, kSlice, kIso, kView,
     kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
-    kMouse, kKey, kScroll, kGamepad, kFrames,
+    kMouse, kKey, kScroll, kGamepad, kFrames, kStation,
   };
   Kind kind = Kind::kFrames;
   std::string where;                 ///< "$[i]": for messages while running.

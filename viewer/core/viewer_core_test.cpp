@@ -352,6 +352,42 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
   EXPECT_THROW(m.Run(ParseScript(R"([{"mouse": "press", "x": 1, "y": 1}])", "s.json"), &cpu), InputError);
 }
 
+TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  options.width = 160;
+  options.height = 90;
+  ViewerModel m(session::Study::Load("examples/trauma_room/viewing_station.json"), options);
+  ASSERT_EQ(m.stations.count("remote consult"), 1u);
+  const Vec3 eye = m.stations.at("remote consult").eye;
+  m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.6, -1.3, 1.35]}])", "s.json"), nullptr);
+  EXPECT_LT((m.stations.at("remote consult").eye - Vec3(0.6, -1.3, 1.35)).norm(), 1e-12);
+  EXPECT_EQ(m.stations_version, 1);
+  EXPECT_NE(eye, m.stations.at("remote consult").eye);
+  // Behind the display (it faces -y), an unknown station: refused, nothing moves.
+  EXPECT_THROW(m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.56, 0.5, 1.2]}])", "s.json"), nullptr),
+               InputError);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"station": "lobby", "eye_at": [0, 0, 1]}])", "s.json"), nullptr), InputError);
+  EXPECT_EQ(m.stations_version, 1);
+  // The display's image is the scene through the display: its centre pixel shows what the eye's
+  // ray through the display's centre hits first.
+  const ViewingStation& st = m.stations.at("remote consult");
+  Rig rig = m.rig();
+  rig.cameras.push_back(DisplayCamera(st));
+  RenderView view;
+  view.camera = int(rig.cameras.size()) - 1;
+  view.width = st.pixels_wide / 8;
+  view.height = st.pixels_high / 8;
+  RenderOptions o;
+  const Image image = Render(m.session().study().prepared(), rig, view, o);
+  const auto hit = m.session().study().caster().Intersect(
+      Ray{st.eye, (st.display_center - st.eye).normalized(), 0.0, 1e30});
+  ASSERT_TRUE(hit);
+  const double depth = image.depth[std::size_t(view.height / 2) * view.width + view.width / 2];
+  EXPECT_NEAR(depth, hit->t, 0.02 * hit->t);  // the centre pixel is half a pixel off the exact centre
+  m.session().WaitFields();
+}
+
 TEST(ViewerModel, GroupEditsAreOneUndoStep) {
   const fs::path scene = CopyScene("group");
   ViewerOptions options;
