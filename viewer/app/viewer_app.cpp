@@ -8,6 +8,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <imgui.h>
+#include <imgui_internal.h>  // BringWindowToDisplayFront: the status bar above the panels
 #include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
@@ -161,7 +162,8 @@ struct ViewerApp::Impl {
   int objective = 0;
   float max_move = 0.3f, max_rotate = 10.0f;
   int points = 800;
-  std::string error;  // the last action's error, shown in the status bar
+  std::string error;       // the last action's error, shown in the status bar (all of it on hover)
+  std::string error_line;  // ... its reason and hint, first in the status bar
 
   Impl(ViewerModel& m, AppOptions o) : model(m), options(o) {}
 
@@ -171,6 +173,7 @@ struct ViewerApp::Impl {
       model.Do(a, nullptr);
     } catch (const InputError& e) {
       error = e.what();
+      error_line = e.reason() + (e.hint().empty() ? "" : " (" + e.hint() + ")");
     }
   }
   Action Make(Action::Kind kind, std::vector<std::string> cameras = {}) const {
@@ -672,16 +675,24 @@ struct ViewerApp::Impl {
     const session::JobStatus f = model.session().jobs().Status("fields");
     const std::string undo = edit.can_undo() ? "undo: " + edit.undo_label() : "nothing to undo";
     const std::string timing = options.show_timing ? " | GPU frame " + std::to_string(int(1000 * gl_seconds)) + " ms" : "";
-    ImGui::Text("%s | fields %s%s%s | %s", undo.c_str(), session::JobStateName(f.state),
+    // The status bar stays on top of the panels (one may have been dragged over it).
+    ImGui::BringWindowToDisplayFront(ImGui::GetCurrentWindow());
+    if (!error.empty()) {
+      // An error first, in red, without the file name the window already shows; all of it on hover.
+      ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.4f, 1.0f), "%s", error_line.c_str());
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", error.c_str());
+      ImGui::SameLine();
+    }
+    ImGui::Text("%s%s | fields %s%s%s%s%s", error.empty() ? "" : "| ", undo.c_str(), session::JobStateName(f.state),
                 f.state == session::JobState::kRunning ? (" " + std::to_string(int(100 * f.progress)) + "%").c_str() : "",
-                timing.c_str(), error.empty() ? model.status.c_str() : error.c_str());
+                timing.c_str(), error.empty() && !model.status.empty() ? " | " : "", error.empty() ? model.status.c_str() : "");
     ImGui::End();
   }
 
   void CameraPanel() {
     const int c = Primary();
     ImGui::SetNextWindowPos(ImVec2(8, 316), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(250, 210), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250, 250), ImGuiCond_FirstUseEver);
     ImGui::Begin("Camera");
     if (c < 0) {
       ImGui::TextDisabled("click a camera to select it");
@@ -714,12 +725,92 @@ struct ViewerApp::Impl {
       a.number = hfov;
       Do(a);
     }
-    ImGui::Text("range %.2f .. %s m", cam.near, std::isfinite(cam.far) ? std::to_string(cam.far).substr(0, 5).c_str() : "inf");
+    LensControls(cam);
     ImGui::DragFloat("snap move m", &move_step, 0.005f, 0.0f, 1.0f, "%.3f");
     ImGui::DragFloat("snap turn deg", &rotate_step, 0.5f, 0.0f, 45.0f, "%.1f");
     ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)", model.selection.size());
     ImGui::End();
   }
+
+  // On/off, colour, resolution, lens model and coefficients, working range: each a script action.
+  void LensControls(const Camera& cam) {
+    const Intrinsics& k = cam.model.intrinsics();
+    bool on = cam.enabled;
+    if (ImGui::Checkbox("on", &on)) Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
+    ImGui::SameLine();
+    float rgb[3] = {float(cam.color.x()), float(cam.color.y()), float(cam.color.z())};
+    if (ImGui::ColorEdit3("colour", rgb, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float)) {
+      Action a = Make(Action::Kind::kColor, {cam.id});
+      a.a = Vec3(std::clamp(rgb[0], 0.0f, 1.0f), std::clamp(rgb[1], 0.0f, 1.0f), std::clamp(rgb[2], 0.0f, 1.0f));
+      a.drag = true;
+      Do(a);
+    }
+    // The working range: near, and far unless unlimited.
+    bool limited = std::isfinite(cam.far);
+    ImGui::SameLine();
+    if (ImGui::Checkbox("far limit", &limited)) {
+      Action a = Make(Action::Kind::kRange, {cam.id});
+      a.far = limited ? std::max(cam.near + 1.0, 5.0) : INFINITY;
+      Do(a);
+    }
+    if (limited) {
+      float n = float(cam.near), f = float(cam.far);
+      if (ImGui::DragFloatRange2("range m", &n, &f, 0.01f, 0.0f, 1e4f, "%.2f", "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+        Action a = Make(Action::Kind::kRange, {cam.id});
+        a.near = n;
+        a.far = std::max(f, n + 1e-3f);
+        a.drag = true;
+        Do(a);
+      }
+    } else {
+      float n = float(cam.near);
+      if (ImGui::DragFloat("near m", &n, 0.01f, 0.0f, 1e4f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+        Action a = Make(Action::Kind::kRange, {cam.id});
+        a.near = n;
+        a.drag = true;
+        Do(a);
+      }
+    }
+    if (!ImGui::CollapsingHeader("Lens and resolution")) return;
+    // Resolution: typed, applied on Enter (the field of view kept: fx, fy, cx, cy scaled); what is
+    // typed shows the camera's again once the field is left without Enter.
+    if (!resolution_active || resolution_camera != cam.id) {
+      resolution[0] = k.width;
+      resolution[1] = k.height;
+      resolution_camera = cam.id;
+    }
+    const bool entered = ImGui::InputInt2("resolution", resolution, ImGuiInputTextFlags_EnterReturnsTrue);
+    resolution_active = ImGui::IsItemActive();
+    if (entered && (resolution[0] != k.width || resolution[1] != k.height)) {
+      Action a = Make(Action::Kind::kIntrinsics, {cam.id});
+      a.width = std::clamp(resolution[0], 1, 65536);
+      a.height = std::clamp(resolution[1], 1, 65536);
+      Do(a);
+      resolution_active = false;
+    }
+    int lens = int(k.model);
+    if (ImGui::Combo("lens", &lens, "pinhole\0brown_conrady\0fisheye\0")) {
+      Action a = Make(Action::Kind::kIntrinsics, {cam.id});
+      a.lens = LensModelName(LensModel(lens));
+      Do(a);
+    }
+    const double values[6] = {k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
+    const std::string name = LensModelName(k.model);
+    for (int i = 0; i < 6; ++i) {
+      if (!LensHasCoefficient(name, i)) continue;
+      float v = float(values[i]);
+      if (ImGui::DragFloat(kCoefficientNames[i], &v, i == 2 || i == 3 ? 0.0001f : 0.001f, -10.0f, 10.0f, "%.4f")) {
+        Action a = Make(Action::Kind::kIntrinsics, {cam.id});
+        a.coefficients[i] = v;
+        a.drag = true;
+        Do(a);
+      }
+    }
+    if (k.model == LensModel::kPinhole) ImGui::TextDisabled("no distortion");
+  }
+  std::string resolution_camera;
+  int resolution[2] = {0, 0};
+  bool resolution_active = false;
 
   void FieldsPanel() {
     ImGui::SetNextWindowPos(ImVec2(8, 534), ImGuiCond_FirstUseEver);

@@ -7,6 +7,7 @@
 
 #include "analysis/error.h"
 #include "analysis/pose.h"
+#include "analysis/rig_check.h"
 #include "app/session/autosave.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
@@ -35,6 +36,33 @@ void CheckOutputPath(const Scene& scene, const std::string& path, const std::str
       throw InputError(where, "", "the screenshot path '" + path + "' is the " + what + " " + file,
                        "write the screenshot elsewhere");
   }
+}
+
+LensModel LensFromName(const std::string& name) {
+  return name == "brown_conrady" ? LensModel::kBrownConrady : name == "fisheye" ? LensModel::kFisheye : LensModel::kPinhole;
+}
+
+// What differs between a camera as saved and as edited that Session::Save cannot write (it writes
+// poses and focal lengths): "resolution, range", empty when nothing.
+std::string UnsavableChanges(const Camera& saved, const Camera& now) {
+  const Intrinsics& p = saved.model.intrinsics();
+  const Intrinsics& q = now.model.intrinsics();
+  std::vector<std::string> what;
+  if (p.width != q.width || p.height != q.height) what.push_back("resolution");
+  if (p.cx != q.cx || p.cy != q.cy) {
+    if (p.width == q.width && p.height == q.height) what.push_back("principal point");
+  }
+  if (p.model != q.model) what.push_back("lens model");
+  else if (p.k1 != q.k1 || p.k2 != q.k2 || p.p1 != q.p1 || p.p2 != q.p2 || p.k3 != q.k3 || p.k4 != q.k4)
+    what.push_back("distortion");
+  if (saved.near != now.near || saved.far != now.far) what.push_back("range");
+  if (saved.color != now.color) what.push_back("colour");
+  if (saved.enabled != now.enabled) what.push_back(now.enabled ? "switched on" : "switched off");
+  if (saved.name != now.name) what.push_back("name");
+  if (saved.pixel_sigma != now.pixel_sigma) what.push_back("pixel noise");
+  std::string out;
+  for (const std::string& w : what) out += (out.empty() ? "" : ", ") + w;
+  return out;
 }
 
 }  // namespace
@@ -207,6 +235,83 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       });
       break;
     }
+    case Kind::kIntrinsics: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      const bool lens_changed = !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
+                                                               [](double v) { return !std::isnan(v); });
+      apply(cams, label("lens", cams), [&](Camera& cam) {
+        Intrinsics k = cam.model.intrinsics();
+        if (a.width > 0) {
+          // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
+          const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;
+          k.fx *= sx;
+          k.fy *= sy;
+          k.cx = (k.cx + 0.5) * sx - 0.5;
+          k.cy = (k.cy + 0.5) * sy - 0.5;
+          k.width = a.width;
+          k.height = a.height;
+        }
+        if (!a.lens.empty()) {
+          const LensModel to = LensFromName(a.lens);
+          if ((to == LensModel::kFisheye) != (k.model == LensModel::kFisheye)) {
+            // Keep the nominal field of view across the projection's change.
+            const double hfov = HfovFromFocal(k.fx, k.width, k.model);
+            if (to != LensModel::kFisheye && !(hfov < M_PI))
+              throw InputError(a.where, "", "camera '" + cam.id + "' sees " + std::to_string(int(std::lround(hfov / kDeg))) +
+                                                " degrees; a " + a.lens + " lens sees less than 180",
+                               "narrow its field of view (hfov) first");
+            const double fx = FocalFromHfov(hfov, k.width, to);
+            k.fy *= fx / k.fx;
+            k.fx = fx;
+          }
+          k.model = to;
+          k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = k.k4 = 0;
+        }
+        const std::string model = LensModelName(k.model);
+        double* c[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
+        for (int i = 0; i < 6; ++i) {
+          if (std::isnan(a.coefficients[i])) continue;
+          if (!LensHasCoefficient(model, i))
+            throw InputError(a.where, "", "camera '" + cam.id + "' has a " + model + " lens, which has no coefficient " +
+                                              kCoefficientNames[i],
+                             model == "pinhole" ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
+                                                : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
+          *c[i] = a.coefficients[i];
+        }
+        cam.model = CameraModel(k);
+        if (lens_changed && k.model != LensModel::kPinhole) {
+          // A lens that folds back inside the image: part of it no ray reaches.
+          const LensCoverage lc = ComputeLensCoverage(cam.model);
+          if (lc.domain_ends_inside_image) {
+            char share[32];
+            std::snprintf(share, sizeof share, "%.1f", 100 * lc.unreachable_fraction);
+            throw InputError(a.where, "", "camera '" + cam.id + "': this " + model +
+                                              " distortion folds back inside the image (its valid domain ends there; " +
+                                              share + " % of the pixels would see nothing)",
+                             "use smaller coefficients");
+          }
+        }
+      });
+      break;
+    }
+    case Kind::kRange: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      apply(cams, label("range", cams), [&](Camera& cam) {
+        const double near = std::isnan(a.near) ? cam.near : a.near;
+        const double far = std::isnan(a.far) ? cam.far : a.far;
+        if (!(far > near))
+          throw InputError(a.where, "", "camera '" + cam.id + "': far (" + std::to_string(far) +
+                                            " m) must be greater than near (" + std::to_string(near) + " m)");
+        cam.near = near;
+        cam.far = far;
+      });
+      break;
+    }
+    case Kind::kColor: {
+      const std::vector<int> cams = CameraIndices(a.cameras, a);
+      apply(cams, label("colour", cams), [&](Camera& cam) { cam.color = a.a; });
+      break;
+    }
     case Kind::kUndo:
       status = edit.can_undo() ? "undo " + edit.undo_label() : "nothing to undo";
       if (edit.Undo()) Edited();
@@ -322,6 +427,15 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       suggestion.reset();
       break;
     case Kind::kSave: {
+      // Saving writes poses and focal lengths only: name what else changed, camera by camera.
+      std::string unsavable;
+      for (int c : edit.Unsaved()) {
+        const std::string what = UnsavableChanges(edit.saved().cameras[c], rig().cameras[c]);
+        if (!what.empty()) unsavable += (unsavable.empty() ? "" : "; ") + rig().cameras[c].id + "'s " + what;
+      }
+      if (!unsavable.empty())
+        throw InputError(file, "", "not saved: saving writes poses and focal lengths only, not " + unsavable,
+                         "undo them, or copy them into the scene file by hand");
       const session::SaveResult r = session_->Save(a.flag);
       if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
       status = r.saved.empty() ? "nothing to save" : "saved " + std::to_string(r.saved.size()) + " cameras into " +
@@ -384,10 +498,20 @@ nlohmann::json ViewerModel::StateJson() const {
   json cameras = json::array();
   for (const Camera& c : rig().cameras) {
     const Vec3 p = c.center();
+    const Intrinsics& k = c.model.intrinsics();
+    json lens = {{"model", LensModelName(k.model)}};
+    const std::string model = LensModelName(k.model);
+    const double* coefficients[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
+    for (int i = 0; i < 6; ++i)
+      if (LensHasCoefficient(model, i)) lens[kCoefficientNames[i]] = *coefficients[i];
     cameras.push_back({{"id", c.id},
                        {"enabled", c.enabled},
                        {"position", {p.x(), p.y(), p.z()}},
-                       {"hfov_deg", HfovFromFocal(c.model.intrinsics().fx, c.model.width(), c.model.intrinsics().model) / kDeg}});
+                       {"hfov_deg", HfovFromFocal(k.fx, c.model.width(), k.model) / kDeg},
+                       {"resolution", {k.width, k.height}},
+                       {"lens", lens},
+                       {"range", {c.near, std::isfinite(c.far) ? json(c.far) : json()}},
+                       {"color", {c.color.x(), c.color.y(), c.color.z()}}});
   }
   json selected = json::array();
   for (int c : selection) selected.push_back(rig().cameras[c].id);

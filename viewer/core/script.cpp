@@ -108,7 +108,8 @@ const std::map<std::string, Kind>& Kinds() {
   static const std::map<std::string, Kind> kinds = {
       {"select", Kind::kSelect}, {"move", Kind::kMove},       {"rotate", Kind::kRotate},
       {"aim", Kind::kAim},       {"orient", Kind::kOrient},   {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
-      {"hfov", Kind::kHfov},     {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
+      {"hfov", Kind::kHfov},     {"intrinsics", Kind::kIntrinsics}, {"range", Kind::kRange},
+      {"color", Kind::kColor},   {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
       {"slice", Kind::kSlice},   {"iso", Kind::kIso},         {"view", Kind::kView},
       {"orbit", Kind::kOrbit},   {"pan", Kind::kPan},         {"dolly", Kind::kDolly},
       {"eye", Kind::kEye},       {"light", Kind::kLight},     {"wait", Kind::kWait},
@@ -185,6 +186,52 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.cameras = e.Ids("hfov", false);
       a.number = e.Number("deg", 1, 359);
       break;
+    case Kind::kIntrinsics: {
+      e.Keys({"intrinsics", "resolution", "model", "k1", "k2", "p1", "p2", "k3", "k4"});
+      a.cameras = e.Ids("intrinsics", false);
+      if (e.Has("resolution")) {
+        const Vec3 v = e.Vector("resolution", 2);
+        if (v.x() < 1 || v.y() < 1 || v.x() > 65536 || v.y() > 65536 || v.x() != std::floor(v.x()) ||
+            v.y() != std::floor(v.y()))
+          e.Fail("resolution", "expected [width, height], whole numbers of pixels from 1 to 65536");
+        a.width = int(v.x());
+        a.height = int(v.y());
+      }
+      if (e.Has("model")) a.lens = e.OneOf("model", {"pinhole", "brown_conrady", "fisheye"});
+      bool any = a.width > 0 || !a.lens.empty();
+      for (int i = 0; i < 6; ++i) {
+        const char* key = kCoefficientNames[i];
+        if (!e.Has(key)) continue;
+        if (!a.lens.empty() && !LensHasCoefficient(a.lens, i))
+          e.Fail(key, "a " + a.lens + " lens has no coefficient " + key,
+                 a.lens == "pinhole" ? "pinhole: no distortion" : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4" : "brown_conrady: k1 k2 p1 p2 k3");
+        a.coefficients[i] = e.Number(key, -1000, 1000);
+        any = true;
+      }
+      if (!any) e.Fail("", "nothing to change", "give resolution, model or coefficients (k1 k2 p1 p2 k3 k4)");
+      break;
+    }
+    case Kind::kRange: {
+      e.Keys({"range", "near", "far"});
+      a.cameras = e.Ids("range", false);
+      if (!e.Has("near") && !e.Has("far")) e.Fail("", "nothing to change", "give near, far or both (metres)");
+      if (e.Has("near")) a.near = e.Number("near", 0, 1e7);
+      if (e.Has("far")) {
+        if (j.at("far").is_null()) a.far = INFINITY;
+        else a.far = e.Number("far", 1e-9, 1e7);
+        if (a.far <= a.near) e.Fail("far", "far must be greater than near");
+      }
+      break;
+    }
+    case Kind::kColor: {
+      e.Keys({"color", "rgb"});
+      a.cameras = e.Ids("color", false);
+      a.a = e.Vector("rgb");
+      for (int i = 0; i < 3; ++i)
+        if (a.a[i] < 0 || a.a[i] > 1)
+          e.Fail("rgb[" + std::to_string(i) + "]", "colour components are linear RGB in [0, 1]");
+      break;
+    }
     case Kind::kUndo:
     case Kind::kRedo:
     case Kind::kReject:
@@ -309,6 +356,14 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
 }
 
 }  // namespace
+
+const char* const kCoefficientNames[6] = {"k1", "k2", "p1", "p2", "k3", "k4"};
+
+bool LensHasCoefficient(const std::string& model, int i) {
+  if (model == "brown_conrady") return i <= 4;
+  if (model == "fisheye") return i == 0 || i == 1 || i == 4 || i == 5;
+  return false;
+}
 
 std::vector<Action> ParseScript(const std::string& text, const std::string& path) {
   CheckJsonLimits(text, path);

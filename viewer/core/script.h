@@ -14,6 +14,11 @@
 ///      {"orient": "c03", "ypr_deg": [30, -10, 0]},      // the scene file's yaw, pitch, roll
 ///      {"enable": ["c01"]}, {"disable": ["c01"]},
 ///      {"hfov": ["c03"], "deg": 55},                    // zoom (focal lengths scaled)
+///      {"intrinsics": "c03", "resolution": [1280, 720],  // same field of view (fx fy cx cy scaled)
+///       "model": "brown_conrady", "k1": -0.1, "k2": 0.01, "p1": 0, "p2": 0, "k3": 0},
+///                                                      // fisheye: k1..k4; pinhole: none
+///      {"range": "c03", "near": 0.3, "far": 5},         // "far": null: no far limit
+///      {"color": "c03", "rgb": [1, 0.2, 0]},             // linear RGB in [0, 1]
 ///      {"undo": 1}, {"redo": 1},
 ///      {"slice": "coverage", "axis": "z", "at": 1.0},   // "slice": "" hides it
 ///      {"iso": "sigma_max", "value": 2.0},              // "iso": "" hides it
@@ -36,6 +41,7 @@
 /// Unknown actions or keys, wrong types and out-of-range values are refused when the script is
 /// read, before anything runs: InputError naming the file and the JSON path ("$[4].by").
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -45,7 +51,7 @@ namespace pandora::viewer {
 
 struct Action {
   enum class Kind {
-    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kUndo, kRedo, kSlice, kIso, kView,
+    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kIntrinsics, kRange, kColor, kUndo, kRedo, kSlice, kIso, kView,
     kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
     kMouse, kKey, kScroll, kGamepad, kFrames, kStation,
   };
@@ -64,7 +70,19 @@ struct Action {
   /// drag (same cameras) as one undo step.
   bool drag = false;
   unsigned long long seed = 1;
+  /// intrinsics: the new resolution (0: kept), lens model ("": kept; given, the coefficients not
+  /// given are 0) and coefficients k1 k2 p1 p2 k3 k4 (NaN: not given).
+  int width = 0, height = 0;
+  std::string lens;
+  double coefficients[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
+  /// range: near and far in metres (NaN: kept; far infinite: no far limit).
+  double near = NAN, far = NAN;
 };
+
+/// The names of Action::coefficients, in order: k1 k2 p1 p2 k3 k4.
+extern const char* const kCoefficientNames[6];
+/// Whether lens model `model` ("pinhole", "brown_conrady", "fisheye") has coefficient `i`.
+bool LensHasCoefficient(const std::string& model, int i);
 
 /// Parses a script (the text of `path`); throws InputError naming `path` and the JSON path.
 std::vector<Action> ParseScript(const std::string& text, const std::string& path);

@@ -258,6 +258,59 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   ExpectScriptError("[{\"move\": \"a\", \"by\": [1e300, 0, 0]}]", "$[0].by[0]");
 }
 
+TEST(Script, CameraPanelActionsParseAndRefuseBadValuesWithTheirPath) {
+  const std::vector<Action> s = ParseScript(R"([
+    {"intrinsics": "a", "resolution": [320, 240]},
+    {"intrinsics": ["a", "b"], "model": "brown_conrady", "k1": -0.1, "p2": 0.001},
+    {"intrinsics": "a", "k4": 0.01},
+    {"range": "a", "near": 0.3, "far": 5}, {"range": ["a"], "far": null}, {"range": "a", "near": 1},
+    {"color": "a", "rgb": [1, 0.5, 0]}
+  ])", "s.json");
+  ASSERT_EQ(s.size(), 7u);
+  EXPECT_EQ(s[0].kind, Action::Kind::kIntrinsics);
+  EXPECT_EQ(s[0].width, 320);
+  EXPECT_EQ(s[0].height, 240);
+  EXPECT_TRUE(s[0].lens.empty());
+  EXPECT_EQ(s[1].cameras, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(s[1].lens, "brown_conrady");
+  EXPECT_EQ(s[1].coefficients[0], -0.1);
+  EXPECT_EQ(s[1].coefficients[3], 0.001);
+  EXPECT_TRUE(std::isnan(s[1].coefficients[1]));
+  EXPECT_EQ(s[1].width, 0);
+  EXPECT_EQ(s[2].coefficients[5], 0.01);
+  EXPECT_EQ(s[3].kind, Action::Kind::kRange);
+  EXPECT_EQ(s[3].near, 0.3);
+  EXPECT_EQ(s[3].far, 5);
+  EXPECT_TRUE(std::isnan(s[4].near));
+  EXPECT_TRUE(std::isinf(s[4].far));
+  EXPECT_TRUE(std::isnan(s[5].far));
+  EXPECT_EQ(s[6].kind, Action::Kind::kColor);
+  EXPECT_EQ(s[6].a, Vec3(1, 0.5, 0));
+
+  ExpectScriptError(R"([{"intrinsics": "a"}])", "$[0]");
+  ExpectScriptError(R"([{"intrinsics": [], "k1": 0}])", "$[0].intrinsics");
+  ExpectScriptError(R"([{"intrinsics": "a", "resolution": [640]}])", "$[0].resolution");
+  ExpectScriptError(R"([{"intrinsics": "a", "resolution": [640.5, 480]}])", "$[0].resolution");
+  ExpectScriptError(R"([{"intrinsics": "a", "resolution": [0, 480]}])", "$[0].resolution");
+  ExpectScriptError(R"([{"intrinsics": "a", "resolution": [640, "x"]}])", "$[0].resolution[1]");
+  ExpectScriptError(R"([{"intrinsics": "a", "model": "tsai"}])", "$[0].model");
+  ExpectScriptError(R"([{"intrinsics": "a", "model": "brown_conrady", "k4": 0.1}])", "$[0].k4");
+  ExpectScriptError(R"([{"intrinsics": "a", "model": "fisheye", "p1": 0.1}])", "$[0].p1");
+  ExpectScriptError(R"([{"intrinsics": "a", "model": "pinhole", "k1": 0.1}])", "$[0].k1");
+  ExpectScriptError(R"([{"intrinsics": "a", "k1": "big"}])", "$[0].k1");
+  ExpectScriptError(R"([{"intrinsics": "a", "k2": 1e6}])", "$[0].k2");
+  ExpectScriptError(R"([{"intrinsics": "a", "k5": 0}])", "$[0].k5");
+  ExpectScriptError(R"([{"range": "a"}])", "$[0]");
+  ExpectScriptError(R"([{"range": "a", "near": -1}])", "$[0].near");
+  ExpectScriptError(R"([{"range": "a", "near": 2, "far": 1}])", "$[0].far");
+  ExpectScriptError(R"([{"range": "a", "far": "inf"}])", "$[0].far");
+  ExpectScriptError(R"([{"range": "a", "far": 0}])", "$[0].far");
+  ExpectScriptError(R"([{"color": "a"}])", "$[0].rgb");
+  ExpectScriptError(R"([{"color": "a", "rgb": [1.5, 0, 0]}])", "$[0].rgb[0]");
+  ExpectScriptError(R"([{"color": "a", "rgb": "#ff0000"}])", "$[0].rgb");
+  ExpectScriptError(R"([{"color": "a", "rgb": [1, 0, 0], "alpha": 1}])", "$[0].alpha");
+}
+
 // A copy of the suggest ring scene in a fresh folder (the session saves into it).
 fs::path CopyScene(const std::string& name) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("viewer_" + name);
@@ -415,6 +468,122 @@ TEST(ViewerModel, GroupEditsAreOneUndoStep) {
   EXPECT_FALSE(m.session().rig().Undo());
   for (std::size_t i = 0; i < original.cameras.size(); ++i)
     EXPECT_TRUE(SameCameraGeometry(m.rig().cameras[i], original.cameras[i])) << i;
+  m.session().WaitFields();
+}
+
+// The Camera panel's edits: resolution (same field of view), lens model and coefficients, range,
+// colour; each one undo step, refused clearly where the lens would fold back or the range is empty;
+// saving names what it cannot write.
+TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
+  const fs::path scene = CopyScene("camera_panel");
+  const std::string original_text = Read(scene);
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  const Rig original = m.rig();
+  const std::string a = original.cameras[0].id, b = original.cameras[1].id;
+  auto run = [&](const std::string& text) { m.Run(ParseScript(text, "s.json"), nullptr); };
+
+  // Half the resolution: the same rays through the image's edges (and its corners), the pixel
+  // centre of the principal point halved about the edge.
+  run(R"([{"intrinsics": ")" + a + R"(", "resolution": [320, 240]}])");
+  const Camera& half = m.rig().cameras[0];
+  const Camera& full = original.cameras[0];
+  EXPECT_EQ(half.model.width(), 320);
+  EXPECT_EQ(half.model.height(), 240);
+  EXPECT_EQ(m.StateJson()["undo"], "lens " + a);
+  for (const Vec2 corner : {Vec2(-0.5, -0.5), Vec2(639.5, 479.5), Vec2(319.5, 0)}) {
+    const Vec2 scaled((corner.x() + 0.5) * 0.5 - 0.5, (corner.y() + 0.5) * 0.5 - 0.5);
+    EXPECT_LT((*half.model.Unproject(scaled) - *full.model.Unproject(corner)).norm(), 1e-12);
+  }
+  EXPECT_NEAR(HfovFromFocal(half.model.intrinsics().fx, 320, LensModel::kPinhole),
+              HfovFromFocal(full.model.intrinsics().fx, 640, LensModel::kPinhole), 1e-12);
+
+  // A Brown-Conrady lens on two cameras at once: one undo step.
+  run(R"([{"intrinsics": [")" + a + R"(", ")" + b + R"("], "model": "brown_conrady", "k1": -0.1, "p1": 0.001}])");
+  for (int c : {0, 1}) {
+    const Intrinsics& k = m.rig().cameras[c].model.intrinsics();
+    EXPECT_EQ(k.model, LensModel::kBrownConrady);
+    EXPECT_EQ(k.k1, -0.1);
+    EXPECT_EQ(k.p1, 0.001);
+    EXPECT_EQ(k.k2, 0);
+  }
+  EXPECT_EQ(m.StateJson()["undo"], "lens 2 cameras");
+  EXPECT_EQ(m.StateJson()["cameras"][1]["lens"]["model"], "brown_conrady");
+  EXPECT_EQ(m.StateJson()["cameras"][1]["lens"]["k1"], -0.1);
+  // A coefficient alone changes the lens model the camera has.
+  run(R"([{"intrinsics": ")" + b + R"(", "k2": 0.02}])");
+  EXPECT_EQ(m.rig().cameras[1].model.intrinsics().k2, 0.02);
+  EXPECT_EQ(m.rig().cameras[1].model.intrinsics().k1, -0.1);
+
+  const std::int64_t version = m.session().rig().version();
+  const std::string undo = m.StateJson()["undo"];
+  auto refused = [&](const std::string& text, const std::string& words) {
+    try {
+      run(text);
+      ADD_FAILURE() << "expected a refusal: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(m.session().rig().version(), version) << text;  // nothing applied
+    EXPECT_EQ(m.StateJson()["undo"], undo);
+  };
+  // Barrel distortion so strong that the radial map turns inside the image: refused, nothing changes.
+  refused(R"([{"intrinsics": ")" + b + R"(", "k1": -1.5}])", "folds back inside the image");
+  refused(R"([{"intrinsics": ")" + b + R"(", "k4": 0.1}])", "no coefficient k4");  // a Brown-Conrady lens
+  refused(R"([{"intrinsics": ")" + original.cameras[2].id + R"(", "k1": 0.1}])", "pinhole lens");
+  refused(R"([{"range": ")" + a + R"(", "near": 100}])", "must be greater than near");
+  refused(R"([{"intrinsics": "nope", "k1": 0.1}])", "no camera 'nope'");
+
+  // Fisheye keeps the nominal field of view; a 200 degree fisheye cannot become a pinhole.
+  run(R"([{"intrinsics": ")" + b + R"(", "model": "fisheye", "k4": 0.001}])");
+  const Intrinsics& f = m.rig().cameras[1].model.intrinsics();
+  EXPECT_EQ(f.model, LensModel::kFisheye);
+  EXPECT_EQ(f.k4, 0.001);
+  EXPECT_NEAR(HfovFromFocal(f.fx, f.width, LensModel::kFisheye), 50 * kDeg, 1e-12);
+  run(R"([{"hfov": ")" + b + R"(", "deg": 200}])");
+  EXPECT_THROW(run(R"([{"intrinsics": ")" + b + R"(", "model": "pinhole"}])"), InputError);
+  run(R"([{"undo": 1}, {"undo": 1}])");
+
+  // The working range: the fields follow (a short far range sees less of the region).
+  m.session().WaitFields();
+  const double seen = m.StateJson()["fields"]["coverage_ge"][0];
+  run(R"([{"range": [")" + a + R"(", ")" + b + R"(", ")" + original.cameras[2].id + R"(", ")" +
+      original.cameras[3].id + R"("], "near": 0.5, "far": 2.5}, {"wait": "fields"}])");
+  EXPECT_EQ(m.rig().cameras[0].near, 0.5);
+  EXPECT_EQ(m.rig().cameras[3].far, 2.5);
+  EXPECT_LT(m.StateJson()["fields"]["coverage_ge"][0].get<double>(), seen);
+  run(R"([{"range": ")" + a + R"(", "far": null}])");
+  EXPECT_TRUE(std::isinf(m.rig().cameras[0].far));
+  EXPECT_EQ(m.rig().cameras[0].near, 0.5);
+  EXPECT_TRUE(m.StateJson()["cameras"][0]["range"][1].is_null());
+
+  // Colour: display only, one undo step.
+  run(R"([{"color": ")" + a + R"(", "rgb": [1, 0, 0]}])");
+  EXPECT_EQ(m.rig().cameras[0].color, Vec3(1, 0, 0));
+  EXPECT_EQ(m.StateJson()["undo"], "colour " + a);
+
+  // Saving writes poses and focal lengths only: the refusal names each camera's other changes.
+  try {
+    run(R"([{"save": 1}])");
+    ADD_FAILURE() << "expected the save to be refused";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("not saved: saving writes poses and focal lengths only, not " + a +
+                       "'s resolution, lens model, range, colour; "), std::string::npos) << what;
+    EXPECT_NE(what.find(b + "'s lens model, range; "), std::string::npos) << what;
+  }
+  EXPECT_EQ(Read(scene), original_text);
+
+  // Everything undoes, step by step, to the rig as loaded; then nothing is left to save.
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(m.session().rig().Undo()) << i;
+  EXPECT_FALSE(m.session().rig().Undo());
+  for (std::size_t i = 0; i < original.cameras.size(); ++i) {
+    EXPECT_TRUE(SameCameraGeometry(m.rig().cameras[i], original.cameras[i])) << i;
+    EXPECT_EQ(m.rig().cameras[i].color, original.cameras[i].color);
+  }
+  run(R"([{"save": 1}])");
+  EXPECT_EQ(m.status, "nothing to save");
   m.session().WaitFields();
 }
 
