@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "analysis/error.h"
+#include "render/isosurface.h"
 #include "volume/fields_vdb.h"
 #include "volume/vdb_io.h"
 
@@ -83,6 +84,10 @@ TriangleMesh ExtractIsosurface(const Fields& fields, const std::string& name, do
     }
   });
   return mesh;
+}
+
+TriangleMesh FieldIsosurface(const Fields& fields, const std::string& name, double iso) {
+  return ExtractIsosurface(fields, name, iso);
 }
 
 }  // namespace pandora

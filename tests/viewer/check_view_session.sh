@@ -2,7 +2,7 @@
 # The scripted session of the viewer (issue 11's "Done when"): `pandora view --script` under Xvfb
 # with Mesa's llvmpipe on a copy of the trauma room: load (coverage slice shown), turn camera o3 (the
 # coverage drops, the slice follows), suggest for o3, accept it, undo with the window's Undo button
-# (mouse events) and redo with ctrl+y, save. Checks the log's numbers, the saved file and its backup,
+# (mouse events) and redo with ctrl+y, save, then the coverage isosurface (2.5, slice hidden). Checks the log's numbers, the saved file and its backup,
 # and compares each screenshot with tests/data/viewer/<name>.png (at most 0.5 % of pixels off by more
 # than 8/255: measured run to run 0 %; a moved camera changes several percent).
 # Usage: check_view_session.sh PANDORA PNG_DIFF OUT_DIR   (UPDATE_REFERENCES=1 rewrites the references)
@@ -35,11 +35,12 @@ backup=$(ls "$out"/scene.json.* | grep -v autosave | head -1)
 cmp -s "$backup" "$src"/examples/trauma_room/scene.json || fail "no backup holds the original scene"
 [ ! -e "$out"/scene.json.autosave.json ] || fail "the autosave outlived the save"
 
-for png in 1_loaded 2_turned 3_suggested 4_accepted 5_undone 6_saved o3_view; do
+for png in 1_loaded 2_turned 3_suggested 4_accepted 5_undone 6_saved o3_view 7_iso; do
   if [ "${UPDATE_REFERENCES:-0}" = 1 ]; then mkdir -p "$refs"; cp "$out/$png.png" "$refs/$png.png"; continue; fi
   "$diff" "$out/$png.png" "$refs/$png.png" 0.5 8 || fail "$png.png differs from its reference"
 done
 # The steps must differ from each other where the scene changed (a screenshot that never updates
 # would pass its reference only if the reference were stale too).
 "$diff" "$out"/1_loaded.png "$out"/2_turned.png 0.5 8 >/dev/null && fail "turning o3 changed nothing on screen"
+"$diff" "$out"/6_saved.png "$out"/7_iso.png 0.5 8 >/dev/null && fail "the isosurface (coverage 2.5) is not drawn"
 echo "ok: scripted session"

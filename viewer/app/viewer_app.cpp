@@ -22,6 +22,7 @@
 #include "analysis/error.h"
 #include "analysis/pose.h"
 #include "analysis/color.h"
+#include "render/isosurface.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
 #include "viewer/core/station.h"
@@ -281,6 +282,7 @@ struct ViewerApp::Impl {
     };
     // The slice: its voxels as translucent quads in the plane.
     if (!model.display.overlays.slice_field.empty()) DrawSlice(dl, P);
+    if (!model.display.overlays.iso_field.empty()) DrawIso(dl, P);
     auto frustum = [&](const Camera& cam, ImU32 col, float width) {
       const std::vector<Vec3> border = FrustumBorder(cam, 0.6);
       const Vec3 o = cam.center();
@@ -417,6 +419,70 @@ struct ViewerApp::Impl {
         if (ok) dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3], Color(rgb, ov.slice_opacity));
       }
   }
+
+  // The isosurface of the live fields as translucent triangles, back to front, shaded as the CPU
+  // renderer shades it (0.35 + 0.65 |n . d|); where the scene hides a triangle (its centre) from the
+  // eye it is drawn at a quarter of the opacity. The mesh is extracted again only when the fields or
+  // the iso choice change; the order and the hidden flags only when the view does.
+  void DrawIso(ImDrawList* dl, const Projector& P) {
+    const OverlayOptions& ov = model.display.overlays;
+    char key[256];
+    std::snprintf(key, sizeof key, "%s %.17g", ov.iso_field.c_str(), ov.iso_value);
+    model.session().ReadFields([&](const Fields& f, std::int64_t v) {
+      if (v == iso_version && key == iso_key) return;
+      iso_version = v;
+      iso_key = key;
+      iso_view_key.clear();
+      try {
+        iso_mesh = FieldIsosurface(f, ov.iso_field, ov.iso_value);
+      } catch (const std::exception&) {
+        iso_mesh = TriangleMesh();
+      }
+    });
+    const std::size_t n = iso_mesh.triangles.size();
+    if (n == 0) return;
+    const RenderView view = model.MainView();
+    char vkey[256];
+    std::snprintf(vkey, sizeof vkey, "%.17g %.17g %.17g %d %d", view.from.x(), view.from.y(), view.from.z(),
+                  view.width, view.height);
+    if (vkey != iso_view_key) {
+      iso_view_key = vkey;
+      std::vector<std::pair<double, int>> depth(n);
+      std::vector<Ray> rays(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3i& t = iso_mesh.triangles[i];
+        const Vec3 c = (iso_mesh.vertices[t[0]] + iso_mesh.vertices[t[1]] + iso_mesh.vertices[t[2]]) / 3.0;
+        const double d = (c - view.from).norm();
+        depth[i] = {-d, int(i)};
+        rays[i] = Ray{view.from, (c - view.from) / std::max(d, 1e-12), 0.0, std::max(0.0, d - 1e-3)};
+      }
+      std::sort(depth.begin(), depth.end());  // farthest first
+      model.session().study().caster().OccludedBatch(rays, &iso_hidden);
+      iso_order.resize(n);
+      iso_shade.resize(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        iso_order[i] = depth[i].second;
+        const Eigen::Vector3i& t = iso_mesh.triangles[depth[i].second];
+        const Vec3 a = iso_mesh.vertices[t[0]], b = iso_mesh.vertices[t[1]], c = iso_mesh.vertices[t[2]];
+        const Vec3 normal = (b - a).cross(c - a).normalized();
+        iso_shade[i] = 0.35 + 0.65 * std::abs(normal.dot(rays[depth[i].second].direction));
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3i& t = iso_mesh.triangles[iso_order[i]];
+      const auto a = P.Point(iso_mesh.vertices[t[0]]), b = P.Point(iso_mesh.vertices[t[1]]),
+                 c = P.Point(iso_mesh.vertices[t[2]]);
+      if (!a || !b || !c) continue;
+      const double alpha = ov.iso_opacity * (iso_hidden[iso_order[i]] ? 0.25 : 1.0);
+      dl->AddTriangleFilled(*a, *b, *c, Color(iso_shade[i] * ov.iso_color, alpha));
+    }
+  }
+  std::int64_t iso_version = -2;
+  std::string iso_key, iso_view_key;
+  TriangleMesh iso_mesh;
+  std::vector<int> iso_order;
+  std::vector<double> iso_shade;
+  std::vector<uint8_t> iso_hidden;
 
   // Translate handles along world X, Y, Z and rotation rings about them, at the primary camera.
   void DrawGizmo(ImDrawList* dl, const Projector& P) {
@@ -813,8 +879,8 @@ struct ViewerApp::Impl {
   bool resolution_active = false;
 
   void FieldsPanel() {
-    ImGui::SetNextWindowPos(ImVec2(8, 534), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(250, 150), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(266, float(std::max(40, model.height - 230))), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250, 195), ImGuiCond_FirstUseEver);
     ImGui::Begin("Fields");
     VoxelLattice lattice;
     std::string numbers;
@@ -857,6 +923,20 @@ struct ViewerApp::Impl {
       a.flag = a.text.empty();
       a.text2 = axis == 0 ? "x" : axis == 1 ? "y" : "z";
       a.number = at;
+      Do(a);
+    }
+    // The isosurface: field and value.
+    int iso_current = 0;
+    for (int i = 1; i < 4; ++i)
+      if (ov.iso_field == fields[i]) iso_current = i;
+    float iso_value = float(ov.iso_value);
+    bool iso_changed = ImGui::Combo("iso", &iso_current, "off\0coverage\0resolution\0sigma_max\0");
+    iso_changed |= ImGui::DragFloat("iso value", &iso_value, 0.05f, -1e6f, 1e6f, "%.2f");
+    if (iso_changed) {
+      Action a = Make(Action::Kind::kIso);
+      a.text = fields[iso_current];
+      a.flag = a.text.empty();
+      a.number = iso_value;
       Do(a);
     }
     ImGui::End();

@@ -17,6 +17,7 @@
 #include "viewer/core/model.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
+#include "render/isosurface.h"
 #include "viewer/core/station.h"
 #include "volume/fields.h"
 
@@ -585,6 +586,36 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
   run(R"([{"save": 1}])");
   EXPECT_EQ(m.status, "nothing to save");
   m.session().WaitFields();
+}
+
+// The isosurface the window draws: the iso action picks a live field and value ("" hides it and
+// keeps the value); FieldIsosurface gives the renderer's mesh of the live fields, inside the lattice.
+TEST(ViewerModel, IsoActionAndTheLiveFieldsIsosurface) {
+  const fs::path scene = CopyScene("iso");
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  m.Run(ParseScript(R"([{"wait": "fields"}, {"iso": "coverage", "value": 2.5}])", "s.json"), nullptr);
+  EXPECT_EQ(m.display.overlays.iso_field, "coverage");
+  EXPECT_EQ(m.display.overlays.iso_value, 2.5);
+  m.session().ReadFields([&](const Fields& f, std::int64_t) {
+    const TriangleMesh mesh = FieldIsosurface(f, "coverage", 2.5);
+    ASSERT_GT(mesh.triangles.size(), 0u);
+    const Vec3 lo = f.lattice.origin, hi = f.lattice.Center(f.lattice.dims.x() - 1, f.lattice.dims.y() - 1,
+                                                             f.lattice.dims.z() - 1);
+    for (const Vec3& v : mesh.vertices)
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_GE(v[k], lo[k] - f.lattice.voxel_size);
+        EXPECT_LE(v[k], hi[k] + f.lattice.voxel_size);
+      }
+    // A value no voxel passes gives no surface; a field that is not live is refused.
+    EXPECT_EQ(FieldIsosurface(f, "coverage", 99.5).triangles.size(), 0u);
+    EXPECT_THROW(FieldIsosurface(f, "sigma_max", 1.0), InputError);
+  });
+  m.Run(ParseScript(R"([{"iso": ""}])", "s.json"), nullptr);
+  EXPECT_TRUE(m.display.overlays.iso_field.empty());
+  EXPECT_EQ(m.display.overlays.iso_value, 2.5);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"iso": "sigma_max", "value": 1}])", "s.json"), nullptr), InputError);
 }
 
 }  // namespace
