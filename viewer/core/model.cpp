@@ -143,6 +143,70 @@ void ViewerModel::Edited() {
   if (on_edit) on_edit();
 }
 
+std::vector<std::string> ViewerModel::LiveFields() const {
+  return options_.fields.empty() ? DefaultFields() : options_.fields;
+}
+
+void ViewerModel::Compare(const Action& a) {
+  const std::vector<std::string> names = LiveFields();
+  // Every rig asked for exists before anything is evaluated.
+  std::vector<const Rig*> others;
+  for (const std::string& name : a.cameras) {
+    if (name == "saved") {
+      others.push_back(&session_->rig().saved());
+      continue;
+    }
+    const Rig* found = nullptr;
+    std::string list;
+    for (const Rig& r : scene().rigs) {
+      if (r.name == name) found = &r;
+      list += (list.empty() ? "" : ", ") + r.name;
+    }
+    if (!found) throw InputError(a.where, "", "no rig '" + name + "' in " + scene().path, "compare with saved or " + list);
+    others.push_back(found);
+  }
+  // The edited rig: its live fields once they have caught up.
+  const session::JobStatus s = session_->WaitFields();
+  if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+  std::vector<Summary> summaries;
+  session_->ReadFields([&](const Fields& f, std::int64_t) {
+    summaries.push_back(Summarize(scene(), rig(), f, names, 1));
+  });
+  summaries.back().rig = rig().name + " (edited)";
+  for (std::size_t i = 0; i < others.size(); ++i) {
+    const Rig& other = *others[i];
+    auto same = [&](const Rig& x) {
+      if (x.name != other.name || x.cameras.size() != other.cameras.size()) return false;
+      for (std::size_t c = 0; c < x.cameras.size(); ++c)
+        if (!SameCameraGeometry(x.cameras[c], other.cameras[c])) return false;
+      return true;
+    };
+    Summary summary;
+    if (same(rig())) {
+      summary = summaries.front();  // nothing edited: the live fields are this rig's
+    } else {
+      const auto hit = std::find_if(compare_cache_.begin(), compare_cache_.end(),
+                                    [&](const CachedSummary& c) { return same(c.rig); });
+      if (hit != compare_cache_.end()) {
+        summary = hit->summary;
+      } else {
+        FieldOptions fo;
+        fo.fields = names;
+        fo.scene_path = scene().path;
+        const Fields f = EvaluateFields(scene(), other, session_->study().caster(), fo);
+        summary = Summarize(scene(), other, f, names, 1);
+        compare_cache_.push_back({other, summary});
+        if (compare_cache_.size() > 8) compare_cache_.erase(compare_cache_.begin());
+      }
+    }
+    summary.rig = a.cameras[i] == "saved" ? other.name + " (saved)" : other.name;
+    summaries.push_back(std::move(summary));
+  }
+  comparison = report::CompareRigs(summaries, scene().study);
+  comparison_rig_version = session_->rig().version();
+  status = "compared " + std::to_string(summaries.size()) + " rigs";
+}
+
 void ViewerModel::Run(const std::vector<Action>& script, Frontend* frontend) {
   for (const Action& a : script) Do(a, frontend);
 }
@@ -312,6 +376,9 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       apply(cams, label("colour", cams), [&](Camera& cam) { cam.color = a.a; });
       break;
     }
+    case Kind::kCompare:
+      Compare(a);
+      break;
     case Kind::kUndo:
       status = edit.can_undo() ? "undo " + edit.undo_label() : "nothing to undo";
       if (edit.Undo()) Edited();
@@ -541,6 +608,7 @@ nlohmann::json ViewerModel::StateJson() const {
             {"cameras", cameras},
             {"fields", fields},
             {"status", status}};
+  if (comparison) j["comparison"] = *comparison;
   if (suggestion) {
     json ids = json::array();
     for (const CameraChange& c : suggestion->cameras) ids.push_back(c.id);

@@ -17,6 +17,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "app/session/session.h"
+#include "render/report/rig_comparison.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
 
@@ -76,6 +77,10 @@ class ViewerModel {
   /// The scene's viewing stations as placed in this session (not saved into the scene file).
   std::map<std::string, ViewingStation> stations;
   std::int64_t stations_version = 0;    ///< Bumps when a station moves.
+  /// The last "compare": the edited rig (its live fields, as they were) first, then the rig as last
+  /// saved and / or other rigs of the scene (each evaluated once and kept while it stays the same).
+  std::optional<report::RigComparison> comparison;
+  std::int64_t comparison_rig_version = -1;  ///< The edited rig's version it was made for.
 
   /// The main view as the renderer takes it.
   RenderView MainView() const { return view.ToRenderView(width, height); }
@@ -89,6 +94,14 @@ class ViewerModel {
   int CameraIndex(const std::string& id, const Action& action) const;
   std::vector<int> CameraIndices(const std::vector<std::string>& ids, const Action& action) const;
   void Edited();  // fields in the background, autosave, on_edit
+  void Compare(const Action& action);
+  std::vector<std::string> LiveFields() const;
+  // Summaries of rigs other than the edited one, evaluated once (Compare).
+  struct CachedSummary {
+    Rig rig;
+    Summary summary;
+  };
+  std::vector<CachedSummary> compare_cache_;
   std::string drag_label_;  // the drag in progress (its steps amend one edit), empty: none
   ViewerOptions options_;
   std::unique_ptr<session::Session> session_;

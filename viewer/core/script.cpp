@@ -109,7 +109,7 @@ const std::map<std::string, Kind>& Kinds() {
       {"select", Kind::kSelect}, {"move", Kind::kMove},       {"rotate", Kind::kRotate},
       {"aim", Kind::kAim},       {"orient", Kind::kOrient},   {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
       {"hfov", Kind::kHfov},     {"intrinsics", Kind::kIntrinsics}, {"range", Kind::kRange},
-      {"color", Kind::kColor},   {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
+      {"color", Kind::kColor},   {"compare", Kind::kCompare}, {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
       {"slice", Kind::kSlice},   {"iso", Kind::kIso},         {"view", Kind::kView},
       {"orbit", Kind::kOrbit},   {"pan", Kind::kPan},         {"dolly", Kind::kDolly},
       {"eye", Kind::kEye},       {"light", Kind::kLight},     {"wait", Kind::kWait},
@@ -230,6 +230,16 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       for (int i = 0; i < 3; ++i)
         if (a.a[i] < 0 || a.a[i] > 1)
           e.Fail("rgb[" + std::to_string(i) + "]", "colour components are linear RGB in [0, 1]");
+      break;
+    }
+    case Kind::kCompare: {
+      e.Keys({"compare"});
+      a.cameras = e.Ids("compare", false);
+      if (a.cameras.size() > 8) e.Fail("compare", "compare with at most 8 rigs");
+      for (std::size_t i = 0; i < a.cameras.size(); ++i)
+        for (std::size_t k = 0; k < i; ++k)
+          if (a.cameras[i] == a.cameras[k])
+            e.Fail("compare[" + std::to_string(i) + "]", "'" + a.cameras[i] + "' is named twice");
       break;
     }
     case Kind::kUndo:

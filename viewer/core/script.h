@@ -19,6 +19,8 @@
 ///                                                      // fisheye: k1..k4; pinhole: none
 ///      {"range": "c03", "near": 0.3, "far": 5},         // "far": null: no far limit
 ///      {"color": "c03", "rgb": [1, 0.2, 0]},             // linear RGB in [0, 1]
+///      {"compare": "saved"}, {"compare": ["saved", "grid4x2"]},  // the edited rig against the
+///                                                      // rig as saved and / or other rigs
 ///      {"undo": 1}, {"redo": 1},
 ///      {"slice": "coverage", "axis": "z", "at": 1.0},   // "slice": "" hides it
 ///      {"iso": "sigma_max", "value": 2.0},              // "iso": "" hides it
@@ -51,13 +53,14 @@ namespace pandora::viewer {
 
 struct Action {
   enum class Kind {
-    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kIntrinsics, kRange, kColor, kUndo, kRedo, kSlice, kIso, kView,
+    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kIntrinsics, kRange, kColor, kCompare, kUndo, kRedo, kSlice, kIso, kView,
     kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
     kMouse, kKey, kScroll, kGamepad, kFrames, kStation,
   };
   Kind kind = Kind::kFrames;
   std::string where;                 ///< "$[i]": for messages while running.
-  std::vector<std::string> cameras;  ///< Camera ids (select, move, ... accept; empty accept: all).
+  std::vector<std::string> cameras;  ///< Camera ids (select, move, ... accept; empty accept: all);
+                                     ///< compare: "saved" or rig names.
   std::string text;    ///< Field, view, wait target, objective, path, key, mouse action, light pattern.
   std::string text2;   ///< slice axis "x"/"y"/"z", surface mode, mouse button, screenshot camera.
   Vec3 a = Vec3::Zero(), b = Vec3::Zero();  ///< by/to/axis/at/eye; gamepad left (x, y), right (x, y).

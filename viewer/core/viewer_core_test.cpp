@@ -20,6 +20,7 @@
 #include "render/isosurface.h"
 #include "viewer/core/station.h"
 #include "volume/fields.h"
+#include "volume/summary.h"
 
 namespace pandora::viewer {
 namespace {
@@ -616,6 +617,61 @@ TEST(ViewerModel, IsoActionAndTheLiveFieldsIsosurface) {
   EXPECT_TRUE(m.display.overlays.iso_field.empty());
   EXPECT_EQ(m.display.overlays.iso_value, 2.5);
   EXPECT_THROW(m.Run(ParseScript(R"([{"iso": "sigma_max", "value": 1}])", "s.json"), nullptr), InputError);
+}
+
+// The Compare panel's numbers: the edited rig (its live fields) against the rig as saved, with the
+// saved rig evaluated once (a full evaluation's numbers) and nothing evaluated while nothing differs.
+TEST(ViewerModel, CompareTheEditedRigWithTheSavedOne) {
+  const std::vector<Action> s = ParseScript(R"([{"compare": "saved"}, {"compare": ["saved", "grid4x2"]}])", "s.json");
+  EXPECT_EQ(s[0].kind, Action::Kind::kCompare);
+  EXPECT_EQ(s[1].cameras, (std::vector<std::string>{"saved", "grid4x2"}));
+  ExpectScriptError(R"([{"compare": []}])", "$[0].compare");
+  ExpectScriptError(R"([{"compare": 1}])", "$[0].compare");
+  ExpectScriptError(R"([{"compare": ["saved", "saved"]}])", "$[0].compare[1]");
+  ExpectScriptError(R"([{"compare": "saved", "rig": "x"}])", "$[0].rig");
+
+  const fs::path scene = CopyScene("compare");
+  ViewerOptions options;
+  options.fields = {"coverage", "resolution", "sigma_max"};
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  auto run = [&](const std::string& text) { m.Run(ParseScript(text, "s.json"), nullptr); };
+  auto value = [&](const std::string& key, std::size_t rig) {
+    const report::ComparisonRow* row = m.comparison->Find(key);
+    EXPECT_TRUE(row) << key;
+    return row && row->values[rig] ? *row->values[rig] : NAN;
+  };
+  // Nothing edited: both columns are the live fields' numbers.
+  run(R"([{"compare": "saved"}])");
+  ASSERT_TRUE(m.comparison);
+  EXPECT_EQ(m.comparison->rigs, (std::vector<std::string>{"ring (edited)", "ring (saved)"}));
+  EXPECT_GT(value("coverage_ge3", 0), 0);
+  for (const char* key : {"coverage_ge1", "coverage_ge2", "coverage_ge3", "resolution_p50_px_per_m", "sigma_max_p90_mm"})
+    EXPECT_EQ(value(key, 0), value(key, 1)) << key;
+  EXPECT_EQ(m.StateJson()["comparison"]["rigs"][1], "ring (saved)");
+
+  // Turn a camera away: the edited column drops, the saved column is a full evaluation of the rig
+  // as loaded; comparing again gives the same numbers (the saved rig's are kept).
+  const Rig loaded = m.rig();
+  const std::string c = loaded.cameras[1].id;
+  run(R"([{"rotate": ")" + c + R"(", "axis": [0, 0, 1], "deg": 40}, {"compare": "saved"}])");
+  EXPECT_EQ(m.comparison_rig_version, m.session().rig().version());
+  EXPECT_LT(value("coverage_ge3", 0), value("coverage_ge3", 1));
+  FieldOptions fo;
+  fo.fields = options.fields;
+  const Fields full = EvaluateFields(m.scene(), loaded, m.session().study().caster(), fo);
+  const Summary expected = Summarize(m.scene(), loaded, full, options.fields, 1);
+  EXPECT_EQ(value("coverage_ge3", 1), expected.coverage.ge3);
+  EXPECT_EQ(value("resolution_p50_px_per_m", 1), *expected.resolution_px_per_m->p50);
+  const double saved_ge3 = value("coverage_ge3", 1), edited_ge3 = value("coverage_ge3", 0);
+  run(R"([{"compare": "saved"}])");
+  EXPECT_EQ(value("coverage_ge3", 1), saved_ge3);
+  EXPECT_EQ(value("coverage_ge3", 0), edited_ge3);
+  // The best of a row is the higher coverage (the saved rig's here).
+  EXPECT_TRUE(m.comparison->Find("coverage_ge3")->best[1]);
+  // Undo: the edited rig is the saved one again.
+  run(R"([{"undo": 1}, {"compare": "saved"}])");
+  EXPECT_EQ(value("coverage_ge3", 0), saved_ge3);
+  EXPECT_THROW(run(R"([{"compare": ["saved", "nope"]}])"), InputError);
 }
 
 }  // namespace
