@@ -479,6 +479,10 @@ struct ViewerApp::Impl {
         iso_shade[i] = 0.35 + 0.65 * std::abs(normal.dot(rays[depth[i].second].direction));
       }
     }
+    // No anti-aliased fringes: adjacent triangles share their edges, and the fringes would triple
+    // the vertices (and show the mesh's edges through the translucency).
+    const ImDrawListFlags flags = dl->Flags;
+    dl->Flags &= ~ImDrawListFlags_AntiAliasedFill;
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3i& t = iso_mesh.triangles[iso_order[i]];
       const auto a = P.Point(iso_mesh.vertices[t[0]]), b = P.Point(iso_mesh.vertices[t[1]]),
@@ -487,6 +491,7 @@ struct ViewerApp::Impl {
       const double alpha = ov.iso_opacity * (iso_hidden[iso_order[i]] ? 0.25 : 1.0);
       dl->AddTriangleFilled(*a, *b, *c, Color(iso_shade[i] * ov.iso_color, alpha));
     }
+    dl->Flags = flags;
   }
   std::int64_t iso_version = -2;
   std::string iso_key, iso_view_key;
