@@ -494,7 +494,7 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
   EXPECT_EQ(half.model.width(), 320);
   EXPECT_EQ(half.model.height(), 240);
   EXPECT_EQ(m.StateJson()["undo"], "lens " + a);
-  for (const Vec2 corner : {Vec2(-0.5, -0.5), Vec2(639.5, 479.5), Vec2(319.5, 0)}) {
+  for (const Vec2& corner : {Vec2(-0.5, -0.5), Vec2(639.5, 479.5), Vec2(319.5, 0)}) {
     const Vec2 scaled((corner.x() + 0.5) * 0.5 - 0.5, (corner.y() + 0.5) * 0.5 - 0.5);
     EXPECT_LT((*half.model.Unproject(scaled) - *full.model.Unproject(corner)).norm(), 1e-12);
   }
