@@ -46,6 +46,16 @@ unsigned char ToSrgb8(double linear) {
   return static_cast<unsigned char>(std::lround(255.0 * s));
 }
 
+// Linear RGB (3 floats per pixel) to 8-bit sRGB RGBA, opaque.
+std::vector<unsigned char> ToRgba8(const std::vector<float>& rgb) {
+  std::vector<unsigned char> rgba(rgb.size() / 3 * 4);
+  for (std::size_t i = 0; i < rgb.size() / 3; ++i) {
+    for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(rgb[3 * i + k]);
+    rgba[4 * i + 3] = 255;
+  }
+  return rgba;
+}
+
 ImU32 Color(const Vec3& rgb, double alpha = 1.0) {
   return IM_COL32(ToSrgb8(rgb.x()), ToSrgb8(rgb.y()), ToSrgb8(rgb.z()), int(255 * alpha));
 }
@@ -238,12 +248,7 @@ struct ViewerApp::Impl {
     const auto t0 = std::chrono::steady_clock::now();
     const GlImage image = gl->Render(model.rig(), view, gl_options);
     gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
-    for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
-      for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
-      rgba[4 * i + 3] = 255;
-    }
-    Upload(&main_texture, image.width, image.height, rgba);
+    Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
   }
 
   static void Upload(GLuint* texture, int w, int h, const std::vector<unsigned char>& rgba) {
@@ -256,6 +261,17 @@ struct ViewerApp::Impl {
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   }
 
+  // The display settings for the small exact views (a camera's, a station's display): the light
+  // and surfaces as in the main view, without the slice, isosurface, key or float layers.
+  RenderOptions InsetOptions() const {
+    RenderOptions o = model.display;
+    o.layers = false;
+    o.overlays.slice_field.clear();
+    o.overlays.iso_field.clear();
+    o.overlays.key = false;
+    return o;
+  }
+
   void RenderCameraView(int c) {
     CameraView& v = camera_views[c];
     const std::int64_t version = model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
@@ -266,18 +282,8 @@ struct ViewerApp::Impl {
     view.camera = c;
     view.width = std::max(16, int(std::lround(m.width() * scale)));
     view.height = std::max(16, int(std::lround(m.height() * scale)));
-    RenderOptions o = model.display;
-    o.layers = false;
-    o.overlays.slice_field.clear();
-    o.overlays.iso_field.clear();
-    o.overlays.key = false;
-    const Image image = model.session().Render(view, o);
-    std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
-    for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
-      for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
-      rgba[4 * i + 3] = 255;
-    }
-    Upload(&v.texture, image.width, image.height, rgba);
+    const Image image = model.session().Render(view, InsetOptions());
+    Upload(&v.texture, image.width, image.height, ToRgba8(image.rgb));
     v.version = version;
     v.width = image.width;
     v.height = image.height;
@@ -343,19 +349,10 @@ struct ViewerApp::Impl {
         const double scale = std::min(1.0, 320.0 / st.pixels_wide);
         view.width = std::max(16, int(std::lround(st.pixels_wide * scale)));
         view.height = std::max(16, int(std::lround(st.pixels_high * scale)));
-        RenderOptions o = model.display;
-        o.layers = false;
-        o.overlays.slice_field.clear();
-        o.overlays.iso_field.clear();
-        o.overlays.key = false;
+        RenderOptions o = InsetOptions();
         o.overlays.cameras = false;
         const Image image = pandora::Render(model.session().study().prepared(), rig, view, o);
-        std::vector<unsigned char> rgba(std::size_t(image.width) * image.height * 4);
-        for (std::size_t i = 0; i < std::size_t(image.width) * image.height; ++i) {
-          for (int k = 0; k < 3; ++k) rgba[4 * i + k] = ToSrgb8(image.rgb[3 * i + k]);
-          rgba[4 * i + 3] = 255;
-        }
-        Upload(&v.texture, image.width, image.height, rgba);
+        Upload(&v.texture, image.width, image.height, ToRgba8(image.rgb));
         v.version = version;
       }
       const std::array<Vec3, 4> c = DisplayCorners(st);
