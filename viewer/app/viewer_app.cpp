@@ -1035,6 +1035,21 @@ struct ViewerApp::Impl {
     ImGui::DragFloat("max move m", &max_move, 0.01f, 0.0f, 10.0f, "%.2f");
     ImGui::DragFloat("max turn deg", &max_rotate, 0.5f, 0.0f, 179.0f, "%.1f");
     ImGui::DragInt("points", &points, 10, 50, 20000);
+    // Mount of the selected cameras: free, on a rail (a line), on a plane (a wall), or in a box.
+    ImGui::Combo("mount", &mount, "free\0rail\0plane\0box\0");
+    if (mount == 1 || mount == 2) ImGui::DragFloat3(mount == 1 ? "rail direction" : "plane normal", mount_axis, 0.05f);
+    if (mount == 3) {
+      ImGui::DragFloat3("box min m", mount_box, 0.01f);
+      ImGui::DragFloat3("box max m", mount_box + 3, 0.01f);
+    }
+    ImGui::Checkbox("keep-out box", &keep_out_on);
+    if (keep_out_on) {
+      ImGui::DragFloat3("keep-out min m", keep_out, 0.01f);
+      ImGui::DragFloat3("keep-out max m", keep_out + 3, 0.01f);
+    }
+    ImGui::DragFloat("clearance m", &clearance, 0.005f, 0.0f, 2.0f, "%.3f");
+    ImGui::Checkbox("zoom", &zoom_on);
+    if (zoom_on) ImGui::DragFloat2("hfov range deg", zoom, 0.5f, 1.0f, 179.0f, "%.1f");
     const session::JobStatus s = model.session().jobs().Status("suggest");
     const bool running = s.state == session::JobState::kRunning || s.state == session::JobState::kQueued;
     if (model.selection.empty()) {
@@ -1049,6 +1064,25 @@ struct ViewerApp::Impl {
       a.number = max_move;
       a.number2 = max_rotate;
       a.number3 = points;
+      a.clearance = clearance;
+      if (mount == 1 || mount == 2) {
+        a.mount = mount == 1 ? "rail" : "plane";
+        a.a = Vec3(mount_axis[0], mount_axis[1], mount_axis[2]);
+      } else if (mount == 3) {
+        a.mount = "box";
+        a.mount_box.min = Vec3(mount_box[0], mount_box[1], mount_box[2]);
+        a.mount_box.max = Vec3(mount_box[3], mount_box[4], mount_box[5]);
+      }
+      if (keep_out_on) {
+        Aabb b;
+        b.min = Vec3(keep_out[0], keep_out[1], keep_out[2]);
+        b.max = Vec3(keep_out[3], keep_out[4], keep_out[5]);
+        a.keep_out = {b};
+      }
+      if (zoom_on) {
+        a.min_hfov = zoom[0];
+        a.max_hfov = zoom[1];
+      }
       Do(a);
       waiting_for_suggestion = true;
     }
@@ -1081,6 +1115,10 @@ struct ViewerApp::Impl {
     ImGui::End();
   }
   bool waiting_for_suggestion = false;
+  int mount = 0;
+  float mount_axis[3] = {1, 0, 0}, mount_box[6] = {-1, -1, 0, 1, 1, 3}, keep_out[6] = {-0.5, -0.5, 0, 0.5, 0.5, 2};
+  bool keep_out_on = false, zoom_on = false;
+  float clearance = 0.1f, zoom[2] = {30, 60};
 
   void DisplayPanel() {
     ImGui::SetNextWindowPos(ImVec2(266, 8), ImGuiCond_FirstUseEver);

@@ -461,7 +461,18 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       CameraLimits limits;
       limits.max_move = a.number;
       limits.max_rotate_deg = a.number2;
+      limits.min_hfov_deg = a.min_hfov;
+      limits.max_hfov_deg = a.max_hfov;
+      if (a.mount == "rail" || a.mount == "plane") {
+        limits.mount.kind = a.mount == "rail" ? MountConstraint::Kind::kLine : MountConstraint::Kind::kPlane;
+        limits.mount.axis = a.a;
+      } else if (a.mount == "box") {
+        limits.mount.kind = MountConstraint::Kind::kBox;
+        limits.mount.box = a.mount_box;
+      }
       o.limits = {limits};
+      o.keep_out = a.keep_out;
+      if (!std::isnan(a.clearance)) o.clearance = a.clearance;
       const std::optional<Objective> objective = ParseObjective(a.text);
       if (!objective)
         throw InputError(a.where + ".objective", "", "unknown objective '" + a.text + "'",

@@ -73,6 +73,12 @@ class Entry {
     }
     return out;
   }
+  // [x0, y0, z0, x1, y1, z1] under `key`, or at index `i` of this (array) value.
+  Aabb Box(const std::string& key) const {
+    if (!Has(key)) Fail(key, "missing");
+    return BoxOf(j_.at(key), key);
+  }
+  Aabb Box(std::size_t i) const { return BoxOf(j_.at(i), "[" + std::to_string(i) + "]"); }
   // A camera id or a list of them.
   std::vector<std::string> Ids(const std::string& key, bool allow_empty) const {
     const json& v = j_.at(key);
@@ -94,6 +100,21 @@ class Entry {
   }
 
  private:
+  Aabb BoxOf(const json& v, const std::string& key) const {
+    // key: a member name ("box": "$[0].box") or an element ("[1]": "$[0].keep_out[1]").
+    auto fail = [&](const std::string& sub, const std::string& reason) {
+      throw InputError(file_, path_ + (key.rfind("[", 0) == 0 ? "" : ".") + key + sub, reason);
+    };
+    if (!v.is_array() || v.size() != 6) fail("", "expected a box [x0, y0, z0, x1, y1, z1]");
+    Aabb b;
+    for (int i = 0; i < 6; ++i) {
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || std::abs(v[i].get<double>()) > 1e7)
+        fail("[" + std::to_string(i) + "]", "expected a finite number of at most 1e7 in size");
+      (i < 3 ? b.min : b.max)[i % 3] = v[i].get<double>();
+    }
+    if ((b.min.array() > b.max.array()).any()) fail("", "the box's min exceeds its max");
+    return b;
+  }
   static std::string Short(double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%g", v);
@@ -292,13 +313,41 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.text = e.OneOf("wait", {"fields", "suggest", "render"});
       break;
     case Kind::kSuggest:
-      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed"});
+      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane", "box",
+              "keep_out", "clearance", "hfov_range"});
       a.cameras = e.Ids("suggest", false);
       a.text = e.Has("objective") ? e.String("objective") : "coverage2";
       a.number = e.Number("max_move", 0, 1e4, 0.3);
       a.number2 = e.Number("max_rotate", 0, 179.999, 10);
       a.number3 = e.Number("points", 1, 1e6, 800);
       a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
+      if (int(e.Has("rail")) + int(e.Has("plane")) + int(e.Has("box")) > 1)
+        e.Fail("", "give at most one mount: 'rail', 'plane' or 'box'");
+      for (const char* mount : {"rail", "plane"})
+        if (e.Has(mount)) {
+          a.mount = mount;
+          a.a = e.Vector(mount);
+          if (!(a.a.norm() > 0)) e.Fail(mount, "the direction must be a non-zero vector");
+        }
+      if (e.Has("box")) {
+        a.mount = "box";
+        a.mount_box = e.Box("box");
+      }
+      if (e.Has("keep_out")) {
+        const json& boxes = j.at("keep_out");
+        if (!boxes.is_array() || boxes.size() > 1000) e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+          const Entry box(boxes, where + ".keep_out", file);
+          a.keep_out.push_back(box.Box(i));
+        }
+      }
+      if (e.Has("clearance")) a.clearance = e.Number("clearance", 0, 1e4);
+      if (e.Has("hfov_range")) {
+        const Vec3 r = e.Vector("hfov_range", 2);
+        if (!(r.x() > 0 && r.x() <= r.y() && r.y() < 360)) e.Fail("hfov_range", "expected [min, max] degrees, 0 < min <= max < 360");
+        a.min_hfov = r.x();
+        a.max_hfov = r.y();
+      }
       break;
     case Kind::kAccept:
       e.Keys({"accept"});

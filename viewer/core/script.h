@@ -29,7 +29,9 @@
 ///      {"light": "grid", "grid": 16, "brightness": 0.5, "surface": "material"},
 ///      {"wait": "fields"},                              // or "suggest", "render"
 ///      {"suggest": ["c03"], "objective": "coverage2", "max_move": 0.3, "max_rotate": 10,
-///       "points": 600, "seed": 1},
+///       "points": 600, "seed": 1, "rail": [1, 0, 0],   // or "plane": [0, 0, 1], or "box": [x0, y0,
+///       "keep_out": [[x0, y0, z0, x1, y1, z1]],         // z0, x1, y1, z1]; all optional
+///       "clearance": 0.1, "hfov_range": [40, 60]},
 ///      {"accept": ["c03"]}, {"accept": "all"}, {"reject": 1},
 ///      {"save": 1},                                     // {"save": "force"} over a changed file
 ///      {"screenshot": "out/main.png"}, {"screenshot": "out/c03.png", "camera": "c03"},
@@ -44,6 +46,7 @@
 /// read, before anything runs: InputError naming the file and the JSON path ("$[4].by").
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -80,6 +83,14 @@ struct Action {
   double coefficients[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
   /// range: near and far in metres (NaN: kept; far infinite: no far limit).
   double near = NAN, far = NAN;
+  /// suggest: the mount of every selected camera ("", "rail" along `a`, "plane" with normal `a`,
+  /// "box" `mount_box`), keep-out boxes, the clearance from surfaces (NaN: the library's default)
+  /// and a zoom range in degrees (both 0: none).
+  std::string mount;
+  Aabb mount_box;
+  std::vector<Aabb> keep_out;
+  double clearance = NAN;
+  double min_hfov = 0, max_hfov = 0;
 };
 
 /// The names of Action::coefficients, in order: k1 k2 p1 p2 k3 k4.

@@ -258,6 +258,24 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   ExpectScriptError("[{\"undo\": 1, \"bogus\": 2}]", "$[0].bogus");
   ExpectScriptError("[{\"eye\": [1, 1, 1], \"at\": [1, 1, 1]}]", "$[0].at");
   ExpectScriptError("[{\"move\": \"a\", \"by\": [1e300, 0, 0]}]", "$[0].by[0]");
+  // Suggest's mounts, keep-out boxes and zoom range.
+  const std::vector<Action> m = ParseScript(
+      R"([{"suggest": ["a"], "rail": [1, 0, 0], "keep_out": [[0, 0, 0, 1, 1, 1], [2, 2, 2, 3, 3, 3]],
+           "clearance": 0.2, "hfov_range": [30, 50]},
+          {"suggest": ["a"], "box": [-1, -1, 0, 1, 1, 2]}])", "s.json");
+  EXPECT_EQ(m[0].mount, "rail");
+  ASSERT_EQ(m[0].keep_out.size(), 2u);
+  EXPECT_EQ(m[0].keep_out[1].min, Vec3(2, 2, 2));
+  EXPECT_EQ(m[0].clearance, 0.2);
+  EXPECT_EQ(m[0].max_hfov, 50);
+  EXPECT_EQ(m[1].mount, "box");
+  EXPECT_EQ(m[1].mount_box.max, Vec3(1, 1, 2));
+  ExpectScriptError(R"([{"suggest": ["a"], "rail": [1, 0, 0], "plane": [0, 0, 1]}])", "$[0]");
+  ExpectScriptError(R"([{"suggest": ["a"], "rail": [0, 0, 0]}])", "$[0].rail");
+  ExpectScriptError(R"([{"suggest": ["a"], "box": [1, 0, 0, 0, 1, 1]}])", "$[0].box");
+  ExpectScriptError(R"([{"suggest": ["a"], "keep_out": [[0, 0, 0, 1, 1, 1], [0, 0, "x", 1, 1, 1]]}])",
+                    "$[0].keep_out[1][2]");
+  ExpectScriptError(R"([{"suggest": ["a"], "hfov_range": [50, 30]}])", "$[0].hfov_range");
 }
 
 TEST(Script, CameraPanelActionsParseAndRefuseBadValuesWithTheirPath) {
@@ -440,6 +458,27 @@ TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
   ASSERT_TRUE(hit);
   const double depth = image.depth[std::size_t(view.height / 2) * view.width + view.width / 2];
   EXPECT_NEAR(depth, hit->t, 0.02 * hit->t);  // the centre pixel is half a pixel off the exact centre
+  m.session().WaitFields();
+}
+
+TEST(ViewerModel, SuggestKeepsTheMountAndTheKeepOutBox) {
+  const fs::path scene = CopyScene("mount");
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  const std::string c = m.rig().cameras[3].id;  // the ring's camera that looks away (suggest_ring.json)
+  const Vec3 start = m.rig().cameras[3].center();
+  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "objective": "coverage4", "max_move": 0.5, "max_rotate": 60,
+                         "points": 200, "rail": [1, 0, 0], "keep_out": [[-10, -10, -10, -0.05, 10, 10]]},
+                        {"wait": "suggest"}])", "s.json"),
+        nullptr);
+  ASSERT_TRUE(m.suggestion);
+  ASSERT_EQ(m.suggestion->cameras.size(), 1u);
+  const Vec3 after = m.suggestion->cameras[0].after.translation();
+  // On the rail through the start along x: y and z unchanged; never into the keep-out half-space.
+  EXPECT_NEAR(after.y(), start.y(), 1e-9);
+  EXPECT_NEAR(after.z(), start.z(), 1e-9);
+  EXPECT_GT(after.x(), -0.05);
   m.session().WaitFields();
 }
 
