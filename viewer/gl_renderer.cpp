@@ -7,7 +7,11 @@
 //     place of the occlusion segment) and adds the camera's term of the light rule into a float
 //     accumulation target (additive blending, rig order) and ORs its bit into an RG32UI mask
 //     (ping-pong between two mask textures: integer targets do not blend).
-//  3. Compose: MaterialColor (or the light alone) and the background, then read back.
+//  3. Compose: MaterialColor (or the light alone) and the background, then read back. Hidden-line
+//     mode: the G-buffer pass also stores each fragment's coverage by its triangle's drawn edges
+//     (render/frame.cpp's rule, from the screen derivatives of the barycentric coordinates), so
+//     only edges of visible surface are drawn; contour mode: the compose pass finds object, depth
+//     and crease discontinuities between neighbouring pixels of the G-buffer (Finish's rules).
 #include "viewer/gl_renderer.h"
 
 #include <epoxy/gl.h>
@@ -38,18 +42,24 @@ const char* kGBufferVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;  // relative to the scene's centre
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 albedo;
+layout(location = 3) in vec2 tag;  // object index, drawn-edge bits (bit i: edge opposite vertex i)
 uniform mat3 view_R;   // camera_from_world rotation of the eye (OpenCV frame: y down, z forward)
 uniform vec3 view_t;   // camera-frame position of the scene's centre
 uniform vec4 proj;     // 2f/W, 2f/H, A, B: clip = (proj.x x, proj.y y, A z + B, z)
 out vec3 v_position;
 flat out vec3 v_normal;
 flat out vec3 v_albedo;
+flat out vec2 v_tag;
+out vec3 v_bary;
 void main() {
   vec3 c = view_R * position + view_t;
   gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z);
   v_position = position;
   v_normal = normal;
   v_albedo = albedo;
+  v_tag = tag;
+  int corner = gl_VertexID % 3;  // non-indexed triangles: vertex i of its triangle
+  v_bary = vec3(corner == 0 ? 1.0 : 0.0, corner == 1 ? 1.0 : 0.0, corner == 2 ? 1.0 : 0.0);
 }
 )";
 
@@ -57,16 +67,32 @@ const char* kGBufferFragment = R"(#version 330 core
 in vec3 v_position;
 flat in vec3 v_normal;
 flat in vec3 v_albedo;
+flat in vec2 v_tag;
+in vec3 v_bary;
 uniform vec3 eye;
+uniform int edges;         // 1: hidden-line mode, the drawn edges' coverage into g_normal.w
+uniform float line_width;  // output pixels
 layout(location = 0) out vec4 g_position;  // xyz, 1 (-1: no surface)
-layout(location = 1) out vec4 g_normal;    // turned towards the eye
-layout(location = 2) out vec4 g_albedo;
+layout(location = 1) out vec4 g_normal;    // turned towards the eye; w: edge coverage
+layout(location = 2) out vec4 g_albedo;    // w: object index
 void main() {
   vec3 n = v_normal;
   if (dot(n, v_position - eye) > 0.0) n = -n;
+  // Coverage by the drawn edges as render/frame.cpp: LineCoverage(|lambda_i| / |grad lambda_i|)
+  // with the gradient in output pixels (here the screen derivatives of the barycentrics).
+  float a = 0.0;
+  int drawn = int(v_tag.y + 0.5);
+  vec3 gx = dFdx(v_bary), gy = dFdy(v_bary);
+  if (edges != 0) {
+    for (int i = 0; i < 3; ++i) {
+      if ((drawn & (1 << i)) == 0) continue;
+      float g = length(vec2(gx[i], gy[i]));
+      if (g > 0.0) a = max(a, clamp(0.5 * line_width + 0.5 - abs(v_bary[i]) / g, 0.0, 1.0));
+    }
+  }
   g_position = vec4(v_position, 1.0);
-  g_normal = vec4(n, 0.0);
-  g_albedo = vec4(v_albedo, 1.0);
+  g_normal = vec4(n, a);
+  g_albedo = vec4(v_albedo, v_tag.x);
 }
 )";
 
@@ -326,11 +352,39 @@ uniform sampler2D g_position_tex;
 uniform sampler2D g_normal_tex;
 uniform sampler2D g_albedo_tex;
 uniform sampler2D light_tex;
-uniform int material;
+uniform int surface;  // 0 material, 1 black, 2 hidden line, 3 contours
 uniform float ambient;
 uniform vec3 background;
 uniform vec3 eye;
+uniform float line_grey;
 layout(location = 0) out vec4 o_color;
+// Contours as render/frame.cpp's Finish: for the pair (p, q), q right of or below p, the line
+// weight it gives `self` (p when first, q otherwise). Missing surface on one side: the surface
+// pixel; another object, or q's depth more than 5 % of p's from where q's ray meets p's plane: the
+// nearer pixel; normals more than 30 degrees apart: both, at half weight.
+float PairContour(ivec2 p, ivec2 q, bool first) {
+  ivec2 size = textureSize(g_position_tex, 0);
+  if (q.x >= size.x || q.y >= size.y || p.x < 0 || p.y < 0) return 0.0;
+  vec4 gp = texelFetch(g_position_tex, p, 0), gq = texelFetch(g_position_tex, q, 0);
+  bool hp = gp.w >= 0.0, hq = gq.w >= 0.0;
+  if (!hp && !hq) return 0.0;
+  if (hp != hq) return (first ? hp : hq) ? 1.0 : 0.0;
+  vec3 np = texelFetch(g_normal_tex, p, 0).xyz, nq = texelFetch(g_normal_tex, q, 0).xyz;
+  float tp = length(gp.xyz - eye), tq = length(gq.xyz - eye);
+  bool jump = texelFetch(g_albedo_tex, p, 0).w != texelFetch(g_albedo_tex, q, 0).w;
+  if (!jump) {
+    vec3 dp = (gp.xyz - eye) / tp, dq = (gq.xyz - eye) / tq;
+    float denom = dot(np, dq);
+    if (denom != 0.0) {
+      float predicted = tp * dot(np, dp) / denom;
+      jump = !(predicted > 0.0) || abs(predicted - tq) > 0.05 * tp;
+    } else {
+      jump = true;
+    }
+  }
+  if (jump) return (first == (tp <= tq)) ? 1.0 : 0.0;
+  return dot(np, nq) < 0.8660254037844387 ? 0.5 : 0.0;
+}
 void main() {
   ivec2 ip = ivec2(gl_FragCoord.xy);
   vec4 g = texelFetch(g_position_tex, ip, 0);
@@ -339,7 +393,20 @@ void main() {
     return;
   }
   vec3 L = texelFetch(light_tex, ip, 0).xyz;
-  if (material == 0) {
+  if (surface == 2) {
+    float a = texelFetch(g_normal_tex, ip, 0).w;
+    o_color = vec4(mix(L, vec3(line_grey), a), 1.0);
+    return;
+  }
+  if (surface == 3) {
+    float a = max(max(PairContour(ip, ip + ivec2(1, 0), true),
+                      PairContour(ip - ivec2(1, 0), ip, false)),
+                  max(PairContour(ip, ip + ivec2(0, 1), true),
+                      PairContour(ip - ivec2(0, 1), ip, false)));
+    o_color = vec4(mix(L, vec3(line_grey), a), 1.0);
+    return;
+  }
+  if (surface != 0) {
     o_color = vec4(L, 1.0);
     return;
   }
@@ -461,6 +528,42 @@ std::array<Mat3, 6> CubeFaces() {
   f[4] = frame(Vec3::UnitZ(), Vec3::UnitY());
   f[5] = frame(-Vec3::UnitZ(), Vec3::UnitY());
   return f;
+}
+
+// Which of each triangle's edges the hidden-line mode draws, as render/frame.cpp's
+// ComputeDrawnEdges (PreparedScene::DrawnEdges, not reachable from a Scene without building a
+// ray caster): edges between triangles more than 1 degree from coplanar, and boundary edges.
+// Bit i: the edge opposite vertex i. Edges are matched by their exact end points.
+std::vector<uint8_t> DrawnEdges(const TriangleMesh& mesh) {
+  const std::size_t n = mesh.triangles.size();
+  std::vector<Vec3> normals(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Vec3 c = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+                       .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
+    const double len = c.norm();
+    normals[t] = len > 0 ? Vec3(c / len) : Vec3::Zero();
+  }
+  std::map<std::array<double, 6>, std::vector<std::pair<uint32_t, uint8_t>>> edges;
+  for (std::size_t t = 0; t < n; ++t)
+    for (int i = 0; i < 3; ++i) {
+      Vec3 a = mesh.vertices[mesh.triangles[t][(i + 1) % 3]];
+      Vec3 b = mesh.vertices[mesh.triangles[t][(i + 2) % 3]];
+      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
+        std::swap(a, b);
+      edges[{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}].push_back({uint32_t(t), uint8_t(i)});
+    }
+  const double cos_crease = std::cos(1.0 * kPi / 180.0);
+  std::vector<uint8_t> drawn(n, 0);
+  for (const auto& [key, list] : edges) {
+    bool draw = list.size() == 1;
+    for (std::size_t a = 0; a < list.size() && !draw; ++a)
+      for (std::size_t b = a + 1; b < list.size() && !draw; ++b)
+        draw = std::abs(normals[list[a].first].dot(normals[list[b].first])) < cos_crease;
+    if (draw)
+      for (const auto& [t, i] : list) drawn[t] |= uint8_t(1u << i);
+  }
+  return drawn;
 }
 
 // Cameras per light pass: the uniform block holds kCameraVec4 vec4s per camera (16 KiB, the
@@ -779,8 +882,9 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     const int mat = scene.objects[o].material;
     if (mat >= 0 && mat < int(scene.materials.size())) object_color[o] = scene.materials[mat].color;
   }
+  const std::vector<uint8_t> drawn = DrawnEdges(m.mesh);
   std::vector<float> data;
-  data.reserve(m.mesh.triangles.size() * 27);
+  data.reserve(m.mesh.triangles.size() * 33);
   for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
     const Eigen::Vector3i& tri = m.mesh.triangles[t];
     const Vec3 a = m.mesh.vertices[tri[0]], b = m.mesh.vertices[tri[1]],
@@ -792,6 +896,8 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
       const Vec3 r = *p - m.origin;
       for (const Vec3* v : std::array<const Vec3*, 3>{&r, &n, &albedo})
         for (int k = 0; k < 3; ++k) data.push_back(float((*v)(k)));
+      data.push_back(float(triangle_object[t]));
+      data.push_back(float(drawn[t]));
     }
   }
   m.vertex_count = GLsizei(3 * m.mesh.triangles.size());
@@ -801,10 +907,10 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
                GL_STATIC_DRAW);
-  const GLsizei stride = 9 * sizeof(float);
-  for (int k = 0; k < 3; ++k) {
+  const GLsizei stride = 11 * sizeof(float);
+  for (int k = 0; k < 4; ++k) {
     glEnableVertexAttribArray(k);
-    glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, stride,
+    glVertexAttribPointer(k, k < 3 ? 3 : 2, GL_FLOAT, GL_FALSE, stride,
                           reinterpret_cast<const void*>(std::size_t(3 * k) * sizeof(float)));
   }
   glGenVertexArrays(1, &m.empty_vao);
@@ -929,6 +1035,8 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glUniform4f(Loc(m.gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
                 float(ab(1)));
     SetVec3(m.gbuffer_program, "eye", eye_rel);
+    glUniform1i(Loc(m.gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
+    glUniform1f(Loc(m.gbuffer_program, "line_width"), float(options.line_width_px));
     glBindVertexArray(m.vao);
     glDrawArrays(GL_TRIANGLES, 0, m.vertex_count);
   }
@@ -1064,7 +1172,12 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   glUniform1i(Loc(p, "g_normal_tex"), 1);
   glUniform1i(Loc(p, "g_albedo_tex"), 2);
   glUniform1i(Loc(p, "light_tex"), 3);
-  glUniform1i(Loc(p, "material"), options.material ? 1 : 0);
+  const int surface = options.surface == Surface::kMaterial     ? 0
+                      : options.surface == Surface::kHiddenLine ? 2
+                      : options.surface == Surface::kContours   ? 3
+                                                                : 1;
+  glUniform1i(Loc(p, "surface"), surface);
+  glUniform1f(Loc(p, "line_grey"), float(options.line_grey));
   glUniform1f(Loc(p, "ambient"), float(options.ambient));
   SetVec3(p, "background", options.background);
   SetVec3(p, "eye", eye_rel);

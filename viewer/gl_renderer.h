@@ -21,6 +21,7 @@
 #include "analysis/geometry.h"
 #include "analysis/scene.h"
 #include "render/light.h"
+#include "render/render.h"
 
 namespace pandora {
 
@@ -29,15 +30,21 @@ struct RenderView;
 /// How a GPU frame is drawn: the CPU renderer's RenderOptions that apply, and the shadow maps.
 struct GlRenderOptions {
   Pattern pattern = Pattern::kUniform;
-  /// false: Surface::kBlack (the light only); true: Surface::kMaterial, albedo * light plus the
-  /// ambient term of MaterialColor. Material colours only: textures are not drawn yet.
-  bool material = true;
+  /// What a surface shows, as render's RenderOptions::surface: kMaterial, albedo * light plus the
+  /// ambient term of MaterialColor (material colours only: textures are not drawn yet); kBlack,
+  /// the light only; kHiddenLine, the light with grey mesh edges (the drawn-edge set of
+  /// render/frame.cpp: edges between triangles more than 1 degree apart and boundary edges) where
+  /// the surface next to them is visible; kContours, the light with grey contours found in the
+  /// G-buffer by the CPU renderer's rules (object, depth and 30-degree normal discontinuities
+  /// between neighbouring pixels).
+  Surface surface = Surface::kMaterial;
   /// NaN (the default): DefaultBrightness of the rig's enabled cameras.
   double brightness = std::numeric_limits<double>::quiet_NaN();
   double ambient = 0.15;
   int grid_pixels = 32;
   double grid_fill = 0.15;
-  double line_width_px = 1.2;
+  double line_width_px = 1.2;  ///< Grid lines and mesh edges, output pixels.
+  double line_grey = 0.25;     ///< Linear grey of mesh edges and contours.
   Vec3 background{0.02, 0.02, 0.03};
   /// Texels per side of each camera's distance map, 512 .. 4096 (std::invalid_argument outside).
   /// A camera whose field reaches 75 degrees off its axis or more (wide fisheyes) gets a cube of

@@ -242,7 +242,7 @@ struct ViewerApp::Impl {
     }
     gl_options.shadow_map_size = moving ? std::min(shadow_map_size, 1024) : shadow_map_size;
     gl_options.pattern = model.display.pattern;
-    gl_options.material = model.display.surface == Surface::kMaterial;
+    gl_options.surface = model.display.surface;
     gl_options.brightness = model.display.brightness;
     gl_options.grid_pixels = model.display.grid_pixels;
     const auto t0 = std::chrono::steady_clock::now();
