@@ -1129,8 +1129,9 @@ struct ViewerApp::Impl {
     bool changed = ImGui::Combo("light", &pattern, "uniform\0grid\0");
     int grid = model.display.grid_pixels;
     changed |= ImGui::DragInt("grid px", &grid, 1, 1, 1000);
-    bool material = model.display.surface == Surface::kMaterial;
-    changed |= ImGui::Checkbox("material", &material);
+    // The paper's display modes: material colours, black, hidden-line edges, contours.
+    int surface = int(model.display.surface);
+    changed |= ImGui::Combo("surfaces", &surface, "material\0black\0hidden-line\0contours\0");
     bool automatic = std::isnan(model.display.brightness);
     float brightness = automatic ? float(DefaultBrightness(model.rig().enabled_count())) : float(model.display.brightness);
     changed |= ImGui::Checkbox("auto brightness", &automatic);
@@ -1141,7 +1142,8 @@ struct ViewerApp::Impl {
       a.text = pattern ? "grid" : "uniform";
       a.number = grid;
       a.number2 = automatic ? NAN : brightness;
-      a.text2 = material ? "material" : "black";
+      const char* names[] = {"material", "black", "hidden-line", "contours"};
+      a.text2 = names[std::clamp(surface, 0, 3)];
       Do(a);
     }
     ImGui::End();
