@@ -153,9 +153,9 @@ int Run(int argc, char** argv) {
   if (bench_frames > 0) ao.visible = false, ao.show_timing = false, ao.motion_scale = 1.0;
   if (bench_frames > 0) {
     // Full resolution throughout, then as interaction draws it (reduced while moving).
+    pandora::viewer::ViewerApp window(model, ao);
     for (const double scale : {1.0, 0.5}) {
-      ao.motion_scale = scale;
-      pandora::viewer::ViewerApp window(model, ao);
+      window.SetMotionScale(scale);
       Bench(model, window, bench_frames, scale);
     }
     return 0;

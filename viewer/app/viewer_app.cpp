@@ -1308,6 +1308,11 @@ bool ViewerApp::Frame() {
   return open;
 }
 
+void ViewerApp::SetMotionScale(double scale) {
+  impl_->options.motion_scale = scale;
+  impl_->main_key.clear();  // draw the next frame anew
+}
+
 void ViewerApp::Loop() {
   while (Frame()) {
   }

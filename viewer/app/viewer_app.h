@@ -37,6 +37,9 @@ class ViewerApp : public Frontend {
   bool Frame();
   /// Frames until the window closes.
   void Loop();
+  /// AppOptions::motion_scale from now on (the frame-rate bench measures both in one window: a
+  /// second window would reconnect to the X server while it resets after the first).
+  void SetMotionScale(double scale);
 
   // Frontend: the window's own picture (after a frame is drawn), or a camera's exact view.
   void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;
