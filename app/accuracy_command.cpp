@@ -4,12 +4,18 @@
 // writes every file in one output transaction.
 #include <tbb/global_control.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "analysis/error.h"
+#include "analysis/input_file.h"
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
@@ -19,6 +25,54 @@
 #include "suggest/accuracy.h"
 
 namespace pandora::app {
+namespace {
+
+// The GPU renderer against the exact one: pandora_gl_bench (beside this program, the only code that
+// links GL) on the scene's first view, its CSV read back.
+// The bench program; InputError naming --gpu when it cannot run (checked before any study runs).
+std::string GpuBench(const Scene& scene) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::string bench = (self.parent_path() / "pandora_gl_bench").string();
+  if (!std::filesystem::exists(bench))
+    throw InputError("--gpu", "", "the GPU bench " + bench + " is not built", "build the pandora_gl_bench target");
+  if (!std::getenv("DISPLAY"))
+    throw InputError("--gpu", "", "needs a display for OpenGL", "run under `xvfb-run -a` on a machine without one");
+  if (scene.views.empty()) throw InputError("--gpu", "", "the scene has no views to render", "add one to \"views\"");
+  return bench;
+}
+
+report::AccuracySection GpuStudy(const Scene& scene, const Rig& rig, bool quick) {
+  const std::string bench = GpuBench(scene);
+  char name[] = "/tmp/pandora_gpu_XXXXXX";
+  const int fd = mkstemp(name);
+  if (fd < 0) throw InputError("--gpu", "", "cannot create a temporary file");
+  close(fd);
+  const std::string size = quick ? "320x180" : "1280x720";
+  const std::string frames = quick ? "1" : "5";
+  std::vector<std::string> args{bench, scene.path, "--rig", rig.name, "--size", size, "--frames", frames,
+                                "--cpu-frames", quick ? "1" : "3", "--csv", name};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    execv(bench.c_str(), argv.data());
+    std::_Exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string csv = WIFEXITED(status) && WEXITSTATUS(status) == 0
+                              ? ReadInputFile(name, 1 << 20, "GPU bench output") : std::string();
+  std::remove(name);
+  if (csv.empty()) throw InputError("--gpu", "", "the GPU bench failed (exit " + std::to_string(WEXITSTATUS(status)) + ")");
+  const std::string note = "view '" + scene.views.begin()->first + "' at " + size + ", rig " + rig.name + " (" +
+                           std::to_string(rig.enabled_count()) + " cameras); times are of this machine's GL";
+  return report::GpuSection(report::ParseGpuAccuracyCsv(csv, bench), note);
+}
+
+}  // namespace
 
 int RunAccuracy(const AccuracyArgs& args) {
   using Clock = std::chrono::steady_clock;
@@ -28,6 +82,7 @@ int RunAccuracy(const AccuracyArgs& args) {
   const Rig rig = study->FindRig(args.rig, "--rig");
   const AccuracyOptions options = args.quick ? AccuracyOptions::Quick() : AccuracyOptions();
   options.Check();
+  if (args.gpu) GpuBench(scene);  // a missing display fails now, not after the other studies
   OutputTransaction output;
   AddSceneInputs(output, scene);
   // Staged first, so that a bad --out fails before minutes of work; written last.
@@ -57,6 +112,7 @@ int RunAccuracy(const AccuracyArgs& args) {
   const MonteCarloStudy monte_carlo = RunMonteCarloStudy(scene, rig, *caster, options);
   emit(report::MonteCarloSection(monte_carlo, threads));
   emit(report::SteadySection(RunSteadyStudy(scene, monte_carlo, options)));
+  if (args.gpu) emit(GpuStudy(scene, rig, args.quick));
 
   WriteFileAtomically(tables_path, markdown);
   written.push_back(tables_path);

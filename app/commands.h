@@ -59,6 +59,9 @@ struct AccuracyArgs {
   std::string rig;
   std::string out = "out/accuracy";
   bool quick = false;  ///< Fewer voxel sizes, trials and sample points (tests).
+  /// Also the GPU renderer against the exact one per shadow-map size (runs pandora_gl_bench, beside
+  /// this program; needs a display, e.g. under xvfb-run).
+  bool gpu = false;
 };
 int RunAccuracy(const AccuracyArgs& args);
 

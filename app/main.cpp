@@ -213,6 +213,8 @@ int main(int argc, char** argv) {
   acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
   acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
+  acc->add_flag("--gpu", accuracy.gpu,
+                "Also the GPU renderer of pandora view against the exact one per shadow-map size (needs a display)");
   acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
 
   RenderArgs render;

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "analysis/atomic_file.h"
 #include "analysis/error.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
@@ -48,6 +49,10 @@ int main(int argc, char** argv) {
   app.add_option("--shadow-mode", shadow_mode, "0 distance, 1 plane, 2 either");
   app.add_flag("--verbose", verbose, "per-camera disagreement");
   app.add_option("--png", png_dir, "write CPU | GPU comparison PNGs into this folder");
+  std::string csv_path;
+  app.add_option("--csv", csv_path,
+                 "also write map,gpu_ms,eye_only_ms,cpu_ms,differ_compared_pct,differ_all_pct per map size "
+                 "(what `pandora accuracy --gpu` reads)");
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = scene_path == "lens_room" ? testing::LensRoom() : LoadScene(scene_path);
@@ -89,6 +94,7 @@ int main(int argc, char** argv) {
         "| differ (compared) | differ (all) | excluded | RGB max | RGB > 1e-3 | RGB mean | RGB "
         "mean all |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::string csv = "map,gpu_ms,eye_only_ms,cpu_ms,differ_compared_pct,differ_all_pct\n";
     for (int map : maps) {
       GlRenderOptions options;
       options.pattern = cpu_options.pattern;
@@ -143,7 +149,12 @@ int main(int argc, char** argv) {
       }
       if (!png_dir.empty())
         WriteComparisonPng(cpu, gpu, png_dir + "/compare_" + std::to_string(map) + ".png");
+      char row[256];
+      std::snprintf(row, sizeof row, "%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", map, 1e3 * Median(total),
+                    1e3 * Median(eye_only), 1e3 * Median(cpu_times), 100 * c.mask_share(), 100 * c.mask_share_all());
+      csv += row;
     }
+    if (!csv_path.empty()) WriteFileAtomically(csv_path, csv);
   } catch (const InputError& e) {
     std::fprintf(stderr, "pandora_gl_bench: %s\n", e.what());
     return 2;

@@ -1,6 +1,10 @@
 // The tables, CSV files and plots of `pandora accuracy` (render/report/accuracy_tables.h).
 #include "render/report/accuracy_tables.h"
 
+#include <cstdio>
+
+#include "analysis/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -298,6 +302,71 @@ AccuracySection SteadySection(const SteadyStudy& st) {
       "posterior position variance; reference: the closed form evaluated in long double");
   section.csv = CsvText(header, csv);
   section.svg = RenderLogLogSvg(plot);
+  return section;
+}
+
+std::vector<GpuAccuracyRow> ParseGpuAccuracyCsv(const std::string& text, const std::string& file) {
+  std::vector<GpuAccuracyRow> rows;
+  std::size_t start = text.find('\n');  // the header
+  int line = 1;
+  while (start != std::string::npos && start + 1 < text.size()) {
+    const std::size_t end = text.find('\n', start + 1);
+    const std::string row = text.substr(start + 1, end == std::string::npos ? std::string::npos : end - start - 1);
+    ++line;
+    start = end;
+    if (row.empty()) continue;
+    GpuAccuracyRow r;
+    char rest = 0;
+    if (std::sscanf(row.c_str(), "%d,%lf,%lf,%lf,%lf,%lf%c", &r.map, &r.gpu_ms, &r.eye_only_ms, &r.cpu_ms,
+                    &r.differ_compared_pct, &r.differ_all_pct, &rest) != 6)
+      throw InputError(file, "", "line " + std::to_string(line) + " is not six numbers: '" + row + "'");
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+AccuracySection GpuSection(const std::vector<GpuAccuracyRow>& rows, const std::string& view_note) {
+  AccuracySection section;
+  section.title = "GPU projective light (pandora view) against the exact renderer, per shadow-map size";
+  section.csv_name = "accuracy_gpu.csv";
+  section.svg_name = "accuracy_gpu.svg";
+  section.table = Table({"map", "GPU frame (ms)", "eye-only frame (ms)", "CPU frame (ms)", "sets differ, off edges",
+                         "sets differ, all pixels"});
+  std::vector<std::vector<std::string>> csv;
+  LogLogPlot plot;
+  plot.title = "GPU renderer: pixels whose camera sets differ from the exact renderer, against frame time";
+  plot.x_label = "GPU frame time (ms, every map drawn)";
+  plot.y_label = "pixels whose camera sets differ (%)";
+  plot.note = view_note;
+  PlotSeries off, all;
+  off.label = "off the one-pixel edge band";
+  all.label = "all pixels";
+  for (const GpuAccuracyRow& r : rows) {
+    section.table.AddRow({std::to_string(r.map), Cell("%.1f", r.gpu_ms), Cell("%.1f", r.eye_only_ms),
+                          Cell("%.1f", r.cpu_ms), Cell("%.4f %%", r.differ_compared_pct),
+                          Cell("%.3f %%", r.differ_all_pct)});
+    csv.push_back({std::to_string(r.map), CsvNumber(r.gpu_ms), CsvNumber(r.eye_only_ms), CsvNumber(r.cpu_ms),
+                   CsvNumber(r.differ_compared_pct), CsvNumber(r.differ_all_pct)});
+    for (PlotSeries* s : {&off, &all}) {
+      s->x.push_back(r.gpu_ms);
+      s->y.push_back(s == &off ? r.differ_compared_pct : r.differ_all_pct);
+      s->point_labels.push_back(std::to_string(r.map));
+    }
+  }
+  if (!rows.empty()) {
+    PlotMarker cpu;
+    cpu.x = rows.front().cpu_ms;
+    cpu.label = "exact CPU frame";
+    plot.vertical_lines.push_back(cpu);
+  }
+  plot.series = {off, all};
+  section.csv = CsvText({"map", "gpu_ms", "eye_only_ms", "cpu_ms", "differ_compared_pct", "differ_all_pct"}, csv);
+  section.svg = RenderLogLogSvg(plot);
+  section.notes.push_back(view_note);
+  section.notes.push_back("Zero shares are not drawn on the log axis. A pixel's camera set is the cameras whose light "
+                          "reaches the surface point it shows; the edge band is one pixel around every edge of the "
+                          "exact image (footprints, shadows, silhouettes), where a rasteriser and a ray caster "
+                          "legitimately disagree (docs/viewer.md).");
   return section;
 }
 

@@ -41,4 +41,21 @@ AccuracySection SteadySection(const SteadyStudy& study);
 /// "# pandora accuracy: SCENE, rig RIG" and a blank line: the head of accuracy_tables.md.
 std::string AccuracyTablesHeading(const std::string& scene_path, const std::string& rig);
 
+/// One shadow-map size of the GPU renderer against the exact CPU renderer (pandora_gl_bench --csv).
+struct GpuAccuracyRow {
+  int map = 0;                ///< Texels per side of each camera's distance map.
+  double gpu_ms = 0;          ///< Whole GPU frame, every map drawn.
+  double eye_only_ms = 0;     ///< A frame that moves only the eye (maps kept).
+  double cpu_ms = 0;          ///< The exact CPU renderer, same view.
+  double differ_compared_pct = 0;  ///< Pixels whose camera sets differ, off the one-pixel edge band.
+  double differ_all_pct = 0;       ///< ... over all pixels.
+};
+
+/// Reads pandora_gl_bench's CSV; InputError(file, "", ...) when a line is not six numbers.
+std::vector<GpuAccuracyRow> ParseGpuAccuracyCsv(const std::string& text, const std::string& file);
+
+/// (d) accuracy_gpu.{csv,svg}: per map size the share of pixels whose camera sets differ from the
+/// exact renderer's against the GPU frame time, the CPU frame as the baseline; `device` names the GL.
+AccuracySection GpuSection(const std::vector<GpuAccuracyRow>& rows, const std::string& view_note);
+
 }  // namespace pandora::report
