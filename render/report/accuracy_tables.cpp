@@ -334,7 +334,7 @@ AccuracySection GpuSection(const std::vector<GpuAccuracyRow>& rows, const std::s
                          "sets differ, all pixels"});
   std::vector<std::vector<std::string>> csv;
   LogLogPlot plot;
-  plot.title = "GPU renderer: pixels whose camera sets differ from the exact renderer, against frame time";
+  plot.title = "GPU light: pixels whose camera sets differ, against frame time";
   plot.x_label = "GPU frame time (ms, every map drawn)";
   plot.y_label = "pixels whose camera sets differ (%)";
   plot.note = view_note;
