@@ -175,52 +175,6 @@ class ViewRays {
   Camera pinhole_;
 };
 
-// Which of each triangle's edges the hidden-line mode draws: edges between triangles that are not
-// coplanar (dihedral angle above 1 degree) and boundary edges. Bit i: the edge opposite vertex i.
-std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
-  struct Key {
-    std::array<double, 6> v;
-    bool operator==(const Key& o) const { return v == o.v; }
-  };
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      std::size_t h = 0;
-      for (double x : k.v) h = h * 1000003u ^ std::hash<double>()(x);
-      return h;
-    }
-  };
-  const std::size_t n = mesh.triangles.size();
-  std::vector<Vec3> normals(n);
-  for (std::size_t t = 0; t < n; ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Vec3 c = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
-                       .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    const double len = c.norm();
-    normals[t] = len > 0 ? Vec3(c / len) : Vec3::Zero();
-  }
-  std::unordered_map<Key, std::vector<std::pair<uint32_t, uint8_t>>, Hash> edges;
-  edges.reserve(3 * n);
-  for (std::size_t t = 0; t < n; ++t)
-    for (int i = 0; i < 3; ++i) {
-      Vec3 a = mesh.vertices[mesh.triangles[t][(i + 1) % 3]];
-      Vec3 b = mesh.vertices[mesh.triangles[t][(i + 2) % 3]];
-      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
-        std::swap(a, b);
-      edges[Key{{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}}].push_back({uint32_t(t), uint8_t(i)});
-    }
-  const double cos_crease = std::cos(1.0 * M_PI / 180.0);
-  std::vector<uint8_t> drawn(n, 0);
-  for (const auto& [key, list] : edges) {
-    bool draw = list.size() == 1;
-    for (std::size_t a = 0; a < list.size() && !draw; ++a)
-      for (std::size_t b = a + 1; b < list.size() && !draw; ++b)
-        draw = std::abs(normals[list[a].first].dot(normals[list[b].first])) < cos_crease;
-    if (draw)
-      for (const auto& [t, i] : list) drawn[t] |= uint8_t(1u << i);
-  }
-  return drawn;
-}
-
 // Cheap necessary conditions of VisibilityTester::TestGeometry's kSeen, tested first: the point
 // faces the camera, lies within its working range, and (for lenses under 180 degrees) in front of
 // it within the normalized-coordinate bounds of the whole (distorted) image. A point failing any of
@@ -360,7 +314,7 @@ const std::vector<int>& PreparedSceneData::ObjectTextures() const {
 }
 
 const std::vector<uint8_t>& PreparedSceneData::DrawnEdges() const {
-  std::call_once(edges_once, [this] { drawn_edges = ComputeDrawnEdges(mesh); });
+  std::call_once(edges_once, [this] { drawn_edges = pandora::ComputeDrawnEdges(mesh); });
   return drawn_edges;
 }
 
@@ -1019,6 +973,50 @@ std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, do
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,
                                    const RenderView& view, int x, int y) {
   return PixelPicker(scene, rig, view).Pick(x, y);
+}
+
+std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
+  struct Key {
+    std::array<double, 6> v;
+    bool operator==(const Key& o) const { return v == o.v; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::size_t h = 0;
+      for (double x : k.v) h = h * 1000003u ^ std::hash<double>()(x);
+      return h;
+    }
+  };
+  const std::size_t n = mesh.triangles.size();
+  std::vector<Vec3> normals(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Vec3 c = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+                       .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
+    const double len = c.norm();
+    normals[t] = len > 0 ? Vec3(c / len) : Vec3::Zero();
+  }
+  std::unordered_map<Key, std::vector<std::pair<uint32_t, uint8_t>>, Hash> edges;
+  edges.reserve(3 * n);
+  for (std::size_t t = 0; t < n; ++t)
+    for (int i = 0; i < 3; ++i) {
+      Vec3 a = mesh.vertices[mesh.triangles[t][(i + 1) % 3]];
+      Vec3 b = mesh.vertices[mesh.triangles[t][(i + 2) % 3]];
+      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
+        std::swap(a, b);
+      edges[Key{{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}}].push_back({uint32_t(t), uint8_t(i)});
+    }
+  const double cos_crease = std::cos(1.0 * M_PI / 180.0);
+  std::vector<uint8_t> drawn(n, 0);
+  for (const auto& [key, list] : edges) {
+    bool draw = list.size() == 1;
+    for (std::size_t a = 0; a < list.size() && !draw; ++a)
+      for (std::size_t b = a + 1; b < list.size() && !draw; ++b)
+        draw = std::abs(normals[list[a].first].dot(normals[list[b].first])) < cos_crease;
+    if (draw)
+      for (const auto& [t, i] : list) drawn[t] |= uint8_t(1u << i);
+  }
+  return drawn;
 }
 
 }  // namespace pandora

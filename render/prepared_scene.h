@@ -7,8 +7,10 @@
 /// Render(prepared, rig, view, options) in render/render.h, or ProgressiveRender
 /// (render/progressive.h) for interactive use. Light header: no Embree, OpenVDB or image library.
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
@@ -22,6 +24,12 @@ namespace internal {
 struct PreparedSceneData;
 struct PreparedOverlaysData;
 }  // namespace internal
+
+/// Which of each triangle's edges the hidden-line mode draws (Surface::kHiddenLine): edges between
+/// triangles more than 1 degree from coplanar, and boundary edges, matched by their exact end
+/// points. Bit i of entry t: the edge of triangle t opposite its vertex i. PreparedScene computes it
+/// once per scene; the GPU renderer of the viewer draws the same set.
+std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh);
 
 /// A scene prepared for rendering. Holds a copy of everything it derives from the Scene (the
 /// Scene itself may go away), and either borrows, shares or owns the ray caster. The parts only

@@ -10,6 +10,7 @@
 
 #include "analysis/error.h"
 #include "analysis/uncertainty_reference.h"
+#include "tests/expect_input_error.h"
 #include "tests/fixtures.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
@@ -17,16 +18,7 @@
 namespace pandora {
 namespace {
 
-template <class Fn>
-InputError ErrorOf(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no InputError";
-  return InputError("", "", "");
-}
+using testing::ErrorOf;
 
 // A 4 x 4 x 2.5 m room, a 1 m region at 0.1 m voxels, four cameras 1.8 m out and 1.2 m above the
 // region's centre (0, 0, 0.5).

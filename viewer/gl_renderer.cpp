@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/prepared_scene.h"
 #include "render/render.h"
 
 namespace pandora {
@@ -530,42 +531,6 @@ std::array<Mat3, 6> CubeFaces() {
   return f;
 }
 
-// Which of each triangle's edges the hidden-line mode draws, as render/frame.cpp's
-// ComputeDrawnEdges (PreparedScene::DrawnEdges, not reachable from a Scene without building a
-// ray caster): edges between triangles more than 1 degree from coplanar, and boundary edges.
-// Bit i: the edge opposite vertex i. Edges are matched by their exact end points.
-std::vector<uint8_t> DrawnEdges(const TriangleMesh& mesh) {
-  const std::size_t n = mesh.triangles.size();
-  std::vector<Vec3> normals(n);
-  for (std::size_t t = 0; t < n; ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Vec3 c = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
-                       .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    const double len = c.norm();
-    normals[t] = len > 0 ? Vec3(c / len) : Vec3::Zero();
-  }
-  std::map<std::array<double, 6>, std::vector<std::pair<uint32_t, uint8_t>>> edges;
-  for (std::size_t t = 0; t < n; ++t)
-    for (int i = 0; i < 3; ++i) {
-      Vec3 a = mesh.vertices[mesh.triangles[t][(i + 1) % 3]];
-      Vec3 b = mesh.vertices[mesh.triangles[t][(i + 2) % 3]];
-      if (std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3))
-        std::swap(a, b);
-      edges[{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}].push_back({uint32_t(t), uint8_t(i)});
-    }
-  const double cos_crease = std::cos(1.0 * kPi / 180.0);
-  std::vector<uint8_t> drawn(n, 0);
-  for (const auto& [key, list] : edges) {
-    bool draw = list.size() == 1;
-    for (std::size_t a = 0; a < list.size() && !draw; ++a)
-      for (std::size_t b = a + 1; b < list.size() && !draw; ++b)
-        draw = std::abs(normals[list[a].first].dot(normals[list[b].first])) < cos_crease;
-    if (draw)
-      for (const auto& [t, i] : list) drawn[t] |= uint8_t(1u << i);
-  }
-  return drawn;
-}
-
 // Cameras per light pass: the uniform block holds kCameraVec4 vec4s per camera (16 KiB, the
 // least GL 3.3 guarantees, fits 64 x 10 x 16 bytes).
 constexpr int kCameraVec4 = 10;
@@ -882,7 +847,7 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     const int mat = scene.objects[o].material;
     if (mat >= 0 && mat < int(scene.materials.size())) object_color[o] = scene.materials[mat].color;
   }
-  const std::vector<uint8_t> drawn = DrawnEdges(m.mesh);
+  const std::vector<uint8_t> drawn = ComputeDrawnEdges(m.mesh);
   std::vector<float> data;
   data.reserve(m.mesh.triangles.size() * 33);
   for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {

@@ -48,6 +48,13 @@ void Session::ReadFields(const std::function<void(const Fields&, std::int64_t)>&
   fn(evaluator_->fields(), fields_version_);
 }
 
+bool Session::TryReadFields(const std::function<void(const Fields&, std::int64_t)>& fn) const {
+  std::unique_lock<std::mutex> lock(fields_mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return false;
+  fn(evaluator_->fields(), fields_version_);
+  return true;
+}
+
 Fields Session::TakeFields() {
   std::lock_guard<std::mutex> lock(fields_mutex_);
   fields_version_ = -1;

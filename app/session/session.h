@@ -58,6 +58,9 @@ class Session {
 
   /// Calls fn(fields, rig version they reflect) under the fields' lock (-1: none yet).
   void ReadFields(const std::function<void(const Fields&, std::int64_t)>& fn) const;
+  /// The same without waiting: false (and `fn` not called) while an update holds the fields. What a
+  /// window drawing every frame calls, so that a background update never stalls a frame.
+  bool TryReadFields(const std::function<void(const Fields&, std::int64_t)>& fn) const;
   /// Moves the fields out (a command that writes them); the next update evaluates in full.
   Fields TakeFields();
 

@@ -381,6 +381,16 @@ TEST(Autosave, WritesOnlyEditedCamerasAndRecoversThemAsOneUndoStep) {
   EXPECT_THROW(RecoverAutosave(again, *stale, path), InputError);
 }
 
+TEST(Session, TryReadFieldsReadsWhenNoUpdateHoldsThem) {
+  Session session(Study::Load("tests/data/minimal.json"), SessionOptions());
+  session.UpdateFields();
+  std::int64_t tried = -5, read = -6;
+  EXPECT_TRUE(session.TryReadFields([&](const Fields&, std::int64_t v) { tried = v; }));
+  session.ReadFields([&](const Fields&, std::int64_t v) { read = v; });
+  EXPECT_EQ(tried, read);
+  EXPECT_EQ(tried, session.rig().version());
+}
+
 TEST(Session, UnknownRigNamesTheOption) {
   const auto study = Study::Load("tests/data/minimal.json");
   SessionOptions options;

@@ -14,6 +14,7 @@
 #include "analysis/error.h"
 #include "analysis/primitives.h"
 #include "render/report/plot.h"
+#include "tests/expect_input_error.h"
 #include "tests/fixtures.h"
 
 namespace pandora::report {
@@ -31,16 +32,7 @@ Scene TwoRigRoom() {
   return scene;
 }
 
-template <class Fn>
-InputError ErrorOf(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no InputError";
-  return InputError("", "", "");
-}
+using testing::ErrorOf;
 
 TEST(ReportOptions, ErrorsNameTheOptionNeverAFlag) {
   ReportOptions o;

@@ -8,16 +8,13 @@
 #include <cstdlib>
 #include <string>
 
+#include "analysis/color.h"
 #include "analysis/error.h"
 #include "render/render.h"
 
 namespace {
 
-int Srgb8(float linear) {
-  const double c = std::clamp(double(linear), 0.0, 1.0);
-  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
-  return int(std::lround(255.0 * s));
-}
+int Srgb8(float linear) { return int(std::lround(255.0 * pandora::SrgbFromLinear(linear))); }
 
 }  // namespace
 

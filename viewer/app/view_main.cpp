@@ -12,6 +12,7 @@
 
 #include "analysis/atomic_file.h"
 #include "analysis/error.h"
+#include "analysis/output_transaction.h"
 #include "app/session/autosave.h"
 #include "app/session/study.h"
 #include "viewer/app/viewer_app.h"
@@ -165,9 +166,16 @@ int Run(int argc, char** argv) {
     window.Loop();
     return 0;
   }
+  // The log, like the screenshots, never replaces an input and appears whole (also after an error).
+  pandora::OutputTransaction log_output;
+  for (const auto& [path, what] : model.scene().InputFiles()) log_output.AddInput(path, what);
+  log_output.AddInput(script, "script");
+  const std::string staged_log = log.empty() ? "" : log_output.Stage(log, "--log");
   nlohmann::json states = nlohmann::json::array();
   auto write_log = [&] {
-    if (!log.empty()) pandora::WriteFileAtomically(log, states.dump(1) + "\n");
+    if (log.empty()) return;
+    pandora::WriteFileAtomically(staged_log, states.dump(1) + "\n");
+    log_output.Commit();
   };
   try {
     window.Frame();
@@ -179,7 +187,13 @@ int Run(int argc, char** argv) {
       states.push_back(std::move(s));
     }
     model.session().WaitFields();
-    if (!screenshot.empty()) window.Screenshot(model, screenshot, -1);
+    if (!screenshot.empty()) {
+      pandora::viewer::Action shot;
+      shot.kind = pandora::viewer::Action::Kind::kScreenshot;
+      shot.where = "--screenshot";
+      shot.text = screenshot;
+      model.Do(shot, &window);
+    }
   } catch (...) {
     write_log();
     throw;

@@ -41,9 +41,7 @@ std::string g_glfw_error;
 void OnGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (" + std::to_string(code) + ")"; }
 
 unsigned char ToSrgb8(double linear) {
-  const double c = std::clamp(linear, 0.0, 1.0);
-  const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
-  return static_cast<unsigned char>(std::lround(255.0 * s));
+  return static_cast<unsigned char>(std::lround(255.0 * SrgbFromLinear(linear)));
 }
 
 // Linear RGB (3 floats per pixel) to 8-bit sRGB RGBA, opaque.
@@ -209,6 +207,15 @@ struct ViewerApp::Impl {
   std::vector<std::string> SelectedIds() const {
     std::vector<std::string> ids;
     for (int c : model.selection) ids.push_back(model.rig().cameras[c].id);
+    return ids;
+  }
+  // The selection after a click on camera `id`: that camera alone, or with ctrl the selection with
+  // it added (or removed when it was in).
+  std::vector<std::string> ToggledSelection(const std::string& id) const {
+    std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
+    const auto it = std::find(ids.begin(), ids.end(), id);
+    if (it != ids.end()) ids.erase(it);
+    else ids.push_back(id);
     return ids;
   }
   std::optional<Ray> MouseRay(double x, double y) const {
@@ -389,7 +396,8 @@ struct ViewerApp::Impl {
     std::int64_t version = -1;
     char key[256];
     std::snprintf(key, sizeof key, "%s %d %.17g", ov.slice_field.c_str(), ov.slice_axis, ov.slice_position);
-    model.session().ReadFields([&](const Fields& f, std::int64_t v) {
+    version = slice_version;
+    model.session().TryReadFields([&](const Fields& f, std::int64_t v) {  // busy: keep the last one
       version = v;
       if (v == slice_version && key == slice_key) return;
       try {
@@ -436,7 +444,7 @@ struct ViewerApp::Impl {
     const OverlayOptions& ov = model.display.overlays;
     char key[256];
     std::snprintf(key, sizeof key, "%s %.17g", ov.iso_field.c_str(), ov.iso_value);
-    model.session().ReadFields([&](const Fields& f, std::int64_t v) {
+    model.session().TryReadFields([&](const Fields& f, std::int64_t v) {  // busy: keep the last one
       if (v == iso_version && key == iso_key) return;
       iso_version = v;
       iso_key = key;
@@ -625,10 +633,7 @@ struct ViewerApp::Impl {
     const int c = PickCamera(model.rig(), *ray, radius);
     std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
     if (c >= 0) {
-      const std::string& id = model.rig().cameras[c].id;
-      const auto it = std::find(ids.begin(), ids.end(), id);
-      if (it != ids.end()) ids.erase(it);
-      else ids.push_back(id);
+      ids = ToggledSelection(model.rig().cameras[c].id);
     } else {
       PixelPicker picker(model.session().study().prepared(), model.rig(), model.MainView());
       const int px = std::clamp(int(std::lround(x)), 0, model.width - 1);
@@ -719,11 +724,7 @@ struct ViewerApp::Impl {
       ImGui::SameLine();
       const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
       if (ImGui::Selectable(cam.id.c_str(), selected)) {
-        std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
-        const auto it = std::find(ids.begin(), ids.end(), cam.id);
-        if (it != ids.end()) ids.erase(it);
-        else ids.push_back(cam.id);
-        Do(Make(Action::Kind::kSelect, ids));
+        Do(Make(Action::Kind::kSelect, ToggledSelection(cam.id)));
       }
       ImGui::PopID();
     }
@@ -892,29 +893,34 @@ struct ViewerApp::Impl {
   int resolution[2] = {0, 0};
   bool resolution_active = false;
 
+  std::int64_t fields_numbers_version = -2;  // -2: never read
+  std::string fields_numbers;
+  VoxelLattice fields_lattice;
+
   void FieldsPanel() {
     ImGui::SetNextWindowPos(ImVec2(266, float(std::max(40, model.height - 230))), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(250, 195), ImGuiCond_FirstUseEver);
     ImGui::Begin("Fields");
-    VoxelLattice lattice;
-    std::string numbers;
-    model.session().ReadFields([&](const Fields& f, std::int64_t version) {
-      lattice = f.lattice;
-      const auto& h = f.stats.coverage_histogram;
-      std::int64_t total = 0;
-      for (auto n : h) total += n;
-      std::int64_t at_least = total;
-      for (std::size_t k = 1; k < h.size() && k <= 3; ++k) {
-        at_least -= h[k - 1];
+    // The numbers of the fields' latest version, worked out once per version (the median copies
+    // and partially sorts every sigma); while an update holds the fields, the last ones stay.
+    model.session().TryReadFields([&](const Fields& f, std::int64_t version) {
+      if (version == fields_numbers_version) return;
+      fields_numbers_version = version;
+      fields_lattice = f.lattice;
+      fields_numbers.clear();
+      const std::vector<double> shares = CoverageAtLeast(f.stats.coverage_histogram);
+      for (std::size_t k = 1; k <= shares.size() && k <= 3; ++k) {
         char cell[48];
-        std::snprintf(cell, sizeof cell, ">=%zu %.1f%%  ", k, total ? 100.0 * at_least / total : 0.0);
-        numbers += cell;
+        std::snprintf(cell, sizeof cell, ">=%zu %.1f%%  ", k, 100.0 * shares[k - 1]);
+        fields_numbers += cell;
       }
       const auto p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
-      if (p50) numbers += "\nsigma_max p50 " + std::to_string(*p50).substr(0, 5) + " mm";
-      numbers += version == model.session().rig().version() ? "" : "\n(updating)";
+      if (p50) fields_numbers += "\nsigma_max p50 " + std::to_string(*p50).substr(0, 5) + " mm";
     });
-    ImGui::TextUnformatted(numbers.empty() ? "evaluating..." : numbers.c_str());
+    const VoxelLattice& lattice = fields_lattice;
+    const std::string numbers =
+        fields_numbers + (fields_numbers_version == model.session().rig().version() ? "" : "\n(updating)");
+    ImGui::TextUnformatted(fields_numbers_version == -2 ? "evaluating..." : numbers.c_str());
     const char* fields[] = {"", "coverage", "resolution", "sigma_max"};
     const OverlayOptions& ov = model.display.overlays;
     int current = 0;
@@ -1345,11 +1351,9 @@ void ViewerApp::Screenshot(const ViewerModel& model, const std::string& path, in
   image.rgb.resize(std::size_t(fw) * fh * 3);
   for (int y = 0; y < fh; ++y)
     for (int x = 0; x < fw; ++x)
-      for (int k = 0; k < 3; ++k) {
-        const double s = pixels[(std::size_t(fh - 1 - y) * fw + x) * 4 + k] / 255.0;
+      for (int k = 0; k < 3; ++k)
         image.rgb[(std::size_t(y) * fw + x) * 3 + k] =
-            float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
-      }
+            float(LinearFromSrgb(pixels[(std::size_t(fh - 1 - y) * fw + x) * 4 + k] / 255.0));
   WritePng(image, path);
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/error.h"
+#include "analysis/output_transaction.h"
 #include "analysis/pose.h"
 #include "analysis/rig_check.h"
 #include "app/session/autosave.h"
@@ -23,19 +24,6 @@ std::vector<std::string> DefaultFields() { return {"coverage", "cameras", "resol
 
 Vec3 UpFor(const Vec3& from, const Vec3& at) {
   return std::abs((at - from).normalized().z()) > 0.99 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
-}
-
-// Refuses an output path that is one of the scene's input files.
-void CheckOutputPath(const Scene& scene, const std::string& path, const std::string& where) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path out = fs::weakly_canonical(path, ec);
-  for (const auto& [file, what] : scene.InputFiles()) {
-    std::error_code ec2;
-    if (!ec && fs::weakly_canonical(file, ec2) == out && !ec2)
-      throw InputError(where, "", "the screenshot path '" + path + "' is the " + what + " " + file,
-                       "write the screenshot elsewhere");
-  }
 }
 
 LensModel LensFromName(const std::string& name) {
@@ -66,6 +54,18 @@ std::string UnsavableChanges(const Camera& saved, const Camera& now) {
 }
 
 }  // namespace
+
+std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram) {
+  std::int64_t total = 0;
+  for (std::int64_t n : histogram) total += n;
+  std::vector<double> shares;
+  std::int64_t at_least = total;
+  for (std::size_t k = 1; k < histogram.size(); ++k) {
+    at_least -= histogram[k - 1];
+    shares.push_back(total > 0 ? double(at_least) / total : 0.0);
+  }
+  return shares;
+}
 
 void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, int camera) {
   RenderOptions options = model.display;
@@ -522,8 +522,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
     }
     case Kind::kScreenshot: {
       if (!frontend) throw InputError(a.where, "", "screenshots need a front end");
-      CheckOutputPath(scene(), a.text, a.where);
-      frontend->Screenshot(*this, a.text, a.text2.empty() ? -1 : CameraIndex(a.text2, a));
+      const int camera = a.text2.empty() ? -1 : CameraIndex(a.text2, a);
+      // As every command's outputs: never onto an input, written whole or not at all.
+      OutputTransaction output;
+      for (const auto& [path, what] : scene().InputFiles()) output.AddInput(path, what);
+      frontend->Screenshot(*this, output.Stage(a.text, a.where), camera);
+      output.Commit();
       break;
     }
     case Kind::kSize:
@@ -597,16 +601,7 @@ nlohmann::json ViewerModel::StateJson() const {
   session_->ReadFields([&](const Fields& f, std::int64_t version) {
     fields["rig_version"] = version;
     // coverage_ge[k - 1]: share of the free region voxels seen by at least k cameras.
-    const auto& h = f.stats.coverage_histogram;
-    std::int64_t total = 0;
-    for (std::int64_t n : h) total += n;
-    json ge = json::array();
-    std::int64_t at_least = total;
-    for (std::size_t k = 1; k < h.size(); ++k) {
-      at_least -= h[k - 1];
-      ge.push_back(total > 0 ? double(at_least) / total : 0.0);
-    }
-    fields["coverage_ge"] = ge;
+    fields["coverage_ge"] = CoverageAtLeast(f.stats.coverage_histogram);
     const std::optional<double> p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
     fields["sigma_max_p50_mm"] = p50 ? json(*p50) : json();
   });

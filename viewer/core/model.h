@@ -25,6 +25,10 @@ namespace pandora::viewer {
 
 class ViewerModel;
 
+/// Shares of the voxels of a field evaluation's coverage histogram seen by at least k cameras:
+/// entry k - 1 for k = 1, 2, ... (0 for an empty histogram).
+std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram);
+
 /// What a front end does for the actions that need a window: screenshots, raw input, frames.
 class Frontend {
  public:
