@@ -315,6 +315,45 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
   return out;
 }
 
+std::string ReplaceStations(const std::string& text, const std::string& scene_path,
+                            const std::vector<StationMove>& stations) {
+  ordered_json root;
+  try {
+    root = ordered_json::parse(text);
+  } catch (const std::exception& e) {
+    throw InputError(scene_path, "$", std::string("malformed JSON: ") + e.what());
+  }
+  const double mpu = MetresPerUnit(root, scene_path);
+  for (const StationMove& move : stations) {
+    const std::string where = "$.stations." + move.name;
+    if (!root.is_object() || !root.contains("stations") || !root["stations"].is_object() ||
+        !root["stations"].contains(move.name) || !root["stations"][move.name].is_object())
+      throw InputError(scene_path, where, "no viewing station '" + move.name + "'",
+                       "the scene file no longer has the station the session moved");
+    ordered_json& station = root["stations"][move.name];
+    if (!station.contains("display") || !station["display"].is_object())
+      throw InputError(scene_path, where + ".display", "the station has no display");
+    ordered_json& display = station["display"];
+    const std::optional<Vec3> center0 = FileVec3(display, "center"), facing0 = FileVec3(display, "facing");
+    if (!center0 || !facing0)
+      throw InputError(scene_path, where + ".display", "the display has no 'center' or 'facing' point");
+    Vec3 center = move.display_center / mpu, eye = move.eye / mpu;
+    Vec3 facing = *facing0 + (center - *center0);
+    for (int i = 0; i < 3; ++i) {
+      center[i] = Clean(center[i]);
+      eye[i] = Clean(eye[i]);
+      facing[i] = Clean(facing[i]);
+    }
+    display["center"] = Array(center);
+    display["facing"] = Array(facing);
+    station["eye"] = Array(eye);
+  }
+  const auto [indent, ch] = Indentation(text);
+  std::string out = root.dump(indent, ch);
+  if (!text.empty() && text.back() == '\n') out += "\n";
+  return out;
+}
+
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options) {
   const std::string text = ReadJsonText(suggestion_path, "suggestion file");
   json j;

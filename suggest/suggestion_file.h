@@ -52,6 +52,21 @@ std::string ReplacePoses(const std::string& scene_text, const std::string& scene
                          const std::string& rig, const std::vector<PoseUpdate>& poses,
                          std::vector<std::string>* notes = nullptr);
 
+/// A viewing station placed anew (metres, world frame): its eye and its display's centre. The
+/// display keeps its orientation (its `facing` point moves with its centre).
+struct StationMove {
+  std::string name;
+  Vec3 eye = Vec3::Zero();
+  Vec3 display_center = Vec3::Zero();
+};
+
+/// The scene file text with each listed station's `eye` and `display.center` replaced (in the
+/// file's units, numbers written as ReplacePoses writes them) and its `display.facing` moved by the
+/// centre's displacement. Everything else keeps its order and value. Throws InputError (file =
+/// scene_path) when the JSON or a station cannot be found.
+std::string ReplaceStations(const std::string& scene_text, const std::string& scene_path,
+                            const std::vector<StationMove>& stations);
+
 struct AcceptOptions {
   std::vector<std::string> cameras;  ///< Ids to accept; empty: all cameras of the suggestion.
   bool force = false;                ///< Accept even when the scene file changed since.

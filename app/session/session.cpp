@@ -132,7 +132,7 @@ void Session::ApplySuggestion(const Suggestion& suggestion) {
                 study_->scene().path);
 }
 
-SaveResult Session::Save(bool force) {
+SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Scene& scene = study_->scene();
   if (saved_text_.empty())
     throw InputError(scene.path, "", "this study was not loaded from a file", "nothing to save to");
@@ -169,15 +169,17 @@ SaveResult Session::Save(bool force) {
                      "undo those changes or edit the scene file by hand");
   SaveResult result;
   result.scene_path = scene.path;
-  if (poses.empty()) return result;
+  if (poses.empty() && stations.empty()) return result;
   // The file must be the one the session knows, or the edits would overwrite someone's changes.
   const std::string on_disk = ReadInputFile(scene.path, InputLimits::kJsonBytes, "scene file");
   if (!force && on_disk != saved_text_)
     throw InputError(scene.path, "", "the scene file changed on disk since it was loaded",
                      "reload it, or save with force to overwrite (a backup is kept)");
-  const std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);
+  std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);
+  if (!stations.empty()) text = ReplaceStations(text, scene.path, stations);
   result.backup_path = ReplaceSceneFileWithBackup(scene.path, on_disk, text);
   for (const PoseUpdate& u : poses) result.saved.push_back(u.id);
+  for (const StationMove& s : stations) result.saved_stations.push_back(s.name);
   saved_text_ = text;
   rig_.MarkSaved();
   return result;

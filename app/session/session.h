@@ -18,6 +18,7 @@
 #include "app/session/study.h"
 #include "render/render.h"
 #include "suggest/suggest.h"
+#include "suggest/suggestion_file.h"
 #include "volume/fields.h"
 
 namespace pandora::session {
@@ -35,6 +36,7 @@ struct SessionOptions {
 struct SaveResult {
   std::string scene_path, backup_path;
   std::vector<std::string> saved;  ///< Camera ids written.
+  std::vector<std::string> saved_stations;  ///< Viewing stations written.
   std::vector<std::string> notes;  ///< As `pandora accept`'s (an `up` that changed, ...).
 };
 
@@ -96,8 +98,9 @@ class Session {
   /// `pandora accept` does (each in its camera's own form). Refuses (InputError) when the file
   /// changed on disk since it was loaded or last saved (unless `force`), when the study has no file
   /// text, or when an edit is of a kind the scene file cannot take this way (enabled, lens model,
-  /// principal point, range, pixel noise): those are listed.
-  SaveResult Save(bool force = false);
+  /// principal point, range, pixel noise): those are listed. `stations` (viewing stations moved in
+  /// the session, suggest/suggestion_file.h ReplaceStations) are written in the same file write.
+  SaveResult Save(bool force = false, const std::vector<StationMove>& stations = {});
 
  private:
   std::shared_ptr<const Study> study_;

@@ -28,7 +28,7 @@ awk -v a="$turned" -v b="$accepted" 'BEGIN { exit !(b > a) }' || fail "accepting
 [ "$undone" = "$turned" ] || fail "undo (the window's button) did not restore the turned state"
 [ "$redone" = "$accepted" ] || fail "redo (ctrl+y) did not restore the accepted state"
 saved=$(jq -c '.[] | select(.action == "$[21]") | {unsaved, status}' "$out"/log.json)
-jq -e '.unsaved == 0 and (.status | startswith("saved 1 cameras"))' <<<"$saved" >/dev/null ||
+jq -e '.unsaved == 0 and (.status | startswith("saved 1 camera "))' <<<"$saved" >/dev/null ||
   fail "the save did not write one camera: $saved"
 cmp -s "$out"/scene.json "$src"/examples/trauma_room/scene.json && fail "the scene file was not saved"
 backup=$(ls "$out"/scene.json.* | grep -v autosave | head -1)

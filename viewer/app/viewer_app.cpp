@@ -163,6 +163,11 @@ struct ViewerApp::Impl {
   int hover_handle = -1;  // 0..2 axes, 3..5 rings
   bool hover_ring = false;
   float move_step = 0.0f, rotate_step = 0.0f;  // snap steps (0: off)
+  // A viewing station's eye or display centre picked for the gizmo (translation only); empty: none.
+  std::string station;
+  bool station_display = false;
+  Vec3 station_start = Vec3::Zero();  // where the point was when the drag began
+  std::optional<std::pair<Vec3, double>> script_gizmo;  // a script's gizmo drag: origin, length at its press
 
   // Camera views (exact, CPU) of the selected cameras.
   struct CameraView {
@@ -188,6 +193,7 @@ struct ViewerApp::Impl {
   Impl(ViewerModel& m, AppOptions o) : model(m), options(o) {}
 
   void Do(const Action& a) {
+    if (a.kind == Action::Kind::kSelect && !a.cameras.empty()) station.clear();  // the gizmo goes to the cameras
     try {
       error.clear();
       model.Do(a, nullptr);
@@ -221,10 +227,23 @@ struct ViewerApp::Impl {
   std::optional<Ray> MouseRay(double x, double y) const {
     return PixelRay(model.rig(), model.MainView(), x, y);
   }
-  double GizmoLength() const {
+  // The picked station point, when the station still exists.
+  std::optional<Vec3> StationPoint() const {
+    const auto it = model.stations.find(station);
+    if (station.empty() || it == model.stations.end()) return std::nullopt;
+    return station_display ? it->second.display_center : it->second.eye;
+  }
+  // Where the gizmo sits: the picked station point, else the primary camera's centre.
+  std::optional<Vec3> GizmoOrigin() const {
+    if (const auto p = StationPoint()) return p;
     const int c = Primary();
-    if (c < 0) return 0.3;
-    return 0.12 * (model.rig().cameras[c].center() - model.view.Eye()).norm();
+    if (c < 0) return std::nullopt;
+    return model.rig().cameras[c].center();
+  }
+  double GizmoLength() const {
+    const auto o = GizmoOrigin();
+    if (!o) return 0.3;
+    return 0.12 * (*o - model.view.Eye()).norm();
   }
 
   void RenderMain() {
@@ -374,7 +393,13 @@ struct ViewerApp::Impl {
         line(c[k], c[(k + 1) % 4], IM_COL32(230, 230, 230, 255), 2.0f);
         line(st.eye, c[k], IM_COL32(230, 230, 230, 90), 1.0f);
       }
+      if (const auto d = P.Point(st.display_center)) {
+        const bool picked = station == name && station_display;
+        const float r = picked ? 5.0f : 3.5f;
+        dl->AddRectFilled(ImVec2(d->x - r, d->y - r), ImVec2(d->x + r, d->y + r), IM_COL32(255, 255, 255, 255));
+      }
       if (const auto e = P.Point(st.eye)) {
+        if (station == name && !station_display) dl->AddCircle(*e, 8.0f, IM_COL32(255, 255, 255, 230), 0, 1.5f);
         dl->AddCircleFilled(*e, 4.0f, IM_COL32(255, 255, 255, 255));
         dl->AddText(ImVec2(e->x + 6, e->y - 7), IM_COL32(255, 255, 255, 255), (name + " eye").c_str());
       }
@@ -507,9 +532,10 @@ struct ViewerApp::Impl {
 
   // Translate handles along world X, Y, Z and rotation rings about them, at the primary camera.
   void DrawGizmo(ImDrawList* dl, const Projector& P) {
-    const int c = Primary();
-    if (c < 0) return;
-    const Vec3 o = model.rig().cameras[c].center();
+    const auto origin = GizmoOrigin();
+    if (!origin) return;
+    const Vec3 o = *origin;
+    const bool rings = !StationPoint();  // a station point only moves
     const double len = GizmoLength();
     const ImU32 axis_col[3] = {IM_COL32(230, 60, 60, 255), IM_COL32(60, 200, 60, 255), IM_COL32(70, 110, 240, 255)};
     for (int k = 0; k < 3; ++k) {
@@ -517,6 +543,7 @@ struct ViewerApp::Impl {
       const bool hot = (drag == Drag::kAxis && drag_handle == k) || (drag == Drag::kNone && hover_handle == k);
       if (P.Segment(o, o + len * Vec3::Unit(k), &a, &b)) dl->AddLine(a, b, axis_col[k], hot ? 4.0f : 2.5f);
       // The ring in the plane normal to axis k.
+      if (!rings) continue;
       const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
       const bool ring_hot = (drag == Drag::kRing && drag_handle == k) || (drag == Drag::kNone && hover_handle == k + 3);
       for (int i = 0; i < 48; ++i) {
@@ -530,10 +557,11 @@ struct ViewerApp::Impl {
 
   // Which gizmo handle is under the mouse: 0..2 axes, 3..5 rings, -1 none.
   int HandleAt(double x, double y) const {
-    const int c = Primary();
-    if (c < 0) return -1;
+    const auto origin = GizmoOrigin();
+    if (!origin) return -1;
+    const bool rings = !StationPoint();
     const Projector P(model.MainView());
-    const Vec3 o = model.rig().cameras[c].center();
+    const Vec3 o = *origin;
     const double len = GizmoLength();
     const ImVec2 m{float(x), float(y)};
     int best = -1;
@@ -544,6 +572,7 @@ struct ViewerApp::Impl {
         const double d = SegmentDistance(m, a, b);
         if (d < best_d) best_d = d, best = k;
       }
+      if (!rings) continue;
       const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
       for (int i = 0; i < 48; ++i) {
         const double t0 = 2 * M_PI * i / 48, t1 = 2 * M_PI * (i + 1) / 48;
@@ -573,6 +602,7 @@ struct ViewerApp::Impl {
         drag = hover_handle < 3 ? Drag::kAxis : Drag::kRing;
         drag_handle = hover_handle % 3;
         applied = 0;
+        if (const auto p = StationPoint()) station_start = *p;
         if (const auto r = MouseRay(x, y)) drag_ray = *r;
       } else {
         drag = Drag::kClick;  // becomes an orbit once the mouse moves
@@ -594,9 +624,26 @@ struct ViewerApp::Impl {
   }
 
   void DragGizmo(double x, double y) {
-    const int c = Primary();
     const auto ray = MouseRay(x, y);
-    if (c < 0 || !ray) return;
+    if (!ray) return;
+    if (StationPoint() && drag == Drag::kAxis) {
+      // A station's eye or display: the `station` action with the absolute position.
+      const Vec3 axis = Vec3::Unit(drag_handle);
+      const auto t0 = AxisParameter(drag_ray, station_start, axis);
+      const auto t1 = AxisParameter(*ray, station_start, axis);
+      if (!t0 || !t1) return;
+      const double total = Snap(*t1 - *t0, move_step);
+      if (total == applied) return;
+      Action a = Make(Action::Kind::kStation);
+      a.text = station;
+      a.flag = station_display;
+      a.a = station_start + total * axis;
+      Do(a);
+      applied = total;
+      return;
+    }
+    const int c = Primary();
+    if (c < 0) return;
     const Vec3 o = model.rig().cameras[c].center();
     const Vec3 axis = Vec3::Unit(drag_handle);
     if (drag == Drag::kAxis) {
@@ -630,6 +677,28 @@ struct ViewerApp::Impl {
     const auto ray = MouseRay(x, y);
     if (!ray) return;
     const double radius = 0.02 * (model.view.Eye() - model.view.target).norm() + 0.02;
+    // A station's eye or display centre within 8 pixels: picked for the gizmo (the cameras
+    // deselected); a click elsewhere drops it.
+    {
+      const Projector P(model.MainView());
+      double best = 8.0;
+      std::string picked;
+      bool display = false;
+      for (const auto& [name, st] : model.stations)
+        for (int k = 0; k < 2; ++k)
+          if (const auto q = P.Point(k ? st.display_center : st.eye)) {
+            const double d = std::hypot(q->x - x, q->y - y);
+            if (d < best) best = d, picked = name, display = k == 1;
+          }
+      station = picked;
+      station_display = display;
+      if (!picked.empty()) {
+        Do(Make(Action::Kind::kSelect));
+        model.status = "station '" + picked + "': " + (display ? "display" : "eye") +
+                       " (drag the gizmo's axes; Save writes it into the scene file)";
+        return;
+      }
+    }
     const int c = PickCamera(model.rig(), *ray, radius);
     std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
     if (c >= 0) {
@@ -657,7 +726,7 @@ struct ViewerApp::Impl {
       if (input.ctrl && key == GLFW_KEY_Z) Do(Make(input.shift ? Action::Kind::kRedo : Action::Kind::kUndo));
       else if (input.ctrl && key == GLFW_KEY_Y) Do(Make(Action::Kind::kRedo));
       else if (input.ctrl && key == GLFW_KEY_S) Do(Make(Action::Kind::kSave));
-      else if (key == GLFW_KEY_ESCAPE) Do(Make(Action::Kind::kSelect));
+      else if (key == GLFW_KEY_ESCAPE) station.clear(), Do(Make(Action::Kind::kSelect));
       else if (key == GLFW_KEY_F) model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
     }
     input.pressed.clear();
@@ -1362,13 +1431,44 @@ void ViewerApp::Input(ViewerModel&, const Action& a) {
   using Kind = Action::Kind;
   const int button = a.text2 == "right" ? 1 : a.text2 == "middle" ? 2 : 0;
   switch (a.kind) {
-    case Kind::kMouse:
-      m.input.x = a.number3;
-      m.input.y = a.number2;
+    case Kind::kMouse: {
+      double x = a.number3, y = a.number2;
+      const Projector P(m.model.MainView());
+      auto pixel = [&](const Vec3& w) {
+        const auto q = P.Point(w);
+        if (!q) throw InputError(a.where, "", "the point is behind the main view's eye");
+        x = q->x;
+        y = q->y;
+      };
+      if (a.has_a) {
+        pixel(a.a);
+      } else if (a.gizmo >= 0) {
+        // The handle as it was when the drag began: a move "by" d aims where the handle's grip
+        // point would be after moving d metres along the axis (turning d degrees on a ring).
+        if (a.text == "press" || !m.script_gizmo) {
+          const auto o = m.GizmoOrigin();
+          if (!o) throw InputError(a.where, "", "no gizmo: select a camera or pick a station point first");
+          m.script_gizmo = std::make_pair(*o, m.GizmoLength());
+        }
+        const auto [o, len] = *m.script_gizmo;
+        const int k = a.gizmo % 3;
+        const Vec3 axis = Vec3::Unit(k);
+        if (a.gizmo < 3) {
+          pixel(o + (0.6 * len + a.number) * axis);
+        } else {
+          const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
+          const double t = 0.6 + a.number * kDeg;  // the grip at 0.6 rad round the ring
+          pixel(o + 0.8 * len * (std::cos(t) * u + std::sin(t) * v));
+        }
+        if (a.text == "release") m.script_gizmo.reset();
+      }
+      m.input.x = x;
+      m.input.y = y;
       if (a.text == "press") m.input.down[button] = true;
       if (a.text == "release") m.input.down[button] = false;
       Frame();
       break;
+    }
     case Kind::kScroll:
       m.input.x = a.number3;
       m.input.y = a.number2;

@@ -118,6 +118,7 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   display.pixel_sigma = s.study.pixel_sigma;
   display.layers = false;
   stations = s.stations;
+  saved_stations = s.stations;
   session_->UpdateFieldsInBackground();
 }
 
@@ -514,10 +515,24 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (!unsavable.empty())
         throw InputError(file, "", "not saved: saving writes poses and focal lengths only, not " + unsavable,
                          "undo them, or copy them into the scene file by hand");
-      const session::SaveResult r = session_->Save(a.flag);
+      std::vector<StationMove> moved;
+      for (const auto& [name, st] : stations) {
+        const ViewingStation& before = saved_stations.at(name);
+        if (st.eye != before.eye || st.display_center != before.display_center)
+          moved.push_back({name, st.eye, st.display_center});
+      }
+      const session::SaveResult r = session_->Save(a.flag, moved);
+      saved_stations = stations;
       if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
-      status = r.saved.empty() ? "nothing to save" : "saved " + std::to_string(r.saved.size()) + " cameras into " +
-                                                          r.scene_path + " (previous file kept as " + r.backup_path + ")";
+      std::string what;
+      auto count = [](std::size_t n, const std::string& what) {
+        return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+      };
+      if (!r.saved.empty()) what = count(r.saved.size(), "camera");
+      if (!r.saved_stations.empty())
+        what += (what.empty() ? "" : " and ") + count(r.saved_stations.size(), "viewing station");
+      status = what.empty() ? "nothing to save"
+                            : "saved " + what + " into " + r.scene_path + " (previous file kept as " + r.backup_path + ")";
       break;
     }
     case Kind::kScreenshot: {
@@ -614,6 +629,13 @@ nlohmann::json ViewerModel::StateJson() const {
             {"cameras", cameras},
             {"fields", fields},
             {"status", status}};
+  if (!stations.empty()) {
+    json st = json::object();
+    for (const auto& [name, s] : stations)
+      st[name] = {{"eye", {s.eye.x(), s.eye.y(), s.eye.z()}},
+                  {"display_center", {s.display_center.x(), s.display_center.y(), s.display_center.z()}}};
+    j["stations"] = st;
+  }
   if (comparison) j["comparison"] = *comparison;
   if (suggestion) {
     json ids = json::array();

@@ -78,8 +78,11 @@ class ViewerModel {
   std::vector<int> selection;           ///< Rig indices.
   std::optional<Suggestion> suggestion; ///< Suggested poses waiting for accept or reject (ghosts).
   std::string status;                   ///< The last action's one-line message.
-  /// The scene's viewing stations as placed in this session (not saved into the scene file).
+  /// The scene's viewing stations as placed in this session; Save writes the moved ones (eye and
+  /// display centre) into the scene file with the cameras. Station moves are not undo steps.
   std::map<std::string, ViewingStation> stations;
+  /// The stations as loaded or last saved.
+  std::map<std::string, ViewingStation> saved_stations;
   std::int64_t stations_version = 0;    ///< Bumps when a station moves.
   /// The last "compare": the edited rig (its live fields, as they were) first, then the rig as last
   /// saved and / or other rigs of the scene (each evaluated once and kept while it stays the same).

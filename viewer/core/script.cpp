@@ -373,11 +373,23 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       break;
     }
     case Kind::kMouse:
-      e.Keys({"mouse", "button", "x", "y"});
+      e.Keys({"mouse", "button", "x", "y", "at", "gizmo", "by"});
       a.text = e.OneOf("mouse", {"press", "release", "move"});
       a.text2 = e.Has("button") ? e.OneOf("button", {"left", "right", "middle"}) : "left";
-      a.number3 = e.Number("x", -1e5, 1e5);
-      a.number2 = e.Number("y", -1e5, 1e5);
+      if (int(e.Has("x") || e.Has("y")) + int(e.Has("at")) + int(e.Has("gizmo")) != 1)
+        e.Fail("", "give the pointer as one of 'x' and 'y' (pixels), 'at' (a world point) or 'gizmo' (a handle)");
+      if (e.Has("at")) {
+        a.a = e.Vector("at");
+        a.has_a = true;
+      } else if (e.Has("gizmo")) {
+        const std::string h = e.OneOf("gizmo", {"x", "y", "z", "rx", "ry", "rz"});
+        a.gizmo = (h[0] == 'r' ? 3 : 0) + (h.back() - 'x');
+        a.number = e.Number("by", -1e4, 1e4, 0);
+      } else {
+        a.number3 = e.Number("x", -1e5, 1e5);
+        a.number2 = e.Number("y", -1e5, 1e5);
+      }
+      if (e.Has("by") && !e.Has("gizmo")) e.Fail("by", "'by' goes with 'gizmo'");
       break;
     case Kind::kKey:
       e.Keys({"key"});

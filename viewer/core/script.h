@@ -37,6 +37,9 @@
 ///      {"screenshot": "out/main.png"}, {"screenshot": "out/c03.png", "camera": "c03"},
 ///      {"size": [1280, 720]},                           // the main view's size in pixels
 ///      {"mouse": "press", "button": "left", "x": 640, "y": 360},  // raw input, GL front end only
+///      {"mouse": "press", "at": [x, y, z]},   // ... at the pixel where a world point appears
+///      {"mouse": "press", "gizmo": "x"},      // ... on the gizmo's x handle (x, y, z; "rx"... rings)
+///      {"mouse": "move", "gizmo": "x", "by": 0.25},  // ... where the handle is 0.25 m further
 ///      {"key": "ctrl+z"}, {"scroll": 1.0, "x": 640, "y": 360},
 ///      {"gamepad": "c03", "left": [0, -1], "right": [0, 0], "seconds": 0.5},
 ///      {"frames": 3},                                   // let the window draw
@@ -91,6 +94,9 @@ struct Action {
   std::vector<Aabb> keep_out;
   double clearance = NAN;
   double min_hfov = 0, max_hfov = 0;
+  /// mouse: the gizmo handle aimed at (0..2 axes x y z, 3..5 rings; -1: none) and "by" along it
+  /// (metres, or degrees on a ring; in `number`); with `has_a`, the world point `a` instead of x, y.
+  int gizmo = -1;
 };
 
 /// The names of Action::coefficients, in order: k1 k2 p1 p2 k3 k4.

@@ -276,6 +276,21 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   ExpectScriptError(R"([{"suggest": ["a"], "keep_out": [[0, 0, 0, 1, 1, 1], [0, 0, "x", 1, 1, 1]]}])",
                     "$[0].keep_out[1][2]");
   ExpectScriptError(R"([{"suggest": ["a"], "hfov_range": [50, 30]}])", "$[0].hfov_range");
+  // The pointer as a world point or a gizmo handle.
+  const std::vector<Action> p = ParseScript(
+      R"([{"mouse": "press", "at": [1, 2, 3]}, {"mouse": "move", "gizmo": "ry", "by": -15}, {"mouse": "release", "gizmo": "z"}])",
+      "s.json");
+  EXPECT_TRUE(p[0].has_a);
+  EXPECT_EQ(p[0].a, Vec3(1, 2, 3));
+  EXPECT_EQ(p[0].gizmo, -1);
+  EXPECT_EQ(p[1].gizmo, 4);
+  EXPECT_EQ(p[1].number, -15);
+  EXPECT_EQ(p[2].gizmo, 2);
+  EXPECT_EQ(p[2].number, 0);
+  ExpectScriptError(R"([{"mouse": "press", "x": 1, "y": 1, "at": [0, 0, 0]}])", "$[0]");
+  ExpectScriptError(R"([{"mouse": "press"}])", "$[0]");
+  ExpectScriptError(R"([{"mouse": "press", "gizmo": "w"}])", "$[0].gizmo");
+  ExpectScriptError(R"([{"mouse": "move", "x": 1, "y": 1, "by": 2}])", "$[0].by");
 }
 
 TEST(Script, CameraPanelActionsParseAndRefuseBadValuesWithTheirPath) {
@@ -458,6 +473,48 @@ TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
   ASSERT_TRUE(hit);
   const double depth = image.depth[std::size_t(view.height / 2) * view.width + view.width / 2];
   EXPECT_NEAR(depth, hit->t, 0.02 * hit->t);  // the centre pixel is half a pixel off the exact centre
+  m.session().WaitFields();
+}
+
+TEST(ViewerModel, SaveWritesMovedViewingStationsWithABackup) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "viewer_station_save";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file("examples/trauma_room/viewing_station.json", dir / "scene.json");
+  const fs::path scene = dir / "scene.json";
+  const std::string original = Read(scene);
+  const Scene before = LoadScene(scene.string());
+  const ViewingStation st0 = before.stations.at("remote consult");
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  options.width = 160;
+  options.height = 90;
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  const Vec3 center = st0.display_center + Vec3(0.25, 0.0, -0.1);
+  m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.6, -1.3, 1.35]},
+                        {"station": "remote consult", "display_at": [)" +
+                        std::to_string(center.x()) + "," + std::to_string(center.y()) + "," + std::to_string(center.z()) +
+                        R"(]}, {"save": 1}])", "s.json"),
+        nullptr);
+  EXPECT_NE(m.status.find("saved 1 viewing station into"), std::string::npos) << m.status;
+  // The file reloads with the moved eye and display, the display turned as before; a backup keeps
+  // the original; the cameras are untouched.
+  const Scene after = LoadScene(scene.string());
+  const ViewingStation& st = after.stations.at("remote consult");
+  EXPECT_LT((st.eye - Vec3(0.6, -1.3, 1.35)).norm(), 1e-9);
+  EXPECT_LT((st.display_center - m.stations.at("remote consult").display_center).norm(), 1e-9);
+  EXPECT_LT((st.display_normal - st0.display_normal).norm(), 1e-9);
+  EXPECT_LT((st.display_up - st0.display_up).norm(), 1e-9);
+  EXPECT_EQ(st.display_width, st0.display_width);
+  for (std::size_t c = 0; c < before.rigs[0].cameras.size(); ++c)
+    EXPECT_EQ(after.rigs[0].cameras[c].world_from_camera.matrix(), before.rigs[0].cameras[c].world_from_camera.matrix());
+  bool backup = false;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path() != scene && Read(e.path()) == original) backup = true;
+  EXPECT_TRUE(backup);
+  // Nothing moved since: a second save writes nothing.
+  m.Run(ParseScript(R"([{"save": 1}])", "s.json"), nullptr);
+  EXPECT_EQ(m.status, "nothing to save");
   m.session().WaitFields();
 }
 
