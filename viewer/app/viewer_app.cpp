@@ -182,6 +182,8 @@ struct ViewerApp::Impl {
   std::int64_t slice_version = -2;
   std::string slice_key;
   FieldSlice slice;
+  std::string slice_view_key;         // the view and slice slice_hidden was tested for
+  std::vector<uint8_t> slice_hidden;  // per slice voxel: the scene hides its centre from the eye
 
   // Suggest panel settings.
   int objective = 0;
@@ -315,14 +317,58 @@ struct ViewerApp::Impl {
     v.height = image.height;
   }
 
+  // Overlay lines and points tested against the scene: each line is cut into pieces of about
+  // 8 pixels and each piece (each point) is hidden when the scene is between the eye and its middle
+  // (one occlusion ray, exact, as the isosurface's triangles); hidden ones are drawn faded. Collected
+  // while the overlays are drawn, tested in one batch and drawn by FlushOverlayPieces.
+  struct OverlayPiece {
+    Vec3 mid;
+    ImVec2 a, b;
+    ImU32 color;
+    float width;
+    float radius;  // > 0: a filled dot at a
+  };
+  std::vector<OverlayPiece> pieces;
+  void Line(const Projector& P, const Vec3& a, const Vec3& b, ImU32 col, float width) {
+    ImVec2 pa, pb;
+    if (!P.Segment(a, b, &pa, &pb)) return;
+    const double pixels = std::hypot(pb.x - pa.x, pb.y - pa.y);
+    const int n = std::clamp(int(pixels / 8.0), 1, 64);
+    for (int i = 0; i < n; ++i) {
+      const Vec3 p = a + (b - a) * (double(i) / n), q = a + (b - a) * (double(i + 1) / n);
+      ImVec2 qa, qb;
+      if (P.Segment(p, q, &qa, &qb)) pieces.push_back({0.5 * (p + q), qa, qb, col, width, 0.0f});
+    }
+  }
+  void Dot(const Projector& P, const Vec3& p, ImU32 col, float radius) {
+    if (const auto q = P.Point(p)) pieces.push_back({p, *q, *q, col, 0.0f, radius});
+  }
+  void FlushOverlayPieces(ImDrawList* dl) {
+    const Vec3 eye = model.MainView().from;
+    std::vector<Ray> rays(pieces.size());
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      const Vec3 d = pieces[i].mid - eye;
+      const double len = d.norm();
+      // Short of the point by a millimetre or 1e-4 of the distance: a line on a wall stays visible.
+      rays[i] = Ray{eye, d / std::max(len, 1e-12), 0.0, std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
+    }
+    std::vector<uint8_t> hidden;
+    model.session().study().caster().OccludedBatch(rays, &hidden);
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      const OverlayPiece& p = pieces[i];
+      ImU32 col = p.color;
+      if (hidden[i]) col = (col & 0x00FFFFFF) | (ImU32((col >> 24) * 0.3) << 24);  // a third of the opacity
+      if (p.radius > 0) dl->AddCircleFilled(p.a, hidden[i] ? 0.75f * p.radius : p.radius, col);
+      else dl->AddLine(p.a, p.b, col, hidden[i] ? std::max(1.0f, 0.7f * p.width) : p.width);
+    }
+    pieces.clear();
+  }
+
   // Camera bodies, frusta, the selection, the suggestion's ghosts, the slice, the gizmo.
   void DrawOverlays(ImDrawList* dl) {
     const Projector P(model.MainView());
     const Rig& rig = model.rig();
-    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
-      ImVec2 pa, pb;
-      if (P.Segment(a, b, &pa, &pb)) dl->AddLine(pa, pb, col, width);
-    };
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) { Line(P, a, b, col, width); };
     // The slice: its voxels as translucent quads in the plane.
     if (!model.display.overlays.slice_field.empty()) DrawSlice(dl, P);
     if (!model.display.overlays.iso_field.empty()) DrawIso(dl, P);
@@ -339,8 +385,8 @@ struct ViewerApp::Impl {
       const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
       const ImU32 col = cam.enabled ? Color(cam.color, selected ? 1.0 : 0.8) : IM_COL32(110, 110, 110, 160);
       frustum(cam, col, selected ? 2.5f : 1.2f);
+      Dot(P, cam.center(), col, selected ? 6.0f : 4.0f);
       if (const auto p = P.Point(cam.center())) {
-        dl->AddCircleFilled(*p, selected ? 6.0f : 4.0f, col);
         if (selected) dl->AddCircle(*p, 9.0f, IM_COL32(255, 255, 255, 230), 0, 1.5f);
         dl->AddText(ImVec2(p->x + 7, p->y - 7), col, cam.id.c_str());
       }
@@ -353,17 +399,15 @@ struct ViewerApp::Impl {
         line(ch.before.translation(), ch.after.translation(), IM_COL32(255, 255, 255, 160), 1.0f);
       }
     DrawStations(dl, P);
-    DrawGizmo(dl, P);
+    FlushOverlayPieces(dl);
+    DrawGizmo(dl, P);  // always on top
   }
 
   // Viewing stations: each display textured with the scene as its viewer's eye sees it through the
   // display (exact CPU renderer, the display's off-axis camera), the eye's lines to the display's
   // corners, and the tracker's range as a red wireframe.
   void DrawStations(ImDrawList* dl, const Projector& P) {
-    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
-      ImVec2 pa, pb;
-      if (P.Segment(a, b, &pa, &pb)) dl->AddLine(pa, pb, col, width);
-    };
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) { Line(P, a, b, col, width); };
     for (const auto& [name, st] : model.stations) {
       CameraView& v = station_views[name];
       const std::int64_t version = model.session().rig().version() * 1000003 + model.stations_version;
@@ -438,6 +482,28 @@ struct ViewerApp::Impl {
     const int ua = slice.u_axis(), va = slice.v_axis();
     const double lo = std::isfinite(ov.slice_min) ? ov.slice_min : slice.min;
     const double hi = std::isfinite(ov.slice_max) ? ov.slice_max : slice.max;
+    // Voxels the scene hides from the eye (the ray to the voxel's centre is blocked) at a third of
+    // the opacity; tested again only when the view or the slice changes.
+    const RenderView view = model.MainView();
+    char vkey[512];
+    std::snprintf(vkey, sizeof vkey, "%s %lld %.17g %.17g %.17g", key, static_cast<long long>(slice_version),
+                  view.from.x(), view.from.y(), view.from.z());
+    if (vkey != slice_view_key) {
+      slice_view_key = vkey;
+      std::vector<Ray> rays(std::size_t(slice.width) * slice.height);
+      for (int row = 0; row < slice.height; ++row)
+        for (int col = 0; col < slice.width; ++col) {
+          Vec3 c = Vec3::Zero();
+          c[slice.axis] = slice.coordinate;
+          c[ua] = slice.u_min + h * col;
+          c[va] = slice.v_max - h * row;
+          const Vec3 d = c - view.from;
+          const double len = d.norm();
+          rays[std::size_t(row) * slice.width + col] =
+              Ray{view.from, d / std::max(len, 1e-12), 0.0, std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
+        }
+      model.session().study().caster().OccludedBatch(rays, &slice_hidden);
+    }
     for (int row = 0; row < slice.height; ++row)
       for (int col = 0; col < slice.width; ++col) {
         const std::size_t o = std::size_t(row) * slice.width + col;
@@ -457,7 +523,7 @@ struct ViewerApp::Impl {
         std::optional<ImVec2> q[4];
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) ok = bool(q[k] = P.Point(corners[k]));
-        if (ok) dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3], Color(rgb, ov.slice_opacity));
+        if (ok) dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3], Color(rgb, ov.slice_opacity * (slice_hidden[o] ? 0.33 : 1.0)));
       }
   }
 
