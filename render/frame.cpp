@@ -367,6 +367,13 @@ PreparedScene::~PreparedScene() = default;
 PreparedScene::PreparedScene(PreparedScene&&) noexcept = default;
 PreparedScene& PreparedScene::operator=(PreparedScene&&) noexcept = default;
 const RayCaster& PreparedScene::caster() const { return *data_->caster; }
+
+const std::vector<Image>& PreparedScene::Textures() const {
+  data_->ObjectTextures();
+  return data_->textures;
+}
+
+const std::vector<int>& PreparedScene::ObjectTextures() const { return data_->ObjectTextures(); }
 std::size_t PreparedScene::triangle_count() const { return data_->mesh.triangles.size(); }
 void PreparedScene::PrepareAll() const {
   data_->ObjectTextures();

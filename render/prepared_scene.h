@@ -19,6 +19,7 @@ namespace pandora {
 
 class Fields;
 struct OverlayOptions;
+struct Image;  // render/render.h
 
 namespace internal {
 struct PreparedSceneData;
@@ -61,6 +62,12 @@ class PreparedScene {
   /// Prepares now what would otherwise be prepared at first use (textures, hidden-line edges), e.g.
   /// on a loading thread so that the first frame of each mode does not pay for it.
   void PrepareAll() const;
+  /// The decoded diffuse textures (linear RGB, row 0 at the top, render/render.h's Image), decoded
+  /// at the first call (as Surface::kMaterial's first frame does), and per object of the scene the
+  /// index of its texture, or -1 (no texture, no texture coordinates, or a texture that could not be
+  /// read). What the GPU renderer of the viewer uploads.
+  const std::vector<Image>& Textures() const;
+  const std::vector<int>& ObjectTextures() const;
 
   /// Internal to render/.
   const internal::PreparedSceneData& data() const { return *data_; }

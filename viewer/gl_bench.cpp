@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     }
 
     GlContext context;
-    GlRenderer renderer(scene);
+    GlRenderer renderer(scene, &prepared);
     std::printf("device: %s\n", context.Description().c_str());
     std::printf("scene: %s (%zu triangles), rig %s (%d enabled cameras), %dx%d, pattern %s\n",
                 scene_path.c_str(), renderer.triangle_count(), rig.name.c_str(),

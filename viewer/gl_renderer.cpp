@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "analysis/color.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 
@@ -44,6 +45,7 @@ layout(location = 0) in vec3 position;  // relative to the scene's centre
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 albedo;
 layout(location = 3) in vec2 tag;  // object index, drawn-edge bits (bit i: edge opposite vertex i)
+layout(location = 4) in vec2 uv;   // texture coordinate (v = 0: the texture's bottom row)
 uniform mat3 view_R;   // camera_from_world rotation of the eye (OpenCV frame: y down, z forward)
 uniform vec3 view_t;   // camera-frame position of the scene's centre
 uniform vec4 proj;     // 2f/W, 2f/H, A, B: clip = (proj.x x, proj.y y, A z + B, z)
@@ -52,8 +54,10 @@ flat out vec3 v_normal;
 flat out vec3 v_albedo;
 flat out vec2 v_tag;
 out vec3 v_bary;
+out vec2 v_uv;
 void main() {
   vec3 c = view_R * position + view_t;
+  v_uv = uv;
   gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z);
   v_position = position;
   v_normal = normal;
@@ -70,7 +74,10 @@ flat in vec3 v_normal;
 flat in vec3 v_albedo;
 flat in vec2 v_tag;
 in vec3 v_bary;
+in vec2 v_uv;
 uniform vec3 eye;
+uniform int textured;         // 1: albedo times the texture (bilinear, repeat, filtered in linear)
+uniform sampler2D albedo_tex; // sRGB8: decoded to linear before filtering, as the CPU's texels
 uniform int edges;         // 1: hidden-line mode, the drawn edges' coverage into g_normal.w
 uniform float line_width;  // output pixels
 layout(location = 0) out vec4 g_position;  // xyz, 1 (-1: no surface)
@@ -93,7 +100,10 @@ void main() {
   }
   g_position = vec4(v_position, 1.0);
   g_normal = vec4(n, a);
-  g_albedo = vec4(v_albedo, v_tag.x);
+  vec3 albedo = v_albedo;
+  // The texture's row 0 is the image's top (uploaded as decoded), v = 0 its bottom: t = 1 - v.
+  if (textured != 0) albedo *= texture(albedo_tex, vec2(v_uv.x, 1.0 - v_uv.y)).rgb;
+  g_albedo = vec4(albedo, v_tag.x);
 }
 )";
 
@@ -651,6 +661,15 @@ struct GlRenderer::Impl {
     return program;
   }
   GLuint empty_vao = 0, camera_ubo = 0;
+  // Triangles are uploaded grouped by texture: draw g covers vertices [first, first + count) with
+  // texture texture_ids[g] (0: none).
+  struct Draw {
+    GLint first = 0;
+    GLsizei count = 0;
+    GLuint texture = 0;
+  };
+  std::vector<Draw> draws;
+  std::vector<GLuint> texture_ids;
 
   // Per view size.
   int width = 0, height = 0;
@@ -773,6 +792,7 @@ struct GlRenderer::Impl {
     glDeleteFramebuffers(1, &shadow_fbo);
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &camera_ubo);
+    if (!texture_ids.empty()) glDeleteTextures(GLsizei(texture_ids.size()), texture_ids.data());
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
     for (GLuint p : {gbuffer_program, shadow_program, compose_program}) glDeleteProgram(p);
@@ -834,7 +854,8 @@ struct GlRenderer::Impl {
   }
 };
 
-GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   std::vector<int> triangle_object;
   m.mesh = scene.AllTriangles(&triangle_object);
@@ -848,21 +869,66 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     if (mat >= 0 && mat < int(scene.materials.size())) object_color[o] = scene.materials[mat].color;
   }
   const std::vector<uint8_t> drawn = ComputeDrawnEdges(m.mesh);
+  // Textures: each decoded image once, as sRGB8 (the PNG's own 8-bit values; GL decodes them to
+  // linear before filtering, as the CPU filters its decoded texels), bilinear with repeat, no mip
+  // maps (the CPU samples the base level). Triangles are grouped by texture for one draw each.
+  std::vector<int> object_texture(scene.objects.size(), -1);
+  if (prepared) {
+    const std::vector<Image>& images = prepared->Textures();
+    const std::vector<int>& of_object = prepared->ObjectTextures();
+    GLint max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    m.texture_ids.assign(images.size(), 0);
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      const Image& im = images[i];
+      if (im.width <= 0 || im.height <= 0 || im.width > max_size || im.height > max_size) continue;
+      std::vector<unsigned char> texels(std::size_t(3) * im.width * im.height);
+      for (std::size_t k = 0; k < texels.size(); ++k)
+        texels[k] = static_cast<unsigned char>(
+            std::lround(255.0 * std::clamp(SrgbFromLinear(std::clamp(double(im.rgb[k]), 0.0, 1.0)), 0.0, 1.0)));
+      glGenTextures(1, &m.texture_ids[i]);
+      glBindTexture(GL_TEXTURE_2D, m.texture_ids[i]);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, im.width, im.height, 0, GL_RGB, GL_UNSIGNED_BYTE, texels.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    }
+    for (std::size_t o = 0; o < object_texture.size() && o < of_object.size(); ++o)
+      if (of_object[o] >= 0 && of_object[o] < int(m.texture_ids.size()) && m.texture_ids[of_object[o]] != 0 &&
+          m.mesh.corner_uvs.size() == m.mesh.triangles.size())
+        object_texture[o] = of_object[o];
+  }
+  std::vector<int> order(m.mesh.triangles.size());
+  for (std::size_t t = 0; t < order.size(); ++t) order[t] = int(t);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return object_texture[triangle_object[a]] < object_texture[triangle_object[b]];
+  });
   std::vector<float> data;
-  data.reserve(m.mesh.triangles.size() * 33);
-  for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+  data.reserve(m.mesh.triangles.size() * 39);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const int t = order[i];
+    const int texture = object_texture[triangle_object[t]];
+    const GLuint id = texture >= 0 ? m.texture_ids[texture] : 0u;
+    if (m.draws.empty() || m.draws.back().texture != id) m.draws.push_back({GLint(3 * i), 0, id});
+    m.draws.back().count += 3;
     const Eigen::Vector3i& tri = m.mesh.triangles[t];
     const Vec3 a = m.mesh.vertices[tri[0]], b = m.mesh.vertices[tri[1]],
                c = m.mesh.vertices[tri[2]];
     Vec3 n = (b - a).cross(c - a);
     n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitZ();
     const Vec3& albedo = object_color[triangle_object[t]];
-    for (const Vec3* p : {&a, &b, &c}) {
-      const Vec3 r = *p - m.origin;
+    for (int corner = 0; corner < 3; ++corner) {
+      const Vec3 r = (corner == 0 ? a : corner == 1 ? b : c) - m.origin;
       for (const Vec3* v : std::array<const Vec3*, 3>{&r, &n, &albedo})
         for (int k = 0; k < 3; ++k) data.push_back(float((*v)(k)));
       data.push_back(float(triangle_object[t]));
       data.push_back(float(drawn[t]));
+      const Eigen::Vector2d uv = texture >= 0 ? m.mesh.corner_uvs[t][corner] : Eigen::Vector2d::Zero();
+      data.push_back(float(uv.x()));
+      data.push_back(float(uv.y()));
     }
   }
   m.vertex_count = GLsizei(3 * m.mesh.triangles.size());
@@ -872,11 +938,11 @@ GlRenderer::GlRenderer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
                GL_STATIC_DRAW);
-  const GLsizei stride = 11 * sizeof(float);
-  for (int k = 0; k < 4; ++k) {
+  const GLsizei stride = 13 * sizeof(float);
+  for (int k = 0; k < 5; ++k) {
     glEnableVertexAttribArray(k);
     glVertexAttribPointer(k, k < 3 ? 3 : 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(std::size_t(3 * k) * sizeof(float)));
+                          reinterpret_cast<const void*>(std::size_t(k < 4 ? 3 * k : 11) * sizeof(float)));
   }
   glGenVertexArrays(1, &m.empty_vao);
   m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
@@ -1002,8 +1068,14 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     SetVec3(m.gbuffer_program, "eye", eye_rel);
     glUniform1i(Loc(m.gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
     glUniform1f(Loc(m.gbuffer_program, "line_width"), float(options.line_width_px));
+    glUniform1i(Loc(m.gbuffer_program, "albedo_tex"), 0);
+    glActiveTexture(GL_TEXTURE0);
     glBindVertexArray(m.vao);
-    glDrawArrays(GL_TRIANGLES, 0, m.vertex_count);
+    for (const Impl::Draw& d : m.draws) {
+      glUniform1i(Loc(m.gbuffer_program, "textured"), d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
+      glBindTexture(GL_TEXTURE_2D, d.texture);
+      glDrawArrays(GL_TRIANGLES, d.first, d.count);
+    }
   }
 
   // Clear the light and the first mask.

@@ -21,6 +21,7 @@
 #include "analysis/geometry.h"
 #include "analysis/scene.h"
 #include "render/light.h"
+#include "render/prepared_scene.h"
 #include "render/render.h"
 
 namespace pandora {
@@ -31,7 +32,7 @@ struct RenderView;
 struct GlRenderOptions {
   Pattern pattern = Pattern::kUniform;
   /// What a surface shows, as render's RenderOptions::surface: kMaterial, albedo * light plus the
-  /// ambient term of MaterialColor (material colours only: textures are not drawn yet); kBlack,
+  /// ambient term of MaterialColor (textured when the renderer was given a PreparedScene); kBlack,
   /// the light only; kHiddenLine, the light with grey mesh edges (the drawn-edge set of
   /// render/frame.cpp: edges between triangles more than 1 degree apart and boundary edges) where
   /// the surface next to them is visible; kContours, the light with grey contours found in the
@@ -98,8 +99,11 @@ class GlRenderer {
  public:
   /// Uploads scene.AllTriangles() (positions relative to the centre of Scene::ContentBounds(), in
   /// float), each triangle's geometric normal and its object's material colour, and compiles the
-  /// shaders. Throws std::runtime_error with the GL info log when a shader does not compile.
-  explicit GlRenderer(const Scene& scene);
+  /// shaders. With `prepared` (the same scene's), the objects' diffuse textures too (the decoded
+  /// images of PreparedScene::Textures(), drawn in Surface::kMaterial as the CPU renderer does:
+  /// colour times the bilinear, repeating texel); without it, material colours only. Throws
+  /// std::runtime_error with the GL info log when a shader does not compile.
+  explicit GlRenderer(const Scene& scene, const PreparedScene* prepared = nullptr);
   ~GlRenderer();
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;

@@ -1421,7 +1421,7 @@ ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_u
   ImGui::StyleColorsDark();
   ImGui::GetStyle().WindowRounding = 3.0f;
   ImGui_ImplOpenGL3_Init("#version 330 core");
-  m.gl = std::make_unique<GlRenderer>(model.scene());
+  m.gl = std::make_unique<GlRenderer>(model.scene(), &model.session().study().prepared());
   m.shadow_map_size = options.shadow_map_size;
   m.map_index = options.shadow_map_size >= 4096 ? 3 : options.shadow_map_size >= 2048 ? 2 : options.shadow_map_size >= 1024 ? 1 : 0;
 }
