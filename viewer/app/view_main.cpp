@@ -37,13 +37,17 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 // `pandora bench --viewer`: whole frames of the window (GPU light, overlays, panels, swap) while the
 // eye orbits (each camera's shadow maps reused) and while every camera moves (maps redrawn each
 // frame, the fields updating in the background), against the exact CPU renderer of the same view.
-int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& window, int frames, double scale) {
+int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& window, int frames, double scale,
+          double target_hz) {
   using pandora::viewer::Action;
   model.session().WaitFields();
   window.Frame();  // first frame: programs, maps
+  std::vector<double> scales;
   auto run = [&](bool move_cameras) {
     std::vector<double> times;
-    for (int i = 0; i < frames; ++i) {
+    // Adaptive: 8 frames untimed first, as the scale settles.
+    const int warm = target_hz > 0 ? 8 : 0;
+    for (int i = 0; i < warm + frames; ++i) {
       if (move_cameras) {
         Action a;
         a.kind = Action::Kind::kMove;
@@ -57,8 +61,9 @@ int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& windo
       }
       const auto t0 = std::chrono::steady_clock::now();
       window.Frame();
-      times.push_back(Seconds(t0));
+      if (i >= warm) times.push_back(Seconds(t0));
     }
+    scales.push_back(window.MotionScaleNow());
     std::sort(times.begin(), times.end());
     return times[times.size() / 2];
   };
@@ -73,10 +78,15 @@ int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& windo
     model.session().Render(model.MainView(), options);
     cpu = std::min(cpu, Seconds(t0));
   }
-  std::printf("pandora bench --viewer: %s, rig %s (%d enabled cameras), %dx%d, %d frames each (median); "
-              "while moving drawn at %.2f of the resolution\n",
+  char how[160];
+  if (target_hz > 0)
+    std::snprintf(how, sizeof how, "while moving drawn at an adaptive scale aiming at %.0f Hz (reached %.2f navigating, %.2f cameras moving)",
+                  target_hz, scales[0], scales[1]);
+  else
+    std::snprintf(how, sizeof how, "while moving drawn at %.2f of the resolution", scale);
+  std::printf("pandora bench --viewer: %s, rig %s (%d enabled cameras), %dx%d, %d frames each (median); %s\n",
               model.scene().path.c_str(), model.rig().name.c_str(), model.rig().enabled_count(), model.width,
-              model.height, frames, scale);
+              model.height, frames, how);
   std::printf("  navigating (eye orbits, shadow maps reused)       %8.1f ms  %6.2f frames/s\n", 1000 * navigate,
               1 / navigate);
   std::printf("  all cameras moving (maps redrawn, fields live)    %8.1f ms  %6.2f frames/s\n", 1000 * moving,
@@ -92,6 +102,7 @@ int Run(int argc, char** argv) {
   std::string scene, rig, fields, script, screenshot, log, size = "1280x720";
   bool hidden = false, recover = false, discard = false, no_autosave = false;
   int shadow_map = 2048, bench_frames = 0;
+  double target_hz = 30;
   app.add_option("scene", scene, "Scene file (JSON)")->required();
   app.add_option("--rig", rig, "Rig to edit (default: the first)");
   app.add_option("--fields", fields, "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
@@ -101,6 +112,11 @@ int Run(int argc, char** argv) {
   app.add_option("--size", size, "Window size WxH")->capture_default_str();
   app.add_option("--shadow-map", shadow_map, "Shadow map size per camera, 512 to 4096")->capture_default_str()
       ->check(CLI::Range(512, 4096));
+  app.add_option("--target-hz", target_hz,
+                 "While the view or cameras move, draw at a resolution adapted to this frame rate "
+                 "(0: a fixed half resolution); full resolution 0.3 s after it stops")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 240.0));
   app.add_flag("--hidden", hidden, "No visible window (scripts, tests)");
   app.add_option("--bench", bench_frames, "Measure frame rates over this many frames (navigating; all cameras moving) "
                                           "against the exact CPU renderer, print them and exit")
@@ -149,15 +165,17 @@ int Run(int argc, char** argv) {
   ao.height = height;
   ao.visible = !hidden;
   ao.shadow_map_size = shadow_map;
+  ao.target_hz = target_hz;
   ao.show_timing = script.empty();
   if (!script.empty()) ao.motion_scale = 1.0;  // every scripted frame in full: reproducible pictures
   if (bench_frames > 0) ao.visible = false, ao.show_timing = false, ao.motion_scale = 1.0;
   if (bench_frames > 0) {
     // Full resolution throughout, then as interaction draws it (reduced while moving).
     pandora::viewer::ViewerApp window(model, ao);
-    for (const double scale : {1.0, 0.5}) {
-      window.SetMotionScale(scale);
-      Bench(model, window, bench_frames, scale);
+    // Full resolution throughout, a fixed half, then what the window does: adaptive, 30 Hz.
+    for (const auto& [scale, hz] : {std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{0.5, 30.0}}) {
+      window.SetMotionScale(scale, hz);
+      Bench(model, window, bench_frames, scale, hz);
     }
     return 0;
   }

@@ -147,7 +147,12 @@ struct ViewerApp::Impl {
   std::string main_key;  // what the main texture shows
   bool main_full = false;  // ... at full resolution
   bool full_now = false;   // a screenshot: draw in full whatever moved just before
-  std::chrono::steady_clock::time_point last_change;
+  std::chrono::steady_clock::time_point last_change, last_rig_change;
+  std::int64_t main_rig_version = -1;
+  double motion_now = 0.5;       // the scale of the next moving frame (adapted to AppOptions::target_hz)
+  double overhead_seconds = 0;   // the frame's time besides the main picture (running mean)
+  double frame_gl_seconds = 0;   // this frame's main picture, 0 when it was kept
+  static constexpr double kMinMotionScale = 0.2;
   int shadow_map_size = 2048;
   InputState input;
   ImGuiContext* imgui = nullptr;
@@ -192,7 +197,7 @@ struct ViewerApp::Impl {
   std::string error;       // the last action's error, shown in the status bar (all of it on hover)
   std::string error_line;  // ... its reason and hint, first in the status bar
 
-  Impl(ViewerModel& m, AppOptions o) : model(m), options(o) {}
+  Impl(ViewerModel& m, AppOptions o) : model(m), options(o) { motion_now = o.motion_scale; }
 
   void Do(const Action& a) {
     if (a.kind == Action::Kind::kSelect && !a.cameras.empty()) station.clear();  // the gizmo goes to the cameras
@@ -258,25 +263,41 @@ struct ViewerApp::Impl {
                   int(model.display.surface), shadow_map_size);
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
+    const std::int64_t rig_version = model.session().rig().version();
+    if (rig_version != main_rig_version) last_rig_change = now;
+    main_rig_version = rig_version;
+    auto since = [&](std::chrono::steady_clock::time_point t) { return std::chrono::duration<double>(now - t).count(); };
     // Reduced while things move, full once idle.
-    const bool moving = options.motion_scale < 1 && !full_now &&
-                        (drag != Drag::kNone || std::chrono::duration<double>(now - last_change).count() < 0.3);
+    const bool moving = options.motion_scale < 1 && !full_now && (drag != Drag::kNone || since(last_change) < 0.3);
     if (key == main_key && main_texture && (moving || main_full)) return;
     main_key = key;
     main_full = !moving;
     if (moving) {
-      view.width = std::max(16, int(std::lround(view.width * options.motion_scale)));
-      view.height = std::max(16, int(std::lround(view.height * options.motion_scale)));
+      view.width = std::max(16, int(std::lround(view.width * motion_now)));
+      view.height = std::max(16, int(std::lround(view.height * motion_now)));
     }
-    gl_options.shadow_map_size = moving ? std::min(shadow_map_size, 1024) : shadow_map_size;
+    // Maps: at most 1024 texels while the eye moves (drawn once, then reused), 512 while cameras
+    // move (their maps are drawn every frame).
+    gl_options.shadow_map_size =
+        !moving ? shadow_map_size : std::min(shadow_map_size, since(last_rig_change) < 0.3 ? 512 : 1024);
     gl_options.pattern = model.display.pattern;
     gl_options.surface = model.display.surface;
     gl_options.brightness = model.display.brightness;
     gl_options.grid_pixels = model.display.grid_pixels;
     const auto t0 = std::chrono::steady_clock::now();
     const GlImage image = gl->Render(model.rig(), view, gl_options);
-    gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    frame_gl_seconds = gl_seconds;
+    // Adaptive resolution while moving: the next moving frame's scale aims at the target rate
+    // from this frame's light and the rest of the frame (panels, overlays, swap: overhead_seconds),
+    // the picture's cost taken as proportional to its pixels; at most 30 % per frame, within
+    // [kMinMotionScale, 1].
+    if (moving && options.target_hz > 0) {
+      const double total = gl_seconds + overhead_seconds;
+      const double factor = std::clamp(std::sqrt((1.0 / options.target_hz) / std::max(total, 1e-4)), 0.7, 1.3);
+      motion_now = std::clamp(motion_now * factor, kMinMotionScale, 1.0);
+    }
   }
 
   static void Upload(GLuint* texture, int w, int h, const std::vector<unsigned char>& rgba) {
@@ -1322,6 +1343,11 @@ struct ViewerApp::Impl {
     const auto now = std::chrono::steady_clock::now();
     frame_seconds = std::chrono::duration<double>(now - last_frame).count();
     last_frame = now;
+    // The last frame's time besides its picture, while frames follow each other (not after a wait
+    // for input).
+    if (frame_gl_seconds > 0 && frame_seconds < 1.0)
+      overhead_seconds = 0.7 * overhead_seconds + 0.3 * std::max(0.0, frame_seconds - frame_gl_seconds);
+    frame_gl_seconds = 0;
     int w = 0, h = 0;
     glfwGetWindowSize(window, &w, &h);
     if (w > 0 && h > 0 && (w != model.width || h != model.height) && options.visible) {
@@ -1449,10 +1475,14 @@ bool ViewerApp::Frame() {
   return open;
 }
 
-void ViewerApp::SetMotionScale(double scale) {
+void ViewerApp::SetMotionScale(double scale, double target_hz) {
   impl_->options.motion_scale = scale;
+  impl_->options.target_hz = target_hz;
+  impl_->motion_now = scale;
   impl_->main_key.clear();  // draw the next frame anew
 }
+
+double ViewerApp::MotionScaleNow() const { return impl_->motion_now; }
 
 void ViewerApp::Loop() {
   while (Frame()) {

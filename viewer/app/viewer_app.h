@@ -22,8 +22,11 @@ struct AppOptions {
   /// While the view or the rig changes (and for 0.3 s after), the main view is drawn at this
   /// fraction of the window's resolution and with shadow maps of at most 1024 texels, then again
   /// in full once idle: interaction stays responsive on software GL (docs/viewer.md, "Frame rate").
-  /// 1: always full.
+  /// 1: always full. With target_hz, where moving frames start: each moving frame's scale is then
+  /// adapted (0.2 .. 1) so that frames take about 1 / target_hz.
   double motion_scale = 0.5;
+  /// The frame rate the reduced frames aim at while moving (0: keep motion_scale).
+  double target_hz = 30;
 };
 
 class ViewerApp : public Frontend {
@@ -37,9 +40,11 @@ class ViewerApp : public Frontend {
   bool Frame();
   /// Frames until the window closes.
   void Loop();
-  /// AppOptions::motion_scale from now on (the frame-rate bench measures both in one window: a
+  /// AppOptions::motion_scale and target_hz from now on (the frame-rate bench measures both in one window: a
   /// second window would reconnect to the X server while it resets after the first).
-  void SetMotionScale(double scale);
+  void SetMotionScale(double scale, double target_hz = 0);
+  /// The scale the next moving frame is drawn at (adapted when target_hz is set).
+  double MotionScaleNow() const;
 
   // Frontend: the window's own picture (after a frame is drawn), or a camera's exact view.
   void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;
