@@ -420,6 +420,17 @@ struct ViewerApp::Impl {
         line(ch.before.translation(), ch.after.translation(), IM_COL32(255, 255, 255, 160), 1.0f);
       }
     DrawStations(dl, P);
+    // The suggest panel's keep-out boxes (red) and the box mount (white), while the panel uses them.
+    auto box = [&](const float* b, ImU32 col) {
+      const Vec3 lo(std::min(b[0], b[3]), std::min(b[1], b[4]), std::min(b[2], b[5]));
+      const Vec3 hi(std::max(b[0], b[3]), std::max(b[1], b[4]), std::max(b[2], b[5]));
+      auto corner = [&](int k) { return Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z()); };
+      for (int k = 0; k < 8; ++k)
+        for (int bit : {1, 2, 4})
+          if (!(k & bit)) line(corner(k), corner(k | bit), col, 1.5f);
+    };
+    for (const auto& k : keep_outs) box(k.data(), IM_COL32(235, 60, 60, 230));
+    if (mount == 3) box(mount_box, IM_COL32(240, 240, 240, 200));
     FlushOverlayPieces(dl);
     DrawGizmo(dl, P);  // always on top
   }
@@ -1204,10 +1215,22 @@ struct ViewerApp::Impl {
       ImGui::DragFloat3("box min m", mount_box, 0.01f);
       ImGui::DragFloat3("box max m", mount_box + 3, 0.01f);
     }
-    ImGui::Checkbox("keep-out box", &keep_out_on);
-    if (keep_out_on) {
-      ImGui::DragFloat3("keep-out min m", keep_out, 0.01f);
-      ImGui::DragFloat3("keep-out max m", keep_out + 3, 0.01f);
+    // Keep-out boxes (drawn in red in the view): no suggested camera centre inside any of them.
+    for (std::size_t i = 0; i < keep_outs.size(); ++i) {
+      ImGui::PushID(int(i));
+      ImGui::DragFloat3("keep-out min m", keep_outs[i].data(), 0.01f);
+      ImGui::DragFloat3("keep-out max m", keep_outs[i].data() + 3, 0.01f);
+      const bool remove = ImGui::SmallButton("remove keep-out box");
+      ImGui::PopID();
+      if (remove) {
+        keep_outs.erase(keep_outs.begin() + long(i));
+        break;
+      }
+    }
+    if (ImGui::Button("add keep-out box")) {
+      // Around the view's target, half a metre each way, floor to 2 m.
+      const Vec3 t = model.view.target;
+      keep_outs.push_back({float(t.x() - 0.5), float(t.y() - 0.5), 0.0f, float(t.x() + 0.5), float(t.y() + 0.5), 2.0f});
     }
     ImGui::DragFloat("clearance m", &clearance, 0.005f, 0.0f, 2.0f, "%.3f");
     ImGui::Checkbox("zoom", &zoom_on);
@@ -1235,11 +1258,11 @@ struct ViewerApp::Impl {
         a.mount_box.min = Vec3(mount_box[0], mount_box[1], mount_box[2]);
         a.mount_box.max = Vec3(mount_box[3], mount_box[4], mount_box[5]);
       }
-      if (keep_out_on) {
+      for (const auto& k : keep_outs) {
         Aabb b;
-        b.min = Vec3(keep_out[0], keep_out[1], keep_out[2]);
-        b.max = Vec3(keep_out[3], keep_out[4], keep_out[5]);
-        a.keep_out = {b};
+        b.min = Vec3(k[0], k[1], k[2]);
+        b.max = Vec3(k[3], k[4], k[5]);
+        a.keep_out.push_back(b);
       }
       if (zoom_on) {
         a.min_hfov = zoom[0];
@@ -1278,8 +1301,9 @@ struct ViewerApp::Impl {
   }
   bool waiting_for_suggestion = false;
   int mount = 0;
-  float mount_axis[3] = {1, 0, 0}, mount_box[6] = {-1, -1, 0, 1, 1, 3}, keep_out[6] = {-0.5, -0.5, 0, 0.5, 0.5, 2};
-  bool keep_out_on = false, zoom_on = false;
+  float mount_axis[3] = {1, 0, 0}, mount_box[6] = {-1, -1, 0, 1, 1, 3};
+  std::vector<std::array<float, 6>> keep_outs;
+  bool zoom_on = false;
   float clearance = 0.1f, zoom[2] = {30, 60};
 
   void DisplayPanel() {
