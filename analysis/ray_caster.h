@@ -63,6 +63,26 @@ class RayCaster {
 /// size rather than its distance from the world origin. Throws std::runtime_error when Embree fails.
 std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh);
 
+/// Ray casters for a scene whose parts move rigidly (analysis/motion.h): one BVH per part, built
+/// once; At() gives the caster of one time sample by building only a top-level BVH over the parts
+/// with their transforms (Embree instancing; microseconds for a few parts). Immutable; At() may be
+/// called from several threads, and its casters outlive this object safely.
+class RigidPartsRayCaster {
+ public:
+  virtual ~RigidPartsRayCaster() = default;
+  /// The caster with part k moved by transforms[k] (world_from_rest; missing entries: identity).
+  /// Hits report the triangle's index as given at construction and the moved normal.
+  virtual std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms) const = 0;
+  virtual std::size_t part_count() const = 0;
+};
+
+/// Builds the parts' BVHs (single precision in a frame centred on all parts' rest bounds, robust
+/// mode, high quality). `triangle_index[k][i]` is the index hits report for triangle i of part k
+/// (e.g. its index in Scene::AllTriangles()); when a part's list is missing or of the wrong size, the
+/// parts' triangles are numbered consecutively. Throws std::runtime_error when Embree fails.
+std::unique_ptr<RigidPartsRayCaster> MakeEmbreeRigidParts(const std::vector<TriangleMesh>& parts,
+                                                          const std::vector<std::vector<int>>& triangle_index = {});
+
 /// Double-precision brute force (Moller-Trumbore over every triangle). O(triangles) per ray.
 std::unique_ptr<RayCaster> MakeBruteForceRayCaster(const TriangleMesh& mesh);
 

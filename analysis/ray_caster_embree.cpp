@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -81,8 +82,93 @@ void SetLane(P* p, int lane, const RTCRay& r) {
   p->flags[lane] = 0;
 }
 
+// The parts of a RigidPartsRayCaster: one device, one bottom-level scene per part (vertices in the
+// rest world frame minus `offset`), and each part's triangle indices in the caller's numbering.
+struct EmbreeParts {
+  RTCDevice device = nullptr;
+  std::vector<RTCScene> scenes;            // null for an empty part
+  std::vector<std::vector<int>> global;    // [part][primID] -> caller's triangle index
+  std::vector<Aabb> bounds;                // rest bounds per part
+  Vec3 offset = Vec3::Zero();
+  std::size_t triangles = 0;
+  ~EmbreeParts() {
+    for (RTCScene s : scenes)
+      if (s) rtcReleaseScene(s);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+// Triangles of `mesh` into a new geometry of `scene` (vertices minus `offset`, in float).
+void AttachTriangles(RTCDevice device, RTCScene scene, const TriangleMesh& mesh, const Vec3& offset) {
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
+  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+  if (!v || !idx) throw std::runtime_error("Embree: cannot allocate geometry buffers");
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3 p = mesh.vertices[i] - offset;
+    v[3 * i + 0] = static_cast<float>(p.x());
+    v[3 * i + 1] = static_cast<float>(p.y());
+    v[3 * i + 2] = static_cast<float>(p.z());
+  }
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) idx[3 * i + k] = static_cast<unsigned>(mesh.triangles[i][k]);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene, geom);
+  rtcReleaseGeometry(geom);
+}
+
+int NativePacketWidth(RTCDevice device) {
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) return 16;
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) return 8;
+  if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED)) return 4;
+  return 1;
+}
+
 class EmbreeRayCaster final : public RayCaster {
  public:
+  // One time sample of rigid parts: a top-level scene of one instance per part with its transform
+  // (world_from_rest), over the parts' shared bottom-level scenes. Only this small top-level BVH is
+  // built.
+  EmbreeRayCaster(std::shared_ptr<const EmbreeParts> parts, const std::vector<Eigen::Isometry3d>& transforms)
+      : triangles_(parts->triangles), offset_(parts->offset), parts_(std::move(parts)) {
+    device_ = parts_->device;
+    rtcRetainDevice(device_);
+    scene_ = rtcNewScene(device_);
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    part_rotation_.resize(parts_->scenes.size(), Mat3::Identity());
+    for (std::size_t k = 0; k < parts_->scenes.size(); ++k) {
+      const Eigen::Isometry3d T = k < transforms.size() ? transforms[k] : Eigen::Isometry3d::Identity();
+      part_rotation_[k] = T.linear();
+      // Part bounds at the sample: the rest box's corners moved.
+      const Aabb& b = parts_->bounds[k];
+      if (!b.empty())
+        for (int c = 0; c < 8; ++c)
+          bounds_.Extend(T * Vec3(c & 1 ? b.max.x() : b.min.x(), c & 2 ? b.max.y() : b.min.y(),
+                                  c & 4 ? b.max.z() : b.min.z()));
+      if (!parts_->scenes[k]) continue;
+      // In the recentred frame: x' = R x + (R o + t - o), o the offset.
+      const Mat3 R = T.linear();
+      const Vec3 t = R * offset_ + T.translation() - offset_;
+      float xfm[12];
+      for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row) xfm[3 * col + row] = static_cast<float>(R(row, col));
+      for (int row = 0; row < 3; ++row) xfm[9 + row] = static_cast<float>(t[row]);
+      RTCGeometry inst = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(inst, parts_->scenes[k]);
+      rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+      rtcCommitGeometry(inst);
+      rtcAttachGeometryByID(scene_, inst, static_cast<unsigned>(k));
+      rtcReleaseGeometry(inst);
+    }
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
+      throw std::runtime_error("Embree: instance scene build failed");
+    packet_width_ = NativePacketWidth(device_);
+  }
+
   explicit EmbreeRayCaster(const TriangleMesh& mesh) : triangles_(mesh.triangles.size()) {
     bounds_ = mesh.Bounds();
     offset_ = bounds_.empty() ? Vec3::Zero() : bounds_.center();
@@ -93,36 +179,23 @@ class EmbreeRayCaster final : public RayCaster {
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
 
-    if (!mesh.triangles.empty()) {
-      RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-          geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
-      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles_));
-      if (!v || !idx) throw std::runtime_error("Embree: cannot allocate geometry buffers");
-      for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-        const Vec3 p = mesh.vertices[i] - offset_;
-        v[3 * i + 0] = static_cast<float>(p.x());
-        v[3 * i + 1] = static_cast<float>(p.y());
-        v[3 * i + 2] = static_cast<float>(p.z());
-      }
-      for (std::size_t i = 0; i < triangles_; ++i)
-        for (int k = 0; k < 3; ++k) idx[3 * i + k] = static_cast<unsigned>(mesh.triangles[i][k]);
-      rtcCommitGeometry(geom);
-      rtcAttachGeometry(scene_, geom);
-      rtcReleaseGeometry(geom);
-    }
+    if (!mesh.triangles.empty()) AttachTriangles(device_, scene_, mesh, offset_);
     rtcCommitScene(scene_);
     if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
       throw std::runtime_error("Embree: scene build failed");
-    if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED))
-      packet_width_ = 16;
-    else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED))
-      packet_width_ = 8;
-    else if (rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED))
-      packet_width_ = 4;
-    else
-      packet_width_ = 1;
+    packet_width_ = NativePacketWidth(device_);
+  }
+
+  // The caller's triangle index and the world normal of a hit (instances report their part's
+  // local primitive and normal).
+  void MapHit(unsigned inst, unsigned prim, const Vec3& ng, int* triangle, Vec3* normal) const {
+    if (!parts_ || inst == RTC_INVALID_GEOMETRY_ID) {
+      *triangle = static_cast<int>(prim);
+      *normal = ng.normalized();
+      return;
+    }
+    *triangle = parts_->global[inst][prim];
+    *normal = (part_rotation_[inst] * ng).normalized();
   }
 
   ~EmbreeRayCaster() override {
@@ -146,12 +219,13 @@ class EmbreeRayCaster final : public RayCaster {
     Fill(ray, &rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene_, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     RayHit hit;
     hit.t = rh.ray.tfar;
-    hit.triangle = static_cast<int>(rh.hit.primID);
-    hit.normal = Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+    MapHit(rh.hit.instID[0], rh.hit.primID, Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), &hit.triangle,
+           &hit.normal);
     return hit;
   }
 
@@ -208,6 +282,7 @@ class EmbreeRayCaster final : public RayCaster {
         SetLane(&packet.ray, lane, rays[start + std::min(lane, n - 1)]);
         packet.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
         packet.hit.primID[lane] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
       }
       HitPacket<W>::Intersect(valid, scene_, &context, &packet);
       for (int lane = 0; lane < n; ++lane) out(start + lane, packet, lane);
@@ -227,8 +302,11 @@ class EmbreeRayCaster final : public RayCaster {
           h.reset();
           return;
         }
-        h = RayHit{p.ray.tfar[lane], static_cast<int>(p.hit.primID[lane]),
-                   Vec3(p.hit.Ng_x[lane], p.hit.Ng_y[lane], p.hit.Ng_z[lane]).normalized()};
+        RayHit hit;
+        hit.t = p.ray.tfar[lane];
+        MapHit(p.hit.instID[0][lane], p.hit.primID[lane], Vec3(p.hit.Ng_x[lane], p.hit.Ng_y[lane], p.hit.Ng_z[lane]),
+               &hit.triangle, &hit.normal);
+        h = hit;
       });
     }
   }
@@ -278,12 +356,62 @@ class EmbreeRayCaster final : public RayCaster {
   Aabb bounds_;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::shared_ptr<const EmbreeParts> parts_;  // set for a sample of rigid parts
+  std::vector<Mat3> part_rotation_;           // per part: world_from_rest rotation (normals)
+};
+
+class EmbreeRigidParts final : public RigidPartsRayCaster {
+ public:
+  EmbreeRigidParts(const std::vector<TriangleMesh>& parts, const std::vector<std::vector<int>>& triangle_index) {
+    auto data = std::make_shared<EmbreeParts>();
+    Aabb all;
+    for (const TriangleMesh& m : parts) all.Extend(m.Bounds());
+    data->offset = all.empty() ? Vec3::Zero() : all.center();
+    data->device = rtcNewDevice(nullptr);
+    if (!data->device) throw std::runtime_error("Embree: cannot create a device");
+    int next = 0;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const TriangleMesh& mesh = parts[k];
+      data->bounds.push_back(mesh.Bounds());
+      std::vector<int> global(mesh.triangles.size());
+      for (std::size_t i = 0; i < global.size(); ++i)
+        global[i] = k < triangle_index.size() && triangle_index[k].size() == global.size() ? triangle_index[k][i]
+                                                                                          : next + int(i);
+      next += int(global.size());
+      data->triangles += global.size();
+      data->global.push_back(std::move(global));
+      if (mesh.triangles.empty()) {
+        data->scenes.push_back(nullptr);
+        continue;
+      }
+      RTCScene scene = rtcNewScene(data->device);
+      rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+      rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+      AttachTriangles(data->device, scene, mesh, data->offset);
+      rtcCommitScene(scene);
+      data->scenes.push_back(scene);
+    }
+    if (rtcGetDeviceError(data->device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: part build failed");
+    data_ = std::move(data);
+  }
+  std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms) const override {
+    return std::make_unique<EmbreeRayCaster>(data_, transforms);
+  }
+  std::size_t part_count() const override { return data_->scenes.size(); }
+
+ private:
+  std::shared_ptr<const EmbreeParts> data_;
 };
 
 }  // namespace
 
 std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh) {
   return std::make_unique<EmbreeRayCaster>(mesh);
+}
+
+std::unique_ptr<RigidPartsRayCaster> MakeEmbreeRigidParts(const std::vector<TriangleMesh>& parts,
+                                                          const std::vector<std::vector<int>>& triangle_index) {
+  return std::make_unique<EmbreeRigidParts>(parts, triangle_index);
 }
 
 int EmbreePacketWidth(const RayCaster& caster) {

@@ -566,7 +566,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
   const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
                                                   "capsule", "plane",  "mesh"};
   std::vector<std::string> allowed = {"name",  "position", "rotation_deg", "quaternion",
-                                      "scale", "material", "color",        "solid"};
+                                      "scale", "material", "color",        "solid", "group"};
   allowed.insert(allowed.end(), geometry_keys.begin(), geometry_keys.end());
   node.CheckKeys(allowed);
 
@@ -577,6 +577,18 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
   }
   const std::string kind = node.OneOf(geometry_keys, "geometry key");
   const Node geometry = node.Get(kind);
+  std::string group;
+  if (auto n = node.Find("group")) group = n->NonEmptyString();
+  const std::size_t first_object = scene->objects.size();
+  // Every object this entry adds (a mesh file's parts too) belongs to the group.
+  struct GroupAssign {
+    Scene* scene;
+    std::size_t first;
+    const std::string& group;
+    ~GroupAssign() {
+      for (std::size_t o = first; o < scene->objects.size(); ++o) scene->objects[o].group = group;
+    }
+  } assign{scene, first_object, group};
 
   // Instance transform: translate * rotate * scale, in metres.
   Vec3 position = Vec3::Zero();
@@ -893,7 +905,7 @@ Rig ReadRig(const Node& node, std::set<std::string>* names) {
 
 Study ReadStudy(const Node& node) {
   node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
-                  "max_sigma_mm"});
+                  "max_sigma_mm", "time"});
   Study study;
   const Node region = node.Get("region");
   region.CheckKeys({"box", "mesh"});
@@ -969,6 +981,30 @@ Study ReadStudy(const Node& node) {
                 "posterior is after each frame's update (the usual report), prior before it");
       study.steady_prior = which == "prior";
     }
+  }
+  if (auto t = node.Find("time")) {
+    t->CheckKeys({"times", "poses", "samples", "min_cameras"});
+    TimeStudy time;
+    const int axes = int(t->Has("times")) + int(t->Has("poses")) + int(t->Has("samples"));
+    if (axes > 1) t->Fail("give one of 'times', 'poses' or 'samples'");
+    if (auto n = t->Find("times")) {
+      const size_t count = n->ArraySize("an array of times in seconds");
+      if (count == 0 || count > 100000) n->Fail("expected 1 to 100000 times");
+      for (size_t i = 0; i < count; ++i) {
+        const double v = n->At(i).Number();
+        if (!std::isfinite(v) || std::abs(v) > 1e9) n->At(i).Fail("expected a time in seconds within 1e9");
+        if (i > 0 && !(v > time.times.back())) n->At(i).Fail("times must increase");
+        time.times.push_back(v);
+      }
+    }
+    if (auto n = t->Find("poses")) {
+      const size_t count = n->ArraySize("an array of pose names");
+      if (count == 0 || count > 100000) n->Fail("expected 1 to 100000 pose names");
+      for (size_t i = 0; i < count; ++i) time.poses.push_back(n->At(i).NonEmptyString());
+    }
+    if (auto n = t->Find("samples")) time.samples = n->Integer(1, 100000);
+    if (auto n = t->Find("min_cameras")) time.min_cameras = n->Integer(1, 1000);
+    study.time = time;
   }
   // Checked after the motion model is known: steady-state fields need one.
   if (auto problem = CheckFieldList(study.fields, study.motion.has_value())) {
@@ -1172,6 +1208,147 @@ const Rig& Scene::FindRig(const std::string& name) const {
                    SuggestionHint(name, names, "rigs in this scene"));
 }
 
+// "motions": {"GROUP": {"keyframes": [{"t", "move", "yaw_deg"}, ...]} | {"poses": {"NAME": {"move",
+// "yaw_deg"}}} | {"random": {"box", "yaw_deg": [lo, hi], "samples", "seed"}}}; then the study's time
+// axis checked against them.
+GroupPose ReadGroupPose(const Node& node) {
+  node.CheckKeys({"move", "yaw_deg", "t"});
+  GroupPose p;
+  if (auto n = node.Find("move")) p.move = n->Point();
+  if (auto n = node.Find("yaw_deg")) {
+    p.yaw_deg = n->Number();
+    if (!(std::abs(p.yaw_deg) <= 36000)) n->Fail("expected degrees within 36000");
+  }
+  return p;
+}
+
+void ReadMotions(const Node& motions, Scene* scene) {
+  motions.ExpectObject("an object of motions by group or object name");
+  std::vector<int> owner(scene->objects.size(), -1);
+  for (const auto& item : motions.value().items()) {
+    const Node m(&item.value(), MemberPath(motions.path(), item.key()), &motions.context());
+    ObjectMotion motion;
+    motion.name = item.key();
+    Aabb bounds;
+    for (std::size_t o = 0; o < scene->objects.size(); ++o) {
+      const SceneObject& object = scene->objects[o];
+      const bool member = object.group == motion.name || object.name == motion.name ||
+                          object.name.rfind(motion.name + "/", 0) == 0;
+      if (!member) continue;
+      if (owner[o] >= 0)
+        m.Fail("object " + Quoted(object.name) + " is moved by motion " + Quoted(scene->motions[owner[o]].name) +
+                   " already", "an object belongs to one moving group");
+      owner[o] = int(scene->motions.size());
+      motion.objects.push_back(int(o));
+      bounds.Extend(object.mesh.Bounds());
+    }
+    if (motion.objects.empty()) {
+      std::set<std::string> names;
+      for (const SceneObject& object : scene->objects) {
+        names.insert(object.name);
+        if (!object.group.empty()) names.insert(object.group);
+      }
+      m.Fail("no object or group named " + Quoted(motion.name),
+             SuggestionHint(motion.name, std::vector<std::string>(names.begin(), names.end()),
+                            "objects and groups"));
+    }
+    if (!bounds.empty()) motion.anchor = Vec3(bounds.center().x(), bounds.center().y(), bounds.min.z());
+    m.CheckKeys({"keyframes", "poses", "random"});
+    const std::string kind = m.OneOf({"keyframes", "poses", "random"}, "kind of motion");
+    if (kind == "keyframes") {
+      motion.kind = ObjectMotion::Kind::kKeyframes;
+      const Node k = m.Get("keyframes");
+      const size_t count = k.ArraySize("an array of keyframes {\"t\", \"move\", \"yaw_deg\"}");
+      if (count == 0 || count > 100000) k.Fail("expected 1 to 100000 keyframes");
+      for (size_t i = 0; i < count; ++i) {
+        const Node f = k.At(i);
+        const double t = f.Get("t").Number();
+        if (!std::isfinite(t) || std::abs(t) > 1e9) f.Get("t").Fail("expected a time in seconds within 1e9");
+        if (i > 0 && !(t > motion.keyframes.back().first)) f.Get("t").Fail("keyframe times must increase");
+        motion.keyframes.emplace_back(t, ReadGroupPose(f));
+      }
+    } else if (kind == "poses") {
+      motion.kind = ObjectMotion::Kind::kPoses;
+      const Node p = m.Get("poses");
+      p.ExpectObject("an object of named poses {\"move\", \"yaw_deg\"}");
+      if (p.value().empty()) p.Fail("at least one pose is needed");
+      for (const auto& pose : p.value().items()) {
+        const Node n(&pose.value(), MemberPath(p.path(), pose.key()), &motions.context());
+        if (pose.key().empty()) n.Fail("pose names must not be empty");
+        if (n.Has("t")) n.Get("t").Fail("a named pose has no time", "use \"keyframes\" for timed poses");
+        motion.poses.emplace_back(pose.key(), ReadGroupPose(n));
+      }
+    } else {
+      motion.kind = ObjectMotion::Kind::kRandom;
+      const Node r = m.Get("random");
+      r.CheckKeys({"box", "yaw_deg", "samples", "seed"});
+      const Node box = r.Get("box");
+      box.CheckKeys({"min", "max"});
+      motion.box.min = box.Get("min").Point();
+      motion.box.max = box.Get("max").Point();
+      for (int i = 0; i < 3; ++i)
+        if (!(motion.box.max[i] >= motion.box.min[i]))
+          box.Get("max").At(i).Fail("max must not be less than min (axis " + std::string(1, "xyz"[i]) + ")");
+      if (auto y = r.Find("yaw_deg")) {
+        const Vec2 range = y->Vector2();
+        if (!(range[0] <= range[1]) || !(std::abs(range[0]) <= 36000 && std::abs(range[1]) <= 36000))
+          y->Fail("expected [min, max] degrees with min <= max, within 36000");
+        motion.yaw_min_deg = range[0];
+        motion.yaw_max_deg = range[1];
+      }
+      if (auto n = r.Find("samples")) motion.samples = n->Integer(1, 100000);
+      if (auto n = r.Find("seed")) motion.seed = std::uint64_t(n->Integer(0, 2147483647));
+    }
+    scene->motions.push_back(std::move(motion));
+  }
+}
+
+// The study's time axis against the motions: every motion must be evaluable at every sample.
+void CheckTimeAxis(const Node& root, const Scene& scene) {
+  const std::optional<TimeStudy>& time = scene.study.time;
+  const auto time_node = root.Get("study").Find("time");
+  if (scene.motions.empty()) {
+    if (time_node)
+      time_node->Fail("the study has a time axis but the scene has no \"motions\"", "remove it, or add motions");
+    return;
+  }
+  bool any_keyframes = false;
+  const ObjectMotion* first_poses = nullptr;
+  for (const ObjectMotion& m : scene.motions) {
+    any_keyframes |= m.kind == ObjectMotion::Kind::kKeyframes;
+    if (m.kind == ObjectMotion::Kind::kPoses && !first_poses) first_poses = &m;
+  }
+  const Node motions = root.Get("motions");
+  std::vector<std::string> names;
+  if (time && !time->poses.empty()) names = time->poses;
+  else if (!(time && (!time->times.empty() || time->samples > 0)) && first_poses)
+    for (const auto& [name, pose] : first_poses->poses) names.push_back(name);
+  const bool by_pose = !names.empty();
+  for (const ObjectMotion& m : scene.motions) {
+    const Node node = motions.Get(m.name);
+    if (m.kind == ObjectMotion::Kind::kKeyframes && by_pose)
+      node.Fail("a keyframed motion cannot be evaluated at named poses",
+                "give the study's \"time\" as \"times\" or \"samples\", or give this group named poses");
+    if (m.kind == ObjectMotion::Kind::kPoses) {
+      if (!by_pose)
+        (time_node ? *time_node : node)
+            .Fail("motion " + Quoted(m.name) + " has named poses but the study's time axis is not a list of poses",
+                  "give \"time\": {\"poses\": [...]} in the study");
+      for (const std::string& name : names) {
+        bool found = false;
+        for (const auto& [pose, value] : m.poses) found |= pose == name;
+        if (!found) {
+          std::vector<std::string> have;
+          for (const auto& [pose, value] : m.poses) have.push_back(pose);
+          node.Get("poses").Fail("no pose " + Quoted(name) + " (asked for by the study's time axis)",
+                                 SuggestionHint(name, have, "poses of this group"));
+        }
+      }
+    }
+  }
+  (void)any_keyframes;
+}
+
 Scene ParseScene(const std::string& json_text, const std::string& path,
                  const LoadOptions& options) {
   Context context;
@@ -1180,7 +1357,8 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   context.options = options;
   const json root_value = ParseJson(json_text, path);
   const Node root(&root_value, "$", &context);
-  root.CheckKeys({"pandora", "units", "materials", "objects", "rigs", "study", "views", "stations"});
+  root.CheckKeys({"pandora", "units", "materials", "objects", "rigs", "study", "views", "stations",
+                  "motions"});
 
   Scene scene;
   scene.path = path;
@@ -1216,6 +1394,9 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   for (size_t i = 0; i < rig_count; ++i) scene.rigs.push_back(ReadRig(rigs.At(i), &rig_names));
 
   scene.study = ReadStudy(root.Get("study"));
+
+  if (auto motions = root.Find("motions")) ReadMotions(*motions, &scene);
+  if (root.Has("motions") || scene.study.time) CheckTimeAxis(root, scene);
 
   if (auto views = root.Find("views")) {
     views->ExpectObject("an object of named views");

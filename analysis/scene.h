@@ -13,6 +13,7 @@
 
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
+#include "analysis/motion.h"
 #include "analysis/uncertainty.h"
 
 namespace pandora {
@@ -34,6 +35,9 @@ struct SceneObject {
   TriangleMesh mesh;    ///< World coordinates.
   int material = -1;    ///< Index into Scene::materials, -1 for the default.
   bool solid = false;   ///< Closed (checked on load); its inside is filled: voxels there stay inactive.
+  /// The moving group it belongs to ("group" in the file; empty: none). A motion named after the
+  /// group, or after the object itself, moves it (analysis/motion.h).
+  std::string group;
 };
 
 /// A named set of cameras.
@@ -87,6 +91,9 @@ struct Study {
   /// Refuse regions whose grids would exceed this. The file gives it in MiB ("memory_budget_mb",
   /// default 4096); stored in bytes.
   double memory_budget_bytes = 4096.0 * 1024.0 * 1024.0;
+  /// The time axis for moving objects ("time"); unset: inferred from the motions
+  /// (Scene::TimeSamples).
+  std::optional<TimeStudy> time;
 };
 
 /// Every field name a study may ask for, in output order:
@@ -164,6 +171,15 @@ struct Scene {
   Study study;
   std::map<std::string, View> views;  ///< Named viewpoints, by name.
   std::map<std::string, ViewingStation> stations;  ///< Viewing stations, by name.
+  /// Moving groups ("motions"), in file order; empty for a static scene.
+  std::vector<ObjectMotion> motions;
+
+  /// The study's time samples: each motion's pose at each sample (analysis/motion.h). Empty for a
+  /// static scene. Consistent by construction: LoadScene refuses motions the time axis cannot
+  /// evaluate (a keyframed motion with pose names, a named-pose motion without a pose asked for).
+  std::vector<TimeSample> TimeSamples() const;
+  /// The camera count the time summaries count against (study.time.min_cameras, default 3).
+  int TimeMinCameras() const { return study.time ? study.time->min_cameras : 3; }
 
   /// All triangles of all objects, for ray casting. Also returns, per triangle, its object index.
   TriangleMesh AllTriangles(std::vector<int>* triangle_object = nullptr) const;
@@ -186,6 +202,11 @@ struct Scene {
   /// "$.rigs") naming the available rigs when there is none of that name.
   const Rig& FindRig(const std::string& name) const;
 };
+
+/// The scene at one time sample: every moving group's objects transformed by its pose (their
+/// meshes, hence AllTriangles(), ContentBounds() and solids, follow); no motions left (a static
+/// scene). Rigs, study, views and stations are those of `scene`.
+Scene SceneAtSample(const Scene& scene, const TimeSample& sample);
 
 /// Options for LoadScene.
 struct LoadOptions {
