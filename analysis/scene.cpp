@@ -905,7 +905,7 @@ Rig ReadRig(const Node& node, std::set<std::string>* names) {
 
 Study ReadStudy(const Node& node) {
   node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
-                  "max_sigma_mm", "time"});
+                  "max_sigma_mm", "time", "targets"});
   Study study;
   const Node region = node.Get("region");
   region.CheckKeys({"box", "mesh"});
@@ -1005,6 +1005,17 @@ Study ReadStudy(const Node& node) {
     if (auto n = t->Find("samples")) time.samples = n->Integer(1, 100000);
     if (auto n = t->Find("min_cameras")) time.min_cameras = n->Integer(1, 1000);
     study.time = time;
+  }
+  if (auto t = node.Find("targets")) {
+    t->CheckKeys({"objects", "points", "seed"});
+    SurfaceTargets targets;
+    const Node names = t->Get("objects");
+    const size_t count = names.ArraySize("an array of object or group names");
+    if (count == 0 || count > 1000) names.Fail("expected 1 to 1000 names");
+    for (size_t i = 0; i < count; ++i) targets.names.push_back(names.At(i).NonEmptyString());
+    if (auto n = t->Find("points")) targets.points = n->Integer(1, 10000000);
+    if (auto n = t->Find("seed")) targets.seed = std::uint64_t(n->Integer(0, 2147483647));
+    study.targets = targets;
   }
   // Checked after the motion model is known: steady-state fields need one.
   if (auto problem = CheckFieldList(study.fields, study.motion.has_value())) {
@@ -1396,6 +1407,22 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   scene.study = ReadStudy(root.Get("study"));
 
   if (auto motions = root.Find("motions")) ReadMotions(*motions, &scene);
+  if (scene.study.targets) {
+    const Node names = root.Get("study").Get("targets").Get("objects");
+    std::set<std::string> known;
+    for (const SceneObject& o : scene.objects) {
+      known.insert(o.name);
+      if (!o.group.empty()) known.insert(o.group);
+      const auto slash = o.name.find('/');
+      if (slash != std::string::npos) known.insert(o.name.substr(0, slash));
+    }
+    for (size_t i = 0; i < scene.study.targets->names.size(); ++i) {
+      const std::string& name = scene.study.targets->names[i];
+      if (!known.count(name))
+        names.At(i).Fail("no object or group named " + Quoted(name),
+                         SuggestionHint(name, std::vector<std::string>(known.begin(), known.end()), "objects and groups"));
+    }
+  }
   if (root.Has("motions") || scene.study.time) CheckTimeAxis(root, scene);
 
   if (auto views = root.Find("views")) {

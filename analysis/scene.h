@@ -75,6 +75,14 @@ struct Region {
   std::string file;   ///< The mesh file (resolved against the scene file's folder) when kind == kMesh.
 };
 
+/// Surface targets ("study": {"targets": ...}): points spread over named objects' surfaces
+/// (analysis/surface_targets.h).
+struct SurfaceTargets {
+  std::vector<std::string> names;  ///< Groups or objects, in file order.
+  int points = 2000;               ///< Points per target.
+  std::uint64_t seed = 1;
+};
+
 /// What to compute and where.
 struct Study {
   Region region;
@@ -94,6 +102,8 @@ struct Study {
   /// The time axis for moving objects ("time"); unset: inferred from the motions
   /// (Scene::TimeSamples).
   std::optional<TimeStudy> time;
+  /// Surface targets; unset: none.
+  std::optional<SurfaceTargets> targets;
 };
 
 /// Every field name a study may ask for, in output order:

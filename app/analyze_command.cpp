@@ -2,19 +2,23 @@
 #include <tbb/info.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
+#include "analysis/motion.h"
 #include "analysis/rig_check.h"
+#include "analysis/surface_targets.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
 #include "app/session/session.h"
 #include "app/output.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
+#include "volume/time_fields.h"
 #include "volume/vdb_io.h"
 
 #ifndef PANDORA_VERSION
@@ -88,8 +92,34 @@ int RunAnalyze(const AnalyzeArgs& args) {
   const std::string summary_path = output.Stage((out / "summary.json").string(), "--out");
 
   session.UpdateFields();
-  const Fields fields = session.TakeFields();
+  Fields fields = session.TakeFields();
   bar.Finish();
+  // Moving objects: the fields at every time sample; surface targets at each (docs/time.md).
+  std::optional<TimeSummary> time;
+  std::vector<SurfaceTargetResult> targets;
+  std::vector<std::string> sample_labels;
+  if (!scene.motions.empty() || scene.study.targets) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto parts = MakeSceneParts(scene);
+    const double parts_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::vector<TimeSample> samples = scene.TimeSamples();
+    for (const TimeSample& s : samples) sample_labels.push_back(s.label);
+    if (!samples.empty()) {
+      FieldOptions over_time = options;
+      // The per-camera sets of every sample are not kept: coverage and the uncertainty fields are.
+      over_time.fields.erase(std::remove(over_time.fields.begin(), over_time.fields.end(), "cameras"),
+                             over_time.fields.end());
+      ProgressBar time_bar("over " + std::to_string(samples.size()) + " time samples", !args.quiet);
+      over_time.progress = [&time_bar](double f) { time_bar.Update(f); };
+      TimeFieldsResult result =
+          EvaluateFieldsOverTime(scene, rig, *parts, samples, over_time, scene.TimeMinCameras());
+      time_bar.Finish();
+      result.summary.parts_seconds = parts_seconds;
+      time = result.summary;
+      AddTimeGrids(&fields, &result);
+    }
+    targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
+  }
   const RayCaster& caster = study->caster();
 
   const int threads = static_cast<int>(
@@ -98,7 +128,10 @@ int RunAnalyze(const AnalyzeArgs& args) {
   RigCheckOptions check;
   check.visible_voxels = fields.stats.per_camera_seen;
   const std::vector<Warning> warnings = CheckRig(scene, rig, caster, check);
-  const Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
+  Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
+  typed.time = time;
+  typed.targets = std::move(targets);
+  typed.sample_labels = sample_labels;
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{

@@ -25,6 +25,9 @@ struct Fields::Impl {
   std::vector<openvdb::BoolGrid::Ptr> visible;
   /// resolution, sigma_max, ...: the requested float fields by name.
   std::map<std::string, openvdb::FloatGrid::Ptr> floats;
+  /// Grids beyond FieldNames(), written to fields.vdb after the others by name (the fields over time:
+  /// "coverage_min", "coverage_time_share"; volume/time_fields.h). Not read back.
+  std::map<std::string, openvdb::FloatGrid::Ptr> extra;
 
   /// The float grid `name`, or null when it was not requested.
   openvdb::FloatGrid::Ptr Float(const std::string& name) const {

@@ -202,6 +202,52 @@ void to_json(nlohmann::json& j, const Summary& s) {
                     {"path", w.json_path},
                     {"message", w.reason}});
   j["warnings"] = list;
+  auto opt = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  if (s.time) {
+    const TimeSummary& t = *s.time;
+    nlohmann::json rows = nlohmann::json::array();
+    for (const TimeSampleSummary& r : t.samples)
+      rows.push_back({{"label", r.label},
+                      {"time", r.time},
+                      {"region_voxels", r.region_voxels},
+                      {"ge1", r.ge1},
+                      {"ge2", r.ge2},
+                      {"ge3", r.ge3},
+                      {"ge_k", r.ge_k},
+                      {"sigma_max_p50_mm", opt(r.sigma_max_p50)},
+                      {"sigma_max_p90_mm", opt(r.sigma_max_p90)},
+                      {"seconds", r.seconds}});
+    j["time"] = {{"min_cameras", t.min_cameras},
+                 {"samples", rows},
+                 {"voxels", t.voxels},
+                 {"always", t.always},
+                 {"mean", t.mean},
+                 {"worst_sample", t.samples.empty() ? nlohmann::json() : nlohmann::json(t.samples[t.worst_sample].label)},
+                 {"sigma_max_mm", {{"p50", opt(t.sigma_max_p50)}, {"p90", opt(t.sigma_max_p90)}, {"p99", opt(t.sigma_max_p99)}}},
+                 {"seconds", t.seconds},
+                 {"parts_seconds", t.parts_seconds}};
+  }
+  if (!s.targets.empty()) {
+    nlohmann::json targets = nlohmann::json::array();
+    for (const SurfaceTargetResult& r : s.targets) {
+      nlohmann::json per_sample = nlohmann::json::array();
+      for (std::size_t k = 0; k < r.sample_share.size(); ++k)
+        per_sample.push_back({{"label", k < s.sample_labels.size() ? s.sample_labels[k] : "as placed"},
+                              {"share", r.sample_share[k]}});
+      nlohmann::json per_camera = nlohmann::json::array();
+      for (std::size_t c = 0; c < r.per_camera.size() && c < s.per_camera.size(); ++c)
+        per_camera.push_back({{"id", s.per_camera[c].id}, {"share", r.per_camera[c]}});
+      targets.push_back({{"name", r.name},
+                         {"points", r.points},
+                         {"samples", r.samples},
+                         {"share_ge", r.share_ge},
+                         {"always", r.always},
+                         {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
+                         {"per_sample", per_sample},
+                         {"per_camera", per_camera}});
+    }
+    j["targets"] = targets;
+  }
   j["timing"] = {{"seconds", s.timing.seconds},
                  {"active_set_seconds", s.timing.active_set_seconds},
                  {"rays", s.timing.rays},
@@ -258,6 +304,26 @@ std::string FormatSummary(const Summary& s) {
     const std::string nominal = Format("(%.1f x %.1f)", c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg);
     out += Format("%-12s %-20s %7.1f%%   %-15s %s%s\n", c.id.c_str(), c.name.c_str(), 100 * c.visible_fraction,
                   fov.c_str(), nominal.c_str(), c.enabled ? "" : "  (disabled)");
+  }
+  if (s.time) {
+    const TimeSummary& t = *s.time;
+    out += Format("over %zu time samples (seen by >= %d cameras): always %.1f%%, on average %.1f%%, worst %s %.1f%%; %.2f s\n",
+                  t.samples.size(), t.min_cameras, 100 * t.always, 100 * t.mean,
+                  t.samples.empty() ? "-" : t.samples[t.worst_sample].label.c_str(),
+                  t.samples.empty() ? 0.0 : 100 * t.samples[t.worst_sample].ge_k, t.seconds);
+    for (const TimeSampleSummary& r : t.samples)
+      out += Format("  %-24s >=1 %5.1f%%  >=2 %5.1f%%  >=3 %5.1f%%%s\n", r.label.c_str(), 100 * r.ge1, 100 * r.ge2,
+                    100 * r.ge3, r.sigma_max_p90 ? Format("  sigma_max p90 %.3g mm", *r.sigma_max_p90).c_str() : "");
+  }
+  for (const SurfaceTargetResult& r : s.targets) {
+    const int k = s.time ? s.time->min_cameras : 3;
+    out += Format("target %-16s %d points x %d samples: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%; >= %d in every sample %.1f%%",
+                  r.name.c_str(), r.points, r.samples, 100 * r.share_ge[0], 100 * r.share_ge[1], 100 * r.share_ge[2], k,
+                  100 * r.always);
+    if (r.samples > 1)
+      out += Format(", worst %s %.1f%%", r.worst_sample < int(s.sample_labels.size()) ? s.sample_labels[r.worst_sample].c_str() : "-",
+                    100 * r.sample_share[r.worst_sample]);
+    out += "\n";
   }
   out += Format("%.3f s, %.3g rays (%.3g rays/s), %.3g point-camera tests\n", s.timing.seconds,
                 static_cast<double>(s.timing.rays), s.timing.rays_per_second(),

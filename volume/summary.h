@@ -14,7 +14,9 @@
 
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
+#include "analysis/surface_targets.h"
 #include "volume/fields.h"
+#include "volume/time_fields.h"
 
 namespace pandora {
 
@@ -91,6 +93,12 @@ struct Summary {
   std::optional<UncertaintySummary> uncertainty;  ///< With an uncertainty field.
   std::vector<Warning> warnings;                  ///< CheckRig's, in order.
   TimingSummary timing;
+  /// With moving objects: the fields over the study's time samples (volume/time_fields.h).
+  std::optional<TimeSummary> time;
+  /// With surface targets: each target's shares (analysis/surface_targets.h; `cameras` left out
+  /// of the JSON).
+  std::vector<SurfaceTargetResult> targets;
+  std::vector<std::string> sample_labels;  ///< The time samples' labels (for the targets' rows).
 };
 
 /// Summarises the evaluated `fields` of `rig` in `scene`. `field_names`: the fields that were asked

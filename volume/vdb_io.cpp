@@ -53,6 +53,9 @@ void Describe(openvdb::GridBase& grid) {
       {"condition", {"1", "condition number of the information matrix J"}},
       {"sigma_max_steady", {"mm", "worst-direction 1-sigma of the steady-state Kalman covariance"}},
       {"sigma_mean_steady", {"mm", "sqrt(trace/3) of the steady-state Kalman covariance"}},
+      {"coverage_min", {"cameras", "fewest cameras that see the voxel over the time samples where it is free"}},
+      {"coverage_time_share",
+       {"1", "share of the time samples (where the voxel is free) in which enough cameras see it"}},
   };
   auto it = kDescriptions.find(grid.getName());
   if (it == kDescriptions.end()) return;
@@ -220,6 +223,12 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
       copy->insertMeta(static_cast<const openvdb::MetaMap&>(*f));
       grids.push_back(copy);
     }
+  for (const auto& [name, f] : g.extra) {
+    auto copy = openvdb::FloatGrid::create(f->treePtr());
+    copy->setTransform(f->transformPtr());
+    copy->setName(name);
+    grids.push_back(copy);
+  }
   for (openvdb::GridBase::Ptr& grid : grids) {
     for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
     Describe(*grid);

@@ -1,0 +1,138 @@
+#include "analysis/surface_targets.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/ray_caster.h"
+#include "analysis/visibility.h"
+
+namespace pandora {
+namespace {
+
+std::uint64_t Mix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+double Uniform01(std::uint64_t seed, std::uint64_t i, int component) {
+  return double(Mix(Mix(seed) ^ Mix(i * 4 + std::uint64_t(component) + 1)) >> 11) * 0x1p-53;
+}
+
+}  // namespace
+
+void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std::vector<Vec3>* points,
+                   std::vector<Vec3>* normals) {
+  points->clear();
+  normals->clear();
+  std::vector<double> cumulative;
+  cumulative.reserve(mesh.triangles.size());
+  double total = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    total += 0.5 * (b - a).cross(c - a).norm();
+    cumulative.push_back(total);
+  }
+  if (!(total > 0) || count <= 0) return;
+  for (int i = 0; i < count; ++i) {
+    const double pick = Uniform01(seed, std::uint64_t(i), 0) * total;
+    const std::size_t k = std::min<std::size_t>(
+        std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin(), cumulative.size() - 1);
+    const Eigen::Vector3i& t = mesh.triangles[k];
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    // Uniform on the triangle: (1 - sqrt(r1)) a + sqrt(r1) (1 - r2) b + sqrt(r1) r2 c.
+    const double r1 = std::sqrt(Uniform01(seed, std::uint64_t(i), 1)), r2 = Uniform01(seed, std::uint64_t(i), 2);
+    points->push_back((1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c);
+    normals->push_back((b - a).cross(c - a).normalized());
+  }
+}
+
+std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, const Rig& rig,
+                                                        const RigidPartsRayCaster& parts,
+                                                        const std::vector<TimeSample>& samples_in,
+                                                        int min_cameras) {
+  std::vector<SurfaceTargetResult> out;
+  if (!scene.study.targets) return out;
+  const SurfaceTargets& spec = *scene.study.targets;
+  const std::vector<TimeSample> samples = samples_in.empty() ? std::vector<TimeSample>{TimeSample{"as placed", 0, {}}}
+                                                             : samples_in;
+  const int kmax = std::max(3, min_cameras);
+  // Each sample's caster and tester, built once for all targets.
+  std::vector<std::unique_ptr<RayCaster>> casters;
+  std::vector<std::unique_ptr<VisibilityTester>> testers;
+  for (const TimeSample& s : samples) {
+    casters.push_back(parts.At(PartTransforms(scene, s)));
+    testers.push_back(std::make_unique<VisibilityTester>(rig.cameras, *casters.back(), scene.ContentBounds().diagonal()));
+  }
+  for (std::size_t g = 0; g < spec.names.size(); ++g) {
+    const std::string& name = spec.names[g];
+    // The target's objects (a group, an object, a mesh file's parts) and its motion, if any.
+    TriangleMesh mesh;
+    for (const SceneObject& o : scene.objects)
+      if (o.group == name || o.name == name || o.name.rfind(name + "/", 0) == 0) mesh.Append(o.mesh);
+    int motion = -1;
+    for (std::size_t k = 0; k < scene.motions.size(); ++k)
+      if (scene.motions[k].name == name) motion = int(k);
+    SurfaceTargetResult r;
+    r.name = name;
+    std::vector<Vec3> points, normals;
+    SampleSurface(mesh, spec.points, spec.seed + g, &points, &normals);
+    r.points = int(points.size());
+    r.samples = int(samples.size());
+    r.cameras.assign(std::size_t(r.samples) * r.points, 0);
+    std::vector<std::vector<std::int64_t>> seen_by(samples.size(), std::vector<std::int64_t>(rig.cameras.size(), 0));
+    for (std::size_t s = 0; s < samples.size(); ++s) {
+      // The target's transform at this sample: its own motion, or none.
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      if (motion >= 0 && motion < int(samples[s].poses.size()))
+        T = PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
+      std::vector<std::vector<std::uint8_t>> sees(rig.cameras.size(), std::vector<std::uint8_t>(points.size(), 0));
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 64), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const Vec3 X = T * points[i], n = T.linear() * normals[i];
+          int count = 0;
+          for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+            if (!rig.cameras[c].enabled) continue;
+            if (testers[s]->Test(int(c), X, &n) == ViewResult::kSeen) {
+              ++count;
+              sees[c][i] = 1;
+            }
+          }
+          r.cameras[s * points.size() + i] = std::uint16_t(std::min(count, 65535));
+        }
+      });
+      for (std::size_t c = 0; c < rig.cameras.size(); ++c)
+        for (std::uint8_t v : sees[c]) seen_by[s][c] += v;
+    }
+    const double pairs = double(r.points) * r.samples;
+    r.share_ge.assign(kmax, 0.0);
+    r.sample_share.assign(samples.size(), 0.0);
+    std::vector<std::uint8_t> always(points.size(), 1);
+    for (std::size_t s = 0; s < samples.size(); ++s)
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const int n = r.cameras[s * points.size() + i];
+        for (int k = 1; k <= std::min(n, kmax); ++k) r.share_ge[k - 1] += 1;
+        if (n >= min_cameras) r.sample_share[s] += 1;
+        else always[i] = 0;
+      }
+    for (double& v : r.share_ge) v = pairs > 0 ? v / pairs : 0.0;
+    for (double& v : r.sample_share) v = r.points > 0 ? v / r.points : 0.0;
+    double a = 0;
+    for (std::uint8_t v : always) a += v;
+    r.always = r.points > 0 ? a / r.points : 0.0;
+    r.worst_sample = int(std::min_element(r.sample_share.begin(), r.sample_share.end()) - r.sample_share.begin());
+    r.per_camera.assign(rig.cameras.size(), 0.0);
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      double n = 0;
+      for (std::size_t s = 0; s < samples.size(); ++s) n += double(seen_by[s][c]);
+      r.per_camera[c] = pairs > 0 ? n / pairs : 0.0;
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace pandora

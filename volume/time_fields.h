@@ -1,0 +1,68 @@
+#pragma once
+/// \file time_fields.h
+/// Fields over time: the study's fields evaluated at every time sample of a scene with moving
+/// objects (analysis/motion.h), each sample over the scene as it is then (the moved objects occlude,
+/// a solid body's inside is not free space while it is there), with the sample's ray caster from the
+/// scene's rigid parts (no BVH rebuilt). Combined per voxel into the worst case and the share of
+/// time, and per sample into the summary's rows. docs/time.md.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/motion.h"
+#include "analysis/scene.h"
+#include "volume/fields.h"
+
+namespace pandora {
+
+class RigidPartsRayCaster;
+
+/// One time sample's headline numbers.
+struct TimeSampleSummary {
+  std::string label;
+  double time = 0;
+  std::int64_t region_voxels = 0;  ///< Free region voxels at this sample.
+  double ge1 = 0, ge2 = 0, ge3 = 0, ge_k = 0;  ///< Shares seen by >= 1, 2, 3, min_cameras cameras.
+  std::optional<double> sigma_max_p50, sigma_max_p90;  ///< mm, with an uncertainty field.
+  double seconds = 0;
+};
+
+/// The fields over all samples: what summary.json's "time" holds.
+struct TimeSummary {
+  int min_cameras = 3;
+  std::vector<TimeSampleSummary> samples;
+  /// Voxels free in at least one sample.
+  std::int64_t voxels = 0;
+  /// Share of those voxels whose coverage_min (the fewest cameras over the samples where the voxel
+  /// is free) is at least min_cameras: covered all the time.
+  double always = 0;
+  /// Share of (voxel, sample) pairs, over the free pairs, seen by >= min_cameras cameras.
+  double mean = 0;
+  int worst_sample = 0;  ///< The sample with the lowest ge_k.
+  /// sigma_max over every triangulable (voxel, sample) pair, mm (with an uncertainty field).
+  std::optional<double> sigma_max_p50, sigma_max_p90, sigma_max_p99;
+  double seconds = 0;        ///< Wall time of all samples.
+  double parts_seconds = 0;  ///< Building the parts' BVHs once (set by the caller).
+};
+
+struct TimeFieldsResult {
+  TimeSummary summary;
+  /// Grids for fields.vdb (Fields::Impl::extra): "coverage_min" (Float, whole numbers: the fewest
+  /// cameras over the samples where the voxel is free) and "coverage_time_share" (Float in [0, 1]:
+  /// the share of those samples with >= min_cameras cameras), active on the voxels free in at least
+  /// one sample.
+  Fields grids;
+};
+
+/// Evaluates `options.fields` for `rig` at every sample and combines them. `parts` is
+/// MakeSceneParts(scene). Throws as EvaluateFields.
+TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
+                                        const std::vector<TimeSample>& samples, const FieldOptions& options,
+                                        int min_cameras);
+
+/// Moves the result's grids into `fields` (written to fields.vdb with them).
+void AddTimeGrids(Fields* fields, TimeFieldsResult* result);
+
+}  // namespace pandora
