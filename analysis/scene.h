@@ -11,6 +11,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "analysis/calibration.h"
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
 #include "analysis/uncertainty.h"
@@ -87,6 +88,8 @@ struct Study {
   /// Refuse regions whose grids would exceed this. The file gives it in MiB ("memory_budget_mb",
   /// default 4096); stored in bytes.
   double memory_budget_bytes = 4096.0 * 1024.0 * 1024.0;
+  /// Calibration feasibility to simulate ("calibration", docs/calibration.md); none when absent.
+  std::optional<CalibrationSpec> calibration;
 };
 
 /// Every field name a study may ask for, in output order:
