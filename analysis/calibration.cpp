@@ -181,11 +181,20 @@ BoardView TestBoard(const VisibilityTester& tester, int camera, const Calibratio
   return BoardView::kSeen;
 }
 
+BoardView ViewOfPose(const VisibilityTester& tester, int camera, const CalibrationSpec& spec,
+                     const CalibrationPose& pose) {
+  if (spec.target == CalibrationSpec::Target::kBoard) return TestBoard(tester, camera, spec.board, pose);
+  switch (tester.Test(camera, pose.position)) {
+    case ViewResult::kSeen: return BoardView::kSeen;
+    case ViewResult::kDisabled: return BoardView::kDisabled;
+    case ViewResult::kOccluded: return BoardView::kOccluded;
+    default: return BoardView::kNotInImage;
+  }
+}
+
 bool ObservesPose(const VisibilityTester& tester, int camera, const CalibrationSpec& spec,
                   const CalibrationPose& pose) {
-  if (spec.target == CalibrationSpec::Target::kWand)
-    return tester.Test(camera, pose.position) == ViewResult::kSeen;
-  return TestBoard(tester, camera, spec.board, pose) == BoardView::kSeen;
+  return ViewOfPose(tester, camera, spec, pose) == BoardView::kSeen;
 }
 
 CalibrationGraph BuildCalibrationGraph(const std::vector<std::vector<std::int64_t>>& shared,
@@ -293,15 +302,20 @@ CalibrationResult EvaluateCalibration(const VisibilityTester& tester, const Cali
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i)
                         for (std::size_t c = 0; c < n; ++c)
-                          seen[i * n + c] = ObservesPose(tester, static_cast<int>(c), spec, poses[i]) ? 1 : 0;
+                          seen[i * n + c] = static_cast<std::uint8_t>(
+                              ViewOfPose(tester, static_cast<int>(c), spec, poses[i]));
                     });
   result.observed.assign(n, 0);
+  result.missed.assign(n, {});
   result.shared.assign(n, std::vector<std::int64_t>(n, 0));
   std::vector<int> who;
   for (std::size_t i = 0; i < poses.size(); ++i) {
     who.clear();
-    for (std::size_t c = 0; c < n; ++c)
-      if (seen[i * n + c]) who.push_back(static_cast<int>(c));
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::uint8_t view = seen[i * n + c];
+      if (view == static_cast<std::uint8_t>(BoardView::kSeen)) who.push_back(static_cast<int>(c));
+      else if (view != static_cast<std::uint8_t>(BoardView::kDisabled)) ++result.missed[c][view];
+    }
     result.poses_observed += who.empty() ? 0 : 1;
     result.poses_shared += who.size() >= 2 ? 1 : 0;
     for (int a : who)
@@ -351,6 +365,11 @@ void to_json(nlohmann::json& j, const CalibrationResult& r) {
   for (std::size_t c = 0; c < r.camera_ids.size(); ++c) {
     nlohmann::json e = {{"id", r.camera_ids[c]}, {"enabled", bool(r.enabled[c])}, {"observed", r.observed[c]}};
     e["component"] = r.graph.component[c] >= 0 ? nlohmann::json(r.graph.component[c]) : nlohmann::json();
+    nlohmann::json missed = nlohmann::json::object();
+    for (BoardView v : {BoardView::kTilted, BoardView::kNotInImage, BoardView::kTooSmall, BoardView::kOccluded})
+      if (r.spec.target == CalibrationSpec::Target::kBoard || v == BoardView::kNotInImage || v == BoardView::kOccluded)
+        missed[BoardViewName(v)] = r.missed[c][static_cast<int>(v)];
+    e["missed"] = std::move(missed);
     per_camera.push_back(std::move(e));
   }
   j["per_camera"] = std::move(per_camera);
@@ -389,6 +408,12 @@ std::string FormatCalibration(const CalibrationResult& r) {
   for (const std::vector<int>& comp : r.graph.components) s += "  [" + names(comp) + "]";
   s += "\n";
   if (!r.graph.uncalibratable.empty()) s += "  uncalibratable: " + names(r.graph.uncalibratable) + "\n";
+  for (int c : r.graph.uncalibratable) {
+    s += "    " + r.camera_ids[c] + ": " + std::to_string(r.observed[c]) + " poses; missed";
+    for (int v = 0; v < kBoardViewCount; ++v)
+      if (r.missed[c][v] > 0) s += std::string(" ") + BoardViewName(static_cast<BoardView>(v)) + " " + std::to_string(r.missed[c][v]);
+    s += "\n";
+  }
   if (!r.graph.weakest_links.empty()) {
     s += "  weakest links:";
     for (std::size_t k = 0; k < r.graph.weakest_links.size() && k < 3; ++k) {

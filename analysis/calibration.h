@@ -10,6 +10,7 @@
 /// Light header: no Embree, CGAL or OpenVDB. Scene, Rig and VisibilityTester are declared here only;
 /// the scene file's "study.calibration" section (docs/scene-format.md) reads into CalibrationSpec.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -78,6 +79,8 @@ enum class BoardView : std::uint8_t {
   kOccluded,      ///< The segment from the camera to a corner hits scene geometry.
 };
 
+constexpr int kBoardViewCount = 6;
+
 /// "seen", "disabled", "tilted", "not_in_image", "too_small", "occluded".
 const char* BoardViewName(BoardView view);
 
@@ -91,8 +94,13 @@ std::vector<Vec3> BoardCorners(const CalibrationBoard& board, const CalibrationP
 BoardView TestBoard(const VisibilityTester& tester, int camera, const CalibrationBoard& board,
                     const CalibrationPose& pose, double* min_edge_px = nullptr);
 
-/// Whether camera `camera` detects the target in `pose`: a wand's marker when VisibilityTester::Test
-/// sees the point, a board when TestBoard says kSeen.
+/// What camera `camera` makes of the target in `pose`: for a board TestBoard's answer; for a wand
+/// VisibilityTester::Test's, as kSeen, kDisabled, kOccluded, or kNotInImage (out of range, behind
+/// the camera, outside the image).
+BoardView ViewOfPose(const VisibilityTester& tester, int camera, const CalibrationSpec& spec,
+                     const CalibrationPose& pose);
+
+/// ViewOfPose(...) == BoardView::kSeen.
 bool ObservesPose(const VisibilityTester& tester, int camera, const CalibrationSpec& spec,
                   const CalibrationPose& pose);
 
@@ -132,6 +140,9 @@ struct CalibrationResult {
   std::int64_t poses_observed = 0;  ///< Observed by at least one camera.
   std::int64_t poses_shared = 0;    ///< Observed by at least two cameras.
   std::vector<std::int64_t> observed;             ///< Per camera, poses it observes.
+  /// Per camera, the poses it misses by the first rule that fails: [camera][BoardView] (kSeen and
+  /// kDisabled entries stay 0; a wand has only kNotInImage and kOccluded).
+  std::vector<std::array<std::int64_t, kBoardViewCount>> missed;
   std::vector<std::vector<std::int64_t>> shared;  ///< [a][b] poses both observe; [a][a] = observed.
   CalibrationGraph graph;
   /// Every enabled camera in one component, none uncalibratable, at least one camera enabled.
@@ -160,7 +171,8 @@ CalibrationResult SimulateCalibration(const Scene& scene, const Rig& rig, const 
 
 /// summary.json's "calibration": target, samples, seed, min_shared, orientation, [board {squares,
 /// square_m, tilt_max_deg, min_px_per_square}], poses, poses_observed, poses_shared, cameras (ids),
-/// per_camera [{id, enabled, observed, component}], shared (matrix, rig order), components (lists
+/// per_camera [{id, enabled, observed, component, missed {tilted, not_in_image, too_small,
+/// occluded} (a wand: not_in_image, occluded)}], shared (matrix, rig order), components (lists
 /// of ids), uncalibratable (ids), weakest_links [{a, b, shared}] (ids), calibratable, seconds.
 /// Every number is a finite integer but board sizes and seconds; a disabled camera's component is
 /// null.

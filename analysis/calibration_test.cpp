@@ -60,6 +60,14 @@ TEST(Calibration, WandCountsWorkedOutByHand) {
   EXPECT_EQ(r.shared, (Matrix{{2, 2, 2, 0}, {2, 3, 2, 0}, {2, 2, 3, 0}, {0, 0, 0, 1}}));
   EXPECT_EQ(r.poses_observed, 5);
   EXPECT_EQ(r.poses_shared, 2);
+  // Why the others are missed: A never for occlusion, C once (the third), E three times.
+  const auto missed = [&](int c, BoardView v) { return r.missed[c][static_cast<int>(v)]; };
+  EXPECT_EQ(missed(0, BoardView::kNotInImage), 3);
+  EXPECT_EQ(missed(0, BoardView::kOccluded), 0);
+  EXPECT_EQ(missed(2, BoardView::kNotInImage), 1);
+  EXPECT_EQ(missed(2, BoardView::kOccluded), 1);
+  EXPECT_EQ(missed(3, BoardView::kNotInImage), 1);
+  EXPECT_EQ(missed(3, BoardView::kOccluded), 3);
   // Links A-B, A-C, B-C (2 shared poses each); E is alone.
   EXPECT_EQ(r.graph.component, (std::vector<int>{0, 0, 0, 1}));
   EXPECT_EQ(r.graph.components, (std::vector<std::vector<int>>{{0, 1, 2}, {3}}));
@@ -170,6 +178,7 @@ TEST(Calibration, DeterministicForASeed) {
     b = SimulateCalibration(scene, scene.rigs[0], *caster, spec);
   }
   EXPECT_EQ(a.shared, b.shared);
+  EXPECT_EQ(a.missed, b.missed);
   EXPECT_EQ(a.poses_observed, b.poses_observed);
   EXPECT_GT(a.poses_shared, 0);
   // Another seed draws other poses.
@@ -326,6 +335,8 @@ TEST(Calibration, JsonHoldsTheCountsAndGraphByCameraId) {
   EXPECT_EQ(j.at("components").at(1), nlohmann::json::array({"away"}));
   EXPECT_EQ(j.at("calibratable"), false);
   EXPECT_FALSE(j.contains("board"));
+  EXPECT_EQ(j.at("per_camera").at(4).at("missed").at("not_in_image"), 100);
+  EXPECT_FALSE(j.at("per_camera").at(4).at("missed").contains("tilted"));
   const std::string text = FormatCalibration(r);
   EXPECT_NE(text.find("uncalibratable: away"), std::string::npos) << text;
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "analysis/calibration.h"
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
@@ -98,7 +99,9 @@ int RunAnalyze(const AnalyzeArgs& args) {
   RigCheckOptions check;
   check.visible_voxels = fields.stats.per_camera_seen;
   const std::vector<Warning> warnings = CheckRig(scene, rig, caster, check);
-  const Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
+  Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
+  if (scene.study.calibration)
+    typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{
