@@ -128,8 +128,8 @@ std::vector<Vec3> BoardCorners(const CalibrationBoard& board, const CalibrationP
   const Vec3 x = pose.orientation.col(0), y = pose.orientation.col(1);
   for (int j = 0; j <= board.squares_y; ++j)
     for (int i = 0; i <= board.squares_x; ++i)
-      corners.push_back(pose.position + board.square_m * ((i - 0.5 * board.squares_x) * x +
-                                                          (j - 0.5 * board.squares_y) * y));
+      corners.push_back(pose.position +
+                        board.square_m * ((i - 0.5 * board.squares_x) * x + (j - 0.5 * board.squares_y) * y));
   return corners;
 }
 
@@ -164,7 +164,8 @@ BoardView TestBoard(const VisibilityTester& tester, int camera, const Calibratio
     for (int i = 0; i < nx; ++i) {
       const Vec2& p = pixels[std::size_t(j) * nx + i];
       if (i + 1 < nx) min_edge = std::min(min_edge, (pixels[std::size_t(j) * nx + i + 1] - p).norm());
-      if (j < board.squares_y) min_edge = std::min(min_edge, (pixels[std::size_t(j + 1) * nx + i] - p).norm());
+      if (j < board.squares_y)
+        min_edge = std::min(min_edge, (pixels[std::size_t(j + 1) * nx + i] - p).norm());
     }
   }
   if (min_edge_px) *min_edge_px = min_edge;
@@ -229,7 +230,8 @@ CalibrationGraph BuildCalibrationGraph(const std::vector<std::vector<std::int64_
   for (int k = 0; k < static_cast<int>(g.components.size()); ++k)
     if (g.largest < 0 || g.components[k].size() > g.components[g.largest].size()) g.largest = k;
   for (int c = 0; c < n; ++c)
-    if (enabled[c] && (g.component[c] != g.largest || shared[c][c] < min_shared)) g.uncalibratable.push_back(c);
+    if (enabled[c] && (g.component[c] != g.largest || shared[c][c] < min_shared))
+      g.uncalibratable.push_back(c);
   return g;
 }
 
@@ -298,13 +300,13 @@ CalibrationResult EvaluateCalibration(const VisibilityTester& tester, const Cali
   }
   result.poses = static_cast<std::int64_t>(poses.size());
   std::vector<std::uint8_t> seen(poses.size() * n, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses.size(), 8),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i)
-                        for (std::size_t c = 0; c < n; ++c)
-                          seen[i * n + c] = static_cast<std::uint8_t>(
-                              ViewOfPose(tester, static_cast<int>(c), spec, poses[i]));
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, poses.size(), 8), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          for (std::size_t c = 0; c < n; ++c)
+            seen[i * n + c] =
+                static_cast<std::uint8_t>(ViewOfPose(tester, static_cast<int>(c), spec, poses[i]));
+      });
   result.observed.assign(n, 0);
   result.missed.assign(n, {});
   result.shared.assign(n, std::vector<std::int64_t>(n, 0));
@@ -313,8 +315,10 @@ CalibrationResult EvaluateCalibration(const VisibilityTester& tester, const Cali
     who.clear();
     for (std::size_t c = 0; c < n; ++c) {
       const std::uint8_t view = seen[i * n + c];
-      if (view == static_cast<std::uint8_t>(BoardView::kSeen)) who.push_back(static_cast<int>(c));
-      else if (view != static_cast<std::uint8_t>(BoardView::kDisabled)) ++result.missed[c][view];
+      if (view == static_cast<std::uint8_t>(BoardView::kSeen))
+        who.push_back(static_cast<int>(c));
+      else if (view != static_cast<std::uint8_t>(BoardView::kDisabled))
+        ++result.missed[c][view];
     }
     result.poses_observed += who.empty() ? 0 : 1;
     result.poses_shared += who.size() >= 2 ? 1 : 0;
@@ -323,8 +327,10 @@ CalibrationResult EvaluateCalibration(const VisibilityTester& tester, const Cali
   }
   for (std::size_t c = 0; c < n; ++c) result.observed[c] = result.shared[c][c];
   result.graph = BuildCalibrationGraph(result.shared, result.enabled, spec.min_shared);
-  const bool any_enabled = std::find(result.enabled.begin(), result.enabled.end(), true) != result.enabled.end();
-  result.calibratable = any_enabled && result.graph.components.size() == 1 && result.graph.uncalibratable.empty();
+  const bool any_enabled =
+      std::find(result.enabled.begin(), result.enabled.end(), true) != result.enabled.end();
+  result.calibratable =
+      any_enabled && result.graph.components.size() == 1 && result.graph.uncalibratable.empty();
   return result;
 }
 
@@ -363,11 +369,14 @@ void to_json(nlohmann::json& j, const CalibrationResult& r) {
   j["cameras"] = r.camera_ids;
   nlohmann::json per_camera = nlohmann::json::array();
   for (std::size_t c = 0; c < r.camera_ids.size(); ++c) {
-    nlohmann::json e = {{"id", r.camera_ids[c]}, {"enabled", bool(r.enabled[c])}, {"observed", r.observed[c]}};
+    nlohmann::json e = {
+        {"id", r.camera_ids[c]}, {"enabled", bool(r.enabled[c])}, {"observed", r.observed[c]}};
     e["component"] = r.graph.component[c] >= 0 ? nlohmann::json(r.graph.component[c]) : nlohmann::json();
     nlohmann::json missed = nlohmann::json::object();
-    for (BoardView v : {BoardView::kTilted, BoardView::kNotInImage, BoardView::kTooSmall, BoardView::kOccluded})
-      if (r.spec.target == CalibrationSpec::Target::kBoard || v == BoardView::kNotInImage || v == BoardView::kOccluded)
+    for (BoardView v :
+         {BoardView::kTilted, BoardView::kNotInImage, BoardView::kTooSmall, BoardView::kOccluded})
+      if (r.spec.target == CalibrationSpec::Target::kBoard || v == BoardView::kNotInImage ||
+          v == BoardView::kOccluded)
         missed[BoardViewName(v)] = r.missed[c][static_cast<int>(v)];
     e["missed"] = std::move(missed);
     per_camera.push_back(std::move(e));
@@ -389,7 +398,8 @@ void to_json(nlohmann::json& j, const CalibrationResult& r) {
 std::string FormatCalibration(const CalibrationResult& r) {
   std::string s;
   char line[256];
-  std::snprintf(line, sizeof line, "calibration (%s): %lld poses, %lld seen by >= 1 camera, %lld by >= 2; %s\n",
+  std::snprintf(line, sizeof line,
+                "calibration (%s): %lld poses, %lld seen by >= 1 camera, %lld by >= 2; %s\n",
                 CalibrationTargetName(r.spec.target), static_cast<long long>(r.poses),
                 static_cast<long long>(r.poses_observed), static_cast<long long>(r.poses_shared),
                 r.calibratable ? "calibratable as one rig" : "NOT calibratable as one rig");
@@ -401,9 +411,11 @@ std::string FormatCalibration(const CalibrationResult& r) {
   };
   std::string observed;
   for (std::size_t c = 0; c < r.camera_ids.size(); ++c)
-    if (r.enabled[c]) observed += (observed.empty() ? "" : "  ") + r.camera_ids[c] + " " + std::to_string(r.observed[c]);
+    if (r.enabled[c])
+      observed += (observed.empty() ? "" : "  ") + r.camera_ids[c] + " " + std::to_string(r.observed[c]);
   s += "  poses per camera  " + observed + "\n";
-  std::snprintf(line, sizeof line, "  components (shared >= %d): %zu", r.spec.min_shared, r.graph.components.size());
+  std::snprintf(line, sizeof line, "  components (shared >= %d): %zu", r.spec.min_shared,
+                r.graph.components.size());
   s += line;
   for (const std::vector<int>& comp : r.graph.components) s += "  [" + names(comp) + "]";
   s += "\n";
@@ -411,7 +423,9 @@ std::string FormatCalibration(const CalibrationResult& r) {
   for (int c : r.graph.uncalibratable) {
     s += "    " + r.camera_ids[c] + ": " + std::to_string(r.observed[c]) + " poses; missed";
     for (int v = 0; v < kBoardViewCount; ++v)
-      if (r.missed[c][v] > 0) s += std::string(" ") + BoardViewName(static_cast<BoardView>(v)) + " " + std::to_string(r.missed[c][v]);
+      if (r.missed[c][v] > 0)
+        s += std::string(" ") + BoardViewName(static_cast<BoardView>(v)) + " " +
+             std::to_string(r.missed[c][v]);
     s += "\n";
   }
   if (!r.graph.weakest_links.empty()) {

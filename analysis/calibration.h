@@ -51,7 +51,7 @@ struct CalibrationSpec {
   /// sphere, uniform turn in the plane).
   enum class Orientation { kTowardCamera, kUniform };
   Target target = Target::kWand;
-  int samples = 2000;   ///< Poses.
+  int samples = 2000;  ///< Poses.
   std::uint64_t seed = 1;
   int min_shared = 20;  ///< Poses two cameras must share to link them in the graph.
   Orientation orientation = Orientation::kTowardCamera;
@@ -72,11 +72,11 @@ struct CalibrationPose {
 /// Why a board pose is or is not detected by a camera, in the order the tests run (cheapest first).
 enum class BoardView : std::uint8_t {
   kSeen = 0,
-  kDisabled,      ///< The camera is disabled.
-  kTilted,        ///< Front face turned away, or beyond tilt_max_deg from facing the camera.
-  kNotInImage,    ///< A corner projects outside the image, out of range or behind the camera.
-  kTooSmall,      ///< A projected square edge is shorter than min_px_per_square.
-  kOccluded,      ///< The segment from the camera to a corner hits scene geometry.
+  kDisabled,    ///< The camera is disabled.
+  kTilted,      ///< Front face turned away, or beyond tilt_max_deg from facing the camera.
+  kNotInImage,  ///< A corner projects outside the image, out of range or behind the camera.
+  kTooSmall,    ///< A projected square edge is shorter than min_px_per_square.
+  kOccluded,    ///< The segment from the camera to a corner hits scene geometry.
 };
 
 constexpr int kBoardViewCount = 6;
@@ -136,10 +136,10 @@ struct CalibrationResult {
   CalibrationSpec spec;
   std::vector<std::string> camera_ids;  ///< Rig order, disabled cameras included.
   std::vector<bool> enabled;
-  std::int64_t poses = 0;           ///< Poses placed in the region's free space.
-  std::int64_t poses_observed = 0;  ///< Observed by at least one camera.
-  std::int64_t poses_shared = 0;    ///< Observed by at least two cameras.
-  std::vector<std::int64_t> observed;             ///< Per camera, poses it observes.
+  std::int64_t poses = 0;              ///< Poses placed in the region's free space.
+  std::int64_t poses_observed = 0;     ///< Observed by at least one camera.
+  std::int64_t poses_shared = 0;       ///< Observed by at least two cameras.
+  std::vector<std::int64_t> observed;  ///< Per camera, poses it observes.
   /// Per camera, the poses it misses by the first rule that fails: [camera][BoardView] (kSeen and
   /// kDisabled entries stay 0; a wand has only kNotInImage and kOccluded).
   std::vector<std::array<std::int64_t, kBoardViewCount>> missed;

@@ -5,6 +5,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "analysis/calibration.h"
@@ -85,11 +86,8 @@ TEST(Calibration, WandCountsWorkedOutByHand) {
 
 TEST(Calibration, GraphOfAHandMadeMatrix) {
   // Camera 4 is disabled: its strong link to 3 must not count.
-  const Matrix shared{{100, 50, 30, 10, 0},
-                      {50, 80, 40, 0, 0},
-                      {30, 40, 90, 25, 0},
-                      {10, 0, 25, 30, 60},
-                      {0, 0, 0, 60, 70}};
+  const Matrix shared{
+      {100, 50, 30, 10, 0}, {50, 80, 40, 0, 0}, {30, 40, 90, 25, 0}, {10, 0, 25, 30, 60}, {0, 0, 0, 60, 70}};
   const std::vector<bool> enabled{true, true, true, true, false};
   CalibrationGraph g = BuildCalibrationGraph(shared, enabled, 20);
   // Edges >= 20: 0-1 50, 1-2 40, 0-2 30, 2-3 25. Maximum spanning tree: 0-1, 1-2, 2-3.
@@ -214,7 +212,7 @@ TEST(Calibration, BoardTiltAndPixelRules) {
   const std::vector<Camera> cams{testing::TestCamera("c", Vec3::Zero(), Vec3(1, 0, 0))};
   const VisibilityTester tester(cams, *caster, 5.0);
   const double f = cams[0].model.intrinsics().fx;  // 320 / tan(30 deg)
-  CalibrationBoard board;  // 7 x 5 squares of 0.04 m
+  CalibrationBoard board;                          // 7 x 5 squares of 0.04 m
   // Facing the camera, the board is parallel to the image plane at depth 2: every square edge
   // projects to exactly f * 0.04 / 2 pixels (11.09).
   const double edge = f * 0.04 / 2;
@@ -273,7 +271,8 @@ nlohmann::json SceneWithCalibration(const nlohmann::json& calibration) {
 }
 
 std::string PathOfError(const nlohmann::json& calibration) {
-  const InputError e = testing::ErrorOf([&] { ParseScene(SceneWithCalibration(calibration).dump(), "s.json"); });
+  const InputError e =
+      testing::ErrorOf([&] { ParseScene(SceneWithCalibration(calibration).dump(), "s.json"); });
   EXPECT_EQ(e.file(), "s.json");
   return e.json_path();
 }
@@ -295,8 +294,9 @@ TEST(Calibration, SceneFileSectionAndItsErrors) {
   EXPECT_EQ(s.study.calibration->board.squares_x, 9);
   EXPECT_DOUBLE_EQ(s.study.calibration->board.square_m, 0.05);
   EXPECT_EQ(s.study.calibration->seed, 3u);
-  EXPECT_FALSE(ParseScene(SceneWithCalibration({{"target", "wand"}}).dump(), "s.json").study.calibration->target ==
-               CalibrationSpec::Target::kBoard);
+  EXPECT_FALSE(
+      ParseScene(SceneWithCalibration({{"target", "wand"}}).dump(), "s.json").study.calibration->target ==
+      CalibrationSpec::Target::kBoard);
 
   EXPECT_EQ(PathOfError(nlohmann::json::object()), "$.study.calibration");
   EXPECT_EQ(PathOfError({{"target", "stick"}}), "$.study.calibration.target");

@@ -44,7 +44,8 @@ std::string ComponentColor(int component) {
 }
 
 bool IsUncalibratable(const CalibrationResult& r, int c) {
-  return std::find(r.graph.uncalibratable.begin(), r.graph.uncalibratable.end(), c) != r.graph.uncalibratable.end();
+  return std::find(r.graph.uncalibratable.begin(), r.graph.uncalibratable.end(), c) !=
+         r.graph.uncalibratable.end();
 }
 
 // The miss reasons of camera `c` with a count, "occluded 551, tilted 1449".
@@ -97,13 +98,15 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
     const bool bad = IsUncalibratable(r, c);
     const std::string fill = !r.enabled[c] ? "#999999" : bad ? kUncalibratable : "#222222";
     const std::string weight = bad ? " font-weight=\"bold\"" : "";
-    s << "<text x=\"" << Num(12 + label) << "\" y=\"" << Num(top + mid + 4) << "\" font-size=\"12\" text-anchor=\"end\" fill=\""
-      << fill << "\"" << weight << ">" << Escape(r.camera_ids[c]) << "</text>\n";
-    s << "<text transform=\"translate(" << Num(left + mid + 4) << "," << Num(34 + label) << ") rotate(-90)\" font-size=\"12\" fill=\""
-      << fill << "\"" << weight << ">" << Escape(r.camera_ids[c]) << "</text>\n";
+    s << "<text x=\"" << Num(12 + label) << "\" y=\"" << Num(top + mid + 4)
+      << "\" font-size=\"12\" text-anchor=\"end\" fill=\"" << fill << "\"" << weight << ">"
+      << Escape(r.camera_ids[c]) << "</text>\n";
+    s << "<text transform=\"translate(" << Num(left + mid + 4) << "," << Num(34 + label)
+      << ") rotate(-90)\" font-size=\"12\" fill=\"" << fill << "\"" << weight << ">"
+      << Escape(r.camera_ids[c]) << "</text>\n";
     const std::string color = ComponentColor(r.graph.component[c]);
-    s << "<rect x=\"" << Num(left - gap - band) << "\" y=\"" << Num(top + c * cell) << "\" width=\"" << Num(band)
-      << "\" height=\"" << cell << "\" fill=\"" << color << "\"/>\n";
+    s << "<rect x=\"" << Num(left - gap - band) << "\" y=\"" << Num(top + c * cell) << "\" width=\""
+      << Num(band) << "\" height=\"" << cell << "\" fill=\"" << color << "\"/>\n";
     s << "<rect x=\"" << Num(left + c * cell) << "\" y=\"" << Num(top - gap - band) << "\" width=\"" << cell
       << "\" height=\"" << Num(band) << "\" fill=\"" << color << "\"/>\n";
   }
@@ -131,8 +134,8 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
       if (numbers && r.enabled[a] && r.enabled[b] && (v > 0 || a == b)) {
         const std::string text = v >= 10000 ? Num(v / 1000.0) + "k" : std::to_string(v);
         const int size = text.size() <= 3 ? 10 : 8;
-        s << "<text x=\"" << Num(x + cell / 2.0) << "\" y=\"" << Num(y + cell / 2.0 + size * 0.35) << "\" font-size=\""
-          << size << "\" text-anchor=\"middle\" fill=\"" << text_color << "\""
+        s << "<text x=\"" << Num(x + cell / 2.0) << "\" y=\"" << Num(y + cell / 2.0 + size * 0.35)
+          << "\" font-size=\"" << size << "\" text-anchor=\"middle\" fill=\"" << text_color << "\""
           << (a == b ? " font-style=\"italic\"" : "") << ">" << text << "</text>\n";
       }
     }
@@ -144,23 +147,28 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
         s << "<rect x=\"" << Num(left + b * cell + 1) << "\" y=\"" << Num(top + a * cell + 1) << "\" width=\""
           << cell - 2 << "\" height=\"" << cell - 2 << "\" fill=\"none\" stroke=\""
           << (link[a][b] == 2 ? kUncalibratable : "#000000") << "\" stroke-width=\"2\"/>\n";
-  s << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(side) << "\" height=\"" << Num(side)
-    << "\" fill=\"none\" stroke=\"#555555\" stroke-width=\"1\"/>\n";
+  s << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(side) << "\" height=\""
+    << Num(side) << "\" fill=\"none\" stroke=\"#555555\" stroke-width=\"1\"/>\n";
 
   // Legend: the ramp with its ends, then the special cells.
   const double ramp_w = 200, ramp_h = 12, lx = 12;
-  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top - 6) << "\" font-size=\"11\">poses both cameras "
+  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top - 6)
+    << "\" font-size=\"11\">poses both cameras "
     << "observe (linked at &#8805; " << r.spec.min_shared << ")</text>\n";
   for (int i = 0; i < 50; ++i)
-    s << "<rect x=\"" << Num(lx + ramp_w * i / 50) << "\" y=\"" << Num(legend_top) << "\" width=\"" << Num(ramp_w / 50 + 0.5)
-      << "\" height=\"" << Num(ramp_h) << "\" fill=\"" << HexColor(Viridis((i + 0.5) / 50)).data() << "\"/>\n";
-  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top + ramp_h + 12) << "\" font-size=\"10\">0</text>\n"
+    s << "<rect x=\"" << Num(lx + ramp_w * i / 50) << "\" y=\"" << Num(legend_top) << "\" width=\""
+      << Num(ramp_w / 50 + 0.5) << "\" height=\"" << Num(ramp_h) << "\" fill=\""
+      << HexColor(Viridis((i + 0.5) / 50)).data() << "\"/>\n";
+  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top + ramp_h + 12)
+    << "\" font-size=\"10\">0</text>\n"
     << "<text x=\"" << Num(lx + ramp_w) << "\" y=\"" << Num(legend_top + ramp_h + 12)
     << "\" font-size=\"10\" text-anchor=\"end\">" << max_shared << "</text>\n";
   const double sx = lx + 265;
   const auto swatch = [&](double y, const std::string& rect_attrs, const std::string& text) {
-    s << "<rect x=\"" << Num(sx) << "\" y=\"" << Num(y) << "\" width=\"12\" height=\"12\" " << rect_attrs << "/>\n"
-      << "<text x=\"" << Num(sx + 18) << "\" y=\"" << Num(y + 10) << "\" font-size=\"10\">" << text << "</text>\n";
+    s << "<rect x=\"" << Num(sx) << "\" y=\"" << Num(y) << "\" width=\"12\" height=\"12\" " << rect_attrs
+      << "/>\n"
+      << "<text x=\"" << Num(sx + 18) << "\" y=\"" << Num(y + 10) << "\" font-size=\"10\">" << text
+      << "</text>\n";
   };
   swatch(legend_top - 16, "fill=\"" + std::string(kBelowMinimum) + "\" stroke=\"#cccccc\"",
          "1 to " + std::to_string(std::max(1, r.spec.min_shared - 1)) + " shared: no link");
@@ -199,7 +207,8 @@ std::string CalibrationIntroHtml(const CalibrationSpec& spec) {
   }
   s << " Two cameras are linked when they share at least " << spec.min_shared
     << " poses; a camera outside the largest linked group, or observing fewer poses, cannot be "
-       "calibrated with the rest. Seed " << spec.seed << ".</p>\n";
+       "calibrated with the rest. Seed "
+    << spec.seed << ".</p>\n";
   return s.str();
 }
 
@@ -211,19 +220,25 @@ std::string CalibrationCellHtml(
   s << "<p class=\"" << (r.calibratable ? "calib-ok" : "calib-bad") << "\">"
     << (r.calibratable ? "Calibratable as one rig" : "<b>Not calibratable as one rig</b>") << ": "
     << r.graph.components.size() << " component" << (r.graph.components.size() == 1 ? "" : "s") << ", "
-    << r.graph.uncalibratable.size() << " uncalibratable camera" << (r.graph.uncalibratable.size() == 1 ? "" : "s")
-    << "; " << r.poses_observed << " of " << r.poses << " poses seen by a camera, " << r.poses_shared
-    << " by two or more (simulated in " << Num(r.seconds * 1e3) << " ms).</p>\n";
-  s << svg_image(CalibrationMatrixSvg(r, "Co-visibility: " + rig_name), rig_name + " calibration co-visibility matrix");
+    << r.graph.uncalibratable.size() << " uncalibratable camera"
+    << (r.graph.uncalibratable.size() == 1 ? "" : "s") << "; " << r.poses_observed << " of " << r.poses
+    << " poses seen by a camera, " << r.poses_shared << " by two or more (simulated in "
+    << Num(r.seconds * 1e3) << " ms).</p>\n";
+  s << svg_image(CalibrationMatrixSvg(r, "Co-visibility: " + rig_name),
+                 rig_name + " calibration co-visibility matrix");
   s << "<div class=\"scroll\"><table class=\"calibration\"><thead><tr><th>camera</th><th>component</th>"
-       "<th>poses</th><th>share</th><th style=\"text-align:left\">missed (first failing rule)</th></tr></thead><tbody>\n";
+       "<th>poses</th><th>share</th><th style=\"text-align:left\">missed (first failing "
+       "rule)</th></tr></thead><tbody>\n";
   for (int c = 0; c < n; ++c) {
     const bool bad = IsUncalibratable(r, c);
-    s << "<tr" << (!r.enabled[c] ? " class=\"disabled\"" : bad ? " class=\"uncalibratable\"" : "") << "><td>"
-      << Escape(r.camera_ids[c]) << "</td><td>";
+    s << "<tr"
+      << (!r.enabled[c] ? " class=\"disabled\""
+          : bad         ? " class=\"uncalibratable\""
+                        : "")
+      << "><td>" << Escape(r.camera_ids[c]) << "</td><td>";
     if (r.graph.component[c] >= 0)
-      s << "<span class=\"swatch\" style=\"background:" << ComponentColor(r.graph.component[c]) << "\"></span>"
-        << r.graph.component[c] + 1 << (bad ? " (uncalibratable)" : "");
+      s << "<span class=\"swatch\" style=\"background:" << ComponentColor(r.graph.component[c])
+        << "\"></span>" << r.graph.component[c] + 1 << (bad ? " (uncalibratable)" : "");
     else
       s << "disabled";
     s << "</td><td>" << r.observed[c] << "</td><td>"

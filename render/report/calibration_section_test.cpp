@@ -37,7 +37,7 @@ TEST(CalibrationSection, HeatMapCellsLabelsAndLinks) {
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   EXPECT_EQ(Count(svg, "stroke=\"#cccccc\" stroke-width=\"0.5\""), 16);  // 4 x 4 cells
-  EXPECT_EQ(Count(svg, ">c&amp;d</text>"), 2);                            // both axes, escaped
+  EXPECT_EQ(Count(svg, ">c&amp;d</text>"), 2);                           // both axes, escaped
   EXPECT_EQ(Count(svg, "c&d"), 0);
   EXPECT_NE(svg.find("&lt;rig&gt;"), std::string::npos);
   // The tree: a-b (30, the weakest, red) and b-c&d (50, black), each drawn in both halves.
@@ -54,12 +54,13 @@ TEST(CalibrationSection, HeatMapCellsLabelsAndLinks) {
 TEST(CalibrationSection, CellEmbedsTheMapOnceAndListsCameras) {
   const CalibrationResult r = FourCameras();
   int images = 0;
-  const std::string html = CalibrationCellHtml(r, "ring", [&](const std::string& svg, const std::string& alt) {
-    ++images;
-    EXPECT_EQ(alt, "ring calibration co-visibility matrix");
-    EXPECT_NE(svg.find("Co-visibility: ring"), std::string::npos);
-    return std::string("<img>");
-  });
+  const std::string html =
+      CalibrationCellHtml(r, "ring", [&](const std::string& svg, const std::string& alt) {
+        ++images;
+        EXPECT_EQ(alt, "ring calibration co-visibility matrix");
+        EXPECT_NE(svg.find("Co-visibility: ring"), std::string::npos);
+        return std::string("<img>");
+      });
   EXPECT_EQ(images, 1);
   EXPECT_NE(html.find("Not calibratable as one rig"), std::string::npos);
   EXPECT_EQ(Count(html, "<tr class=\"uncalibratable\">"), 1);

@@ -567,13 +567,12 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
 
   // Calibration feasibility (render/report/calibration_section.h), when the study asks for it.
   if (study.calibration) {
-    body << "<h2 id=\"calibration\">Calibration</h2>\n" << CalibrationIntroHtml(*study.calibration) << RigRow(heads);
+    body << "<h2 id=\"calibration\">Calibration</h2>\n" << CalibrationIntroHtml(*study.calibration)
+         << RigRow(heads);
+    const auto svg_image = [&](const std::string& svg, const std::string& alt) { return fig.Svg(svg, alt); };
     std::vector<std::string> cells;
     for (const RigReport& r : reports)
-      cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, [&](const std::string& svg,
-                                                                                 const std::string& alt) {
-        return fig.Svg(svg, alt);
-      }));
+      cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, svg_image));
     body << RigRow(cells);
   }
 
@@ -611,7 +610,8 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
           "margin-right:8px}ul.warnings{color:#8a4b00}ul.warnings code{color:#555}\n"
           ".scroll{overflow-x:auto}table.cameras td{white-space:nowrap}\n"
           ".meta,.note{color:#555}#image-check{font-size:12px}#image-check.bad{color:#b00;font-weight:bold}\n"
-          "#image-check.ok{color:#070}tr.uncalibratable,.calib-bad{color:#c00000}\n</style>\n</head>\n<body data-expected-images=\""
+          "#image-check.ok{color:#070}tr.uncalibratable,.calib-bad{color:#c00000}\n"
+          "</style>\n</head>\n<body data-expected-images=\""
        << fig.count() << "\">\n"
        << body.str() << summaries
        << "<script>\n"
