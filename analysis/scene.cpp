@@ -903,9 +903,68 @@ Rig ReadRig(const Node& node, std::set<std::string>* names) {
   return rig;
 }
 
+// "study.calibration" (docs/calibration.md): the target and how it is moved.
+CalibrationSpec ReadCalibration(const Node& node) {
+  node.CheckKeys({"target", "samples", "seed", "min_shared", "orientation", "board"});
+  CalibrationSpec spec;
+  const Node target = node.Get("target");
+  const std::string kind = target.String();
+  if (kind != "wand" && kind != "board")
+    target.Fail("expected \"wand\" or \"board\", got " + Quoted(kind),
+                "a wand is one marker seen from all sides; a board is a planar checkerboard or ChArUco");
+  spec.target = kind == "wand" ? CalibrationSpec::Target::kWand : CalibrationSpec::Target::kBoard;
+  if (auto n = node.Find("samples")) spec.samples = n->Integer(1, 1000000);
+  if (auto n = node.Find("seed")) spec.seed = static_cast<std::uint64_t>(n->Integer(0, 2147483647));
+  if (auto n = node.Find("min_shared")) {
+    spec.min_shared = n->Integer(1, 1000000);
+    if (spec.min_shared > spec.samples)
+      n->Fail("min_shared " + std::to_string(spec.min_shared) + " is more than the " +
+                  std::to_string(spec.samples) + " samples: no pair of cameras could be linked",
+              "lower min_shared or raise samples");
+  }
+  for (const char* key : {"orientation", "board"}) {
+    if (spec.target == CalibrationSpec::Target::kWand && node.Has(key))
+      node.Get(key).Fail(std::string("\"") + key + "\" applies to a board, and the target is a wand",
+                         "remove it, or set \"target\": \"board\"");
+  }
+  if (auto n = node.Find("orientation")) {
+    const std::string which = n->String();
+    if (which != "toward_camera" && which != "uniform")
+      n->Fail("expected \"toward_camera\" or \"uniform\", got " + Quoted(which),
+              "toward_camera: the board is turned to a camera that sees it; uniform: any rotation");
+    spec.orientation = which == "uniform" ? CalibrationSpec::Orientation::kUniform
+                                          : CalibrationSpec::Orientation::kTowardCamera;
+  }
+  if (auto board = node.Find("board")) {
+    board->CheckKeys({"squares", "square_m", "tilt_max_deg", "min_px_per_square"});
+    CalibrationBoard& b = spec.board;
+    if (auto n = board->Find("squares")) {
+      if (n->ArraySize("an array of 2 whole numbers of squares [x, y]") != 2)
+        n->Fail("expected an array of 2 whole numbers of squares [x, y], got an array of " +
+                std::to_string(n->value().size()));
+      b.squares_x = n->At(0).Integer(2, 100);
+      b.squares_y = n->At(1).Integer(2, 100);
+    }
+    if (auto n = board->Find("square_m")) b.square_m = n->PositiveLength();
+    if (auto n = board->Find("tilt_max_deg")) {
+      b.tilt_max_deg = n->Number();
+      if (!(b.tilt_max_deg > 0 && b.tilt_max_deg < 90))
+        n->Fail("must be an angle in degrees in (0, 90), got " + FormatNumber(b.tilt_max_deg),
+                "detectors lose a board seen more obliquely than about 60-75 degrees");
+    }
+    if (auto n = board->Find("min_px_per_square")) {
+      b.min_px_per_square = n->NonNegative();
+      if (b.min_px_per_square > 1e5)
+        n->Fail("must be at most 1e5 pixels, got " + FormatNumber(b.min_px_per_square));
+    }
+  }
+  return spec;
+}
+
 Study ReadStudy(const Node& node) {
   node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
-                  "max_sigma_mm", "time", "targets"});
+                  "max_sigma_mm", "time", "targets",
+                  "calibration"});
   Study study;
   const Node region = node.Get("region");
   region.CheckKeys({"box", "mesh"});
@@ -1017,6 +1076,7 @@ Study ReadStudy(const Node& node) {
     if (auto n = t->Find("seed")) targets.seed = std::uint64_t(n->Integer(0, 2147483647));
     study.targets = targets;
   }
+  if (auto n = node.Find("calibration")) study.calibration = ReadCalibration(*n);
   // Checked after the motion model is known: steady-state fields need one.
   if (auto problem = CheckFieldList(study.fields, study.motion.has_value())) {
     const auto n = node.Find("fields");

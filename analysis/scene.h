@@ -11,6 +11,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "analysis/calibration.h"
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
 #include "analysis/motion.h"
@@ -104,6 +105,8 @@ struct Study {
   std::optional<TimeStudy> time;
   /// Surface targets; unset: none.
   std::optional<SurfaceTargets> targets;
+  /// Calibration feasibility to simulate ("calibration", docs/calibration.md); none when absent.
+  std::optional<CalibrationSpec> calibration;
 };
 
 /// Every field name a study may ask for, in output order:

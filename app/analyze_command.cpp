@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "analysis/calibration.h"
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
 #include "analysis/motion.h"
@@ -132,6 +133,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   typed.time = time;
   typed.targets = std::move(targets);
   typed.sample_labels = sample_labels;
+  if (scene.study.calibration)
+    typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{

@@ -255,6 +255,7 @@ void to_json(nlohmann::json& j, const Summary& s) {
                  {"point_camera_tests", s.timing.point_camera_tests},
                  {"tests_per_second", s.timing.tests_per_second()},
                  {"threads", s.timing.threads}};
+  if (s.calibration) j["calibration"] = *s.calibration;
 }
 
 nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
@@ -328,6 +329,7 @@ std::string FormatSummary(const Summary& s) {
   out += Format("%.3f s, %.3g rays (%.3g rays/s), %.3g point-camera tests\n", s.timing.seconds,
                 static_cast<double>(s.timing.rays), s.timing.rays_per_second(),
                 static_cast<double>(s.timing.point_camera_tests));
+  if (s.calibration) out += FormatCalibration(*s.calibration);
   return out;
 }
 

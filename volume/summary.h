@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/calibration.h"
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
 #include "analysis/surface_targets.h"
@@ -99,6 +100,9 @@ struct Summary {
   /// of the JSON).
   std::vector<SurfaceTargetResult> targets;
   std::vector<std::string> sample_labels;  ///< The time samples' labels (for the targets' rows).
+  /// The calibration simulation (analysis/calibration.h) when the study asks for one; the caller
+  /// sets it (Summarize does not: it needs the ray caster).
+  std::optional<CalibrationResult> calibration;
 };
 
 /// Summarises the evaluated `fields` of `rig` in `scene`. `field_names`: the fields that were asked
@@ -116,9 +120,9 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
 /// unobservable_voxels, pixel_sigma, sigma_max_mm {p50, p90, p99}, [max_sigma_mm,
 /// meets_max_sigma], [motion {q, rate_hz, covariance}, sigma_max_steady_mm, [meets_max_sigma_
 /// steady]]}, timing {seconds, active_set_seconds, rays, rays_per_second, point_camera_tests,
-/// tests_per_second, threads}, fields, region {min, max, dims, kind}, scene, scene_sha256, and
-/// warnings [{kind, camera, path, message}] (always present, empty when none). Percentiles
-/// without a value are null.
+/// tests_per_second, threads}, fields, region {min, max, dims, kind}, scene, scene_sha256,
+/// warnings [{kind, camera, path, message}] (always present, empty when none), and calibration
+/// (analysis/calibration.h's to_json) when set. Percentiles without a value are null.
 void to_json(nlohmann::json& j, const Summary& summary);
 
 /// to_json(Summarize(...)): the summary.json of one evaluation.
@@ -128,8 +132,8 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
 
 /// The table `pandora analyze` prints: the rig and region, coverage shares, the resolution and
 /// sigma_max percentiles when present ("-" for a percentile without a value), one line per camera
-/// (share of the region seen, effective and nominal FOV, disabled ones marked) and the timing.
-/// Lines end in '\n'.
+/// (share of the region seen, effective and nominal FOV, disabled ones marked), the timing, and
+/// FormatCalibration's lines when the calibration is set. Lines end in '\n'.
 std::string FormatSummary(const Summary& summary);
 
 /// Nearest-rank percentiles of the active values of the float grid `name` of `fields` (tiles count

@@ -18,6 +18,7 @@
 #include "analysis/color.h"
 #include "analysis/error.h"
 #include "render/render.h"
+#include "render/report/calibration_section.h"
 #include "render/report/plot.h"
 #include "render/report/report_images.h"
 
@@ -275,6 +276,8 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
     check.visible_voxels = r.fields.stats.per_camera_seen;
     r.warnings = CheckRig(scene, *rig, caster, check);
     r.summary = Summarize(scene, *rig, r.fields, data.field_names, threads, r.warnings);
+    if (scene.study.calibration)
+      r.summary.calibration = SimulateCalibration(scene, *rig, caster, *scene.study.calibration);
     data.rigs.push_back(std::move(r));
   }
 
@@ -562,6 +565,17 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     body << RigRow(cells);
   }
 
+  // Calibration feasibility (render/report/calibration_section.h), when the study asks for it.
+  if (study.calibration) {
+    body << "<h2 id=\"calibration\">Calibration</h2>\n" << CalibrationIntroHtml(*study.calibration)
+         << RigRow(heads);
+    const auto svg_image = [&](const std::string& svg, const std::string& alt) { return fig.Svg(svg, alt); };
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports)
+      cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, svg_image));
+    body << RigRow(cells);
+  }
+
   // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.
   std::string summaries;
   for (const RigReport& r : reports) {
@@ -596,7 +610,8 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
           "margin-right:8px}ul.warnings{color:#8a4b00}ul.warnings code{color:#555}\n"
           ".scroll{overflow-x:auto}table.cameras td{white-space:nowrap}\n"
           ".meta,.note{color:#555}#image-check{font-size:12px}#image-check.bad{color:#b00;font-weight:bold}\n"
-          "#image-check.ok{color:#070}\n</style>\n</head>\n<body data-expected-images=\""
+          "#image-check.ok{color:#070}tr.uncalibratable,.calib-bad{color:#c00000}\n"
+          "</style>\n</head>\n<body data-expected-images=\""
        << fig.count() << "\">\n"
        << body.str() << summaries
        << "<script>\n"
