@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "analysis/ray_caster.h"
@@ -76,6 +77,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     int motion = -1;
     for (std::size_t k = 0; k < scene.motions.size(); ++k)
       if (scene.motions[k].name == name) motion = int(k);
+    const auto t0 = std::chrono::steady_clock::now();
     SurfaceTargetResult r;
     r.name = name;
     std::vector<Vec3> points, normals;
@@ -130,6 +132,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
       for (std::size_t s = 0; s < samples.size(); ++s) n += double(seen_by[s][c]);
       r.per_camera[c] = pairs > 0 ? n / pairs : 0.0;
     }
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.push_back(std::move(r));
   }
   return out;

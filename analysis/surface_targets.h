@@ -34,6 +34,7 @@ struct SurfaceTargetResult {
   /// cameras[sample * points + point]: how many cameras see the point at that sample (kept for
   /// tests and pictures).
   std::vector<std::uint16_t> cameras;
+  double seconds = 0;  ///< Wall time of this target's points over all samples.
 };
 
 /// Points uniform by area on `mesh` (seeded, reproducible), with their triangles' unit normals.

@@ -244,7 +244,8 @@ void to_json(nlohmann::json& j, const Summary& s) {
                          {"always", r.always},
                          {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
                          {"per_sample", per_sample},
-                         {"per_camera", per_camera}});
+                         {"per_camera", per_camera},
+                         {"seconds", r.seconds}});
     }
     j["targets"] = targets;
   }

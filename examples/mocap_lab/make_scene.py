@@ -35,7 +35,7 @@ def person(name, x, y, material):
 
 def look(cid, position, target, color):
     return {"id": cid, "color": color, "position": [round(v, 4) for v in position],
-            "look_at": target, "up": [0, 0, 1], "resolution": [2048, 1088], "hfov_deg": 62,
+            "look_at": target, "up": [0, 0, 1], "resolution": [2048, 1536], "hfov_deg": 66,
             "range": {"near": 0.3, "far": 12.0}}
 
 
