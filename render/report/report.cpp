@@ -17,8 +17,12 @@
 #include "analysis/atomic_file.h"
 #include "analysis/color.h"
 #include "analysis/error.h"
+#include "analysis/motion.h"
+#include "analysis/surface_targets.h"
+#include "volume/time_fields.h"
 #include "render/render.h"
 #include "render/report/calibration_section.h"
+#include "render/report/time_section.h"
 #include "render/report/plot.h"
 #include "render/report/report_images.h"
 
@@ -261,6 +265,15 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
   }
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  // Moving objects and surface targets (docs/time.md): the scene's rigid parts, built once.
+  std::unique_ptr<RigidPartsRayCaster> parts;
+  std::vector<TimeSample> samples;
+  std::vector<std::string> sample_labels;
+  if (!scene.motions.empty() || scene.study.targets) {
+    parts = MakeSceneParts(scene);
+    samples = scene.TimeSamples();
+    for (const TimeSample& s : samples) sample_labels.push_back(s.label);
+  }
   for (const Rig* rig : rigs) {
     FieldOptions field_options;
     field_options.scene_path = scene.path;
@@ -278,6 +291,17 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
     r.summary = Summarize(scene, *rig, r.fields, data.field_names, threads, r.warnings);
     if (scene.study.calibration)
       r.summary.calibration = SimulateCalibration(scene, *rig, caster, *scene.study.calibration);
+    if (parts) {
+      if (!samples.empty()) {
+        FieldOptions over_time = field_options;
+        over_time.fields.erase(std::remove(over_time.fields.begin(), over_time.fields.end(), "cameras"),
+                               over_time.fields.end());
+        r.summary.time =
+            EvaluateFieldsOverTime(scene, *rig, *parts, samples, over_time, scene.TimeMinCameras()).summary;
+      }
+      r.summary.targets = EvaluateSurfaceTargets(scene, *rig, *parts, samples, scene.TimeMinCameras());
+      r.summary.sample_labels = sample_labels;
+    }
     data.rigs.push_back(std::move(r));
   }
 
@@ -574,6 +598,17 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     for (const RigReport& r : reports)
       cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, svg_image));
     body << RigRow(cells);
+  }
+
+  // Over time and on bodies (render/report/time_section.h), with moving objects or targets.
+  {
+    std::vector<const Summary*> summaries;
+    std::vector<std::string> names;
+    for (const RigReport& r : reports) {
+      summaries.push_back(&r.summary);
+      names.push_back(r.rig.name);
+    }
+    body << TimeSectionHtml(summaries, names);
   }
 
   // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.
