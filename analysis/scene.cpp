@@ -964,7 +964,7 @@ CalibrationSpec ReadCalibration(const Node& node) {
 Study ReadStudy(const Node& node) {
   node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
                   "max_sigma_mm", "time", "targets",
-                  "calibration"});
+                  "calibration", "pixel_targets", "dori"});
   Study study;
   const Node region = node.Get("region");
   region.CheckKeys({"box", "mesh"});
@@ -1065,6 +1065,24 @@ Study ReadStudy(const Node& node) {
     if (auto n = t->Find("min_cameras")) time.min_cameras = n->Integer(1, 1000);
     study.time = time;
   }
+  if (auto list = node.Find("pixel_targets")) {
+    const size_t count = list->ArraySize("an array of {\"name\", \"size_m\", \"min_px\"}");
+    if (count > 16) list->Fail("at most 16 pixel targets");
+    std::set<std::string> names;
+    for (size_t i = 0; i < count; ++i) {
+      const Node t = list->At(i);
+      t.CheckKeys({"name", "size_m", "min_px"});
+      PixelTarget p;
+      p.name = t.Get("name").NonEmptyString();
+      if (!names.insert(p.name).second) t.Get("name").Fail("duplicate pixel target name " + Quoted(p.name));
+      p.size_m = t.Get("size_m").PositiveLength();
+      const Node px = t.Get("min_px");
+      p.min_px = px.Positive();
+      if (!(p.min_px <= 1e5)) px.Fail("expected at most 1e5 pixels");
+      study.pixel_targets.push_back(p);
+    }
+  }
+  if (auto n = node.Find("dori")) study.dori = n->Bool();
   if (auto t = node.Find("targets")) {
     t->CheckKeys({"objects", "points", "seed"});
     SurfaceTargets targets;

@@ -84,6 +84,16 @@ struct SurfaceTargets {
   std::uint64_t seed = 1;
 };
 
+/// A pixel-size target ("study": {"pixel_targets": [...]}): an object of `size_m` metres must span
+/// at least `min_px` pixels (a 14 mm marker over 4 px, a face over 80 px), i.e. a camera's pixel
+/// density at the point must be at least min_px / size_m px/m (volume/pixel_targets.h).
+struct PixelTarget {
+  std::string name;
+  double size_m = 0.014;
+  double min_px = 4;
+  double px_per_m() const { return min_px / size_m; }
+};
+
 /// What to compute and where.
 struct Study {
   Region region;
@@ -105,6 +115,11 @@ struct Study {
   std::optional<TimeStudy> time;
   /// Surface targets; unset: none.
   std::optional<SurfaceTargets> targets;
+  /// Pixel-size targets, in file order (at most 16).
+  std::vector<PixelTarget> pixel_targets;
+  /// Surveillance DORI classes (EN 62676-4: detection 25, observation 62.5, recognition 125,
+  /// identification 250 px/m of the best camera) as a field and summary ("dori": true).
+  bool dori = false;
   /// Calibration feasibility to simulate ("calibration", docs/calibration.md); none when absent.
   std::optional<CalibrationSpec> calibration;
 };

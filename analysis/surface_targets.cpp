@@ -86,6 +86,9 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     r.samples = int(samples.size());
     r.cameras.assign(std::size_t(r.samples) * r.points, 0);
     std::vector<std::vector<std::int64_t>> seen_by(samples.size(), std::vector<std::int64_t>(rig.cameras.size(), 0));
+    const std::size_t pixel_count = scene.study.pixel_targets.size();
+    std::vector<std::int64_t> pixel_pairs(pixel_count, 0);
+    std::vector<std::uint16_t> pixel_cameras(pixel_count * points.size());
     for (std::size_t s = 0; s < samples.size(); ++s) {
       // The target's transform at this sample: its own motion, or none.
       Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -96,11 +99,16 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           const Vec3 X = T * points[i], n = T.linear() * normals[i];
           int count = 0;
+          for (std::size_t p = 0; p < pixel_count; ++p) pixel_cameras[p * points.size() + i] = 0;
           for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
             if (!rig.cameras[c].enabled) continue;
-            if (testers[s]->Test(int(c), X, &n) == ViewResult::kSeen) {
+            Mat23 J;
+            if (testers[s]->Test(int(c), X, &n, &J) == ViewResult::kSeen) {
               ++count;
               sees[c][i] = 1;
+              const double density = PixelDensity(J);
+              for (std::size_t p = 0; p < pixel_count; ++p)
+                if (density >= scene.study.pixel_targets[p].px_per_m()) ++pixel_cameras[p * points.size() + i];
             }
           }
           r.cameras[s * points.size() + i] = std::uint16_t(std::min(count, 65535));
@@ -108,6 +116,8 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
       });
       for (std::size_t c = 0; c < rig.cameras.size(); ++c)
         for (std::uint8_t v : sees[c]) seen_by[s][c] += v;
+      for (std::size_t p = 0; p < pixel_count; ++p)
+        for (std::size_t i = 0; i < points.size(); ++i) pixel_pairs[p] += pixel_cameras[p * points.size() + i] >= min_cameras;
     }
     const double pairs = double(r.points) * r.samples;
     r.share_ge.assign(kmax, 0.0);
@@ -126,6 +136,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     for (std::uint8_t v : always) a += v;
     r.always = r.points > 0 ? a / r.points : 0.0;
     r.worst_sample = int(std::min_element(r.sample_share.begin(), r.sample_share.end()) - r.sample_share.begin());
+    for (std::size_t p = 0; p < pixel_count; ++p) r.pixel_share.push_back(pairs > 0 ? double(pixel_pairs[p]) / pairs : 0.0);
     r.per_camera.assign(rig.cameras.size(), 0.0);
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
       double n = 0;

@@ -34,6 +34,9 @@ struct SurfaceTargetResult {
   /// cameras[sample * points + point]: how many cameras see the point at that sample (kept for
   /// tests and pictures).
   std::vector<std::uint16_t> cameras;
+  /// Per pixel target of the study (Study::pixel_targets): share of the (point, sample) pairs seen
+  /// by at least min_cameras cameras each at that target's pixel density or more.
+  std::vector<double> pixel_share;
   double seconds = 0;  ///< Wall time of this target's points over all samples.
 };
 

@@ -19,6 +19,7 @@
 #include "app/output.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
+#include "volume/pixel_targets.h"
 #include "volume/time_fields.h"
 #include "volume/vdb_io.h"
 
@@ -121,6 +122,10 @@ int RunAnalyze(const AnalyzeArgs& args) {
     }
     targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
   }
+  // Pixel-size targets and DORI classes, from the fields without casting again.
+  std::vector<PixelTargetSummary> pixel_targets = EvaluatePixelTargets(scene, rig, fields, scene.TimeMinCameras(), &fields);
+  std::optional<DoriSummary> dori;
+  if (scene.study.dori) dori = EvaluateDori(scene, fields, &fields);
   const RayCaster& caster = study->caster();
 
   const int threads = static_cast<int>(
@@ -133,6 +138,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   typed.time = time;
   typed.targets = std::move(targets);
   typed.sample_labels = sample_labels;
+  typed.pixel_targets = std::move(pixel_targets);
+  typed.dori = dori;
   if (scene.study.calibration)
     typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
   nlohmann::json summary = typed;

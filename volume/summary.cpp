@@ -246,9 +246,32 @@ void to_json(nlohmann::json& j, const Summary& s) {
                          {"per_sample", per_sample},
                          {"per_camera", per_camera},
                          {"seconds", r.seconds}});
+      if (!r.pixel_share.empty()) {
+        nlohmann::json pixel = nlohmann::json::object();
+        for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
+          pixel[s.pixel_targets[p].target.name] = r.pixel_share[p];
+        targets.back()["pixel_share"] = pixel;
+      }
     }
     j["targets"] = targets;
   }
+  if (!s.pixel_targets.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const PixelTargetSummary& p : s.pixel_targets)
+      list.push_back({{"name", p.target.name},
+                      {"size_m", p.target.size_m},
+                      {"min_px", p.target.min_px},
+                      {"px_per_m", p.target.px_per_m()},
+                      {"share_ge", p.share_ge},
+                      {"seconds", p.seconds}});
+    j["pixel_targets"] = list;
+  }
+  if (s.dori)
+    j["dori"] = {{"detection", s.dori->detection},
+                 {"observation", s.dori->observation},
+                 {"recognition", s.dori->recognition},
+                 {"identification", s.dori->identification},
+                 {"px_per_m", {kDoriPxPerM[0], kDoriPxPerM[1], kDoriPxPerM[2], kDoriPxPerM[3]}}};
   j["timing"] = {{"seconds", s.timing.seconds},
                  {"active_set_seconds", s.timing.active_set_seconds},
                  {"rays", s.timing.rays},
@@ -317,11 +340,21 @@ std::string FormatSummary(const Summary& s) {
       out += Format("  %-24s >=1 %5.1f%%  >=2 %5.1f%%  >=3 %5.1f%%%s\n", r.label.c_str(), 100 * r.ge1, 100 * r.ge2,
                     100 * r.ge3, r.sigma_max_p90 ? Format("  sigma_max p90 %.3g mm", *r.sigma_max_p90).c_str() : "");
   }
+  for (const PixelTargetSummary& p : s.pixel_targets)
+    out += Format("pixels    %-12s (%.4g m over >= %.4g px: >= %.0f px/m) by >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%% of the region\n",
+                  p.target.name.c_str(), p.target.size_m, p.target.min_px, p.target.px_per_m(), 100 * p.share_ge[0],
+                  100 * p.share_ge[1], 100 * p.share_ge[2]);
+  if (s.dori)
+    out += Format("DORI      detection %.1f%%, observation %.1f%%, recognition %.1f%%, identification %.1f%% of the region\n",
+                  100 * s.dori->detection, 100 * s.dori->observation, 100 * s.dori->recognition,
+                  100 * s.dori->identification);
   for (const SurfaceTargetResult& r : s.targets) {
     const int k = s.time ? s.time->min_cameras : 3;
     out += Format("target %-16s %d points x %d samples: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%; >= %d in every sample %.1f%%",
                   r.name.c_str(), r.points, r.samples, 100 * r.share_ge[0], 100 * r.share_ge[1], 100 * r.share_ge[2], k,
                   100 * r.always);
+    for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
+      out += Format("; %s size by >= %d: %.1f%%", s.pixel_targets[p].target.name.c_str(), k, 100 * r.pixel_share[p]);
     if (r.samples > 1)
       out += Format(", worst %s %.1f%%", r.worst_sample < int(s.sample_labels.size()) ? s.sample_labels[r.worst_sample].c_str() : "-",
                     100 * r.sample_share[r.worst_sample]);

@@ -17,6 +17,7 @@
 #include "analysis/scene.h"
 #include "analysis/surface_targets.h"
 #include "volume/fields.h"
+#include "volume/pixel_targets.h"
 #include "volume/time_fields.h"
 
 namespace pandora {
@@ -100,6 +101,10 @@ struct Summary {
   /// of the JSON).
   std::vector<SurfaceTargetResult> targets;
   std::vector<std::string> sample_labels;  ///< The time samples' labels (for the targets' rows).
+  /// With study.pixel_targets: each over the region (volume/pixel_targets.h).
+  std::vector<PixelTargetSummary> pixel_targets;
+  /// With study.dori: the DORI classes' shares.
+  std::optional<DoriSummary> dori;
   /// The calibration simulation (analysis/calibration.h) when the study asks for one; the caller
   /// sets it (Summarize does not: it needs the ray caster).
   std::optional<CalibrationResult> calibration;

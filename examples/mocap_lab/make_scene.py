@@ -120,6 +120,8 @@ def main():
             "fields": ["coverage", "cameras", "sigma_max"],
             "time": {"poses": list(POSES.keys()), "min_cameras": 3},
             "targets": {"objects": ["a", "b"], "points": 3000, "seed": 1},
+            "pixel_targets": [{"name": "marker", "size_m": 0.014, "min_px": 4},
+                              {"name": "face", "size_m": 0.16, "min_px": 80}],
         },
         "views": {"overview": {"from": [-4.5, -4.0, 3.6], "at": [0.0, 0.0, 0.9], "fov_deg": 60}},
     }

@@ -1,0 +1,49 @@
+#pragma once
+/// \file pixel_targets.h
+/// Pixel-size targets: "a 14 mm marker spans at least 4 pixels", "a face at least 80 pixels", in
+/// as many cameras as triangulation needs; and the surveillance DORI classes of EN 62676-4 (the
+/// best camera's pixel density at least 25 / 62.5 / 125 / 250 px/m: detection, observation,
+/// recognition, identification). Computed after the fields from the per-camera visibility grids
+/// and each camera's projection Jacobian (analysis/visibility.h PixelDensity): no ray is cast again.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/scene.h"
+#include "volume/fields.h"
+
+namespace pandora {
+
+/// One pixel target over the region.
+struct PixelTargetSummary {
+  PixelTarget target;
+  /// share_ge[j - 1]: share of the free region voxels seen by at least j cameras each at a pixel
+  /// density of at least target.px_per_m(), j = 1 .. max(3, min_cameras).
+  std::vector<double> share_ge;
+  double seconds = 0;
+};
+
+/// The DORI classes over the region (the best camera's density, the resolution field).
+struct DoriSummary {
+  /// Share of the free region voxels whose best density reaches detection (25 px/m), observation
+  /// (62.5), recognition (125), identification (250).
+  double detection = 0, observation = 0, recognition = 0, identification = 0;
+};
+
+/// The EN 62676-4 thresholds, px/m.
+inline constexpr double kDoriPxPerM[4] = {25.0, 62.5, 125.0, 250.0};
+
+/// Evaluates scene.study.pixel_targets over `fields` (which must hold the "cameras" field) for
+/// `rig`; when `grids` is not null, adds per target a float grid "pixels_<name>" (cameras that meet
+/// it, whole numbers) to its Fields::Impl::extra. Throws InputError (path "$.study.pixel_targets")
+/// when the cameras field is missing.
+std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig, const Fields& fields,
+                                                    int min_cameras, Fields* grids);
+
+/// The DORI shares from the resolution field (InputError "$.study.dori" when it is missing); with
+/// `grids`, adds a float grid "dori" (the class 0 .. 4 reached, active on the free region voxels).
+DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids);
+
+}  // namespace pandora
