@@ -89,6 +89,9 @@ struct RenderArgs {
   double slice_at = kUnset;
   std::string iso;             ///< Field whose isosurface is drawn.
   double iso_value = kUnset;
+  /// `--time-sample`: the scene at one of the study's time samples (docs/time.md): its number
+  /// (1-based), its pose name or its label; empty: the scene as placed.
+  std::string time_sample;
   bool quiet = false;
 };
 int RunRender(const RenderArgs& args);

@@ -227,6 +227,8 @@ int main(int argc, char** argv) {
   rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
   rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");
   rn->add_option("--camera", render.camera, "Render what this camera (id) images, distortion included");
+  rn->add_option("--time-sample", render.time_sample,
+                 "The scene at one of the study's time samples: its number, pose name or label (docs/time.md)");
   rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)")
       ->check(Number(0, 180, "degrees", false, true, true));
   rn->add_option("--size", render.size, "Image size WxH (default 1280x720; the camera's with --camera)");

@@ -79,7 +79,27 @@ int RunRender(const RenderArgs& args) {
   session::SessionOptions session_options;
   session_options.rig = args.rig;
   session_options.rig_option = "--rig";
-  const session::Session session(session::Study::Load(args.scene), session_options);
+  std::shared_ptr<const session::Study> study = session::Study::Load(args.scene);
+  if (!args.time_sample.empty()) {
+    // The scene moved to one time sample: by number, pose name or label.
+    const Scene& placed = study->scene();
+    const std::vector<TimeSample> samples = placed.TimeSamples();
+    if (samples.empty())
+      throw InputError("--time-sample", "", "the scene has no moving objects", "add \"motions\" (docs/time.md)");
+    int pick = -1;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      if (samples[i].label == args.time_sample || samples[i].label == "pose '" + args.time_sample + "'" ||
+          std::to_string(i + 1) == args.time_sample)
+        pick = int(i);
+    if (pick < 0) {
+      std::string labels;
+      for (std::size_t i = 0; i < samples.size(); ++i)
+        labels += (labels.empty() ? "" : ", ") + std::to_string(i + 1) + " " + samples[i].label;
+      throw InputError("--time-sample", "", "no time sample '" + args.time_sample + "'", "the samples: " + labels);
+    }
+    study = session::Study::FromScene(SceneAtSample(placed, samples[pick]), study->text());
+  }
+  const session::Session session(study, session_options);
   const Scene& scene = session.study().scene();
   const Rig& rig = session.rig().rig();
   OutputTransaction output;

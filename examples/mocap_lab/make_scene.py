@@ -123,7 +123,7 @@ def main():
             "pixel_targets": [{"name": "marker", "size_m": 0.014, "min_px": 4},
                               {"name": "face", "size_m": 0.16, "min_px": 80}],
         },
-        "views": {"overview": {"from": [-4.5, -4.0, 3.6], "at": [0.0, 0.0, 0.9], "fov_deg": 60}},
+        "views": {"overview": {"from": [-3.1, -2.2, 2.9], "at": [0.4, 0.2, 0.7], "fov_deg": 70}},
     }
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scene.json")
     with open(path, "w") as f:
