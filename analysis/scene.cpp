@@ -961,18 +961,14 @@ CalibrationSpec ReadCalibration(const Node& node) {
   return spec;
 }
 
-Study ReadStudy(const Node& node) {
-  node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
-                  "max_sigma_mm", "time", "targets",
-                  "calibration", "pixel_targets", "dori"});
-  Study study;
-  const Node region = node.Get("region");
+Region ReadRegion(const Node& region, const Node& node) {
+  Region out;
   region.CheckKeys({"box", "mesh"});
   const std::string kind = region.OneOf({"box", "mesh"}, "region shape");
   if (kind == "box") {
     const Node box = region.Get("box");
     box.CheckKeys({"min", "max", "center", "size"});
-    study.region.kind = Region::Kind::kBox;
+    out.kind = Region::Kind::kBox;
     if (box.Has("min") || box.Has("max")) {
       for (const char* key : {"center", "size"}) {
         if (box.Has(key)) {
@@ -988,28 +984,36 @@ Study ReadStudy(const Node& node) {
                               std::string(1, "xyz"[i]) + ")");
         }
       }
-      study.region.box.min = min;
-      study.region.box.max = max;
+      out.box.min = min;
+      out.box.max = max;
     } else {
       const Vec3 center = box.Get("center").Point();
       const Vec3 size = box.Get("size").PositiveVector3() * node.context().metres_per_unit;
-      study.region.box.min = center - 0.5 * size;
-      study.region.box.max = center + 0.5 * size;
+      out.box.min = center - 0.5 * size;
+      out.box.max = center + 0.5 * size;
     }
   } else {
-    study.region.kind = Region::Kind::kMesh;
+    out.kind = Region::Kind::kMesh;
     const MeshReference reference = ReadMeshReference(region.Get("mesh"));
-    study.region.file = reference.resolved;
+    out.file = reference.resolved;
     if (node.context().options.load_meshes) {
       TriangleMesh mesh;
       for (const MeshPart& part : LoadMeshParts(reference)) mesh.Append(part.mesh);
       mesh = WeldVertices(Transformed(mesh, reference.file_to_object));
       CheckSolid(mesh, reference.file_node, "the region mesh", "repair the mesh");
-      study.region.box = mesh.Bounds();
-      study.region.mesh = std::move(mesh);
+      out.box = mesh.Bounds();
+      out.mesh = std::move(mesh);
     }
   }
+  return out;
+}
 
+Study ReadStudy(const Node& node) {
+  node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
+                  "max_sigma_mm", "time", "targets",
+                  "calibration", "pixel_targets", "dori", "regions"});
+  Study study;
+  study.region = ReadRegion(node.Get("region"), node);
   if (auto n = node.Find("voxel_size")) study.voxel_size = n->PositiveLength();
   if (auto n = node.Find("fields")) {
     const size_t count = n->ArraySize("an array of field names");
@@ -1083,6 +1087,15 @@ Study ReadStudy(const Node& node) {
     }
   }
   if (auto n = node.Find("dori")) study.dori = n->Bool();
+  if (auto regions = node.Find("regions")) {
+    regions->ExpectObject("an object of named regions {\"box\": ...} or {\"mesh\": ...}");
+    if (regions->value().size() > 64) regions->Fail("at most 64 named regions");
+    for (const auto& item : regions->value().items()) {
+      const Node r(&item.value(), MemberPath(regions->path(), item.key()), &node.context());
+      if (item.key().empty()) r.Fail("region names must not be empty");
+      study.regions.emplace_back(item.key(), ReadRegion(r, node));
+    }
+  }
   if (auto t = node.Find("targets")) {
     t->CheckKeys({"objects", "points", "seed"});
     SurfaceTargets targets;
@@ -1235,6 +1248,8 @@ std::vector<std::pair<std::string, std::string>> Scene::InputFiles() const {
     files.emplace_back((p.is_absolute() ? p : folder / p).lexically_normal().string(), "mesh file");
   }
   if (!study.region.file.empty()) files.emplace_back(study.region.file, "mesh file");
+  for (const auto& [name, r] : study.regions)
+    if (!r.file.empty()) files.emplace_back(r.file, "mesh file");
   for (const Material& m : materials)
     if (!m.texture.empty()) files.emplace_back(m.texture, "texture");
   return files;

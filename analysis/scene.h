@@ -115,6 +115,9 @@ struct Study {
   std::optional<TimeStudy> time;
   /// Surface targets; unset: none.
   std::optional<SurfaceTargets> targets;
+  /// Named sub-regions ("regions"), each summarised from the same fields (its free voxels: centres
+  /// inside it and inside the study region), in file order.
+  std::vector<std::pair<std::string, Region>> regions;
   /// Pixel-size targets, in file order (at most 16).
   std::vector<PixelTarget> pixel_targets;
   /// Surveillance DORI classes (EN 62676-4: detection 25, observation 62.5, recognition 125,

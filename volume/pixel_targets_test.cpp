@@ -7,7 +7,9 @@
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
 #include "analysis/visibility.h"
+#include "analysis/primitives.h"
 #include "volume/fields_vdb.h"
+#include "volume/summary.h"
 
 namespace pandora {
 namespace {
@@ -110,6 +112,40 @@ TEST(PixelTargets, DoriClassesFromTheBestCamerasDensity) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.json_path(), "$.study.pixel_targets");
   }
+}
+
+// Named sub-regions: two halves of the study region split at x = 0 (the one given as a closed
+// mesh box) partition its voxels, their shares weighted by their voxels add up to the whole
+// region's, and a region equal to the study region repeats the summary's coverage.
+TEST(NamedRegions, PartitionTheStudyRegion) {
+  Scene scene = TestScene();
+  Region left, right, all;
+  left.box.min = Vec3(-1.5, -1.5, 0);
+  left.box.max = Vec3(-1e-9, 1.5, 2);
+  right.kind = Region::Kind::kMesh;
+  right.box.min = Vec3(1e-9, -1.5, 0);
+  right.box.max = Vec3(1.5, 1.5, 2);
+  right.mesh = MakeBox(right.box.size());
+  for (Vec3& v : right.mesh.vertices) v += right.box.center();
+  all.box = scene.study.region.box;
+  scene.study.regions = {{"left", left}, {"right", right}, {"all", all}};
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage", "cameras", "resolution", "sigma_max"};
+  const Fields fields = EvaluateFields(scene, scene.rigs[0], *caster, options);
+  const Summary s = Summarize(scene, scene.rigs[0], fields, options.fields, 1);
+  ASSERT_EQ(s.regions.size(), 3u);
+  const RegionSummary &l = s.regions[0], &r = s.regions[1], &a = s.regions[2];
+  EXPECT_EQ(a.voxels, s.region_voxels);
+  EXPECT_EQ(l.voxels + r.voxels, s.region_voxels);
+  EXPECT_GT(l.voxels, 0);
+  EXPECT_GT(r.voxels, 0);
+  EXPECT_DOUBLE_EQ(a.ge2, s.coverage.ge2);
+  EXPECT_NEAR(l.ge1 * l.voxels + r.ge1 * r.voxels, s.coverage.ge1 * s.region_voxels, 1e-9);
+  EXPECT_NEAR(l.ge3 * l.voxels + r.ge3 * r.voxels, s.coverage.ge3 * s.region_voxels, 1e-9);
+  EXPECT_EQ(a.sigma_max_p90, s.uncertainty->sigma_max_mm.p90);
+  // The halves differ: camera "a" (x = 3) sees more of the right half.
+  EXPECT_NE(l.ge3, r.ge3);
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 #include "volume/summary.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 
+#include "analysis/inside_mesh.h"
 #include "analysis/text.h"
 #include "volume/fields_vdb.h"
 
@@ -65,6 +67,50 @@ nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
   for (std::size_t i = 0; i < percentiles.size(); ++i)
     j["p" + std::to_string(percentiles[i])] = Value(values[i]);
   return j;
+}
+
+std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fields) {
+  std::vector<RegionSummary> out;
+  const Fields::Impl& g = fields.impl();
+  if (scene.study.regions.empty() || !g.coverage) return out;
+  const openvdb::FloatGrid::Ptr sigma = g.Float("sigma_max"), resolution = g.Float("resolution");
+  for (const auto& [name, region] : scene.study.regions) {
+    std::unique_ptr<InsideMesh> inside;
+    if (region.kind == Region::Kind::kMesh && !region.mesh.triangles.empty())
+      inside = std::make_unique<InsideMesh>(region.mesh);
+    RegionSummary r;
+    r.name = name;
+    std::int64_t ge[3] = {0, 0, 0};
+    std::vector<float> sigmas, densities;
+    auto sa = sigma ? std::optional(sigma->getConstAccessor()) : std::nullopt;
+    auto ra = resolution ? std::optional(resolution->getConstAccessor()) : std::nullopt;
+    for (auto it = g.coverage->cbeginValueOn(); it; ++it) {
+      openvdb::CoordBBox box;
+      it.getBoundingBox(box);
+      for (auto c = box.begin(); c; ++c) {
+        const openvdb::Vec3d w = g.coverage->indexToWorld(*c);
+        const Vec3 p(w.x(), w.y(), w.z());
+        if (!region.box.Contains(p) || (inside && !inside->Inside(p))) continue;
+        ++r.voxels;
+        const int n = *it;
+        for (int k = 0; k < 3; ++k) ge[k] += n >= k + 1;
+        if (sa && sa->isValueOn(*c)) sigmas.push_back(sa->getValue(*c));
+        if (ra && ra->isValueOn(*c)) densities.push_back(ra->getValue(*c));
+      }
+    }
+    const double n = r.voxels > 0 ? double(r.voxels) : 1.0;
+    r.ge1 = ge[0] / n;
+    r.ge2 = ge[1] / n;
+    r.ge3 = ge[2] / n;
+    if (resolution) r.resolution_p10 = NearestRankPercentile(densities, 10);
+    if (sigma) {
+      r.triangulable = double(sigmas.size()) / n;
+      r.sigma_max_p50 = NearestRankPercentile(sigmas, 50);
+      r.sigma_max_p90 = NearestRankPercentile(sigmas, 90);
+    }
+    out.push_back(r);
+  }
+  return out;
 }
 
 Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
@@ -138,6 +184,7 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
   s.timing.rays = st.rays;
   s.timing.point_camera_tests = st.point_camera_tests;
   s.timing.threads = threads;
+  s.regions = SummarizeRegions(scene, fields);
   return s;
 }
 
@@ -272,6 +319,20 @@ void to_json(nlohmann::json& j, const Summary& s) {
                  {"recognition", s.dori->recognition},
                  {"identification", s.dori->identification},
                  {"px_per_m", {kDoriPxPerM[0], kDoriPxPerM[1], kDoriPxPerM[2], kDoriPxPerM[3]}}};
+  if (!s.regions.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const RegionSummary& r : s.regions)
+      list.push_back({{"name", r.name},
+                      {"voxels", r.voxels},
+                      {"ge1", r.ge1},
+                      {"ge2", r.ge2},
+                      {"ge3", r.ge3},
+                      {"resolution_p10_px_per_m", opt(r.resolution_p10)},
+                      {"triangulable", r.triangulable},
+                      {"sigma_max_p50_mm", opt(r.sigma_max_p50)},
+                      {"sigma_max_p90_mm", opt(r.sigma_max_p90)}});
+    j["regions"] = list;
+  }
   j["timing"] = {{"seconds", s.timing.seconds},
                  {"active_set_seconds", s.timing.active_set_seconds},
                  {"rays", s.timing.rays},
@@ -340,6 +401,10 @@ std::string FormatSummary(const Summary& s) {
       out += Format("  %-24s >=1 %5.1f%%  >=2 %5.1f%%  >=3 %5.1f%%%s\n", r.label.c_str(), 100 * r.ge1, 100 * r.ge2,
                     100 * r.ge3, r.sigma_max_p90 ? Format("  sigma_max p90 %.3g mm", *r.sigma_max_p90).c_str() : "");
   }
+  for (const RegionSummary& r : s.regions)
+    out += Format("region    %-12s %lld voxels: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%%s\n", r.name.c_str(),
+                  static_cast<long long>(r.voxels), 100 * r.ge1, 100 * r.ge2, 100 * r.ge3,
+                  r.sigma_max_p90 ? Format("; sigma_max p50 %.3g, p90 %.3g mm", *r.sigma_max_p50, *r.sigma_max_p90).c_str() : "");
   for (const PixelTargetSummary& p : s.pixel_targets)
     out += Format("pixels    %-12s (%.4g m over >= %.4g px: >= %.0f px/m) by >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%% of the region\n",
                   p.target.name.c_str(), p.target.size_m, p.target.min_px, p.target.px_per_m(), 100 * p.share_ge[0],

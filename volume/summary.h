@@ -77,6 +77,20 @@ struct TimingSummary {
   double tests_per_second() const { return seconds > 0 ? point_camera_tests / seconds : 0.0; }
 };
 
+/// One named sub-region of the study (Study::regions), from the same fields: its free voxels
+/// (centres inside it, free in the study region) and their shares.
+struct RegionSummary {
+  std::string name;
+  std::int64_t voxels = 0;
+  double ge1 = 0, ge2 = 0, ge3 = 0;
+  std::optional<double> resolution_p10;            ///< px/m, with the resolution field.
+  std::optional<double> sigma_max_p50, sigma_max_p90;  ///< mm, with sigma_max; over its triangulable voxels.
+  double triangulable = 0;                         ///< Share with a sigma_max (with sigma_max).
+};
+
+/// The named sub-regions of `scene`'s study over `fields`.
+std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fields);
+
 /// Everything summary.json holds, typed.
 struct Summary {
   std::string scene, scene_sha256;  ///< Scene::path and Scene::sha256.
@@ -105,6 +119,8 @@ struct Summary {
   std::vector<PixelTargetSummary> pixel_targets;
   /// With study.dori: the DORI classes' shares.
   std::optional<DoriSummary> dori;
+  /// With study.regions: each named sub-region (Summarize fills it).
+  std::vector<RegionSummary> regions;
   /// The calibration simulation (analysis/calibration.h) when the study asks for one; the caller
   /// sets it (Summarize does not: it needs the ray caster).
   std::optional<CalibrationResult> calibration;

@@ -120,6 +120,8 @@ def main():
             "fields": ["coverage", "cameras", "sigma_max"],
             "time": {"poses": list(POSES.keys()), "min_cameras": 3},
             "targets": {"objects": ["a", "b"], "points": 3000, "seed": 1},
+            "regions": {"centre": {"box": {"min": [-1.0, -1.0, 0.05], "max": [1.0, 1.0, 2.05]}},
+                        "feet": {"box": {"min": [-2.0, -1.5, 0.05], "max": [2.0, 1.5, 0.35]}}},
             "pixel_targets": [{"name": "marker", "size_m": 0.014, "min_px": 4},
                               {"name": "face", "size_m": 0.16, "min_px": 80}],
         },
