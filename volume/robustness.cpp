@@ -378,12 +378,14 @@ std::string FormatCriticality(const CriticalityTable& t, int rows) {
                 t.k, 100 * t.ge_k, t.rows[t.worst].id.c_str(), 100 * t.rows[t.worst].ge_k, 100 * t.worst_loss(),
                 100 * t.mean_ge_k);
   const std::vector<int> order = t.MostCritical();
-  out += Format("  %-12s %7s %7s %7s %7s%s\n", "fails", ">=1", ">=2", ">=3", Format(">=%d", t.k).c_str(),
+  const bool k_column = t.k > 3;  // ge1..ge3 already show k <= 3
+  out += Format("  %-12s %7s %7s %7s%s%s\n", "fails", ">=1", ">=2", ">=3",
+                k_column ? Format(" %7s", Format(">=%d", t.k).c_str()).c_str() : "",
                 t.uncertainty ? "  triangulable  sigma_max p50 / p90 mm" : "");
   for (int i = 0; i < rows && i < static_cast<int>(order.size()); ++i) {
     const CriticalityRow& r = t.rows[order[i]];
-    std::string line = Format("  %-12s %6.1f%% %6.1f%% %6.1f%% %6.1f%%", r.id.c_str(), 100 * r.ge1, 100 * r.ge2,
-                              100 * r.ge3, 100 * r.ge_k);
+    std::string line = Format("  %-12s %6.1f%% %6.1f%% %6.1f%%", r.id.c_str(), 100 * r.ge1, 100 * r.ge2, 100 * r.ge3);
+    if (k_column) line += Format(" %6.1f%%", 100 * r.ge_k);
     if (t.uncertainty) {
       const auto cell = [](const std::optional<double>& v) { return v ? Format("%.3g", *v) : std::string("-"); };
       line += Format("  %11.1f%%  %s / %s", 100 * r.triangulable.value_or(0), cell(r.sigma_max_p50_mm).c_str(),
