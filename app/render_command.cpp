@@ -79,6 +79,7 @@ int RunRender(const RenderArgs& args) {
   session::SessionOptions session_options;
   session_options.rig = args.rig;
   session_options.rig_option = "--rig";
+  session_options.disable = args.disable;
   const session::Session session(session::Study::Load(args.scene), session_options);
   const Scene& scene = session.study().scene();
   const Rig& rig = session.rig().rig();
