@@ -19,6 +19,7 @@
 #include "analysis/error.h"
 #include "render/render.h"
 #include "render/report/calibration_section.h"
+#include "render/report/robustness_section.h"
 #include "render/report/plot.h"
 #include "render/report/report_images.h"
 
@@ -278,6 +279,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
     r.summary = Summarize(scene, *rig, r.fields, data.field_names, threads, r.warnings);
     if (scene.study.calibration)
       r.summary.calibration = SimulateCalibration(scene, *rig, caster, *scene.study.calibration);
+    r.summary.robustness = ComputeCriticality(scene, *rig, r.fields, caster, scene.TimeMinCameras());
     data.rigs.push_back(std::move(r));
   }
 
@@ -573,6 +575,15 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     std::vector<std::string> cells;
     for (const RigReport& r : reports)
       cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, svg_image));
+    body << RigRow(cells);
+  }
+
+  // N-1 robustness (render/report/robustness_section.h): the most critical cameras of each rig.
+  if (std::all_of(reports.begin(), reports.end(), [](const RigReport& r) { return r.summary.robustness; })) {
+    body << "<h2 id=\"robustness\">Robustness</h2>\n" << RobustnessIntroHtml(reports[0].summary.robustness->k)
+         << RigRow(heads);
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) cells.push_back(RobustnessCellHtml(*r.summary.robustness));
     body << RigRow(cells);
   }
 

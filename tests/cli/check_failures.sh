@@ -46,6 +46,10 @@ done
   fail "render --disable exit code $?"
 "$pandora" report "$scene" --rig octagon --disable "$worst" --voxel-size 0.02 --width 64 --camera-width 32 \
   --out "$work/report" -q || fail "report --disable exit code $?"
+grep -q '<h2 id="robustness">Robustness</h2>' "$work/report/report.html" || fail "no robustness section"
+# The disabled camera has no row; the other seven do, the table shows the five most critical.
+[ "$(grep -c '<tr><td>o[1-8]</td><td>[0-9.]*%</td>' "$work/report/report.html")" -eq 5 ] || fail "robustness rows"
+grep -q "<tr><td>$worst</td><td>[0-9.]*%</td>" "$work/report/report.html" && fail "disabled $worst has a row"
 
 err() { bash "$(dirname "$0")/expect_error.sh" "$pandora" "$@" >/dev/null || fail "bad --disable: $*"; }
 err "$work/bad1" "--disable: no camera 'zz' in rig 'octagon' (hint: cameras: o1, o2" -- \
