@@ -42,9 +42,10 @@ struct Partial {
   // Per rig camera: voxels it sees with exactly j[t] cameras (they drop below j[t] when it fails).
   std::vector<std::array<std::int64_t, 4>> exactly;
   std::vector<std::int64_t> seen;
-  // Per rig camera: sigma_max (mm) at the voxels it sees that are triangulable intact (removed
-  // when it fails) and those triangulable after it fails (added).
-  std::vector<std::vector<float>> removed, added;
+  // Per rig camera: the voxels it sees that are triangulable intact (indices into the intact
+  // sigma_max list: removed when it fails) and sigma_max (mm) where they are after it fails (added).
+  std::vector<std::vector<std::int64_t>> removed;
+  std::vector<std::vector<float>> added;
   explicit Partial(std::size_t cameras)
       : exactly(cameras), seen(cameras, 0), removed(cameras), added(cameras) {}
 };
@@ -108,6 +109,20 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     }
   }
   const std::array<BandScale, 64>& scales = BandScales();
+  // Every triangulable voxel's sigma_max, leaf by leaf in `origins` order (ascending offset within
+  // a leaf): base[i] is where leaf i's values start.
+  std::vector<std::int64_t> base(origins.size() + 1, 0);
+  std::vector<float> intact;
+  if (table.uncertainty) {
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+      const auto* leaf = sigma_grid->tree().probeConstLeaf(origins[i]);
+      base[i + 1] = base[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
+    }
+    // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
+    if (base.back() != static_cast<std::int64_t>(sigma_grid->activeVoxelCount()))
+      throw std::invalid_argument("ComputeCriticality: the sigma_max field does not match the camera sets");
+    intact.resize(static_cast<std::size_t>(base.back()));
+  }
 
   tbb::enumerable_thread_specific<Partial> partials([&] { return Partial(camera_count); });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4), [&](const auto& range) {
@@ -118,6 +133,7 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     std::vector<std::uint8_t> band;
     std::vector<std::array<double, 6>> upper_rows;
     std::vector<std::int32_t> failed, seeing;
+    std::vector<Int128> fixed;
     std::array<std::vector<double>, 6> upper;
     std::array<std::vector<double>, 3> eigen;
     std::array<std::vector<double>, kStatRows> stats;
@@ -166,13 +182,13 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
       const auto* sigma_leaf = sigma_grid->tree().probeConstLeaf(origin);
       upper_rows.clear();
       failed.clear();
+      std::int64_t index = base[i];
       for (int o = 0; o < 512; ++o) {
-        if (count[o] == 0) continue;
-        const bool triangulable = sigma_leaf && sigma_leaf->isValueOn(o);
-        if (triangulable) {
-          const float s = sigma_leaf->getValue(o);
+        if (sigma_leaf && sigma_leaf->isValueOn(o)) {  // triangulable intact
+          intact[static_cast<std::size_t>(index)] = sigma_leaf->getValue(o);
           for (std::size_t e = 0; e < n_cams; ++e)
-            if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(s);
+            if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(index);
+          ++index;
         }
         if (count[o] < 3) continue;
         // The seeing cameras' contributions, ascending camera (the evaluator's view order).
@@ -207,15 +223,20 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
         }
         Sum6 full{};
         const bool full_exact = top != kNotExact && m - 1 <= kMaxExactCameras;
-        if (full_exact)
-          for (int a = 0; a < m; ++a) Accumulate(full, &contribution[6 * a], scales[top], true);
+        if (full_exact) {
+          fixed.resize(6 * m);
+          for (int a = 0; a < m; ++a)
+            for (int q = 0; q < 6; ++q) {
+              fixed[6 * a + q] = ToFixed(contribution[6 * a + q], scales[top].q);
+              full.v[q] += fixed[6 * a + q];
+            }
+        }
         for (int f = 0; f < m; ++f) {
           std::array<double, 6> row;
           if (full_exact && (band[f] < top || top_count > 1)) {
             // The others' band is still `top`: the exact sum less f's rounded contribution.
-            Sum6 s = full;
-            Accumulate(s, &contribution[6 * f], scales[top], false);
-            for (int q = 0; q < 6; ++q) row[q] = ToDouble(s.v[q]) * scales[top].up[0] * scales[top].up[1];
+            for (int q = 0; q < 6; ++q)
+              row[q] = ToDouble(full.v[q] - fixed[6 * f + q]) * scales[top].up[0] * scales[top].up[1];
           } else {
             // As Derive re-sums a voxel: the others' largest band, or in double in rig order.
             std::uint8_t b = 0;
@@ -263,7 +284,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   std::array<std::int64_t, 4> at_least{};
   std::vector<std::array<std::int64_t, 4>> exactly(camera_count);
   std::vector<std::int64_t> seen(camera_count, 0);
-  std::vector<std::vector<float>> removed(camera_count), added(camera_count);
+  std::vector<std::vector<std::int64_t>> removed(camera_count);
+  std::vector<std::vector<float>> added(camera_count);
   for (Partial& p : partials) {
     for (int t = 0; t < 4; ++t) at_least[t] += p.at_least[t];
     for (std::size_t c = 0; c < camera_count; ++c) {
@@ -275,17 +297,6 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   }
   const std::int64_t region = table.region_voxels;
   table.ge_k = Fraction(at_least[3], region);
-  std::vector<float> intact;  // every triangulable voxel's sigma_max, ascending
-  if (table.uncertainty) {
-    intact.reserve(sigma_grid->activeVoxelCount());
-    for (auto it = sigma_grid->cbeginValueOn(); it; ++it) {
-      if (it.isVoxelValue())
-        intact.push_back(*it);
-      else
-        intact.insert(intact.end(), it.getVoxelCount(), *it);
-    }
-    std::sort(intact.begin(), intact.end());
-  }
   for (std::size_t c = 0; c < camera_count; ++c) {
     if (!rig.cameras[c].enabled) continue;
     CriticalityRow row;
@@ -302,20 +313,20 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table.rows.size(), 1), [&](const auto& range) {
       for (std::size_t r = range.begin(); r != range.end(); ++r) {
         CriticalityRow& row = table.rows[r];
-        std::vector<float>& out = removed[row.camera];
+        const std::vector<std::int64_t>& out = removed[row.camera];
         const std::vector<float>& in = added[row.camera];
-        std::sort(out.begin(), out.end());
         // The multiset intact - out + in: the sigma_max list of the rig without this camera.
+        std::vector<unsigned char> gone(intact.size(), 0);
+        for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
         std::vector<float> after;
         after.reserve(intact.size() - out.size() + in.size());
-        std::set_difference(intact.begin(), intact.end(), out.begin(), out.end(), std::back_inserter(after));
-        if (after.size() + out.size() != intact.size())
-          throw std::logic_error("ComputeCriticality: a removed sigma_max is not in the field");
+        for (std::size_t v = 0; v < intact.size(); ++v)
+          if (!gone[v]) after.push_back(intact[v]);
         after.insert(after.end(), in.begin(), in.end());
         row.triangulable_voxels = static_cast<std::int64_t>(after.size());
         row.triangulable = Fraction(row.triangulable_voxels, region);
         row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
-        row.sigma_max_p90_mm = NearestRankPercentile(after, 90);
+        row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
       }
     });
   }
