@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analysis/primitives.h"
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
 #include "volume/robustness.h"
 #include "volume/summary.h"
+#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
@@ -124,6 +126,40 @@ TEST(Robustness, EachRowEqualsRemovingThatCameraInTheTraumaRoom) {
   options.fields = scene.study.fields;  // all nine, the steady ones included
   const CriticalityTable table = ExpectRowsEqualRecompute(scene, scene.FindRig("octagon"), options, 3);
   EXPECT_EQ(table.rows.size(), 8u);
+}
+
+// The exact information sums round each contribution on a grid set by the voxel's largest one,
+// in bands of 32 binades (volume/information_sum.h). Two near cameras (1.6 s away) and four far
+// ones (25 s away, the same lens) around a post give contributions about 250 times apart: at
+// s = 1e-3 on both sides of the band boundary 2^33 (near about 5e11 / m^2, far 2e9), at s = 150
+// of the boundary 2 (near about 20, far 0.09). Where one near camera is the only one in the
+// top band, its failure moves the voxel to the far cameras' band and the sum is rebuilt from them;
+// where both see the voxel, its contribution is subtracted. Every scale: exact.
+TEST(Robustness, EachRowEqualsRemovingThatCameraAtExtremeScales) {
+  for (const double s : {1e-3, 1.0, 150.0, 1e6}) {
+    SCOPED_TRACE("scale " + std::to_string(s));
+    Scene scene;
+    scene.path = "synthetic.json";
+    scene.objects.push_back(testing::TestObject("post", MakeBox(s * Vec3(0.15, 0.15, 0.9)), s * Vec3(0.1, 0, 0.45), true));
+    scene.study.region.box.min = s * Vec3(-0.5, -0.5, 0);
+    scene.study.region.box.max = s * Vec3(0.5, 0.5, 1);
+    scene.study.voxel_size = 0.08 * s;
+    const Vec3 centre = s * Vec3(0, 0, 0.5);
+    Rig rig;
+    rig.name = "near_far";
+    rig.cameras.push_back(testing::TestCamera("n0", s * Vec3(1.6, 0, 1.2), centre, 60));
+    rig.cameras.push_back(testing::TestCamera("n1", s * Vec3(0, 1.6, 1.9), centre, 60));
+    rig.cameras.push_back(testing::TestCamera("f0", s * Vec3(25, 0, 5), centre, 60));
+    rig.cameras.push_back(testing::TestCamera("f1", s * Vec3(0, 25, 8), centre, 60));
+    rig.cameras.push_back(testing::TestCamera("f2", s * Vec3(-25, 0, 5), centre, 60));
+    rig.cameras.push_back(testing::TestCamera("f3", s * Vec3(0, -25, 8), centre, 60));
+    scene.rigs.push_back(rig);
+    FieldOptions options;
+    options.fields = {"coverage", "cameras", "sigma_max"};
+    const CriticalityTable table = ExpectRowsEqualRecompute(scene, rig, options, 3);
+    EXPECT_EQ(table.rows.size(), 6u);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
 }
 
 TEST(Robustness, CoverageOnlyHasNoUncertaintyColumns) {
