@@ -79,7 +79,9 @@ int RunAccuracy(const AccuracyArgs& args) {
   const Clock::time_point start = Clock::now();
   const auto study = session::Study::Load(args.scene);  // the scene and its ray caster, once
   const Scene& scene = study->scene();
-  const Rig rig = study->FindRig(args.rig, "--rig");
+  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
+  if (args.gpu && !args.disable.empty())  // the GL bench runs the rig as the file has it
+    throw InputError("--disable", "", "cannot be combined with --gpu", "run the GPU study without --disable");
   const AccuracyOptions options = args.quick ? AccuracyOptions::Quick() : AccuracyOptions();
   options.Check();
   if (args.gpu) GpuBench(scene);  // a missing display fails now, not after the other studies

@@ -18,6 +18,7 @@
 #include "app/session/session.h"
 #include "app/output.h"
 #include "volume/fields.h"
+#include "volume/robustness.h"
 #include "volume/summary.h"
 #include "volume/pixel_targets.h"
 #include "volume/time_fields.h"
@@ -69,6 +70,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   session::SessionOptions so;
   so.rig = args.rig;
   so.rig_option = "--rig";
+  so.disable = args.disable;
   so.incremental = false;  // one evaluation: no per-pair state
   FieldOptions& options = so.fields;
   options.scene_path = scene.path;
@@ -142,6 +144,11 @@ int RunAnalyze(const AnalyzeArgs& args) {
   typed.dori = dori;
   if (scene.study.calibration)
     typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
+  // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets (docs/failures.md).
+  if (HasCameraSets(fields)) {
+    typed.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
+    AddCoverageN1Grid(&fields);
+  }
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{

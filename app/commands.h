@@ -19,6 +19,7 @@ double CheckPositiveOption(const char* option, double value, const char* unit);
 struct AnalyzeArgs {
   std::string scene;
   std::string rig;
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string out = "out";
   double voxel_size = kUnset;  ///< kUnset: the scene's study.voxel_size.
   std::string fields;     ///< Comma-separated; empty: the scene's study.fields.
@@ -57,6 +58,7 @@ int RunBench(const BenchArgs& args);
 struct AccuracyArgs {
   std::string scene;
   std::string rig;
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string out = "out/accuracy";
   bool quick = false;  ///< Fewer voxel sizes, trials and sample points (tests).
   /// Also the GPU renderer against the exact one per shadow-map size (runs pandora_gl_bench, beside
@@ -70,6 +72,7 @@ int RunAccuracy(const AccuracyArgs& args);
 struct RenderArgs {
   std::string scene;
   std::string rig;
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string view;            ///< Name in the scene's "views".
   std::string from, at, up;    ///< "X,Y,Z" each.
   std::string camera;          ///< Camera id: render what that camera images.
@@ -102,6 +105,7 @@ int RunRender(const RenderArgs& args);
 struct ExportSurfaceArgs {
   std::string scene;
   std::string rig;
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   double spacing = 0.02;  ///< Metres between samples (one per spacing^2 of area on average).
   std::string out;        ///< The .ply file.
   unsigned long long seed = 1;
@@ -117,6 +121,7 @@ int RunExportSurface(const ExportSurfaceArgs& args);
 struct ReportArgs {
   std::string scene;
   std::vector<std::string> rigs;  ///< Names (each may be comma-separated); empty: every rig.
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled in every rig that has them.
   std::string out = "report";
   double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
   int width = 640;                ///< Pixels across the renders from the named views.
@@ -131,6 +136,7 @@ int RunReport(const ReportArgs& args);
 struct SuggestArgs {
   std::string scene;
   std::string rig;
+  std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string cameras;            ///< Comma-separated camera ids.
   std::string max_move = "0.3";   ///< Metres: one value, or one per selected camera (commas).
   std::string max_rotate = "10";  ///< Degrees: likewise.

@@ -29,7 +29,7 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig& rig = study->FindRig(args.rig, "--rig");
+  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
   const SurfaceSelection selection =
       args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
   const std::vector<SurfaceSample> samples =

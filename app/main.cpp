@@ -175,6 +175,7 @@ int main(int argc, char** argv) {
   CLI::App* a = app.add_subcommand("analyze", "Evaluate fields over the study region; write fields.vdb and summary.json");
   a->add_option("scene", analyze.scene, "Scene file (JSON)")->required();
   a->add_option("--rig", analyze.rig, "Rig name (default: the first rig)");
+  a->add_option("--disable", analyze.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   a->add_option("--out", analyze.out, "Output folder")->capture_default_str();
   a->add_option("--voxel-size", analyze.voxel_size, "Voxel size in metres (default: study.voxel_size)")
       ->check(Number(0, HUGE_VAL, "metres", false, true));
@@ -211,6 +212,7 @@ int main(int argc, char** argv) {
       "accuracy", "Error against run time: voxel size, Monte Carlo trials, steady-state solvers");
   acc->add_option("scene", accuracy.scene, "Scene file (JSON)")->required();
   acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
+  acc->add_option("--disable", accuracy.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
   acc->add_flag("--quick", accuracy.quick, "Fewer voxel sizes, trials and sample points (for tests)");
   acc->add_flag("--gpu", accuracy.gpu,
@@ -222,6 +224,7 @@ int main(int argc, char** argv) {
       "render", "Render the scene lit by every enabled camera as a projector of its own colour (PNG or EXR)");
   rn->add_option("scene", render.scene, "Scene file (JSON)")->required();
   rn->add_option("--rig", render.rig, "Rig name (default: the first rig)");
+  rn->add_option("--disable", render.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   rn->add_option("--view", render.view, "Named view from the scene's \"views\"");
   rn->add_option("--from", render.from, "Eye position X,Y,Z (with --at)");
   rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
@@ -259,6 +262,7 @@ int main(int argc, char** argv) {
       "export-surface", "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
   es->add_option("scene", surface.scene, "Scene file (JSON)")->required();
   es->add_option("--rig", surface.rig, "Rig name (default: the first rig)");
+  es->add_option("--disable", surface.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   es->add_option("--spacing", surface.spacing, "Distance between samples in metres")
       ->capture_default_str()->check(Number(0, HUGE_VAL, "metres", false, true));
   es->add_option("--out", surface.out, "Output PLY file")->required();
@@ -273,6 +277,7 @@ int main(int argc, char** argv) {
       "report", "One self-contained HTML report: renders, field slices, histograms, cameras, rigs side by side");
   rep->add_option("scene", report.scene, "Scene file (JSON)")->required();
   rep->add_option("--rig", report.rigs, "Rig name(s), repeatable or comma-separated (default: every rig)");
+  rep->add_option("--disable", report.disable, "Camera ids to disable in every rig of the report that has them, comma-separated or repeated")->delimiter(',');
   rep->add_option("--out", report.out, "Output folder (report.html is written there)")->capture_default_str();
   rep->add_option("--voxel-size", report.voxel_size, "Voxel size in metres (default: study.voxel_size)")
       ->check(Number(0, HUGE_VAL, "metres", false, true));
@@ -289,6 +294,7 @@ int main(int argc, char** argv) {
       "suggest", "Nudge the selected cameras within limits to improve an objective; write a suggestion");
   sg->add_option("scene", suggest.scene, "Scene file (JSON)")->required();
   sg->add_option("--rig", suggest.rig, "Rig name (default: the first rig)");
+  sg->add_option("--disable", suggest.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   sg->add_option("--cameras", suggest.cameras, "Comma-separated ids of the cameras that may move")->required();
   sg->add_option("--max-move", suggest.max_move, "Largest move, metres: one value, or one per camera in --cameras order")->capture_default_str();
   sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation, degrees: one value, or one per camera")->capture_default_str();

@@ -79,6 +79,7 @@ int RunRender(const RenderArgs& args) {
   session::SessionOptions session_options;
   session_options.rig = args.rig;
   session_options.rig_option = "--rig";
+  session_options.disable = args.disable;
   std::shared_ptr<const session::Study> study = session::Study::Load(args.scene);
   if (!args.time_sample.empty()) {
     // The scene moved to one time sample: by number, pose name or label.

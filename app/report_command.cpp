@@ -1,9 +1,11 @@
 // `pandora report`: one self-contained HTML page per scene (docs/report.md). The page and its
 // numbers are render/report/report.h; this parses the options, checks them, runs and prints.
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <sstream>
 
+#include "analysis/error.h"
 #include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
 #include "analysis/scene.h"
@@ -27,6 +29,31 @@ std::vector<std::string> SplitList(const std::vector<std::string>& items) {
   return out;
 }
 
+// --disable: each id disabled in every rig of the report that has it; an id that none of them has
+// (or an empty one) is an error naming the option.
+void DisableInReportRigs(Scene* scene, const std::vector<std::string>& rigs, const std::vector<std::string>& ids) {
+  std::vector<Rig*> selected;
+  for (Rig& rig : scene->rigs)
+    if (rigs.empty() || std::find(rigs.begin(), rigs.end(), rig.name) != rigs.end()) selected.push_back(&rig);
+  for (const std::string& id : ids) {
+    if (id.empty()) throw InputError("--disable", "", "an empty camera id", "e.g. --disable c1,c2");
+    bool found = false;
+    for (Rig* rig : selected) {
+      const int index = rig->FindCamera(id);
+      if (index < 0) continue;
+      rig->cameras[index].enabled = false;
+      found = true;
+    }
+    if (found) continue;
+    std::string names, cameras;
+    for (const Rig* rig : selected) {
+      names += (names.empty() ? "'" : ", '") + rig->name + "'";
+      cameras += (cameras.empty() ? "" : "; ") + rig->name + ": " + rig->CameraIds();
+    }
+    throw InputError("--disable", "", "no camera '" + id + "' in rig " + names, "cameras: " + cameras);
+  }
+}
+
 }  // namespace
 
 int RunReport(const ReportArgs& args) {
@@ -47,15 +74,22 @@ int RunReport(const ReportArgs& args) {
   options.rig_started = [&](const std::string& rig) { bar.emplace("report " + rig, !args.quiet); };
   options.progress = [&](double fraction) { bar->Update(fraction); };
   WithFlagNames(flags, [&] { options.Check(scene); });
+  // --disable applies to a copy of the scene whose rigs the report evaluates.
+  Scene disabled;
+  if (!args.disable.empty()) {
+    disabled = scene;
+    DisableInReportRigs(&disabled, options.rigs, args.disable);
+  }
+  const Scene& report_scene = args.disable.empty() ? scene : disabled;
 
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const report::ReportTarget target = report::StageReport(output, args.out, "--out");
   const RayCaster* caster = &study->caster();
   const report::ReportData data =
-      WithFlagNames(flags, [&] { return report::ComputeReport(scene, *caster, options); });
+      WithFlagNames(flags, [&] { return report::ComputeReport(report_scene, *caster, options); });
   bar.reset();
-  const report::ReportFile file = report::WriteReport(scene, *caster, data, options, target);
+  const report::ReportFile file = report::WriteReport(report_scene, *caster, data, options, target);
   output.Commit();
   if (!args.quiet) {
     std::printf("wrote %s (%d images, %.1f MiB)\n", file.path.c_str(), file.images, file.bytes / 1048576.0);

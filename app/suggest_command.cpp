@@ -23,6 +23,7 @@ int RunSuggest(const SuggestArgs& args) {
   session::SessionOptions session_options;
   session_options.rig = args.rig;
   session_options.rig_option = "--rig";
+  session_options.disable = args.disable;
   session::Session session(session::Study::Load(args.scene), session_options);
   const Scene& scene = session.study().scene();
   const Rig file_rig = session.rig().rig();

@@ -22,6 +22,7 @@
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "volume/fields_vdb.h"
+#include "volume/information_sum.h"
 
 namespace pandora {
 
@@ -30,51 +31,7 @@ Fields::~Fields() = default;
 Fields::Fields(Fields&&) noexcept = default;
 Fields& Fields::operator=(Fields&&) noexcept = default;
 
-namespace {
-
-bool Wants(const std::vector<std::string>& fields, const std::string& name) {
-  return std::find(fields.begin(), fields.end(), name) != fields.end();
-}
-
-// The float fields in a fixed order.
-enum FloatField {
-  kResolution,
-  kSigmaMax,
-  kSigmaMean,
-  kAngle,
-  kCondition,
-  kSigmaMaxSteady,
-  kSigmaMeanSteady,
-  kFloatFieldCount
-};
-const char* const kFloatFieldNames[kFloatFieldCount] = {
-    "resolution", "sigma_max",        "sigma_mean",       "triangulation_angle",
-    "condition",  "sigma_max_steady", "sigma_mean_steady"};
-
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-
-// Bytes per voxel of each grid at full density, leaf masks and node overhead included (an OpenVDB
-// leaf of 512 voxels carries ~100 bytes of masks and header).
-double BytesPerVoxel(const std::string& field) {
-  const double overhead = 0.25;
-  if (field == "coverage") return 4 + overhead;
-  if (field == "cameras") return 8 + overhead;
-  return 4 + overhead;  // float fields
-}
-
-// Rows of the per-candidate statistics arrays.
-enum StatRow {
-  kObservable,    // 1 or 0
-  kSigmaMaxMm,    // sqrt of the largest variance, mm
-  kSigmaMeanMm,   // sqrt(trace / 3), mm
-  kCond,          // largest / smallest eigenvalue of J
-  kVar0,          // variances 1 / lambda_k, m^2 (descending); the steady pass overwrites them
-  kVar1,
-  kVar2,
-  kSteadyMaxMm,
-  kSteadyMeanMm,
-  kStatRows
-};
+namespace information {
 
 // From the eigenvalues of J (ascending, three arrays of n) the static statistics into out[row][m].
 // Eigenvalues are clipped at 0 (round-off); a voxel is observable when the smallest exceeds
@@ -108,6 +65,42 @@ void StaticStatistics(int n, double* const* eigenvalues, double* const* out) {
     sigma_mean[m] = 1e3 * std::sqrt((v0[m] + v1[m] + v2[m]) / 3.0);
     condition[m] = l2 / l0;
   }
+}
+
+}  // namespace information
+
+using namespace information;
+
+namespace {
+
+bool Wants(const std::vector<std::string>& fields, const std::string& name) {
+  return std::find(fields.begin(), fields.end(), name) != fields.end();
+}
+
+// The float fields in a fixed order.
+enum FloatField {
+  kResolution,
+  kSigmaMax,
+  kSigmaMean,
+  kAngle,
+  kCondition,
+  kSigmaMaxSteady,
+  kSigmaMeanSteady,
+  kFloatFieldCount
+};
+const char* const kFloatFieldNames[kFloatFieldCount] = {
+    "resolution", "sigma_max",        "sigma_mean",       "triangulation_angle",
+    "condition",  "sigma_max_steady", "sigma_mean_steady"};
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+
+// Bytes per voxel of each grid at full density, leaf masks and node overhead included (an OpenVDB
+// leaf of 512 voxels carries ~100 bytes of masks and header).
+double BytesPerVoxel(const std::string& field) {
+  const double overhead = 0.25;
+  if (field == "coverage") return 4 + overhead;
+  if (field == "cameras") return 8 + overhead;
+  return 4 + overhead;  // float fields
 }
 
 // Steady-state statistics from the steady position variances in rows kVar0..kVar2.
@@ -262,125 +255,6 @@ inline int PopcountInline(std::uint64_t x) {
   x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
   x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
   return static_cast<int>((x * 0x0101010101010101ULL) >> 56);
-}
-
-// ---------------------------------------------------------------------------------------------
-// The exact information sum. A voxel's information J is the sum of its cameras' contributions
-// (six doubles each). Summed in double, the bits depend on the order, so an update would have to
-// re-read every camera's contribution. Instead each contribution is rounded once to a fixed-point
-// integer (int128) on a grid of spacing 2^q and the integers are summed: exact, so in any order
-// and by subtracting one camera's old contribution and adding its new one, with the same bits.
-// The grid depends on the voxel's largest contribution: its "band" is the largest IEEE exponent
-// field e (biased, 0..2047) of the contribution's six entries, shifted right by 5 (bands of 32
-// binades). A voxel's band k is the largest band of its contributions; then every entry is below
-// 2^(32 (k + 1) - 1023), q = 32 (k + 1) - 1129, every rounded entry is below 2^106 in magnitude and
-// the sum of up to 2^20 of them below 2^126: no overflow. The spacing is 2^-74 .. 2^-106 of the
-// largest entry of the largest contribution, itself at most the largest eigenvalue of J (J is a
-// sum of positive semi-definite matrices, so its largest entry is on the diagonal), so the
-// rounding moves every eigenvalue by at most 2^-75 N lambda_max (Weyl), far below the 2^-53
-// lambda_max of the double sum and of the eigenvalue solver. The integer sum is then rounded to
-// double once (correctly rounded), so J is at least as accurate as a double sum in rig order.
-// Voxels with a contribution in band 63 (an entry >= 2^993, inf or NaN) or more than 2^20 cameras
-// are summed in double in rig order as before (a function of the contributions only, so a full
-// evaluation and an update choose alike). Per voxel the evaluator keeps the sums, the band and how
-// many contributions are in it; an update that removes the last one of the top band, or adds one
-// above it, re-sums that voxel from every camera.
-constexpr int kBandShift = 5;
-constexpr std::uint8_t kNotExact = 63;  // also: a voxel without contributions
-constexpr int kMaxExactCameras = 1 << 20;
-using Int128 = __int128;
-struct Sum6 {
-  Int128 v[6];
-};
-
-inline std::uint64_t DoubleBits(double x) {
-  std::uint64_t b;
-  std::memcpy(&b, &x, sizeof(b));
-  return b;
-}
-inline double BitsDouble(std::uint64_t b) {
-  double x;
-  std::memcpy(&x, &b, sizeof(x));
-  return x;
-}
-inline std::uint8_t Band(const double* c) {
-  std::uint64_t e = 0;
-  for (int k = 0; k < 6; ++k) e = std::max(e, (DoubleBits(c[k]) >> 52) & 0x7ff);
-  return static_cast<std::uint8_t>(e >> kBandShift);
-}
-
-// Per band k < 63: its q, and 2^q as two factors (2^q itself may underflow).
-struct BandScale {
-  int q;
-  double up[2];
-};
-const std::array<BandScale, 64>& BandScales() {
-  static const std::array<BandScale, 64> table = [] {
-    std::array<BandScale, 64> t{};
-    for (int k = 0; k < 63; ++k) {
-      const int q = 32 * (k + 1) - 1129;
-      const int half = q / 2;
-      t[k].q = q;
-      t[k].up[0] = std::ldexp(1.0, half);
-      t[k].up[1] = std::ldexp(1.0, q - half);
-    }
-    return t;
-  }();
-  return table;
-}
-
-// c / 2^q rounded to the nearest integer (ties to even), from c's bits: no multiplication, no
-// library call. For a contribution in band k or below with q = 32 (k + 1) - 1129 the result is
-// below 2^106 in magnitude, so the left shift is at most 54.
-inline Int128 ToFixed(double c, int q) {
-  const std::uint64_t b = DoubleBits(c);
-  int e = static_cast<int>((b >> 52) & 0x7ff);
-  std::uint64_t m = b & ((std::uint64_t{1} << 52) - 1);
-  if (e != 0)
-    m |= std::uint64_t{1} << 52;
-  else
-    e = 1;  // subnormal
-  const int shift = e - 1075 - q;  // |c| / 2^q = m 2^shift
-  Int128 v;
-  if (shift >= 0) {
-    v = static_cast<Int128>(static_cast<unsigned __int128>(m) << shift);
-  } else if (shift < -63) {
-    v = 0;  // m < 2^53: below one half
-  } else {
-    const int r = -shift;
-    const std::uint64_t t = m >> r, rest = m & ((std::uint64_t{1} << r) - 1),
-                        half = std::uint64_t{1} << (r - 1);
-    v = static_cast<Int128>(t + ((rest > half) | ((rest == half) & (t & 1))));
-  }
-  return (b >> 63) ? -v : v;
-}
-
-// The int128 as the nearest double (ties to even), without a library call.
-inline double ToDouble(Int128 s) {
-  const bool negative = s < 0;
-  const unsigned __int128 u = negative ? -static_cast<unsigned __int128>(s) : s;
-  double d;
-  if ((u >> 63) == 0) {
-    d = static_cast<double>(static_cast<std::int64_t>(u));
-  } else {
-    // Keep the top 63 bits, the dropped ones as a sticky bit: one correct rounding to 53 bits.
-    const std::uint64_t hi = static_cast<std::uint64_t>(u >> 64);
-    const int bits = hi ? 128 - __builtin_clzll(hi) : 64;
-    const int shift = bits - 63;
-    std::uint64_t t = static_cast<std::uint64_t>(u >> shift);
-    if (static_cast<std::uint64_t>(u) & ((std::uint64_t{1} << shift) - 1)) t |= 1;
-    d = static_cast<double>(static_cast<std::int64_t>(t)) *
-        BitsDouble(static_cast<std::uint64_t>(1023 + shift) << 52);
-  }
-  return negative ? -d : d;
-}
-
-// Adds (`add`) or subtracts contribution c rounded on its band's grid.
-inline void Accumulate(Sum6& sum, const double* c, const BandScale& scale, bool add) {
-  for (int k = 0; k < 6; ++k) {
-    const Int128 v = ToFixed(c[k], scale.q);
-    sum.v[k] = add ? sum.v[k] + v : sum.v[k] - v;
-  }
 }
 
 // What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,

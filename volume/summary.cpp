@@ -341,6 +341,7 @@ void to_json(nlohmann::json& j, const Summary& s) {
                  {"tests_per_second", s.timing.tests_per_second()},
                  {"threads", s.timing.threads}};
   if (s.calibration) j["calibration"] = *s.calibration;
+  if (s.robustness) j["robustness"] = *s.robustness;
 }
 
 nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
@@ -429,6 +430,7 @@ std::string FormatSummary(const Summary& s) {
                 static_cast<double>(s.timing.rays), s.timing.rays_per_second(),
                 static_cast<double>(s.timing.point_camera_tests));
   if (s.calibration) out += FormatCalibration(*s.calibration);
+  if (s.robustness) out += FormatCriticality(*s.robustness);
   return out;
 }
 

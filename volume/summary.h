@@ -18,6 +18,7 @@
 #include "analysis/surface_targets.h"
 #include "volume/fields.h"
 #include "volume/pixel_targets.h"
+#include "volume/robustness.h"
 #include "volume/time_fields.h"
 
 namespace pandora {
@@ -124,6 +125,9 @@ struct Summary {
   /// The calibration simulation (analysis/calibration.h) when the study asks for one; the caller
   /// sets it (Summarize does not: it needs the ray caster).
   std::optional<CalibrationResult> calibration;
+  /// N-1 robustness (volume/robustness.h) when the "cameras" field was evaluated; the caller sets
+  /// it (ComputeCriticality needs the ray caster).
+  std::optional<CriticalityTable> robustness;
 };
 
 /// Summarises the evaluated `fields` of `rig` in `scene`. `field_names`: the fields that were asked
@@ -142,8 +146,8 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
 /// meets_max_sigma], [motion {q, rate_hz, covariance}, sigma_max_steady_mm, [meets_max_sigma_
 /// steady]]}, timing {seconds, active_set_seconds, rays, rays_per_second, point_camera_tests,
 /// tests_per_second, threads}, fields, region {min, max, dims, kind}, scene, scene_sha256,
-/// warnings [{kind, camera, path, message}] (always present, empty when none), and calibration
-/// (analysis/calibration.h's to_json) when set. Percentiles without a value are null.
+/// warnings [{kind, camera, path, message}] (always present, empty when none), calibration
+/// (analysis/calibration.h's to_json) and robustness (volume/robustness.h's to_json) when set. Percentiles without a value are null.
 void to_json(nlohmann::json& j, const Summary& summary);
 
 /// to_json(Summarize(...)): the summary.json of one evaluation.
@@ -154,7 +158,8 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
 /// The table `pandora analyze` prints: the rig and region, coverage shares, the resolution and
 /// sigma_max percentiles when present ("-" for a percentile without a value), one line per camera
 /// (share of the region seen, effective and nominal FOV, disabled ones marked), the timing, and
-/// FormatCalibration's lines when the calibration is set. Lines end in '\n'.
+/// FormatCalibration's lines when the calibration is set, FormatCriticality's when the robustness
+/// is. Lines end in '\n'.
 std::string FormatSummary(const Summary& summary);
 
 /// Nearest-rank percentiles of the active values of the float grid `name` of `fields` (tiles count

@@ -12,7 +12,8 @@ namespace pandora::session {
 Session::Session(std::shared_ptr<const Study> study, SessionOptions options)
     : study_(std::move(study)),
       options_(std::move(options)),
-      rig_(study_->FindRig(options_.rig, options_.rig_option)),
+      rig_(DisableCameras(study_->FindRig(options_.rig, options_.rig_option), options_.disable,
+                          options_.disable_option)),
       saved_text_(study_->text()) {
   evaluator_ = std::make_unique<FieldEvaluator>(study_->scene(), study_->caster(), options_.fields,
                                                 options_.incremental);

@@ -205,6 +205,37 @@ TEST(Session, FieldsFollowEditsUndoAndBackgroundUpdates) {
   ExpectFieldsOf(session, original, options.fields);
 }
 
+// --disable: the session's rig has the named cameras disabled (not as an edit: nothing to undo or
+// save), its fields are those of that rig, and an unknown id is an InputError naming the option.
+TEST(Session, DisabledCamerasAreOffForTheSessionOnly) {
+  const auto study = Study::Load("tests/data/minimal.json");
+  SessionOptions options;
+  options.fields.fields = {"coverage", "cameras"};
+  const Rig file_rig = study->FindRig("");
+  ASSERT_GE(file_rig.cameras.size(), 2u);
+  options.disable = {file_rig.cameras[1].id};
+  Session session(study, options);
+  EXPECT_TRUE(session.rig().rig().cameras[0].enabled);
+  EXPECT_FALSE(session.rig().rig().cameras[1].enabled);
+  EXPECT_FALSE(session.rig().can_undo());
+  session.UpdateFields();
+  Rig expected = file_rig;
+  expected.cameras[1].enabled = false;
+  ExpectFieldsOf(session, expected, options.fields);
+  session.ReadFields([&](const Fields& f, std::int64_t) { EXPECT_EQ(f.stats.per_camera_seen[1], 0); });
+
+  options.disable = {file_rig.cameras[0].id, "no-such-camera"};
+  try {
+    Session bad(study, options);
+    ADD_FAILURE() << "no error for an unknown id";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("--disable"), std::string::npos) << message;
+    EXPECT_NE(message.find("no camera 'no-such-camera' in rig '" + file_rig.name + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find(file_rig.CameraIds()), std::string::npos) << message;
+  }
+}
+
 // The interactive suggest-and-accept loop in memory: a suggestion runs in the background on the rig
 // as it is, is applied as one undo step, undone, and refused once the rig has moved on.
 TEST(Session, SuggestInTheBackgroundThenApplyAndUndo) {

@@ -42,4 +42,15 @@ const Rig& Study::FindRig(const std::string& name, const std::string& option) co
   throw InputError(scene_.path, "$.rigs", "no rig named '" + name + "'", "rigs in this scene: " + names);
 }
 
+Rig DisableCameras(Rig rig, const std::vector<std::string>& ids, const std::string& option) {
+  for (const std::string& id : ids) {
+    if (id.empty()) throw InputError(option, "", "an empty camera id", "e.g. " + option + " c1,c2");
+    const int index = rig.FindCamera(id);
+    if (index < 0)
+      throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "cameras: " + rig.CameraIds());
+    rig.cameras[index].enabled = false;
+  }
+  return rig;
+}
+
 }  // namespace pandora::session

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
@@ -47,5 +48,10 @@ class Study {
   mutable std::once_flag prepared_once_;
   mutable std::unique_ptr<PreparedScene> prepared_;
 };
+
+/// `rig` with the cameras `ids` disabled, for one run (`--disable ID[,ID...]`: what the rig loses
+/// when they fail; docs/failures.md). Throws InputError naming `option` for an empty id or one that
+/// is not in the rig (the hint lists the rig's ids). Disabling a disabled camera is no error.
+Rig DisableCameras(Rig rig, const std::vector<std::string>& ids, const std::string& option);
 
 }  // namespace pandora::session

@@ -23,6 +23,7 @@
 #include "render/render.h"
 #include "render/report/calibration_section.h"
 #include "render/report/time_section.h"
+#include "render/report/robustness_section.h"
 #include "render/report/plot.h"
 #include "render/report/report_images.h"
 
@@ -302,6 +303,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
       r.summary.targets = EvaluateSurfaceTargets(scene, *rig, *parts, samples, scene.TimeMinCameras());
       r.summary.sample_labels = sample_labels;
     }
+    r.summary.robustness = ComputeCriticality(scene, *rig, r.fields, caster, scene.TimeMinCameras());
     data.rigs.push_back(std::move(r));
   }
 
@@ -609,6 +611,15 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
       names.push_back(r.rig.name);
     }
     body << TimeSectionHtml(summaries, names);
+  }
+
+  // N-1 robustness (render/report/robustness_section.h): the most critical cameras of each rig.
+  if (std::all_of(reports.begin(), reports.end(), [](const RigReport& r) { return r.summary.robustness; })) {
+    body << "<h2 id=\"robustness\">Robustness</h2>\n" << RobustnessIntroHtml(reports[0].summary.robustness->k)
+         << RigRow(heads);
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) cells.push_back(RobustnessCellHtml(*r.summary.robustness));
+    body << RigRow(cells);
   }
 
   // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.

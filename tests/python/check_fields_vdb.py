@@ -148,6 +148,16 @@ def main():
         for key in ("value_units", "description", "scene_sha256", "rig"):
             expect(key in g.metadata, f"{name}: no {key} metadata")
         checked.append(name)
+    # N-1 (docs/failures.md): coverage after the worst single failure, max(coverage - 1, 0), on the
+    # same voxels as coverage; written by analyze with the cameras field.
+    n1 = by_name.get("coverage_n1")
+    expect(n1 is not None and type(n1).__name__ == "FloatGrid", "no FloatGrid 'coverage_n1'")
+    expect(n1.activeVoxelCount() == coverage.activeVoxelCount(),
+           f"coverage_n1: {n1.activeVoxelCount()} active voxels, coverage {coverage.activeVoxelCount()}")
+    after = np.zeros(dims, dtype=np.float32)
+    n1.copyToArray(after, ijk=(0, 0, 0))
+    expect(np.array_equal(after, np.maximum(cov - 1, 0)), "coverage_n1 differs from max(coverage - 1, 0)")
+    checked.append("coverage_n1")
     expect(sorted(checked) == sorted(by_name), f"unexpected grids: {sorted(set(by_name) - set(checked))}")
     print(f"ok: pyopenvdb read {len(grids)} grids; coverage = sum of {len(ids)} camera grids on "
           f"{region_voxels} voxels; counts match summary.json")

@@ -105,6 +105,9 @@ int Run(int argc, char** argv) {
   double target_hz = 30;
   app.add_option("scene", scene, "Scene file (JSON)")->required();
   app.add_option("--rig", rig, "Rig to edit (default: the first)");
+  std::vector<std::string> disable;
+  app.add_option("--disable", disable, "Camera ids to disable for this session, comma-separated or repeated "
+                                       "(not saved)")->delimiter(',');
   app.add_option("--fields", fields, "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
   app.add_option("--script", script, "Replay these actions (a JSON array; docs/viewer.md), then exit");
   app.add_option("--screenshot", screenshot, "With --script: the window at the end, as PNG");
@@ -140,6 +143,7 @@ int Run(int argc, char** argv) {
   const auto study = pandora::session::Study::Load(scene);
   pandora::viewer::ViewerOptions vo;
   vo.rig = rig;
+  vo.disable = disable;
   vo.width = width;
   vo.height = height;
   if (!fields.empty()) {

@@ -100,6 +100,7 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   session::SessionOptions so;
   so.rig = options_.rig;
   so.rig_option = "--rig";
+  so.disable = options_.disable;
   so.fields.fields = options_.fields.empty() ? DefaultFields() : options_.fields;
   so.fields.scene_path = study->scene().path;
   so.incremental = true;

@@ -49,6 +49,7 @@ class CpuFrontend : public Frontend {
 
 struct ViewerOptions {
   std::string rig;                  ///< Empty: the first.
+  std::vector<std::string> disable;  ///< Camera ids disabled for the session (--disable; not saved).
   std::vector<std::string> fields;  ///< Live fields; empty: coverage, cameras, resolution, sigma_max.
   std::string autosave_path;        ///< Empty: no autosave.
   int width = 1280, height = 720;   ///< The main view.
