@@ -16,7 +16,7 @@ header_bytes=$(printf '%s\n' "$header" | wc -c)
 [ "$(printf '%s\n' "$header" | sed -n 2p)" = "format binary_little_endian 1.0" ] || fail "format line"
 for p in "float x" "float y" "float z" "float nx" "float ny" "float nz" "uchar red" "uchar green" \
          "uchar blue" "float coverage" "float resolution" "float sigma_max" "uchar triangulable" "int object"; do
-  printf '%s\n' "$header" | grep -qx "property $p" || fail "no 'property $p' in the header"
+  grep -qx "property $p" <<<"$header" || fail "no 'property $p' in the header"
 done
 count=$(printf '%s\n' "$header" | sed -n 's/^element vertex \([0-9]*\)$/\1/p')
 [ -n "$count" ] && [ "$count" -gt 1000 ] || fail "vertex count '$count'"
@@ -32,7 +32,8 @@ all=$(head -c 4096 "$out/all.ply" | sed -n 's/^element vertex \([0-9]*\)$/\1/p')
 [ "$all" -gt "$count" ] || fail "--all-surfaces: $all samples, not more than $count"
 ratio=$(( 1000 * all / count ))
 [ "$ratio" -ge 1150 ] && [ "$ratio" -le 1250 ] || fail "--all-surfaces / default = $ratio / 1000, expected about 1200"
-head -c 4096 "$out/a.ply" | grep -q "^comment surfaces: facing the region or a camera" || fail "no 'surfaces' comment"
+comment=$(head -c 4096 "$out/a.ply" | tr -c "[:print:]\n" " ")
+grep -q "^comment surfaces: facing the region or a camera" <<<"$comment" || fail "no 'surfaces' comment"
 leftover=$(find "$out" -name '*.tmp-*' | head -1)
 [ -z "$leftover" ] || fail "temporary file left: $leftover"
 echo "ok: $count samples facing the region ($all with --all-surfaces), $size bytes"
