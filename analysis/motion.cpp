@@ -5,6 +5,7 @@
 #include <set>
 
 #include "analysis/ray_caster.h"
+#include "analysis/seeded.h"
 #include "analysis/scene.h"
 
 namespace pandora {
@@ -12,18 +13,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// SplitMix64: a well-mixed 64-bit value from (seed, stream, index), so that each draw depends only
-// on its own indices.
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-double Uniform01(std::uint64_t seed, int index, int component) {
-  const std::uint64_t h = Mix(Mix(seed) ^ Mix(std::uint64_t(index) * 8 + std::uint64_t(component) + 1));
-  return double(h >> 11) * 0x1p-53;  // [0, 1)
-}
 
 std::string Short(double v) {
   char b[32];
@@ -58,9 +47,9 @@ GroupPose ObjectMotion::AtTime(double t) const {
 GroupPose ObjectMotion::RandomDraw(int i) const {
   GroupPose p;
   Vec3 at;
-  for (int k = 0; k < 3; ++k) at[k] = box.min[k] + Uniform01(seed, i, k) * (box.max[k] - box.min[k]);
+  for (int k = 0; k < 3; ++k) at[k] = box.min[k] + SeededUniform(seed, std::uint64_t(i), std::uint64_t(k)) * (box.max[k] - box.min[k]);
   p.move = at - anchor;
-  p.yaw_deg = yaw_min_deg + Uniform01(seed, i, 3) * (yaw_max_deg - yaw_min_deg);
+  p.yaw_deg = yaw_min_deg + SeededUniform(seed, std::uint64_t(i), 3) * (yaw_max_deg - yaw_min_deg);
   return p;
 }
 

@@ -8,23 +8,10 @@
 #include <cmath>
 
 #include "analysis/ray_caster.h"
+#include "analysis/seeded.h"
 #include "analysis/visibility.h"
 
 namespace pandora {
-namespace {
-
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-double Uniform01(std::uint64_t seed, std::uint64_t i, int component) {
-  return double(Mix(Mix(seed) ^ Mix(i * 4 + std::uint64_t(component) + 1)) >> 11) * 0x1p-53;
-}
-
-}  // namespace
-
 void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std::vector<Vec3>* points,
                    std::vector<Vec3>* normals) {
   points->clear();
@@ -39,13 +26,13 @@ void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std:
   }
   if (!(total > 0) || count <= 0) return;
   for (int i = 0; i < count; ++i) {
-    const double pick = Uniform01(seed, std::uint64_t(i), 0) * total;
+    const double pick = SeededUniform(seed, std::uint64_t(i), 0) * total;
     const std::size_t k = std::min<std::size_t>(
         std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin(), cumulative.size() - 1);
     const Eigen::Vector3i& t = mesh.triangles[k];
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     // Uniform on the triangle: (1 - sqrt(r1)) a + sqrt(r1) (1 - r2) b + sqrt(r1) r2 c.
-    const double r1 = std::sqrt(Uniform01(seed, std::uint64_t(i), 1)), r2 = Uniform01(seed, std::uint64_t(i), 2);
+    const double r1 = std::sqrt(SeededUniform(seed, std::uint64_t(i), 1)), r2 = SeededUniform(seed, std::uint64_t(i), 2);
     points->push_back((1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c);
     normals->push_back((b - a).cross(c - a).normalized());
   }

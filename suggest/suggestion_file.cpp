@@ -210,15 +210,19 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   return j.dump(1) + "\n";
 }
 
-std::string ReplacePoses(const std::string& text, const std::string& scene_path,
-                         const std::string& rig_name, const std::vector<PoseUpdate>& poses,
-                         std::vector<std::string>* notes) {
-  ordered_json root;
+// The scene text as ordered JSON (keys keep their order when written back).
+static ordered_json ParseOrdered(const std::string& text, const std::string& scene_path) {
   try {
-    root = ordered_json::parse(text);
+    return ordered_json::parse(text);
   } catch (const std::exception& e) {
     throw InputError(scene_path, "$", std::string("malformed JSON: ") + e.what());
   }
+}
+
+std::string ReplacePoses(const std::string& text, const std::string& scene_path,
+                         const std::string& rig_name, const std::vector<PoseUpdate>& poses,
+                         std::vector<std::string>* notes) {
+  ordered_json root = ParseOrdered(text, scene_path);
   const double mpu = MetresPerUnit(root, scene_path);
   if (!root.contains("rigs") || !root["rigs"].is_array())
     throw InputError(scene_path, "$.rigs", "no rigs");
@@ -317,12 +321,7 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
 
 std::string ReplaceStations(const std::string& text, const std::string& scene_path,
                             const std::vector<StationMove>& stations) {
-  ordered_json root;
-  try {
-    root = ordered_json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(scene_path, "$", std::string("malformed JSON: ") + e.what());
-  }
+  ordered_json root = ParseOrdered(text, scene_path);
   const double mpu = MetresPerUnit(root, scene_path);
   for (const StationMove& move : stations) {
     const std::string where = "$.stations." + move.name;

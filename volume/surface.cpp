@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "analysis/atomic_file.h"
+#include "analysis/seeded.h"
 #include "analysis/error.h"
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
@@ -16,21 +17,6 @@
 
 namespace pandora {
 namespace {
-
-// SplitMix64's finaliser: a bijective 64-bit mix, enough to turn counters into independent uniform
-// bits (the same on every platform, unlike std:: distributions).
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-// Uniform in [0, 1) from 53 bits of a hash of (seed, a, b, c).
-double Uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
-  const std::uint64_t h = Mix(Mix(Mix(Mix(seed) ^ a) ^ b) ^ c);
-  return static_cast<double>(h >> 11) * 0x1.0p-53;
-}
 
 double TriangleArea(const TriangleMesh& mesh, const Eigen::Vector3i& t, Vec3* normal) {
   const Vec3& a = mesh.vertices[t[0]];
@@ -136,15 +122,15 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
       const double whole = std::floor(e);
       std::uint64_t n = static_cast<std::uint64_t>(whole);
       // The extra point uses sample index 2^63 so it never shares random numbers with the others.
-      if (Uniform(seed, oi, ti, std::uint64_t{1} << 63) < e - whole) ++n;
+      if (SeededUniform(seed, oi, ti, std::uint64_t{1} << 63) < e - whole) ++n;
       const Vec3& p0 = mesh.vertices[t[0]];
       const Vec3& p1 = mesh.vertices[t[1]];
       const Vec3& p2 = mesh.vertices[t[2]];
       for (std::uint64_t s = 0; s < n; ++s) {
         // Uniform on the triangle: with r1, r2 uniform, (1 - sqrt r1, sqrt r1 (1 - r2), sqrt r1 r2)
         // are barycentric coordinates of uniform density (Osada et al. 2002).
-        const double r1 = std::sqrt(Uniform(seed, oi, ti, 2 * s));
-        const double r2 = Uniform(seed, oi, ti, 2 * s + 1);
+        const double r1 = std::sqrt(SeededUniform(seed, oi, ti, 2 * s));
+        const double r2 = SeededUniform(seed, oi, ti, 2 * s + 1);
         SurfaceSample sample;
         sample.position = (1 - r1) * p0 + r1 * (1 - r2) * p1 + r1 * r2 * p2;
         sample.normal = normal;

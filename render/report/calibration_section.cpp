@@ -1,6 +1,7 @@
 // The report's calibration section (render/report/calibration_section.h): a heat map of the
 // co-visibility matrix drawn as SVG by hand (as plot.cpp draws its plots) and plain HTML tables.
 #include "render/report/calibration_section.h"
+#include "render/report/table.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,20 +19,6 @@ constexpr const char* kComponentColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9
 constexpr int kComponentColorCount = sizeof(kComponentColors) / sizeof(kComponentColors[0]);
 constexpr const char* kUncalibratable = "#c00000";
 constexpr const char* kBelowMinimum = "#d9d9d9";
-
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string Num(double v) {
   char b[32];
@@ -91,7 +78,7 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
     << "\" viewBox=\"0 0 " << Num(width) << " " << Num(height)
     << "\" font-family=\"DejaVu Sans, Arial, Helvetica, sans-serif\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"12\" y=\"20\" font-size=\"14\" font-weight=\"bold\">" << Escape(title) << "</text>\n";
+    << "<text x=\"12\" y=\"20\" font-size=\"14\" font-weight=\"bold\">" << HtmlEscape(title) << "</text>\n";
   // Ids, component bands.
   for (int c = 0; c < n; ++c) {
     const double mid = c * cell + cell / 2.0;
@@ -100,10 +87,10 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
     const std::string weight = bad ? " font-weight=\"bold\"" : "";
     s << "<text x=\"" << Num(12 + label) << "\" y=\"" << Num(top + mid + 4)
       << "\" font-size=\"12\" text-anchor=\"end\" fill=\"" << fill << "\"" << weight << ">"
-      << Escape(r.camera_ids[c]) << "</text>\n";
+      << HtmlEscape(r.camera_ids[c]) << "</text>\n";
     s << "<text transform=\"translate(" << Num(left + mid + 4) << "," << Num(34 + label)
       << ") rotate(-90)\" font-size=\"12\" fill=\"" << fill << "\"" << weight << ">"
-      << Escape(r.camera_ids[c]) << "</text>\n";
+      << HtmlEscape(r.camera_ids[c]) << "</text>\n";
     const std::string color = ComponentColor(r.graph.component[c]);
     s << "<rect x=\"" << Num(left - gap - band) << "\" y=\"" << Num(top + c * cell) << "\" width=\""
       << Num(band) << "\" height=\"" << cell << "\" fill=\"" << color << "\"/>\n";
@@ -235,7 +222,7 @@ std::string CalibrationCellHtml(
       << (!r.enabled[c] ? " class=\"disabled\""
           : bad         ? " class=\"uncalibratable\""
                         : "")
-      << "><td>" << Escape(r.camera_ids[c]) << "</td><td>";
+      << "><td>" << HtmlEscape(r.camera_ids[c]) << "</td><td>";
     if (r.graph.component[c] >= 0)
       s << "<span class=\"swatch\" style=\"background:" << ComponentColor(r.graph.component[c])
         << "\"></span>" << r.graph.component[c] + 1 << (bad ? " (uncalibratable)" : "");
@@ -255,7 +242,7 @@ std::string CalibrationCellHtml(
     const std::size_t shown = std::min<std::size_t>(r.graph.weakest_links.size(), 5);
     for (std::size_t k = 0; k < shown; ++k) {
       const CalibrationLink& l = r.graph.weakest_links[k];
-      s << "<tr><td>" << Escape(r.camera_ids[l.a]) << " &ndash; " << Escape(r.camera_ids[l.b]) << "</td><td>"
+      s << "<tr><td>" << HtmlEscape(r.camera_ids[l.a]) << " &ndash; " << HtmlEscape(r.camera_ids[l.b]) << "</td><td>"
         << l.shared << "</td></tr>\n";
     }
     s << "</tbody></table>\n";

@@ -3,6 +3,7 @@
 // When the file has several rigs they are laid out in columns, the same figures per rig on the same
 // scales, with the headline numbers compared in one table.
 #include "render/report/report.h"
+#include "render/report/table.h"
 
 #include <tbb/global_control.h>
 
@@ -34,20 +35,6 @@
 namespace pandora::report {
 namespace {
 
-std::string Html(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 std::string Fmt(const char* format, double v) {
   char b[64];
   std::snprintf(b, sizeof b, format, v);
@@ -64,7 +51,7 @@ std::string Swatch(const Camera& cam) {
 std::string ColourKey(const Rig& rig) {
   std::string s = "<div class=\"key\">";
   for (const Camera& cam : rig.cameras)
-    if (cam.enabled) s += "<span class=\"entry\">" + Swatch(cam) + Html(cam.id) + "</span> ";
+    if (cam.enabled) s += "<span class=\"entry\">" + Swatch(cam) + HtmlEscape(cam.id) + "</span> ";
   return s + "</div>";
 }
 
@@ -74,7 +61,7 @@ class Figures {
   std::string Img(const std::string& mime, const std::string& bytes, const std::string& alt,
                   const std::string& css_class = "") {
     ++count_;
-    return "<img src=\"" + DataUri(mime, bytes) + "\" alt=\"" + Html(alt) + "\"" +
+    return "<img src=\"" + DataUri(mime, bytes) + "\" alt=\"" + HtmlEscape(alt) + "\"" +
            (css_class.empty() ? "" : " class=\"" + css_class + "\"") + ">";
   }
   std::string Svg(const std::string& svg, const std::string& alt) {
@@ -101,7 +88,7 @@ std::string HeadlineTable(const ReportData& data) {
   const RigComparison& c = data.comparison;
   const std::size_t n = c.rigs.size();
   std::string s = "<table class=\"numbers\"><thead><tr><th></th>";
-  for (const std::string& name : c.rigs) s += "<th>" + Html(name) + "</th>";
+  for (const std::string& name : c.rigs) s += "<th>" + HtmlEscape(name) + "</th>";
   s += "</tr></thead><tbody>\n";
   s += "<tr><td>Enabled cameras</td>";
   for (int cameras : c.enabled_cameras) s += "<td>" + std::to_string(cameras) + "</td>";
@@ -138,7 +125,7 @@ std::string CameraTable(const RigReport& r, const Study& study) {
     const std::string sigma = cam.pixel_sigma > 0 ? Fmt("%g", cam.pixel_sigma)
                                                   : Fmt("%g", study.pixel_sigma) + " (study)";
     s += std::string("<tr") + (cam.enabled ? "" : " class=\"disabled\"") + "><td>" +
-         (cam.enabled ? Swatch(cam) : "") + Html(cam.id) + "</td><td>" + Html(cam.name) + "</td><td>" +
+         (cam.enabled ? Swatch(cam) : "") + HtmlEscape(cam.id) + "</td><td>" + HtmlEscape(cam.name) + "</td><td>" +
          std::to_string(k.width) + " &times; " + std::to_string(k.height) + "</td><td>" +
          Fmt("%.1f", pc.lens.hfov_deg) + " &times; " + Fmt("%.1f", pc.lens.vfov_deg) + "</td><td>" +
          Fmt("%.1f", pc.lens.nominal_hfov_deg) + " &times; " + Fmt("%.1f", pc.lens.nominal_vfov_deg) +
@@ -154,7 +141,7 @@ std::string WarningList(const RigReport& r, const std::string& file) {
   if (r.warnings.empty()) return "<p class=\"note\">No warnings.</p>\n";
   std::string s = "<ul class=\"warnings\">\n";
   for (const Warning& w : r.warnings)
-    s += "<li><code>" + Html(file + ": " + w.json_path) + "</code>: " + Html(w.reason) + "</li>\n";
+    s += "<li><code>" + HtmlEscape(file + ": " + w.json_path) + "</code>: " + HtmlEscape(w.reason) + "</li>\n";
   return s + "</ul>\n";
 }
 
@@ -377,8 +364,8 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
   const int view_width = options.view_width;
   Figures fig;
   std::ostringstream body;
-  body << "<h1>Pandora report: " << Html(std::filesystem::path(scene.path).filename().string())
-       << "</h1>\n<p class=\"meta\">Scene <code>" << Html(scene.path) << "</code> (SHA-256 <code>"
+  body << "<h1>Pandora report: " << HtmlEscape(std::filesystem::path(scene.path).filename().string())
+       << "</h1>\n<p class=\"meta\">Scene <code>" << HtmlEscape(scene.path) << "</code> (SHA-256 <code>"
        << scene.sha256.substr(0, 16) << "&hellip;</code>), pandora " << PANDORA_VERSION
        << ". Voxel size " << Fmt("%g", reports[0].fields.lattice.voxel_size * 1e3)
        << " mm; region " << (study.region.kind == Region::Kind::kBox ? "box" : "mesh") << " "
@@ -392,7 +379,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
          << Fmt("%g", study.motion->rate_hz) << " Hz (" << (study.steady_prior ? "prior" : "posterior")
          << " covariance)";
   body << ". Rigs: ";
-  for (std::size_t i = 0; i < n; ++i) body << (i ? ", " : "") << "<b>" << Html(reports[i].rig.name) << "</b>";
+  for (std::size_t i = 0; i < n; ++i) body << (i ? ", " : "") << "<b>" << HtmlEscape(reports[i].rig.name) << "</b>";
   body << ".</p>\n<p id=\"image-check\" class=\"pending\">checking images&hellip;</p>\n";
 
   body << "<h2 id=\"numbers\">" << (n > 1 ? "Rigs compared" : "Summary") << "</h2>\n"
@@ -405,7 +392,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
   // Rig headers for the column layout.
   std::vector<std::string> heads;
   for (const RigReport& r : reports)
-    heads.push_back("<h3 class=\"rig\">" + Html(r.rig.name) + " &mdash; " +
+    heads.push_back("<h3 class=\"rig\">" + HtmlEscape(r.rig.name) + " &mdash; " +
                     std::to_string(r.rig.enabled_count()) + " cameras</h3>");
 
   // Warnings (as `pandora analyze` prints them): nonsense placements and lenses.
@@ -450,7 +437,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
         const Image image = Render(scene, r.rig, caster, ViewFromScene(view, view_width, height), render);
         cells.push_back("<figure>" +
                         fig.Img("image/png", PngBytes(image), r.rig.name + " view " + name, "render") +
-                        "<figcaption>view <b>" + Html(name) + "</b></figcaption></figure>");
+                        "<figcaption>view <b>" + HtmlEscape(name) + "</b></figcaption></figure>");
       }
       body << RigRow(cells);
     }
@@ -478,7 +465,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
         render.overlays.key = false;  // the key is above the views, once per rig
         const Image image = Render(scene, r.rig, caster, view, render);
         cell += "<figure>" + fig.Img("image/png", PngBytes(image), r.rig.name + " camera " + cam.id, "thumb") +
-                "<figcaption>" + Html(cam.id) + (cam.name != cam.id ? " (" + Html(cam.name) + ")" : "") +
+                "<figcaption>" + HtmlEscape(cam.id) + (cam.name != cam.id ? " (" + HtmlEscape(cam.name) + ")" : "") +
                 "</figcaption></figure>";
       }
       cells.push_back(cell + "</div>");
@@ -503,7 +490,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     if (field != "coverage")
       bar.swatches.push_back({HexColor(kNoValueColor).data(), field == "sigma_max" ? "not triangulable" : "unseen"});
     bar.swatches.push_back({HexColor(kOutsideRegionColor).data(), "outside region"});
-    body << "<h3>" << Html(field) << "</h3>\n";
+    body << "<h3>" << HtmlEscape(field) << "</h3>\n";
     const std::string legend = fig.Svg(RenderColorbarSvg(bar), field + " colour scale");
     body << "<div class=\"legend\">" << legend << "</div>\n";
     std::vector<std::string> cells;
@@ -628,7 +615,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     std::string json = nlohmann::json(r.summary).dump();
     for (std::size_t p = json.find("</"); p != std::string::npos; p = json.find("</", p + 2))
       json.replace(p, 2, "<\\/");
-    summaries += "<script type=\"application/json\" class=\"summary\" data-rig=\"" + Html(r.rig.name) +
+    summaries += "<script type=\"application/json\" class=\"summary\" data-rig=\"" + HtmlEscape(r.rig.name) +
                  "\">" + json + "</script>\n";
   }
   std::ostringstream page;
@@ -637,7 +624,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
           "style-src 'unsafe-inline'; script-src 'unsafe-inline'\">\n"
        << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
        << "<meta name=\"generator\" content=\"pandora " << PANDORA_VERSION << "\">\n"
-       << "<title>Pandora report: " << Html(scene.path) << "</title>\n<style>\n"
+       << "<title>Pandora report: " << HtmlEscape(scene.path) << "</title>\n<style>\n"
        << "body{font-family:'DejaVu Sans',Arial,Helvetica,sans-serif;margin:24px auto;max-width:"
        << (n > 1 ? 1500 : 900) << "px;padding:0 16px;color:#222;font-size:14px}\n"
           "h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #ccc;padding-bottom:4px;margin-top:32px}\n"

@@ -1,4 +1,5 @@
 #include "render/report/robustness_section.h"
+#include "render/report/table.h"
 
 #include <sstream>
 
@@ -6,20 +7,6 @@
 
 namespace pandora::report {
 namespace {
-
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string Percent(double share) { return Format("%.1f%%", 100 * share); }
 
@@ -42,7 +29,7 @@ std::string RobustnessCellHtml(const CriticalityTable& t, int rows) {
   if (t.worst < 0) return "<p>No enabled camera.</p>\n";
   const CriticalityRow& worst = t.rows[t.worst];
   s << "<p>Seen by &ge; " << t.k << ": intact " << Percent(t.ge_k) << "; worst single failure <b>"
-    << Escape(worst.id) << "</b> " << Percent(worst.ge_k) << Format(" (&minus;%.1f points)", 100 * t.worst_loss())
+    << HtmlEscape(worst.id) << "</b> " << Percent(worst.ge_k) << Format(" (&minus;%.1f points)", 100 * t.worst_loss())
     << "; mean over failures " << Percent(t.mean_ge_k) << ".</p>\n";
   s << "<div class=\"scroll\"><table class=\"robustness\"><thead><tr><th>fails</th><th>&ge; 1</th>"
        "<th>&ge; 2</th><th>&ge; 3</th>";
@@ -52,7 +39,7 @@ std::string RobustnessCellHtml(const CriticalityTable& t, int rows) {
   const std::vector<int> order = t.MostCritical();
   for (int i = 0; i < rows && i < static_cast<int>(order.size()); ++i) {
     const CriticalityRow& r = t.rows[order[i]];
-    s << "<tr><td>" << Escape(r.id) << "</td><td>" << Percent(r.ge1) << "</td><td>" << Percent(r.ge2)
+    s << "<tr><td>" << HtmlEscape(r.id) << "</td><td>" << Percent(r.ge1) << "</td><td>" << Percent(r.ge2)
       << "</td><td>" << Percent(r.ge3) << "</td>";
     if (t.k > 3) s << "<td>" << Percent(r.ge_k) << "</td>";
     if (t.uncertainty)

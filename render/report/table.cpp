@@ -7,6 +7,20 @@
 #include <cstdio>
 
 namespace pandora::report {
+
+std::string HtmlEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
 namespace {
 
 // Display width: UTF-8 continuation bytes do not count.

@@ -10,6 +10,9 @@
 
 namespace pandora::report {
 
+/// `s` with & < > " replaced by their HTML entities, for text and attribute values in the report.
+std::string HtmlEscape(const std::string& s);
+
 /// A table of already formatted cells.
 class Table {
  public:

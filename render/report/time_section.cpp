@@ -1,4 +1,5 @@
 #include "render/report/time_section.h"
+#include "render/report/table.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -6,20 +7,6 @@
 
 namespace pandora::report {
 namespace {
-
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string Percent(double v) {
   char b[32];
@@ -37,7 +24,7 @@ std::string Row(const std::string& label, const std::vector<std::optional<double
   for (std::size_t i = 0; i < values.size(); ++i) {
     std::string cell = values[i] ? Percent(*values[i]) : "&ndash;";
     if (values[i] && values.size() > 1 && *values[i] == best) cell = "<b>" + cell + "</b>";
-    if (i < notes.size() && !notes[i].empty()) cell += " <span class=\"note\">" + Escape(notes[i]) + "</span>";
+    if (i < notes.size() && !notes[i].empty()) cell += " <span class=\"note\">" + HtmlEscape(notes[i]) + "</span>";
     out += "<td>" + cell + "</td>";
   }
   return out + "</tr>\n";
@@ -71,7 +58,7 @@ std::string TimeSectionHtml(const std::vector<const Summary*>& summaries, const 
           "tested against every camera as a surface point (facing it, not hidden, the body itself "
           "included). k = " + ks + " cameras. The volume as placed is under <a href=\"#numbers\">the numbers</a> above.</p>\n";
   html += "<table class=\"compare\"><tr><th></th>";
-  for (const std::string& name : rig_names) html += "<th>" + Escape(name) + "</th>";
+  for (const std::string& name : rig_names) html += "<th>" + HtmlEscape(name) + "</th>";
   html += "</tr>\n";
   auto each = [&](auto get) {
     std::vector<std::optional<double>> v;
@@ -99,7 +86,7 @@ std::string TimeSectionHtml(const std::vector<const Summary*>& summaries, const 
         if (t.name == target) return &t;
       return nullptr;
     };
-    const std::string name = Escape(target);
+    const std::string name = HtmlEscape(target);
     for (int j = 1; j <= 3; ++j)
       html += Row(name + ": points seen by &ge; " + std::to_string(j), each([&](const Summary& s) {
                     const SurfaceTargetResult* t = find(s);
@@ -128,12 +115,12 @@ std::string TimeSectionHtml(const std::vector<const Summary*>& summaries, const 
   if (labels.size() > 1) {
     html += "<h3>Sample by sample (share seen by &ge; " + ks + " cameras)</h3>\n<div class=\"scroll\"><table class=\"compare\"><tr><th>Sample</th>";
     for (const std::string& name : rig_names) {
-      if (samples > 0) html += "<th>" + Escape(name) + ": volume</th>";
-      for (const std::string& target : targets) html += "<th>" + Escape(name) + ": " + Escape(target) + "</th>";
+      if (samples > 0) html += "<th>" + HtmlEscape(name) + ": volume</th>";
+      for (const std::string& target : targets) html += "<th>" + HtmlEscape(name) + ": " + HtmlEscape(target) + "</th>";
     }
     html += "</tr>\n";
     for (std::size_t i = 0; i < labels.size(); ++i) {
-      html += "<tr><th>" + Escape(labels[i]) + "</th>";
+      html += "<tr><th>" + HtmlEscape(labels[i]) + "</th>";
       for (const Summary* s : summaries) {
         if (samples > 0)
           html += "<td>" + (s->time && i < s->time->samples.size() ? Percent(s->time->samples[i].ge_k) : "&ndash;") + "</td>";
