@@ -122,6 +122,8 @@ def main():
             "targets": {"objects": ["a", "b"], "points": 3000, "seed": 1},
             "regions": {"centre": {"box": {"min": [-1.0, -1.0, 0.05], "max": [1.0, 1.0, 2.05]}},
                         "feet": {"box": {"min": [-2.0, -1.5, 0.05], "max": [2.0, 1.5, 0.35]}}},
+            "calibration": {"target": "board", "samples": 2000, "seed": 1, "min_shared": 20,
+                            "board": {"squares": [9, 7], "square_m": 0.06, "tilt_max_deg": 60, "min_px_per_square": 10}},
             "pixel_targets": [{"name": "marker", "size_m": 0.014, "min_px": 4},
                               {"name": "face", "size_m": 0.16, "min_px": 80}],
         },
