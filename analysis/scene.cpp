@@ -1315,6 +1315,19 @@ const Rig& Scene::FindRig(const std::string& name) const {
 // "motions": {"GROUP": {"keyframes": [{"t", "move", "yaw_deg"}, ...]} | {"poses": {"NAME": {"move",
 // "yaw_deg"}}} | {"random": {"box", "yaw_deg": [lo, hi], "samples", "seed"}}}; then the study's time
 // axis checked against them.
+// The names a motion or a target may use, sorted: objects, their groups, and the part before the
+// '/' of a mesh file's parts or of "patient/torso"-style names.
+std::vector<std::string> GroupNames(const Scene& scene) {
+  std::set<std::string> names;
+  for (const SceneObject& o : scene.objects) {
+    names.insert(o.name);
+    if (!o.group.empty()) names.insert(o.group);
+    const auto slash = o.name.find('/');
+    if (slash != std::string::npos) names.insert(o.name.substr(0, slash));
+  }
+  return std::vector<std::string>(names.begin(), names.end());
+}
+
 GroupPose ReadGroupPose(const Node& node) {
   node.CheckKeys({"move", "yaw_deg", "t"});
   GroupPose p;
@@ -1346,16 +1359,9 @@ void ReadMotions(const Node& motions, Scene* scene) {
       motion.objects.push_back(int(o));
       bounds.Extend(object.mesh.Bounds());
     }
-    if (motion.objects.empty()) {
-      std::set<std::string> names;
-      for (const SceneObject& object : scene->objects) {
-        names.insert(object.name);
-        if (!object.group.empty()) names.insert(object.group);
-      }
+    if (motion.objects.empty())
       m.Fail("no object or group named " + Quoted(motion.name),
-             SuggestionHint(motion.name, std::vector<std::string>(names.begin(), names.end()),
-                            "objects and groups"));
-    }
+             SuggestionHint(motion.name, GroupNames(*scene), "objects and groups"));
     if (!bounds.empty()) motion.anchor = Vec3(bounds.center().x(), bounds.center().y(), bounds.min.z());
     m.CheckKeys({"keyframes", "poses", "random"});
     const std::string kind = m.OneOf({"keyframes", "poses", "random"}, "kind of motion");
@@ -1502,18 +1508,11 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto motions = root.Find("motions")) ReadMotions(*motions, &scene);
   if (scene.study.targets) {
     const Node names = root.Get("study").Get("targets").Get("objects");
-    std::set<std::string> known;
-    for (const SceneObject& o : scene.objects) {
-      known.insert(o.name);
-      if (!o.group.empty()) known.insert(o.group);
-      const auto slash = o.name.find('/');
-      if (slash != std::string::npos) known.insert(o.name.substr(0, slash));
-    }
+    const std::vector<std::string> known = GroupNames(scene);
     for (size_t i = 0; i < scene.study.targets->names.size(); ++i) {
       const std::string& name = scene.study.targets->names[i];
-      if (!known.count(name))
-        names.At(i).Fail("no object or group named " + Quoted(name),
-                         SuggestionHint(name, std::vector<std::string>(known.begin(), known.end()), "objects and groups"));
+      if (!std::binary_search(known.begin(), known.end(), name))
+        names.At(i).Fail("no object or group named " + Quoted(name), SuggestionHint(name, known, "objects and groups"));
     }
   }
   if (root.Has("motions") || scene.study.time) CheckTimeAxis(root, scene);
