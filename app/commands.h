@@ -148,6 +148,9 @@ struct SuggestArgs {
   std::vector<std::string> keep_out;   ///< Boxes "x0,y0,z0,x1,y1,z1".
   std::vector<std::string> target_surfaces;
   bool with_region = false;       ///< Region points as well as surface points.
+  /// `--over-time`: the targets are the study's surface targets at every time sample (each point
+  /// tested against its sample's scene); docs/time.md.
+  bool over_time = false;
   int points = 1500;
   double snap_move = 0, snap_rotate = 0;
   double clearance = 0.1;         ///< Metres from every scene surface (`--clearance`).

@@ -310,6 +310,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(Number(0, HUGE_VAL, "metres"));
   sg->add_option("--target-surface", suggest.target_surfaces, "Object whose surface is the target (repeatable)");
   sg->add_flag("--with-region", suggest.with_region, "With --target-surface: region points as well");
+  sg->add_flag("--over-time", suggest.over_time,
+               "Target the study's surface targets at every time sample (moving people; --points per target)");
   sg->add_option("--points", suggest.points, "Target points")
       ->capture_default_str()->check(Number(1, 1000000, "target points", true));
   sg->add_option("--snap-move", suggest.snap_move, "Round moves to multiples of this, metres (0: off)")

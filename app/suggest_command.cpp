@@ -6,6 +6,8 @@
 #include <optional>
 
 #include "analysis/error.h"
+#include "analysis/motion.h"
+#include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -27,7 +29,7 @@ int RunSuggest(const SuggestArgs& args) {
   session::Session session(session::Study::Load(args.scene), session_options);
   const Scene& scene = session.study().scene();
   const Rig file_rig = session.rig().rig();
-  const SuggestOptions options = SuggestOptionsFromArgs(args, scene, file_rig);
+  SuggestOptions options = SuggestOptionsFromArgs(args, scene, file_rig);
   std::optional<std::vector<double>> perturbation;
   if (!args.perturb.empty()) {
     perturbation = ParseNumbers("--perturb", args.perturb, 2);
@@ -48,11 +50,28 @@ int RunSuggest(const SuggestArgs& args) {
   }
 
   // Run: a benchmark perturbation is an edit of the session's rig; the suggestion starts from it.
-  const std::vector<TargetPoint> targets =
-      SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
+  // Over time: the study's surface targets at every sample, each against its sample's caster.
+  std::unique_ptr<RigidPartsRayCaster> parts;
+  std::vector<std::unique_ptr<RayCaster>> sample_casters;
+  std::vector<TargetPoint> targets;
+  if (args.over_time) {
+    if (!args.target_surfaces.empty())
+      throw InputError("--over-time", "", "takes the study's targets; --target-surface is for a static scene",
+                       "give one of them");
+    const std::vector<TimeSample> samples = scene.TimeSamples();
+    targets = SampleTimeTargets(scene, samples, args.points, args.seed);
+    parts = MakeSceneParts(scene);
+    for (const TimeSample& s : samples) {
+      sample_casters.push_back(parts->At(PartTransforms(scene, s)));
+      options.sample_casters.push_back(sample_casters.back().get());
+    }
+  } else {
+    targets = SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
+  }
   std::optional<double> original;
   if (perturbation) {
-    original = EvaluateExact(scene, file_rig, session.study().caster(), targets, options.objective).objective;
+    original = EvaluateExact(scene, file_rig, session.study().caster(), targets, options.objective,
+                             options.sample_casters).objective;
     const Rig perturbed = PerturbCameras(file_rig, options.cameras, (*perturbation)[0], (*perturbation)[1], args.seed);
     std::vector<session::EditableRig::Pose> poses;
     for (int c : options.cameras) poses.push_back({perturbed.cameras[c].id, perturbed.cameras[c].world_from_camera, 1.0});

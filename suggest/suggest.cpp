@@ -18,6 +18,8 @@
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "suggest/suggest.h"
+
+#include "analysis/surface_targets.h"
 #include "suggest/suggest_internal.h"
 
 namespace pandora {
@@ -261,8 +263,10 @@ double RotationAngleDeg(const Mat3& a, const Mat3& b) {
 
 ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
                                const std::vector<TargetPoint>& targets, const Objective& objective,
-                               const std::vector<int>& selected)
+                               const std::vector<int>& selected, const std::vector<const RayCaster*>& sample_casters)
     : caster_(caster), targets_(targets), objective_(objective) {
+  casters_ = sample_casters;
+  if (casters_.empty()) casters_.push_back(&caster_);
   scene_scale_ = std::max(scene.Bounds().diagonal(), 1e-300);
   geometry_scale_ = std::max(scene.ContentBounds().diagonal(), 1e-300);
   region_scale_ = scene.study.region.box.diagonal();
@@ -289,11 +293,12 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   fixed_.J.assign(n, Mat3::Zero());
   fixed_.dmax.assign(n, 0.0);
   fixed_.dpow.assign(n, 0.0);
-  const VisibilityTester tester(fixed, caster, geometry_scale_);
+  const auto testers = Testers(fixed);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const TargetPoint& t = targets_[i];
       const Vec3* normal = t.normal ? &*t.normal : nullptr;
+      const VisibilityTester& tester = *testers[Sample(i)];
       for (int c = 0; c < static_cast<int>(fixed.size()); ++c) {
         Mat23 A;
         if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
@@ -308,6 +313,28 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   });
 }
 
+std::vector<std::unique_ptr<VisibilityTester>> ExactEvaluator::Testers(const std::vector<Camera>& cameras) const {
+  std::vector<std::unique_ptr<VisibilityTester>> out;
+  for (const RayCaster* c : casters_) out.push_back(std::make_unique<VisibilityTester>(cameras, *c, geometry_scale_));
+  return out;
+}
+
+void ExactEvaluator::OccludedByPoint(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const {
+  if (casters_.size() == 1) return casters_[0]->OccludedBatch(rays, occluded);
+  const std::size_t n = targets_.size();
+  occluded->assign(rays.size(), 0);
+  for (std::size_t s = 0; s < casters_.size(); ++s) {
+    std::vector<std::size_t> index;
+    for (std::size_t r = 0; r < rays.size(); ++r)
+      if (n > 0 && Sample(r % n) == s) index.push_back(r);
+    std::vector<Ray> part(index.size());
+    for (std::size_t k = 0; k < index.size(); ++k) part[k] = rays[index[k]];
+    std::vector<uint8_t> hit;
+    casters_[s]->OccludedBatch(part, &hit);
+    for (std::size_t k = 0; k < index.size(); ++k) (*occluded)[index[k]] = hit[k];
+  }
+}
+
 Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
                                  const std::vector<double>& focal_scales) const {
   ++evaluations_;
@@ -315,7 +342,7 @@ Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
   for (std::size_t c = 0; c < cams.size() && c < poses.size(); ++c) cams[c].world_from_camera = poses[c];
   for (std::size_t c = 0; c < cams.size() && c < focal_scales.size(); ++c)
     if (focal_scales[c] != 1.0) cams[c] = Zoomed(cams[c], focal_scales[c]);
-  const VisibilityTester tester(cams, caster_, geometry_scale_);
+  const auto testers = Testers(cams);
   const std::size_t n = targets_.size();
   std::vector<int> count = fixed_.count;
   std::vector<Mat3> J = fixed_.J;
@@ -324,6 +351,7 @@ Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const TargetPoint& t = targets_[i];
       const Vec3* normal = t.normal ? &*t.normal : nullptr;
+      const VisibilityTester& tester = *testers[Sample(i)];
       for (int c = 0; c < static_cast<int>(cams.size()); ++c) {
         Mat23 A;
         if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
@@ -341,7 +369,7 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
   Camera cam = selected_[c];
   cam.world_from_camera = pose;
   if (focal_scale != 1.0) cam = Zoomed(cam, focal_scale);
-  const VisibilityTester tester({cam}, caster_, geometry_scale_);
+  const auto testers = Testers({cam});
   const std::size_t n = targets_.size();
   CameraView v;
   v.seen.assign(n, 0);
@@ -352,7 +380,7 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const TargetPoint& t = targets_[i];
       Mat23 A;
-      if (tester.Test(0, t.p, t.normal ? &*t.normal : nullptr, &A) != ViewResult::kSeen) continue;
+      if (testers[Sample(i)]->Test(0, t.p, t.normal ? &*t.normal : nullptr, &A) != ViewResult::kSeen) continue;
       v.seen[i] = 1;
       v.info[i] = A.transpose() * A / (s * s);
       v.density[i] = PixelDensity(A);
@@ -757,8 +785,9 @@ void FillChanges(const Rig& rig, const SuggestOptions& options,
 // Exact evaluation of a whole rig, and the baseline
 
 Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                      const std::vector<TargetPoint>& targets, const Objective& objective) {
-  suggest_detail::ExactEvaluator ev(scene, rig, caster, targets, objective, {});
+                      const std::vector<TargetPoint>& targets, const Objective& objective,
+                      const std::vector<const RayCaster*>& sample_casters) {
+  suggest_detail::ExactEvaluator ev(scene, rig, caster, targets, objective, {}, sample_casters);
   Metrics m = ev.Evaluate({});
   if (objective.kind == ObjectiveKind::kMix) {
     ev.SetReference(m.sigma_mean, m.min_resolution);
@@ -776,7 +805,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   auto elapsed = [&]() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras, options.sample_casters);
   const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
@@ -847,6 +876,40 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   s.seconds = elapsed();
   s.message = s.improved ? "baseline improved the objective" : "baseline found no improvement";
   return s;
+}
+
+std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector<TimeSample>& samples_in,
+                                           int points, std::uint64_t seed) {
+  if (!scene.study.targets)
+    throw InputError(scene.path, "$.study.targets", "suggesting over time needs surface targets",
+                     "name the moving groups to see under \"study\": {\"targets\": {\"objects\": [...]}}");
+  const std::vector<TimeSample> samples =
+      samples_in.empty() ? std::vector<TimeSample>{TimeSample{"as placed", 0, {}}} : samples_in;
+  std::vector<TargetPoint> out;
+  const std::vector<std::string>& names = scene.study.targets->names;
+  for (std::size_t g = 0; g < names.size(); ++g) {
+    TriangleMesh mesh;
+    for (const SceneObject& o : scene.objects)
+      if (o.group == names[g] || o.name == names[g] || o.name.rfind(names[g] + "/", 0) == 0) mesh.Append(o.mesh);
+    int motion = -1;
+    for (std::size_t k = 0; k < scene.motions.size(); ++k)
+      if (scene.motions[k].name == names[g]) motion = int(k);
+    std::vector<Vec3> p, n;
+    SampleSurface(mesh, points, seed + g, &p, &n);
+    for (std::size_t s = 0; s < samples.size(); ++s) {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      if (motion >= 0 && motion < int(samples[s].poses.size()))
+        T = PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        TargetPoint t;
+        t.p = T * p[i];
+        t.normal = Vec3(T.linear() * n[i]);
+        t.sample = int(s);
+        out.push_back(t);
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace pandora

@@ -76,6 +76,8 @@ bool ObjectiveHigherIsBetter(const Objective& objective);
 struct TargetPoint {
   Vec3 p = Vec3::Zero();
   std::optional<Vec3> normal;
+  /// The time sample the point belongs to (SuggestOptions::sample_casters); 0 for a static scene.
+  int sample = 0;
 };
 
 /// Samples `count` target points. With no surface names: stratified jittered samples of the study
@@ -128,6 +130,10 @@ struct TracePoint {
 
 struct SuggestOptions {
   std::vector<int> cameras;           ///< Rig indices of the selected cameras (distinct, enabled).
+  /// With moving objects: the ray caster of each time sample (RigidPartsRayCaster::At); target
+  /// point i is tested against sample_casters[targets[i].sample]. Empty: the static caster for all.
+  /// The casters must outlive the call.
+  std::vector<const RayCaster*> sample_casters;
   std::vector<CameraLimits> limits;   ///< One per selected camera, or one for all.
   std::vector<Aabb> keep_out;         ///< Boxes no selected camera centre may enter.
   /// Metres every suggested camera centre keeps from every scene surface (any object's triangles:
@@ -174,7 +180,15 @@ struct Suggestion {
 /// The exact evaluation of a rig over target points (the selected cameras' poses may be replaced).
 /// Builds one VisibilityTester over the enabled cameras with the real ray caster.
 Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                      const std::vector<TargetPoint>& targets, const Objective& objective);
+                      const std::vector<TargetPoint>& targets, const Objective& objective,
+                      const std::vector<const RayCaster*>& sample_casters = {});
+
+/// Target points on the surfaces of the study's targets (Study::targets) at every time sample:
+/// `points` per target spread by area (seeded), each moved with its group to every sample, with the
+/// sample's index. What a suggestion optimises to see moving bodies over time. Throws InputError
+/// (file = scene.path, "$.study.targets") when the study has no targets.
+std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector<TimeSample>& samples,
+                                           int points, std::uint64_t seed);
 
 /// Checks the selection and the limits (throws InputError naming `options.scene_path` and the
 /// option) and runs the Ceres nudge. Every candidate pose keeps the limits, the keep-out boxes and

@@ -117,7 +117,7 @@ class Surrogate {
       }
     }
     std::vector<uint8_t> occluded;
-    ev_.caster().OccludedBatch(rays, &occluded);
+    ev_.OccludedByPoint(rays, &occluded);
     auto clear = [&](int k, std::size_t i) {
       const Ray& r = rays[k * n + i];
       return r.t_far <= r.t_near || !occluded[k * n + i] ? 1.0 : 0.0;
@@ -365,7 +365,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   const std::size_t nsel = options.cameras.size();
-  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras);
+  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras, options.sample_casters);
   const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;

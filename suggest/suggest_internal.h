@@ -38,7 +38,7 @@ class ExactEvaluator {
  public:
   ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
                  const std::vector<TargetPoint>& targets, const Objective& objective,
-                 const std::vector<int>& selected);
+                 const std::vector<int>& selected, const std::vector<const RayCaster*>& sample_casters = {});
 
   /// Metrics with the selected cameras at `poses` (world_from_camera, one per selected camera) and,
   /// when given, their focal lengths scaled by `focal_scales`.
@@ -72,13 +72,24 @@ class ExactEvaluator {
   double sigma_cap_mm() const { return sigma_cap_mm_; }
   double PixelSigma(const Camera& c) const { return c.pixel_sigma > 0 ? c.pixel_sigma : pixel_sigma_; }
   const RayCaster& caster() const { return caster_; }
+  /// Occluded() of rays laid out as [k * targets().size() + i] (k any number of rounds), each
+  /// against the caster of target i's time sample.
+  void OccludedByPoint(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const;
   std::int64_t evaluations() const { return evaluations_; }
 
  private:
   Metrics Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
                     const std::vector<double>& dmax) const;
 
+  // One tester per time sample's caster for `cameras`; target i uses testers[Sample(i)].
+  std::vector<std::unique_ptr<VisibilityTester>> Testers(const std::vector<Camera>& cameras) const;
+  std::size_t Sample(std::size_t i) const {
+    const int s = targets_[i].sample;
+    return s >= 0 && std::size_t(s) < casters_.size() ? std::size_t(s) : 0;
+  }
+
   const RayCaster& caster_;
+  std::vector<const RayCaster*> casters_;  // per time sample; {&caster_} for a static scene
   std::vector<TargetPoint> targets_;
   Objective objective_;
   std::vector<Camera> selected_;
