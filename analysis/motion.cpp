@@ -155,9 +155,19 @@ std::unique_ptr<RigidPartsRayCaster> MakeSceneParts(const Scene& scene) {
 
 std::vector<Eigen::Isometry3d> PartTransforms(const Scene& scene, const TimeSample& sample) {
   std::vector<Eigen::Isometry3d> out(scene.motions.size() + 1, Eigen::Isometry3d::Identity());
-  for (std::size_t k = 0; k < scene.motions.size() && k < sample.poses.size(); ++k)
-    out[k + 1] = PoseTransform(sample.poses[k], scene.motions[k].anchor);
+  for (std::size_t k = 0; k < scene.motions.size(); ++k) out[k + 1] = MotionTransform(scene, int(k), sample);
   return out;
+}
+
+std::vector<TimeSample> SamplesOrAsPlaced(std::vector<TimeSample> samples) {
+  if (samples.empty()) samples.push_back(TimeSample{"as placed", 0, {}});
+  return samples;
+}
+
+Eigen::Isometry3d MotionTransform(const Scene& scene, int motion, const TimeSample& sample) {
+  if (motion < 0 || motion >= int(scene.motions.size()) || motion >= int(sample.poses.size()))
+    return Eigen::Isometry3d::Identity();
+  return PoseTransform(sample.poses[motion], scene.motions[motion].anchor);
 }
 
 }  // namespace pandora

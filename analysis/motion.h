@@ -74,6 +74,13 @@ struct TimeSample {
   std::vector<GroupPose> poses;
 };
 
+/// `samples`, or for a static scene (none) the one sample "as placed" (no poses).
+std::vector<TimeSample> SamplesOrAsPlaced(std::vector<TimeSample> samples);
+
+/// Where Scene::motions[motion] puts its objects at `sample` (world_from_rest); the identity for
+/// motion -1 or a sample without poses.
+Eigen::Isometry3d MotionTransform(const Scene& scene, int motion, const TimeSample& sample);
+
 /// The scene's rigid parts for ray casting: part 0 holds the objects that do not move, part k + 1 the
 /// objects of Scene::motions[k], each at rest; every triangle keeps its index of
 /// Scene::AllTriangles(). At(PartTransforms(scene, sample)) is then the caster of SceneAtSample(scene,

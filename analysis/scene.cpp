@@ -1349,9 +1349,7 @@ void ReadMotions(const Node& motions, Scene* scene) {
     Aabb bounds;
     for (std::size_t o = 0; o < scene->objects.size(); ++o) {
       const SceneObject& object = scene->objects[o];
-      const bool member = object.group == motion.name || object.name == motion.name ||
-                          object.name.rfind(motion.name + "/", 0) == 0;
-      if (!member) continue;
+      if (!object.InGroup(motion.name)) continue;
       if (owner[o] >= 0)
         m.Fail("object " + Quoted(object.name) + " is moved by motion " + Quoted(scene->motions[owner[o]].name) +
                    " already", "an object belongs to one moving group");

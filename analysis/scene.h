@@ -39,6 +39,10 @@ struct SceneObject {
   /// The moving group it belongs to ("group" in the file; empty: none). A motion named after the
   /// group, or after the object itself, moves it (analysis/motion.h).
   std::string group;
+
+  /// True when a motion or a target named `n` takes this object: its group, its own name, or the
+  /// part before the '/' of a mesh file's part ("patient/torso" belongs to "patient").
+  bool InGroup(const std::string& n) const { return group == n || name == n || name.rfind(n + "/", 0) == 0; }
 };
 
 /// A named set of cameras.

@@ -38,6 +38,19 @@ void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std:
   }
 }
 
+TargetSurface FindTargetSurface(const Scene& scene, const std::string& name) {
+  TargetSurface t;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    if (!scene.objects[o].InGroup(name)) continue;
+    if (t.mesh.triangles.empty() && t.motion < 0)
+      for (std::size_t k = 0; k < scene.motions.size(); ++k)
+        for (int member : scene.motions[k].objects)
+          if (member == int(o)) t.motion = int(k);
+    t.mesh.Append(scene.objects[o].mesh);
+  }
+  return t;
+}
+
 std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, const Rig& rig,
                                                         const RigidPartsRayCaster& parts,
                                                         const std::vector<TimeSample>& samples_in,
@@ -45,8 +58,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
   std::vector<SurfaceTargetResult> out;
   if (!scene.study.targets) return out;
   const SurfaceTargets& spec = *scene.study.targets;
-  const std::vector<TimeSample> samples = samples_in.empty() ? std::vector<TimeSample>{TimeSample{"as placed", 0, {}}}
-                                                             : samples_in;
+  const std::vector<TimeSample> samples = SamplesOrAsPlaced(samples_in);
   const int kmax = std::max(3, min_cameras);
   // Each sample's caster and tester, built once for all targets.
   std::vector<std::unique_ptr<RayCaster>> casters;
@@ -57,18 +69,12 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
   }
   for (std::size_t g = 0; g < spec.names.size(); ++g) {
     const std::string& name = spec.names[g];
-    // The target's objects (a group, an object, a mesh file's parts) and its motion, if any.
-    TriangleMesh mesh;
-    for (const SceneObject& o : scene.objects)
-      if (o.group == name || o.name == name || o.name.rfind(name + "/", 0) == 0) mesh.Append(o.mesh);
-    int motion = -1;
-    for (std::size_t k = 0; k < scene.motions.size(); ++k)
-      if (scene.motions[k].name == name) motion = int(k);
+    const TargetSurface surface = FindTargetSurface(scene, name);
     const auto t0 = std::chrono::steady_clock::now();
     SurfaceTargetResult r;
     r.name = name;
     std::vector<Vec3> points, normals;
-    SampleSurface(mesh, spec.points, spec.seed + g, &points, &normals);
+    SampleSurface(surface.mesh, spec.points, spec.seed + g, &points, &normals);
     r.points = int(points.size());
     r.samples = int(samples.size());
     r.cameras.assign(std::size_t(r.samples) * r.points, 0);
@@ -77,10 +83,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     std::vector<std::int64_t> pixel_pairs(pixel_count, 0);
     std::vector<std::uint16_t> pixel_cameras(pixel_count * points.size());
     for (std::size_t s = 0; s < samples.size(); ++s) {
-      // The target's transform at this sample: its own motion, or none.
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      if (motion >= 0 && motion < int(samples[s].poses.size()))
-        T = PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
+      const Eigen::Isometry3d T = MotionTransform(scene, surface.motion, samples[s]);
       std::vector<std::vector<std::uint8_t>> sees(rig.cameras.size(), std::vector<std::uint8_t>(points.size(), 0));
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 64), [&](const auto& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {

@@ -40,6 +40,14 @@ struct SurfaceTargetResult {
   double seconds = 0;  ///< Wall time of this target's points over all samples.
 };
 
+/// A target's surface as placed (the triangles of the objects SceneObject::InGroup(name) takes) and
+/// the motion that moves them (index into Scene::motions, that of its first object; -1: none).
+struct TargetSurface {
+  TriangleMesh mesh;
+  int motion = -1;
+};
+TargetSurface FindTargetSurface(const Scene& scene, const std::string& name);
+
 /// Points uniform by area on `mesh` (seeded, reproducible), with their triangles' unit normals.
 void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std::vector<Vec3>* points,
                    std::vector<Vec3>* normals);

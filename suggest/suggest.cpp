@@ -883,23 +883,15 @@ std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector
   if (!scene.study.targets)
     throw InputError(scene.path, "$.study.targets", "suggesting over time needs surface targets",
                      "name the moving groups to see under \"study\": {\"targets\": {\"objects\": [...]}}");
-  const std::vector<TimeSample> samples =
-      samples_in.empty() ? std::vector<TimeSample>{TimeSample{"as placed", 0, {}}} : samples_in;
+  const std::vector<TimeSample> samples = SamplesOrAsPlaced(samples_in);
   std::vector<TargetPoint> out;
   const std::vector<std::string>& names = scene.study.targets->names;
   for (std::size_t g = 0; g < names.size(); ++g) {
-    TriangleMesh mesh;
-    for (const SceneObject& o : scene.objects)
-      if (o.group == names[g] || o.name == names[g] || o.name.rfind(names[g] + "/", 0) == 0) mesh.Append(o.mesh);
-    int motion = -1;
-    for (std::size_t k = 0; k < scene.motions.size(); ++k)
-      if (scene.motions[k].name == names[g]) motion = int(k);
+    const TargetSurface surface = FindTargetSurface(scene, names[g]);
     std::vector<Vec3> p, n;
-    SampleSurface(mesh, points, seed + g, &p, &n);
+    SampleSurface(surface.mesh, points, seed + g, &p, &n);
     for (std::size_t s = 0; s < samples.size(); ++s) {
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      if (motion >= 0 && motion < int(samples[s].poses.size()))
-        T = PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
+      const Eigen::Isometry3d T = MotionTransform(scene, surface.motion, samples[s]);
       for (std::size_t i = 0; i < p.size(); ++i) {
         TargetPoint t;
         t.p = T * p[i];

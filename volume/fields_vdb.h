@@ -45,4 +45,19 @@ struct Fields::Impl {
   }
 };
 
+/// Calls fn(coord, value) for every active voxel of `grid`, the voxels of an active tile one by one
+/// (the coverage grid stores culled blocks as tiles).
+template <typename Grid, typename Fn>
+void ForEachActiveVoxel(const Grid& grid, Fn&& fn) {
+  for (auto it = grid.cbeginValueOn(); it; ++it) {
+    if (it.isVoxelValue()) {
+      fn(it.getCoord(), *it);
+      continue;
+    }
+    openvdb::CoordBBox box;
+    it.getBoundingBox(box);
+    for (auto c = box.begin(); c; ++c) fn(*c, *it);
+  }
+}
+
 }  // namespace pandora

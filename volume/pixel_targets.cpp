@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <map>
 
 #include "analysis/error.h"
 #include "analysis/visibility.h"
@@ -22,57 +21,58 @@ std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const R
     throw InputError(scene.path, "$.study.pixel_targets", "pixel targets need the coverage and cameras fields",
                      "add \"coverage\" and \"cameras\" to the study's fields");
   const int kmax = std::max(3, min_cameras);
+  const auto t0 = std::chrono::steady_clock::now();
   // The caster is not used: the visibility is known; only TestGeometry's Jacobian is needed.
   const auto none = MakeBruteForceRayCaster(TriangleMesh());
   const VisibilityTester tester(rig.cameras, *none, scene.ContentBounds().diagonal());
-  // The free voxels (the coverage grid's active set, tiles included) get an index each.
-  std::map<openvdb::Coord, std::int64_t> index;
-  for (auto it = g.coverage->cbeginValueOn(); it; ++it) {
-    openvdb::CoordBBox box;
-    it.getBoundingBox(box);
-    for (auto c = box.begin(); c; ++c) index.emplace(*c, 0);
-  }
-  std::int64_t next = 0;
-  for (auto& [c, i] : index) i = next++;
-  for (const PixelTarget& target : scene.study.pixel_targets) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const double need = target.px_per_m();
-    std::vector<std::uint16_t> count(std::size_t(next), 0);
-    for (std::size_t c = 0; c < g.visible.size() && c < rig.cameras.size(); ++c) {
-      if (!g.visible[c] || !rig.cameras[c].enabled) continue;
-      std::vector<openvdb::Coord> voxels;
-      for (auto it = g.visible[c]->cbeginValueOn(); it; ++it) voxels.push_back(it.getCoord());
-      std::vector<std::uint8_t> meets(voxels.size(), 0);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, voxels.size(), 1024), [&](const auto& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const openvdb::Vec3d w = g.visible[c]->indexToWorld(voxels[i]);
-          Mat23 J;
-          if (tester.TestGeometry(int(c), Vec3(w.x(), w.y(), w.z()), nullptr, nullptr, &J) == ViewResult::kSeen &&
-              PixelDensity(J) >= need)
-            meets[i] = 1;
-        }
-      });
+  // Per target, the cameras meeting it at each voxel; each (voxel, camera) density computed once.
+  const std::vector<PixelTarget>& targets = scene.study.pixel_targets;
+  std::vector<openvdb::Int32Grid::Ptr> counts;
+  for (std::size_t t = 0; t < targets.size(); ++t) counts.push_back(openvdb::Int32Grid::create(0));
+  for (std::size_t c = 0; c < g.visible.size() && c < rig.cameras.size(); ++c) {
+    if (!g.visible[c] || !rig.cameras[c].enabled) continue;
+    std::vector<openvdb::Coord> voxels;
+    for (auto it = g.visible[c]->cbeginValueOn(); it; ++it) voxels.push_back(it.getCoord());
+    std::vector<double> density(voxels.size(), 0.0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, voxels.size(), 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const openvdb::Vec3d w = g.visible[c]->indexToWorld(voxels[i]);
+        Mat23 J;
+        if (tester.TestGeometry(int(c), Vec3(w.x(), w.y(), w.z()), nullptr, nullptr, &J) == ViewResult::kSeen)
+          density[i] = PixelDensity(J);
+      }
+    });
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      auto acc = counts[t]->getAccessor();
       for (std::size_t i = 0; i < voxels.size(); ++i)
-        if (meets[i]) {
-          const auto it = index.find(voxels[i]);
-          if (it != index.end()) ++count[std::size_t(it->second)];
-        }
+        if (density[i] >= targets[t].px_per_m()) acc.setValue(voxels[i], acc.getValue(voxels[i]) + 1);
     }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (std::size_t t = 0; t < targets.size(); ++t) {
     PixelTargetSummary s;
-    s.target = target;
+    s.target = targets[t];
     s.share_ge.assign(kmax, 0.0);
-    for (std::uint16_t n : count)
-      for (int j = 1; j <= std::min<int>(n, kmax); ++j) s.share_ge[j - 1] += 1;
-    for (double& v : s.share_ge) v = next > 0 ? v / double(next) : 0.0;
+    std::int64_t voxels = 0;
+    openvdb::FloatGrid::Ptr grid;
     if (grids) {
-      auto grid = openvdb::FloatGrid::create(0.0f);
+      grid = openvdb::FloatGrid::create(0.0f);
       grid->setTransform(g.coverage->transformPtr()->copy());
-      auto acc = grid->getAccessor();
-      for (const auto& [c, i] : index) acc.setValue(c, float(count[std::size_t(i)]));
-      grid->pruneGrid();
-      grids->impl().extra["pixels_" + target.name] = grid;
     }
-    s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // Over the free voxels (the coverage grid's active set).
+    auto count = counts[t]->getConstAccessor();
+    ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) {
+      const int n = count.getValue(c);
+      for (int j = 1; j <= std::min(n, kmax); ++j) s.share_ge[j - 1] += 1;
+      if (grid) grid->tree().setValue(c, float(n));
+      ++voxels;
+    });
+    for (double& v : s.share_ge) v = voxels > 0 ? v / double(voxels) : 0.0;
+    if (grid) {
+      grid->pruneGrid();
+      grids->impl().extra["pixels_" + targets[t].name] = grid;
+    }
+    s.seconds = seconds;
     out.push_back(s);
   }
   return out;
@@ -92,18 +92,14 @@ DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids
     grid->setTransform(g.coverage->transformPtr()->copy());
   }
   auto res = resolution->getConstAccessor();
-  for (auto it = g.coverage->cbeginValueOn(); it; ++it) {
-    openvdb::CoordBBox box;
-    it.getBoundingBox(box);
-    for (auto c = box.begin(); c; ++c) {
-      ++total;
-      const float d = res.isValueOn(*c) ? res.getValue(*c) : 0.0f;
-      int cls = 0;
-      for (int k = 0; k < 4; ++k)
-        if (d >= kDoriPxPerM[k]) cls = k + 1, ++reached[k];
-      if (grid) grid->tree().setValue(*c, float(cls));
-    }
-  }
+  ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) {
+    ++total;
+    const float d = res.isValueOn(c) ? res.getValue(c) : 0.0f;
+    int cls = 0;
+    for (int k = 0; k < 4; ++k)
+      if (d >= kDoriPxPerM[k]) cls = k + 1, ++reached[k];
+    if (grid) grid->tree().setValue(c, float(cls));
+  });
   const double n = total > 0 ? double(total) : 1.0;
   s.detection = reached[0] / n;
   s.observation = reached[1] / n;

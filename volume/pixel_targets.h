@@ -22,7 +22,7 @@ struct PixelTargetSummary {
   /// share_ge[j - 1]: share of the free region voxels seen by at least j cameras each at a pixel
   /// density of at least target.px_per_m(), j = 1 .. max(3, min_cameras).
   std::vector<double> share_ge;
-  double seconds = 0;
+  double seconds = 0;  ///< The pass over the camera sets, shared by all the study's pixel targets.
 };
 
 /// The DORI classes over the region (the best camera's density, the resolution field).

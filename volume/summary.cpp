@@ -84,20 +84,15 @@ std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fi
     std::vector<float> sigmas, densities;
     auto sa = sigma ? std::optional(sigma->getConstAccessor()) : std::nullopt;
     auto ra = resolution ? std::optional(resolution->getConstAccessor()) : std::nullopt;
-    for (auto it = g.coverage->cbeginValueOn(); it; ++it) {
-      openvdb::CoordBBox box;
-      it.getBoundingBox(box);
-      for (auto c = box.begin(); c; ++c) {
-        const openvdb::Vec3d w = g.coverage->indexToWorld(*c);
-        const Vec3 p(w.x(), w.y(), w.z());
-        if (!region.box.Contains(p) || (inside && !inside->Inside(p))) continue;
-        ++r.voxels;
-        const int n = *it;
-        for (int k = 0; k < 3; ++k) ge[k] += n >= k + 1;
-        if (sa && sa->isValueOn(*c)) sigmas.push_back(sa->getValue(*c));
-        if (ra && ra->isValueOn(*c)) densities.push_back(ra->getValue(*c));
-      }
-    }
+    ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int n) {
+      const openvdb::Vec3d w = g.coverage->indexToWorld(c);
+      const Vec3 p(w.x(), w.y(), w.z());
+      if (!region.box.Contains(p) || (inside && !inside->Inside(p))) return;
+      ++r.voxels;
+      for (int k = 0; k < 3; ++k) ge[k] += n >= k + 1;
+      if (sa && sa->isValueOn(c)) sigmas.push_back(sa->getValue(c));
+      if (ra && ra->isValueOn(c)) densities.push_back(ra->getValue(c));
+    });
     const double n = r.voxels > 0 ? double(r.voxels) : 1.0;
     r.ge1 = ge[0] / n;
     r.ge2 = ge[1] / n;

@@ -62,19 +62,14 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
     const openvdb::Int32Grid::Ptr& coverage = f.impl().coverage;
     if (coverage) {
       if (!transform) transform = coverage->transformPtr()->copy();
-      for (auto it = coverage->cbeginValueOn(); it; ++it) {
-        const int value = *it;
-        openvdb::CoordBBox box;
-        it.getBoundingBox(box);
-        for (auto c = box.begin(); c; ++c) {
-          if (value < min_acc.getValue(*c)) min_acc.setValue(*c, value);
-          else min_acc.setValueOn(*c);
-          free_acc.setValue(*c, free_acc.getValue(*c) + 1);
-          if (value >= min_cameras) good_acc.setValue(*c, good_acc.getValue(*c) + 1);
-          ++free_pairs;
-          good_pairs += value >= min_cameras;
-        }
-      }
+      ForEachActiveVoxel(*coverage, [&](const openvdb::Coord& c, int value) {
+        if (value < min_acc.getValue(c)) min_acc.setValue(c, value);
+        else min_acc.setValueOn(c);
+        free_acc.setValue(c, free_acc.getValue(c) + 1);
+        if (value >= min_cameras) good_acc.setValue(c, good_acc.getValue(c) + 1);
+        ++free_pairs;
+        good_pairs += value >= min_cameras;
+      });
     }
     row.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     out.samples.push_back(row);
