@@ -299,7 +299,8 @@ int main(int argc, char** argv) {
   sg->add_option("--max-move", suggest.max_move, "Largest move, metres: one value, or one per camera in --cameras order")->capture_default_str();
   sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation, degrees: one value, or one per camera")->capture_default_str();
   sg->add_option("--objective", suggest.objective,
-                 "coverage2 (coverageK), sigma-mean, sigma-p90 (sigma-pNN), resolution, mix")->capture_default_str();
+                 "coverage2 (coverageK), sigma-mean, sigma-p90 (sigma-pNN), resolution, mix, "
+                 "coverage3-n1 (coverageK-n1, after the worst camera failure), calibration (study.calibration)")->capture_default_str();
   sg->add_option("--weights", suggest.weights, "Mix weights WC,WS,WR (coverage, sigma, resolution)");
   sg->add_option("--rail", suggest.rail, "Mount: stay on the line through the camera along [ID:]DX,DY,DZ (repeatable)");
   sg->add_option("--plane", suggest.plane, "Mount: stay on the plane through the camera with normal [ID:]NX,NY,NZ (repeatable)");

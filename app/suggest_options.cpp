@@ -87,7 +87,8 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   const std::optional<Objective> objective = ParseObjective(args.objective);
   if (!objective)
     throw InputError("--objective", "", "unknown objective '" + args.objective + "'",
-                     "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution or mix");
+                     "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution, mix, "
+                     "coverage3-n1 (coverageK-n1: after the worst camera failure) or calibration");
   options.objective = *objective;
   if (!args.weights.empty()) {
     const std::vector<double> w = ParseNumbers("--weights", args.weights, 3);

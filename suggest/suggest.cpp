@@ -86,6 +86,17 @@ std::optional<Objective> ParseObjective(const std::string& name) {
     o.kind = ObjectiveKind::kMix;
     return o;
   }
+  if (name == "calibration") {
+    o.kind = ObjectiveKind::kCalibration;
+    return o;
+  }
+  if (name.size() > 3 && name.compare(name.size() - 3, 3, "-n1") == 0) {
+    const std::optional<Objective> base = ParseObjective(name.substr(0, name.size() - 3));
+    if (!base || base->kind != ObjectiveKind::kCoverage) return std::nullopt;
+    o = *base;
+    o.kind = ObjectiveKind::kCoverageN1;
+    return o;
+  }
   return std::nullopt;
 }
 
@@ -99,13 +110,14 @@ std::string ObjectiveName(const Objective& o) {
     }
     case ObjectiveKind::kResolution: return "resolution";
     case ObjectiveKind::kMix: return "mix";
+    case ObjectiveKind::kCoverageN1: return "coverage" + std::to_string(o.k) + "-n1";
+    case ObjectiveKind::kCalibration: return "calibration";
   }
   return "?";
 }
 
 bool ObjectiveHigherIsBetter(const Objective& o) {
-  return o.kind == ObjectiveKind::kCoverage || o.kind == ObjectiveKind::kResolution ||
-         o.kind == ObjectiveKind::kMix;
+  return o.kind != ObjectiveKind::kSigmaMean && o.kind != ObjectiveKind::kSigmaPercentile;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -276,8 +288,14 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   std::vector<Camera> fixed;
   const std::set<int> sel(selected.begin(), selected.end());
   for (int i = 0; i < static_cast<int>(rig.cameras.size()); ++i) {
-    if (sel.count(i)) selected_.push_back(rig.cameras[i]);
-    else if (rig.cameras[i].enabled) fixed.push_back(rig.cameras[i]);
+    if (sel.count(i)) {
+      selected_.push_back(rig.cameras[i]);
+      selected_rig_.push_back(i);
+    } else if (rig.cameras[i].enabled) {
+      fixed.push_back(rig.cameras[i]);
+      fixed_rig_.push_back(i);
+      fixed_ids_.push_back(rig.cameras[i].id);
+    }
   }
   // A density scale for the soft maximum (keeps d^8 in range for any unit of length).
   Vec3 centre = scene.study.region.box.empty() ? Vec3::Zero() : scene.study.region.box.center();
@@ -293,6 +311,8 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   fixed_.J.assign(n, Mat3::Zero());
   fixed_.dmax.assign(n, 0.0);
   fixed_.dpow.assign(n, 0.0);
+  const bool n1 = objective_.kind == ObjectiveKind::kCoverageN1;
+  if (n1) fixed_.seen_by.assign(n, {});
   const auto testers = Testers(fixed);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -308,9 +328,49 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
         const double d = PixelDensity(A);
         fixed_.dmax[i] = std::max(fixed_.dmax[i], d);
         fixed_.dpow[i] += std::pow(d / density_scale_, kSoftMaxPower);
+        if (n1) fixed_.seen_by[i].push_back(c);
       }
     }
   });
+
+  if (objective_.kind == ObjectiveKind::kCalibration) {
+    if (!scene.study.calibration)
+      throw InputError(scene.path, "$.study.calibration",
+                       "the calibration objective needs the study's calibration target",
+                       "add \"calibration\": {\"target\": \"wand\"} (or a board) to \"study\"; "
+                       "docs/calibration.md");
+    calib_spec_ = *scene.study.calibration;
+    // The poses are drawn once, for the rig as it starts (a board turns to a camera of that rig),
+    // so every candidate is judged on the same poses; on the static scene (the caster as placed).
+    const VisibilityTester all(rig.cameras, caster_, geometry_scale_);
+    calib_poses_ = SampleCalibrationPoses(scene, all, calib_spec_);
+    const VisibilityTester fixed_tester(fixed, caster_, geometry_scale_);
+    calib_fixed_.resize(fixed.size());
+    for (std::size_t c = 0; c < fixed.size(); ++c) calib_fixed_[c] = CalibrationBits(fixed_tester, static_cast<int>(c));
+    calib_fixed_shared_.assign(fixed.size(), std::vector<std::int64_t>(fixed.size(), 0));
+    for (std::size_t a = 0; a < fixed.size(); ++a)
+      for (std::size_t b = a; b < fixed.size(); ++b)
+        calib_fixed_shared_[a][b] = calib_fixed_shared_[b][a] = SharedBits(calib_fixed_[a], calib_fixed_[b]);
+  }
+}
+
+std::vector<std::uint64_t> ExactEvaluator::CalibrationBits(const VisibilityTester& tester, int camera) const {
+  const std::size_t poses = calib_poses_.size();
+  std::vector<std::uint8_t> seen(poses, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t p = r.begin(); p != r.end(); ++p)
+      seen[p] = ObservesPose(tester, camera, calib_spec_, calib_poses_[p]) ? 1 : 0;
+  });
+  std::vector<std::uint64_t> bits((poses + 63) / 64, 0);
+  for (std::size_t p = 0; p < poses; ++p)
+    if (seen[p]) bits[p / 64] |= std::uint64_t(1) << (p % 64);
+  return bits;
+}
+
+std::int64_t ExactEvaluator::SharedBits(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
+  std::int64_t n = 0;
+  for (std::size_t w = 0; w < a.size() && w < b.size(); ++w) n += __builtin_popcountll(a[w] & b[w]);
+  return n;
 }
 
 std::vector<std::unique_ptr<VisibilityTester>> ExactEvaluator::Testers(const std::vector<Camera>& cameras) const {
@@ -338,31 +398,16 @@ void ExactEvaluator::OccludedByPoint(const std::vector<Ray>& rays, std::vector<u
 Metrics ExactEvaluator::Evaluate(const std::vector<Eigen::Isometry3d>& poses,
                                  const std::vector<double>& focal_scales) const {
   ++evaluations_;
-  std::vector<Camera> cams = selected_;
-  for (std::size_t c = 0; c < cams.size() && c < poses.size(); ++c) cams[c].world_from_camera = poses[c];
-  for (std::size_t c = 0; c < cams.size() && c < focal_scales.size(); ++c)
-    if (focal_scales[c] != 1.0) cams[c] = Zoomed(cams[c], focal_scales[c]);
-  const auto testers = Testers(cams);
-  const std::size_t n = targets_.size();
-  std::vector<int> count = fixed_.count;
-  std::vector<Mat3> J = fixed_.J;
-  std::vector<double> dmax = fixed_.dmax;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const TargetPoint& t = targets_[i];
-      const Vec3* normal = t.normal ? &*t.normal : nullptr;
-      const VisibilityTester& tester = *testers[Sample(i)];
-      for (int c = 0; c < static_cast<int>(cams.size()); ++c) {
-        Mat23 A;
-        if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
-        const double s = PixelSigma(cams[c]);
-        count[i] += 1;
-        J[i] += A.transpose() * A / (s * s);
-        dmax[i] = std::max(dmax[i], PixelDensity(A));
-      }
-    }
-  });
-  return Summarise(count, J, dmax);
+  // Each selected camera's view, then the sums in the order Combine adds them (the same rounding).
+  std::vector<CameraView> views(selected_.size());
+  std::vector<const CameraView*> ptrs(selected_.size());
+  for (std::size_t c = 0; c < selected_.size(); ++c) {
+    const Eigen::Isometry3d pose = c < poses.size() ? poses[c] : selected_[c].world_from_camera;
+    const double scale = c < focal_scales.size() ? focal_scales[c] : 1.0;
+    views[c] = View(static_cast<int>(c), pose, scale);
+    ptrs[c] = &views[c];
+  }
+  return Summary(ptrs);
 }
 
 CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double focal_scale) const {
@@ -386,22 +431,31 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
       v.density[i] = PixelDensity(A);
     }
   });
+  if (objective_.kind == ObjectiveKind::kCalibration) {
+    const VisibilityTester tester({cam}, caster_, geometry_scale_);
+    v.calib = CalibrationBits(tester, 0);
+  }
   return v;
 }
 
 Metrics ExactEvaluator::Combine(const std::vector<const CameraView*>& views, bool objective_only) const {
   ++evaluations_;
-  if (objective_only && objective_.kind == ObjectiveKind::kCoverage) {
+  const bool counts_only = objective_.kind == ObjectiveKind::kCoverage ||
+                           objective_.kind == ObjectiveKind::kCoverageN1 ||
+                           objective_.kind == ObjectiveKind::kCalibration;
+  if (objective_only && counts_only) {
     const std::size_t n = targets_.size();
     std::size_t k_count = 0;
+    std::vector<int> count(n);
     for (std::size_t i = 0; i < n; ++i) {
-      int count = fixed_.count[i];
-      for (const CameraView* v : views) count += v->seen[i];
-      k_count += count >= objective_.k;
+      count[i] = fixed_.count[i];
+      for (const CameraView* v : views) count[i] += v->seen[i];
+      k_count += count[i] >= objective_.k;
     }
     Metrics m;
     m.coverage_k = n > 0 ? double(k_count) / n : 0.0;
     m.objective = m.coverage_k;
+    AddObjectiveMeasures(count, views, &m);
     return m;
   }
   return Summary(views);
@@ -420,11 +474,89 @@ Metrics ExactEvaluator::Summary(const std::vector<const CameraView*>& views) con
       J[i] += v->info[i];
       dmax[i] = std::max(dmax[i], v->density[i]);
     }
-  return Summarise(count, J, dmax);
+  return Summarise(count, J, dmax, views);
+}
+
+void ExactEvaluator::AddObjectiveMeasures(const std::vector<int>& count,
+                                          const std::vector<const CameraView*>& views, Metrics* m) const {
+  const std::size_t nfixed = fixed_rig_.size(), nsel = selected_rig_.size();
+  auto id_of = [&](std::size_t c) { return c < nfixed ? fixed_ids_[c] : selected_[c - nfixed].id; };
+  auto rig_of = [&](std::size_t c) { return c < nfixed ? fixed_rig_[c] : selected_rig_[c - nfixed]; };
+  if (objective_.kind == ObjectiveKind::kCoverageN1) {
+    // A camera's failure loses exactly the points it sees that have k cameras, no more.
+    const std::size_t n = count.size();
+    std::vector<std::int64_t> lost(nfixed + nsel, 0);
+    std::int64_t k_count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      k_count += count[i] >= objective_.k;
+      if (count[i] != objective_.k) continue;
+      for (int f : fixed_.seen_by[i]) ++lost[f];
+      for (std::size_t c = 0; c < nsel && c < views.size(); ++c)
+        if (views[c]->seen[i]) ++lost[nfixed + c];
+    }
+    Metrics::N1 r;
+    std::int64_t worst = 0;
+    int worst_rig = -1;
+    for (std::size_t c = 0; c < lost.size(); ++c)
+      if (worst_rig < 0 || lost[c] > worst || (lost[c] == worst && rig_of(c) < worst_rig)) {
+        worst = lost[c];
+        worst_rig = rig_of(c);
+        r.worst_camera = id_of(c);
+      }
+    r.coverage_k = n > 0 ? double(k_count - worst) / n : 0.0;
+    m->n1 = r;
+    m->objective = r.coverage_k;
+  }
+  if (objective_.kind == ObjectiveKind::kCalibration) {
+    // The co-visibility matrix: the fixed cameras' block once, the selected cameras' rows now.
+    const std::size_t nc = nfixed + nsel;
+    std::vector<std::vector<std::int64_t>> shared(nc, std::vector<std::int64_t>(nc, 0));
+    auto bits = [&](std::size_t c) -> const std::vector<std::uint64_t>& {
+      return c < nfixed ? calib_fixed_[c] : views[c - nfixed]->calib;
+    };
+    for (std::size_t a = 0; a < nc; ++a)
+      for (std::size_t b = a; b < nc; ++b)
+        shared[a][b] = shared[b][a] = a < nfixed && b < nfixed ? calib_fixed_shared_[a][b] : SharedBits(bits(a), bits(b));
+    Metrics::Calibration r;
+    r.poses = static_cast<std::int64_t>(calib_poses_.size());
+    // The maximum spanning tree (Prim, complete graph): its weakest edge is the chain's strength.
+    if (nc == 1) r.weakest = shared[0][0];
+    if (nc > 1) {
+      std::vector<bool> in(nc, false);
+      std::vector<std::int64_t> best(nc, -1);
+      std::vector<std::size_t> from(nc, 0);
+      in[0] = true;
+      for (std::size_t c = 1; c < nc; ++c) best[c] = shared[0][c];
+      r.weakest = std::numeric_limits<std::int64_t>::max();
+      for (std::size_t step = 1; step < nc; ++step) {
+        std::size_t next = nc;
+        for (std::size_t c = 0; c < nc; ++c)
+          if (!in[c] && (next == nc || best[c] > best[next])) next = c;
+        in[next] = true;
+        r.tree_total += best[next];
+        if (best[next] < r.weakest) {
+          r.weakest = best[next];
+          r.weakest_a = id_of(from[next]);
+          r.weakest_b = id_of(next);
+        }
+        for (std::size_t c = 0; c < nc; ++c)
+          if (!in[c] && shared[next][c] > best[c]) {
+            best[c] = shared[next][c];
+            from[c] = next;
+          }
+      }
+    }
+    const CalibrationGraph graph =
+        BuildCalibrationGraph(shared, std::vector<bool>(nc, true), calib_spec_.min_shared);
+    r.components = static_cast<int>(graph.components.size());
+    r.uncalibratable = static_cast<int>(graph.uncalibratable.size());
+    m->calibration = r;
+    m->objective = static_cast<double>(r.weakest);
+  }
 }
 
 Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
-                                  const std::vector<double>& dmax) const {
+                                  const std::vector<double>& dmax, const std::vector<const CameraView*>& views) const {
   Metrics m;
   const std::size_t n = count.size();
   if (n == 0) return m;
@@ -471,7 +603,10 @@ Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vect
                     objective_.w_resolution * (r > 0 ? m.min_resolution / r : 0.0);
       break;
     }
+    case ObjectiveKind::kCoverageN1:
+    case ObjectiveKind::kCalibration: break;  // AddObjectiveMeasures
   }
+  AddObjectiveMeasures(count, views, &m);
   return m;
 }
 
@@ -481,6 +616,12 @@ double ExactEvaluator::Score(const Metrics& m) const {
   // untriangulable points is better (and any finite percentile is better still).
   if (objective_.kind == ObjectiveKind::kSigmaPercentile && std::isinf(m.objective))
     return -1e300 * (1.0 + m.untriangulable);
+  // Between two chains of equal strength the one with more shared poses along its tree is better:
+  // the tree's total, as a fraction below 1, breaks the tie without changing the order of strengths.
+  if (objective_.kind == ObjectiveKind::kCalibration && m.calibration) {
+    const double cams = static_cast<double>(fixed_rig_.size() + selected_rig_.size());
+    return m.objective + double(m.calibration->tree_total) / (cams * double(m.calibration->poses) + 1.0);
+  }
   return ObjectiveHigherIsBetter(objective_) ? m.objective : -m.objective;
 }
 

@@ -53,6 +53,16 @@ enum class ObjectiveKind {
                     ///< and while the percentile is +inf a smaller untriangulable share is better.
   kResolution,      ///< Minimum over the points of the best pixel density, px/m (higher); unseen: 0.
   kMix,             ///< Weighted mix of the three, each relative to its value at the start (higher).
+  /// N-1: the share of target points still seen by at least `k` cameras after the worst single
+  /// camera failure (any enabled camera, selected or fixed, fails; the worst is the one that leaves
+  /// the smallest share), as volume/robustness.h defines it for the fields (higher).
+  kCoverageN1,
+  /// Calibration connectivity (needs the study's "calibration", docs/calibration.md): the strength
+  /// of the calibration chain, the largest number of shared target poses w such that the cameras
+  /// sharing >= w poses connect every enabled camera (the weakest edge of the maximum spanning tree
+  /// of the co-visibility graph; 0 while some camera shares no pose with the rest). Every camera is
+  /// calibratable with the rest when it is >= the study's min_shared (higher).
+  kCalibration,
 };
 
 struct Objective {
@@ -64,7 +74,8 @@ struct Objective {
 };
 
 /// Parses an objective name: "coverage" / "coverageK" (K = 1..64, e.g. "coverage2"), "sigma-mean",
-/// "sigma-pNN" (e.g. "sigma-p90"), "resolution", "mix". Returns nullopt for anything else.
+/// "sigma-pNN" (e.g. "sigma-p90"), "resolution", "mix", "coverage-n1" / "coverageK-n1" (e.g.
+/// "coverage3-n1"), "calibration". Returns nullopt for anything else.
 std::optional<Objective> ParseObjective(const std::string& name);
 /// The canonical name ("coverage2", "sigma-p90", ...).
 std::string ObjectiveName(const Objective& objective);
@@ -101,6 +112,23 @@ struct Metrics {
   double sigma_mean = 0;       ///< Mean sigma_max (mm), untriangulable points counted as the cap.
   double untriangulable = 0;   ///< Share of points that are not triangulable.
   double min_resolution = 0;   ///< px/m; 0 when some point is seen by no camera.
+  /// With the N-1 objective: the share seen by >= k cameras after the worst single failure, and
+  /// that camera's id (the first in rig order on a tie; empty without enabled cameras).
+  struct N1 {
+    double coverage_k = 0;
+    std::string worst_camera;
+  };
+  std::optional<N1> n1;
+  /// With the calibration objective: the co-visibility graph of the study's calibration poses.
+  struct Calibration {
+    std::int64_t weakest = 0;     ///< The chain's strength, poses (the objective).
+    std::string weakest_a, weakest_b;  ///< The cameras of that weakest spanning-tree edge.
+    std::int64_t tree_total = 0;  ///< Shared poses summed over the maximum spanning tree's edges.
+    int components = 0;           ///< Components of the graph of edges >= min_shared.
+    int uncalibratable = 0;       ///< Enabled cameras outside the largest one (CalibrationGraph).
+    std::int64_t poses = 0;       ///< Calibration poses simulated.
+  };
+  std::optional<Calibration> calibration;
 };
 
 /// One selected camera's result.
@@ -144,8 +172,8 @@ struct SuggestOptions {
   int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
   /// Candidate poses per active camera at each of the three radii of the exact screening before the
-  /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives; the others, whose
-  /// exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
+  /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives (N-1 included); the
+  /// others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
   /// poses only.
   int screening_candidates = 200;
   /// Installable steps (0: none): each camera's centre is rounded per axis of its mount: along a

@@ -82,7 +82,14 @@ class Surrogate {
       case ObjectiveKind::kSigmaPercentile: weights_ = {0, 1, 0}; break;
       case ObjectiveKind::kResolution: weights_ = {0, 0, 1}; break;
       case ObjectiveKind::kMix: weights_ = {o.w_coverage, o.w_sigma, o.w_resolution}; break;
+      // N-1 has no smooth form of its own: a point seen by k + 1 cameras survives any one failure,
+      // so the nudge pushes towards k + 1 (every step is judged by the exact N-1 share).
+      case ObjectiveKind::kCoverageN1: weights_ = {1, 0, 0}; k_ = o.k + 1; break;
+      // Calibration: more target points seen by >= 2 cameras means more shared calibration poses;
+      // the screening's exact jumps and the judge of every step do the rest.
+      case ObjectiveKind::kCalibration: weights_ = {1, 0, 0}; k_ = 2; break;
     }
+    if (o.kind != ObjectiveKind::kCoverageN1 && o.kind != ObjectiveKind::kCalibration) k_ = o.k;
     for (int t = 0; t < 3; ++t)
       if (weights_[t] > 0) terms_.push_back(t);
     occlusion_.resize(ev.selected_cameras().size());
@@ -190,7 +197,7 @@ class Surrogate {
   void Residuals(const std::vector<const Contribution*>& contributions, double* r) const {
     const auto& fixed = ev_.fixed();
     const std::size_t n = ev_.targets().size();
-    const double k = ev_.objective().k;
+    const double k = k_;
     const double eps = 1.0 / (ev_.region_scale() * ev_.region_scale());
     const double ds = ev_.density_scale();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -242,6 +249,7 @@ class Surrogate {
   const ExactEvaluator& ev_;
   bool need_info_;
   std::vector<double> weights_;
+  int k_ = 2;  // the count of the coverage term
   std::vector<int> terms_;
   std::vector<double> scale_;
   struct Occlusion {
@@ -302,7 +310,7 @@ class SurrogateCost final : public ceres::CostFunction {
     const std::size_t na = active_.size();
     std::vector<Contribution> current(na);
     std::vector<const Contribution*> ptrs;
-    // Frozen (inactive) cameras contribute at their start pose.
+    // Frozen (inactive) cameras contribute at the polish's start pose.
     for (const Contribution& f : *frozen_) ptrs.push_back(&f);
     const std::size_t base = ptrs.size();
     for (std::size_t a = 0; a < na; ++a) {
@@ -402,7 +410,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     return finish("the limits are zero: every selected camera keeps its pose; nothing to suggest");
 
   // A camera whose smooth weight is zero at every target point (nothing in its image, its range, or
-  // everything occluded) has no gradient: it stays where it is, and says so.
+  // everything occluded) has no gradient: the nudge leaves it where it is and says so (the exact
+  // screening still tries to move it).
   std::vector<int> active;
   std::vector<Contribution> start_weights(nsel);
   auto occlusion_delta = [&](std::size_t c) { return kOcclusionDelta * charts[c].max_move; };
@@ -420,16 +429,11 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
                           "no gradient, left in place";
     }
   }
-  if (active.empty())
-    return finish("no improvement found: no selected camera sees any target point, so the smooth "
-                  "objective has no gradient; aim the cameras at the region first");
-
-  // Inactive selected cameras (zero limits or no gradient) contribute at their start pose.
-  std::vector<int> inactive;
-  for (std::size_t c = 0; c < nsel; ++c)
-    if (std::find(active.begin(), active.end(), static_cast<int>(c)) == active.end())
-      inactive.push_back(static_cast<int>(c));
-  std::vector<Contribution> frozen(inactive.size());
+  const std::string no_gradient =
+      "no improvement found: no selected camera sees any target point, so the smooth objective has "
+      "no gradient; aim the cameras at the region first";
+  if (active.empty() && options.screening_candidates <= 0) return finish(no_gradient);
+  const bool start_without_gradient = active.empty();
 
   // Screening (exact), before the Ceres nudge: look across the whole limits for a better start. The
   // smooth surrogate sees occluders only through a local linearisation, so from the current poses it
@@ -438,7 +442,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // one visibility test per point) and combined with the other cameras' cached views, which is one
   // exact evaluation of the objective at a joint pose; a better one is kept at once. Each camera gets
   // `screening_candidates` candidates uniform in the ball of radius 1 (the whole limits) around its
-  // best pose, then as many within 0.4 and within 0.15; last, joint moves of all active cameras within
+  // best pose, then as many within 0.4 and within 0.15; last, joint moves of all movable cameras within
   // 0.15 (some points are gained only when two selected cameras move together). Three independent
   // chains from the current poses; the best end is polished below. Deterministic (fixed seed).
   std::vector<std::vector<double>> screened_x;  // the screening's best, when it beat the start
@@ -498,13 +502,18 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     };
     constexpr int kChains = 3;
     constexpr double kJointRadius = 0.15;
-    // Coverage is judged from counts alone; the other objectives need every point's covariance or
-    // density at each evaluation (about 2x the cost, and a slower polish), so they get a quarter of
-    // the candidates (sigma-p90 on the trauma room: 3.2 s with all, 0.8 s with a quarter).
-    const int candidates = options.objective.kind == ObjectiveKind::kCoverage
+    // Coverage (and its N-1 form) is judged from counts alone; the other objectives need every
+    // point's covariance or density at each evaluation (about 2x the cost, and a slower polish), or
+    // for calibration a test of every calibration pose per candidate, so they get a quarter of the
+    // candidates (sigma-p90 on the trauma room: 3.2 s with all, 0.8 s with a quarter).
+    const int candidates = options.objective.kind == ObjectiveKind::kCoverage ||
+                                   options.objective.kind == ObjectiveKind::kCoverageN1
                                ? options.screening_candidates
                                : std::max(1, options.screening_candidates / 4);
-    const int joint_candidates = active.size() > 1 ? candidates * 3 / 4 : 0;
+    // Every movable camera is screened, also one without a gradient at the start (it sees no target
+    // point, e.g. a camera turned away whose calibration links are what is asked): exact jumps
+    // need no gradient.
+    const int joint_candidates = movable.size() > 1 ? candidates * 3 / 4 : 0;
     std::vector<CameraView> screened_view;
     for (int chain = 0; chain < kChains; ++chain) {
       cur_x = x;  // the current poses
@@ -514,7 +523,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
       }
       cur_score = start_score;
       for (double radius : {1.0, 0.4, 0.15})
-        for (int c : active)
+        for (int c : movable)
           for (int k = 0; k < candidates; ++k) {
             std::vector<std::vector<double>> xs = cur_x;
             xs[c] = sample(charts[c], cur_x[c], radius);
@@ -522,8 +531,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
           }
       for (int k = 0; k < joint_candidates; ++k) {
         std::vector<std::vector<double>> xs = cur_x;
-        for (int c : active) xs[c] = sample(charts[c], cur_x[c], kJointRadius);
-        try_move(active, xs);
+        for (int c : movable) xs[c] = sample(charts[c], cur_x[c], kJointRadius);
+        try_move(movable, xs);
       }
       if (cur_score > screened_score && cur_score > start_score) {
         screened_score = cur_score;
@@ -589,7 +598,28 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // ended best on the trauma-room benchmark and doubled the time.)
   run_x = screened_x.empty() ? x : screened_x;
   run_score = screened_x.empty() ? start_score : screened_score;
-  const int outer = std::max(1, options.outer_iterations);
+  // The polish moves the cameras with a gradient where it starts (a camera the screening turned
+  // towards the target points gains one); the others contribute where they are.
+  if (!screened_x.empty()) {
+    std::vector<std::vector<double>> xs = run_x;
+    auto [poses, ok] = poses_of(xs);
+    (void)ok;
+    active.clear();
+    for (int c : movable) {
+      surrogate.UpdateOcclusion(c, poses[c], occlusion_delta(c));
+      Contribution w;
+      surrogate.Contribute(c, poses[c], scales[c], &w);
+      double wmax = 0;
+      for (double v : w.w) wmax = std::max(wmax, v);
+      if (wmax > 1e-12) active.push_back(c);
+    }
+  }
+  std::vector<int> inactive;
+  for (std::size_t c = 0; c < nsel; ++c)
+    if (std::find(active.begin(), active.end(), static_cast<int>(c)) == active.end())
+      inactive.push_back(static_cast<int>(c));
+  std::vector<Contribution> frozen(inactive.size());
+  const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
   for (int o = 0; o < outer; ++o) {
     // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
     surrogate.set_border_width(o == 0 ? kBorderWidth : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
@@ -598,7 +628,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     (void)ok;
     for (int c : active) surrogate.UpdateOcclusion(c, poses[c], occlusion_delta(c));
     for (std::size_t f = 0; f < inactive.size(); ++f)
-      surrogate.Contribute(inactive[f], start[inactive[f]], 1.0, &frozen[f]);
+      surrogate.Contribute(inactive[f], poses[inactive[f]], scales[inactive[f]], &frozen[f]);
     {
       std::vector<Contribution> current(active.size());
       std::vector<const Contribution*> ptrs;
@@ -705,7 +735,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   if (s.improved) {
     s.after = best_m;
     FillChanges(rig, options, best_poses, best_scales, placement, &s);
-    for (int c : active) s.cameras[c].note.clear();
+    for (CameraChange& c : s.cameras)
+      if (c.move_m > 0 || c.rotate_deg > 0 || c.focal_scale != 1.0) c.note.clear();
     std::string extra;
     if (std::isinf(s.after.objective))
       extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
@@ -717,6 +748,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     return finish("no improvement found: the optimum improved " + name + " to " +
                   Num("%.6g", s.unsnapped->objective) +
                   " but the snapped poses do not; use finer snap steps");
+  if (start_without_gradient) return finish(no_gradient);
   return finish("no improvement found: the exact " + name + " did not improve within the limits (it stays " +
                 Num("%.6g", s.before.objective) + ")");
 }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "analysis/calibration.h"
 #include "analysis/visibility.h"
 #include "suggest/suggest.h"
 #include "suggest/surface_distance.h"
@@ -20,6 +21,8 @@ struct FixedContribution {
   std::vector<Mat3> J;           ///< Information sum A^T A / sigma^2, 1/m^2.
   std::vector<double> dmax;      ///< Best pixel density, px/m (0 when none sees it).
   std::vector<double> dpow;      ///< Sum over seeing cameras of (d / density_scale)^kSoftMaxPower.
+  /// N-1 objective only: per point the fixed cameras (indices into the fixed list) that see it.
+  std::vector<std::vector<int>> seen_by;
 };
 
 inline constexpr double kSoftMaxPower = 8.0;
@@ -30,6 +33,8 @@ struct CameraView {
   std::vector<std::uint8_t> seen;  ///< 1 where the camera sees the point.
   std::vector<Mat3> info;          ///< A^T A / sigma^2 where seen (zero elsewhere), 1/m^2.
   std::vector<double> density;     ///< Pixel density where seen, px/m (0 elsewhere).
+  /// Calibration objective only: bit p set where the camera observes calibration pose p.
+  std::vector<std::uint64_t> calib;
 };
 
 /// Exact evaluation with the fixed cameras precomputed: only the selected cameras are tested again
@@ -79,7 +84,13 @@ class ExactEvaluator {
 
  private:
   Metrics Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
-                    const std::vector<double>& dmax) const;
+                    const std::vector<double>& dmax, const std::vector<const CameraView*>& views) const;
+  // The N-1 and calibration measures of the objectives that need them, from the counts and views.
+  void AddObjectiveMeasures(const std::vector<int>& count, const std::vector<const CameraView*>& views,
+                            Metrics* m) const;
+  // Which calibration poses camera `camera` of `tester` observes, as bits.
+  std::vector<std::uint64_t> CalibrationBits(const VisibilityTester& tester, int camera) const;
+  static std::int64_t SharedBits(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b);
 
   // One tester per time sample's caster for `cameras`; target i uses testers[Sample(i)].
   std::vector<std::unique_ptr<VisibilityTester>> Testers(const std::vector<Camera>& cameras) const;
@@ -99,6 +110,15 @@ class ExactEvaluator {
   double pixel_sigma_ = 0.5;
   double ref_sigma_mean_ = 0, ref_min_resolution_ = 0;
   mutable std::int64_t evaluations_ = 0;
+  // Camera ids: the fixed (enabled, unselected) cameras in rig order, then the selected ones.
+  std::vector<std::string> fixed_ids_;
+  std::vector<int> fixed_rig_, selected_rig_;  // rig indices
+  // Calibration objective: the study's spec, its poses (drawn once for the starting rig), what each
+  // fixed camera observes (bits) and the fixed cameras' shared counts.
+  CalibrationSpec calib_spec_;
+  std::vector<CalibrationPose> calib_poses_;
+  std::vector<std::vector<std::uint64_t>> calib_fixed_;
+  std::vector<std::vector<std::int64_t>> calib_fixed_shared_;
 };
 
 /// How a selected camera's pose is parameterised: x = (translation coordinates, rotation vector),

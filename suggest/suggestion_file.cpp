@@ -32,13 +32,22 @@ using ordered_json = nlohmann::ordered_json;
 json Finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json MetricsJson(const Metrics& m) {
-  return json{{"objective", Finite(m.objective)},
-              {"coverage_k", m.coverage_k},
-              {"coverage2", m.coverage2},
-              {"sigma_max_mm", {{"p50", Finite(m.sigma_p50)}, {"p90", Finite(m.sigma_p90)}, {"p95", Finite(m.sigma_p95)}}},
-              {"sigma_max_mean_mm", Finite(m.sigma_mean)},
-              {"untriangulable", m.untriangulable},
-              {"min_resolution_px_per_m", Finite(m.min_resolution)}};
+  json j{{"objective", Finite(m.objective)},
+         {"coverage_k", m.coverage_k},
+         {"coverage2", m.coverage2},
+         {"sigma_max_mm", {{"p50", Finite(m.sigma_p50)}, {"p90", Finite(m.sigma_p90)}, {"p95", Finite(m.sigma_p95)}}},
+         {"sigma_max_mean_mm", Finite(m.sigma_mean)},
+         {"untriangulable", m.untriangulable},
+         {"min_resolution_px_per_m", Finite(m.min_resolution)}};
+  if (m.n1) j["n1"] = {{"coverage_k", m.n1->coverage_k}, {"worst_camera", m.n1->worst_camera}};
+  if (m.calibration)
+    j["calibration"] = {{"weakest_shared", m.calibration->weakest},
+                        {"weakest_link", {m.calibration->weakest_a, m.calibration->weakest_b}},
+                        {"tree_shared", m.calibration->tree_total},
+                        {"components", m.calibration->components},
+                        {"uncalibratable", m.calibration->uncalibratable},
+                        {"poses", m.calibration->poses}};
+  return j;
 }
 
 json PoseJson(const Eigen::Isometry3d& pose) {

@@ -50,6 +50,22 @@ std::string FormatSuggestion(const Suggestion& s, const SuggestionContext& conte
   row("sigma_max p95 (mm)", s.before.sigma_p95, s.after.sigma_p95);
   row("untriangulable (share)", s.before.untriangulable, s.after.untriangulable);
   row("min resolution (px/m)", s.before.min_resolution, s.after.min_resolution);
+  if (s.before.n1 && s.after.n1) {
+    row("N-1 coverage >= " + std::to_string(s.objective.k) + " (share)", s.before.n1->coverage_k,
+        s.after.n1->coverage_k);
+    out += Format("%-26s %14s %14s\n", "  worst failure", s.before.n1->worst_camera.c_str(),
+                  s.after.n1->worst_camera.c_str());
+  }
+  if (s.before.calibration && s.after.calibration) {
+    const Metrics::Calibration& a = *s.before.calibration;
+    const Metrics::Calibration& b = *s.after.calibration;
+    row("calibration weakest link", double(a.weakest), double(b.weakest));
+    out += Format("%-26s %14s %14s\n", "  between", (a.weakest_a + "-" + a.weakest_b).c_str(),
+                  (b.weakest_a + "-" + b.weakest_b).c_str());
+    row("  tree shared poses", double(a.tree_total), double(b.tree_total));
+    row("  components", a.components, b.components);
+    row("  uncalibratable cameras", a.uncalibratable, b.uncalibratable);
+  }
   if (s.unsnapped)
     out += "(before snapping the optimum had objective " + TableValue(s.unsnapped->objective) + ")\n";
   out += "\n";

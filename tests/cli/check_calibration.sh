@@ -34,6 +34,18 @@ html="$work/r/report.html"
 grep -q '<h2 id="calibration">Calibration</h2>' "$html" || fail "no calibration section"
 grep -q 'alt="pair calibration co-visibility matrix"' "$html" || fail "no heat map"
 
+# suggest --objective calibration turns "away" back until it links to the rest (the suggestion
+# file's "after" says so); without the study's calibration the objective is a one-line error.
+"$pandora" suggest "$scene" --cameras away --max-move 0 --max-rotate 170 --objective calibration \
+  --points 200 --out "$work/s.json" -q || fail "suggest exit code $?"
+[ "$(jq '.improved' "$work/s.json")" = true ] || fail "calibration suggestion did not improve"
+[ "$(jq '.metrics.before.calibration.uncalibratable' "$work/s.json")" -eq 1 ] || fail "before: $(jq -c .metrics.before "$work/s.json")"
+[ "$(jq '.metrics.after.calibration.uncalibratable' "$work/s.json")" -eq 0 ] || fail "after: $(jq -c .metrics.after "$work/s.json")"
+[ "$(jq '.metrics.after.calibration.weakest_shared >= 10' "$work/s.json")" = true ] || fail "weakest link"
+bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/nocal" '$.study.calibration' -- \
+  suggest "$minimal" --cameras a --objective calibration --out "$work/nocal/s.json" >/dev/null ||
+  fail "calibration objective without study.calibration"
+
 jq '.study.calibration.board = {"squares": [7, 5]}' "$scene" >"$work/bad.json"
 bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad_out" '$.study.calibration.board' -- \
   analyze "$work/bad.json" --out "$work/bad_out" >/dev/null || fail "bad calibration key"

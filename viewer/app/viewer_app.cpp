@@ -1200,11 +1200,12 @@ struct ViewerApp::Impl {
     ImGui::SetNextWindowPos(ImVec2(float(model.width - 290), float(model.height - 290)), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(280, 250), ImGuiCond_FirstUseEver);
     ImGui::Begin("Suggest");
-    const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution"};
+    const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution",
+                                "coverage3-n1", "calibration"};
     if (model.suggestion)  // the panel shows what the suggestion on screen was asked for
-      for (int i = 0; i < 5; ++i)
+      for (int i = 0; i < IM_ARRAYSIZE(objectives); ++i)
         if (ObjectiveName(model.suggestion->objective) == objectives[i]) objective = i;
-    ImGui::Combo("objective", &objective, objectives, 5);
+    ImGui::Combo("objective", &objective, objectives, IM_ARRAYSIZE(objectives));
     ImGui::DragFloat("max move m", &max_move, 0.01f, 0.0f, 10.0f, "%.2f");
     ImGui::DragFloat("max turn deg", &max_rotate, 0.5f, 0.0f, 179.0f, "%.1f");
     ImGui::DragInt("points", &points, 10, 50, 20000);
