@@ -21,6 +21,7 @@
 /// For Brown-Conrady the 2x2 Jacobian of the full distortion (tangential terms included) must also have
 /// a positive determinant.
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -111,6 +112,8 @@ class CameraModel {
 };
 
 /// A posed camera with its working range and display attributes.
+struct PtzHead;
+
 struct Camera {
   std::string id;           ///< Unique within its rig.
   std::string name;         ///< Human label (defaults to id).
@@ -121,6 +124,9 @@ struct Camera {
   double near = 0.0;        ///< Working range, Euclidean distance from the centre, metres.
   double far = std::numeric_limits<double>::infinity();
   double pixel_sigma = 0.0;  ///< Pixel noise 1-sigma (pixels) for uncertainty; 0: the study's.
+  /// A pan-tilt-zoom camera's head (analysis/ptz.h); null for a fixed camera. The pose and
+  /// intrinsics above are the head's current setting.
+  std::shared_ptr<const PtzHead> ptz;
 
   Vec3 center() const { return world_from_camera.translation(); }
   Eigen::Isometry3d camera_from_world() const { return world_from_camera.inverse(); }

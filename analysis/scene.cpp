@@ -20,6 +20,7 @@
 #include "analysis/palette.h"
 #include "analysis/pose.h"
 #include "analysis/primitives.h"
+#include "analysis/ptz.h"
 #include "analysis/sha256.h"
 
 namespace pandora {
@@ -840,10 +841,151 @@ Intrinsics ReadIntrinsics(const Node& node) {
   return k;
 }
 
+// A PTZ camera's head ("ptz", docs/ptz.md): its file pose is the home pose at the pivot; the
+// camera becomes the head's current setting.
+void ReadPtz(const Node& node, Camera* camera) {
+  node.CheckKeys({"pan_deg", "tilt_deg", "hfov_deg", "pan_range_deg", "tilt_range_deg", "pan_speed_deg_s",
+                  "tilt_speed_deg_s", "zoom_hfov_deg", "zoom_speed_pct_s", "home_hfov_deg", "pan_axis",
+                  "offset_m", "trace_s", "presets", "tour"});
+  auto head = std::make_shared<PtzHead>();
+  PtzHead& h = *head;
+  h.home = camera->world_from_camera;
+  const Vec3 x_home = h.home.linear().col(0);
+  if (auto n = node.Find("pan_axis")) {
+    const Vec3 a = n->Vector3();
+    if (!(a.norm() > 0)) n->Fail("the pan axis must not be the zero vector");
+    h.pan_axis = a.normalized();
+    if (std::abs(h.pan_axis.dot(x_home)) > 1e-6)
+      n->Fail("the home view's image x axis is not perpendicular to the pan axis (the head is not level)",
+              "aim the camera with \"look_at\" and an \"up\" along the pan axis");
+  } else {
+    h.pan_axis = std::abs(x_home.z()) <= 1e-9 ? Vec3::UnitZ() : Vec3(-h.home.linear().col(1));
+  }
+  const double el0 = h.HomeElevationDeg();
+  auto range = [&](const char* key, double lo, double hi, double* out_lo, double* out_hi) {
+    *out_lo = lo;
+    *out_hi = hi;
+    if (auto n = node.Find(key)) {
+      const Vec2 r = n->Vector2();
+      if (!(r.x() <= 0 && r.y() >= 0))
+        n->Fail("the range must hold home (0), got [" + FormatNumber(r.x()) + ", " + FormatNumber(r.y()) + "]");
+      if (r.x() < lo - 1e-9 || r.y() > hi + 1e-9)
+        n->Fail("the range must lie within [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "] degrees",
+                std::string(key) == "tilt_range_deg"
+                    ? "the optical axis cannot tilt past straight up or down (home elevation " + FormatNumber(el0) + " deg)"
+                    : "a pan range spans at most one turn");
+      *out_lo = r.x();
+      *out_hi = r.y();
+    }
+  };
+  range("pan_range_deg", -360, 360, &h.pan_min_deg, &h.pan_max_deg);
+  if (!node.Has("pan_range_deg")) {
+    h.pan_min_deg = -180;
+    h.pan_max_deg = 180;
+  }
+  if (h.pan_max_deg - h.pan_min_deg > 360.0 + 1e-9)
+    node.Get("pan_range_deg").Fail("a pan range spans at most 360 degrees",
+                                   "a head that turns without end: [-180, 180]");
+  range("tilt_range_deg", -90 - el0, 90 - el0, &h.tilt_min_deg, &h.tilt_max_deg);
+  auto speed = [&](const char* key, double* v) {
+    if (auto n = node.Find(key)) *v = n->Positive();
+  };
+  speed("pan_speed_deg_s", &h.pan_speed_deg_s);
+  speed("tilt_speed_deg_s", &h.tilt_speed_deg_s);
+  double zoom_pct = 50;
+  speed("zoom_speed_pct_s", &zoom_pct);
+  h.zoom_speed = zoom_pct / 100.0;
+  speed("trace_s", &h.trace_s);
+  const Intrinsics k = camera->model.intrinsics();
+  auto focal = [&](const Node& n) {
+    const double hfov = n.Positive();
+    const double max = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+    if (!(hfov < max)) n.Fail("a field of view must be below " + FormatNumber(max) + " degrees");
+    return FocalFromHfov(hfov * kDegree, k.width, k.model);
+  };
+  h.focal_min = h.focal_max = k.fx;
+  if (auto n = node.Find("zoom_hfov_deg")) {
+    if (!n->value().is_array() || n->value().size() != 2) n->Fail("expected [widest, narrowest] degrees");
+    const double a = focal(n->At(0)), b = focal(n->At(1));
+    h.focal_min = std::min(a, b);
+    h.focal_max = std::max(a, b);
+    if (k.fx < h.focal_min * (1 - 1e-9) || k.fx > h.focal_max * (1 + 1e-9))
+      n->Fail("the camera's own field of view (its current zoom) lies outside the zoom range",
+              "give the camera's hfov_deg within zoom_hfov_deg");
+  }
+  auto state = [&](const Node& n, PtzState* s) {
+    if (auto p = n.Find("pan_deg")) {
+      s->pan_deg = p->Number();
+      if (s->pan_deg < h.pan_min_deg - 1e-9 || s->pan_deg > h.pan_max_deg + 1e-9)
+        p->Fail("outside the pan range [" + FormatNumber(h.pan_min_deg) + ", " + FormatNumber(h.pan_max_deg) + "]");
+    }
+    if (auto p = n.Find("tilt_deg")) {
+      s->tilt_deg = p->Number();
+      if (s->tilt_deg < h.tilt_min_deg - 1e-9 || s->tilt_deg > h.tilt_max_deg + 1e-9)
+        p->Fail("outside the tilt range [" + FormatNumber(h.tilt_min_deg) + ", " + FormatNumber(h.tilt_max_deg) + "]");
+    }
+    if (auto p = n.Find("hfov_deg")) {
+      s->focal = focal(*p);
+      if (s->focal < h.focal_min * (1 - 1e-9) || s->focal > h.focal_max * (1 + 1e-9))
+        p->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
+      s->focal = std::clamp(s->focal, h.focal_min, h.focal_max);
+    }
+  };
+  h.home_focal = h.focal_min;
+  if (auto n = node.Find("home_hfov_deg")) {
+    h.home_focal = focal(*n);
+    if (h.home_focal < h.focal_min * (1 - 1e-9) || h.home_focal > h.focal_max * (1 + 1e-9))
+      n->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
+    h.home_focal = std::clamp(h.home_focal, h.focal_min, h.focal_max);
+  }
+  h.current.focal = k.fx;
+  state(node, &h.current);
+  if (node.Has("hfov_deg"))
+    node.Get("hfov_deg").Fail("the current zoom is the camera's own \"hfov_deg\" (or focal)", "remove ptz.hfov_deg");
+  if (auto n = node.Find("offset_m")) {
+    n->Vector3();  // three numbers
+    for (int i = 0; i < 3; ++i) h.offset[i] = n->At(i).Length();
+  }
+  if (auto n = node.Find("presets")) {
+    const size_t count = n->ArraySize("an array of presets");
+    std::set<std::string> names;
+    for (size_t i = 0; i < count; ++i) {
+      const Node p = n->At(i);
+      p.CheckKeys({"name", "pan_deg", "tilt_deg", "hfov_deg"});
+      PtzPreset preset;
+      preset.name = p.Get("name").NonEmptyString();
+      if (!names.insert(preset.name).second) p.Get("name").Fail("duplicate preset name " + Quoted(preset.name));
+      preset.state.focal = h.current.focal;
+      state(p, &preset.state);
+      h.presets.push_back(preset);
+    }
+  }
+  if (auto n = node.Find("tour")) {
+    const size_t count = n->ArraySize("an array of tour stops");
+    if (count == 0) n->Fail("a tour needs at least one stop");
+    std::vector<std::string> names;
+    for (const PtzPreset& p : h.presets) names.push_back(p.name);
+    for (size_t i = 0; i < count; ++i) {
+      const Node stop = n->At(i);
+      stop.CheckKeys({"preset", "dwell_s"});
+      const Node name = stop.Get("preset");
+      const std::string preset = name.NonEmptyString();
+      const auto it = std::find(names.begin(), names.end(), preset);
+      if (it == names.end()) name.Fail("no preset " + Quoted(preset), SuggestionHint(preset, names, "presets"));
+      PtzTourStop t;
+      t.preset = static_cast<int>(it - names.begin());
+      t.dwell_s = stop.Get("dwell_s").NonNegative();
+      h.tour.push_back(t);
+    }
+  }
+  *camera = h.CameraAt(*camera, h.current);
+  camera->ptz = head;
+}
+
 Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
   node.CheckKeys({"id", "name", "color", "enabled", "position", "look_at", "up", "quaternion",
                   "euler_deg", "resolution", "hfov_deg", "focal_px", "lens", "principal_point",
-                  "distortion", "range", "pixel_sigma"});
+                  "distortion", "range", "pixel_sigma", "ptz"});
   Camera camera;
   const Node id = node.Get("id");
   if (id.value().is_number_integer()) {
@@ -880,6 +1022,7 @@ Camera ReadCamera(const Node& node, size_t index, std::set<std::string>* ids) {
       }
     }
   }
+  if (auto n = node.Find("ptz")) ReadPtz(*n, &camera);
   return camera;
 }
 

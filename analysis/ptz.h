@@ -1,0 +1,117 @@
+#pragma once
+/// \file ptz.h
+/// Pan-tilt-zoom cameras (the Pandora paper's section 6; docs/ptz.md). A PTZ camera is a camera of a
+/// rig with a "ptz" block: its file pose is the **home** pose (the neutral orientation at the pivot,
+/// the point where the pan and tilt axes meet); pan turns about the pan axis (fixed to the base, a
+/// world direction), tilt about the camera's image x axis after the pan, zoom scales the focal
+/// lengths about the principal point. The centre of projection may sit `offset` from the pivot
+/// (camera frame), as it does in real domes; the paper assumed none.
+///
+/// Everything else in Pandora sees a PTZ camera at its **current** pan, tilt and zoom (Camera's pose
+/// and intrinsics are those); the head here gives the poses it can reach and how long that takes:
+/// each axis moves at its own constant speed, all at once, so a move takes the longest of the three
+/// axis times.
+///
+/// Light header (Eigen only).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/geometry.h"
+#include "analysis/ray_caster.h"  // Ray
+
+namespace pandora {
+
+struct Camera;
+class RayCaster;
+
+/// A pan / tilt / zoom setting. Angles in degrees relative to home; `focal` in pixels (fx; fy
+/// scales with it).
+struct PtzState {
+  double pan_deg = 0, tilt_deg = 0, focal = 0;
+};
+
+/// A named setting (a preset of the camera's controller).
+struct PtzPreset {
+  std::string name;
+  PtzState state;
+};
+
+/// One stop of a tour: a preset and how long the camera stays there.
+struct PtzTourStop {
+  int preset = 0;  ///< Index into PtzHead::presets.
+  double dwell_s = 0;
+};
+
+/// The mechanics of a PTZ camera.
+struct PtzHead {
+  Eigen::Isometry3d home = Eigen::Isometry3d::Identity();  ///< world_from_camera at pan = tilt = 0.
+  Vec3 pan_axis = Vec3::UnitZ();  ///< World, unit; the home image x axis is perpendicular to it.
+  Vec3 offset = Vec3::Zero();     ///< Centre of projection from the pivot, camera frame, metres.
+  double pan_min_deg = -180, pan_max_deg = 180;  ///< A span of 360 or more: continuous pan.
+  double tilt_min_deg = -90, tilt_max_deg = 90;  ///< Relative to home (positive: up).
+  double focal_min = 0, focal_max = 0;           ///< Zoom range, pixels (wide to tele).
+  double pan_speed_deg_s = 90, tilt_speed_deg_s = 60;
+  double zoom_speed = 0.5;  ///< Fraction of [focal_min, focal_max] per second (the paper's %/s / 100).
+  double home_focal = 0;    ///< The zoom at home (default: the widest, focal_min).
+  double trace_s = 3;       ///< The default time budget of the traces, seconds.
+  PtzState current;         ///< The setting the camera is at (its Camera pose and intrinsics).
+  std::vector<PtzPreset> presets;
+  std::vector<PtzTourStop> tour;
+
+  /// Home elevation of the optical axis above the plane perpendicular to the pan axis, degrees.
+  double HomeElevationDeg() const;
+  bool ContinuousPan() const { return pan_max_deg - pan_min_deg >= 360.0; }
+  PtzState Home() const { return {0.0, 0.0, home_focal}; }
+
+  /// world_from_camera at `s` (rotation and the centre moved by the offset).
+  Eigen::Isometry3d Pose(const PtzState& s) const;
+  /// `base` (the camera as the file describes it, any current state) at setting `s`: its pose, and
+  /// its focal lengths scaled to s.focal about the principal point.
+  Camera CameraAt(const Camera& base, const PtzState& s) const;
+
+  /// Seconds to move from `a` to `b`, every axis at once at its speed: max(|dpan| / pan speed,
+  /// |dtilt| / tilt speed, |dfocal| / zoom speed). A continuous pan takes the shorter way round.
+  double MoveTime(const PtzState& a, const PtzState& b) const;
+  /// The setting `t` seconds into the move from `a` to `b` (each axis moving at its speed until it
+  /// arrives; b itself from MoveTime(a, b) on).
+  PtzState Along(const PtzState& a, const PtzState& b, double t) const;
+  /// Pan `deg` wrapped to the pan range when continuous (else unchanged).
+  double WrapPan(double deg) const;
+};
+
+/// The sweep of the traces: what a PTZ camera can see from `from` within a time budget. With a
+/// zero offset the answer for a point depends only on its direction from the pivot, and the pose
+/// that best shows it is found in closed form (docs/ptz.md): the reachable pan nearest to the
+/// point's azimuth, then the tilt that puts it on the image's horizontal midline (clamped to the
+/// reachable tilts); with an offset the pose is refined by a fixed point (the centre moves with the
+/// pose), which is exact to O(offset / distance)^2.
+class PtzReach {
+ public:
+  /// `base` is the camera (its lens, range and current state); `head` its mechanics.
+  PtzReach(const Camera& base, const PtzHead& head, const PtzState& from);
+
+  /// The best pose for seeing `X` among the settings reachable within `t` seconds from `from`
+  /// (widest reachable zoom); nullopt when X lies behind every such pose.
+  std::optional<PtzState> BestPose(const Vec3& X, double t) const;
+  /// True when some setting reachable within `t` sees X geometrically: inside the image (lens and
+  /// distortion), within range, and facing `normal` when given. Occlusion is not tested: the
+  /// segment from the centre at BestPose to X is returned in `segment` (t_near / t_far with the
+  /// visibility tolerance of `epsilon`) for the caller to cast.
+  bool Reachable(const Vec3& X, double t, const Vec3* normal = nullptr, Ray* segment = nullptr,
+                 double epsilon = 0) const;
+  /// The shortest time after which X is geometrically reachable (bisection to `tolerance_s` on
+  /// Reachable, which is monotone in t); +inf when X is not reachable at all.
+  double ReachTime(const Vec3& X, const Vec3* normal = nullptr, double tolerance_s = 1e-4) const;
+  /// The longest move from `from` to any setting (the budget beyond which nothing new is reached).
+  double MaxTime() const { return max_time_; }
+
+ private:
+  const Camera& base_;
+  const PtzHead& head_;
+  PtzState from_;
+  double max_time_ = 0;
+};
+
+}  // namespace pandora
