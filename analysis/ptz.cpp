@@ -83,6 +83,15 @@ PtzState PtzHead::Along(const PtzState& a, const PtzState& b, double t) const {
   return s;
 }
 
+std::vector<PtzState> PtzHead::Path(const PtzState& a, const PtzState& b) const {
+  const double total = MoveTime(a, b);
+  std::vector<PtzState> out{a};
+  if (!(total > 0)) return out;
+  for (int k = 1; k < total; ++k) out.push_back(Along(a, b, k));
+  out.push_back(Along(a, b, total));
+  return out;
+}
+
 PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from)
     : base_(base), head_(head), from_(from) {
   const double pan_span = head.ContinuousPan()

@@ -79,6 +79,9 @@ struct PtzHead {
   PtzState Along(const PtzState& a, const PtzState& b, double t) const;
   /// Pan `deg` wrapped to the pan range when continuous (else unchanged).
   double WrapPan(double deg) const;
+  /// The paper's "path": the settings from `a` to `b` one per second (a at 0 s, then 1 s, 2 s, ...)
+  /// and b itself last (at MoveTime(a, b)); just {a} when a == b.
+  std::vector<PtzState> Path(const PtzState& a, const PtzState& b) const;
 };
 
 /// The sweep of the traces: what a PTZ camera can see from `from` within a time budget. With a

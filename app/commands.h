@@ -95,6 +95,11 @@ struct RenderArgs {
   /// `--time-sample`: the scene at one of the study's time samples (docs/time.md): its number
   /// (1-based), its pose name or its label; empty: the scene as placed.
   std::string time_sample;
+  /// `--ptz`: how PTZ cameras light the scene (docs/ptz.md): "single" (their current setting, as
+  /// everywhere), "path" (home to current, one light per second, later darker), "all" (everything
+  /// reachable from home within --ptz-time seconds, later seconds darker).
+  std::string ptz = "single";
+  double ptz_time = kUnset;  ///< `--ptz-time`: the budget of "all" (default: each head's trace_s).
   bool quiet = false;
 };
 int RunRender(const RenderArgs& args);

@@ -232,6 +232,11 @@ int main(int argc, char** argv) {
   rn->add_option("--camera", render.camera, "Render what this camera (id) images, distortion included");
   rn->add_option("--time-sample", render.time_sample,
                  "The scene at one of the study's time samples: its number, pose name or label (docs/time.md)");
+  rn->add_option("--ptz", render.ptz,
+                 "PTZ traces: single (current setting), path (home to current, one per second), all "
+                 "(reachable within --ptz-time)")->capture_default_str();
+  rn->add_option("--ptz-time", render.ptz_time, "Time budget of --ptz all, seconds (default: the head's trace_s)")
+      ->check(Number(0, 1e6, "seconds", false, true, true));
   rn->add_option("--fov", render.fov, "Horizontal field of view in degrees (default: the view's, else 60)")
       ->check(Number(0, 180, "degrees", false, true, true));
   rn->add_option("--size", render.size, "Image size WxH (default 1280x720; the camera's with --camera)");

@@ -18,6 +18,7 @@
 #include <unordered_map>
 
 #include "analysis/error.h"
+#include "analysis/ptz.h"
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "render/colormap.h"
@@ -427,6 +428,7 @@ struct GroupScratch {
   std::vector<int> owner;
   std::vector<Mat23> jacobians;
   std::vector<uint8_t> occluded;
+  std::vector<double> shade;  // per segment: the light's factor (PTZ traces: later seconds darker)
   std::vector<Ray> primary;
   std::vector<int> primary_owner;
   std::vector<std::optional<RayHit>> primary_hits;
@@ -466,6 +468,9 @@ struct FrameRenderer::Impl {
   bool have_slice = false;
   double slice_min = 0, slice_max = 0;
   const RayCaster* iso_caster = nullptr;
+  // PTZ "all" traces: per rig camera its reach (null for an ordinary light) and budget.
+  std::vector<std::unique_ptr<PtzReach>> reach;
+  std::vector<double> reach_budget;
   const std::vector<int>* object_texture = nullptr;
   const std::vector<uint8_t>* drawn_edges = nullptr;
 };
@@ -512,6 +517,15 @@ FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, cons
         rig.cameras[c].pixel_sigma > 0 ? rig.cameras[c].pixel_sigma : options.pixel_sigma;
   m.culls.reserve(camera_count);
   for (const Camera& cam : rig.cameras) m.culls.emplace_back(cam);
+  m.reach.resize(camera_count);
+  m.reach_budget.assign(camera_count, 0.0);
+  for (const RenderOptions::PtzTrace& t : options.ptz_all) {
+    if (t.camera < 0 || t.camera >= camera_count || !rig.cameras[t.camera].ptz)
+      throw std::invalid_argument("Render: a PTZ trace names a camera without a PTZ head");
+    const Camera& cam = rig.cameras[t.camera];
+    m.reach[t.camera] = std::make_unique<PtzReach>(cam, *cam.ptz, cam.ptz->Home());
+    m.reach_budget[t.camera] = std::max(0.0, t.budget_s);
+  }
   if (m.overlays) {
     m.have_slice = m.overlays->have_slice;
     m.slice_min = std::isfinite(ov.slice_min) ? ov.slice_min : m.overlays->slice.min;
@@ -660,22 +674,45 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   std::vector<Mat23>& jacobians = scratch->jacobians;
   std::vector<uint8_t>& occluded = scratch->occluded;
   const int camera_count = int(rig.cameras.size());
+  std::vector<double>& shade = scratch->shade;
   for (int c = 0; c < camera_count && !box.empty(); ++c) {
     if (!rig.cameras[c].enabled) continue;
-    if (!m.culler.MayIntersect(c, box)) continue;
+    const PtzReach* reach = m.reach[c].get();
+    if (!reach && !m.culler.MayIntersect(c, box)) continue;
     const Cull& cull = m.culls[c];
     segments.clear();
     owner.clear();
     jacobians.clear();
+    shade.clear();
     for (int i = 0; i < int(s.size()); ++i) {
       if (!s[i].hit) continue;
       const Vec3 X = s[i].X + m.lift * s[i].n;
-      if (!cull.MaySee(X, s[i].n)) continue;
       Ray seg;
       Mat23 J;
-      if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) !=
-          ViewResult::kSeen)
-        continue;
+      if (reach) {
+        // The first whole second (0 = from home) from which a reachable setting sees X.
+        const double budget = m.reach_budget[c];
+        if (!reach->Reachable(X, budget, &s[i].n)) continue;
+        const int seconds = std::max(1, static_cast<int>(std::ceil(budget - 1e-9)));
+        int k = 0;
+        while (k < seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n)) ++k;
+        reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg);
+        const double tol = m.tester.Tolerance(c, seg.t_far);
+        seg.t_near = tol;
+        seg.t_far = std::max(tol, seg.t_far - tol);
+        if (m.need_jacobian) {
+          const std::optional<PtzState> pose = reach->BestPose(X, std::min<double>(k, budget));
+          const Camera at = rig.cameras[c].ptz->CameraAt(rig.cameras[c], *pose);
+          if (!at.Project(X, &J)) J.setZero();
+        }
+        shade.push_back(1.0 - 0.6 * k / seconds);
+      } else {
+        if (!cull.MaySee(X, s[i].n)) continue;
+        if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) !=
+            ViewResult::kSeen)
+          continue;
+        shade.push_back(1.0);
+      }
       if (seg.t_far <= seg.t_near) seg.t_far = seg.t_near;  // at the centre: nothing between
       segments.push_back(seg);
       owner.push_back(i);
@@ -705,8 +742,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       if (smp.weight == 0) continue;
       CameraAtPoint at;
       at.sees = true;
-      at.color = cam.color;
-      if (options.pattern == Pattern::kGrid) {
+      at.color = shade[k] * cam.color;
+      if (options.pattern == Pattern::kGrid && !reach) {
         const auto pixel = cam.Project(smp.X);
         // Derivative of the hit point per output pixel on the hit plane (ray differentials), and
         // of the camera's pixel coordinates through the projection Jacobian.

@@ -117,6 +117,15 @@ struct RenderOptions {
   bool layers = true;
   /// Study pixel sigma for the sigma_max layer, for cameras without their own (Study::pixel_sigma).
   double pixel_sigma = 0.5;
+  /// PTZ traces in the "all" mode (docs/ptz.md): rig camera `camera` (which must have a PTZ head)
+  /// lights every point some setting reachable from home within `budget_s` seconds sees (image,
+  /// range, facing, occlusion from that setting's centre), darker for later seconds: the colour
+  /// times 1 - 0.6 k / ceil(budget_s) for a point first reached in second k (0: seen from home).
+  struct PtzTrace {
+    int camera = -1;
+    double budget_s = 3;
+  };
+  std::vector<PtzTrace> ptz_all;
 };
 
 /// The rendered image and its per-pixel layers (row-major, y down, index y * width + x). The layers
