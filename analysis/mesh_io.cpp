@@ -17,6 +17,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <string>
@@ -701,6 +702,80 @@ void CheckCollada(const std::string& path, uint64_t file_size) {
   }
 }
 
+// --- glTF skins and animations. Assimp 5.2's glTF 2 reader dereferences a skin's
+// inverseBindMatrices accessor without checking that the skin has one (the spec makes it optional),
+// and takes skin joints and animation channels' nodes and samplers on trust: such a file crashes it.
+
+// The JSON of a .gltf file, or the JSON chunk of a .glb; empty when there is none to read.
+std::string GltfJson(const std::string& path, const std::string& extension, uint64_t file_size) {
+  if (extension == ".gltf") return ReadStart(path, file_size);
+  const std::string head = ReadStart(path, 20);
+  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0 || head.compare(16, 4, "JSON") != 0) return {};
+  uint32_t length = 0;
+  std::memcpy(&length, head.data() + 12, 4);
+  if (uint64_t(length) + 20 > file_size) return {};
+  return ReadStart(path, 20 + uint64_t(length)).substr(20);
+}
+
+void CheckGltfSkins(const std::string& path, const std::string& extension, uint64_t file_size) {
+  const nlohmann::json g = nlohmann::json::parse(GltfJson(path, extension, file_size), nullptr, false);
+  if (!g.is_object()) return;  // assimp reports what it cannot parse
+  auto count = [&](const char* key) {
+    const auto it = g.find(key);
+    return it != g.end() && it->is_array() ? it->size() : std::size_t(0);
+  };
+  // An index into g[key]: an unsigned integer below its size.
+  auto index_ok = [&](const nlohmann::json& v, const char* key) {
+    return v.is_number_unsigned() && v.get<std::uint64_t>() < count(key);
+  };
+  const auto skins = g.find("skins");
+  if (skins != g.end() && skins->is_array()) {
+    for (std::size_t i = 0; i < skins->size(); ++i) {
+      const nlohmann::json& skin = (*skins)[i];
+      const std::string name = "skin " + std::to_string(i);
+      if (!skin.is_object()) ThrowCorrupt(path, "glTF", name + " is not an object");
+      if (!skin.contains("inverseBindMatrices"))
+        throw InputError(path, "", "cannot read mesh file: glTF " + name + " has no inverseBindMatrices, which assimp 5.2 cannot read",
+                         "export the skin with its inverse bind matrices (Blender's glTF exporter writes them)");
+      if (!index_ok(skin["inverseBindMatrices"], "accessors"))
+        ThrowCorrupt(path, "glTF", name + "'s inverseBindMatrices names no accessor of the file");
+      const auto joints = skin.find("joints");
+      if (joints == skin.end() || !joints->is_array() || joints->empty())
+        ThrowCorrupt(path, "glTF", name + " has no joints");
+      for (const auto& j : *joints)
+        if (!index_ok(j, "nodes")) ThrowCorrupt(path, "glTF", name + " has a joint that names no node of the file");
+    }
+  }
+  const auto animations = g.find("animations");
+  if (animations != g.end() && animations->is_array()) {
+    for (std::size_t i = 0; i < animations->size(); ++i) {
+      const nlohmann::json& a = (*animations)[i];
+      const std::string name = "animation " + std::to_string(i);
+      if (!a.is_object()) ThrowCorrupt(path, "glTF", name + " is not an object");
+      const auto samplers = a.find("samplers");
+      const std::size_t sampler_count = samplers != a.end() && samplers->is_array() ? samplers->size() : 0;
+      for (std::size_t k = 0; k < sampler_count; ++k) {
+        const nlohmann::json& sm = (*samplers)[k];
+        if (!sm.is_object() || !sm.contains("input") || !sm.contains("output") || !index_ok(sm["input"], "accessors") ||
+            !index_ok(sm["output"], "accessors"))
+          ThrowCorrupt(path, "glTF", name + ": sampler " + std::to_string(k) + " names no input or output accessor");
+      }
+      const auto channels = a.find("channels");
+      if (channels == a.end() || !channels->is_array()) continue;
+      for (std::size_t k = 0; k < channels->size(); ++k) {
+        const nlohmann::json& ch = (*channels)[k];
+        const std::string where = name + ": channel " + std::to_string(k);
+        if (!ch.is_object() || !ch.contains("sampler") || !ch["sampler"].is_number_unsigned() ||
+            ch["sampler"].get<std::uint64_t>() >= sampler_count)
+          ThrowCorrupt(path, "glTF", where + " names no sampler of its animation");
+        const auto target = ch.find("target");
+        if (target == ch.end() || !target->is_object() || (target->contains("node") && !index_ok((*target)["node"], "nodes")))
+          ThrowCorrupt(path, "glTF", where + " targets no node of the file");
+      }
+    }
+  }
+}
+
 // Rejects an empty file, and the damage assimp does not survive in the formats it reads blindly.
 // The format is the one assimp will pick: by the extension, or by the content when assimp does not
 // know the extension.
@@ -723,6 +798,8 @@ void CheckBeforeAssimp(const std::string& path, const Assimp::Importer& importer
   } else if (extension == ".dae" ||
              ((extension == ".xml" || !known) && start.find("<COLLADA") != std::string::npos)) {
     CheckCollada(path, file_size);
+  } else if (extension == ".gltf" || extension == ".glb") {
+    CheckGltfSkins(path, extension, file_size);
   }
 }
 
@@ -897,7 +974,11 @@ auto ReadCheckedFile(const std::string& path, unsigned steps, Use&& use) {
   }
   if (budget.exceeded()) ThrowOverBudget(path, file_size);  // assimp caught the bad_alloc itself
   if (scene == nullptr) fail();
-  return use(*scene);
+  try {
+    return use(*scene);
+  } catch (const std::bad_alloc&) {
+    ThrowOverBudget(path, file_size);  // a damaged file's counts asked for more than the budget
+  }
 }
 
 }  // namespace
@@ -1099,8 +1180,13 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
     for (const aiNode* node : order) {
       const int mesh_node = node_index.at(node);
       for (unsigned n = 0; n < node->mNumMeshes; ++n) {
+        if (node->mMeshes[n] >= scene.mNumMeshes || scene.mMeshes[node->mMeshes[n]] == nullptr)
+          corrupt("node '" + Printable(node->mName.C_Str()) + "' names a mesh the file does not have");
         const aiMesh& mesh = *scene.mMeshes[node->mMeshes[n]];
         if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+        if (mesh.mNumBones > 0 && mesh.mBones == nullptr) corrupt("a mesh has no bone list");
+        for (unsigned b = 0; b < mesh.mNumBones; ++b)
+          if (mesh.mBones[b] == nullptr) corrupt("a mesh has a missing bone");
         Part& p = parts[mesh.mMaterialIndex];
         // Influences of each vertex of this mesh, as bone indices of the part.
         std::vector<std::vector<std::pair<int, double>>> infl(mesh.mNumVertices);
@@ -1113,8 +1199,15 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
           if (!Finite(offset)) corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has an offset matrix that is not finite");
           const int index = int(p.binding.bones.size());
           p.binding.bones.emplace_back(bone_node, offset);
-          for (unsigned w = 0; w < bone.mNumWeights; ++w)
-            if (bone.mWeights[w].mWeight > 0) infl[bone.mWeights[w].mVertexId].emplace_back(index, bone.mWeights[w].mWeight);
+          if (bone.mNumWeights > 0 && bone.mWeights == nullptr) corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has no weights");
+          for (unsigned w = 0; w < bone.mNumWeights; ++w) {
+            // Checked before post-processing, and again: assimp's steps keep damaged weights.
+            const aiVertexWeight& vw = bone.mWeights[w];
+            if (vw.mVertexId >= mesh.mNumVertices || !std::isfinite(vw.mWeight) || vw.mWeight < 0)
+              corrupt("bone '" + Printable(bone.mName.C_Str()) + "' weighs a vertex past the end of its mesh, or by a "
+                      "negative or non-finite weight");
+            if (vw.mWeight > 0) infl[vw.mVertexId].emplace_back(index, vw.mWeight);
+          }
         }
         std::vector<int> remap(mesh.mNumVertices);
         for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
@@ -1160,6 +1253,8 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
         for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
           const aiFace& face = mesh.mFaces[f];
           if (face.mNumIndices != 3) continue;
+          if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices)
+            throw InputError(path, "", "cannot read mesh file: corrupt mesh data: a triangle refers to a vertex past the end of its mesh");
           out.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]);
           if (mesh.mTextureCoords[0] != nullptr) {
             out.corner_uvs.resize(out.triangles.size() - 1);

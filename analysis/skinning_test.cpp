@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -318,6 +319,33 @@ TEST(Skinning, BadAnimationsNameTheirJsonPath) {
   const InputError still = ErrorOf([&] { LoadScene(dir.File("scene.json")); });
   EXPECT_EQ(still.json_path(), "$.objects[0].mesh.file");
   EXPECT_NE(std::string(still.what()).find("no animation"), std::string::npos) << still.what();
+  // Files that crashed assimp 5.2 (found by damaging this file): a skin without inverseBindMatrices
+  // (optional in glTF) and a joint naming no node. Both are errors at the file, with or without
+  // "animation".
+  auto damaged = [&](const std::string& from, const std::string& to) {
+    std::string t = tube.Gltf();
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  for (const auto& [from, to, says] : std::vector<std::array<std::string, 3>>{
+           {"\"inverseBindMatrices\"", "\"inverseBindMatriceX\"", "no inverseBindMatrices"},
+           {"\"joints\": [\n    1,\n    2\n   ]", "\"joints\": [\n    1,\n    7\n   ]", "names no node"}}) {
+    dir.Write("still.gltf", damaged(from, to));
+    for (const std::string& animation : {std::string(R"({"clip": 0})"), std::string()}) {
+      std::string text = BarScene(dir, &tube, animation, animation.empty() ? "" : R"({"times": [0]})");
+      dir.Write("still.gltf", damaged(from, to));  // BarScene rewrote bar.gltf only
+      text.replace(text.find("bar.gltf"), 8, "still.gltf");
+      dir.Write("scene.json", text);
+      const InputError e = ErrorOf([&] { LoadScene(dir.File("scene.json")); });
+      EXPECT_EQ(e.json_path(), "$.objects[0].mesh.file") << from;
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+  dir.Write("still.gltf", [&] {
+    std::string t = tube.Gltf();
+    const std::size_t a = t.find("\"animations\"");
+    return t.erase(a, t.find("\"asset\"") - a);
+  }());
   // The same still file without "animation" loads as a plain mesh.
   std::string plain = BarScene(dir, &tube, "", "");
   plain.replace(plain.find("bar.gltf"), 8, "still.gltf");
