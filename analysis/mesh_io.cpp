@@ -17,6 +17,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <string>
@@ -701,6 +702,80 @@ void CheckCollada(const std::string& path, uint64_t file_size) {
   }
 }
 
+// --- glTF skins and animations. Assimp 5.2's glTF 2 reader dereferences a skin's
+// inverseBindMatrices accessor without checking that the skin has one (the spec makes it optional),
+// and takes skin joints and animation channels' nodes and samplers on trust: such a file crashes it.
+
+// The JSON of a .gltf file, or the JSON chunk of a .glb; empty when there is none to read.
+std::string GltfJson(const std::string& path, const std::string& extension, uint64_t file_size) {
+  if (extension == ".gltf") return ReadStart(path, file_size);
+  const std::string head = ReadStart(path, 20);
+  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0 || head.compare(16, 4, "JSON") != 0) return {};
+  uint32_t length = 0;
+  std::memcpy(&length, head.data() + 12, 4);
+  if (uint64_t(length) + 20 > file_size) return {};
+  return ReadStart(path, 20 + uint64_t(length)).substr(20);
+}
+
+void CheckGltfSkins(const std::string& path, const std::string& extension, uint64_t file_size) {
+  const nlohmann::json g = nlohmann::json::parse(GltfJson(path, extension, file_size), nullptr, false);
+  if (!g.is_object()) return;  // assimp reports what it cannot parse
+  auto count = [&](const char* key) {
+    const auto it = g.find(key);
+    return it != g.end() && it->is_array() ? it->size() : std::size_t(0);
+  };
+  // An index into g[key]: an unsigned integer below its size.
+  auto index_ok = [&](const nlohmann::json& v, const char* key) {
+    return v.is_number_unsigned() && v.get<std::uint64_t>() < count(key);
+  };
+  const auto skins = g.find("skins");
+  if (skins != g.end() && skins->is_array()) {
+    for (std::size_t i = 0; i < skins->size(); ++i) {
+      const nlohmann::json& skin = (*skins)[i];
+      const std::string name = "skin " + std::to_string(i);
+      if (!skin.is_object()) ThrowCorrupt(path, "glTF", name + " is not an object");
+      if (!skin.contains("inverseBindMatrices"))
+        throw InputError(path, "", "cannot read mesh file: glTF " + name + " has no inverseBindMatrices, which assimp 5.2 cannot read",
+                         "export the skin with its inverse bind matrices (Blender's glTF exporter writes them)");
+      if (!index_ok(skin["inverseBindMatrices"], "accessors"))
+        ThrowCorrupt(path, "glTF", name + "'s inverseBindMatrices names no accessor of the file");
+      const auto joints = skin.find("joints");
+      if (joints == skin.end() || !joints->is_array() || joints->empty())
+        ThrowCorrupt(path, "glTF", name + " has no joints");
+      for (const auto& j : *joints)
+        if (!index_ok(j, "nodes")) ThrowCorrupt(path, "glTF", name + " has a joint that names no node of the file");
+    }
+  }
+  const auto animations = g.find("animations");
+  if (animations != g.end() && animations->is_array()) {
+    for (std::size_t i = 0; i < animations->size(); ++i) {
+      const nlohmann::json& a = (*animations)[i];
+      const std::string name = "animation " + std::to_string(i);
+      if (!a.is_object()) ThrowCorrupt(path, "glTF", name + " is not an object");
+      const auto samplers = a.find("samplers");
+      const std::size_t sampler_count = samplers != a.end() && samplers->is_array() ? samplers->size() : 0;
+      for (std::size_t k = 0; k < sampler_count; ++k) {
+        const nlohmann::json& sm = (*samplers)[k];
+        if (!sm.is_object() || !sm.contains("input") || !sm.contains("output") || !index_ok(sm["input"], "accessors") ||
+            !index_ok(sm["output"], "accessors"))
+          ThrowCorrupt(path, "glTF", name + ": sampler " + std::to_string(k) + " names no input or output accessor");
+      }
+      const auto channels = a.find("channels");
+      if (channels == a.end() || !channels->is_array()) continue;
+      for (std::size_t k = 0; k < channels->size(); ++k) {
+        const nlohmann::json& ch = (*channels)[k];
+        const std::string where = name + ": channel " + std::to_string(k);
+        if (!ch.is_object() || !ch.contains("sampler") || !ch["sampler"].is_number_unsigned() ||
+            ch["sampler"].get<std::uint64_t>() >= sampler_count)
+          ThrowCorrupt(path, "glTF", where + " names no sampler of its animation");
+        const auto target = ch.find("target");
+        if (target == ch.end() || !target->is_object() || (target->contains("node") && !index_ok((*target)["node"], "nodes")))
+          ThrowCorrupt(path, "glTF", where + " targets no node of the file");
+      }
+    }
+  }
+}
+
 // Rejects an empty file, and the damage assimp does not survive in the formats it reads blindly.
 // The format is the one assimp will pick: by the extension, or by the content when assimp does not
 // know the extension.
@@ -723,6 +798,8 @@ void CheckBeforeAssimp(const std::string& path, const Assimp::Importer& importer
   } else if (extension == ".dae" ||
              ((extension == ".xml" || !known) && start.find("<COLLADA") != std::string::npos)) {
     CheckCollada(path, file_size);
+  } else if (extension == ".gltf" || extension == ".glb") {
+    CheckGltfSkins(path, extension, file_size);
   }
 }
 
@@ -745,6 +822,22 @@ void CheckImportedScene(const aiScene& scene, const std::string& path) {
     if (scene.mNumMaterials > 0 && mesh->mMaterialIndex >= scene.mNumMaterials) {
       fail(name + " uses material " + std::to_string(mesh->mMaterialIndex) + " of " +
            std::to_string(scene.mNumMaterials));
+    }
+    // Bones: what joining vertices and our skinning read (vertex ids, weights).
+    if (mesh->mNumBones > 0 && mesh->mBones == nullptr) fail(name + " has no bone list");
+    for (unsigned b = 0; b < mesh->mNumBones; ++b) {
+      const aiBone* bone = mesh->mBones[b];
+      if (bone == nullptr) fail(name + ": bone " + std::to_string(b) + " is missing");
+      if (bone->mNumWeights > 0 && bone->mWeights == nullptr)
+        fail(name + ": bone '" + Printable(bone->mName.C_Str()) + "' has no weights");
+      for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+        const aiVertexWeight& vw = bone->mWeights[w];
+        if (vw.mVertexId >= mesh->mNumVertices)
+          fail(name + ": bone '" + Printable(bone->mName.C_Str()) + "' weighs vertex " + std::to_string(vw.mVertexId) +
+               " but the mesh has " + std::to_string(mesh->mNumVertices) + " vertices");
+        if (!std::isfinite(vw.mWeight) || vw.mWeight < 0)
+          fail(name + ": bone '" + Printable(bone->mName.C_Str()) + "' has a weight that is negative or not finite");
+      }
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
@@ -822,9 +915,11 @@ std::uint64_t AssimpBudgetBytes(std::uint64_t file_size) {
                    "export it again");
 }
 
-}  // namespace
-
-std::vector<MeshPart> LoadMeshFile(const std::string& path) {
+// Reads `path` with assimp after the checks above, runs the post-processing steps `steps` and
+// hands the result to `use` while the import's memory budget is open. Throws InputError as
+// LoadMeshFile documents.
+template <typename Use>
+auto ReadCheckedFile(const std::string& path, unsigned steps, Use&& use) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     throw InputError(path, "", "mesh file not found",
@@ -873,13 +968,27 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
     const aiScene* raw = importer.ReadFile(path, 0);
     if (raw == nullptr) fail();
     CheckImportedScene(*raw, path);
-    scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                         aiProcess_PreTransformVertices | aiProcess_SortByPType);
+    scene = importer.ApplyPostProcessing(steps);
   } catch (const std::bad_alloc&) {
     ThrowOverBudget(path, file_size);
   }
   if (budget.exceeded()) ThrowOverBudget(path, file_size);  // assimp caught the bad_alloc itself
   if (scene == nullptr) fail();
+  try {
+    return use(*scene);
+  } catch (const std::bad_alloc&) {
+    ThrowOverBudget(path, file_size);  // a damaged file's counts asked for more than the budget
+  }
+}
+
+}  // namespace
+
+std::vector<MeshPart> LoadMeshFile(const std::string& path) {
+  return ReadCheckedFile(path,
+                         aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                             aiProcess_PreTransformVertices | aiProcess_SortByPType,
+                         [&](const aiScene& imported) {
+  const aiScene* scene = &imported;
   // A scene left without meshes (AI_SCENE_FLAGS_INCOMPLETE) is reported below as having no
   // triangles.
   const fs::path folder = fs::path(path).parent_path();
@@ -948,6 +1057,247 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
                      "points and lines are ignored; export the surfaces as polygons");
   }
   return result;
+                         });
+}
+
+namespace {
+
+Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d out;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out(r, c) = m[r][c];
+  return out;
+}
+
+bool Finite(const Eigen::Matrix4d& m) { return m.allFinite(); }
+
+// The node tree, parents before children; `index` maps each node to its position.
+void ReadNodes(const aiNode* root, Skeleton* skeleton, std::map<const aiNode*, int>* index) {
+  std::vector<std::pair<const aiNode*, int>> stack{{root, -1}};
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    const int self = int(skeleton->nodes.size());
+    (*index)[node] = self;
+    SkeletonNode n;
+    n.name = node->mName.C_Str();
+    n.parent = parent;
+    n.rest_local = ToEigen(node->mTransformation);
+    skeleton->nodes.push_back(std::move(n));
+    for (unsigned i = node->mNumChildren; i-- > 0;) stack.push_back({node->mChildren[i], self});
+  }
+}
+
+}  // namespace
+
+SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
+  return ReadCheckedFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType,
+                         [&](const aiScene& scene) {
+    auto corrupt = [&](const std::string& detail) {
+      throw InputError(path, "", "cannot read mesh file: corrupt animation data: " + detail,
+                       "the file is damaged; export it again");
+    };
+    auto skeleton = std::make_shared<Skeleton>();
+    std::map<const aiNode*, int> node_index;
+    if (scene.mRootNode == nullptr) corrupt("the file has no node tree");
+    ReadNodes(scene.mRootNode, skeleton.get(), &node_index);
+    for (const SkeletonNode& n : skeleton->nodes)
+      if (!Finite(n.rest_local)) corrupt("node '" + Printable(n.name) + "' has a transform that is not finite");
+    auto find_node = [&](const aiString& name) {
+      for (std::size_t i = 0; i < skeleton->nodes.size(); ++i)
+        if (skeleton->nodes[i].name == name.C_Str()) return int(i);
+      return -1;
+    };
+
+    // Clips: key times in seconds, quaternions normalised in double.
+    if (scene.mNumAnimations == 0 || scene.mAnimations == nullptr)
+      throw InputError(path, "", "mesh file has no animation",
+                       "\"animation\" needs a file with an animation clip (glTF, FBX, COLLADA with bones "
+                       "and keyframes); remove \"animation\" for a still object");
+    for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
+      const aiAnimation* anim = scene.mAnimations[a];
+      if (anim == nullptr) corrupt("animation " + std::to_string(a) + " is missing");
+      const std::string clip_name = "animation " + std::to_string(a);
+      const double ticks = anim->mTicksPerSecond > 0 && std::isfinite(anim->mTicksPerSecond) ? anim->mTicksPerSecond : 25.0;
+      SkinClip clip;
+      clip.name = anim->mName.C_Str();
+      if (!std::isfinite(anim->mDuration) || anim->mDuration < 0) corrupt(clip_name + " has a duration that is not finite");
+      clip.duration_s = anim->mDuration / ticks;
+      if (anim->mNumChannels > 0 && anim->mChannels == nullptr) corrupt(clip_name + " has no channel list");
+      double last_key = 0;
+      for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+        const aiNodeAnim* ch = anim->mChannels[c];
+        if (ch == nullptr) corrupt(clip_name + ": channel " + std::to_string(c) + " is missing");
+        NodeChannel channel;
+        channel.node = find_node(ch->mNodeName);
+        if (channel.node < 0) continue;  // keys for a node the file does not have: nothing moves
+        if ((ch->mNumPositionKeys > 0 && !ch->mPositionKeys) || (ch->mNumRotationKeys > 0 && !ch->mRotationKeys) ||
+            (ch->mNumScalingKeys > 0 && !ch->mScalingKeys))
+          corrupt(clip_name + ": channel of node '" + Printable(ch->mNodeName.C_Str()) + "' has no keys");
+        auto time_of = [&](double ticks_value) {
+          if (!std::isfinite(ticks_value)) corrupt(clip_name + " has a key time that is not finite");
+          last_key = std::max(last_key, ticks_value / ticks);
+          return ticks_value / ticks;
+        };
+        auto vec = [&](const aiVector3D& v) {
+          if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+            corrupt(clip_name + " has a key value that is not finite");
+          return Vec3(v.x, v.y, v.z);
+        };
+        for (unsigned k = 0; k < ch->mNumPositionKeys; ++k)
+          channel.position.emplace_back(time_of(ch->mPositionKeys[k].mTime), vec(ch->mPositionKeys[k].mValue));
+        for (unsigned k = 0; k < ch->mNumScalingKeys; ++k)
+          channel.scaling.emplace_back(time_of(ch->mScalingKeys[k].mTime), vec(ch->mScalingKeys[k].mValue));
+        for (unsigned k = 0; k < ch->mNumRotationKeys; ++k) {
+          const aiQuaternion& q = ch->mRotationKeys[k].mValue;
+          Eigen::Quaterniond e(q.w, q.x, q.y, q.z);
+          if (!e.coeffs().allFinite() || !(e.norm() > 1e-6))
+            corrupt(clip_name + " has a rotation key that is not a rotation");
+          channel.rotation.emplace_back(time_of(ch->mRotationKeys[k].mTime), e.normalized());
+        }
+        auto by_time = [](const auto& x, const auto& y) { return x.first < y.first; };
+        std::stable_sort(channel.position.begin(), channel.position.end(), by_time);
+        std::stable_sort(channel.rotation.begin(), channel.rotation.end(), by_time);
+        std::stable_sort(channel.scaling.begin(), channel.scaling.end(), by_time);
+        clip.channels.push_back(std::move(channel));
+      }
+      if (!(clip.duration_s > 0)) clip.duration_s = last_key;
+      skeleton->clips.push_back(std::move(clip));
+    }
+
+    // Vertices per material: the file's mesh-space positions and their influences; welded where
+    // both the position and the influences are equal.
+    struct Part {
+      MeshPart part;
+      SkinBinding binding;
+      std::map<std::vector<double>, int> weld;
+    };
+    std::map<unsigned, Part> parts;
+    const fs::path folder = fs::path(path).parent_path();
+    // Nodes in the skeleton's order (depth first, file order), each mesh where a node places it.
+    std::vector<const aiNode*> order(node_index.size());
+    for (const auto& [node, i] : node_index) order[i] = node;
+    for (const aiNode* node : order) {
+      const int mesh_node = node_index.at(node);
+      for (unsigned n = 0; n < node->mNumMeshes; ++n) {
+        if (node->mMeshes[n] >= scene.mNumMeshes || scene.mMeshes[node->mMeshes[n]] == nullptr)
+          corrupt("node '" + Printable(node->mName.C_Str()) + "' names a mesh the file does not have");
+        const aiMesh& mesh = *scene.mMeshes[node->mMeshes[n]];
+        if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+        if (mesh.mNumBones > 0 && mesh.mBones == nullptr) corrupt("a mesh has no bone list");
+        for (unsigned b = 0; b < mesh.mNumBones; ++b)
+          if (mesh.mBones[b] == nullptr) corrupt("a mesh has a missing bone");
+        Part& p = parts[mesh.mMaterialIndex];
+        // Influences of each vertex of this mesh, as bone indices of the part.
+        std::vector<std::vector<std::pair<int, double>>> infl(mesh.mNumVertices);
+        for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+          const aiBone& bone = *mesh.mBones[b];
+          const int bone_node = find_node(bone.mName);
+          if (bone_node < 0)
+            corrupt("bone '" + Printable(bone.mName.C_Str()) + "' names no node of the file");
+          const Eigen::Matrix4d offset = ToEigen(bone.mOffsetMatrix);
+          if (!Finite(offset)) corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has an offset matrix that is not finite");
+          const int index = int(p.binding.bones.size());
+          p.binding.bones.emplace_back(bone_node, offset);
+          if (bone.mNumWeights > 0 && bone.mWeights == nullptr) corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has no weights");
+          for (unsigned w = 0; w < bone.mNumWeights; ++w) {
+            // Checked before post-processing, and again: assimp's steps keep damaged weights.
+            const aiVertexWeight& vw = bone.mWeights[w];
+            if (vw.mVertexId >= mesh.mNumVertices || !std::isfinite(vw.mWeight) || vw.mWeight < 0)
+              corrupt("bone '" + Printable(bone.mName.C_Str()) + "' weighs a vertex past the end of its mesh, or by a "
+                      "negative or non-finite weight");
+            if (vw.mWeight > 0) infl[vw.mVertexId].emplace_back(index, vw.mWeight);
+          }
+        }
+        std::vector<int> remap(mesh.mNumVertices);
+        for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+          const aiVector3D& x = mesh.mVertices[v];
+          if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
+            throw InputError(path, "", "cannot read mesh file: a vertex has non-finite coordinates");
+          auto& list = infl[v];
+          double sum = 0;
+          for (const auto& [b, w] : list) sum += w;
+          if (!(sum > 0)) {
+            // No weight: the vertex hangs rigidly on its mesh's node.
+            list.clear();
+            int bone = -1;
+            for (std::size_t b = 0; b < p.binding.bones.size(); ++b)
+              if (p.binding.bones[b].first == mesh_node && p.binding.bones[b].second == Eigen::Matrix4d::Identity()) bone = int(b);
+            if (bone < 0) {
+              bone = int(p.binding.bones.size());
+              p.binding.bones.emplace_back(mesh_node, Eigen::Matrix4d::Identity());
+            }
+            list.emplace_back(bone, 1.0);
+          } else {
+            for (auto& bw : list) bw.second /= sum;
+          }
+          std::sort(list.begin(), list.end());
+          std::vector<double> key{double(x.x), double(x.y), double(x.z)};
+          for (const auto& [b, w] : list) {
+            // Bones are keyed by node and offset, so equal influences from two meshes weld.
+            key.push_back(double(p.binding.bones[b].first));
+            for (int r = 0; r < 3; ++r)
+              for (int c = 0; c < 4; ++c) key.push_back(p.binding.bones[b].second(r, c));
+            key.push_back(w);
+          }
+          auto [it, added] = p.weld.emplace(std::move(key), int(p.binding.mesh_vertices.size()));
+          if (added) {
+            p.binding.mesh_vertices.emplace_back(x.x, x.y, x.z);
+            if (p.binding.first.empty()) p.binding.first.push_back(0);
+            p.binding.influences.insert(p.binding.influences.end(), list.begin(), list.end());
+            p.binding.first.push_back(int(p.binding.influences.size()));
+          }
+          remap[v] = it->second;
+        }
+        TriangleMesh& out = p.part.mesh;
+        for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+          const aiFace& face = mesh.mFaces[f];
+          if (face.mNumIndices != 3) continue;
+          if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices)
+            throw InputError(path, "", "cannot read mesh file: corrupt mesh data: a triangle refers to a vertex past the end of its mesh");
+          out.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]);
+          if (mesh.mTextureCoords[0] != nullptr) {
+            out.corner_uvs.resize(out.triangles.size() - 1);
+            std::array<Eigen::Vector2d, 3> uv;
+            for (int k = 0; k < 3; ++k) {
+              const aiVector3D& t = mesh.mTextureCoords[0][face.mIndices[k]];
+              uv[k] = std::isfinite(t.x) && std::isfinite(t.y) ? Eigen::Vector2d(t.x, t.y) : Eigen::Vector2d::Zero();
+            }
+            out.corner_uvs.push_back(uv);
+          } else if (!out.corner_uvs.empty()) {
+            out.corner_uvs.resize(out.triangles.size());
+          }
+        }
+      }
+    }
+
+    SkinnedMeshFile result;
+    const std::vector<Eigen::Matrix4d> rest = skeleton->Globals(-1, 0);
+    for (auto& [material_index, p] : parts) {
+      if (p.part.mesh.triangles.empty()) continue;
+      p.part.mesh.vertices = p.binding.Skin(rest);
+      for (const Vec3& v : p.part.mesh.vertices)
+        if (!v.allFinite()) corrupt("the rest pose has a vertex that is not finite");
+      p.part.material_name = "material" + std::to_string(material_index);
+      if (material_index < scene.mNumMaterials) {
+        const aiMaterial& material = *scene.mMaterials[material_index];
+        aiString name;
+        if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS && name.length > 0) p.part.material_name = name.C_Str();
+        p.part.has_material = p.part.material_name != AI_DEFAULT_MATERIAL_NAME;
+        if (p.part.has_material) {
+          MaterialColor(material, &p.part.color);
+          p.part.texture = MaterialTexture(material, folder);
+        }
+      }
+      result.parts.push_back(std::move(p.part));
+      result.bindings.push_back(std::make_shared<const SkinBinding>(std::move(p.binding)));
+    }
+    if (result.parts.empty())
+      throw InputError(path, "", "mesh file has no triangles",
+                       "points and lines are ignored; export the surfaces as polygons");
+    result.skeleton = std::move(skeleton);
+    return result;
+  });
 }
 
 }  // namespace pandora

@@ -3,10 +3,12 @@
 /// Reading triangle meshes from files through assimp (OBJ+MTL, glTF/GLB, PLY, STL, COLLADA, FBX and
 /// the other formats assimp reads). The only place that includes assimp.
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "analysis/geometry.h"
+#include "analysis/skinning.h"
 
 namespace pandora {
 
@@ -33,5 +35,23 @@ struct MeshPart {
 /// before its post-processing runs (faces without vertices or with indices past the end), and
 /// reported as "corrupt ...".
 std::vector<MeshPart> LoadMeshFile(const std::string& path);
+
+/// A mesh file read for skinned animation (analysis/skinning.h).
+struct SkinnedMeshFile {
+  /// One part per material as LoadMeshFile groups them; each mesh in the rest pose (the node tree
+  /// as the file places it, skinned), in the file's root frame; vertices welded only where both the
+  /// position and the influences are equal.
+  std::vector<MeshPart> parts;
+  std::vector<std::shared_ptr<const SkinBinding>> bindings;  ///< Per part, vertex for vertex.
+  std::shared_ptr<const Skeleton> skeleton;  ///< The node tree and every clip (key times in seconds).
+};
+
+/// Reads a mesh file with its node tree, bones and animations, without baking the node transforms
+/// in: the same format list and damage checks as LoadMeshFile (bone weights naming vertices past
+/// the end, negative or non-finite weights, non-finite keys and matrices are "corrupt ..."). Bone
+/// weights are normalised to sum to 1; vertices without weight hang rigidly on their mesh's node
+/// (so node-animated rigid meshes play too). Throws InputError (file `path`, empty JSON path) as
+/// LoadMeshFile does, and when the file has no animation.
+SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path);
 
 }  // namespace pandora

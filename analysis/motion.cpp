@@ -55,7 +55,7 @@ GroupPose ObjectMotion::RandomDraw(int i) const {
 
 std::vector<TimeSample> Scene::TimeSamples() const {
   std::vector<TimeSample> out;
-  if (motions.empty()) return out;
+  if (!Animated()) return out;
   bool any_keyframes = false, any_poses = false;
   int random_samples = 0;
   double t0 = 0, t1 = 0;
@@ -72,8 +72,21 @@ std::vector<TimeSample> Scene::TimeSamples() const {
       random_samples = std::max(random_samples, m.samples);
     }
   }
+  // Skinned clips: one play from scene time 0, [0, duration / speed], in as many uniform samples as
+  // the clip has distinct key times (at least 2).
+  std::vector<double> skin_times;
+  for (const SkinnedObject& k : skins) {
+    if (!k.skeleton || k.clip < 0 || k.clip >= int(k.skeleton->clips.size())) continue;
+    const SkinClip& clip = k.skeleton->clips[k.clip];
+    const double span = clip.duration_s / k.speed;
+    t0 = any_keyframes ? std::min(t0, 0.0) : 0.0;
+    t1 = any_keyframes ? std::max(t1, span) : span;
+    any_keyframes = true;
+    const int n = std::max<int>(2, int(std::min<std::size_t>(clip.KeyTimes().size(), 100000)));
+    for (int i = 0; i < n; ++i) skin_times.push_back(span * i / (n - 1));
+  }
   // The axis: the study's, else inferred (pose names of the first motion with poses; else every
-  // keyframe time; else the random draws).
+  // keyframe time and the skinned clips' times; else the random draws).
   std::vector<double> times;
   std::vector<std::string> pose_names;
   int count = 0;
@@ -88,7 +101,7 @@ std::vector<TimeSample> Scene::TimeSamples() const {
   } else if (any_poses) {
     for (const auto& [name, pose] : first_poses->poses) pose_names.push_back(name);
   } else if (any_keyframes) {
-    std::set<double> all;
+    std::set<double> all(skin_times.begin(), skin_times.end());
     for (const ObjectMotion& m : motions)
       for (const auto& [t, pose] : m.keyframes) all.insert(t);
     times.assign(all.begin(), all.end());
@@ -99,6 +112,7 @@ std::vector<TimeSample> Scene::TimeSamples() const {
   for (int i = 0; i < n; ++i) {
     TimeSample s;
     s.time = !times.empty() ? times[i] : double(i);
+    s.timed = !times.empty();
     s.label = !pose_names.empty() ? "pose '" + pose_names[i] + "'"
               : !times.empty()    ? "t=" + Short(times[i]) + " s"
                                   : "draw " + std::to_string(i + 1);
@@ -124,8 +138,34 @@ std::vector<TimeSample> Scene::TimeSamples() const {
   return out;
 }
 
+int MotionOfObject(const Scene& scene, int object) {
+  for (std::size_t k = 0; k < scene.motions.size(); ++k)
+    for (int o : scene.motions[k].objects)
+      if (o == object) return int(k);
+  return -1;
+}
+
+std::vector<Vec3> ObjectVerticesAt(const Scene& scene, int object, const TimeSample& sample) {
+  const SceneObject& o = scene.objects[object];
+  std::vector<Vec3> v;
+  if (o.skin >= 0 && o.skin < int(scene.skins.size())) v = scene.skins[o.skin].VerticesAt(sample.SkinTime());
+  if (v.size() != o.mesh.vertices.size()) v = o.mesh.vertices;
+  const int motion = MotionOfObject(scene, object);
+  if (motion >= 0 && motion < int(sample.poses.size())) {
+    const Eigen::Isometry3d T = MotionTransform(scene, motion, sample);
+    for (Vec3& p : v) p = T * p;
+  }
+  return v;
+}
+
 Scene SceneAtSample(const Scene& scene, const TimeSample& sample) {
   Scene out = scene;
+  for (const SkinnedObject& k : scene.skins) {
+    std::vector<Vec3> v = k.VerticesAt(sample.SkinTime());
+    if (v.size() == out.objects[k.object].mesh.vertices.size()) out.objects[k.object].mesh.vertices = std::move(v);
+  }
+  for (SceneObject& o : out.objects) o.skin = -1;
+  out.skins.clear();
   out.motions.clear();
   for (std::size_t k = 0; k < scene.motions.size() && k < sample.poses.size(); ++k) {
     const ObjectMotion& m = scene.motions[k];
@@ -137,10 +177,12 @@ Scene SceneAtSample(const Scene& scene, const TimeSample& sample) {
 }
 
 std::unique_ptr<RigidPartsRayCaster> MakeSceneParts(const Scene& scene) {
+  const std::size_t rigid = scene.motions.size() + 1;
   std::vector<int> part_of(scene.objects.size(), 0);
   for (std::size_t k = 0; k < scene.motions.size(); ++k)
     for (int o : scene.motions[k].objects) part_of[o] = int(k) + 1;
-  std::vector<TriangleMesh> parts(scene.motions.size() + 1);
+  for (std::size_t j = 0; j < scene.skins.size(); ++j) part_of[scene.skins[j].object] = int(rigid + j);
+  std::vector<TriangleMesh> parts(rigid + scene.skins.size());
   std::vector<std::vector<int>> index(parts.size());
   int next = 0;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -150,17 +192,34 @@ std::unique_ptr<RigidPartsRayCaster> MakeSceneParts(const Scene& scene) {
     for (std::size_t i = 0; i < mesh.triangles.size(); ++i) index[k].push_back(next + int(i));
     next += int(mesh.triangles.size());
   }
-  return MakeEmbreeRigidParts(parts, index);
+  std::vector<bool> deforms(parts.size(), false);
+  for (std::size_t j = 0; j < scene.skins.size(); ++j) deforms[rigid + j] = true;
+  return MakeEmbreeRigidParts(parts, index, deforms);
 }
 
 std::vector<Eigen::Isometry3d> PartTransforms(const Scene& scene, const TimeSample& sample) {
-  std::vector<Eigen::Isometry3d> out(scene.motions.size() + 1, Eigen::Isometry3d::Identity());
+  const std::size_t rigid = scene.motions.size() + 1;
+  std::vector<Eigen::Isometry3d> out(rigid + scene.skins.size(), Eigen::Isometry3d::Identity());
   for (std::size_t k = 0; k < scene.motions.size(); ++k) out[k + 1] = MotionTransform(scene, int(k), sample);
+  for (std::size_t j = 0; j < scene.skins.size(); ++j)
+    out[rigid + j] = MotionTransform(scene, MotionOfObject(scene, scene.skins[j].object), sample);
   return out;
 }
 
+std::vector<std::vector<Vec3>> PartVertices(const Scene& scene, const TimeSample& sample) {
+  const std::size_t rigid = scene.motions.size() + 1;
+  std::vector<std::vector<Vec3>> out(rigid + scene.skins.size());
+  for (std::size_t j = 0; j < scene.skins.size(); ++j) out[rigid + j] = scene.skins[j].VerticesAt(sample.SkinTime());
+  return out;
+}
+
+std::unique_ptr<RayCaster> CasterAtSample(const RigidPartsRayCaster& parts, const Scene& scene,
+                                          const TimeSample& sample) {
+  return parts.At(PartTransforms(scene, sample), PartVertices(scene, sample));
+}
+
 std::vector<TimeSample> SamplesOrAsPlaced(std::vector<TimeSample> samples) {
-  if (samples.empty()) samples.push_back(TimeSample{"as placed", 0, {}});
+  if (samples.empty()) samples.push_back(TimeSample{"as placed", 0, {}, false});
   return samples;
 }
 

@@ -20,6 +20,7 @@
 namespace pandora {
 
 struct Scene;
+class RayCaster;
 class RigidPartsRayCaster;
 
 /// A rigid pose of a moving group, relative to where the file places it.
@@ -72,6 +73,11 @@ struct TimeSample {
   std::string label;
   double time = 0;  ///< Seconds (keyframed samples), else the sample's index.
   std::vector<GroupPose> poses;
+  /// True when `time` is seconds (a time axis of times or uniform samples): skinned objects play
+  /// their clip at `time`. Named-pose and random-draw samples (false) show them at scene time 0.
+  bool timed = false;
+  /// The scene time skinned objects take at this sample (seconds).
+  double SkinTime() const { return timed ? time : 0.0; }
 };
 
 /// `samples`, or for a static scene (none) the one sample "as placed" (no poses).
@@ -81,12 +87,27 @@ std::vector<TimeSample> SamplesOrAsPlaced(std::vector<TimeSample> samples);
 /// motion -1 or a sample without poses.
 Eigen::Isometry3d MotionTransform(const Scene& scene, int motion, const TimeSample& sample);
 
-/// The scene's rigid parts for ray casting: part 0 holds the objects that do not move, part k + 1 the
-/// objects of Scene::motions[k], each at rest; every triangle keeps its index of
-/// Scene::AllTriangles(). At(PartTransforms(scene, sample)) is then the caster of SceneAtSample(scene,
-/// sample) without building its BVH again.
+/// Index into Scene::motions of the motion that moves object `object`, or -1.
+int MotionOfObject(const Scene& scene, int object);
+
+/// Object `object`'s vertices (world) at `sample`: a skinned object's pose at sample.SkinTime()
+/// (analysis/skinning.h), then its group's rigid motion; SceneAtSample's mesh of the object.
+std::vector<Vec3> ObjectVerticesAt(const Scene& scene, int object, const TimeSample& sample);
+
+/// The scene's parts for ray casting: part 0 holds the objects that do not move, part k + 1 the
+/// objects of Scene::motions[k] that are not skinned, part motions.size() + 1 + j the object of
+/// Scene::skins[j], each at rest; every triangle keeps its index of Scene::AllTriangles().
+/// CasterAtSample(parts, scene, sample) is then the caster of SceneAtSample(scene, sample) without
+/// building the rigid parts' BVHs again (only the skinned parts' vertices are replaced).
 std::unique_ptr<RigidPartsRayCaster> MakeSceneParts(const Scene& scene);
-/// The parts' transforms at `sample` (part 0 the identity).
+/// The parts' transforms at `sample` (part 0 the identity; a skinned part its group's motion).
 std::vector<Eigen::Isometry3d> PartTransforms(const Scene& scene, const TimeSample& sample);
+/// The parts' vertices at `sample` before their transforms: empty for the rigid parts, the skinned
+/// pose (world, before the group's motion) for each skinned part.
+std::vector<std::vector<Vec3>> PartVertices(const Scene& scene, const TimeSample& sample);
+/// parts.At(PartTransforms(scene, sample), PartVertices(scene, sample)); `parts` is
+/// MakeSceneParts(scene).
+std::unique_ptr<RayCaster> CasterAtSample(const RigidPartsRayCaster& parts, const Scene& scene,
+                                          const TimeSample& sample);
 
 }  // namespace pandora

@@ -65,14 +65,24 @@ std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh);
 
 /// Ray casters for a scene whose parts move rigidly (analysis/motion.h): one BVH per part, built
 /// once; At() gives the caster of one time sample by building only a top-level BVH over the parts
-/// with their transforms (Embree instancing; microseconds for a few parts). Immutable; At() may be
-/// called from several threads, and its casters outlive this object safely.
+/// with their transforms (Embree instancing; microseconds for a few parts); deformable parts (skinned
+/// meshes) get their sample's vertices and a refit of their own BVH. At() may be called from several
+/// threads, and its casters outlive this object safely.
 class RigidPartsRayCaster {
  public:
   virtual ~RigidPartsRayCaster() = default;
   /// The caster with part k moved by transforms[k] (world_from_rest; missing entries: identity).
   /// Hits report the triangle's index as given at construction and the moved normal.
-  virtual std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms) const = 0;
+  std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms) const {
+    return At(transforms, {});
+  }
+  /// The same with the vertices of deformable parts replaced: vertices[k], when part k was built
+  /// deformable and it has the part's vertex count, is that part's mesh (same triangles) before
+  /// transforms[k]; else the part keeps its rest mesh. A deformed part's BVH is refitted to the
+  /// new vertices (RTC_BUILD_QUALITY_REFIT), built only when no earlier caster's BVH of that part
+  /// is free (the first sample, or casters alive at once); rigid parts keep theirs.
+  virtual std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms,
+                                        const std::vector<std::vector<Vec3>>& vertices) const = 0;
   virtual std::size_t part_count() const = 0;
 };
 
@@ -80,8 +90,10 @@ class RigidPartsRayCaster {
 /// mode, high quality). `triangle_index[k][i]` is the index hits report for triangle i of part k
 /// (e.g. its index in Scene::AllTriangles()); when a part's list is missing or of the wrong size, the
 /// parts' triangles are numbered consecutively. Throws std::runtime_error when Embree fails.
+/// `deformable[k]` marks part k as one whose vertices At() may replace (a skinned mesh).
 std::unique_ptr<RigidPartsRayCaster> MakeEmbreeRigidParts(const std::vector<TriangleMesh>& parts,
-                                                          const std::vector<std::vector<int>>& triangle_index = {});
+                                                          const std::vector<std::vector<int>>& triangle_index = {},
+                                                          const std::vector<bool>& deformable = {});
 
 /// Double-precision brute force (Moller-Trumbore over every triangle). O(triangles) per ray.
 std::unique_ptr<RayCaster> MakeBruteForceRayCaster(const TriangleMesh& mesh);

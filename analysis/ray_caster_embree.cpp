@@ -8,6 +8,7 @@
 #include <chrono>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -84,17 +85,80 @@ void SetLane(P* p, int lane, const RTCRay& r) {
 
 // The parts of a RigidPartsRayCaster: one device, one bottom-level scene per part (vertices in the
 // rest world frame minus `offset`), and each part's triangle indices in the caller's numbering.
+// A deformable part's bottom-level scene whose vertices a sample replaces (refit).
+struct DeformedBlas {
+  RTCScene scene = nullptr;
+  RTCGeometry geometry = nullptr;
+};
+
 struct EmbreeParts {
   RTCDevice device = nullptr;
   std::vector<RTCScene> scenes;            // null for an empty part
   std::vector<std::vector<int>> global;    // [part][primID] -> caller's triangle index
   std::vector<Aabb> bounds;                // rest bounds per part
+  std::vector<int> bounds_vertices;        // vertices per part
   Vec3 offset = Vec3::Zero();
   std::size_t triangles = 0;
+  // Deformable parts: their triangles, and the scenes no caster uses now (a caster takes one, or
+  // builds one, for its sample and gives it back when it is destroyed, so a sequence of samples
+  // refits one BVH while casters alive at once each keep their own).
+  std::vector<std::vector<Eigen::Vector3i>> deformable;  // per part; empty: rigid
+  mutable std::mutex pool_mutex;
+  mutable std::vector<std::vector<DeformedBlas>> pool;   // per part
   ~EmbreeParts() {
     for (RTCScene s : scenes)
       if (s) rtcReleaseScene(s);
+    for (auto& list : pool)
+      for (DeformedBlas& b : list) {
+        rtcReleaseGeometry(b.geometry);
+        rtcReleaseScene(b.scene);
+      }
     if (device) rtcReleaseDevice(device);
+  }
+
+  // A scene of part k with `vertices` (world frame before the part's transform): a free one of
+  // the pool refitted, else a new one built.
+  DeformedBlas Take(std::size_t k, const std::vector<Vec3>& vertices) const {
+    DeformedBlas b;
+    {
+      std::lock_guard<std::mutex> lock(pool_mutex);
+      if (!pool[k].empty()) {
+        b = pool[k].back();
+        pool[k].pop_back();
+      }
+    }
+    const std::vector<Eigen::Vector3i>& tris = deformable[k];
+    if (!b.scene) {
+      b.geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetGeometryBuildQuality(b.geometry, RTC_BUILD_QUALITY_REFIT);
+      rtcSetNewGeometryBuffer(b.geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                              vertices.size());
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          b.geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tris.size()));
+      if (!idx) throw std::runtime_error("Embree: cannot allocate geometry buffers");
+      for (std::size_t i = 0; i < tris.size(); ++i)
+        for (int c = 0; c < 3; ++c) idx[3 * i + c] = static_cast<unsigned>(tris[i][c]);
+      b.scene = rtcNewScene(device);
+      rtcSetSceneFlags(b.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC);
+      rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_LOW);  // Embree refits only under LOW (MEDIUM: 5 ms rebuilds, measured)
+      rtcAttachGeometry(b.scene, b.geometry);
+    }
+    auto* v = static_cast<float*>(rtcGetGeometryBufferData(b.geometry, RTC_BUFFER_TYPE_VERTEX, 0));
+    if (!v) throw std::runtime_error("Embree: no vertex buffer");
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const Vec3 p = vertices[i] - offset;
+      v[3 * i + 0] = static_cast<float>(p.x());
+      v[3 * i + 1] = static_cast<float>(p.y());
+      v[3 * i + 2] = static_cast<float>(p.z());
+    }
+    rtcUpdateGeometryBuffer(b.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(b.geometry);
+    rtcCommitScene(b.scene);
+    return b;
+  }
+  void Give(std::size_t k, DeformedBlas b) const {
+    std::lock_guard<std::mutex> lock(pool_mutex);
+    pool[k].push_back(b);
   }
 };
 
@@ -131,7 +195,8 @@ class EmbreeRayCaster final : public RayCaster {
   // One time sample of rigid parts: a top-level scene of one instance per part with its transform
   // (world_from_rest), over the parts' shared bottom-level scenes. Only this small top-level BVH is
   // built.
-  EmbreeRayCaster(std::shared_ptr<const EmbreeParts> parts, const std::vector<Eigen::Isometry3d>& transforms)
+  EmbreeRayCaster(std::shared_ptr<const EmbreeParts> parts, const std::vector<Eigen::Isometry3d>& transforms,
+                  const std::vector<std::vector<Vec3>>& vertices = {})
       : triangles_(parts->triangles), offset_(parts->offset), parts_(std::move(parts)) {
     device_ = parts_->device;
     rtcRetainDevice(device_);
@@ -142,13 +207,23 @@ class EmbreeRayCaster final : public RayCaster {
     for (std::size_t k = 0; k < parts_->scenes.size(); ++k) {
       const Eigen::Isometry3d T = k < transforms.size() ? transforms[k] : Eigen::Isometry3d::Identity();
       part_rotation_[k] = T.linear();
-      // Part bounds at the sample: the rest box's corners moved.
-      const Aabb& b = parts_->bounds[k];
-      if (!b.empty())
-        for (int c = 0; c < 8; ++c)
-          bounds_.Extend(T * Vec3(c & 1 ? b.max.x() : b.min.x(), c & 2 ? b.max.y() : b.min.y(),
-                                  c & 4 ? b.max.z() : b.min.z()));
-      if (!parts_->scenes[k]) continue;
+      RTCScene blas = parts_->scenes[k];
+      const bool deformed = k < vertices.size() && !parts_->deformable[k].empty() &&
+                            vertices[k].size() == std::size_t(parts_->bounds_vertices[k]);
+      if (deformed) {
+        for (const Vec3& v : vertices[k]) bounds_.Extend(T * v);
+        const DeformedBlas d = parts_->Take(k, vertices[k]);
+        borrowed_.emplace_back(k, d);
+        blas = d.scene;
+      } else {
+        // Part bounds at the sample: the rest box's corners moved.
+        const Aabb& b = parts_->bounds[k];
+        if (!b.empty())
+          for (int c = 0; c < 8; ++c)
+            bounds_.Extend(T * Vec3(c & 1 ? b.max.x() : b.min.x(), c & 2 ? b.max.y() : b.min.y(),
+                                    c & 4 ? b.max.z() : b.min.z()));
+      }
+      if (!blas) continue;
       // In the recentred frame: x' = R x + (R o + t - o), o the offset.
       const Mat3 R = T.linear();
       const Vec3 t = R * offset_ + T.translation() - offset_;
@@ -157,7 +232,7 @@ class EmbreeRayCaster final : public RayCaster {
         for (int row = 0; row < 3; ++row) xfm[3 * col + row] = static_cast<float>(R(row, col));
       for (int row = 0; row < 3; ++row) xfm[9 + row] = static_cast<float>(t[row]);
       RTCGeometry inst = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(inst, parts_->scenes[k]);
+      rtcSetGeometryInstancedScene(inst, blas);
       rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
       rtcCommitGeometry(inst);
       rtcAttachGeometryByID(scene_, inst, static_cast<unsigned>(k));
@@ -200,6 +275,7 @@ class EmbreeRayCaster final : public RayCaster {
 
   ~EmbreeRayCaster() override {
     rtcReleaseScene(scene_);
+    for (const auto& [k, b] : borrowed_) parts_->Give(k, b);
     rtcReleaseDevice(device_);
   }
 
@@ -358,12 +434,20 @@ class EmbreeRayCaster final : public RayCaster {
   RTCScene scene_ = nullptr;
   std::shared_ptr<const EmbreeParts> parts_;  // set for a sample of rigid parts
   std::vector<Mat3> part_rotation_;           // per part: world_from_rest rotation (normals)
+  std::vector<std::pair<std::size_t, DeformedBlas>> borrowed_;  // deformed parts' scenes, given back
 };
 
 class EmbreeRigidParts final : public RigidPartsRayCaster {
  public:
-  EmbreeRigidParts(const std::vector<TriangleMesh>& parts, const std::vector<std::vector<int>>& triangle_index) {
+  EmbreeRigidParts(const std::vector<TriangleMesh>& parts, const std::vector<std::vector<int>>& triangle_index,
+                   const std::vector<bool>& deformable) {
     auto data = std::make_shared<EmbreeParts>();
+    data->deformable.resize(parts.size());
+    data->pool.resize(parts.size());
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      data->bounds_vertices.push_back(int(parts[k].vertices.size()));
+      if (k < deformable.size() && deformable[k]) data->deformable[k] = parts[k].triangles;
+    }
     Aabb all;
     for (const TriangleMesh& m : parts) all.Extend(m.Bounds());
     data->offset = all.empty() ? Vec3::Zero() : all.center();
@@ -394,8 +478,9 @@ class EmbreeRigidParts final : public RigidPartsRayCaster {
     if (rtcGetDeviceError(data->device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: part build failed");
     data_ = std::move(data);
   }
-  std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms) const override {
-    return std::make_unique<EmbreeRayCaster>(data_, transforms);
+  std::unique_ptr<RayCaster> At(const std::vector<Eigen::Isometry3d>& transforms,
+                                const std::vector<std::vector<Vec3>>& vertices) const override {
+    return std::make_unique<EmbreeRayCaster>(data_, transforms, vertices);
   }
   std::size_t part_count() const override { return data_->scenes.size(); }
 
@@ -410,8 +495,9 @@ std::unique_ptr<RayCaster> MakeEmbreeRayCaster(const TriangleMesh& mesh) {
 }
 
 std::unique_ptr<RigidPartsRayCaster> MakeEmbreeRigidParts(const std::vector<TriangleMesh>& parts,
-                                                          const std::vector<std::vector<int>>& triangle_index) {
-  return std::make_unique<EmbreeRigidParts>(parts, triangle_index);
+                                                          const std::vector<std::vector<int>>& triangle_index,
+                                                          const std::vector<bool>& deformable) {
+  return std::make_unique<EmbreeRigidParts>(parts, triangle_index, deformable);
 }
 
 int EmbreePacketWidth(const RayCaster& caster) {

@@ -321,7 +321,6 @@ class Node {
     return color;
   }
 
- private:
   std::string TypeName() const {
     if (value_->is_number()) return "a number";
     if (value_->is_string()) return "a string";
@@ -331,6 +330,7 @@ class Node {
     return "null";
   }
 
+ private:
   const json* value_;
   std::string path_;
   const Context* context_;
@@ -504,6 +504,63 @@ std::vector<MeshPart> LoadMeshParts(const MeshReference& reference) {
   }
 }
 
+// Loads a mesh file with its bones and clips, rethrowing its errors at the "file" field.
+SkinnedMeshFile LoadSkinnedParts(const MeshReference& reference) {
+  try {
+    return LoadSkinnedMeshFile(reference.resolved);
+  } catch (const InputError& e) {
+    reference.file_node.Fail(e.reason() + " (" + reference.resolved + ")", e.hint());
+  }
+}
+
+// "animation": {"clip", "speed", "offset_s", "loop"}: everything but the clip, which needs the file.
+SkinnedObject ReadAnimation(const Node& node) {
+  node.CheckKeys({"clip", "speed", "offset_s", "loop"});
+  SkinnedObject skin;
+  if (auto n = node.Find("clip")) {
+    if (n->value().is_string()) n->NonEmptyString();
+    else if (n->value().is_number()) n->Integer(0, 1000000);
+    else n->Fail("expected a clip name or index, got " + n->TypeName(), "give the clip's name, e.g. \"walk\", or its index");
+  }
+  if (auto n = node.Find("speed")) {
+    skin.speed = n->Positive();
+    if (!(skin.speed <= 1000)) n->Fail("expected a speed in (0, 1000] clip seconds per second");
+  }
+  if (auto n = node.Find("offset_s")) {
+    skin.offset_s = n->Number();
+    if (!std::isfinite(skin.offset_s) || std::abs(skin.offset_s) > 1e9) n->Fail("expected a time in seconds within 1e9");
+  }
+  if (auto n = node.Find("loop")) skin.loop = n->Bool();
+  return skin;
+}
+
+// The clip "animation"."clip" names in `skeleton` (by name, or index); the only clip when none is named.
+int ResolveClip(const Node& node, const Skeleton& skeleton) {
+  const int count = int(skeleton.clips.size());
+  const auto n = node.Find("clip");
+  if (!n) {
+    if (count == 1) return 0;
+    node.Fail("the mesh file has " + std::to_string(count) + " animation clips; name one with \"clip\"",
+              "the clips: " + skeleton.ClipList());
+  }
+  if (n->value().is_number()) {
+    const int index = n->Integer(0, 1000000);
+    if (index >= count)
+      n->Fail("no clip " + std::to_string(index) + ": the mesh file has " + std::to_string(count),
+              "the clips: " + skeleton.ClipList());
+    return index;
+  }
+  const std::string name = n->NonEmptyString();
+  std::vector<std::string> names;
+  for (int i = 0; i < count; ++i) {
+    if (skeleton.clips[i].name == name) return i;
+    if (!skeleton.clips[i].name.empty()) names.push_back(skeleton.clips[i].name);
+  }
+  n->Fail("no clip " + Quoted(name) + " in the mesh file",
+          names.size() == std::size_t(count) ? SuggestionHint(name, names, "clips in this file")
+                                              : "the clips: " + skeleton.ClipList());
+}
+
 TriangleMesh Transformed(const TriangleMesh& mesh, const Eigen::Affine3d& transform) {
   TriangleMesh out = mesh;
   for (Vec3& v : out.vertices) v = transform * v;
@@ -567,7 +624,8 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
   const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
                                                   "capsule", "plane",  "mesh"};
   std::vector<std::string> allowed = {"name",  "position", "rotation_deg", "quaternion",
-                                      "scale", "material", "color",        "solid", "group"};
+                                      "scale", "material", "color",        "solid", "group",
+                                      "animation"};
   allowed.insert(allowed.end(), geometry_keys.begin(), geometry_keys.end());
   node.CheckKeys(allowed);
 
@@ -646,14 +704,35 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     return n ? n->Integer(kMinSegments, kMaxSegments) : kDefaultSegments;
   };
 
+  const std::optional<Node> animation = node.Find("animation");
+  if (animation && kind != "mesh")
+    animation->Fail("\"animation\" needs a mesh file with bones and an animation clip, not a " + kind,
+                    "give \"mesh\": {\"file\": ...} with a glTF, FBX or COLLADA file, or remove \"animation\"");
   if (kind == "mesh") {
     const MeshReference reference = ReadMeshReference(geometry);
     const Eigen::Affine3d transform = world_from_object * reference.file_to_object;
+    std::optional<SkinnedObject> skin;
+    if (animation) skin = ReadAnimation(*animation);
     if (!context.options.load_meshes) {
       scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid});
+      if (skin) {  // no skeleton: the object stays as placed
+        skin->object = int(scene->objects.size()) - 1;
+        scene->objects.back().skin = int(scene->skins.size());
+        scene->skins.push_back(*skin);
+      }
       return;
     }
-    std::vector<MeshPart> parts = LoadMeshParts(reference);
+    std::vector<MeshPart> parts;
+    SkinnedMeshFile skinned;
+    if (skin) {
+      skinned = LoadSkinnedParts(reference);
+      skin->skeleton = skinned.skeleton;
+      skin->world_from_file = transform;
+      skin->clip = ResolveClip(*animation, *skinned.skeleton);
+      parts = skinned.parts;
+    } else {
+      parts = LoadMeshParts(reference);
+    }
     TriangleMesh all;
     std::set<std::string> part_names;
     for (MeshPart& part : parts) {
@@ -675,6 +754,13 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
             AddMaterial(scene, Material{name + "/" + part.material_name, part.color, part.texture});
       }
       if (solid) all.Append(object.mesh);
+      if (skin) {
+        SkinnedObject part_skin = *skin;
+        part_skin.object = int(scene->objects.size());
+        part_skin.binding = skinned.bindings[std::size_t(&part - parts.data())];
+        object.skin = int(scene->skins.size());
+        scene->skins.push_back(std::move(part_skin));
+      }
       scene->objects.push_back(std::move(object));
     }
     if (solid) {
@@ -1559,8 +1645,12 @@ void CheckTimeAxis(const Node& root, const Scene& scene) {
   const std::optional<TimeStudy>& time = scene.study.time;
   const auto time_node = root.Get("study").Find("time");
   if (scene.motions.empty()) {
-    if (time_node)
-      time_node->Fail("the study has a time axis but the scene has no \"motions\"", "remove it, or add motions");
+    if (time_node && scene.skins.empty())
+      time_node->Fail("the study has a time axis but the scene has no \"motions\" and no \"animation\"",
+                      "remove it, or add motions or an animated mesh");
+    if (time && !time->poses.empty())
+      time_node->Get("poses").Fail("the study's time axis names poses but no motion has named poses",
+                                   "give \"times\" or \"samples\" for animated meshes");
     return;
   }
   bool any_keyframes = false;

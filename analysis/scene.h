@@ -15,6 +15,7 @@
 #include "analysis/camera.h"
 #include "analysis/geometry.h"
 #include "analysis/motion.h"
+#include "analysis/skinning.h"
 #include "analysis/uncertainty.h"
 
 namespace pandora {
@@ -39,6 +40,8 @@ struct SceneObject {
   /// The moving group it belongs to ("group" in the file; empty: none). A motion named after the
   /// group, or after the object itself, moves it (analysis/motion.h).
   std::string group;
+  /// Index into Scene::skins when the object plays a skinned animation ("animation"); else -1.
+  int skin = -1;
 
   /// True when a motion or a target named `n` takes this object: its group, its own name, or the
   /// part before the '/' of a mesh file's part ("patient/torso" belongs to "patient").
@@ -208,6 +211,12 @@ struct Scene {
   std::map<std::string, ViewingStation> stations;  ///< Viewing stations, by name.
   /// Moving groups ("motions"), in file order; empty for a static scene.
   std::vector<ObjectMotion> motions;
+  /// Objects that play a skinned animation ("animation" on a mesh object), in object order; empty
+  /// when none. Their meshes in `objects` are the rest pose (analysis/skinning.h).
+  std::vector<SkinnedObject> skins;
+
+  /// True when the scene changes over time: moving groups or skinned animations.
+  bool Animated() const { return !motions.empty() || !skins.empty(); }
 
   /// The study's time samples: each motion's pose at each sample (analysis/motion.h). Empty for a
   /// static scene. Consistent by construction: LoadScene refuses motions the time axis cannot
@@ -238,9 +247,9 @@ struct Scene {
   const Rig& FindRig(const std::string& name) const;
 };
 
-/// The scene at one time sample: every moving group's objects transformed by its pose (their
-/// meshes, hence AllTriangles(), ContentBounds() and solids, follow); no motions left (a static
-/// scene). Rigs, study, views and stations are those of `scene`.
+/// The scene at one time sample: every skinned object in its pose at the sample
+/// (ObjectVerticesAt), every moving group's objects transformed by its pose (their meshes, hence
+/// AllTriangles(), ContentBounds() and solids, follow); no motions or skins left (a static scene). Rigs, study, views and stations are those of `scene`.
 Scene SceneAtSample(const Scene& scene, const TimeSample& sample);
 
 /// Options for LoadScene.

@@ -13,9 +13,12 @@
 
 namespace pandora {
 void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std::vector<Vec3>* points,
-                   std::vector<Vec3>* normals) {
+                   std::vector<Vec3>* normals, std::vector<int>* triangles,
+                   std::vector<Eigen::Vector2d>* barycentric) {
   points->clear();
   normals->clear();
+  if (triangles) triangles->clear();
+  if (barycentric) barycentric->clear();
   std::vector<double> cumulative;
   cumulative.reserve(mesh.triangles.size());
   double total = 0;
@@ -35,6 +38,42 @@ void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std:
     const double r1 = std::sqrt(SeededUniform(seed, std::uint64_t(i), 1)), r2 = SeededUniform(seed, std::uint64_t(i), 2);
     points->push_back((1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c);
     normals->push_back((b - a).cross(c - a).normalized());
+    if (triangles) triangles->push_back(int(k));
+    if (barycentric) barycentric->emplace_back(r1 * (1 - r2), r1 * r2);
+  }
+}
+
+SurfacePoints SampleTargetPoints(const TargetSurface& surface, int count, std::uint64_t seed) {
+  SurfacePoints out;
+  SampleSurface(surface.mesh, count, seed, &out.points, &out.normals, &out.triangles, &out.barycentric);
+  return out;
+}
+
+void PlaceTargetPoints(const Scene& scene, const TargetSurface& surface, const SurfacePoints& rest,
+                       const TimeSample& sample, std::vector<Vec3>* points, std::vector<Vec3>* normals) {
+  points->resize(rest.points.size());
+  normals->resize(rest.points.size());
+  if (!surface.skinned) {
+    const Eigen::Isometry3d T = MotionTransform(scene, surface.motion, sample);
+    for (std::size_t i = 0; i < rest.points.size(); ++i) {
+      (*points)[i] = T * rest.points[i];
+      (*normals)[i] = T.linear() * rest.normals[i];
+    }
+    return;
+  }
+  std::vector<Vec3> posed;
+  posed.reserve(surface.mesh.vertices.size());
+  for (int o : surface.objects) {
+    const std::vector<Vec3> v = ObjectVerticesAt(scene, o, sample);
+    posed.insert(posed.end(), v.begin(), v.end());
+  }
+  for (std::size_t i = 0; i < rest.points.size(); ++i) {
+    const Eigen::Vector3i& t = surface.mesh.triangles[rest.triangles[i]];
+    const Vec3 &a = posed[t[0]], &b = posed[t[1]], &c = posed[t[2]];
+    const Eigen::Vector2d& w = rest.barycentric[i];
+    (*points)[i] = (1 - w[0] - w[1]) * a + w[0] * b + w[1] * c;
+    const Vec3 n = (b - a).cross(c - a);
+    (*normals)[i] = n.norm() > 0 ? Vec3(n.normalized()) : rest.normals[i];
   }
 }
 
@@ -47,6 +86,8 @@ TargetSurface FindTargetSurface(const Scene& scene, const std::string& name) {
         for (int member : scene.motions[k].objects)
           if (member == int(o)) t.motion = int(k);
     t.mesh.Append(scene.objects[o].mesh);
+    t.objects.push_back(int(o));
+    t.skinned |= scene.objects[o].skin >= 0;
   }
   return t;
 }
@@ -64,7 +105,7 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
   std::vector<std::unique_ptr<RayCaster>> casters;
   std::vector<std::unique_ptr<VisibilityTester>> testers;
   for (const TimeSample& s : samples) {
-    casters.push_back(parts.At(PartTransforms(scene, s)));
+    casters.push_back(CasterAtSample(parts, scene, s));
     testers.push_back(std::make_unique<VisibilityTester>(rig.cameras, *casters.back(), scene.ContentBounds().diagonal()));
   }
   for (std::size_t g = 0; g < spec.names.size(); ++g) {
@@ -73,8 +114,9 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     const auto t0 = std::chrono::steady_clock::now();
     SurfaceTargetResult r;
     r.name = name;
-    std::vector<Vec3> points, normals;
-    SampleSurface(surface.mesh, spec.points, spec.seed + g, &points, &normals);
+    const SurfacePoints rest = SampleTargetPoints(surface, spec.points, spec.seed + g);
+    const std::vector<Vec3>& points = rest.points;
+    std::vector<Vec3> placed, placed_normals;
     r.points = int(points.size());
     r.samples = int(samples.size());
     r.cameras.assign(std::size_t(r.samples) * r.points, 0);
@@ -83,11 +125,11 @@ std::vector<SurfaceTargetResult> EvaluateSurfaceTargets(const Scene& scene, cons
     std::vector<std::int64_t> pixel_pairs(pixel_count, 0);
     std::vector<std::uint16_t> pixel_cameras(pixel_count * points.size());
     for (std::size_t s = 0; s < samples.size(); ++s) {
-      const Eigen::Isometry3d T = MotionTransform(scene, surface.motion, samples[s]);
+      PlaceTargetPoints(scene, surface, rest, samples[s], &placed, &placed_normals);
       std::vector<std::vector<std::uint8_t>> sees(rig.cameras.size(), std::vector<std::uint8_t>(points.size(), 0));
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 64), [&](const auto& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const Vec3 X = T * points[i], n = T.linear() * normals[i];
+          const Vec3 &X = placed[i], &n = placed_normals[i];
           int count = 0;
           for (std::size_t p = 0; p < pixel_count; ++p) pixel_cameras[p * points.size() + i] = 0;
           for (std::size_t c = 0; c < rig.cameras.size(); ++c) {

@@ -45,12 +45,31 @@ struct SurfaceTargetResult {
 struct TargetSurface {
   TriangleMesh mesh;
   int motion = -1;
+  std::vector<int> objects;  ///< The objects whose meshes `mesh` appends, in order.
+  /// Some of them play a skinned animation: their points follow the skin (PlaceTargetPoints).
+  bool skinned = false;
 };
 TargetSurface FindTargetSurface(const Scene& scene, const std::string& name);
 
-/// Points uniform by area on `mesh` (seeded, reproducible), with their triangles' unit normals.
+/// Points uniform by area on `mesh` (seeded, reproducible), with their triangles' unit normals; when
+/// asked, each point's triangle and its barycentric weights of the triangle's 2nd and 3rd corners.
 void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed, std::vector<Vec3>* points,
-                   std::vector<Vec3>* normals);
+                   std::vector<Vec3>* normals, std::vector<int>* triangles = nullptr,
+                   std::vector<Eigen::Vector2d>* barycentric = nullptr);
+
+/// A target's points as placed (SampleSurface on TargetSurface::mesh).
+struct SurfacePoints {
+  std::vector<Vec3> points, normals;
+  std::vector<int> triangles;
+  std::vector<Eigen::Vector2d> barycentric;
+};
+SurfacePoints SampleTargetPoints(const TargetSurface& surface, int count, std::uint64_t seed);
+
+/// The points and their unit normals at `sample`: moved rigidly by the surface's motion, or, on a
+/// surface with skinned objects, at the same barycentric coordinates of their triangles in the
+/// sample's pose (ObjectVerticesAt), the normal that of the posed triangle.
+void PlaceTargetPoints(const Scene& scene, const TargetSurface& surface, const SurfacePoints& rest,
+                       const TimeSample& sample, std::vector<Vec3>* points, std::vector<Vec3>* normals);
 
 /// Evaluates every target of scene.study.targets for the enabled cameras of `rig` at `samples`
 /// (Scene::TimeSamples(); an empty list: the scene as placed, one sample). `parts` is

@@ -102,7 +102,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   std::optional<TimeSummary> time;
   std::vector<SurfaceTargetResult> targets;
   std::vector<std::string> sample_labels;
-  if (!scene.motions.empty() || scene.study.targets) {
+  if (scene.Animated() || scene.study.targets) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto parts = MakeSceneParts(scene);
     const double parts_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

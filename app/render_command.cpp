@@ -87,7 +87,7 @@ int RunRender(const RenderArgs& args) {
     const Scene& placed = study->scene();
     const std::vector<TimeSample> samples = placed.TimeSamples();
     if (samples.empty())
-      throw InputError("--time-sample", "", "the scene has no moving objects", "add \"motions\" (docs/time.md)");
+      throw InputError("--time-sample", "", "the scene has no moving objects", "add \"motions\" or an \"animation\" (docs/time.md)");
     int pick = -1;
     for (std::size_t i = 0; i < samples.size(); ++i)
       if (samples[i].label == args.time_sample || samples[i].label == "pose '" + args.time_sample + "'" ||

@@ -62,7 +62,7 @@ int RunSuggest(const SuggestArgs& args) {
     targets = SampleTimeTargets(scene, samples, args.points, args.seed);
     parts = MakeSceneParts(scene);
     for (const TimeSample& s : samples) {
-      sample_casters.push_back(parts->At(PartTransforms(scene, s)));
+      sample_casters.push_back(CasterAtSample(*parts, scene, s));  // skinned parts posed too
       options.sample_casters.push_back(sample_casters.back().get());
     }
   } else {

@@ -1029,14 +1029,14 @@ std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector
   const std::vector<std::string>& names = scene.study.targets->names;
   for (std::size_t g = 0; g < names.size(); ++g) {
     const TargetSurface surface = FindTargetSurface(scene, names[g]);
+    const SurfacePoints rest = SampleTargetPoints(surface, points, seed + g);
     std::vector<Vec3> p, n;
-    SampleSurface(surface.mesh, points, seed + g, &p, &n);
     for (std::size_t s = 0; s < samples.size(); ++s) {
-      const Eigen::Isometry3d T = MotionTransform(scene, surface.motion, samples[s]);
+      PlaceTargetPoints(scene, surface, rest, samples[s], &p, &n);  // rigid motion, or the skin
       for (std::size_t i = 0; i < p.size(); ++i) {
         TargetPoint t;
-        t.p = T * p[i];
-        t.normal = Vec3(T.linear() * n[i]);
+        t.p = p[i];
+        t.normal = n[i];
         t.sample = int(s);
         out.push_back(t);
       }

@@ -33,7 +33,7 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
   for (std::size_t s = 0; s < samples.size(); ++s) {
     const auto t0 = Clock::now();
     const Scene at = SceneAtSample(scene, samples[s]);
-    const auto caster = parts.At(PartTransforms(scene, samples[s]));
+    const auto caster = CasterAtSample(parts, scene, samples[s]);
     if (progress)
       options.progress = [&, s](double f) { progress((double(s) + f) / double(samples.size())); };
     const Fields f = EvaluateFields(at, rig, *caster, options);

@@ -257,7 +257,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster, const R
   std::unique_ptr<RigidPartsRayCaster> parts;
   std::vector<TimeSample> samples;
   std::vector<std::string> sample_labels;
-  if (!scene.motions.empty() || scene.study.targets) {
+  if (scene.Animated() || scene.study.targets) {
     parts = MakeSceneParts(scene);
     samples = scene.TimeSamples();
     for (const TimeSample& s : samples) sample_labels.push_back(s.label);
