@@ -981,6 +981,30 @@ auto ReadCheckedFile(const std::string& path, unsigned steps, Use&& use) {
   }
 }
 
+// Appends a triangle face of an assimp mesh to `out` (vertex v becomes index(v)) with its corner
+// texture coordinates (earlier triangles of the part without any get zeros); skips points and lines.
+template <class Index>
+void AppendTriangle(const aiMesh& mesh, const aiFace& face, const std::string& path, Index index,
+                    TriangleMesh* out) {
+  if (face.mNumIndices != 3) return;  // Points and lines, if any are left.
+  if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices)
+    throw InputError(path, "",
+                     "cannot read mesh file: corrupt mesh data: a triangle refers "
+                     "to a vertex past the end of its mesh");
+  out->triangles.emplace_back(index(face.mIndices[0]), index(face.mIndices[1]), index(face.mIndices[2]));
+  if (mesh.mTextureCoords[0] != nullptr) {
+    out->corner_uvs.resize(out->triangles.size() - 1);
+    std::array<Eigen::Vector2d, 3> uv;
+    for (int k = 0; k < 3; ++k) {
+      const aiVector3D& t = mesh.mTextureCoords[0][face.mIndices[k]];
+      uv[k] = std::isfinite(t.x) && std::isfinite(t.y) ? Eigen::Vector2d(t.x, t.y) : Eigen::Vector2d::Zero();
+    }
+    out->corner_uvs.push_back(uv);
+  } else if (!out->corner_uvs.empty()) {
+    out->corner_uvs.resize(out->triangles.size());
+  }
+}
+
 }  // namespace
 
 std::vector<MeshPart> LoadMeshFile(const std::string& path) {
@@ -1007,30 +1031,8 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path) {
       }
       out.vertices.emplace_back(p.x, p.y, p.z);
     }
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;  // Points and lines, if any are left.
-      if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices) {
-        throw InputError(path, "",
-                         "cannot read mesh file: corrupt mesh data: a triangle refers "
-                         "to a vertex past the end of its mesh");
-      }
-      out.triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]),
-                                 offset + static_cast<int>(face.mIndices[1]),
-                                 offset + static_cast<int>(face.mIndices[2]));
-      if (mesh.mTextureCoords[0] != nullptr) {
-        // Texture coordinates per corner; earlier triangles of this part without any get zeros.
-        out.corner_uvs.resize(out.triangles.size() - 1);
-        std::array<Eigen::Vector2d, 3> uv;
-        for (int k = 0; k < 3; ++k) {
-          const aiVector3D& t = mesh.mTextureCoords[0][face.mIndices[k]];
-          uv[k] = std::isfinite(t.x) && std::isfinite(t.y) ? Eigen::Vector2d(t.x, t.y) : Eigen::Vector2d::Zero();
-        }
-        out.corner_uvs.push_back(uv);
-      } else if (!out.corner_uvs.empty()) {
-        out.corner_uvs.resize(out.triangles.size());
-      }
-    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f)
+      AppendTriangle(mesh, mesh.mFaces[f], path, [offset](unsigned v) { return offset + static_cast<int>(v); }, &out);
   }
 
   std::vector<MeshPart> result;
@@ -1250,24 +1252,8 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
           remap[v] = it->second;
         }
         TriangleMesh& out = p.part.mesh;
-        for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-          const aiFace& face = mesh.mFaces[f];
-          if (face.mNumIndices != 3) continue;
-          if (std::max({face.mIndices[0], face.mIndices[1], face.mIndices[2]}) >= mesh.mNumVertices)
-            throw InputError(path, "", "cannot read mesh file: corrupt mesh data: a triangle refers to a vertex past the end of its mesh");
-          out.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]);
-          if (mesh.mTextureCoords[0] != nullptr) {
-            out.corner_uvs.resize(out.triangles.size() - 1);
-            std::array<Eigen::Vector2d, 3> uv;
-            for (int k = 0; k < 3; ++k) {
-              const aiVector3D& t = mesh.mTextureCoords[0][face.mIndices[k]];
-              uv[k] = std::isfinite(t.x) && std::isfinite(t.y) ? Eigen::Vector2d(t.x, t.y) : Eigen::Vector2d::Zero();
-            }
-            out.corner_uvs.push_back(uv);
-          } else if (!out.corner_uvs.empty()) {
-            out.corner_uvs.resize(out.triangles.size());
-          }
-        }
+        for (unsigned f = 0; f < mesh.mNumFaces; ++f)
+          AppendTriangle(mesh, mesh.mFaces[f], path, [&remap](unsigned v) { return remap[v]; }, &out);
       }
     }
 
