@@ -770,6 +770,9 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
     const Camera& cam = rig.cameras[idx];
     if (!seen.insert(idx).second)
       throw InputError(file, "--cameras", "camera '" + cam.id + "' is selected twice");
+    if (cam.ptz)  // its file pose is its home, not its current setting (docs/ptz.md)
+      throw InputError(file, "--cameras", "camera '" + cam.id + "' is a PTZ camera",
+                       "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its \"ptz\" block");
     if (!cam.enabled)
       throw InputError(file, "--cameras", "camera '" + cam.id + "' is disabled",
                        "enable it in the scene file to move it");

@@ -2,7 +2,8 @@
 # PTZ traces on the command line (docs/ptz.md): examples/ptz_home renders in the three modes; the
 # path mode lights one camera per second; --ptz all with a budget of 0.01 s lights
 # what the home setting sees, so it differs from the current setting's picture; a bad mode and a rig
-# without a PTZ camera are one-line errors with exit code 2.
+# without a PTZ camera are one-line errors with exit code 2, and so is selecting a PTZ camera in
+# suggest (its file pose is its home, not its current setting).
 # Usage: check_ptz.sh PANDORA SCENE WORK_DIR
 set -u
 pandora=$1; scene=$2; work=$3
@@ -26,4 +27,6 @@ bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad2" 'no enabled PTZ c
 jq '.rigs[0].cameras[0].ptz.pan_deg = 400' "$scene" >"$work/badpan.json"
 bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad3" '$.rigs[0].cameras[0].ptz.pan_deg' -- \
   render "$work/badpan.json" --rig home --view overview --out "$work/bad3/x.png" >/dev/null || fail "bad pan"
+bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/bad4" "is a PTZ camera" -- \
+  suggest "$scene" --rig home --cameras dome --out "$work/bad4/s.json" >/dev/null || fail "suggest took a PTZ camera"
 echo "ok"
