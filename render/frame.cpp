@@ -692,11 +692,10 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       if (reach) {
         // The first whole second (0 = from home) from which a reachable setting sees X.
         const double budget = m.reach_budget[c];
-        if (!reach->Reachable(X, budget, &s[i].n)) continue;
         const int seconds = std::max(1, static_cast<int>(std::ceil(budget - 1e-9)));
         int k = 0;
-        while (k < seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n)) ++k;
-        reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg);
+        while (k <= seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg)) ++k;
+        if (k > seconds) continue;  // not reachable within the budget
         const double tol = m.tester.Tolerance(c, seg.t_far);
         seg.t_near = tol;
         seg.t_far = std::max(tol, seg.t_far - tol);
