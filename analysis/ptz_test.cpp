@@ -10,6 +10,8 @@
 #include <random>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/camera.h"
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
@@ -91,6 +93,50 @@ TEST(Ptz, ReachTimeEqualsTheClosedFormWhereOneAxisDecides) {
     const double expected = std::max(0.0, (std::abs(el) - half_v) / 20.0);
     EXPECT_NEAR(reach.ReachTime(X, nullptr, 1e-7), expected, 1e-5) << el;
   }
+}
+
+// A rig written back (viewer save, autosave, output metadata) keeps the head: the file pose is home
+// at the pivot, the ptz block holds the current setting, and it reads back to the same camera.
+TEST(Ptz, RigToJsonKeepsTheHeadAndReadsBack) {
+  const Scene scene = PtzScene(R"("pan_deg": 63, "tilt_deg": -12, "zoom_hfov_deg": [60, 5], "home_hfov_deg": 30,
+      "pan_range_deg": [-170, 170], "tilt_range_deg": [-80, 20], "pan_speed_deg_s": 45, "tilt_speed_deg_s": 30,
+      "zoom_speed_pct_s": 35, "offset_m": [0.01, -0.02, 0.08], "trace_s": 4,
+      "presets": [{"name": "door", "pan_deg": 40, "tilt_deg": -5, "hfov_deg": 20}, {"name": "win", "pan_deg": -90}],
+      "tour": [{"preset": "door", "dwell_s": 5}, {"preset": "win", "dwell_s": 2}])",
+                               R"(, "up": [0, 0, 1])");
+  const nlohmann::json written = RigToJson(scene.rigs[0]);
+  const Rig again = ParseRigJson(written, "again.json", "$.rig");
+  const Camera& a = scene.rigs[0].cameras[0];
+  const Camera& b = again.cameras[0];
+  ASSERT_TRUE(b.ptz);
+  const PtzHead& h = *a.ptz;
+  const PtzHead& g = *b.ptz;
+  EXPECT_LE((a.world_from_camera.matrix() - b.world_from_camera.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LE((h.home.matrix() - g.home.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(a.model.intrinsics().fx, b.model.intrinsics().fx, 1e-9);
+  EXPECT_LE((h.pan_axis - g.pan_axis).norm(), 1e-15);
+  EXPECT_LE((h.offset - g.offset).norm(), 1e-15);
+  for (auto [x, y] : {std::pair{h.pan_min_deg, g.pan_min_deg}, {h.pan_max_deg, g.pan_max_deg},
+                      {h.tilt_min_deg, g.tilt_min_deg}, {h.tilt_max_deg, g.tilt_max_deg},
+                      {h.pan_speed_deg_s, g.pan_speed_deg_s}, {h.tilt_speed_deg_s, g.tilt_speed_deg_s},
+                      {h.zoom_speed, g.zoom_speed}, {h.trace_s, g.trace_s}, {h.current.pan_deg, g.current.pan_deg},
+                      {h.current.tilt_deg, g.current.tilt_deg}})
+    EXPECT_NEAR(x, y, 1e-12);
+  for (auto [x, y] : {std::pair{h.focal_min, g.focal_min}, {h.focal_max, g.focal_max},
+                      {h.home_focal, g.home_focal}, {h.current.focal, g.current.focal}})
+    EXPECT_NEAR(x, y, 1e-9 * x);
+  ASSERT_EQ(g.presets.size(), 2u);
+  EXPECT_EQ(g.presets[1].name, "win");
+  EXPECT_NEAR(g.presets[0].state.focal, h.presets[0].state.focal, 1e-9 * h.presets[0].state.focal);
+  EXPECT_NEAR(g.presets[1].state.pan_deg, -90, 1e-12);
+  ASSERT_EQ(g.tour.size(), 2u);
+  EXPECT_EQ(g.tour[1].preset, 1);
+  EXPECT_EQ(g.tour[0].dwell_s, 5);
+  // A fixed-focal head (no zoom range) reads back too.
+  const Scene fixed = PtzScene(R"("pan_deg": -20, "presets": [{"name": "a", "pan_deg": 10}])");
+  const Rig fixed_again = ParseRigJson(RigToJson(fixed.rigs[0]), "again.json", "$.rig");
+  EXPECT_NEAR(fixed_again.cameras[0].ptz->current.pan_deg, -20, 1e-12);
+  EXPECT_EQ(fixed_again.cameras[0].ptz->focal_min, fixed_again.cameras[0].ptz->focal_max);
 }
 
 // Everywhere: the reach time equals a brute-force sweep of the reachable settings (every pose on a

@@ -714,7 +714,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     std::optional<SkinnedObject> skin;
     if (animation) skin = ReadAnimation(*animation);
     if (!context.options.load_meshes) {
-      scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid});
+      scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid, {}, -1});
       if (skin) {  // no skeleton: the object stays as placed
         skin->object = int(scene->objects.size()) - 1;
         scene->objects.back().skin = int(scene->skins.size());
@@ -794,7 +794,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     }
     mesh = MakePlane(size * unit);
   }
-  scene->objects.push_back({name, kind, Transformed(mesh, world_from_object), material, solid});
+  scene->objects.push_back({name, kind, Transformed(mesh, world_from_object), material, solid, {}, -1});
   CheckObjectBounds(scene->objects.back().mesh, node);
   // Primitives are closed by construction; the check guards against degenerate transforms.
   if (solid) {
@@ -1868,6 +1868,41 @@ json RigToJson(const Rig& rig) {
     if (std::isfinite(camera.far)) range["far"] = camera.far;
     c["range"] = range;
     if (camera.pixel_sigma > 0) c["pixel_sigma"] = camera.pixel_sigma;
+    if (camera.ptz) {
+      // The file pose of a PTZ camera is its home at the pivot; the lens is the current zoom.
+      const PtzHead& h = *camera.ptz;
+      const Eigen::Quaterniond qh(h.home.rotation());
+      const Vec3 pivot = h.home.translation();
+      c["position"] = {pivot.x(), pivot.y(), pivot.z()};
+      c["quaternion"] = {qh.w(), qh.x(), qh.y(), qh.z()};
+      const auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) / kDegree; };
+      json ptz = {{"pan_deg", h.current.pan_deg},
+                  {"tilt_deg", h.current.tilt_deg},
+                  {"pan_axis", {h.pan_axis.x(), h.pan_axis.y(), h.pan_axis.z()}},
+                  {"pan_range_deg", {h.pan_min_deg, h.pan_max_deg}},
+                  {"tilt_range_deg", {h.tilt_min_deg, h.tilt_max_deg}},
+                  {"pan_speed_deg_s", h.pan_speed_deg_s},
+                  {"tilt_speed_deg_s", h.tilt_speed_deg_s},
+                  {"zoom_speed_pct_s", h.zoom_speed * 100.0},
+                  {"offset_m", {h.offset.x(), h.offset.y(), h.offset.z()}},
+                  {"trace_s", h.trace_s}};
+      if (h.focal_max > h.focal_min) {
+        ptz["zoom_hfov_deg"] = {hfov(h.focal_min), hfov(h.focal_max)};
+        ptz["home_hfov_deg"] = hfov(h.home_focal);
+      }
+      json presets = json::array();
+      for (const PtzPreset& p : h.presets)
+        presets.push_back({{"name", p.name},
+                           {"pan_deg", p.state.pan_deg},
+                           {"tilt_deg", p.state.tilt_deg},
+                           {"hfov_deg", hfov(p.state.focal)}});
+      if (!h.presets.empty()) ptz["presets"] = std::move(presets);
+      json tour = json::array();
+      for (const PtzTourStop& s : h.tour)
+        tour.push_back({{"preset", h.presets[s.preset].name}, {"dwell_s", s.dwell_s}});
+      if (!h.tour.empty()) ptz["tour"] = std::move(tour);
+      c["ptz"] = std::move(ptz);
+    }
     cameras.push_back(std::move(c));
   }
   return json{{"name", rig.name}, {"cameras", std::move(cameras)}};
