@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "analysis/camera.h"
+#include "analysis/visibility.h"  // PixelDensity
 
 namespace pandora {
 namespace {
@@ -92,8 +93,94 @@ std::vector<PtzState> PtzHead::Path(const PtzState& a, const PtzState& b) const 
   return out;
 }
 
-PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from)
-    : base_(base), head_(head), from_(from) {
+std::vector<PtzHead::TourLeg> PtzHead::TourLegs(const std::vector<int>& order) const {
+  std::vector<int> stops = order;
+  if (stops.empty())
+    for (int i = 0; i < static_cast<int>(tour.size()); ++i) stops.push_back(i);
+  std::vector<TourLeg> legs;
+  double t = 0;
+  for (std::size_t i = 0; i < stops.size(); ++i) {
+    TourLeg leg;
+    leg.stop = stops[i];
+    leg.from = presets[tour[stops[(i + stops.size() - 1) % stops.size()]].preset].state;
+    leg.to = presets[tour[stops[i]].preset].state;
+    leg.start = t;
+    leg.move_s = MoveTime(leg.from, leg.to);
+    leg.dwell_s = tour[stops[i]].dwell_s;
+    t = leg.end();
+    legs.push_back(leg);
+  }
+  return legs;
+}
+
+PtzState PtzHead::TourState(const std::vector<TourLeg>& legs, double t) const {
+  if (legs.empty()) return current;
+  const double period = legs.back().end();
+  if (period > 0) {
+    t = std::fmod(t, period);
+    if (t < 0) t += period;
+  }
+  for (const TourLeg& leg : legs)
+    if (t < leg.end()) return Along(leg.from, leg.to, t - leg.start);
+  return legs.back().to;
+}
+
+double PtzHead::SampleStep(const Camera& base, const PtzState& a, const PtzState& b) const {
+  const Intrinsics k = base.model.intrinsics();
+  // The narrowest zoom along the move is at one of its ends (the focal moves monotonically).
+  const double f = std::max({a.focal, b.focal, 1e-12});
+  const double hfov = Deg(HfovFromFocal(f, k.width, k.model));
+  const double vfov = Deg(2.0 * std::atan(0.5 * k.height / (f * k.fy / k.fx)));  // pinhole's (a step, not a bound)
+  const double angle = 0.25 * std::min(hfov, vfov);
+  return angle / std::max(pan_speed_deg_s, tilt_speed_deg_s);
+}
+
+double PtzWatch::watched_s() const {
+  double sum = 0;
+  for (const auto& [a, b] : intervals) sum += b - a;
+  return sum;
+}
+
+double PtzWatch::longest_gap_s() const {
+  if (intervals.empty()) return period;
+  double gap = 0;
+  for (std::size_t i = 1; i < intervals.size(); ++i)
+    gap = std::max(gap, intervals[i].first - intervals[i - 1].second);
+  // Around the end of the period into the next.
+  gap = std::max(gap, period - intervals.back().second + intervals.front().first);
+  return std::max(gap, 0.0);
+}
+
+bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const Vec3& X, double min_px_per_m,
+             const Vec3* normal, Ray* segment, double epsilon) {
+  const Eigen::Isometry3d pose = head.Pose(s);
+  const Vec3 to_point = X - pose.translation();
+  const double distance = to_point.norm();
+  if (!(distance >= base.near) || distance > base.far) return false;
+  const Vec3 p_camera = pose.linear().transpose() * to_point;
+  const Intrinsics& k = base.model.intrinsics();
+  const double scale = s.focal / k.fx;
+  Mat23 J;
+  std::optional<Vec2> pixel = base.model.Project(p_camera, min_px_per_m > 0 ? &J : nullptr);
+  if (!pixel) return false;
+  // The zoom scales the pixels about the principal point (the lens's domain is unchanged), and
+  // with them the pixel density.
+  const Vec2 pp(k.cx, k.cy);
+  *pixel = pp + scale * (*pixel - pp);
+  if (!base.model.InImage(*pixel)) return false;
+  if (normal && normal->dot(-to_point) <= 0.0) return false;
+  if (min_px_per_m > 0 && !(scale * PixelDensity(J) >= min_px_per_m)) return false;
+  if (segment) {
+    segment->origin = pose.translation();
+    segment->direction = to_point / distance;
+    segment->t_near = epsilon;
+    segment->t_far = std::max(epsilon, distance - epsilon);
+  }
+  return true;
+}
+
+PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from, double min_px_per_m)
+    : base_(base), head_(head), from_(from), min_px_per_m_(min_px_per_m) {
   const double pan_span = head.ContinuousPan()
                               ? 180.0
                               : std::max(head.pan_max_deg - from.pan_deg, from.pan_deg - head.pan_min_deg);
@@ -101,6 +188,8 @@ PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from
   const double zoom_rate = head.zoom_speed * (head.focal_max - head.focal_min);
   max_time_ = std::max(pan_span / head.pan_speed_deg_s, tilt_span / head.tilt_speed_deg_s);
   if (zoom_rate > 0) max_time_ = std::max(max_time_, (from.focal - head.focal_min) / zoom_rate);
+  // With a density target the head may have to zoom in as far as it goes.
+  if (zoom_rate > 0 && min_px_per_m > 0) max_time_ = std::max(max_time_, (head.focal_max - from.focal) / zoom_rate);
   max_time_ = std::max(max_time_, 0.0);
 }
 
@@ -152,33 +241,27 @@ std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
     s.pan_deg = h.WrapPan(pan);
     s.tilt_deg = std::clamp(el - el0, tilt_lo, tilt_hi);
   }
+  if (min_px_per_m_ > 0) {
+    // The density scales with the focal length: the zoom that meets the target exactly at this
+    // pose, then the widest reachable one at or above it.
+    const Eigen::Isometry3d pose = h.Pose(s);
+    Mat23 J;
+    if (!base_.model.Project(pose.linear().transpose() * (X - pose.translation()), &J)) return std::nullopt;
+    const double density = PixelDensity(J);  // at the camera's own focal
+    if (!(density > 0)) return std::nullopt;
+    const double needed = base_.model.intrinsics().fx * min_px_per_m_ / density;
+    const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, from_.focal + zoom_rate * t) : from_.focal;
+    s.focal = std::max(s.focal, needed);
+    if (s.focal > f_hi) return std::nullopt;
+  }
   return s;
 }
 
 bool PtzReach::Reachable(const Vec3& X, double t, const Vec3* normal, Ray* segment, double epsilon) const {
   const std::optional<PtzState> s = BestPose(X, t);
   if (!s) return false;
-  const Eigen::Isometry3d pose = head_.Pose(*s);
-  const Vec3 to_point = X - pose.translation();
-  const double distance = to_point.norm();
-  if (distance < base_.near || distance > base_.far) return false;
-  const Vec3 p_camera = pose.linear().transpose() * to_point;
-  Intrinsics k = base_.model.intrinsics();
-  const double scale = s->focal / k.fx;
-  std::optional<Vec2> pixel = base_.model.Project(p_camera);
-  if (!pixel) return false;
-  // The zoom scales the pixels about the principal point (the lens's domain is unchanged).
-  const Vec2 pp(k.cx, k.cy);
-  *pixel = pp + scale * (*pixel - pp);
-  if (!base_.model.InImage(*pixel)) return false;
-  if (normal && normal->dot(-to_point) <= 0.0) return false;
-  if (segment) {
-    segment->origin = pose.translation();
-    segment->direction = to_point / distance;
-    segment->t_near = epsilon;
-    segment->t_far = std::max(epsilon, distance - epsilon);
-  }
-  return true;
+  // The density was met when BestPose chose the zoom (up to rounding: not tested twice).
+  return PtzSees(base_, head_, *s, X, 0.0, normal, segment, epsilon);
 }
 
 double PtzReach::ReachTime(const Vec3& X, const Vec3* normal, double tolerance_s) const {

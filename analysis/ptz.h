@@ -82,7 +82,50 @@ struct PtzHead {
   /// The paper's "path": the settings from `a` to `b` one per second (a at 0 s, then 1 s, 2 s, ...)
   /// and b itself last (at MoveTime(a, b)); just {a} when a == b.
   std::vector<PtzState> Path(const PtzState& a, const PtzState& b) const;
+
+  /// One leg of a tour: the move from the previous stop's preset to this stop's, then the dwell.
+  struct TourLeg {
+    double start = 0;   ///< Seconds into the period when the move begins.
+    double move_s = 0;  ///< MoveTime(from, to).
+    double dwell_s = 0;
+    PtzState from, to;
+    int stop = 0;  ///< Index into `tour`.
+    double end() const { return start + move_s + dwell_s; }
+  };
+  /// The tour's legs in `order` (indices into `tour`, each once; empty: the file's order): time 0
+  /// is when the move into the first stop begins (from the last stop's preset), so the period is
+  /// the sum of every move and dwell. Empty without a tour.
+  std::vector<TourLeg> TourLegs(const std::vector<int>& order = {}) const;
+  /// The setting `t` seconds into the tour of `legs` (t taken modulo the period).
+  PtzState TourState(const std::vector<TourLeg>& legs, double t) const;
+  /// A step (seconds) for sampling a move from `a` to `b` so that the view turns by at most a
+  /// quarter of the narrower field of view along it (the narrowest zoom the move passes through).
+  double SampleStep(const Camera& base, const PtzState& a, const PtzState& b) const;
 };
+
+/// Whether `base` at setting `s` of `head` sees X geometrically: inside the image (lens and
+/// distortion), within range, facing `normal` when given, and at a pixel density of at least
+/// `min_px_per_m` (0: any). Occlusion is not tested: on success `segment` (when given) receives the
+/// segment from the setting's centre to X, `epsilon` short of both ends.
+bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const Vec3& X, double min_px_per_m = 0,
+             const Vec3* normal = nullptr, Ray* segment = nullptr, double epsilon = 0);
+
+/// The intervals of a tour's period during which a point is watched: `sees` (a setting -> bool
+/// test, e.g. PtzSees plus occlusion) is evaluated once per dwell and along each move every
+/// PtzHead::SampleStep, each change refined by bisection to `tolerance_s`. Exact up to
+/// `tolerance_s` per change, except that a visibility shorter than the step inside a move may be
+/// missed (docs/ptz.md measures it).
+struct PtzWatch {
+  double period = 0;
+  std::vector<std::pair<double, double>> intervals;  ///< Sorted, disjoint, within [0, period].
+  double watched_s() const;
+  /// The longest stretch without watching, the tour repeating (period when never watched, 0 when
+  /// always).
+  double longest_gap_s() const;
+};
+template <typename Sees>
+PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<PtzHead::TourLeg>& legs,
+                   Sees&& sees, double tolerance_s = 1e-3);
 
 /// The sweep of the traces: what a PTZ camera can see from `from` within a time budget. With a
 /// zero offset the answer for a point depends only on its direction from the pivot, and the pose
@@ -92,11 +135,14 @@ struct PtzHead {
 /// pose), which is exact to O(offset / distance)^2.
 class PtzReach {
  public:
-  /// `base` is the camera (its lens, range and current state); `head` its mechanics.
-  PtzReach(const Camera& base, const PtzHead& head, const PtzState& from);
+  /// `base` is the camera (its lens, range and current state); `head` its mechanics. With
+  /// `min_px_per_m` > 0 a point counts as seen only at a pixel density of at least that: the zoom
+  /// is the widest reachable one that meets it there.
+  PtzReach(const Camera& base, const PtzHead& head, const PtzState& from, double min_px_per_m = 0);
 
   /// The best pose for seeing `X` among the settings reachable within `t` seconds from `from`
-  /// (widest reachable zoom); nullopt when X lies behind every such pose.
+  /// (widest reachable zoom, or with a density target the widest reachable one meeting it); nullopt
+  /// when X lies behind every such pose or no reachable zoom meets the density target.
   std::optional<PtzState> BestPose(const Vec3& X, double t) const;
   /// True when some setting reachable within `t` sees X geometrically: inside the image (lens and
   /// distortion), within range, and facing `normal` when given. Occlusion is not tested: the
@@ -114,7 +160,59 @@ class PtzReach {
   const Camera& base_;
   const PtzHead& head_;
   PtzState from_;
+  double min_px_per_m_ = 0;
   double max_time_ = 0;
 };
+
+// ---- implementation of WatchTour ----
+
+template <typename Sees>
+PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<PtzHead::TourLeg>& legs,
+                   Sees&& sees, double tolerance_s) {
+  PtzWatch w;
+  if (legs.empty()) return w;
+  w.period = legs.back().end();
+  auto add = [&w](double a, double b) {
+    if (!(b > a)) return;
+    if (!w.intervals.empty() && a <= w.intervals.back().second + 1e-12)
+      w.intervals.back().second = std::max(w.intervals.back().second, b);
+    else
+      w.intervals.emplace_back(a, b);
+  };
+  for (const PtzHead::TourLeg& leg : legs) {
+    // The move: samples every step, each change bisected.
+    if (leg.move_s > 0) {
+      const double step = std::min(head.SampleStep(base, leg.from, leg.to), leg.move_s);
+      const int n = static_cast<int>(std::ceil(leg.move_s / step - 1e-9));
+      auto at = [&](double t) { return sees(head.Along(leg.from, leg.to, t)); };
+      double t0 = 0;
+      bool s0 = at(0);
+      double open = s0 ? 0.0 : -1.0;
+      for (int i = 1; i <= n; ++i) {
+        const double t1 = i == n ? leg.move_s : i * step;
+        const bool s1 = at(t1);
+        if (s1 != s0) {
+          double lo = t0, hi = t1;  // sees(lo) == s0, sees(hi) == s1
+          while (hi - lo > tolerance_s) {
+            const double mid = 0.5 * (lo + hi);
+            (at(mid) == s0 ? lo : hi) = mid;
+          }
+          const double change = 0.5 * (lo + hi);
+          if (s1) {
+            open = change;
+          } else {
+            add(leg.start + open, leg.start + change);
+            open = -1.0;
+          }
+        }
+        t0 = t1;
+        s0 = s1;
+      }
+      if (open >= 0) add(leg.start + open, leg.start + leg.move_s);
+    }
+    if (leg.dwell_s > 0 && sees(leg.to)) add(leg.start + leg.move_s, leg.end());
+  }
+  return w;
+}
 
 }  // namespace pandora

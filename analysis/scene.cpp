@@ -1240,7 +1240,7 @@ Region ReadRegion(const Node& region, const Node& node) {
 Study ReadStudy(const Node& node) {
   node.CheckKeys({"region", "voxel_size", "fields", "pixel_sigma", "memory_budget_mb", "motion",
                   "max_sigma_mm", "time", "targets",
-                  "calibration", "pixel_targets", "dori", "regions"});
+                  "calibration", "pixel_targets", "dori", "regions", "ptz"});
   Study study;
   study.region = ReadRegion(node.Get("region"), node);
   if (auto n = node.Find("voxel_size")) study.voxel_size = n->PositiveLength();
@@ -1316,6 +1316,40 @@ Study ReadStudy(const Node& node) {
     }
   }
   if (auto n = node.Find("dori")) study.dori = n->Bool();
+  // The PTZ fields' density target and budgets (volume/ptz_fields.h); default: the first pixel target.
+  if (!study.pixel_targets.empty()) {
+    study.ptz.pixel_target = study.pixel_targets[0].name;
+    study.ptz.min_px_per_m = study.pixel_targets[0].px_per_m();
+  }
+  if (auto p = node.Find("ptz")) {
+    p->CheckKeys({"pixel_target", "min_px_per_m", "within_s"});
+    if (p->Has("pixel_target") && p->Has("min_px_per_m"))
+      p->Get("min_px_per_m").Fail("give either pixel_target or min_px_per_m, not both");
+    if (auto n = p->Find("pixel_target")) {
+      const std::string name = n->NonEmptyString();
+      std::vector<std::string> names;
+      for (const PixelTarget& t : study.pixel_targets) names.push_back(t.name);
+      const auto it = std::find(names.begin(), names.end(), name);
+      if (it == names.end()) n->Fail("no pixel target " + Quoted(name), SuggestionHint(name, names, "pixel_targets"));
+      study.ptz.pixel_target = name;
+      study.ptz.min_px_per_m = study.pixel_targets[it - names.begin()].px_per_m();
+    }
+    if (auto n = p->Find("min_px_per_m")) {
+      study.ptz.pixel_target.clear();
+      study.ptz.min_px_per_m = n->NonNegative();
+      if (!(study.ptz.min_px_per_m <= 1e7)) n->Fail("expected at most 1e7 px/m");
+    }
+    if (auto n = p->Find("within_s")) {
+      const size_t count = n->ArraySize("an array of budgets in seconds");
+      if (count == 0 || count > 32) n->Fail("expected 1 to 32 budgets");
+      study.ptz.within_s.clear();
+      for (size_t i = 0; i < count; ++i) {
+        const double t = n->At(i).Positive();
+        if (!(t <= 1e6)) n->At(i).Fail("expected at most 1e6 seconds");
+        study.ptz.within_s.push_back(t);
+      }
+    }
+  }
   if (auto regions = node.Find("regions")) {
     regions->ExpectObject("an object of named regions {\"box\": ...} or {\"mesh\": ...}");
     if (regions->value().size() > 64) regions->Fail("at most 64 named regions");

@@ -101,6 +101,15 @@ struct PixelTarget {
   double px_per_m() const { return min_px / size_m; }
 };
 
+/// The PTZ fields' settings ("study": {"ptz": ...}; volume/ptz_fields.h, docs/ptz.md).
+struct PtzStudy {
+  /// A PTZ camera sees a point only at a zoom meeting this density, px/m (0: any zoom). Default:
+  /// the study's first pixel target.
+  double min_px_per_m = 0;
+  std::string pixel_target;  ///< Its name when it came from a pixel target.
+  std::vector<double> within_s{1, 2, 5, 10};  ///< Budgets for the shares reachable within them.
+};
+
 /// What to compute and where.
 struct Study {
   Region region;
@@ -130,6 +139,7 @@ struct Study {
   /// Surveillance DORI classes (EN 62676-4: detection 25, observation 62.5, recognition 125,
   /// identification 250 px/m of the best camera) as a field and summary ("dori": true).
   bool dori = false;
+  PtzStudy ptz;
   /// Calibration feasibility to simulate ("calibration", docs/calibration.md); none when absent.
   std::optional<CalibrationSpec> calibration;
 };

@@ -149,6 +149,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
     typed.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
     AddCoverageN1Grid(&fields);
   }
+  // PTZ cameras: reach times, reachable shares, tours (docs/ptz.md).
+  if (RigHasPtz(rig)) typed.ptz = EvaluatePtzFields(scene, rig, caster, fields, &fields);
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   std::map<std::string, std::string> meta{

@@ -337,6 +337,7 @@ void to_json(nlohmann::json& j, const Summary& s) {
                  {"threads", s.timing.threads}};
   if (s.calibration) j["calibration"] = *s.calibration;
   if (s.robustness) j["robustness"] = *s.robustness;
+  if (s.ptz) j["ptz"] = *s.ptz;
 }
 
 nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fields,
@@ -426,6 +427,7 @@ std::string FormatSummary(const Summary& s) {
                 static_cast<double>(s.timing.point_camera_tests));
   if (s.calibration) out += FormatCalibration(*s.calibration);
   if (s.robustness) out += FormatCriticality(*s.robustness);
+  if (s.ptz) out += FormatPtzFields(*s.ptz);
   return out;
 }
 

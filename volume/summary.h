@@ -18,6 +18,7 @@
 #include "analysis/surface_targets.h"
 #include "volume/fields.h"
 #include "volume/pixel_targets.h"
+#include "volume/ptz_fields.h"
 #include "volume/robustness.h"
 #include "volume/time_fields.h"
 
@@ -128,6 +129,8 @@ struct Summary {
   /// N-1 robustness (volume/robustness.h) when the "cameras" field was evaluated; the caller sets
   /// it (ComputeCriticality needs the ray caster).
   std::optional<CriticalityTable> robustness;
+  /// The PTZ fields (volume/ptz_fields.h) when the rig has a PTZ camera; the caller sets it.
+  std::optional<PtzFieldsSummary> ptz;
 };
 
 /// Summarises the evaluated `fields` of `rig` in `scene`. `field_names`: the fields that were asked
@@ -147,7 +150,8 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
 /// steady]]}, timing {seconds, active_set_seconds, rays, rays_per_second, point_camera_tests,
 /// tests_per_second, threads}, fields, region {min, max, dims, kind}, scene, scene_sha256,
 /// warnings [{kind, camera, path, message}] (always present, empty when none), calibration
-/// (analysis/calibration.h's to_json) and robustness (volume/robustness.h's to_json) when set. Percentiles without a value are null.
+/// (analysis/calibration.h's to_json), robustness (volume/robustness.h's to_json) and ptz
+/// (volume/ptz_fields.h's to_json) when set. Percentiles without a value are null.
 void to_json(nlohmann::json& j, const Summary& summary);
 
 /// to_json(Summarize(...)): the summary.json of one evaluation.

@@ -1,0 +1,255 @@
+// PTZ fields (issue 13): the reach time at a density target equals the closed form of the zoom
+// (both axes moving, the zoom deciding) on an empty scene and is never where a wall blocks the pivot;
+// tour watch fractions and longest gaps equal a brute-force time loop over the tour (with and
+// without a centre offset, occluders in the room); the field grids and shares are those values per
+// voxel.
+#include "volume/ptz_fields.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "analysis/camera.h"
+#include "analysis/ptz.h"
+#include "analysis/ray_caster.h"
+#include "analysis/scene.h"
+#include "analysis/visibility.h"
+#include "volume/fields.h"
+#include "volume/fields_vdb.h"
+
+namespace pandora {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+double Rad(double d) { return d * kPi / 180.0; }
+
+// A room with optional objects; PTZ "p" at (0, 0, 3) looking along +y at home; `ptz` is the block's body.
+Scene PtzScene(const std::string& ptz, const std::string& objects = "", const std::string& study_extra = "",
+               const std::string& more_cameras = "") {
+  const std::string text = R"({"pandora": 1, "objects": [)" + objects + R"(],
+    "rigs": [{"name": "r", "cameras": [{"id": "p", "position": [0, 0, 3], "look_at": [0, 5, 3],
+      "resolution": [400, 300], "hfov_deg": 60, "ptz": {)" + ptz + "}}" + more_cameras + R"(]}],
+    "study": {"region": {"box": {"min": [-5, -5, 0], "max": [5, 5, 3]}}, "voxel_size": 0.5)" + study_extra + "}}";
+  return ParseScene(text, "ptz.json");
+}
+
+// Both axes move at once; the zoom decides: a point 30 deg off the home azimuth is centred after
+// 0.1 s of pan, but the zoom that gives it the target density on the axis (f = density x distance)
+// takes (f - f0) / zoom rate.
+TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
+  const Scene scene = PtzScene(R"("pan_speed_deg_s": 300, "tilt_speed_deg_s": 200, "zoom_hfov_deg": [60, 5],
+                                   "zoom_speed_pct_s": 20)");
+  const Rig& rig = scene.rigs[0];
+  const auto empty = MakeBruteForceRayCaster(TriangleMesh());
+  const VisibilityTester tester(rig.cameras, *empty, 10.0);
+  const PtzHead& h = *rig.cameras[0].ptz;
+  const double f0 = FocalFromHfov(Rad(60), 400, LensModel::kPinhole);
+  ASSERT_NEAR(h.current.focal, f0, 1e-9);
+  const double rate = 0.2 * (h.focal_max - h.focal_min);
+  for (const auto& [az, d, density] : {std::tuple{30.0, 8.0, 200.0}, {-75.0, 6.0, 300.0}, {140.0, 4.0, 500.0}}) {
+    const Vec3 X = Vec3(0, 0, 3) + d * Vec3(-std::sin(Rad(az)), std::cos(Rad(az)), 0);
+    const double expected = (density * d - f0) / rate;
+    ASSERT_GT(expected, std::abs(az) / 300 + 0.05);  // the zoom decides
+    EXPECT_NEAR(PtzReachTime(tester, 0, X, density, 1e-6), expected, 2e-6) << az;
+  }
+  // Beyond the narrowest zoom: never. Without a target: the pan alone (half the FOV at the widest).
+  const Vec3 X = Vec3(0, 0, 3) + 8.0 * Vec3(-std::sin(Rad(50)), std::cos(Rad(50)), 0);
+  EXPECT_TRUE(std::isinf(PtzReachTime(tester, 0, X, 1.01 * h.focal_max / 8.0)));
+  const Intrinsics k = rig.cameras[0].model.intrinsics();
+  const double half_h = std::atan((k.width - 1 - k.cx + 0.5) / k.fx) * 180 / kPi;
+  EXPECT_NEAR(PtzReachTime(tester, 0, X, 0.0, 1e-6), (50 - half_h) / 300, 2e-6);
+}
+
+// A wall between the pivot and a point: never reached (the pivot is every setting's centre).
+TEST(PtzFields, AWallBlocksTheReachForEverySetting) {
+  const Scene scene = PtzScene(R"("pan_speed_deg_s": 90)",
+                               R"({"name": "wall", "box": {"size": [2, 0.2, 3.5]}, "position": [0, 2.1, 1.75]})");
+  const Rig& rig = scene.rigs[0];
+  const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
+  const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
+  EXPECT_TRUE(std::isinf(PtzReachTime(tester, 0, Vec3(0, 4, 1), 0.0)));
+  EXPECT_TRUE(std::isinf(PtzReachTime(tester, 0, Vec3(-0.5, 6, 2.5), 0.0)));
+  // Beside the wall: as on an empty scene.
+  const auto empty = MakeBruteForceRayCaster(TriangleMesh());
+  const VisibilityTester open(rig.cameras, *empty, scene.ContentBounds().diagonal());
+  for (const Vec3& X : {Vec3(3, 4, 1), Vec3(-2, 1, 0.5), Vec3(1.5, -3, 2)}) {
+    const double t = PtzReachTime(tester, 0, X, 0.0);
+    EXPECT_TRUE(std::isfinite(t));
+    EXPECT_EQ(t, PtzReachTime(open, 0, X, 0.0));
+  }
+}
+
+// Brute force: step through the tour's period every `dt`, the setting from TourState, seen when
+// PtzSees at the density and the segment from its centre is clear.
+struct Brute {
+  double watched = 0, gap = 0;
+  int changes = 0;
+  double short_s = 0;  // total length of the watched runs shorter than `short_run`
+};
+Brute BruteForceTour(const VisibilityTester& tester, const std::vector<PtzHead::TourLeg>& legs, const Vec3& X,
+                     double px, double dt, double short_run) {
+  const Camera& cam = tester.cameras()[0];
+  const PtzHead& h = *cam.ptz;
+  const double period = legs.back().end();
+  const int n = static_cast<int>(std::ceil(period / dt));
+  std::vector<char> seen(n);
+  Brute b;
+  for (int i = 0; i < n; ++i) {
+    const double t = std::min((i + 0.5) * dt, period);
+    Ray r;
+    bool s = PtzSees(cam, h, h.TourState(legs, t), X, px, nullptr, &r);
+    if (s) {
+      const double eps = tester.Tolerance(0, r.t_far);
+      r.t_near = eps;
+      r.t_far -= eps;
+      s = !(r.t_far > r.t_near) || !tester.caster().Occluded(r);
+    }
+    seen[i] = s;
+    if (s) b.watched += std::min(dt, period - i * dt);
+  }
+  // The longest run of unseen samples, around the end of the period.
+  int first_seen = -1;
+  for (int i = 0; i < n; ++i)
+    if (seen[i]) {
+      first_seen = i;
+      break;
+    }
+  if (first_seen < 0) {
+    b.gap = period;
+    return b;
+  }
+  int run = 0, longest = 0, seen_run = 0;
+  for (int k = 1; k <= n; ++k) {
+    const int i = (first_seen + k) % n;
+    if (seen[i] != seen[(i + n - 1) % n]) ++b.changes;
+    if (!seen[i]) {
+      longest = std::max(longest, ++run);
+      if (seen_run > 0 && seen_run * dt < short_run) b.short_s += seen_run * dt;
+      seen_run = 0;
+    } else {
+      run = 0;
+      ++seen_run;
+    }
+  }
+  b.gap = longest * dt;
+  return b;
+}
+
+TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
+  const std::string objects = R"({"name": "pillar", "box": {"size": [0.4, 0.4, 3]}, "position": [1.2, 1.7, 1.5]},
+      {"name": "cabinet", "box": {"size": [0.5, 2, 1.8]}, "position": [-2.75, 0, 0.9]})";
+  int compared = 0, partial = 0;
+  for (const char* offset : {"[0, 0, 0]", "[0.03, -0.05, 0.12]"}) {
+    const Scene scene = PtzScene(std::string(R"("pan_speed_deg_s": 60, "tilt_speed_deg_s": 30, "zoom_hfov_deg": [60, 10],
+        "zoom_speed_pct_s": 50, "tilt_range_deg": [-80, 10], "offset_m": )") + offset + R"(,
+        "presets": [{"name": "a", "pan_deg": 0, "tilt_deg": -30, "hfov_deg": 40},
+                    {"name": "b", "pan_deg": 100, "tilt_deg": -50, "hfov_deg": 20},
+                    {"name": "c", "pan_deg": -120, "tilt_deg": -20, "hfov_deg": 60}],
+        "tour": [{"preset": "a", "dwell_s": 2}, {"preset": "b", "dwell_s": 1}, {"preset": "c", "dwell_s": 3}])",
+                                 objects);
+    const Rig& rig = scene.rigs[0];
+    const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
+    const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
+    const PtzHead& h = *rig.cameras[0].ptz;
+    const std::vector<PtzHead::TourLeg> legs = h.TourLegs();
+    ASSERT_EQ(legs.size(), 3u);
+    // The period: the dwells plus the three moves (c -> a first).
+    const double moves = h.MoveTime(h.presets[2].state, h.presets[0].state) +
+                         h.MoveTime(h.presets[0].state, h.presets[1].state) +
+                         h.MoveTime(h.presets[1].state, h.presets[2].state);
+    EXPECT_NEAR(legs.back().end(), 6 + moves, 1e-12);
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double dt = 2e-4;
+    // WatchTour samples a move every SampleStep (a quarter of the narrower field of view): a
+    // glimpse shorter than that inside a move may be missed (with an offset the moving centre can
+    // uncover a point behind the pillar's edge for a moment).
+    double step = 0;
+    for (const PtzHead::TourLeg& leg : legs) step = std::max(step, h.SampleStep(rig.cameras[0], leg.from, leg.to));
+    int missed = 0;
+    for (int i = 0; i < 40; ++i) {
+      const Vec3 X(4.5 * u(rng), 4.5 * u(rng), 1.0 + 0.9 * u(rng));
+      const double px = i % 2 ? 0.0 : 60.0;
+      const PtzWatch w = PtzTourWatch(tester, 0, legs, X, px);
+      const Brute b = BruteForceTour(tester, legs, X, px, dt, step);
+      // Each change is placed to the bisection's 1e-3 s and the loop's dt; glimpses shorter than
+      // the step may be missed.
+      const double tol = (b.changes + 1) * (1e-3 + dt) + b.short_s;
+      missed += b.short_s > 0 && std::abs(w.watched_s() - b.watched) > (b.changes + 1) * (1e-3 + dt);
+      EXPECT_NEAR(w.watched_s(), b.watched, tol) << offset << " point " << X.transpose();
+      EXPECT_NEAR(w.longest_gap_s(), b.gap, tol) << offset << " point " << X.transpose();
+      ++compared;
+      partial += w.watched_s() > 0.05 && w.watched_s() < w.period - 0.05;
+    }
+    EXPECT_LE(missed, 2) << offset;  // a rare case, not the rule
+  }
+  EXPECT_EQ(compared, 80);
+  EXPECT_GE(partial, 20);  // the comparison is not between all-or-nothing points
+}
+
+// The grids hold the per-voxel values, the shares count them; the rig's minimum is the minimum.
+TEST(PtzFields, GridsAndSharesAreThePerVoxelValues) {
+  const Scene scene = PtzScene(
+      R"("pan_speed_deg_s": 40, "tilt_speed_deg_s": 20, "zoom_hfov_deg": [60, 8], "zoom_speed_pct_s": 30,
+         "presets": [{"name": "a", "pan_deg": 20, "tilt_deg": -20}, {"name": "b", "pan_deg": -60, "tilt_deg": -40}],
+         "tour": [{"preset": "a", "dwell_s": 2}, {"preset": "b", "dwell_s": 2}])",
+      R"({"name": "pillar", "box": {"size": [0.4, 0.4, 3]}, "position": [1.2, 1.7, 1.5]})",
+      R"(, "pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 20}], "ptz": {"within_s": [0.5, 2]})",
+      R"(, {"id": "q", "position": [4, -4, 2.5], "look_at": [0, 0, 1], "resolution": [320, 240], "hfov_deg": 50,
+            "ptz": {"pan_speed_deg_s": 120, "tilt_speed_deg_s": 90}})");
+  EXPECT_NEAR(scene.study.ptz.min_px_per_m, 125.0, 1e-12);
+  const Rig& rig = scene.rigs[0];
+  const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage"};
+  Fields fields = EvaluateFields(scene, rig, *caster, options);
+  const PtzFieldsSummary s = EvaluatePtzFields(scene, rig, *caster, fields, &fields);
+  ASSERT_EQ(s.cameras.size(), 2u);
+  const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
+  const Fields::Impl& g = fields.impl();
+  const auto reach_p = g.extra.at("ptz_reach_time/p"), reach_q = g.extra.at("ptz_reach_time/q");
+  const auto reach = g.extra.at("ptz_reach_time"), watched = g.extra.at("ptz_watched/p"), gap = g.extra.at("ptz_gap/p");
+  EXPECT_EQ(g.extra.count("ptz_watched/q"), 0u);  // no tour
+  const std::vector<PtzHead::TourLeg> legs = rig.cameras[0].ptz->TourLegs();
+  std::int64_t voxels = 0, reach_p_count = 0, within_p[2] = {0, 0}, either = 0;
+  ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) {
+    ++voxels;
+    const openvdb::Vec3d w = g.coverage->indexToWorld(c);
+    const Vec3 X(w.x(), w.y(), w.z());
+    const double tp = PtzReachTime(tester, 0, X, 125.0), tq = PtzReachTime(tester, 1, X, 125.0);
+    EXPECT_EQ(reach_p->tree().isValueOn(c), std::isfinite(tp));
+    EXPECT_EQ(reach_q->tree().isValueOn(c), std::isfinite(tq));
+    if (std::isfinite(tp)) {
+      EXPECT_EQ(reach_p->tree().getValue(c), static_cast<float>(tp));
+      ++reach_p_count;
+      within_p[0] += static_cast<float>(tp) <= 0.5;
+      within_p[1] += static_cast<float>(tp) <= 2;
+    }
+    const double t = std::min(tp, tq);
+    EXPECT_EQ(reach->tree().isValueOn(c), std::isfinite(t));
+    if (std::isfinite(t)) {
+      EXPECT_EQ(reach->tree().getValue(c), static_cast<float>(t));
+    }
+    either += std::isfinite(t);
+    const PtzWatch watch = PtzTourWatch(tester, 0, legs, X, 125.0);
+    EXPECT_EQ(watched->tree().getValue(c), static_cast<float>(watch.watched_s() / watch.period));
+    EXPECT_EQ(gap->tree().isValueOn(c), !watch.intervals.empty());
+    if (!watch.intervals.empty()) {
+      EXPECT_EQ(gap->tree().getValue(c), static_cast<float>(watch.longest_gap_s()));
+    }
+  });
+  EXPECT_EQ(s.region_voxels, voxels);
+  EXPECT_EQ(s.cameras[0].reachable_voxels, reach_p_count);
+  EXPECT_DOUBLE_EQ(s.cameras[0].within[0], double(within_p[0]) / voxels);
+  EXPECT_DOUBLE_EQ(s.cameras[0].within[1], double(within_p[1]) / voxels);
+  EXPECT_DOUBLE_EQ(s.reachable_share, double(either) / voxels);
+  EXPECT_GT(s.cameras[0].within[1], s.cameras[0].within[0]);  // not all-or-nothing
+  EXPECT_LT(s.cameras[0].reachable_share, 1.0);
+  EXPECT_TRUE(s.cameras[0].tour);
+  EXPECT_GT(s.cameras[0].watched_mean, 0.0);
+}
+
+}  // namespace
+}  // namespace pandora
