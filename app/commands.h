@@ -165,8 +165,15 @@ struct SuggestArgs {
   std::string compare_baseline;   ///< Output folder for the baseline comparison.
   unsigned long long seed = 1;
   bool quiet = false;
+  /// PTZ controller suggestions (docs/ptz.md): "ID:PRESET" (the preset's best setting for the
+  /// targets) or "ID" (the tour order with the shortest longest gap); --target-region names one of
+  /// the study's regions for the target points.
+  std::string ptz_preset, ptz_tour, target_region;
+  std::string tour_objective = "mean";  ///< --tour-objective: mean or max (suggest/ptz_suggest.h).
 };
 int RunSuggest(const SuggestArgs& args);
+/// The PTZ part of `pandora suggest` (app/suggest_ptz_command.cpp).
+int RunSuggestPtz(const SuggestArgs& args);
 
 /// `pandora accept`: writes the suggested poses into the scene file (backup first).
 struct AcceptArgs {

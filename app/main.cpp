@@ -300,7 +300,11 @@ int main(int argc, char** argv) {
   sg->add_option("scene", suggest.scene, "Scene file (JSON)")->required();
   sg->add_option("--rig", suggest.rig, "Rig name (default: the first rig)");
   sg->add_option("--disable", suggest.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
-  sg->add_option("--cameras", suggest.cameras, "Comma-separated ids of the cameras that may move")->required();
+  sg->add_option("--cameras", suggest.cameras, "Comma-separated ids of the cameras that may move (or --ptz-preset / --ptz-tour)");
+  sg->add_option("--ptz-preset", suggest.ptz_preset, "PTZ: ID:PRESET, the pan, tilt and zoom of that preset that best cover the targets");
+  sg->add_option("--ptz-tour", suggest.ptz_tour, "PTZ: ID, the order of its tour's stops with the shortest longest unwatched gap over the targets");
+  sg->add_option("--tour-objective", suggest.tour_objective, "With --ptz-tour: minimise the mean of the points' longest unwatched gaps (mean) or the longest of all (max)")->capture_default_str();
+  sg->add_option("--target-region", suggest.target_region, "Target points in this named region of the study (study.regions) instead of the whole region");
   sg->add_option("--max-move", suggest.max_move, "Largest move, metres: one value, or one per camera in --cameras order")->capture_default_str();
   sg->add_option("--max-rotate", suggest.max_rotate, "Largest rotation, degrees: one value, or one per camera")->capture_default_str();
   sg->add_option("--objective", suggest.objective,

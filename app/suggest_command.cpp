@@ -21,6 +21,11 @@
 namespace pandora::app {
 
 int RunSuggest(const SuggestArgs& args) {
+  if (!args.ptz_preset.empty() || !args.ptz_tour.empty()) return RunSuggestPtz(args);
+  if (args.cameras.empty())
+    throw InputError("--cameras", "", "which cameras may move?", "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
+  if (!args.target_region.empty())
+    throw InputError("--target-region", "", "is for --ptz-preset and --ptz-tour", "use --target-surface for camera nudges");
   // Parse and check: the study through the session layer, then every option against it.
   session::SessionOptions session_options;
   session_options.rig = args.rig;

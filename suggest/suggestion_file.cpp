@@ -21,6 +21,8 @@
 #include "analysis/input_file.h"
 #include "analysis/output_transaction.h"
 #include "analysis/sha256.h"
+#include "suggest/ptz_suggest.h"
+#include "suggest/scene_text.h"
 #include "suggest/suggest.h"
 
 namespace pandora {
@@ -28,6 +30,11 @@ namespace {
 
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
+using scene_text::Clean;
+using scene_text::IdOf;
+using scene_text::Number;
+using scene_text::ParseOrdered;
+using scene_text::ReadJsonText;
 
 json Finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -57,17 +64,7 @@ json PoseJson(const Eigen::Isometry3d& pose) {
 }
 
 // A JSON file's text: a regular file of bounded size, nesting checked before any parser sees it.
-std::string ReadJsonText(const std::string& path, const std::string& what) {
-  std::string text = ReadInputFile(path, InputLimits::kJsonBytes, what);
-  CheckJsonLimits(text, path);
-  return text;
-}
 
-std::string IdOf(const ordered_json& id) {
-  if (id.is_string()) return id.get<std::string>();
-  if (id.is_number_integer()) return std::to_string(id.get<int64_t>());
-  return id.dump();
-}
 
 double MetresPerUnit(const ordered_json& root, const std::string& path) {
   if (!root.contains("units")) return 1.0;
@@ -81,15 +78,6 @@ double MetresPerUnit(const ordered_json& root, const std::string& path) {
   throw InputError(path, "$.units", "unknown unit", "use m, cm, mm, in or ft");
 }
 
-// Indentation of a JSON text: the whitespace run after its first newline (-1: compact).
-std::pair<int, char> Indentation(const std::string& text) {
-  const std::size_t nl = text.find('\n');
-  if (nl == std::string::npos || nl + 1 >= text.size()) return {-1, ' '};
-  const char ch = text[nl + 1] == '\t' ? '\t' : ' ';
-  int n = 0;
-  for (std::size_t i = nl + 1; i < text.size() && text[i] == ch; ++i) ++n;
-  return {n, ch};
-}
 
 Vec3 ReadVec3(const json& j, const std::string& file, const std::string& path) {
   if (!j.is_array() || j.size() != 3) throw InputError(file, path, "expected [x, y, z]");
@@ -118,14 +106,6 @@ Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::st
   return pose;
 }
 
-// The double nearest the 12-significant-digit decimal of v: what a person would have typed.
-double Clean(double v) {
-  if (!std::isfinite(v)) return v;
-  char b[40];
-  std::snprintf(b, sizeof b, "%.12g", v);
-  const double c = std::strtod(b, nullptr);
-  return c == 0 ? 0.0 : c;  // no -0
-}
 
 // A coordinate in file units: the multiple of `step` when it is one (within 1e-6 of a step).
 double OnGrid(double v, double step) {
@@ -136,12 +116,6 @@ double OnGrid(double v, double step) {
   return Clean(v);
 }
 
-// A number as JSON: an integer when it is a whole number (as a person writes 4, not 4.0).
-ordered_json Number(double v) {
-  if (std::isfinite(v) && v == std::round(v) && std::abs(v) < 1e15)
-    return ordered_json(static_cast<std::int64_t>(v));
-  return ordered_json(v);
-}
 
 ordered_json Array(const Vec3& v) { return ordered_json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
 
@@ -220,13 +194,6 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
 }
 
 // The scene text as ordered JSON (keys keep their order when written back).
-static ordered_json ParseOrdered(const std::string& text, const std::string& scene_path) {
-  try {
-    return ordered_json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(scene_path, "$", std::string("malformed JSON: ") + e.what());
-  }
-}
 
 std::string ReplacePoses(const std::string& text, const std::string& scene_path,
                          const std::string& rig_name, const std::vector<PoseUpdate>& poses,
@@ -322,10 +289,7 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
                        "no camera '" + update.id + "' in rig '" + rig_name + "'",
                        "the scene file no longer matches the suggestion");
   }
-  const auto [indent, ch] = Indentation(text);
-  std::string out = root.dump(indent, ch);
-  if (!text.empty() && text.back() == '\n') out += "\n";
-  return out;
+  return scene_text::DumpLike(root, text);
 }
 
 std::string ReplaceStations(const std::string& text, const std::string& scene_path,
@@ -356,10 +320,7 @@ std::string ReplaceStations(const std::string& text, const std::string& scene_pa
     display["facing"] = Array(facing);
     station["eye"] = Array(eye);
   }
-  const auto [indent, ch] = Indentation(text);
-  std::string out = root.dump(indent, ch);
-  if (!text.empty() && text.back() == '\n') out += "\n";
-  return out;
+  return scene_text::DumpLike(root, text);
 }
 
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options) {
@@ -377,6 +338,17 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     return j[key];
   };
   need("pandora_suggestion", &json::is_number);
+  // A PTZ controller suggestion (a preset's setting or a tour's order; suggest/ptz_suggest.h).
+  if (j.is_object() && j.contains("kind") && j["kind"].is_string() && j["kind"].get<std::string>().rfind("ptz_", 0) == 0) {
+    if (!options.cameras.empty())
+      throw InputError("--cameras", "", "a PTZ suggestion changes one camera's preset or tour: accept it whole",
+                       "leave out --cameras");
+    AcceptResult result;
+    std::string what;
+    result.backup_path = AcceptPtzSuggestion(text, suggestion_path, options.force, &result.scene_path, &what);
+    result.accepted.push_back(what);
+    return result;
+  }
   const json& scene_j = need("scene", &json::is_object);
   const std::string rig = need("rig", &json::is_string).get<std::string>();
   const bool improved = need("improved", &json::is_boolean).get<bool>();

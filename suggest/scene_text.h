@@ -1,0 +1,31 @@
+#pragma once
+/// \file scene_text.h
+/// Rewriting a user's scene file text (`pandora accept`, the viewer's save): parse it keeping the
+/// key order, write numbers as a person types them, re-serialise with the file's indentation.
+/// Internal to suggest/ (pulls in nlohmann/json).
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <utility>
+
+namespace pandora::scene_text {
+
+using ordered_json = nlohmann::ordered_json;
+
+/// A JSON input file's text within the input limits (InputError otherwise; `what` names it).
+std::string ReadJsonText(const std::string& path, const std::string& what);
+/// The text parsed with its key order (InputError "$" "malformed JSON: ..." otherwise).
+ordered_json ParseOrdered(const std::string& text, const std::string& path);
+/// Indentation of a JSON text: the whitespace run after its first newline (-1: compact).
+std::pair<int, char> Indentation(const std::string& text);
+/// `root` serialised with `original`'s indentation and final newline.
+std::string DumpLike(const ordered_json& root, const std::string& original);
+/// A camera id as text (ids may be numbers).
+std::string IdOf(const ordered_json& id);
+/// The double nearest the 12-significant-digit decimal of v: what a person would have typed.
+double Clean(double v);
+/// A number as JSON: an integer when it is a whole number (as a person writes 4, not 4.0).
+ordered_json Number(double v);
+
+}  // namespace pandora::scene_text
