@@ -17,6 +17,8 @@
 #include <unistd.h>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "analysis/camera.h"
 #include "analysis/error.h"
 #include "analysis/ray_caster.h"
@@ -203,6 +205,67 @@ TEST(PtzSuggest, AcceptWritesThePresetOrTheTourWithABackup) {
     EXPECT_EQ(g.tour[k].dwell_s, h.tour[t.after[k]].dwell_s);
   }
   EXPECT_NEAR(g.presets[1].state.pan_deg, s.after.pan_deg, 1e-9);  // the accepted preset stays
+  std::filesystem::remove_all(dir);
+}
+
+// A damaged PTZ suggestion file (random bytes changed or cut, every value replaced by a value of
+// another type) is accepted only when it still says something valid, else refused with an
+// InputError; never another exception, and a refused one leaves the scene file as it was.
+TEST(PtzSuggest, DamagedSuggestionFilesAreRefusedCleanly) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pandora_ptz_damage_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "room.json").string();
+  const std::string original = SceneText(kHead);
+  std::ofstream(path) << original;
+  const Scene scene = LoadScene(path);
+  const Rig& rig = scene.rigs[0];
+  const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
+  const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
+  const std::vector<Vec3> points = BoxPoints(Vec3(1.0, 2.2, 0.2), Vec3(3.0, 3.6, 1.8), 60, 3);
+  const std::vector<std::string> valid{
+      PtzPresetSuggestionToJson(SuggestPtzPreset(tester, 0, 1, points, 120), scene, rig),
+      PtzTourSuggestionToJson(SuggestPtzTour(tester, 0, BoxPoints(Vec3(-4.5, -3.5, 0.2), Vec3(4.5, 3.5, 2.0), 80, 5), 40),
+                              scene, rig)};
+  const std::string sug = (dir / "s.json").string();
+  std::mt19937_64 rng(21);
+  int accepted = 0, refused = 0;
+  auto attempt = [&](const std::string& text) {
+    std::ofstream(sug, std::ios::trunc) << text;
+    try {
+      const AcceptResult r = AcceptSuggestion(sug, {});
+      ++accepted;
+      std::filesystem::remove(r.backup_path);
+      std::ofstream(path, std::ios::trunc) << original;  // back to the file the suggestion was made for
+    } catch (const InputError&) {
+      ++refused;
+      EXPECT_EQ(ReadText(path), original) << text;
+    }
+  };
+  for (const std::string& text : valid) {
+    for (int i = 0; i < 150; ++i) {
+      std::string t = text;
+      const int kind = static_cast<int>(rng() % 3);
+      const std::size_t at = rng() % t.size();
+      if (kind == 0) t[at] = static_cast<char>(rng() % 256);
+      if (kind == 1) t.resize(at);
+      if (kind == 2) t.insert(at, 1, "{}[],:\"0-e"[rng() % 11]);
+      attempt(t);
+    }
+    // Every value (depth first) replaced by values of other types.
+    const nlohmann::json j = nlohmann::json::parse(text);
+    const nlohmann::json flat = j.flatten();
+    for (const auto& item : flat.items())
+      for (const nlohmann::json& v : {nlohmann::json(), nlohmann::json("x"), nlohmann::json(-1), nlohmann::json(1e308),
+                                      nlohmann::json::array(), nlohmann::json(true)}) {
+        nlohmann::json f = j;
+        f[nlohmann::json::json_pointer(item.key())] = v;
+        attempt(f.dump());
+      }
+  }
+  std::printf("damaged suggestion files: %d refused, %d accepted\n", refused, accepted);
+  EXPECT_GT(refused, 300);
+  EXPECT_GT(accepted, 0);  // harmless damage (a changed digit in a statistic) still accepts
   std::filesystem::remove_all(dir);
 }
 
