@@ -21,11 +21,13 @@ void WithGrid(const Fields& fields, const std::string& name, const char* option,
   const Fields::Impl& g = fields.impl();
   if (name == kCoverageGrid && g.coverage) return fn(*g.coverage);
   if (auto f = g.Float(name)) return fn(*f);
+  if (auto it = g.extra.find(name); it != g.extra.end() && it->second) return fn(*it->second);
   std::string have;
   for (const auto& grid : g.Grids()) {
     if (grid->getName() == kCamerasGrid) continue;  // a bitmask, not a value to colour
     have += (have.empty() ? "" : ", ") + grid->getName();
   }
+  for (const auto& [extra, grid] : g.extra) have += (have.empty() ? "" : ", ") + extra;
   throw InputError(option, "", "the fields have no grid '" + name + "' to show",
                    have.empty() ? std::string("the fields file holds no value grids")
                                 : "available: " + have);
@@ -33,7 +35,8 @@ void WithGrid(const Fields& fields, const std::string& name, const char* option,
 
 // Fields whose small values are good (uncertainty); the rest are better when large.
 bool LowIsGood(const std::string& name) {
-  return name.rfind("sigma_", 0) == 0 || name == "condition";
+  return name.rfind("sigma_", 0) == 0 || name == "condition" || name.rfind("ptz_reach_time", 0) == 0 ||
+         name.rfind("ptz_gap", 0) == 0;
 }
 
 }  // namespace

@@ -273,9 +273,11 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
   std::vector<const VdbGridInfo*> cameras_info;
   std::set<std::int64_t> indices;
   const VdbGridInfo* first = nullptr;
+  int known = 0;  // grids of FieldNames(), coverage and cameras (a file of derived grids alone is not ours)
   for (const VdbGridInfo& grid : info.grids) {
     const std::string& name = grid.name;
     std::vector<std::string> expected;
+    ++known;
     if (name == kCoverageGrid) {
       expected = {"Tree_float_5_4_3", "Tree_int32_5_4_3"};
     } else if (name == kCamerasGrid) {
@@ -284,7 +286,11 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
       expected = {"Tree_bool_5_4_3"};
     } else if (std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end()) {
       expected = {"Tree_float_5_4_3"};
+    } else if (grid.tree_type == "Tree_float_5_4_3") {
+      expected = {"Tree_float_5_4_3"};  // a derived grid (coverage_n1, ptz_reach_time, ...): Fields::Impl::extra
+      --known;
     } else {
+      --known;
       continue;  // not ours
     }
     if (std::find(expected.begin(), expected.end(), grid.tree_type) == expected.end())
@@ -309,7 +315,7 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     if (!first) first = &grid;
     by_name[name] = &grid;
   }
-  if (by_name.empty()) Refuse(path, "the VDB file holds none of Pandora's field grids");
+  if (by_name.empty() || known <= 0) Refuse(path, "the VDB file holds none of Pandora's field grids");
   if (by_name.count(kCamerasGrid) && !cameras_info.empty())
     Refuse(path, "the file holds both a 'cameras' grid and per-camera 'visible/' grids");
 
@@ -344,8 +350,12 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
           openvdb::gridPtrCast<openvdb::BoolGrid>(base);
     } else {
       auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+      if (!f) Refuse(path, "OpenVDB read a grid of another type than the file declares");
       CheckFinite(*f, path);
-      g.floats[name] = f;
+      if (std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end())
+        g.floats[name] = f;
+      else
+        g.extra[name] = f;
     }
     if (!g.transform) g.transform = base->transformPtr();
   }
