@@ -4,6 +4,7 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
+#include "app/session/ptz_edit.h"
 #include "render/progressive.h"
 #include "suggest/suggestion_file.h"
 
@@ -133,6 +134,27 @@ void Session::ApplySuggestion(const Suggestion& suggestion) {
                 study_->scene().path);
 }
 
+std::string Session::CameraJsonPath(int index) const {
+  const Scene& scene = study_->scene();
+  std::size_t r = 0;
+  while (r < scene.rigs.size() && scene.rigs[r].name != rig_.rig().name) ++r;
+  return "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(index) + "]";
+}
+
+void Session::SetPtzState(int index, const PtzState& state) {
+  const Camera& before = rig_.rig().cameras.at(index);
+  if (!before.ptz)
+    throw InputError(study_->scene().path, CameraJsonPath(index), "camera '" + before.id + "' has no pan-tilt-zoom head",
+                     "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
+  rig_.Apply({"pan/tilt/zoom " + before.id, {{index, before, WithPtzState(before, state)}}});
+}
+
+void Session::RecentrePtz(int index) {
+  const Camera& before = rig_.rig().cameras.at(index);
+  Camera after = RecentredPtz(before, study_->scene().path, CameraJsonPath(index));
+  rig_.Apply({"re-centre " + before.id, {{index, before, std::move(after)}}});
+}
+
 SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Scene& scene = study_->scene();
   if (saved_text_.empty())
@@ -140,6 +162,7 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Rig& now = rig_.rig();
   const Rig& before = rig_.saved();
   std::vector<PoseUpdate> poses;
+  std::vector<PtzHeadUpdate> heads;
   std::string unsupported;
   for (int c : rig_.Unsaved()) {
     const Camera& a = before.cameras[c];
@@ -153,14 +176,21 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
     k.fx = q.fx;
     k.fy = q.fy;
     other.model = CameraModel(k);
-    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color) {
+    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color || !a.ptz != !b.ptz) {
       unsupported += (unsupported.empty() ? "" : ", ") + b.id;
       continue;
     }
     PoseUpdate u;
     u.id = b.id;
-    u.pose = b.world_from_camera;
-    if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
+    if (b.ptz) {
+      // The file pose of a PTZ camera is its home at the pivot; the zoom and the ptz block are
+      // written by ReplacePtzHeads.
+      u.pose = b.ptz->home;
+      heads.push_back({b.id, *a.ptz, *b.ptz, q});
+    } else {
+      u.pose = b.world_from_camera;
+      if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
+    }
     poses.push_back(std::move(u));
   }
   if (!unsupported.empty())
@@ -177,6 +207,7 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
     throw InputError(scene.path, "", "the scene file changed on disk since it was loaded",
                      "reload it, or save with force to overwrite (a backup is kept)");
   std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);
+  if (!heads.empty()) text = ReplacePtzHeads(text, scene.path, now.name, heads);
   if (!stations.empty()) text = ReplaceStations(text, scene.path, stations);
   result.backup_path = ReplaceSceneFileWithBackup(scene.path, on_disk, text);
   for (const PoseUpdate& u : poses) result.saved.push_back(u.id);
