@@ -127,7 +127,8 @@ Camera RecentredPtz(const Camera& camera, const std::string& file, const std::st
   // The scene reader's checks (analysis/scene.cpp ReadPtz), on the new home: a level head, the
   // ranges holding home, the tilt range within the optical axis's straight down .. straight up.
   const double el = n.HomeElevationDeg();
-  if (!(n.tilt_min_deg >= -90 - el - 1e-9 && n.tilt_max_deg <= 90 - el + 1e-9) ||
+  // Along the pan axis (within 1e-6 deg) the elevation's asin has lost the digits the check needs.
+  if (std::abs(el) >= 90 - 1e-6 || !(n.tilt_min_deg >= -90 - el - 1e-9 && n.tilt_max_deg <= 90 - el + 1e-9) ||
       std::abs(n.pan_axis.dot(n.home.linear().col(0))) > 1e-6)
     throw InputError(file, where + ".ptz.tilt_range_deg",
                      "re-centring '" + camera.id + "' at tilt " + Num(tilt) + " deg would make its tilt range [" +

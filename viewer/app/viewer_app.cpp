@@ -256,11 +256,11 @@ struct ViewerApp::Impl {
   void RenderMain() {
     RenderView view = model.MainView();
     char key[512];
-    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d",
+    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g",
                   static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
                   view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
                   int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
-                  int(model.display.surface), shadow_map_size);
+                  int(model.display.surface), shadow_map_size, model.ptz_trace.c_str(), model.ptz_trace_s);
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
     const std::int64_t rig_version = model.session().rig().version();
@@ -285,8 +285,23 @@ struct ViewerApp::Impl {
     gl_options.brightness = model.display.brightness;
     gl_options.grid_pixels = model.display.grid_pixels;
     const auto t0 = std::chrono::steady_clock::now();
-    const GlImage image = gl->Render(model.rig(), view, gl_options);
-    Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    if (model.ptz_trace == "all") {
+      // Everything a PTZ head reaches within the budget: the exact CPU renderer's ptz_all (each
+      // surface point against its own best reachable pose; no GPU version yet), at the rig's
+      // brightness as `pandora render --ptz all`.
+      RenderOptions o = InsetOptions();
+      if (std::isnan(o.brightness)) o.brightness = DefaultBrightness(model.rig().enabled_count());
+      const Rig traced = model.TracedRig(&o.ptz_all);
+      const Image image = RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
+      Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    } else {
+      // "path": the steps home -> current as extra lights, at the rig's own brightness.
+      GlRenderOptions o = gl_options;
+      if (model.ptz_trace != "single" && std::isnan(o.brightness))
+        o.brightness = DefaultBrightness(model.rig().enabled_count());
+      const GlImage image = gl->Render(model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o);
+      Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    }
     gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     frame_gl_seconds = gl_seconds;
     // Adaptive resolution while moving: the next moving frame's scale aims at the target rate
@@ -973,11 +988,75 @@ struct ViewerApp::Impl {
       a.number = hfov;
       Do(a);
     }
+    if (cam.ptz) PtzControls(cam);
     LensControls(cam);
     ImGui::DragFloat("snap move m", &move_step, 0.005f, 0.0f, 1.0f, "%.3f");
     ImGui::DragFloat("snap turn deg", &rotate_step, 0.5f, 0.0f, 45.0f, "%.1f");
     ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)", model.selection.size());
     ImGui::End();
+  }
+
+  // A PTZ camera's head (docs/ptz.md, "In the viewer"): pan, tilt and zoom sliders over its ranges,
+  // its presets, re-centre, and the traces of the main view; each a script action.
+  float trace_seconds = NAN;  // the "all" budget shown (NaN: the head's trace_s)
+  void PtzControls(const Camera& cam) {
+    const PtzHead& h = *cam.ptz;
+    if (!ImGui::CollapsingHeader("Pan / tilt / zoom", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const Intrinsics& k = cam.model.intrinsics();
+    auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kDeg); };
+    float pan = float(h.current.pan_deg), tilt = float(h.current.tilt_deg), zoom = hfov(h.current.focal);
+    Action a = Make(Action::Kind::kPtz, {cam.id});
+    a.drag = true;
+    if (ImGui::SliderFloat("pan deg", &pan, float(h.pan_min_deg), float(h.pan_max_deg), "%.1f")) {
+      a.pan_deg = pan;
+      Do(a);
+    }
+    if (ImGui::SliderFloat("tilt deg", &tilt, float(h.tilt_min_deg), float(h.tilt_max_deg), "%.1f")) {
+      a.tilt_deg = tilt;
+      Do(a);
+    }
+    if (h.focal_max > h.focal_min) {
+      if (ImGui::SliderFloat("zoom hfov deg", &zoom, hfov(h.focal_min), hfov(h.focal_max), "%.1f")) {
+        a.hfov_deg = zoom;
+        Do(a);
+      }
+    } else {
+      ImGui::TextDisabled("fixed focal length (no zoom_hfov_deg)");
+    }
+    if (!h.presets.empty()) {
+      ImGui::TextUnformatted("presets:");
+      for (const PtzPreset& p : h.presets) {
+        ImGui::SameLine();
+        if (ImGui::SmallButton(p.name.c_str())) {
+          Action go = Make(Action::Kind::kPtz, {cam.id});
+          go.preset = p.name;
+          Do(go);
+        }
+      }
+    }
+    if (ImGui::Button("Re-centre")) Do(Make(Action::Kind::kRecentre, {cam.id}));
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("home := the current view; presets and ranges shift so that every preset stays where it is");
+    ImGui::TextUnformatted("trace:");
+    for (const char* mode : {"single", "path", "all"}) {
+      ImGui::SameLine();
+      if (ImGui::RadioButton(mode, model.ptz_trace == mode)) {
+        Action t = Make(Action::Kind::kTrace, {});
+        t.text = mode;
+        t.number = std::isnan(trace_seconds) ? NAN : double(trace_seconds);
+        Do(t);
+      }
+    }
+    float budget = std::isnan(model.ptz_trace_s) ? float(h.trace_s) : float(model.ptz_trace_s);
+    if (ImGui::DragFloat("budget s", &budget, 0.05f, 0.0f, 60.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+      trace_seconds = budget;
+      Action t = Make(Action::Kind::kTrace, {});
+      t.text = model.ptz_trace;
+      t.number = budget;
+      Do(t);
+    }
+    ImGui::TextDisabled(model.ptz_trace == "all" ? "all: exact CPU picture (slow while moving)"
+                                                  : "path: one light per second home -> current");
   }
 
   // On/off, colour, resolution, lens model and coefficients, working range: each a script action.
