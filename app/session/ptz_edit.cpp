@@ -128,7 +128,12 @@ Camera RecentredPtz(const Camera& camera, const std::string& file, const std::st
   // ranges holding home, the tilt range within the optical axis's straight down .. straight up.
   const double el = n.HomeElevationDeg();
   // Along the pan axis (within 1e-6 deg) the elevation's asin has lost the digits the check needs.
-  if (std::abs(el) >= 90 - 1e-6 || !(n.tilt_min_deg >= -90 - el - 1e-9 && n.tilt_max_deg <= 90 - el + 1e-9) ||
+  if (std::abs(el) >= 90 - 1e-6)
+    throw InputError(file, where + ".ptz.tilt_range_deg",
+                     "re-centring '" + camera.id + "' at tilt " + Num(tilt) + " deg would make its home look straight " +
+                         (el > 0 ? "up" : "down") + ", along the pan axis, past which the tilt range cannot reach",
+                     "tilt the head less far before re-centring");
+  if (!(n.tilt_min_deg >= -90 - el - 1e-9 && n.tilt_max_deg <= 90 - el + 1e-9) ||
       std::abs(n.pan_axis.dot(n.home.linear().col(0))) > 1e-6)
     throw InputError(file, where + ".ptz.tilt_range_deg",
                      "re-centring '" + camera.id + "' at tilt " + Num(tilt) + " deg would make its tilt range [" +

@@ -164,7 +164,7 @@ TEST(PtzSession, RecentreRefusesAHomeStraightUpOrDown) {
     const std::string what = e.what();
     EXPECT_NE(what.find(path.string()), std::string::npos) << what;
     EXPECT_NE(what.find("$.rigs[0].cameras[0].ptz.tilt_range_deg"), std::string::npos) << what;
-    EXPECT_NE(what.find("straight up or down"), std::string::npos) << what;
+    EXPECT_NE(what.find("would make its home look straight up, along the pan axis"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
   EXPECT_EQ(session.rig().undo_label(), "pan/tilt/zoom dome");  // nothing applied
