@@ -338,6 +338,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
                                                                [](double v) { return !std::isnan(v); });
       apply(cams, label("lens", cams), [&](Camera& cam) {
         Intrinsics k = cam.model.intrinsics();
+        if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
+          throw InputError(a.where, "", "camera '" + cam.id + "' is a PTZ camera: its zoom range is in pixels of its "
+                                            "resolution and lens, which the viewer does not convert",
+                           "change its resolution or lens model in the scene file");
         if (a.width > 0) {
           // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
           const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;

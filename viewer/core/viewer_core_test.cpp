@@ -840,6 +840,17 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("presets: window, west_door, east_door"), std::string::npos) << e.what();
   }
+  // A resolution or lens model change would leave the zoom range in the old pixels: refused.
+  for (const char* script : {R"([{"intrinsics": "dome", "resolution": [640, 360]}])",
+                             R"([{"intrinsics": "dome", "model": "fisheye"}])"}) {
+    try {
+      m.Run(ParseScript(script, "s.json"), &cpu);
+      ADD_FAILURE() << script;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is a PTZ camera: its zoom range is in pixels"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(m.rig().cameras[0].model.width(), 1280);
   // Re-centre: the view stays, the west door preset is home now.
   const Eigen::Isometry3d pose = m.rig().cameras[0].world_from_camera;
   m.Run(ParseScript(R"([{"recentre": "dome"}])", "s.json"), &cpu);
