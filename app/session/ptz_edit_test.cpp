@@ -56,6 +56,28 @@ double PoseDistance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff();
 }
 
+// The head read back from a saved file equals the session's (angles written to 12 digits).
+void ExpectSameHead(const PtzHead& a, const PtzHead& b) {
+  EXPECT_LT(PoseDistance(a.home, b.home), 1e-9);
+  EXPECT_LT((a.pan_axis - b.pan_axis).norm(), 1e-12);
+  EXPECT_NEAR(a.pan_min_deg, b.pan_min_deg, 1e-9);
+  EXPECT_NEAR(a.pan_max_deg, b.pan_max_deg, 1e-9);
+  EXPECT_NEAR(a.tilt_min_deg, b.tilt_min_deg, 1e-9);
+  EXPECT_NEAR(a.tilt_max_deg, b.tilt_max_deg, 1e-9);
+  EXPECT_NEAR(a.current.pan_deg, b.current.pan_deg, 1e-9);
+  EXPECT_NEAR(a.current.tilt_deg, b.current.tilt_deg, 1e-9);
+  EXPECT_NEAR(a.current.focal, b.current.focal, 1e-9 * b.current.focal);
+  EXPECT_NEAR(a.home_focal, b.home_focal, 1e-9 * b.home_focal);
+  ASSERT_EQ(a.presets.size(), b.presets.size());
+  for (std::size_t i = 0; i < a.presets.size(); ++i) {
+    EXPECT_EQ(a.presets[i].name, b.presets[i].name);
+    EXPECT_NEAR(a.presets[i].state.pan_deg, b.presets[i].state.pan_deg, 1e-9);
+    EXPECT_NEAR(a.presets[i].state.tilt_deg, b.presets[i].state.tilt_deg, 1e-9);
+    EXPECT_NEAR(a.presets[i].state.focal, b.presets[i].state.focal, 1e-9 * b.presets[i].state.focal);
+  }
+  ASSERT_EQ(a.tour.size(), b.tour.size());
+}
+
 TEST(PtzSession, SetStateIsClampedAndOneUndoStep) {
   const fs::path path = CopyPtzScene("set_state");
   Session session(Study::Load(path.string()), {});
@@ -95,7 +117,6 @@ TEST(PtzSession, SetStateIsClampedAndOneUndoStep) {
   EXPECT_TRUE(session.rig().Unsaved().empty());
 
   // A fixed camera has no head: one line naming the file and the camera.
-  Study::Load("tests/data/minimal.json");
   Session fixed(Study::Load("tests/data/minimal.json"), {});
   try {
     fixed.SetPtzState(0, {});
@@ -153,7 +174,7 @@ TEST(PtzSession, RecentreRefusesAHomeStraightUpOrDown) {
   // the new home would look along the pan axis, where the reader's elevation check is undefined.
   const fs::path path = CopyPtzScene("recentre_refused", "\"tilt_range_deg\": [-75, 10], ", "");
   Session session(Study::Load(path.string()), {});
-  const PtzHead& h0 = *session.rig().rig().cameras[0].ptz;
+  const PtzHead h0 = *session.rig().rig().cameras[0].ptz;
   const double el = h0.HomeElevationDeg();
   EXPECT_NEAR(h0.tilt_max_deg, 90 - el, 1e-12);
   session.SetPtzState(0, {20, h0.tilt_max_deg, h0.current.focal});
@@ -174,6 +195,12 @@ TEST(PtzSession, RecentreRefusesAHomeStraightUpOrDown) {
   const PtzHead& h = *session.rig().rig().cameras[0].ptz;
   EXPECT_NEAR(h.tilt_min_deg, -90 - h.HomeElevationDeg(), 1e-9);
   EXPECT_NEAR(h.tilt_max_deg, 90 - h.HomeElevationDeg(), 1e-9);
+  // Saved, the shifted range sits exactly on the reader's limits and is read back.
+  session.Save();
+  const auto reloaded = Study::Load(path.string());
+  const Camera& back = reloaded->FindRig("home").cameras[0];
+  ASSERT_TRUE(back.ptz);
+  ExpectSameHead(*back.ptz, h);
 }
 
 TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
@@ -219,28 +246,6 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
   const Camera w = PtzFollow(cam, wide);
   EXPECT_DOUBLE_EQ(w.ptz->current.focal, Focal(cam, 60));
   EXPECT_DOUBLE_EQ(w.model.intrinsics().fx, Focal(cam, 60));
-}
-
-// The head read back from a saved file equals the session's (angles written to 12 digits).
-void ExpectSameHead(const PtzHead& a, const PtzHead& b) {
-  EXPECT_LT(PoseDistance(a.home, b.home), 1e-9);
-  EXPECT_LT((a.pan_axis - b.pan_axis).norm(), 1e-12);
-  EXPECT_NEAR(a.pan_min_deg, b.pan_min_deg, 1e-9);
-  EXPECT_NEAR(a.pan_max_deg, b.pan_max_deg, 1e-9);
-  EXPECT_NEAR(a.tilt_min_deg, b.tilt_min_deg, 1e-9);
-  EXPECT_NEAR(a.tilt_max_deg, b.tilt_max_deg, 1e-9);
-  EXPECT_NEAR(a.current.pan_deg, b.current.pan_deg, 1e-9);
-  EXPECT_NEAR(a.current.tilt_deg, b.current.tilt_deg, 1e-9);
-  EXPECT_NEAR(a.current.focal, b.current.focal, 1e-9 * b.current.focal);
-  EXPECT_NEAR(a.home_focal, b.home_focal, 1e-9 * b.home_focal);
-  ASSERT_EQ(a.presets.size(), b.presets.size());
-  for (std::size_t i = 0; i < a.presets.size(); ++i) {
-    EXPECT_EQ(a.presets[i].name, b.presets[i].name);
-    EXPECT_NEAR(a.presets[i].state.pan_deg, b.presets[i].state.pan_deg, 1e-9);
-    EXPECT_NEAR(a.presets[i].state.tilt_deg, b.presets[i].state.tilt_deg, 1e-9);
-    EXPECT_NEAR(a.presets[i].state.focal, b.presets[i].state.focal, 1e-9 * b.presets[i].state.focal);
-  }
-  ASSERT_EQ(a.tour.size(), b.tour.size());
 }
 
 TEST(PtzSession, SaveWritesPivotHomeZoomAndTheHeadWithABackup) {
@@ -295,7 +300,8 @@ TEST(PtzSession, SaveWritesPivotHomeZoomAndTheHeadWithABackup) {
   session.rig().Apply({"move dome", {{0, before_move, PtzFollow(before_move, requested)}}});
   const SaveResult r2 = session.Save();
   EXPECT_EQ(fs::path(r2.backup_path).filename(), "scene.json.bak.1");
-  const Camera& moved = Study::Load(path.string())->FindRig("home").cameras[0];
+  const auto moved_study = Study::Load(path.string());
+  const Camera& moved = moved_study->FindRig("home").cameras[0];
   EXPECT_LT((moved.ptz->home.translation() - Vec3(0.4, -2.3, 2.45)).norm(), 1e-12);
   EXPECT_NEAR(moved.ptz->current.pan_deg, -10, 1e-12);
 }
