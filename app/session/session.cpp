@@ -77,7 +77,14 @@ std::int64_t Session::RenderInBackground(
     const RenderView& view, const RenderOptions& options,
     std::shared_ptr<const PreparedOverlays> overlays,
     std::function<void(const Image&, int, std::int64_t)> on_pass) {
-  auto rig = std::make_shared<Rig>(rig_.rig());
+  return RenderInBackground(rig_.rig(), view, options, std::move(overlays), std::move(on_pass));
+}
+
+std::int64_t Session::RenderInBackground(
+    Rig rig_to_render, const RenderView& view, const RenderOptions& options,
+    std::shared_ptr<const PreparedOverlays> overlays,
+    std::function<void(const Image&, int, std::int64_t)> on_pass) {
+  auto rig = std::make_shared<Rig>(std::move(rig_to_render));
   const std::int64_t version = rig_.version();
   const Study* study = study_.get();
   return jobs_.Submit("render", [study, rig, version, view, options, overlays = std::move(overlays),

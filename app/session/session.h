@@ -97,6 +97,12 @@ class Session {
       const RenderView& view, const RenderOptions& options,
       std::shared_ptr<const PreparedOverlays> overlays,
       std::function<void(const Image& image, int pass, std::int64_t rig_version)> on_pass);
+  /// The same with another rig in place of the edited one (a PTZ trace of it: PtzTracedRig);
+  /// `rig_version` is still the edited rig's.
+  std::int64_t RenderInBackground(
+      Rig rig, const RenderView& view, const RenderOptions& options,
+      std::shared_ptr<const PreparedOverlays> overlays,
+      std::function<void(const Image& image, int pass, std::int64_t rig_version)> on_pass);
 
   /// A PTZ camera's current pan, tilt and zoom (clamped to its ranges; docs/ptz.md, "In the
   /// viewer"), one undo step: the camera's pose and focal lengths become PtzHead::CameraAt of it.

@@ -21,12 +21,12 @@ fail() { echo "FAIL: $*"; exit 1; }
 entry() { jq -c ".[] | select(.action == \"\$[$1]\")" "$out"/log.json; }
 jq -e '.ptz_trace == "path"' <<<"$(entry 8)" >/dev/null || fail "the path radio button did not pick the path trace"
 jq -e '.ptz_trace == "all"' <<<"$(entry 10)" >/dev/null || fail "no all trace"
-recentred=$(entry 15)
+recentred=$(entry 21)
 jq -e '.undo == "re-centre dome" and .cameras[0].ptz.pan_deg == 0 and .cameras[0].ptz.tilt_deg == 0
        and (.cameras[0].ptz.tilt_range_deg | (.[0] + 72 | fabs) < 1e-9 and (.[1] - 13 | fabs) < 1e-9)
        and (.cameras[0].ptz.presets[1].pan_deg | fabs) < 1e-9' <<<"$recentred" >/dev/null ||
   fail "the Re-centre button did not re-centre the dome: $recentred"
-jq -e '.status | startswith("saved 1 camera into")' <<<"$(entry 17)" >/dev/null || fail "not saved: $(entry 17)"
+jq -e '.status | startswith("saved 1 camera into")' <<<"$(entry 23)" >/dev/null || fail "not saved: $(entry 23)"
 # The file: the pivot where it was, the zoom, the head's setting, ranges and presets shifted.
 dome=$(jq -c '.rigs[0].cameras[0]' "$out"/scene.json)
 jq -e '.position == [0, -2.3, 2.45] and .hfov_deg == 40 and .ptz.pan_deg == -20 and .ptz.tilt_deg == 0
@@ -38,4 +38,6 @@ cmp -s "$out"/scene.json.bak "$src"/examples/ptz_home/scene.json || fail "no bac
 # Each trace lights more of the room than the one before.
 "$diff" "$out"/1_single.png "$out"/2_path.png 1 8 >/dev/null && fail "the path trace changed nothing on screen"
 "$diff" "$out"/2_path.png "$out"/3_all.png 1 8 >/dev/null && fail "the all trace changed nothing on screen"
+# The window's background (progressive) all trace ends in the exact picture a screenshot renders.
+"$diff" "$out"/3_all_progressive.png "$out"/3_all.png 0 0 || fail "the background all trace is not the exact one"
 echo "ok: PTZ session"

@@ -18,6 +18,8 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 
 #include "analysis/error.h"
@@ -253,7 +255,32 @@ struct ViewerApp::Impl {
     return 0.12 * (*o - model.view.Eye()).norm();
   }
 
+  // The "all" PTZ trace rendered in the background: each completed pass of the progressive CPU
+  // frame (coarse first) is uploaded on the next frame. Shared with the job, which may outlive a frame.
+  struct AllTraceSlot {
+    std::mutex mutex;
+    Image image;
+    bool fresh = false;
+    std::int64_t generation = 0;  // of the newest frame asked for; older jobs' passes are dropped
+  };
+  std::shared_ptr<AllTraceSlot> all_trace = std::make_shared<AllTraceSlot>();
+  std::string all_trace_key;  // the main view's key of the newest "all" frame asked for
+
+  void UploadAllTrace() {
+    std::lock_guard<std::mutex> lock(all_trace->mutex);
+    if (!all_trace->fresh) return;
+    all_trace->fresh = false;
+    if (model.ptz_trace != "all") return;  // a pass that finished after the mode changed
+    Upload(&main_texture, all_trace->image.width, all_trace->image.height, ToRgba8(all_trace->image.rgb));
+  }
+
   void RenderMain() {
+    if (full_now && model.ptz_trace == "all" && !all_trace_key.empty()) {
+      // A screenshot shows the exact picture: the background frame's last pass (or a new frame).
+      const session::JobStatus st = model.session().jobs().Wait("render");
+      if (st.state != session::JobState::kDone) all_trace_key.clear(), main_key.clear();
+    }
+    UploadAllTrace();
     RenderView view = model.MainView();
     char key[512];
     std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g",
@@ -288,14 +315,40 @@ struct ViewerApp::Impl {
     if (model.ptz_trace == "all") {
       // Everything a PTZ head reaches within the budget: the exact CPU renderer's ptz_all (each
       // surface point against its own best reachable pose; no GPU version yet), at the rig's
-      // brightness as `pandora render --ptz all`.
+      // brightness as `pandora render --ptz all`. A screenshot waits for the exact picture; the
+      // window renders it progressively in the background (UploadAllTrace shows each pass).
       RenderOptions o = InsetOptions();
       if (std::isnan(o.brightness)) o.brightness = DefaultBrightness(model.rig().enabled_count());
       const Rig traced = model.TracedRig(&o.ptz_all);
-      const Image image = RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
-      Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+      // A new frame: passes of the older ones are dropped.
+      auto next_generation = [&] {
+        std::lock_guard<std::mutex> lock(all_trace->mutex);
+        all_trace->fresh = false;
+        return ++all_trace->generation;
+      };
+      if (full_now) {
+        next_generation();
+        model.session().jobs().Cancel("render");
+        const Image image = RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
+        Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+        all_trace_key = key;
+      } else if (key != all_trace_key) {
+        // Coarse first (1/64 of the pixels), then refined; a newer frame cancels this one.
+        all_trace_key = key;
+        const std::int64_t generation = next_generation();
+        auto slot = all_trace;
+        model.session().RenderInBackground(traced, model.MainView(), o, nullptr,
+                                           [slot, generation](const Image& image, int, std::int64_t) {
+                                             std::lock_guard<std::mutex> lock(slot->mutex);
+                                             if (slot->generation != generation) return;
+                                             slot->image = image;
+                                             slot->fresh = true;
+                                           });
+      }
+      main_full = true;  // the background frame refines itself
     } else {
       // "path": the steps home -> current as extra lights, at the rig's own brightness.
+      all_trace_key.clear();
       GlRenderOptions o = gl_options;
       if (model.ptz_trace != "single" && std::isnan(o.brightness))
         o.brightness = DefaultBrightness(model.rig().enabled_count());
