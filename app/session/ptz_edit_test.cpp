@@ -306,6 +306,28 @@ TEST(PtzSession, SaveWritesPivotHomeZoomAndTheHeadWithABackup) {
   EXPECT_NEAR(moved.ptz->current.pan_deg, -10, 1e-12);
 }
 
+TEST(PtzSession, SavingASettingKeepsThePoseKeysText) {
+  // Pan, tilt and zoom only: home did not move, so position and look_at keep their text.
+  const fs::path path = CopyPtzScene("save_setting");
+  Session session(Study::Load(path.string()), {});
+  const Camera start = session.rig().rig().cameras[0];
+  session.SetPtzState(0, {-30.5, 4.25, Focal(start, 12)});
+  EXPECT_EQ(session.Save().saved, std::vector<std::string>{"dome"});
+  const std::string text = Read(path);
+  const nlohmann::json dome = nlohmann::json::parse(text)["rigs"][0]["cameras"][0];
+  EXPECT_EQ(dome["look_at"], nlohmann::json::parse("[0, 2.5, 1.5]"));
+  EXPECT_EQ(dome["position"], nlohmann::json::parse("[0, -2.3, 2.45]"));
+  EXPECT_EQ(dome["hfov_deg"], 12);
+  EXPECT_EQ(dome["ptz"]["pan_deg"], -30.5);
+  EXPECT_EQ(dome["ptz"]["tilt_deg"], 4.25);
+  EXPECT_EQ(dome["ptz"]["tilt_range_deg"], nlohmann::json::parse("[-75, 10]"));
+  EXPECT_FALSE(dome["ptz"].contains("pan_range_deg"));
+  const auto reloaded = Study::Load(path.string());
+  const Camera& back = reloaded->FindRig("home").cameras[0];
+  EXPECT_EQ(back.ptz->home.matrix(), start.ptz->home.matrix());
+  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera), 1e-12);
+}
+
 TEST(PtzSession, AutosaveKeepsARecentredHead) {
   const fs::path path = CopyPtzScene("autosave");
   Session session(Study::Load(path.string()), {});

@@ -170,6 +170,7 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Rig& before = rig_.saved();
   std::vector<PoseUpdate> poses;
   std::vector<PtzHeadUpdate> heads;
+  std::vector<std::string> saved;  // camera ids written
   std::string unsupported;
   for (int c : rig_.Unsaved()) {
     const Camera& a = before.cameras[c];
@@ -187,13 +188,15 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
       unsupported += (unsupported.empty() ? "" : ", ") + b.id;
       continue;
     }
+    saved.push_back(b.id);
     PoseUpdate u;
     u.id = b.id;
     if (b.ptz) {
-      // The file pose of a PTZ camera is its home at the pivot; the zoom and the ptz block are
-      // written by ReplacePtzHeads.
-      u.pose = b.ptz->home;
+      // The file pose of a PTZ camera is its home at the pivot (its text is kept while home stays);
+      // the zoom and the ptz block are written by ReplacePtzHeads.
       heads.push_back({b.id, *a.ptz, *b.ptz, q});
+      if (b.ptz->home.matrix() == a.ptz->home.matrix()) continue;
+      u.pose = b.ptz->home;
     } else {
       u.pose = b.world_from_camera;
       if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
@@ -207,7 +210,7 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
                      "undo those changes or edit the scene file by hand");
   SaveResult result;
   result.scene_path = scene.path;
-  if (poses.empty() && stations.empty()) return result;
+  if (saved.empty() && stations.empty()) return result;
   // The file must be the one the session knows, or the edits would overwrite someone's changes.
   const std::string on_disk = ReadInputFile(scene.path, InputLimits::kJsonBytes, "scene file");
   if (!force && on_disk != saved_text_)
@@ -217,7 +220,7 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   if (!heads.empty()) text = ReplacePtzHeads(text, scene.path, now.name, heads);
   if (!stations.empty()) text = ReplaceStations(text, scene.path, stations);
   result.backup_path = ReplaceSceneFileWithBackup(scene.path, on_disk, text);
-  for (const PoseUpdate& u : poses) result.saved.push_back(u.id);
+  result.saved = saved;
   for (const StationMove& s : stations) result.saved_stations.push_back(s.name);
   saved_text_ = text;
   rig_.MarkSaved();
