@@ -328,6 +328,31 @@ TEST(PtzSession, SavingASettingKeepsThePoseKeysText) {
   EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera), 1e-12);
 }
 
+TEST(PtzSession, SaveWritesThePanAxisWhenTheReadersDefaultWouldChange) {
+  // A head mounted rolled (its home image x axis not horizontal): the pan axis defaults to home's
+  // up. After a re-centre with a tilt, home's up is another direction, so the file must say it.
+  const fs::path path = CopyPtzScene("pan_axis", "\"look_at\": [0, 2.5, 1.5], ", "\"look_at\": [0, 2.5, 1.5], \"up\": [0.5, 0, 1], ");
+  Session session(Study::Load(path.string()), {});
+  const Camera start = session.rig().rig().cameras[0];
+  const Vec3 axis0 = start.ptz->pan_axis;
+  EXPECT_GT(std::abs(start.ptz->home.linear()(2, 0)), 0.1);  // rolled
+  EXPECT_LT((axis0 + start.ptz->home.linear().col(1)).norm(), 1e-12);  // the default: home's up
+  session.SetPtzState(0, {10, -20, start.ptz->current.focal});
+  session.RecentrePtz(0);
+  const PtzHead h = *session.rig().rig().cameras[0].ptz;
+  EXPECT_EQ(h.pan_axis, axis0);
+  EXPECT_GT((h.pan_axis + h.home.linear().col(1)).norm(), 0.3);  // no longer home's up
+  session.Save();
+  const nlohmann::json dome = nlohmann::json::parse(Read(path))["rigs"][0]["cameras"][0];
+  EXPECT_TRUE(dome["ptz"].contains("pan_axis"));
+  const auto reloaded = Study::Load(path.string());
+  const Camera& back = reloaded->FindRig("home").cameras[0];
+  ExpectSameHead(*back.ptz, h);
+  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera), 1e-9);
+  for (std::size_t i = 0; i < h.presets.size(); ++i)
+    EXPECT_LT(PoseDistance(back.ptz->Pose(back.ptz->presets[i].state), start.ptz->Pose(start.ptz->presets[i].state)), 1e-9);
+}
+
 TEST(PtzSession, AutosaveKeepsARecentredHead) {
   const fs::path path = CopyPtzScene("autosave");
   Session session(Study::Load(path.string()), {});
