@@ -1057,6 +1057,9 @@ struct ViewerApp::Impl {
     if (!ImGui::CollapsingHeader("Pan / tilt / zoom", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const Intrinsics& k = cam.model.intrinsics();
     auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kDeg); };
+    const Vec3 pivot = h.home.translation();
+    ImGui::TextDisabled("pivot %.3f %.3f %.3f, home elevation %.1f deg", pivot.x(), pivot.y(), pivot.z(),
+                        h.HomeElevationDeg());
     float pan = float(h.current.pan_deg), tilt = float(h.current.tilt_deg), zoom = hfov(h.current.focal);
     Action a = Make(Action::Kind::kPtz, {cam.id});
     a.drag = true;
