@@ -6,6 +6,7 @@
 
 #include "analysis/error.h"
 #include "analysis/ptz.h"
+#include "app/session/ptz_edit.h"
 #include "analysis/rig_check.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -149,35 +150,12 @@ int RunRender(const RenderArgs& args) {
   const std::string ptz_mode = Lower(args.ptz);
   if (ptz_mode != "single" && ptz_mode != "path" && ptz_mode != "all")
     throw InputError("--ptz", "", "unknown mode '" + args.ptz + "'", "use single, path or all");
-  Rig traced = rig;
   if (ptz_mode != "single" && std::isnan(options.brightness))
     options.brightness = DefaultBrightness(rig.enabled_count());  // the rig's, not its traces'
-  if (ptz_mode != "single") {
-    bool any = false;
-    traced.cameras.clear();
-    for (const Camera& cam : rig.cameras) {
-      if (!cam.ptz || !cam.enabled) {
-        traced.cameras.push_back(cam);
-        continue;
-      }
-      any = true;
-      if (ptz_mode == "all") {
-        Camera home = cam.ptz->CameraAt(cam, cam.ptz->Home());
-        traced.cameras.push_back(home);
-        options.ptz_all.push_back({int(traced.cameras.size()) - 1,
-                                   std::isnan(args.ptz_time) ? cam.ptz->trace_s : args.ptz_time});
-        continue;
-      }
-      const std::vector<PtzState> path = cam.ptz->Path(cam.ptz->Home(), cam.ptz->current);
-      for (std::size_t k = 0; k < path.size(); ++k) {
-        Camera step = cam.ptz->CameraAt(cam, path[k]);
-        step.id = cam.id + "@" + std::to_string(k) + (k + 1 == path.size() && k > 0 ? "-end" : "");
-        step.color = (1.0 - 0.6 * double(k) / double(std::max<std::size_t>(1, path.size() - 1))) * cam.color;
-        traced.cameras.push_back(step);
-      }
-    }
-    if (!any) throw InputError("--ptz", "", "rig '" + rig.name + "' has no enabled PTZ camera", "add a \"ptz\" block to a camera (docs/ptz.md)");
-  }
+  bool any = false;
+  const Rig traced = session::PtzTracedRig(rig, ptz_mode, args.ptz_time, &options.ptz_all, &any);
+  if (ptz_mode != "single" && !any)
+    throw InputError("--ptz", "", "rig '" + rig.name + "' has no enabled PTZ camera", "add a \"ptz\" block to a camera (docs/ptz.md)");
   const Image image = ptz_mode == "single"
                           ? session.Render(view, options, overlays.get(), &stats)
                           : RenderWithStats(session.study().prepared(), traced, view, options, overlays.get(), &stats);

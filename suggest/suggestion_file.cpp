@@ -292,6 +292,99 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
   return scene_text::DumpLike(root, text);
 }
 
+std::string ReplacePtzHeads(const std::string& text, const std::string& scene_path, const std::string& rig_name,
+                            const std::vector<PtzHeadUpdate>& heads) {
+  ordered_json root = ParseOrdered(text, scene_path);
+  if (!root.is_object() || !root.contains("rigs") || !root["rigs"].is_array())
+    throw InputError(scene_path, "$.rigs", "no rigs");
+  ordered_json* rig = nullptr;
+  std::size_t rig_index = 0;
+  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
+    ordered_json& candidate = root["rigs"][r];
+    if (candidate.is_object() && candidate.contains("name") && candidate["name"] == rig_name) {
+      rig = &candidate;
+      rig_index = r;
+    }
+  }
+  if (!rig || !(*rig).contains("cameras") || !(*rig)["cameras"].is_array())
+    throw InputError(scene_path, "$.rigs", "no rig called '" + rig_name + "'", "the scene file no longer matches the session");
+  ordered_json& cameras = (*rig)["cameras"];
+  constexpr double kDegree = 3.14159265358979323846 / 180.0;
+  for (const PtzHeadUpdate& u : heads) {
+    std::size_t c = 0;
+    while (c < cameras.size() && !(cameras[c].is_object() && cameras[c].contains("id") && IdOf(cameras[c]["id"]) == u.id)) ++c;
+    const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
+    if (c == cameras.size())
+      throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras",
+                       "no camera '" + u.id + "' in rig '" + rig_name + "'", "the scene file no longer matches the session");
+    ordered_json& cam = cameras[c];
+    if (!cam.contains("ptz") || !cam["ptz"].is_object())
+      throw InputError(scene_path, where, "camera '" + u.id + "' has no \"ptz\" block in the file",
+                       "the scene file no longer matches the session");
+    const PtzHead& a = u.before;
+    const PtzHead& b = u.after;
+    auto hfov = [&](double f) { return Number(Clean(HfovFromFocal(f, u.lens.width, u.lens.model) / kDegree)); };
+    // A value that changed: written (a default that stays left out stays out).
+    auto set = [](ordered_json& obj, const char* key, double now, double before, double default_value) {
+      if (now == before) return;
+      if (now == default_value && !obj.contains(key)) return;
+      obj[key] = Number(Clean(now));
+    };
+    // The zoom: the camera's own lens key.
+    if (b.current.focal != a.current.focal) {
+      if (cam.contains("hfov_deg")) {
+        cam["hfov_deg"] = hfov(b.current.focal);
+      } else {
+        ordered_json rebuilt = ordered_json::object();
+        for (auto it = cam.begin(); it != cam.end(); ++it) {
+          if (it.key() == "focal_px" || it.key() == "lens") rebuilt["focal_px"] = {u.lens.fx, u.lens.fy};
+          else rebuilt[it.key()] = it.value();
+        }
+        cam = std::move(rebuilt);
+      }
+    }
+    ordered_json& head = cam["ptz"];
+    set(head, "pan_deg", b.current.pan_deg, a.current.pan_deg, 0.0);
+    set(head, "tilt_deg", b.current.tilt_deg, a.current.tilt_deg, 0.0);
+    if (b.pan_min_deg != a.pan_min_deg || b.pan_max_deg != a.pan_max_deg)
+      head["pan_range_deg"] = ordered_json::array({Number(Clean(b.pan_min_deg)), Number(Clean(b.pan_max_deg))});
+    if (b.tilt_min_deg != a.tilt_min_deg || b.tilt_max_deg != a.tilt_max_deg)
+      head["tilt_range_deg"] = ordered_json::array({Number(Clean(b.tilt_min_deg)), Number(Clean(b.tilt_max_deg))});
+    if (b.home.linear() != a.home.linear() && !head.contains("pan_axis")) {
+      // The reader's default (analysis/scene.cpp ReadPtz): +z for a level image x axis, else home's up.
+      const Mat3& R = b.home.linear();
+      const Vec3 fallback = std::abs(R(2, 0)) <= 1e-9 ? Vec3::UnitZ() : Vec3(-R.col(1));
+      if ((fallback - b.pan_axis).norm() > 1e-12) {
+        Vec3 axis = b.pan_axis;
+        for (int i = 0; i < 3; ++i) axis[i] = Clean(axis[i]);
+        head["pan_axis"] = Array(axis);
+      }
+    }
+    if (b.presets.size() != a.presets.size())
+      throw InputError(scene_path, where + ".ptz.presets", "the session changed the number of presets, which saving does not write");
+    if (!b.presets.empty()) {
+      if (!head.contains("presets") || !head["presets"].is_array() || head["presets"].size() != b.presets.size())
+        throw InputError(scene_path, where + ".ptz.presets", "the file's presets are not the session's",
+                         "the scene file no longer matches the session");
+      for (std::size_t i = 0; i < b.presets.size(); ++i) {
+        ordered_json& p = head["presets"][i];
+        const std::string at = where + ".ptz.presets[" + std::to_string(i) + "]";
+        if (!p.is_object() || !p.contains("name") || p["name"] != b.presets[i].name)
+          throw InputError(scene_path, at, "not the preset '" + b.presets[i].name + "' the session has",
+                           "the scene file no longer matches the session");
+        set(p, "pan_deg", b.presets[i].state.pan_deg, a.presets[i].state.pan_deg, 0.0);
+        set(p, "tilt_deg", b.presets[i].state.tilt_deg, a.presets[i].state.tilt_deg, 0.0);
+        // Without hfov_deg a preset takes the camera's zoom: keep its own when that changes.
+        if (!p.contains("hfov_deg") && b.current.focal != a.current.focal) p["hfov_deg"] = hfov(b.presets[i].state.focal);
+      }
+    }
+  }
+  const auto [indent, ch] = Indentation(text);
+  std::string out = root.dump(indent, ch);
+  if (!text.empty() && text.back() == '\n') out += "\n";
+  return out;
+}
+
 std::string ReplaceStations(const std::string& text, const std::string& scene_path,
                             const std::vector<StationMove>& stations) {
   ordered_json root = ParseOrdered(text, scene_path);

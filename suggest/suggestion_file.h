@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/ptz.h"
 #include "analysis/scene.h"
 #include "suggest/suggest.h"
 
@@ -51,6 +52,27 @@ struct PoseUpdate {
 std::string ReplacePoses(const std::string& scene_text, const std::string& scene_path,
                          const std::string& rig, const std::vector<PoseUpdate>& poses,
                          std::vector<std::string>* notes = nullptr);
+
+/// A PTZ camera's head as saved (`before`, what the file says) and as edited (`after`), with the
+/// camera's lens at the edited zoom.
+struct PtzHeadUpdate {
+  std::string id;
+  PtzHead before, after;
+  Intrinsics lens;
+};
+
+/// The scene file text with each listed PTZ camera's head written (docs/ptz.md, "In the viewer"):
+/// the zoom in the camera's own lens key (`hfov_deg` keeps its form; `focal_px` or `lens` become
+/// `focal_px` [fx, fy] at their place) and in the "ptz" block pan_deg and tilt_deg, and, where they
+/// changed (a re-centre), pan_range_deg, tilt_range_deg, each preset's pan_deg and tilt_deg, and
+/// pan_axis when the file leaves it out and the reader's default from the new home would differ. A
+/// preset without hfov_deg (which means "the camera's zoom") gets its zoom written when the camera's
+/// zoom changes. Angles are written as ReplacePoses writes numbers (12 significant digits); keys
+/// that did not change keep their text, new keys go last. Call after ReplacePoses, which writes the
+/// position (the pivot) and orientation (home). Throws InputError (file = scene_path, the camera's
+/// JSON path) when the camera, its "ptz" block or a preset cannot be found.
+std::string ReplacePtzHeads(const std::string& scene_text, const std::string& scene_path,
+                            const std::string& rig, const std::vector<PtzHeadUpdate>& heads);
 
 /// A viewing station placed anew (metres, world frame): its eye and its display's centre. The
 /// display keeps its orientation (its `facing` point moves with its centre).

@@ -3,13 +3,16 @@
 #include <stdexcept>
 
 #include "analysis/error.h"
+#include "app/session/ptz_edit.h"
 
 namespace pandora::session {
 
 namespace {
 
 bool SameCamera(const Camera& a, const Camera& b) {
-  return SameCameraGeometry(a, b) && a.id == b.id && a.name == b.name && a.color == b.color;
+  // A PTZ camera's head too: a re-centre changes its home, ranges and presets but not its pose.
+  return SameCameraGeometry(a, b) && a.id == b.id && a.name == b.name && a.color == b.color &&
+         SamePtzHead(a.ptz.get(), b.ptz.get());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
+#include "app/session/ptz_edit.h"
 #include "render/progressive.h"
 #include "suggest/suggestion_file.h"
 
@@ -76,7 +77,14 @@ std::int64_t Session::RenderInBackground(
     const RenderView& view, const RenderOptions& options,
     std::shared_ptr<const PreparedOverlays> overlays,
     std::function<void(const Image&, int, std::int64_t)> on_pass) {
-  auto rig = std::make_shared<Rig>(rig_.rig());
+  return RenderInBackground(rig_.rig(), view, options, std::move(overlays), std::move(on_pass));
+}
+
+std::int64_t Session::RenderInBackground(
+    Rig rig_to_render, const RenderView& view, const RenderOptions& options,
+    std::shared_ptr<const PreparedOverlays> overlays,
+    std::function<void(const Image&, int, std::int64_t)> on_pass) {
+  auto rig = std::make_shared<Rig>(std::move(rig_to_render));
   const std::int64_t version = rig_.version();
   const Study* study = study_.get();
   return jobs_.Submit("render", [study, rig, version, view, options, overlays = std::move(overlays),
@@ -133,6 +141,27 @@ void Session::ApplySuggestion(const Suggestion& suggestion) {
                 study_->scene().path);
 }
 
+std::string Session::CameraJsonPath(int index) const {
+  const Scene& scene = study_->scene();
+  std::size_t r = 0;
+  while (r < scene.rigs.size() && scene.rigs[r].name != rig_.rig().name) ++r;
+  return "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(index) + "]";
+}
+
+void Session::SetPtzState(int index, const PtzState& state) {
+  const Camera& before = rig_.rig().cameras.at(index);
+  if (!before.ptz)
+    throw InputError(study_->scene().path, CameraJsonPath(index), "camera '" + before.id + "' has no pan-tilt-zoom head",
+                     "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
+  rig_.Apply({"pan/tilt/zoom " + before.id, {{index, before, WithPtzState(before, state)}}});
+}
+
+void Session::RecentrePtz(int index) {
+  const Camera& before = rig_.rig().cameras.at(index);
+  Camera after = RecentredPtz(before, study_->scene().path, CameraJsonPath(index));
+  rig_.Apply({"re-centre " + before.id, {{index, before, std::move(after)}}});
+}
+
 SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Scene& scene = study_->scene();
   if (saved_text_.empty())
@@ -140,6 +169,8 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   const Rig& now = rig_.rig();
   const Rig& before = rig_.saved();
   std::vector<PoseUpdate> poses;
+  std::vector<PtzHeadUpdate> heads;
+  std::vector<std::string> saved;  // camera ids written
   std::string unsupported;
   for (int c : rig_.Unsaved()) {
     const Camera& a = before.cameras[c];
@@ -153,14 +184,23 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
     k.fx = q.fx;
     k.fy = q.fy;
     other.model = CameraModel(k);
-    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color) {
+    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color || !a.ptz != !b.ptz) {
       unsupported += (unsupported.empty() ? "" : ", ") + b.id;
       continue;
     }
+    saved.push_back(b.id);
     PoseUpdate u;
     u.id = b.id;
-    u.pose = b.world_from_camera;
-    if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
+    if (b.ptz) {
+      // The file pose of a PTZ camera is its home at the pivot (its text is kept while home stays);
+      // the zoom and the ptz block are written by ReplacePtzHeads.
+      heads.push_back({b.id, *a.ptz, *b.ptz, q});
+      if (b.ptz->home.matrix() == a.ptz->home.matrix()) continue;
+      u.pose = b.ptz->home;
+    } else {
+      u.pose = b.world_from_camera;
+      if (p.fx != q.fx || p.fy != q.fy) u.focal_px = Vec2(q.fx, q.fy);
+    }
     poses.push_back(std::move(u));
   }
   if (!unsupported.empty())
@@ -170,16 +210,17 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
                      "undo those changes or edit the scene file by hand");
   SaveResult result;
   result.scene_path = scene.path;
-  if (poses.empty() && stations.empty()) return result;
+  if (saved.empty() && stations.empty()) return result;
   // The file must be the one the session knows, or the edits would overwrite someone's changes.
   const std::string on_disk = ReadInputFile(scene.path, InputLimits::kJsonBytes, "scene file");
   if (!force && on_disk != saved_text_)
     throw InputError(scene.path, "", "the scene file changed on disk since it was loaded",
                      "reload it, or save with force to overwrite (a backup is kept)");
   std::string text = ReplacePoses(on_disk, scene.path, now.name, poses, &result.notes);
+  if (!heads.empty()) text = ReplacePtzHeads(text, scene.path, now.name, heads);
   if (!stations.empty()) text = ReplaceStations(text, scene.path, stations);
   result.backup_path = ReplaceSceneFileWithBackup(scene.path, on_disk, text);
-  for (const PoseUpdate& u : poses) result.saved.push_back(u.id);
+  result.saved = saved;
   for (const StationMove& s : stations) result.saved_stations.push_back(s.name);
   saved_text_ = text;
   rig_.MarkSaved();

@@ -97,6 +97,23 @@ class Session {
       const RenderView& view, const RenderOptions& options,
       std::shared_ptr<const PreparedOverlays> overlays,
       std::function<void(const Image& image, int pass, std::int64_t rig_version)> on_pass);
+  /// The same with another rig in place of the edited one (a PTZ trace of it: PtzTracedRig);
+  /// `rig_version` is still the edited rig's.
+  std::int64_t RenderInBackground(
+      Rig rig, const RenderView& view, const RenderOptions& options,
+      std::shared_ptr<const PreparedOverlays> overlays,
+      std::function<void(const Image& image, int pass, std::int64_t rig_version)> on_pass);
+
+  /// A PTZ camera's current pan, tilt and zoom (clamped to its ranges; docs/ptz.md, "In the
+  /// viewer"), one undo step: the camera's pose and focal lengths become PtzHead::CameraAt of it.
+  /// Throws InputError (the scene file, the camera's JSON path) for a fixed camera.
+  void SetPtzState(int index, const PtzState& state);
+  /// "Re-centre" a PTZ camera (RecentredPtz in app/session/ptz_edit.h): home becomes the current
+  /// view, pan and tilt 0, presets and ranges shifted; the camera's pose is unchanged. One undo step.
+  /// Throws InputError when the shifted tilt range would fail the scene reader's check.
+  void RecentrePtz(int index);
+  /// "$.rigs[r].cameras[c]": camera `index` of the edited rig in the scene file.
+  std::string CameraJsonPath(int index) const;
 
   /// Writes the edited cameras' poses and focal lengths into the scene file, keeping a backup, as
   /// `pandora accept` does (each in its camera's own form). Refuses (InputError) when the file
@@ -104,6 +121,9 @@ class Session {
   /// text, or when an edit is of a kind the scene file cannot take this way (enabled, lens model,
   /// principal point, range, pixel noise): those are listed. `stations` (viewing stations moved in
   /// the session, suggest/suggestion_file.h ReplaceStations) are written in the same file write.
+  /// A PTZ camera is written as the file describes it: position = pivot, orientation = home, the
+  /// lens = the current zoom, and its "ptz" block's pan_deg / tilt_deg (after a re-centre also the
+  /// shifted ranges and presets) through ReplacePtzHeads; the rest of its block keeps its text.
   SaveResult Save(bool force = false, const std::vector<StationMove>& stations = {});
 
  private:

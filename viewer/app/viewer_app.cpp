@@ -18,6 +18,8 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 
 #include "analysis/error.h"
@@ -253,14 +255,39 @@ struct ViewerApp::Impl {
     return 0.12 * (*o - model.view.Eye()).norm();
   }
 
+  // The "all" PTZ trace rendered in the background: each completed pass of the progressive CPU
+  // frame (coarse first) is uploaded on the next frame. Shared with the job, which may outlive a frame.
+  struct AllTraceSlot {
+    std::mutex mutex;
+    Image image;
+    bool fresh = false;
+    std::int64_t generation = 0;  // of the newest frame asked for; older jobs' passes are dropped
+  };
+  std::shared_ptr<AllTraceSlot> all_trace = std::make_shared<AllTraceSlot>();
+  std::string all_trace_key;  // the main view's key of the newest "all" frame asked for
+
+  void UploadAllTrace() {
+    std::lock_guard<std::mutex> lock(all_trace->mutex);
+    if (!all_trace->fresh) return;
+    all_trace->fresh = false;
+    if (model.ptz_trace != "all") return;  // a pass that finished after the mode changed
+    Upload(&main_texture, all_trace->image.width, all_trace->image.height, ToRgba8(all_trace->image.rgb));
+  }
+
   void RenderMain() {
+    if (full_now && model.ptz_trace == "all" && !all_trace_key.empty()) {
+      // A screenshot shows the exact picture: the background frame's last pass (or a new frame).
+      const session::JobStatus st = model.session().jobs().Wait("render");
+      if (st.state != session::JobState::kDone) all_trace_key.clear(), main_key.clear();
+    }
+    UploadAllTrace();
     RenderView view = model.MainView();
     char key[512];
-    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d",
+    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g",
                   static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
                   view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
                   int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
-                  int(model.display.surface), shadow_map_size);
+                  int(model.display.surface), shadow_map_size, model.ptz_trace.c_str(), model.ptz_trace_s);
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
     const std::int64_t rig_version = model.session().rig().version();
@@ -285,8 +312,49 @@ struct ViewerApp::Impl {
     gl_options.brightness = model.display.brightness;
     gl_options.grid_pixels = model.display.grid_pixels;
     const auto t0 = std::chrono::steady_clock::now();
-    const GlImage image = gl->Render(model.rig(), view, gl_options);
-    Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    if (model.ptz_trace == "all") {
+      // Everything a PTZ head reaches within the budget: the exact CPU renderer's ptz_all (each
+      // surface point against its own best reachable pose; no GPU version yet), at the rig's
+      // brightness as `pandora render --ptz all`. A screenshot waits for the exact picture; the
+      // window renders it progressively in the background (UploadAllTrace shows each pass).
+      RenderOptions o = InsetOptions();
+      if (std::isnan(o.brightness)) o.brightness = DefaultBrightness(model.rig().enabled_count());
+      const Rig traced = model.TracedRig(&o.ptz_all);
+      // A new frame: passes of the older ones are dropped.
+      auto next_generation = [&] {
+        std::lock_guard<std::mutex> lock(all_trace->mutex);
+        all_trace->fresh = false;
+        return ++all_trace->generation;
+      };
+      if (full_now) {
+        next_generation();
+        model.session().jobs().Cancel("render");
+        const Image image = RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
+        Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+        all_trace_key = key;
+      } else if (key != all_trace_key) {
+        // Coarse first (1/64 of the pixels), then refined; a newer frame cancels this one.
+        all_trace_key = key;
+        const std::int64_t generation = next_generation();
+        auto slot = all_trace;
+        model.session().RenderInBackground(traced, model.MainView(), o, nullptr,
+                                           [slot, generation](const Image& image, int, std::int64_t) {
+                                             std::lock_guard<std::mutex> lock(slot->mutex);
+                                             if (slot->generation != generation) return;
+                                             slot->image = image;
+                                             slot->fresh = true;
+                                           });
+      }
+      main_full = true;  // the background frame refines itself
+    } else {
+      // "path": the steps home -> current as extra lights, at the rig's own brightness.
+      all_trace_key.clear();
+      GlRenderOptions o = gl_options;
+      if (model.ptz_trace != "single" && std::isnan(o.brightness))
+        o.brightness = DefaultBrightness(model.rig().enabled_count());
+      const GlImage image = gl->Render(model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o);
+      Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    }
     gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     frame_gl_seconds = gl_seconds;
     // Adaptive resolution while moving: the next moving frame's scale aims at the target rate
@@ -973,11 +1041,78 @@ struct ViewerApp::Impl {
       a.number = hfov;
       Do(a);
     }
+    if (cam.ptz) PtzControls(cam);
     LensControls(cam);
     ImGui::DragFloat("snap move m", &move_step, 0.005f, 0.0f, 1.0f, "%.3f");
     ImGui::DragFloat("snap turn deg", &rotate_step, 0.5f, 0.0f, 45.0f, "%.1f");
     ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)", model.selection.size());
     ImGui::End();
+  }
+
+  // A PTZ camera's head (docs/ptz.md, "In the viewer"): pan, tilt and zoom sliders over its ranges,
+  // its presets, re-centre, and the traces of the main view; each a script action.
+  float trace_seconds = NAN;  // the "all" budget shown (NaN: the head's trace_s)
+  void PtzControls(const Camera& cam) {
+    const PtzHead& h = *cam.ptz;
+    if (!ImGui::CollapsingHeader("Pan / tilt / zoom", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const Intrinsics& k = cam.model.intrinsics();
+    auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kDeg); };
+    const Vec3 pivot = h.home.translation();
+    ImGui::TextDisabled("pivot %.3f %.3f %.3f, home elevation %.1f deg", pivot.x(), pivot.y(), pivot.z(),
+                        h.HomeElevationDeg());
+    float pan = float(h.current.pan_deg), tilt = float(h.current.tilt_deg), zoom = hfov(h.current.focal);
+    Action a = Make(Action::Kind::kPtz, {cam.id});
+    a.drag = true;
+    if (ImGui::SliderFloat("pan deg", &pan, float(h.pan_min_deg), float(h.pan_max_deg), "%.1f")) {
+      a.pan_deg = pan;
+      Do(a);
+    }
+    if (ImGui::SliderFloat("tilt deg", &tilt, float(h.tilt_min_deg), float(h.tilt_max_deg), "%.1f")) {
+      a.tilt_deg = tilt;
+      Do(a);
+    }
+    if (h.focal_max > h.focal_min) {
+      if (ImGui::SliderFloat("zoom hfov deg", &zoom, hfov(h.focal_min), hfov(h.focal_max), "%.1f")) {
+        a.hfov_deg = zoom;
+        Do(a);
+      }
+    } else {
+      ImGui::TextDisabled("fixed focal length (no zoom_hfov_deg)");
+    }
+    if (!h.presets.empty()) {
+      ImGui::TextUnformatted("presets:");
+      for (const PtzPreset& p : h.presets) {
+        ImGui::SameLine();
+        if (ImGui::SmallButton(p.name.c_str())) {
+          Action go = Make(Action::Kind::kPtz, {cam.id});
+          go.preset = p.name;
+          Do(go);
+        }
+      }
+    }
+    if (ImGui::Button("Re-centre")) Do(Make(Action::Kind::kRecentre, {cam.id}));
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("home := the current view; presets and ranges shift so that every preset stays where it is");
+    ImGui::TextUnformatted("trace:");
+    for (const char* mode : {"single", "path", "all"}) {
+      ImGui::SameLine();
+      if (ImGui::RadioButton(mode, model.ptz_trace == mode)) {
+        Action t = Make(Action::Kind::kTrace, {});
+        t.text = mode;
+        t.number = std::isnan(trace_seconds) ? NAN : double(trace_seconds);
+        Do(t);
+      }
+    }
+    float budget = std::isnan(model.ptz_trace_s) ? float(h.trace_s) : float(model.ptz_trace_s);
+    if (ImGui::DragFloat("budget s", &budget, 0.05f, 0.0f, 60.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+      trace_seconds = budget;
+      Action t = Make(Action::Kind::kTrace, {});
+      t.text = model.ptz_trace;
+      t.number = budget;
+      Do(t);
+    }
+    ImGui::TextDisabled(model.ptz_trace == "all" ? "all: exact CPU picture (slow while moving)"
+                                                  : "path: one light per second home -> current");
   }
 
   // On/off, colour, resolution, lens model and coefficients, working range: each a script action.

@@ -10,6 +10,7 @@
 #include "analysis/pose.h"
 #include "analysis/rig_check.h"
 #include "app/session/autosave.h"
+#include "app/session/ptz_edit.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
 #include "volume/fields.h"
@@ -53,6 +54,15 @@ std::string UnsavableChanges(const Camera& saved, const Camera& now) {
   return out;
 }
 
+std::string PtzStatus(const Camera& cam, bool clamped) {
+  const PtzState& s = cam.ptz->current;
+  char line[200];
+  std::snprintf(line, sizeof line, "%s (PTZ): pan %.1f, tilt %.1f, hfov %.1f deg%s", cam.id.c_str(), s.pan_deg,
+                s.tilt_deg, HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kDeg,
+                clamped ? " (limited by its ranges)" : "");
+  return line;
+}
+
 }  // namespace
 
 std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram) {
@@ -65,6 +75,10 @@ std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram) 
     shares.push_back(total > 0 ? double(at_least) / total : 0.0);
   }
   return shares;
+}
+
+Rig ViewerModel::TracedRig(std::vector<RenderOptions::PtzTrace>* all) const {
+  return session::PtzTracedRig(rig(), ptz_trace, ptz_trace_s, all);
 }
 
 void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, int camera) {
@@ -86,6 +100,13 @@ void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, 
     model.session().ReadFields([&](const Fields& fields, std::int64_t) {
       overlays = std::make_unique<PreparedOverlays>(fields, options.overlays);
     });
+  if (camera < 0 && model.ptz_trace != "single") {
+    // The traces light the main view, at the rig's brightness (as `pandora render --ptz`).
+    if (std::isnan(options.brightness)) options.brightness = DefaultBrightness(model.rig().enabled_count());
+    const Rig traced = model.TracedRig(&options.ptz_all);
+    WritePng(RenderWithStats(model.session().study().prepared(), traced, view, options, overlays.get(), nullptr), path);
+    return;
+  }
   WritePng(model.session().Render(view, options, overlays.get()), path);
 }
 
@@ -219,6 +240,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
   const std::string& file = scene().path;
   // Applies camera changes as one undo step (a drag's later steps amend its first).
   const std::string drag = a.drag ? drag_label_ : std::string();
+  std::string ptz_status;  // a PTZ camera's setting after a pose edit
   drag_label_.clear();
   auto apply = [&](const std::vector<int>& cams, const std::string& label, const auto& change) {
     session::Edit e;
@@ -226,6 +248,15 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
     for (int c : cams) {
       session::CameraEdit ce{c, rig().cameras[c], rig().cameras[c]};
       change(ce.after);
+      // A PTZ camera's base stays level and its head turns: a pose or zoom asked of it moves the
+      // pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md, "In the viewer").
+      if (ce.before.ptz && ce.after.ptz == ce.before.ptz &&
+          (ce.after.world_from_camera.matrix() != ce.before.world_from_camera.matrix() ||
+           ce.after.model.intrinsics().fx != ce.before.model.intrinsics().fx)) {
+        bool clamped = false;
+        ce.after = session::PtzFollow(ce.before, ce.after, &clamped);
+        ptz_status = PtzStatus(ce.after, clamped);
+      }
       e.changes.push_back(std::move(ce));
     }
     if (a.drag && drag == label && edit.CanAmend(cams)) edit.Amend(e);
@@ -307,6 +338,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
                                                                [](double v) { return !std::isnan(v); });
       apply(cams, label("lens", cams), [&](Camera& cam) {
         Intrinsics k = cam.model.intrinsics();
+        if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
+          throw InputError(a.where, "", "camera '" + cam.id + "' is a PTZ camera: its zoom range is in pixels of its "
+                                            "resolution and lens, which the viewer does not convert",
+                           "change its resolution or lens model in the scene file");
         if (a.width > 0) {
           // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
           const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;
@@ -581,6 +616,64 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       ++stations_version;
       break;
     }
+    case Kind::kPtz: {
+      const int c = CameraIndex(a.cameras[0], a);
+      const Camera& cam = rig().cameras[c];
+      if (!cam.ptz)
+        throw InputError(a.where, "", "camera '" + cam.id + "' has no pan-tilt-zoom head",
+                         "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
+      PtzState s = cam.ptz->current;
+      if (!a.preset.empty()) {
+        std::string names;
+        const PtzPreset* found = nullptr;
+        for (const PtzPreset& p : cam.ptz->presets) {
+          if (p.name == a.preset) found = &p;
+          names += (names.empty() ? "" : ", ") + p.name;
+        }
+        if (!found)
+          throw InputError(a.where, "", "camera '" + cam.id + "' has no preset '" + a.preset + "'",
+                           names.empty() ? "it has no presets" : "presets: " + names);
+        s = found->state;
+      } else {
+        if (!std::isnan(a.pan_deg)) s.pan_deg = a.pan_deg;
+        if (!std::isnan(a.tilt_deg)) s.tilt_deg = a.tilt_deg;
+        if (!std::isnan(a.hfov_deg)) {
+          const Intrinsics& k = cam.model.intrinsics();
+          if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
+            throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+          s.focal = FocalFromHfov(a.hfov_deg * kDeg, k.width, k.model);
+        }
+      }
+      const PtzState want = s;
+      const PtzState got = session::ClampPtzState(*cam.ptz, want);
+      apply({c}, label("pan/tilt/zoom", {c}), [&](Camera& x) { x = session::WithPtzState(x, want); });
+      const bool clamped = std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 || std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
+                           (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
+      status = PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
+      break;
+    }
+    case Kind::kRecentre: {
+      const int c = CameraIndex(a.cameras[0], a);
+      const std::string where = session_->CameraJsonPath(c);
+      apply({c}, label("re-centre", {c}), [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
+      const PtzHead& h = *rig().cameras[c].ptz;
+      char line[200];
+      std::snprintf(line, sizeof line, "%s: home is now the current view (pan [%.1f, %.1f], tilt [%.1f, %.1f] deg)",
+                    rig().cameras[c].id.c_str(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg, h.tilt_max_deg);
+      status = line;
+      break;
+    }
+    case Kind::kTrace: {
+      bool any = false;
+      session::PtzTracedRig(rig(), a.text, a.number, nullptr, &any);
+      if (!any && a.text != "single")
+        throw InputError(a.where, "", "rig '" + rig().name + "' has no enabled PTZ camera",
+                         "add a \"ptz\" block to a camera (docs/ptz.md)");
+      ptz_trace = a.text;
+      ptz_trace_s = a.number;
+      status = "PTZ trace: " + a.text;
+      break;
+    }
     case Kind::kMouse:
     case Kind::kKey:
     case Kind::kScroll:
@@ -588,6 +681,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (frontend) frontend->Input(*this, a);
       break;
   }
+  if (status.empty() && !ptz_status.empty()) status = ptz_status;
 }
 
 nlohmann::json ViewerModel::StateJson() const {
@@ -610,6 +704,20 @@ nlohmann::json ViewerModel::StateJson() const {
                        {"lens", lens},
                        {"range", {c.near, std::isfinite(c.far) ? json(c.far) : json()}},
                        {"color", {c.color.x(), c.color.y(), c.color.z()}}});
+    if (c.ptz) {
+      const PtzHead& h = *c.ptz;
+      const Vec3 pivot = h.home.translation();
+      const Eigen::Quaterniond q(h.home.rotation());
+      json presets = json::array();
+      for (const PtzPreset& p : h.presets) presets.push_back({{"name", p.name}, {"pan_deg", p.state.pan_deg}, {"tilt_deg", p.state.tilt_deg}});
+      cameras.back()["ptz"] = {{"pan_deg", h.current.pan_deg},
+                               {"tilt_deg", h.current.tilt_deg},
+                               {"pivot", {pivot.x(), pivot.y(), pivot.z()}},
+                               {"home_quaternion", {q.w(), q.x(), q.y(), q.z()}},
+                               {"pan_range_deg", {h.pan_min_deg, h.pan_max_deg}},
+                               {"tilt_range_deg", {h.tilt_min_deg, h.tilt_max_deg}},
+                               {"presets", presets}};
+    }
   }
   json selected = json::array();
   for (int c : selection) selected.push_back(rig().cameras[c].id);
@@ -622,6 +730,7 @@ nlohmann::json ViewerModel::StateJson() const {
     fields["sigma_max_p50_mm"] = p50 ? json(*p50) : json();
   });
   json j = {{"rig", rig().name},
+            {"ptz_trace", ptz_trace},
             {"rig_version", edit.version()},
             {"undo", edit.undo_label()},
             {"redo", edit.redo_label()},

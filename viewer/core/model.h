@@ -8,6 +8,7 @@
 /// for the GPU (CpuFrontend).
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -89,6 +90,15 @@ class ViewerModel {
   /// saved and / or other rigs of the scene (each evaluated once and kept while it stays the same).
   std::optional<report::RigComparison> comparison;
   std::int64_t comparison_rig_version = -1;  ///< The edited rig's version it was made for.
+
+  /// PTZ traces of the main view (docs/ptz.md): "single", "path" (one light per second home ->
+  /// current) or "all" (everything reachable within the budget; the exact CPU renderer's
+  /// RenderOptions::ptz_all); the budget in seconds, NaN: each head's trace_s.
+  std::string ptz_trace = "single";
+  double ptz_trace_s = std::numeric_limits<double>::quiet_NaN();
+  /// The rig the main view lights: the edited rig with the PTZ cameras' traces (PtzTracedRig);
+  /// `all` (may be null) receives the "all" traces for RenderOptions::ptz_all.
+  Rig TracedRig(std::vector<RenderOptions::PtzTrace>* all) const;
 
   /// The main view as the renderer takes it.
   RenderView MainView() const { return view.ToRenderView(width, height); }

@@ -137,7 +137,8 @@ const std::map<std::string, Kind>& Kinds() {
       {"suggest", Kind::kSuggest}, {"accept", Kind::kAccept}, {"reject", Kind::kReject},
       {"save", Kind::kSave},     {"screenshot", Kind::kScreenshot}, {"size", Kind::kSize},
       {"mouse", Kind::kMouse},   {"key", Kind::kKey},         {"scroll", Kind::kScroll},
-      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}, {"station", Kind::kStation}};
+      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}, {"station", Kind::kStation},
+      {"ptz", Kind::kPtz},       {"recentre", Kind::kRecentre}, {"trace", Kind::kTrace}};
   return kinds;
 }
 
@@ -417,6 +418,31 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       if (e.Has("eye_at") == e.Has("display_at")) e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
       a.flag = e.Has("display_at");
       a.a = e.Vector(a.flag ? "display_at" : "eye_at");
+      break;
+    case Kind::kPtz:
+      e.Keys({"ptz", "pan_deg", "tilt_deg", "hfov_deg", "preset", "drag"});
+      a.drag = e.Has("drag") && j.at("drag") == true;
+      a.cameras = {e.String("ptz")};
+      if (e.Has("preset")) {
+        if (e.Has("pan_deg") || e.Has("tilt_deg") || e.Has("hfov_deg"))
+          e.Fail("preset", "give a preset or angles, not both");
+        a.preset = e.String("preset");
+        break;
+      }
+      if (!e.Has("pan_deg") && !e.Has("tilt_deg") && !e.Has("hfov_deg"))
+        e.Fail("", "nothing to change", "give pan_deg, tilt_deg, hfov_deg or a preset");
+      a.pan_deg = e.Number("pan_deg", -360, 360, NAN);
+      a.tilt_deg = e.Number("tilt_deg", -180, 180, NAN);
+      a.hfov_deg = e.Number("hfov_deg", 0.01, 359, NAN);
+      break;
+    case Kind::kRecentre:
+      e.Keys({"recentre"});
+      a.cameras = {e.String("recentre")};
+      break;
+    case Kind::kTrace:
+      e.Keys({"trace", "seconds"});
+      a.text = e.OneOf("trace", {"single", "path", "all"});
+      a.number = e.Number("seconds", 0, 3600, NAN);
       break;
     case Kind::kFrames:
       e.Keys({"frames"});

@@ -43,8 +43,13 @@
 ///      {"key": "ctrl+z"}, {"scroll": 1.0, "x": 640, "y": 360},
 ///      {"gamepad": "c03", "left": [0, -1], "right": [0, 0], "seconds": 0.5},
 ///      {"frames": 3},                                   // let the window draw
-///      {"station": "remote", "eye_at": [x, y, z]}]      // move a viewing station's eye
+///      {"station": "remote", "eye_at": [x, y, z]},      // move a viewing station's eye
 ///                                                      // ("display_at": its display's centre)
+///      {"ptz": "dome", "pan_deg": 30, "tilt_deg": -10, "hfov_deg": 40},  // a PTZ camera's current
+///                                                      // setting (any of the three; clamped)
+///      {"ptz": "dome", "preset": "window"},             // ... go to a preset
+///      {"recentre": "dome"},                            // home := the current view (docs/ptz.md)
+///      {"trace": "path"}, {"trace": "all", "seconds": 1.5}]  // PTZ traces: single, path, all
 /// Unknown actions or keys, wrong types and out-of-range values are refused when the script is
 /// read, before anything runs: InputError naming the file and the JSON path ("$[4].by").
 
@@ -61,7 +66,7 @@ struct Action {
   enum class Kind {
     kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kIntrinsics, kRange, kColor, kCompare, kUndo, kRedo, kSlice, kIso, kView,
     kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
-    kMouse, kKey, kScroll, kGamepad, kFrames, kStation,
+    kMouse, kKey, kScroll, kGamepad, kFrames, kStation, kPtz, kRecentre, kTrace,
   };
   Kind kind = Kind::kFrames;
   std::string where;                 ///< "$[i]": for messages while running.
@@ -97,6 +102,11 @@ struct Action {
   /// mouse: the gizmo handle aimed at (0..2 axes x y z, 3..5 rings; -1: none) and "by" along it
   /// (metres, or degrees on a ring; in `number`); with `has_a`, the world point `a` instead of x, y.
   int gizmo = -1;
+  /// ptz: pan, tilt and horizontal field of view in degrees (NaN: kept) and a preset name ("":
+  /// none; the angles are then not given). trace: `text` the mode, `number` the budget (NaN: each
+  /// head's trace_s).
+  double pan_deg = NAN, tilt_deg = NAN, hfov_deg = NAN;
+  std::string preset;
 };
 
 /// The names of Action::coefficients, in order: k1 k2 p1 p2 k3 k4.

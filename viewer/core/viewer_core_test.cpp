@@ -772,3 +772,129 @@ TEST(ViewerModel, CompareTheEditedRigWithTheSavedOne) {
 
 }  // namespace
 }  // namespace pandora::viewer
+
+namespace pandora::viewer {
+namespace {
+
+// A PTZ camera in the viewer (docs/ptz.md, "In the viewer"): its script actions, the gizmo's turn
+// becoming pan, presets, re-centre, save, and the traces lighting the main view.
+TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
+  // The script actions and their refusals with the JSON path.
+  EXPECT_EQ(ParseScript(R"([{"ptz": "dome", "pan_deg": 63, "tilt_deg": -3, "hfov_deg": 40}])", "s.json")[0].pan_deg, 63);
+  EXPECT_EQ(ParseScript(R"([{"ptz": "dome", "preset": "window"}])", "s.json")[0].preset, "window");
+  EXPECT_EQ(ParseScript(R"([{"trace": "all", "seconds": 1.5}])", "s.json")[0].number, 1.5);
+  EXPECT_TRUE(std::isnan(ParseScript(R"([{"trace": "path"}])", "s.json")[0].number));
+  for (const auto& [script, where] : std::vector<std::pair<std::string, std::string>>{
+           {R"([{"ptz": "dome"}])", "s.json: $[0]: nothing to change"},
+           {R"([{"ptz": "dome", "preset": "window", "pan_deg": 3}])", "s.json: $[0].preset"},
+           {R"([{"ptz": "dome", "tilt_deg": 200}])", "s.json: $[0].tilt_deg"},
+           {R"([{"trace": "sweep"}])", "s.json: $[0].trace: unknown value 'sweep'"},
+           {R"([{"recentre": "dome", "x": 1}])", "s.json: $[0].x"}}) {
+    try {
+      ParseScript(script, "s.json");
+      ADD_FAILURE() << script;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  }
+
+  const fs::path dir = fs::path(::testing::TempDir()) / "viewer_ptz";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file("examples/ptz_home/scene.json", dir / "scene.json");
+  const fs::path scene = dir / "scene.json";
+  const std::string original = Read(scene);
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  options.width = 160;
+  options.height = 100;
+  ViewerModel m(session::Study::Load(scene.string()), options);
+  CpuFrontend cpu;
+  const PtzHead h0 = *m.rig().cameras[0].ptz;
+  auto head = [&]() -> const PtzHead& { return *m.rig().cameras[0].ptz; };
+  m.Run(ParseScript(R"([{"select": "dome"}, {"ptz": "dome", "pan_deg": 30, "tilt_deg": -10, "hfov_deg": 40}])", "s.json"), &cpu);
+  EXPECT_EQ(head().current.pan_deg, 30);
+  EXPECT_EQ(head().current.tilt_deg, -10);
+  EXPECT_EQ(m.status, "dome (PTZ): pan 30.0, tilt -10.0, hfov 40.0 deg");
+  EXPECT_EQ(m.rig().cameras[0].world_from_camera.matrix(), head().Pose(head().current).matrix());
+  // The gizmo's turn of 15 degrees about +z (the pan axis) pans by 15; tilt stays.
+  m.Run(ParseScript(R"([{"rotate": "dome", "axis": [0, 0, 1], "deg": 15}])", "s.json"), &cpu);
+  EXPECT_NEAR(head().current.pan_deg, 45, 1e-9);
+  EXPECT_NEAR(head().current.tilt_deg, -10, 1e-9);
+  EXPECT_EQ(head().home.matrix(), h0.home.matrix());
+  // A turn beyond the tilt range stops at it and says so.
+  m.Run(ParseScript(R"([{"orient": "dome", "ypr_deg": [0, 40, 0]}])", "s.json"), &cpu);
+  EXPECT_NEAR(head().current.tilt_deg, 10, 1e-12);
+  EXPECT_NE(m.status.find("(limited by its ranges)"), std::string::npos) << m.status;
+  // A move takes the pivot along.
+  m.Run(ParseScript(R"([{"undo": 1}, {"move": "dome", "by": [0.2, 0, 0]}])", "s.json"), &cpu);
+  EXPECT_LT((head().home.translation() - h0.home.translation() - Vec3(0.2, 0, 0)).norm(), 1e-15);
+  EXPECT_NEAR(head().current.pan_deg, 45, 1e-9);
+  // Presets; an unknown one is refused naming the presets.
+  m.Run(ParseScript(R"([{"undo": 1}, {"ptz": "dome", "preset": "west_door"}])", "s.json"), &cpu);
+  EXPECT_EQ(head().current.pan_deg, 63);
+  EXPECT_EQ(head().current.tilt_deg, -3);
+  try {
+    m.Run(ParseScript(R"([{"ptz": "dome", "preset": "garage"}])", "s.json"), &cpu);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("presets: window, west_door, east_door"), std::string::npos) << e.what();
+  }
+  // A resolution or lens model change would leave the zoom range in the old pixels: refused.
+  for (const char* script : {R"([{"intrinsics": "dome", "resolution": [640, 360]}])",
+                             R"([{"intrinsics": "dome", "model": "fisheye"}])"}) {
+    try {
+      m.Run(ParseScript(script, "s.json"), &cpu);
+      ADD_FAILURE() << script;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is a PTZ camera: its zoom range is in pixels"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(m.rig().cameras[0].model.width(), 1280);
+  // Re-centre: the view stays, the west door preset is home now.
+  const Eigen::Isometry3d pose = m.rig().cameras[0].world_from_camera;
+  m.Run(ParseScript(R"([{"recentre": "dome"}])", "s.json"), &cpu);
+  EXPECT_LT((m.rig().cameras[0].world_from_camera.matrix() - pose.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(head().presets[1].state.pan_deg, 0, 1e-12);
+  EXPECT_EQ(m.session().rig().undo_label(), "re-centre dome");
+  m.Run(ParseScript(R"([{"ptz": "dome", "pan_deg": -20}])", "s.json"), &cpu);
+
+  // Traces: path and all light parts of the room the current view does not (pixels brighter than
+  // the single trace's by more than 0.05 in linear RGB summed).
+  m.Run(ParseScript(R"([{"screenshot": ")" + (dir / "single.png").string() + R"("},
+                        {"trace": "path"}, {"screenshot": ")" + (dir / "path.png").string() + R"("},
+                        {"trace": "all", "seconds": 1.5}, {"screenshot": ")" + (dir / "all.png").string() + R"("}])",
+                    "s.json"),
+        &cpu);
+  EXPECT_EQ(m.ptz_trace, "all");
+  EXPECT_EQ(m.StateJson()["ptz_trace"], "all");
+  const Image single = ReadPng((dir / "single.png").string());
+  auto newly_lit = [&](const std::string& name) {
+    const Image image = ReadPng((dir / name).string());
+    int n = 0;
+    for (int i = 0; i < image.width * image.height; ++i)
+      n += image.rgb[3 * i] + image.rgb[3 * i + 1] + image.rgb[3 * i + 2] >
+           single.rgb[3 * i] + single.rgb[3 * i + 1] + single.rgb[3 * i + 2] + 0.05;
+    return double(n) / (image.width * image.height);
+  };
+  const double path = newly_lit("path.png"), all = newly_lit("all.png");
+  EXPECT_GT(path, 0.02);
+  EXPECT_GT(all, path);
+  std::printf("newly lit: path %.3f, all %.3f of the pixels\n", path, all);
+
+  // Save: the pivot, home and head go into the file, the original into a backup.
+  m.Run(ParseScript(R"([{"save": 1}])", "s.json"), &cpu);
+  EXPECT_NE(m.status.find("saved 1 camera into"), std::string::npos) << m.status;
+  const Scene saved = LoadScene(scene.string());
+  const Camera& back = saved.rigs[0].cameras[0];
+  ASSERT_TRUE(back.ptz);
+  EXPECT_NEAR(back.ptz->current.pan_deg, -20, 1e-9);
+  EXPECT_NEAR(back.ptz->current.tilt_deg, 0, 1e-9);
+  EXPECT_NEAR(back.ptz->presets[1].state.pan_deg, 0, 1e-9);
+  EXPECT_LT((back.world_from_camera.matrix() - m.rig().cameras[0].world_from_camera.matrix()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ(Read(dir / "scene.json.bak"), original);
+  m.session().WaitFields();
+}
+
+}  // namespace
+}  // namespace pandora::viewer
