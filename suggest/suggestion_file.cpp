@@ -379,10 +379,7 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
       }
     }
   }
-  const auto [indent, ch] = Indentation(text);
-  std::string out = root.dump(indent, ch);
-  if (!text.empty() && text.back() == '\n') out += "\n";
-  return out;
+  return scene_text::DumpLike(root, text);
 }
 
 std::string ReplaceStations(const std::string& text, const std::string& scene_path,
