@@ -27,6 +27,8 @@ FieldSlice SliceField(const Fields& fields, const std::string& field, int axis, 
   openvdb::FloatGrid::Ptr float_grid;
   if (field != kCoverageGrid) {
     float_grid = g.Float(field);
+    if (!float_grid)
+      if (auto it = g.extra.find(field); it != g.extra.end()) float_grid = it->second;  // a derived grid
     if (!float_grid) throw std::invalid_argument("SliceField: field '" + field + "' was not evaluated");
   }
   const VoxelLattice& L = fields.lattice;
