@@ -95,6 +95,46 @@ TEST(Ptz, ReachTimeEqualsTheClosedFormWhereOneAxisDecides) {
   }
 }
 
+// Both axes move at once: a point off in azimuth and elevation is reached when the slower axis gets
+// there, not after the sum. Pan deciding: the tilt (faster here) has put the point on the image's
+// horizontal midline, tilt atan2(sin el, cos el cos d) for an azimuth residual d, and the point
+// enters the image where that midline meets the edge, at d = asin(sin h / cos el) (h: the half
+// angle of the image's horizontal edge). Tilt deciding: the pan has centred the azimuth, and the
+// point enters at the vertical edge, el - tilt = v.
+TEST(Ptz, ReachTimeEqualsTheClosedFormWithBothAxesMoving) {
+  const auto point = [](double az, double el) -> Vec3 {
+    return Vec3(0, 0, 3) + 4.0 * Vec3(-std::sin(Rad(az)) * std::cos(Rad(el)), std::cos(Rad(az)) * std::cos(Rad(el)),
+                                      std::sin(Rad(el)));
+  };
+  {
+    const Scene scene = PtzScene(R"("pan_speed_deg_s": 50, "tilt_speed_deg_s": 40)");
+    const Camera& c = scene.rigs[0].cameras[0];
+    const PtzReach reach(c, *c.ptz, c.ptz->Home());
+    const Intrinsics k = c.model.intrinsics();
+    const double h = std::atan((k.width - 1 - k.cx + 0.5) / k.fx);
+    for (const auto& [az, el] : {std::pair{100.0, -35.0}, {-120.0, -50.0}, {70.0, 25.0}}) {
+      const double d = std::asin(std::sin(h) / std::cos(Rad(el))) * 180 / kPi;
+      const double expected = (std::abs(az) - d) / 50;
+      const double tilt = std::atan2(std::sin(Rad(el)), std::cos(Rad(el)) * std::cos(Rad(d))) * 180 / kPi;
+      ASSERT_LT(std::abs(tilt) / 40, expected - 0.1);  // the tilt is there first: the pan decides
+      EXPECT_NEAR(reach.ReachTime(point(az, el), nullptr, 1e-7), expected, 1e-5) << az << " " << el;
+      EXPECT_LT(expected, std::abs(az) / 50 + std::abs(tilt) / 40 - 0.5);  // not the sum
+    }
+  }
+  {
+    const Scene scene = PtzScene(R"("pan_speed_deg_s": 100, "tilt_speed_deg_s": 20)");
+    const Camera& c = scene.rigs[0].cameras[0];
+    const PtzReach reach(c, *c.ptz, c.ptz->Home());
+    const Intrinsics k = c.model.intrinsics();
+    const double v = std::atan((k.height - 1 - k.cy + 0.5) / k.fy) * 180 / kPi;
+    for (const auto& [az, el] : {std::pair{30.0, -60.0}, {-75.0, -70.0}, {120.0, 55.0}}) {
+      const double expected = (std::abs(el) - v) / 20;
+      ASSERT_LT(std::abs(az) / 100, expected - 0.1);  // the pan is there first: the tilt decides
+      EXPECT_NEAR(reach.ReachTime(point(az, el), nullptr, 1e-7), expected, 1e-5) << az << " " << el;
+    }
+  }
+}
+
 // A rig written back (viewer save, autosave, output metadata) keeps the head: the file pose is home
 // at the pivot, the ptz block holds the current setting, and it reads back to the same camera.
 TEST(Ptz, RigToJsonKeepsTheHeadAndReadsBack) {
