@@ -27,11 +27,7 @@ int RunSuggest(const SuggestArgs& args) {
   if (!args.target_region.empty())
     throw InputError("--target-region", "", "is for --ptz-preset and --ptz-tour", "use --target-surface for camera nudges");
   // Parse and check: the study through the session layer, then every option against it.
-  session::SessionOptions session_options;
-  session_options.rig = args.rig;
-  session_options.rig_option = "--rig";
-  session_options.disable = args.disable;
-  session::Session session(session::Study::Load(args.scene), session_options);
+  session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
   const Rig file_rig = session.rig().rig();
   SuggestOptions options = SuggestOptionsFromArgs(args, scene, file_rig);

@@ -34,6 +34,14 @@ std::vector<std::size_t> Targets(const char* option, const std::string& entry, c
 
 }  // namespace
 
+session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
+  session::SessionOptions o;
+  o.rig = args.rig;
+  o.rig_option = "--rig";
+  o.disable = args.disable;
+  return o;
+}
+
 SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
   SuggestOptions options;
   options.scene_path = scene.path;

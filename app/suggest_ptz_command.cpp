@@ -12,6 +12,7 @@
 #include "app/options.h"
 #include "app/output.h"
 #include "app/session/session.h"
+#include "app/suggest_options.h"
 #include "suggest/ptz_suggest.h"
 #include "suggest/suggest.h"
 
@@ -58,11 +59,7 @@ int RunSuggestPtz(const SuggestArgs& args) {
   if (args.tour_objective != "mean" && args.tour_objective != "max")
     throw InputError("--tour-objective", "", "unknown objective '" + args.tour_objective + "'", "use mean or max");
   const TourObjective objective = args.tour_objective == "max" ? TourObjective::kMax : TourObjective::kMean;
-  session::SessionOptions session_options;
-  session_options.rig = args.rig;
-  session_options.rig_option = "--rig";
-  session_options.disable = args.disable;
-  session::Session session(session::Study::Load(args.scene), session_options);
+  session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
   const Rig& rig = session.rig().rig();
   const bool preset_mode = !args.ptz_preset.empty();

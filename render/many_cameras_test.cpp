@@ -14,6 +14,7 @@
 #include "render/light.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
+#include "render/test_options.h"
 
 namespace pandora {
 namespace {
@@ -71,15 +72,7 @@ Scene ManyCameraScene(int n) {
   return scene;
 }
 
-RenderOptions Plain() {
-  RenderOptions o;
-  o.surface = Surface::kBlack;
-  o.background = Vec3::Zero();
-  o.overlays.cameras = false;
-  o.overlays.key = false;
-  o.layers = false;
-  return o;
-}
+RenderOptions Plain() { return LightOnlyOptions(); }
 
 TEST(ManyCameras, ThousandCameraCoverageEqualsABruteForceVisibilityCount) {
   const Scene scene = ManyCameraScene(1000);

@@ -17,6 +17,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "render/render.h"
+#include "render/test_options.h"
 
 namespace pandora {
 namespace {
@@ -48,12 +49,7 @@ Scene Room(const std::string& offset) {
 }
 
 RenderOptions Black() {
-  RenderOptions o;
-  o.surface = Surface::kBlack;
-  o.background = Vec3::Zero();
-  o.overlays.cameras = false;
-  o.overlays.key = false;
-  o.layers = false;
+  RenderOptions o = LightOnlyOptions();
   o.brightness = 1.0;
   return o;
 }

@@ -85,25 +85,20 @@ json Header(const std::string& kind, const Scene& scene, const Rig& rig, bool im
 // The rig, camera and its ptz block in an ordered scene file; InputError when not there.
 ordered_json& FindPtzBlock(ordered_json& root, const std::string& path, const std::string& rig_name,
                            const std::string& camera, std::string* where) {
-  if (!root.is_object() || !root.contains("rigs") || !root["rigs"].is_array())
-    throw InputError(path, "$.rigs", "no rigs");
-  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
-    ordered_json& rig = root["rigs"][r];
-    if (!rig.is_object() || !rig.contains("name") || rig["name"] != rig_name) continue;
-    if (!rig.contains("cameras") || !rig["cameras"].is_array()) break;
-    for (std::size_t c = 0; c < rig["cameras"].size(); ++c) {
-      ordered_json& cam = rig["cameras"][c];
-      if (!cam.is_object() || !cam.contains("id") || scene_text::IdOf(cam["id"]) != camera) continue;
-      *where = "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "].ptz";
-      if (!cam.contains("ptz") || !cam["ptz"].is_object())
-        throw InputError(path, *where, "camera '" + camera + "' has no ptz block",
-                         "the scene file no longer matches the suggestion");
-      return cam["ptz"];
-    }
-    throw InputError(path, "$.rigs[" + std::to_string(r) + "].cameras", "no camera '" + camera + "' in rig '" + rig_name + "'",
-                     "the scene file no longer matches the suggestion");
+  const std::string hint = "the scene file no longer matches the suggestion";
+  std::size_t r = 0;
+  ordered_json& rig = scene_text::FindRig(root, path, rig_name, hint, &r);
+  const std::string cameras = "$.rigs[" + std::to_string(r) + "].cameras";
+  if (!rig.contains("cameras") || !rig["cameras"].is_array()) throw InputError(path, cameras, "no cameras", hint);
+  for (std::size_t c = 0; c < rig["cameras"].size(); ++c) {
+    ordered_json& cam = rig["cameras"][c];
+    if (!cam.is_object() || !cam.contains("id") || scene_text::IdOf(cam["id"]) != camera) continue;
+    *where = cameras + "[" + std::to_string(c) + "].ptz";
+    if (!cam.contains("ptz") || !cam["ptz"].is_object())
+      throw InputError(path, *where, "camera '" + camera + "' has no ptz block", hint);
+    return cam["ptz"];
   }
-  throw InputError(path, "$.rigs", "no rig called '" + rig_name + "'", "the scene file no longer matches the suggestion");
+  throw InputError(path, cameras, "no camera '" + camera + "' in rig '" + rig_name + "'", hint);
 }
 
 }  // namespace

@@ -57,6 +57,22 @@ ordered_json ParseOrdered(const std::string& text, const std::string& scene_path
   }
 }
 
+ordered_json& FindRig(ordered_json& root, const std::string& path, const std::string& rig_name,
+                      const std::string& hint, std::size_t* index) {
+  if (!root.is_object() || !root.contains("rigs") || !root["rigs"].is_array())
+    throw InputError(path, "$.rigs", "no rigs");
+  ordered_json* rig = nullptr;
+  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
+    ordered_json& candidate = root["rigs"][r];
+    if (candidate.is_object() && candidate.contains("name") && candidate["name"] == rig_name) {
+      rig = &candidate;
+      if (index) *index = r;
+    }
+  }
+  if (!rig) throw InputError(path, "$.rigs", "no rig called '" + rig_name + "'", hint);
+  return *rig;
+}
+
 std::string DumpLike(const ordered_json& root, const std::string& original) {
   const auto [indent, ch] = Indentation(original);
   std::string out = root.dump(indent, ch);

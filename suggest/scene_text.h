@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -21,6 +22,10 @@ ordered_json ParseOrdered(const std::string& text, const std::string& path);
 std::pair<int, char> Indentation(const std::string& text);
 /// `root` serialised with `original`'s indentation and final newline.
 std::string DumpLike(const ordered_json& root, const std::string& original);
+/// The rig called `rig_name` in `root` (its index in `index` when given); InputError (file = path,
+/// "$.rigs") when the file has no rigs or none of that name, with `hint`.
+ordered_json& FindRig(ordered_json& root, const std::string& path, const std::string& rig_name,
+                      const std::string& hint, std::size_t* index = nullptr);
 /// A camera id as text (ids may be numbers).
 std::string IdOf(const ordered_json& id);
 /// The double nearest the 12-significant-digit decimal of v: what a person would have typed.

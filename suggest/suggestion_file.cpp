@@ -193,26 +193,14 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   return j.dump(1) + "\n";
 }
 
-// The scene text as ordered JSON (keys keep their order when written back).
-
 std::string ReplacePoses(const std::string& text, const std::string& scene_path,
                          const std::string& rig_name, const std::vector<PoseUpdate>& poses,
                          std::vector<std::string>* notes) {
   ordered_json root = ParseOrdered(text, scene_path);
   const double mpu = MetresPerUnit(root, scene_path);
-  if (!root.contains("rigs") || !root["rigs"].is_array())
-    throw InputError(scene_path, "$.rigs", "no rigs");
-  ordered_json* rig = nullptr;
   std::size_t rig_index = 0;
-  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
-    ordered_json& candidate = root["rigs"][r];
-    if (candidate.is_object() && candidate.contains("name") && candidate["name"] == rig_name) {
-      rig = &candidate;
-      rig_index = r;
-    }
-  }
-  if (!rig) throw InputError(scene_path, "$.rigs", "no rig called '" + rig_name + "'",
-                             "the scene file no longer matches the suggestion");
+  ordered_json* rig =
+      &scene_text::FindRig(root, scene_path, rig_name, "the scene file no longer matches the suggestion", &rig_index);
   ordered_json& cameras = (*rig)["cameras"];
   for (const PoseUpdate& update : poses) {
     bool found = false;
@@ -295,19 +283,12 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
 std::string ReplacePtzHeads(const std::string& text, const std::string& scene_path, const std::string& rig_name,
                             const std::vector<PtzHeadUpdate>& heads) {
   ordered_json root = ParseOrdered(text, scene_path);
-  if (!root.is_object() || !root.contains("rigs") || !root["rigs"].is_array())
-    throw InputError(scene_path, "$.rigs", "no rigs");
-  ordered_json* rig = nullptr;
   std::size_t rig_index = 0;
-  for (std::size_t r = 0; r < root["rigs"].size(); ++r) {
-    ordered_json& candidate = root["rigs"][r];
-    if (candidate.is_object() && candidate.contains("name") && candidate["name"] == rig_name) {
-      rig = &candidate;
-      rig_index = r;
-    }
-  }
-  if (!rig || !(*rig).contains("cameras") || !(*rig)["cameras"].is_array())
-    throw InputError(scene_path, "$.rigs", "no rig called '" + rig_name + "'", "the scene file no longer matches the session");
+  ordered_json* rig =
+      &scene_text::FindRig(root, scene_path, rig_name, "the scene file no longer matches the session", &rig_index);
+  if (!rig->contains("cameras") || !(*rig)["cameras"].is_array())
+    throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras", "no cameras",
+                     "the scene file no longer matches the session");
   ordered_json& cameras = (*rig)["cameras"];
   constexpr double kDegree = 3.14159265358979323846 / 180.0;
   for (const PtzHeadUpdate& u : heads) {
