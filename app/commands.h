@@ -175,6 +175,23 @@ int RunSuggest(const SuggestArgs& args);
 /// The PTZ part of `pandora suggest` (app/suggest_ptz_command.cpp).
 int RunSuggestPtz(const SuggestArgs& args);
 
+/// `pandora rig`: a generated rig written into the scene file (docs/rig-generators.md).
+struct RigArgs {
+  std::string scene;
+  std::string name;
+  bool replace = false;
+  std::string ring, grid, wall_grid, along;  ///< The layout: exactly one.
+  std::string center, rect, wall, z_range, aim, prefix;
+  double radius = std::numeric_limits<double>::quiet_NaN();
+  double height = std::numeric_limits<double>::quiet_NaN();
+  double start_deg = 0, inset = 0.1, hfov_deg = 60;
+  int count = 0;
+  std::string resolution = "1920x1080";
+  bool dry_run = false;
+  bool quiet = false;
+};
+int RunRig(const RigArgs& args);
+
 /// `pandora accept`: writes the suggested poses into the scene file (backup first).
 struct AcceptArgs {
   std::string suggestion;

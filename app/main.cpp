@@ -294,6 +294,31 @@ int main(int argc, char** argv) {
       ->check(Number(0, 1e6, "times one camera's light", false, true));
   rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
+  RigArgs rig_args;
+  CLI::App* rg = app.add_subcommand("rig", "Generate a rig (ring, ceiling or wall grid, cameras along walls) and write it into the scene file (keeps a backup)");
+  rg->add_option("scene", rig_args.scene, "Scene file (JSON)")->required();
+  rg->add_option("--name", rig_args.name, "Name of the new rig")->required();
+  rg->add_flag("--replace", rig_args.replace, "Overwrite the rig of that name");
+  rg->add_option("--ring", rig_args.ring, "Layout: N cameras on a horizontal circle (--radius, --height, --center X,Y,Z, --start-deg)");
+  rg->add_option("--grid", rig_args.grid, "Layout: NX,NY cameras over a ceiling rectangle (--rect X0,Y0,X1,Y1, --height), looking down unless --aim");
+  rg->add_option("--wall-grid", rig_args.wall_grid, "Layout: NU,NZ cameras over a wall (--wall X0,Y0,X1,Y1, --z-range Z0,Z1, --inset)");
+  rg->add_option("--along", rig_args.along, "Layout: --count cameras evenly along walls X0,Y0,X1,Y1[,X2,Y2...] (--height, --inset)");
+  rg->add_option("--count", rig_args.count, "With --along: how many cameras");
+  rg->add_option("--radius", rig_args.radius, "Ring radius, metres");
+  rg->add_option("--height", rig_args.height, "Camera height, metres");
+  rg->add_option("--center", rig_args.center, "Ring centre X,Y (default: the region's centre)");
+  rg->add_option("--start-deg", rig_args.start_deg, "Ring: the first camera's angle from +x, degrees");
+  rg->add_option("--rect", rig_args.rect, "Ceiling grid rectangle X0,Y0,X1,Y1, metres");
+  rg->add_option("--wall", rig_args.wall, "Wall grid: the wall segment X0,Y0,X1,Y1, metres");
+  rg->add_option("--z-range", rig_args.z_range, "Wall grid: heights Z0,Z1, metres");
+  rg->add_option("--inset", rig_args.inset, "Distance in from the wall, metres")->capture_default_str();
+  rg->add_option("--aim", rig_args.aim, "Point every camera looks at X,Y,Z (default: the region's centre)");
+  rg->add_option("--resolution", rig_args.resolution, "Image size WxH")->capture_default_str();
+  rg->add_option("--hfov", rig_args.hfov_deg, "Horizontal field of view, degrees")->capture_default_str();
+  rg->add_option("--prefix", rig_args.prefix, "Camera id prefix (default: the rig's name and _)");
+  rg->add_flag("--dry-run", rig_args.dry_run, "Print the new scene file instead of writing it");
+  rg->add_flag("-q,--quiet", rig_args.quiet, "Print nothing on success");
+
   SuggestArgs suggest;
   CLI::App* sg = app.add_subcommand(
       "suggest", "Nudge the selected cameras within limits to improve an objective; write a suggestion");
@@ -373,6 +398,7 @@ int main(int argc, char** argv) {
     if (*rep) return RunReport(report);
     if (*sg) return RunSuggest(suggest);
     if (*ac) return RunAccept(accept);
+    if (*rg) return RunRig(rig_args);
   } catch (const pandora::InputError& e) {
     std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
@@ -71,6 +72,18 @@ ordered_json& FindRig(ordered_json& root, const std::string& path, const std::st
   }
   if (!rig) throw InputError(path, "$.rigs", "no rig called '" + rig_name + "'", hint);
   return *rig;
+}
+
+double MetresPerUnit(const ordered_json& root, const std::string& path) {
+  if (!root.contains("units")) return 1.0;
+  const ordered_json& u = root["units"];
+  static const std::map<std::string, double> units{
+      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
+  if (u.is_string()) {
+    auto it = units.find(u.get<std::string>());
+    if (it != units.end()) return it->second;
+  }
+  throw InputError(path, "$.units", "unknown unit", "use m, cm, mm, in or ft");
 }
 
 std::string DumpLike(const ordered_json& root, const std::string& original) {

@@ -26,6 +26,8 @@ std::string DumpLike(const ordered_json& root, const std::string& original);
 /// "$.rigs") when the file has no rigs or none of that name, with `hint`.
 ordered_json& FindRig(ordered_json& root, const std::string& path, const std::string& rig_name,
                       const std::string& hint, std::size_t* index = nullptr);
+/// The file's metres per length unit ("units"; InputError "$.units" for an unknown one).
+double MetresPerUnit(const ordered_json& root, const std::string& path);
 /// A camera id as text (ids may be numbers).
 std::string IdOf(const ordered_json& id);
 /// The double nearest the 12-significant-digit decimal of v: what a person would have typed.

@@ -31,6 +31,7 @@ namespace {
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
 using scene_text::Clean;
+using scene_text::MetresPerUnit;
 using scene_text::IdOf;
 using scene_text::Number;
 using scene_text::ParseOrdered;
@@ -66,17 +67,6 @@ json PoseJson(const Eigen::Isometry3d& pose) {
 // A JSON file's text: a regular file of bounded size, nesting checked before any parser sees it.
 
 
-double MetresPerUnit(const ordered_json& root, const std::string& path) {
-  if (!root.contains("units")) return 1.0;
-  const ordered_json& u = root["units"];
-  static const std::map<std::string, double> units{
-      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
-  if (u.is_string()) {
-    auto it = units.find(u.get<std::string>());
-    if (it != units.end()) return it->second;
-  }
-  throw InputError(path, "$.units", "unknown unit", "use m, cm, mm, in or ft");
-}
 
 
 Vec3 ReadVec3(const json& j, const std::string& file, const std::string& path) {
