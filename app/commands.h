@@ -74,6 +74,12 @@ struct RenderArgs {
   std::string rig;
   std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string view;            ///< Name in the scene's "views".
+  /// `--plan` ("plan") or `--elevation SIDE` ("north", "south", "east", "west"): an orthographic
+  /// proposal view of the scene's content, camera ids labelled (render/render.h PlanView).
+  std::string plan;
+  /// The plan's cut height or the elevation's section coordinate (metres); unset: the study
+  /// region's face on the eye's side.
+  double cut = kUnset;
   std::string from, at, up;    ///< "X,Y,Z" each.
   std::string camera;          ///< Camera id: render what that camera images.
   double fov = kUnset;         ///< Horizontal field of view, degrees.

@@ -226,6 +226,9 @@ int main(int argc, char** argv) {
   rn->add_option("--rig", render.rig, "Rig name (default: the first rig)");
   rn->add_option("--disable", render.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');
   rn->add_option("--view", render.view, "Named view from the scene's \"views\"");
+  rn->add_flag_callback("--plan", [&render]() { render.plan = "plan"; }, "A plan of the scene from above (orthographic, north up, camera ids labelled)");
+  rn->add_option("--elevation", render.plan, "An elevation from SIDE: north, south, east or west (orthographic, camera ids labelled)");
+  rn->add_option("--cut", render.cut, "With --plan: the cut height; with --elevation: the section's coordinate (metres; default: the study region's face on that side)");
   rn->add_option("--from", render.from, "Eye position X,Y,Z (with --at)");
   rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
   rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");

@@ -26,13 +26,18 @@ int RunRender(const RenderArgs& args) {
     throw InputError("--out", "", "unsupported image type '" + ext + "'",
                      "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
   const bool have_from = !args.from.empty() || !args.at.empty();
-  const int viewpoints = int(!args.view.empty()) + int(have_from) + int(!args.camera.empty());
+  const int viewpoints =
+      int(!args.view.empty()) + int(have_from) + int(!args.camera.empty()) + int(!args.plan.empty());
   if (viewpoints > 1)
-    throw InputError(!args.view.empty() ? "--view" : "--from", "",
-                     "give one viewpoint: --view NAME, --from X,Y,Z --at X,Y,Z, or --camera ID");
+    throw InputError(!args.view.empty() ? "--view" : (have_from ? "--from" : "--plan"), "",
+                     "give one viewpoint: --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, --plan or --elevation SIDE");
   if (viewpoints == 0)
     throw InputError("--view", "", "no viewpoint given",
-                     "give --view NAME, --from X,Y,Z --at X,Y,Z, or --camera ID");
+                     "give --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, --plan or --elevation SIDE");
+  if (args.plan.empty() && !std::isnan(args.cut))
+    throw InputError("--cut", "", "is for --plan and --elevation");
+  if (!args.plan.empty() && !std::isnan(args.fov))
+    throw InputError("--fov", "", "a plan or elevation frames the scene itself", "leave out --fov");
   if (have_from && (args.from.empty() || args.at.empty()))
     throw InputError(args.from.empty() ? "--from" : "--at", "", "--from and --at go together");
   if (!std::isnan(args.fov) && !(args.fov > 0 && args.fov < 180))
@@ -112,12 +117,29 @@ int RunRender(const RenderArgs& args) {
   options.pixel_sigma = scene.study.pixel_sigma;
 
   RenderView view;
+  double plan_scale = 0;  // metres per pixel of a plan or elevation
   if (!args.camera.empty()) {
     view.camera = CameraOption(rig, "--camera", args.camera);
     view.width = rig.cameras[view.camera].model.width();
     view.height = rig.cameras[view.camera].model.height();
   } else if (!args.view.empty()) {
     view = NamedView(scene, "--view", args.view, 1280, 720);
+  } else if (!args.plan.empty()) {
+    int w = 1280, h = 720;
+    if (!args.size.empty()) std::tie(w, h) = ParseImageSize("--size", args.size);
+    const std::string side = Lower(args.plan);
+    const Aabb& region = scene.study.region.box;
+    double cut = args.cut;
+    if (std::isnan(cut))
+      cut = side == "plan" ? region.max.z() : side == "north" ? region.max.y() : side == "south" ? region.min.y()
+            : side == "east" ? region.max.x() : region.min.x();
+    const std::optional<RenderView> plan = PlanView(scene.ContentBounds(), side, w, h, cut, &plan_scale);
+    if (!plan)
+      throw InputError("--elevation", "", "unknown side '" + args.plan + "'", "use north, south, east or west (or --plan)");
+    view = *plan;
+    options.overlays.labels = true;
+    // Frusta long enough to read on the plan: 4 % of the framed width.
+    options.overlays.frustum_length = 0.04 * plan_scale * w;
   } else {
     view.from = ParseVec3("--from", args.from);
     view.at = ParseVec3("--at", args.at);
@@ -170,6 +192,9 @@ int RunRender(const RenderArgs& args) {
                 args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
                 brightness, std::isnan(options.brightness) ? " by default" : "",
                 session.study().caster().triangle_count(), stats.seconds);
+    if (plan_scale > 0)
+      std::printf("%s: 1 px = %.3g cm, orthographic to %.2g %% (the eye %.0f times the scene's size away)\n",
+                  args.plan.c_str(), 100 * plan_scale, 100.0 / kPlanDistance, kPlanDistance);
     std::fflush(stdout);
     for (const Warning& w : warnings)
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());

@@ -85,6 +85,7 @@ class ViewRays {
     } else {
       const auto pose = LookAt(view.from, view.at, view.up);
       eye_ = view.from;
+      clip_near_ = view.clip_near;
       R_ = pose->linear();
       f_ = 0.5 * width_ / std::tan(0.5 * view.fov_deg * M_PI / 180.0);
       cx_ = 0.5 * width_ - 0.5;
@@ -101,6 +102,12 @@ class ViewRays {
   }
 
   const Vec3& eye() const { return eye_; }
+  // Where the primary ray along unit `d` starts: RenderView::clip_near along the optical axis.
+  double NearT(const Vec3& d) const {
+    if (!(clip_near_ > 0)) return 0.0;
+    const double c = d.dot(R_.col(2));
+    return c > 0 ? clip_near_ / c : 0.0;
+  }
   bool perspective() const { return cam_ == nullptr; }
   const Camera& pinhole() const { return pinhole_; }
 
@@ -170,6 +177,7 @@ class ViewRays {
   const Camera* cam_ = nullptr;
   Vec3 eye_;
   Mat3 R_;
+  double clip_near_ = 0;
   double f_ = 1, cx_ = 0, cy_ = 0;
   double sx_ = 1, sy_ = 1;
   std::vector<Entry> table_;
@@ -256,12 +264,21 @@ const TileOrderTables& TileOrder() {
 }
 
 // The hit of ray (eye, d): the point and the geometric normal turned towards the eye.
-inline void SetHit(const Vec3& eye, const RayHit& hit, Sample* smp) {
+inline void SetHit(const Vec3& eye, const RayHit& hit, const TriangleMesh& mesh, Sample* smp) {
   smp->hit = true;
-  smp->t = hit.t;
+  // The distance again in double from the hit triangle's plane: the caster's float distance errs
+  // by about 2^-24 of it, which a far eye (a plan's, 500 scene sizes away) would turn into points
+  // off their surface that shadow themselves.
+  double t = hit.t;
+  const double dn = hit.normal.dot(smp->d);
+  if (hit.triangle >= 0 && std::size_t(hit.triangle) < mesh.triangles.size() && std::abs(dn) > 1e-9) {
+    const double plane_t = hit.normal.dot(mesh.vertices[mesh.triangles[hit.triangle][0]] - eye) / dn;
+    if (std::abs(plane_t - t) <= 1e-5 * std::max(1.0, t)) t = plane_t;
+  }
+  smp->t = t;
   smp->triangle = hit.triangle;
   smp->n = hit.normal.dot(smp->d) > 0 ? Vec3(-hit.normal) : hit.normal;
-  smp->X = eye + hit.t * smp->d;
+  smp->X = eye + t * smp->d;
 }
 
 }  // namespace
@@ -647,7 +664,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   primary_owner.clear();
   for (int i = 0; i < int(s.size()); ++i) {
     if (s[i].d.squaredNorm() == 0) continue;
-    primary.push_back(Ray{rays.eye(), s[i].d, 0.0, kInf});
+    primary.push_back(Ray{rays.eye(), s[i].d, rays.NearT(s[i].d), kInf});
     primary_owner.push_back(i);
   }
   primary_hits.resize(primary.size());
@@ -658,7 +675,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       record->primary_rays.insert(record->primary_rays.end(), primary.begin(), primary.end());
   }
   for (std::size_t k = 0; k < primary.size(); ++k)
-    if (primary_hits[k]) SetHit(rays.eye(), *primary_hits[k], &s[primary_owner[k]]);
+    if (primary_hits[k]) SetHit(rays.eye(), *primary_hits[k], scene.mesh, &s[primary_owner[k]]);
   // Cameras that cannot see any of the group's hit points skip it (FrustumCuller is conservative).
   Aabb box;
   for (const Sample& smp : s)
@@ -988,9 +1005,9 @@ std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
                             std::to_string(m.height) + " image");
   internal::Sample smp;
   if (!m.rays.Center(x, y, &smp.d, nullptr, nullptr)) return std::nullopt;
-  const auto hit = m.scene.caster->Intersect(Ray{m.rays.eye(), smp.d, 0.0, internal::kInf});
+  const auto hit = m.scene.caster->Intersect(Ray{m.rays.eye(), smp.d, m.rays.NearT(smp.d), internal::kInf});
   if (!hit) return std::nullopt;
-  internal::SetHit(m.rays.eye(), *hit, &smp);
+  internal::SetHit(m.rays.eye(), *hit, m.scene.mesh, &smp);
   const double lift = 0.1 * m.tester.epsilon();  // as FrameRenderer
   PixelPick pick;
   pick.point = smp.X;
@@ -1010,7 +1027,7 @@ std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, do
   const internal::ViewRays rays(view, rig, /*table=*/false);
   Vec3 d;
   if (!rays.Direction(x, y, &d)) return std::nullopt;
-  return Ray{rays.eye(), d, 0.0, internal::kInf};
+  return Ray{rays.eye(), d, rays.NearT(d), internal::kInf};
 }
 
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,

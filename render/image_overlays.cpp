@@ -165,6 +165,26 @@ void DrawCameraOverlays(const Rig& rig, const Camera& view, const OverlayOptions
     }
   }
   lines.CompositeInto(image);
+  if (!ov.labels) return;
+  // Ids beside the centres, over a dark backing (drawn last: always readable).
+  const int scale = image->height >= 400 ? 2 : 1;
+  const Eigen::Isometry3d cfw = view.camera_from_world();
+  const Intrinsics& k = view.model.intrinsics();
+  for (const Camera& cam : rig.cameras) {
+    if (!cam.enabled) continue;
+    const Vec3 c = cfw * cam.center();
+    if (!(c.z() > 1e-3)) continue;
+    const int px = int(std::lround(k.fx * c.x() / c.z() + k.cx));
+    const int y = int(std::lround(k.fy * c.y() / c.z() + k.cy)) - 2 * scale;
+    const std::string id = cam.id.substr(0, 16);
+    const int w = TextWidth(id, scale);
+    // Right of the centre, or left of it when that would leave the image.
+    const int x = px + 4 * scale + w + scale <= image->width ? px + 4 * scale : px - 4 * scale - w;
+    for (int yy = std::max(0, y - scale); yy < std::min(image->height, y + 6 * scale); ++yy)
+      for (int xx = std::max(0, x - scale); xx < std::min(image->width, x + w + scale); ++xx)
+        for (int ch = 0; ch < 3; ++ch) image->rgb[3 * (std::size_t(yy) * image->width + xx) + ch] *= 0.3f;
+    DrawText(image->rgb.data(), image->width, image->height, x, y, id, cam.color.cwiseMax(Vec3::Constant(0.35)), scale);
+  }
 }
 
 // Colour bar of the slice overlay with its range and the field's name, lower right corner.

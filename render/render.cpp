@@ -28,6 +28,47 @@ std::string FieldUnitLabel(const std::string& field) {
   return field;
 }
 
+std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width, int height,
+                                   double cut, double* metres_per_pixel) {
+  // Towards the eye, and the image's up.
+  Vec3 out, up;
+  if (side == "plan") {
+    out = Vec3::UnitZ();
+    up = Vec3::UnitY();
+  } else if (side == "north") {
+    out = Vec3::UnitY();
+    up = Vec3::UnitZ();
+  } else if (side == "south") {
+    out = -Vec3::UnitY();
+    up = Vec3::UnitZ();
+  } else if (side == "east") {
+    out = Vec3::UnitX();
+    up = Vec3::UnitZ();
+  } else if (side == "west") {
+    out = -Vec3::UnitX();
+    up = Vec3::UnitZ();
+  } else {
+    return std::nullopt;
+  }
+  const Vec3 size = bounds.size().cwiseMax(Vec3::Constant(1e-3));
+  const double diagonal = size.norm();
+  const double distance = kPlanDistance * diagonal;
+  const Vec3 right = up.cross(out);  // image x
+  const double half_w = 0.5 * std::abs(right.dot(size)), half_h = 0.5 * std::abs(up.dot(size));
+  const double half = 1.05 * std::max(half_w, half_h * double(width) / double(height));
+  RenderView v;
+  v.at = bounds.center();
+  v.from = v.at + distance * out;
+  v.up = up;
+  v.fov_deg = 2.0 * std::atan(half / distance) * 180.0 / 3.14159265358979323846;
+  v.width = width;
+  v.height = height;
+  if (metres_per_pixel) *metres_per_pixel = 2.0 * half / width;
+  // The cut: its distance from the eye along the axis (out is a unit axis).
+  if (std::isfinite(cut)) v.clip_near = std::max(0.0, out.dot(v.from) - cut * out.sum());
+  return v;
+}
+
 RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg) {
   RenderView v;
   v.from = view.from;

@@ -49,10 +49,24 @@ struct RenderView {
   /// distortion included: each output pixel is unprojected through the camera model, the camera's
   /// image scaled to width x height). from/at/up/fov_deg are then ignored.
   int camera = -1;
+  /// Main view: nothing nearer than this distance along the optical axis is drawn (a plan's cut
+  /// through the ceiling, an elevation's section); 0: none.
+  double clip_near = 0;
 };
 
 /// A RenderView from a named scene view (View::fov_deg unset: `default_fov_deg`).
 RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg = 60.0);
+
+/// A plan or elevation of `bounds` for proposals: `side` "plan" (from above, north up) or
+/// "north", "south", "east", "west" (from that side, +z up). The eye stands kPlanDistance times the
+/// bounds' diagonal away with the field of view that frames them (5 % margin), so the picture is
+/// orthographic to a relative scale error of depth / distance (at most 1 / kPlanDistance, 0.2 %).
+/// `metres_per_pixel` (if given) receives the scale at the bounds' centre. The view is cut at
+/// `cut` (a plan: the height; an elevation: the coordinate along its axis), nothing on the eye's
+/// side of it drawn (a ceiling, the near wall); NaN: no cut. An unknown side: nullopt.
+inline constexpr double kPlanDistance = 500.0;
+std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width, int height,
+                                   double cut, double* metres_per_pixel = nullptr);
 
 /// How the surfaces themselves look under the projected light.
 enum class Surface {
@@ -65,6 +79,7 @@ enum class Surface {
 /// Overlays drawn in the main view.
 struct OverlayOptions {
   bool cameras = true;             ///< Each enabled camera as a small body plus its frustum wireframe.
+  bool labels = false;             ///< With `cameras`: each camera's id beside its centre (plans).
   double frustum_length = 0.6;     ///< Metres along the axis (clipped to the camera's far distance).
   /// Slice plane through the fields (needs `fields`): empty = none, else the field name, e.g.
   /// "coverage", "resolution", "sigma_max". Coloured with viridis between slice_min and slice_max

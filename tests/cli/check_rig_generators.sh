@@ -3,7 +3,7 @@
 # walls and a ceiling grid are written into the scene file (a backup each time, the file's other
 # rigs untouched), analyze runs on them; a name in use is refused unless --replace; --dry-run writes
 # nothing; a scene in centimetres gets its positions in centimetres; bad layouts are one-line errors
-# with exit code 2 that leave the file as it was.
+# with exit code 2 that leave the file as it was. A generated rig renders as a plan and an elevation.
 # Usage: check_rig_generators.sh PANDORA SCENE WORK_DIR
 set -u
 pandora=$1; scene=$2; work=$3
@@ -38,6 +38,15 @@ jq '.units = "cm" | .objects = [] | .study.region.box = {"min": [-300, -250, 0],
   "$scene" > "$work/cm.json"
 "$pandora" rig "$work/cm.json" --name r --ring 4 --radius 2 --height 2 -q || fail "ring in cm"
 jq -e '.rigs[-1].cameras[0].position == [200, 0, 200]' "$work/cm.json" >/dev/null || fail "cm positions: $(jq -c '.rigs[-1].cameras[0]' "$work/cm.json")"
+# The proposal views of a generated rig: a plan and an elevation, labelled, with their scale.
+"$pandora" render "$work/s.json" --rig walls --plan --size 400x300 --out "$work/plan.png" > "$work/plan.txt" || fail "plan"
+grep -q "plan: 1 px = " "$work/plan.txt" || fail "plan scale: $(cat "$work/plan.txt")"
+"$pandora" render "$work/s.json" --rig walls --elevation south --cut -1 --size 400x300 --out "$work/south.png" -q || fail "elevation"
+[ -s "$work/plan.png" ] && [ -s "$work/south.png" ] || fail "no plan pictures"
+bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/e9" "unknown side 'up'" -- \
+  render "$work/s.json" --rig walls --elevation up --out "$work/e9/x.png" >/dev/null || fail "bad side"
+bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/e10" "--cut" -- \
+  render "$work/s.json" --rig walls --view overview --cut 1 --out "$work/e10/x.png" >/dev/null || fail "--cut without a plan"
 err() { bash "$(dirname "$0")/expect_error.sh" "$pandora" "$work/e$1" "$2" -- "${@:3}" >/dev/null || fail "error $1 ($2)"; }
 err 2 "give one layout" rig "$work/s.json" --name x --ring 4 --grid 2,2 --radius 1 --height 2
 err 3 "which layout" rig "$work/s.json" --name x
