@@ -412,6 +412,32 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     }
   }
 
+  // The plan: the proposal's first picture (orthographic, cut at the region's top, ids labelled).
+  {
+    const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
+    double mpp = 0;
+    const std::optional<RenderView> plan =
+        PlanView(scene.ContentBounds(), "plan", view_width, height, study.region.box.max.z(), &mpp);
+    char note[256];
+    std::snprintf(note, sizeof note,
+                  "From above, north up, orthographic (to %.1f %%), cut at the study region's top (%.2f m): "
+                  "1 px = %.3g cm. Each camera is drawn with its id.",
+                  100.0 / kPlanDistance, study.region.box.max.z(), 100.0 * mpp);
+    body << "<h2 id=\"plan\">Plan</h2>\n<p class=\"note\">" << note << "</p>\n" << RigRow(heads);
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) {
+      RenderOptions render;
+      render.pixel_sigma = study.pixel_sigma;
+      render.brightness = options.brightness;
+      render.layers = false;
+      render.overlays.labels = true;
+      render.overlays.frustum_length = 0.04 * mpp * view_width;
+      const Image image = Render(scene, r.rig, caster, *plan, render);
+      cells.push_back("<figure>" + fig.Img("image/png", PngBytes(image), r.rig.name + " plan", "render") +
+                      "<figcaption>plan</figcaption></figure>");
+    }
+    body << RigRow(cells);
+  }
   // Renders: the named views, then each camera's own view, per rig.
   if (!scene.views.empty()) {
     body << "<h2 id=\"views\">Views</h2>\n<p class=\"note\">Each enabled camera projects light of "

@@ -223,8 +223,10 @@ TEST_F(ReportOnRoom, PageHasOneImagePerFigure) {
   std::filesystem::remove_all(dir);
   const std::string page = html.str();
   EXPECT_EQ(file.bytes, page.size());
-  // No named views: 4 + 5 camera views, 3 legends, 3 fields x 2 planes x 2 rigs, 2 histograms x 2.
-  EXPECT_EQ(file.images, 9 + 3 + 12 + 4);
+  // No named views: a plan per rig, 4 + 5 camera views, 3 legends, 3 fields x 2 planes x 2 rigs,
+  // 2 histograms x 2.
+  EXPECT_EQ(file.images, 2 + 9 + 3 + 12 + 4);
+  EXPECT_NE(page.find("<h2 id=\"plan\">Plan</h2>"), std::string::npos);
   std::size_t imgs = 0;
   for (std::size_t p = page.find("<img "); p != std::string::npos; p = page.find("<img ", p + 1)) ++imgs;
   EXPECT_EQ(imgs, std::size_t(file.images));
