@@ -1,0 +1,304 @@
+// `import pandora`: the scene, its rigs, field evaluation, per-point visibility and covariance, and
+// renders as numpy arrays (docs/python.md). Errors are pandora.InputError with the same file, JSON
+// path, reason and hint as the command line's one-line messages.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "analysis/camera.h"
+#include "analysis/error.h"
+#include "analysis/scene.h"
+#include "analysis/uncertainty.h"
+#include "analysis/visibility.h"
+#include "app/session/study.h"
+#include "render/render.h"
+#include "volume/fields.h"
+#include "volume/fields_vdb.h"
+#include "volume/summary.h"
+
+namespace py = pybind11;
+using namespace pandora;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// A loaded scene: the study (scene, text, ray caster) shared by the rigs and fields made from it.
+struct PyScene {
+  std::shared_ptr<const session::Study> study;
+  const Scene& scene() const { return study->scene(); }
+};
+
+// A rig the script may change (a copy of the file's).
+struct PyRig {
+  std::shared_ptr<const session::Study> study;
+  Rig rig;
+
+  int Index(const std::string& id) const {
+    const int c = rig.FindCamera(id);
+    if (c < 0) throw InputError(study->scene().path, "", "no camera '" + id + "' in rig '" + rig.name + "'");
+    return c;
+  }
+};
+
+struct PyFields {
+  std::shared_ptr<const session::Study> study;
+  std::shared_ptr<Fields> fields;
+  std::vector<std::string> names;
+  nlohmann::json summary;
+};
+
+openvdb::FloatGrid::ConstPtr FloatGrid(const PyFields& f, const std::string& name) {
+  const Fields::Impl& g = f.fields->impl();
+  if (auto grid = g.Float(name)) return grid;
+  if (auto it = g.extra.find(name); it != g.extra.end()) return it->second;
+  return nullptr;
+}
+
+py::array_t<double> Vec3Array(const Vec3& v) {
+  py::array_t<double> a(3);
+  for (int i = 0; i < 3; ++i) a.mutable_at(i) = v[i];
+  return a;
+}
+
+std::vector<Vec3> Points(const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+  if (points.ndim() != 2 || points.shape(1) != 3)
+    throw InputError("points", "", "expected an array of shape (N, 3), metres");
+  std::vector<Vec3> out(points.shape(0));
+  auto r = points.unchecked<2>();
+  for (py::ssize_t i = 0; i < points.shape(0); ++i) {
+    out[i] = Vec3(r(i, 0), r(i, 1), r(i, 2));
+    if (!out[i].allFinite()) throw InputError("points", "[" + std::to_string(i) + "]", "not a finite point");
+  }
+  return out;
+}
+
+double SigmaOf(const Scene& scene, const Camera& c) { return c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma; }
+
+}  // namespace
+
+PYBIND11_MODULE(pandora, m) {
+  m.doc() = "Pandora: multi-camera setup design (coverage, resolution and uncertainty fields)";
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      py::object err = py::handle(input_error.ptr())(py::str(e.what()));
+      // The parts of the one-line message, for scripts that act on them.
+      err.attr("file") = e.file();
+      err.attr("path") = e.json_path();
+      err.attr("reason") = e.reason();
+      err.attr("hint") = e.hint();
+      PyErr_SetObject(input_error.ptr(), err.ptr());
+    }
+  });
+
+  py::class_<PyScene>(m, "Scene", "A scene file, loaded and checked, with its ray caster.")
+      .def_property_readonly("path", [](const PyScene& s) { return s.scene().path; })
+      .def_property_readonly("rigs", [](const PyScene& s) {
+        std::vector<std::string> names;
+        for (const Rig& r : s.scene().rigs) names.push_back(r.name);
+        return names;
+      })
+      .def_property_readonly("voxel_size", [](const PyScene& s) { return s.scene().study.voxel_size; })
+      .def_property_readonly("region", [](const PyScene& s) {
+        const Aabb& b = s.scene().study.region.box;
+        return py::make_tuple(Vec3Array(b.min), Vec3Array(b.max));
+      })
+      .def("rig", [](const PyScene& s, const std::string& name) {
+        const Scene& scene = s.scene();
+        if (name.empty()) return PyRig{s.study, scene.rigs.at(0)};
+        for (const Rig& r : scene.rigs)
+          if (r.name == name) return PyRig{s.study, r};
+        throw InputError(scene.path, "$.rigs", "no rig called '" + name + "'");
+      }, py::arg("name") = "", "A copy of the rig (the first one by default) that the script may change.");
+
+  m.def("load_scene", [](const std::string& path) { return PyScene{session::Study::Load(path)}; },
+        py::arg("path"), "Reads and checks a scene file (meshes, rigs, study); raises pandora.InputError.");
+
+  py::class_<PyRig>(m, "Rig", "A rig of cameras (a copy: changing it does not change the file).")
+      .def_property_readonly("name", [](const PyRig& r) { return r.rig.name; })
+      .def_property_readonly("ids", [](const PyRig& r) {
+        std::vector<std::string> ids;
+        for (const Camera& c : r.rig.cameras) ids.push_back(c.id);
+        return ids;
+      })
+      .def("position", [](const PyRig& r, const std::string& id) { return Vec3Array(r.rig.cameras[r.Index(id)].center()); })
+      .def("rotation", [](const PyRig& r, const std::string& id) -> Mat3 {
+        return r.rig.cameras[r.Index(id)].world_from_camera.linear();
+      }, "world_from_camera rotation (columns: image x right, y down, optical axis).")
+      .def("intrinsics", [](const PyRig& r, const std::string& id) {
+        const Camera& c = r.rig.cameras[r.Index(id)];
+        const Intrinsics& k = c.model.intrinsics();
+        py::dict d;
+        d["width"] = k.width;
+        d["height"] = k.height;
+        d["fx"] = k.fx;
+        d["fy"] = k.fy;
+        d["cx"] = k.cx;
+        d["cy"] = k.cy;
+        d["model"] = k.model == LensModel::kPinhole ? "pinhole" : k.model == LensModel::kBrownConrady ? "brown_conrady" : "fisheye";
+        d["k"] = std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
+        d["enabled"] = c.enabled;
+        return d;
+      })
+      .def("move", [](PyRig& r, const std::string& id, const Vec3& position, const Vec3& look_at, const Vec3& up) {
+        Camera& c = r.rig.cameras[r.Index(id)];
+        if (c.ptz) throw InputError("move", "", "camera '" + id + "' is a PTZ camera: its pose is its head's setting");
+        if (!position.allFinite() || !look_at.allFinite()) throw InputError("move", "", "not a finite position");
+        const auto pose = LookAt(position, look_at, up);
+        if (!pose) throw InputError("move", "", "look_at equals the position, or up is parallel to the view");
+        c.world_from_camera = *pose;
+      }, py::arg("id"), py::arg("position"), py::arg("look_at"), py::arg("up") = Vec3(0, 0, 1),
+         "Places camera `id` at `position` looking at `look_at` (metres, world frame).")
+      .def("set_enabled", [](PyRig& r, const std::string& id, bool on) { r.rig.cameras[r.Index(id)].enabled = on; });
+
+  py::class_<PyFields>(m, "Fields", "Evaluated fields over the study region (sparse OpenVDB grids).")
+      .def_property_readonly("names", [](const PyFields& f) { return f.names; })
+      .def_property_readonly("summary", [](const PyFields& f) { return py::module_::import("json").attr("loads")(f.summary.dump()); },
+                             "summary.json of this evaluation, as a dict.")
+      .def("sparse", [](const PyFields& f, const std::string& name) {
+        // Active voxels: (ijk (N, 3) int32, centres (N, 3) metres, values (N,)).
+        const Fields::Impl& g = f.fields->impl();
+        std::vector<openvdb::Coord> ijk;
+        std::vector<double> values;
+        if (name == "coverage" && g.coverage) {
+          ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int v) { ijk.push_back(c); values.push_back(v); });
+        } else if (auto grid = FloatGrid(f, name)) {
+          ForEachActiveVoxel(*grid, [&](const openvdb::Coord& c, float v) { ijk.push_back(c); values.push_back(v); });
+        } else {
+          throw InputError("sparse", "", "no field '" + name + "' was evaluated");
+        }
+        const std::size_t n = ijk.size();
+        py::array_t<int> idx({n, std::size_t(3)});
+        py::array_t<double> xyz({n, std::size_t(3)});
+        py::array_t<double> val(n);
+        auto I = idx.mutable_unchecked<2>();
+        auto X = xyz.mutable_unchecked<2>();
+        auto V = val.mutable_unchecked<1>();
+        for (std::size_t i = 0; i < n; ++i) {
+          const openvdb::Vec3d w = g.transform->indexToWorld(ijk[i]);
+          for (int a = 0; a < 3; ++a) {
+            I(i, a) = ijk[i][a];
+            X(i, a) = w[a];
+          }
+          V(i) = values[i];
+        }
+        return py::make_tuple(idx, xyz, val);
+      }, py::arg("name"))
+      .def("dense", [](const PyFields& f, const std::string& name) {
+        // The whole lattice (nx, ny, nz), NaN where the field has no value (unseen, solid, outside).
+        const VoxelLattice& L = f.fields->lattice;
+        py::array_t<double> out({std::size_t(L.dims.x()), std::size_t(L.dims.y()), std::size_t(L.dims.z())});
+        auto O = out.mutable_unchecked<3>();
+        for (py::ssize_t i = 0; i < O.shape(0); ++i)
+          for (py::ssize_t j = 0; j < O.shape(1); ++j)
+            for (py::ssize_t k = 0; k < O.shape(2); ++k) O(i, j, k) = kNaN;
+        const Fields::Impl& g = f.fields->impl();
+        auto put = [&](const openvdb::Coord& c, double v) {
+          const openvdb::Coord& o = c;  // index (0, 0, 0) is the lattice's origin
+          if (o.x() >= 0 && o.y() >= 0 && o.z() >= 0 && o.x() < L.dims.x() && o.y() < L.dims.y() && o.z() < L.dims.z())
+            O(o.x(), o.y(), o.z()) = v;
+        };
+        if (name == "coverage" && g.coverage)
+          ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int v) { put(c, v); });
+        else if (auto grid = FloatGrid(f, name))
+          ForEachActiveVoxel(*grid, [&](const openvdb::Coord& c, float v) { put(c, v); });
+        else
+          throw InputError("dense", "", "no field '" + name + "' was evaluated");
+        return out;
+      }, py::arg("name"));
+
+  m.def("evaluate", [](const PyScene& s, const PyRig& r, std::vector<std::string> fields) {
+    const Scene& scene = s.scene();
+    FieldOptions o;
+    o.fields = fields.empty() ? scene.study.fields : fields;
+    o.scene_path = scene.path;
+    o.memory_budget_bytes = scene.study.memory_budget_bytes;
+    PyFields out;
+    out.study = s.study;
+    {
+      py::gil_scoped_release release;
+      out.fields = std::make_shared<Fields>(EvaluateFields(scene, r.rig, s.study->caster(), o));
+    }
+    out.names = o.fields;
+    out.summary = MakeSummary(scene, r.rig, *out.fields, o.fields, 0);
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("fields") = std::vector<std::string>{},
+     "Evaluates the fields (default: the study's) for the rig's enabled cameras.");
+
+  m.def("visibility", [](const PyScene& s, const PyRig& r, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+    const std::vector<Vec3> X = Points(points);
+    const VisibilityTester tester(r.rig.cameras, s.study->caster(), s.scene().ContentBounds().diagonal());
+    const std::size_t C = r.rig.cameras.size();
+    py::array_t<bool> out({X.size(), C});
+    auto O = out.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < X.size(); ++i)
+      for (std::size_t c = 0; c < C; ++c)
+        O(i, c) = r.rig.cameras[c].enabled && tester.Test(int(c), X[i]) == ViewResult::kSeen;
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("points"),
+     "(N, C) booleans: camera c sees point i (image, range, occlusion; the field evaluation's rules).");
+
+  m.def("covariance", [](const PyScene& s, const PyRig& r, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+    const Scene& scene = s.scene();
+    const std::vector<Vec3> X = Points(points);
+    const VisibilityTester tester(r.rig.cameras, s.study->caster(), scene.ContentBounds().diagonal());
+    py::array_t<double> out({X.size(), std::size_t(3), std::size_t(3)});
+    auto O = out.mutable_unchecked<3>();
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      Mat3 J = Mat3::Zero();
+      int cameras = 0;
+      for (std::size_t c = 0; c < r.rig.cameras.size(); ++c) {
+        if (!r.rig.cameras[c].enabled) continue;
+        Mat23 A;
+        if (tester.Test(int(c), X[i], nullptr, &A) != ViewResult::kSeen) continue;
+        const double sigma = SigmaOf(scene, r.rig.cameras[c]);
+        J += A.transpose() * A / (sigma * sigma);
+        ++cameras;
+      }
+      const StaticUncertainty u = StaticFromInformation(DecomposeInformation(J), cameras);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) O(i, a, b) = u.triangulable ? u.covariance(a, b) : kNaN;
+    }
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("points"),
+     "(N, 3, 3) triangulation covariance (m^2) from the cameras that see each point; NaN where not triangulable.");
+
+  m.def("render", [](const PyScene& s, const PyRig& r, const std::string& view, int width, int height, const std::string& plan) {
+    const Scene& scene = s.scene();
+    RenderView v;
+    RenderOptions o;
+    if (!plan.empty()) {
+      double mpp = 0;
+      const std::optional<RenderView> p = PlanView(scene.ContentBounds(), plan, width, height,
+                                                   plan == "plan" ? scene.study.region.box.max.z() : kNaN, &mpp);
+      if (!p) throw InputError("plan", "", "unknown side '" + plan + "'", "use plan, north, south, east or west");
+      v = *p;
+      o.overlays.labels = true;
+    } else {
+      auto it = scene.views.find(view);
+      if (view.empty() && !scene.views.empty()) it = scene.views.begin();
+      if (it == scene.views.end()) throw InputError("view", "", "no view '" + view + "' in the scene");
+      v = ViewFromScene(it->second, width, height);
+    }
+    o.pixel_sigma = scene.study.pixel_sigma;
+    Image image;
+    {
+      py::gil_scoped_release release;
+      image = Render(scene, r.rig, s.study->caster(), v, o);
+    }
+    py::array_t<float> out({std::size_t(image.height), std::size_t(image.width), std::size_t(3)});
+    std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("view") = "", py::arg("width") = 640, py::arg("height") = 400,
+     py::arg("plan") = "", "The projective-light render as an (H, W, 3) float32 linear RGB array.");
+}

@@ -1,0 +1,127 @@
+"""`import pandora` (docs/python.md): the fields as numpy arrays agree with per-point visibility
+(two code paths: the field evaluator and the visibility tester), dense and sparse forms agree, a
+moved camera changes the fields of that rig copy only, the covariance equals a numpy computation
+from finite-difference projection Jacobians, renders are finite images, and bad input raises
+pandora.InputError with the file, JSON path and reason of the command line's message."""
+import json
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+import pandora
+
+SOURCE = pathlib.Path(os.environ.get("PANDORA_SOURCE", pathlib.Path(__file__).resolve().parents[2]))
+MINIMAL = str(SOURCE / "tests" / "data" / "minimal.json")
+
+
+def test_load_scene_and_rigs():
+    scene = pandora.load_scene(MINIMAL)
+    assert scene.rigs == ["pair"]
+    assert scene.voxel_size == pytest.approx(0.05)
+    lo, hi = scene.region
+    np.testing.assert_allclose(lo, [-0.5, -0.5, 0.0])
+    np.testing.assert_allclose(hi, [0.5, 0.5, 0.6])
+    rig = scene.rig()
+    assert rig.ids == ["a", "b"]
+    np.testing.assert_allclose(rig.position("a"), [2, 0, 1])
+    R = rig.rotation("a")
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+    axis = np.array([0, 0, 0.3]) - np.array([2, 0, 1])
+    np.testing.assert_allclose(R[:, 2], axis / np.linalg.norm(axis), atol=1e-12)
+    k = rig.intrinsics("a")
+    assert (k["width"], k["height"], k["model"]) == (640, 480, "pinhole")
+    assert k["fx"] == pytest.approx(320 / np.tan(np.radians(30)))
+
+
+def test_bad_input_raises_input_error_with_its_parts(tmp_path):
+    text = json.loads(pathlib.Path(MINIMAL).read_text())
+    text["rigs"][0]["cameras"][1]["hfov_deg"] = -5
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(text))
+    with pytest.raises(pandora.InputError) as e:
+        pandora.load_scene(str(bad))
+    assert e.value.file == str(bad)
+    assert e.value.path == "$.rigs[0].cameras[1].hfov_deg"
+    assert e.value.reason
+    assert str(bad) in str(e.value)
+    scene = pandora.load_scene(MINIMAL)
+    with pytest.raises(pandora.InputError):
+        scene.rig("nope")
+    with pytest.raises(pandora.InputError):
+        pandora.visibility(scene, scene.rig(), np.array([[0.0, 0.0, np.nan]]))
+    with pytest.raises(pandora.InputError):
+        scene.rig().move("a", [1, 1, 1], [1, 1, 1])
+
+
+def test_coverage_equals_per_point_visibility():
+    scene = pandora.load_scene(MINIMAL)
+    rig = scene.rig()
+    fields = pandora.evaluate(scene, rig, ["coverage", "resolution"])
+    ijk, xyz, cov = fields.sparse("coverage")
+    assert len(cov) > 1000
+    seen = pandora.visibility(scene, rig, xyz)
+    assert seen.shape == (len(cov), 2)
+    np.testing.assert_array_equal(seen.sum(axis=1), cov)
+    assert 0 < (cov == 2).sum() < len(cov)  # the block shadows part of the region
+    assert fields.summary["region_voxels"] == len(cov)
+
+
+def test_dense_and_sparse_agree():
+    scene = pandora.load_scene(MINIMAL)
+    fields = pandora.evaluate(scene, scene.rig(), ["coverage", "resolution"])
+    for name in ("coverage", "resolution"):
+        ijk, xyz, values = fields.sparse(name)
+        dense = fields.dense(name)
+        assert dense.shape == (20, 20, 12)
+        np.testing.assert_array_equal(dense[ijk[:, 0], ijk[:, 1], ijk[:, 2]], values)
+        assert np.isnan(dense).sum() == dense.size - len(values)
+        # The voxel centres: the region's corner plus half a voxel, one voxel apart.
+        np.testing.assert_allclose(xyz, -np.array([0.5, 0.5, 0.0]) + 0.025 + 0.05 * ijk, atol=1e-12)
+
+
+def test_moving_a_camera_changes_that_rig_only():
+    scene = pandora.load_scene(MINIMAL)
+    rig = scene.rig()
+    before = pandora.evaluate(scene, rig, ["coverage"]).sparse("coverage")[2]
+    rig.move("b", [0, 2, 1], [0, 4, 1])  # looking away from the region
+    after = pandora.evaluate(scene, rig, ["coverage"]).sparse("coverage")[2]
+    assert after.max() == 1 and before.max() == 2
+    again = pandora.evaluate(scene, scene.rig(), ["coverage"]).sparse("coverage")[2]
+    np.testing.assert_array_equal(again, before)
+
+
+def project(R, C, k, X):
+    p = R.T @ (X - C)
+    return np.array([k["fx"] * p[0] / p[2] + k["cx"], k["fy"] * p[1] / p[2] + k["cy"]])
+
+
+def test_covariance_equals_numpy_from_finite_differences():
+    scene = pandora.load_scene(MINIMAL)
+    rig = scene.rig()
+    points = np.array([[0.3, -0.35, 0.5], [-0.4, 0.3, 0.45], [0.0, 0.0, 0.55]])
+    cov = pandora.covariance(scene, rig, points)
+    assert cov.shape == (3, 3, 3)
+    sigma = 0.5  # the study's pixel noise
+    for i, X in enumerate(points):
+        J = np.zeros((3, 3))
+        for cam in rig.ids:
+            R, C, k = rig.rotation(cam), rig.position(cam), rig.intrinsics(cam)
+            h = 1e-6
+            A = np.column_stack([(project(R, C, k, X + h * e) - project(R, C, k, X - h * e)) / (2 * h) for e in np.eye(3)])
+            J += A.T @ A / sigma**2
+        np.testing.assert_allclose(cov[i], np.linalg.inv(J), rtol=1e-5, atol=1e-14)
+    # A point only one camera sees: not triangulable, NaN.
+    rig.set_enabled("b", False)
+    assert np.isnan(pandora.covariance(scene, rig, points[:1])).all()
+
+
+def test_render_is_a_finite_image():
+    scene = pandora.load_scene(str(SOURCE / "examples" / "ptz_home" / "scene.json"))
+    rig = scene.rig("home")
+    img = pandora.render(scene, rig, width=160, height=100)
+    assert img.shape == (100, 160, 3) and img.dtype == np.float32
+    assert np.isfinite(img).all() and img.max() > 0
+    plan = pandora.render(scene, rig, width=160, height=100, plan="plan")
+    assert plan.shape == (100, 160, 3) and not np.array_equal(plan, img)
