@@ -274,6 +274,7 @@ class YamlReader {
       if (*i >= lines_.size() || lines_[*i].indent <= indent) Fail(number, field, "missing value");
       YNode node = Block(i, lines_[*i].indent, depth + 1, field);
       node.tag = tag;
+      node.line = number;  // the key's line
       return node;
     }
     if (!tag.empty()) Fail(number, field, "a matrix must be a block of rows, cols, dt, data");
