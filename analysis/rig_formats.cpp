@@ -552,8 +552,16 @@ class OpenCvCameraReader {
     const std::vector<double> t = Matrix(tn, Sub(used), &rows, &cols);
     if (t.size() != 3 || (rows != 3 && cols != 3))
       reader_.Fail(tn.line, Sub(used), "expected a 3x1 vector");
+    // Each check names the field it concerns, at that field's line.
+    const int d_line = d ? d->line : node_.line;
+    const YNode* pose = rn ? rn : rv;
     const auto fail = [&](const std::string& what, const std::string& reason) {
-      reader_.Fail(node_.line, field_.empty() ? what : field_ + " (" + what + ")", reason);
+      std::string key = "camera_matrix";
+      int at = km.line;
+      if (what == "rotation") key = rn ? "R" : "rvec", at = pose->line;
+      if (what == "translation") key = used, at = tn.line;
+      if (what == "distortion") key = "distortion_coefficients", at = d_line;
+      reader_.Fail(at, Sub(key), reason);
     };
     return MakeCamera(id, name, k, r, Vec3(t[0], t[1], t[2]), fail);
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -378,6 +379,69 @@ TEST(RigImport, DamagedFilesEndInInputErrorAndWriteNothing) {
   }
   std::printf("damage: %d refused, %d accepted (still valid)\n", errors, accepted);
   EXPECT_GT(errors, 300);
+}
+
+// Named damages: each refused with its line, field and reason.
+TEST(RigImport, NamedDamagesNameLineFieldAndReason) {
+  const Rig design = LoadRigioScene().FindRig("design");
+  const std::string yaml = RigToOpenCvYaml(design);
+  const ColmapText colmap = RigToColmap(design);
+  const auto replace = [](std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+  };
+  const auto expect = [](const std::function<void()>& read, const std::string& message) {
+    try {
+      read();
+      ADD_FAILURE() << "accepted; expected " << message;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  const auto yml = [&](const std::string& text, const std::string& message) {
+    expect([&] { ParseOpenCvYaml(text, "rig.yml"); }, message);
+  };
+  yml(replace(yaml, "camera_count: 4", "camera_count: 5"),
+      "rig.yml: line 4: camera_count: says 5 cameras but 'cameras' holds 4");
+  yml(replace(yaml, "rows: 3\n         cols: 3", "rows: 2\n         cols: 3"),
+      "rig.yml: line 15: cameras[0].camera_matrix.data: expected 6 numbers (rows x cols), got 9");
+  yml(replace(yaml, "1371.0220864724301, 0.", "1e400, 0."), "cameras[0].camera_matrix.data[0]: expected a finite number, got '1e400'");
+  yml(replace(yaml, "1371.0220864724301, 0.", "1e9, 0."), "fx and fy must be in (0, 1e7] pixels");
+  yml(replace(yaml, "distortion_model: brown_conrady", "distortion_model: rational"),
+      "cameras[1].distortion_model: unknown distortion model 'rational'");
+  yml(replace(yaml, "      T: !!opencv-matrix", "      U: !!opencv-matrix"), "cameras[0].U: unknown field 'U'");
+  yml(replace(yaml, "      image_width: 1920\n", ""), "cameras[0].image_width: missing field");
+  {
+    // The first camera's R with its first entry changed: no longer a rotation.
+    std::string bad = yaml;
+    const std::size_t data = bad.find("data: [ ", bad.find("R: !!opencv-matrix")) + 8;
+    bad.replace(data, bad.find(',', data) - data, "0.5");
+    yml(bad, "rig.yml: line 25: cameras[0].R: not a rotation matrix");
+  }
+  yml(replace(yaml, "id: \"7\"", "id: \"north 1\""), "cameras[1].id: camera id 'north 1' appears twice");
+  yml(replace(yaml, "%YAML:1.0", "%YAML:2.0"), "rig.yml: line 1: not an OpenCV YAML file");
+
+  const auto col = [&](const std::string& cameras, const std::string& images, const std::string& message) {
+    expect([&] { ParseColmap(cameras, "cameras.txt", images, "images.txt", "calib"); }, message);
+  };
+  col(replace(colmap.cameras, "1 PINHOLE 1920 1080 1371.0220864724301 ", "1 PINHOLE 1920 1080 "), colmap.images,
+      "cameras.txt: line 4: PARAMS: PINHOLE has 4 parameters, got 3");
+  col(replace(colmap.cameras, "OPENCV_FISHEYE", "FOV"), colmap.images,
+      "cameras.txt: line 6: MODEL: unsupported camera model 'FOV'");
+  col(replace(colmap.cameras, "1920 1080", "1920 nan"), colmap.images, "cameras.txt: line 4: HEIGHT: expected a whole number");
+  col(replace(colmap.cameras, "FULL_OPENCV 2048 1536 1450.25 1449.75", "FULL_OPENCV 2048 1536 1e400 1449.75"), colmap.images,
+      "cameras.txt: line 5: PARAMS[0]: expected a finite number, got '1e400'");
+  col(colmap.cameras, replace(colmap.images, " 1 north%201.png", " 9 north%201.png"),
+      "images.txt: line 5: CAMERA_ID: no camera '9' in the cameras file");
+  col(colmap.cameras, replace(colmap.images, "1 0 0 0.8701999067534788", "1 0 0 0.9701999067534788"),
+      "images.txt: line 5: QW QX QY QZ: not a unit quaternion");
+  col(colmap.cameras, replace(colmap.images, "north%201.png\n\n", "north%201.png\n1 2\n"),
+      "images.txt: line 6: POINTS2D: expected (X, Y, POINT3D_ID) triples, got 2 numbers");
+  col(colmap.cameras, colmap.images.substr(0, colmap.images.size() - 1),
+      "images.txt: line 11: POINTS2D: missing the POINTS2D line after the image line");
+  col(colmap.cameras, replace(colmap.images, "north%201.png", "7.jpg"), "images.txt: line 7: NAME: two images give the camera id '7'");
 }
 
 // glTF: one camera node per camera at its centre (Y up) looking down its -Z along the optical axis.
