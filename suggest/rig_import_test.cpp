@@ -473,5 +473,36 @@ TEST(RigFormats, GltfCameraNodes) {
   EXPECT_EQ(found, rig.cameras.size());
 }
 
+// The glTF's meshes read back through Pandora's own mesh loader (assimp, Y up): the same
+// triangles, the same bounds to float precision, one part per material with its colour.
+TEST(RigFormats, GltfMeshesLoadBack) {
+  const Scene scene = LoadScene(kScenePath);
+  testing::TempDir dir("rigio_gltf");
+  dir.Write("scene.gltf", SceneToGltf(scene, scene.FindRig("design")));
+  dir.Write("back.json",
+            R"({"objects": [{"name": "all", "mesh": {"file": "scene.gltf"}}],
+                "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [0, -3, 1], "look_at": [0, 0, 1],
+                          "resolution": [64, 48], "hfov_deg": 60}]}],
+                "study": {"region": {"box": {"min": [-1, -1, 0], "max": [1, 1, 2]}}}})");
+  const Scene back = LoadScene(dir.File("back.json"));
+  EXPECT_EQ(back.AllTriangles().triangles.size(), scene.AllTriangles().triangles.size());
+  const Aabb b = back.AllTriangles().Bounds();
+  const Aabb o = scene.AllTriangles().Bounds();
+  EXPECT_LE((o.min - b.min).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LE((o.max - b.max).cwiseAbs().maxCoeff(), 1e-6);
+  ASSERT_EQ(back.objects.size(), scene.objects.size());
+  for (const SceneObject& part : back.objects) {
+    // "all/<material>": the material's colour came through baseColorFactor.
+    const std::string material = part.name.substr(part.name.find('/') + 1);
+    const Material* original = nullptr;
+    for (const SceneObject& object : scene.objects)
+      if (object.material >= 0 && scene.materials[static_cast<std::size_t>(object.material)].name == material)
+        original = &scene.materials[static_cast<std::size_t>(object.material)];
+    ASSERT_NE(original, nullptr) << part.name;
+    ASSERT_GE(part.material, 0);
+    EXPECT_LE((back.materials[static_cast<std::size_t>(part.material)].color - original->color).norm(), 1e-6);
+  }
+}
+
 }  // namespace
 }  // namespace pandora
