@@ -3,6 +3,7 @@
 #include "analysis/rig_formats.h"
 
 #include <cerrno>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -950,7 +951,7 @@ Mat3 GltfFromWorld() {
 
 }  // namespace
 
-std::string SceneToGltf(const Scene& scene, const Rig& rig) {
+std::string SceneToGltf(const Scene& scene, const Rig& rig, bool binary) {
   const Mat3 c = GltfFromWorld();
   std::string buffer;
   json accessors = json::array(), views = json::array(), meshes = json::array(),
@@ -1031,10 +1032,30 @@ std::string SceneToGltf(const Scene& scene, const Rig& rig) {
     doc["materials"] = materials;
     doc["accessors"] = accessors;
     doc["bufferViews"] = views;
-    doc["buffers"] = {{{"byteLength", buffer.size()},
-                       {"uri", "data:application/octet-stream;base64," + Base64(buffer)}}};
+    doc["buffers"] = {{{"byteLength", buffer.size()}}};
+    if (!binary) doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + Base64(buffer);
   }
-  return doc.dump(1) + "\n";
+  if (!binary) return doc.dump(1) + "\n";
+  // GLB: a 12-byte header, a JSON chunk padded with spaces and a BIN chunk padded with zeros, each
+  // a multiple of 4 bytes (glTF 2.0, "Binary glTF Layout").
+  std::string text = doc.dump();
+  while (text.size() % 4) text += ' ';
+  while (buffer.size() % 4) buffer += '\0';
+  std::string glb;
+  const bool has_bin = !meshes.empty();
+  const std::uint32_t total = static_cast<std::uint32_t>(12 + 8 + text.size() + (has_bin ? 8 + buffer.size() : 0));
+  Append(glb, std::uint32_t{0x46546C67});  // "glTF"
+  Append(glb, std::uint32_t{2});
+  Append(glb, total);
+  Append(glb, static_cast<std::uint32_t>(text.size()));
+  Append(glb, std::uint32_t{0x4E4F534A});  // "JSON"
+  glb += text;
+  if (has_bin) {
+    Append(glb, static_cast<std::uint32_t>(buffer.size()));
+    Append(glb, std::uint32_t{0x004E4942});  // "BIN\0"
+    glb += buffer;
+  }
+  return glb;
 }
 
 namespace {

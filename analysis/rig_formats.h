@@ -56,8 +56,9 @@ Rig ParseColmap(const std::string& cameras_text, const std::string& cameras_path
 /// and one perspective camera node per camera of `rig`, named by its id, as a .gltf JSON document
 /// with the buffer embedded (base64). glTF is Y up: world (x, y, z) -> (x, z, -y); a glTF camera
 /// looks down its -Z with +Y up. yfov = 2 atan(h / (2 fy)), aspectRatio = (w fy) / (h fx),
-/// znear = the camera's near (0.01 m when 0), zfar its far when finite.
-std::string SceneToGltf(const Scene& scene, const Rig& rig);
+/// znear = the camera's near (0.01 m when 0), zfar its far when finite. With `binary`, the same as
+/// one .glb file (JSON chunk and BIN chunk).
+std::string SceneToGltf(const Scene& scene, const Rig& rig, bool binary = false);
 
 /// The installation sheet as CSV, one row per camera (docs/tool-chain.md): id, name, colour
 /// (#rrggbb), mount point in cm, pan/tilt/roll in degrees (the scene file's euler_deg yaw, pitch,

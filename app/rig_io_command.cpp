@@ -50,7 +50,9 @@ int RunExportRig(const ExportRigArgs& args) {
         throw InputError(args.scene, "", e.reason(), e.hint());
       }
     } else if (f == "gltf") {
-      bytes = SceneToGltf(scene, rig);
+      // A .glb name gets binary glTF; any other name the .gltf JSON with the buffer embedded.
+      const std::string ext = std::filesystem::path(args.out).extension().string();
+      bytes = SceneToGltf(scene, rig, ext == ".glb" || ext == ".GLB");
     } else {
       bytes = RigToSheetCsv(rig);
     }

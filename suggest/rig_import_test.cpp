@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -477,10 +478,21 @@ TEST(RigFormats, GltfCameraNodes) {
 // triangles, the same bounds to float precision, one part per material with its colour.
 TEST(RigFormats, GltfMeshesLoadBack) {
   const Scene scene = LoadScene(kScenePath);
+  for (const bool binary : {false, true}) {
+  SCOPED_TRACE(binary ? "glb" : "gltf");
   testing::TempDir dir("rigio_gltf");
-  dir.Write("scene.gltf", SceneToGltf(scene, scene.FindRig("design")));
+  const std::string bytes = SceneToGltf(scene, scene.FindRig("design"), binary);
+  if (binary) {
+    ASSERT_EQ(bytes.substr(0, 4), "glTF");
+    std::uint32_t length = 0;
+    std::memcpy(&length, bytes.data() + 8, 4);
+    EXPECT_EQ(length, bytes.size());
+    EXPECT_EQ(bytes.size() % 4, 0u);
+  }
+  const std::string name = binary ? "scene.glb" : "scene.gltf";
+  dir.Write(name, bytes);
   dir.Write("back.json",
-            R"({"objects": [{"name": "all", "mesh": {"file": "scene.gltf"}}],
+            R"({"objects": [{"name": "all", "mesh": {"file": ")" + name + R"("}}],
                 "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [0, -3, 1], "look_at": [0, 0, 1],
                           "resolution": [64, 48], "hfov_deg": 60}]}],
                 "study": {"region": {"box": {"min": [-1, -1, 0], "max": [1, 1, 2]}}}})");
@@ -501,6 +513,7 @@ TEST(RigFormats, GltfMeshesLoadBack) {
     ASSERT_NE(original, nullptr) << part.name;
     ASSERT_GE(part.material, 0);
     EXPECT_LE((back.materials[static_cast<std::size_t>(part.material)].color - original->color).norm(), 1e-6);
+  }
   }
 }
 
