@@ -263,6 +263,34 @@ TEST(RigImport, SceneTextRoundTripInCentimetres) {
   }
 }
 
+// Replacing by id keeps every other key and the keys' order: the orientation is written at the
+// place of look_at / euler_deg / quaternion, the focal length at the place of hfov_deg / focal_px /
+// lens; name, range and the other cameras stay as they were.
+TEST(RigImport, ReplaceKeepsOtherKeysAndOrder) {
+  const std::string text = ReadText(kScenePath);
+  Rig calibrated = LoadRigioScene().FindRig("design");
+  calibrated.cameras.erase(calibrated.cameras.begin() + 2);  // the fisheye stays as designed
+  const nlohmann::ordered_json before = nlohmann::ordered_json::parse(text);
+  const nlohmann::ordered_json after = nlohmann::ordered_json::parse(
+      WriteRigIntoSceneText(text, kScenePath, ViaOpenCv(calibrated), "design", false));
+  const auto keys = [](const nlohmann::ordered_json& camera) {
+    std::vector<std::string> k;
+    for (auto it = camera.begin(); it != camera.end(); ++it) k.push_back(it.key());
+    return k;
+  };
+  const auto& cams = after["rigs"][0]["cameras"];
+  EXPECT_EQ(keys(cams[0]), (std::vector<std::string>{"id", "position", "quaternion", "resolution", "focal_px", "principal_point"}));
+  EXPECT_EQ(keys(cams[1]), (std::vector<std::string>{"id", "name", "position", "quaternion", "resolution", "focal_px",
+                                                     "principal_point", "distortion"}));
+  EXPECT_EQ(cams[1]["name"], "corner \"seven\"");
+  EXPECT_EQ(cams[1]["id"], 7);  // a number stays a number
+  EXPECT_EQ(cams[2], before["rigs"][0]["cameras"][2]);
+  EXPECT_EQ(keys(cams[3]), (std::vector<std::string>{"id", "position", "quaternion", "resolution", "focal_px",
+                                                     "distortion", "principal_point"}));
+  EXPECT_EQ(after["study"], before["study"]);
+  EXPECT_EQ(after["objects"], before["objects"]);
+}
+
 TEST(RigImport, MovedCameraIsReportedAndWrittenWithBackup) {
   testing::TempDir dir("rigio");
   const std::string scene = dir.File("scene.json");
