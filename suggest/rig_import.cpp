@@ -200,7 +200,13 @@ RigImportResult ImportRig(const RigImportOptions& options) {
   RigImportResult result;
   result.scene_path = options.scene;
   if (!options.as.empty()) {
-    if (!design) before.FindRig(options.rig);  // throws naming the rigs
+    if (!design) {
+      try {
+        before.FindRig(options.rig);
+      } catch (const InputError& e) {
+        throw InputError("--rig", "", e.reason(), e.hint());  // names the scene's rigs
+      }
+    }
     result.rig_written = options.as;
     result.new_rig = true;
   } else {
