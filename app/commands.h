@@ -208,3 +208,30 @@ struct AcceptArgs {
 int RunAccept(const AcceptArgs& args);
 
 }  // namespace pandora::app
+
+namespace pandora::app {
+
+/// `pandora export-rig`: the rig as OpenCV YAML, a COLMAP text model (a folder), glTF (meshes and
+/// cameras) or an installation sheet (CSV); analysis/rig_formats.h, docs/tool-chain.md.
+struct ExportRigArgs {
+  std::string scene;
+  std::string rig;
+  std::string format;  ///< opencv | colmap | gltf | sheet
+  std::string out;     ///< A file; a folder for colmap.
+  bool quiet = false;
+};
+int RunExportRig(const ExportRigArgs& args);
+
+/// `pandora import-rig`: a calibrated rig (OpenCV YAML or a COLMAP text model) into the scene file
+/// with a backup, compared with the design (suggest/rig_import.h).
+struct ImportRigArgs {
+  std::string scene;
+  std::string format;  ///< opencv | colmap
+  std::string from;
+  std::string rig;
+  std::string as;
+  bool quiet = false;
+};
+int RunImportRig(const ImportRigArgs& args);
+
+}  // namespace pandora::app

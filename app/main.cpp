@@ -280,6 +280,26 @@ int main(int argc, char** argv) {
   es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
 
+  ExportRigArgs export_rig;
+  CLI::App* er = app.add_subcommand(
+      "export-rig", "Write the rig as OpenCV YAML, a COLMAP text model, glTF (meshes + cameras) or an installation sheet (CSV)");
+  er->add_option("scene", export_rig.scene, "Scene file (JSON)")->required();
+  er->add_option("--rig", export_rig.rig, "Rig name (default: the first rig)");
+  er->add_option("--format", export_rig.format, "opencv | colmap | gltf | sheet")->required();
+  er->add_option("--out", export_rig.out, "Output file (a folder for colmap)")->required();
+  er->add_flag("--quiet,-q", export_rig.quiet, "Print nothing but errors");
+
+  ImportRigArgs import_rig;
+  std::vector<std::string> import_from;
+  CLI::App* ir = app.add_subcommand(
+      "import-rig", "Write a calibrated rig (OpenCV YAML or COLMAP text model) into the scene file (keeps a backup) and compare it with the design");
+  ir->add_option("scene", import_rig.scene, "Scene file (JSON), rewritten")->required();
+  ir->add_option("--from", import_from, "FORMAT PATH: opencv FILE.yml or colmap FOLDER")
+      ->required()->expected(2);
+  ir->add_option("--rig", import_rig.rig, "The design rig: replaced by id, or compared with when --as is given")->required();
+  ir->add_option("--as", import_rig.as, "Write a new rig of this name instead");
+  ir->add_flag("--quiet,-q", import_rig.quiet, "Print nothing but errors");
+
   ReportArgs report;
   CLI::App* rep = app.add_subcommand(
       "report", "One self-contained HTML report: renders, field slices, histograms, cameras, rigs side by side");
@@ -398,6 +418,12 @@ int main(int argc, char** argv) {
     if (*acc) return RunAccuracy(accuracy);
     if (*rn) return RunRender(render);
     if (*es) return RunExportSurface(surface);
+    if (*er) return RunExportRig(export_rig);
+    if (*ir) {
+      import_rig.format = import_from.at(0);
+      import_rig.from = import_from.at(1);
+      return RunImportRig(import_rig);
+    }
     if (*rep) return RunReport(report);
     if (*sg) return RunSuggest(suggest);
     if (*ac) return RunAccept(accept);

@@ -1,7 +1,7 @@
 // Replays files through the fuzz targets in the normal (GCC) build: each file in a child process,
 // which must exit 0 (read) or 2 (InputError), within a time limit; anything else (a signal, another
 // exception, a hang) is a failure naming the file.
-// Usage: fuzz_replay fields|scene|script [--timeout SECONDS] FILE_OR_FOLDER...
+// Usage: fuzz_replay fields|scene|script|rig [--timeout SECONDS] FILE_OR_FOLDER...
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -24,11 +24,11 @@ namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: fuzz_replay fields|scene|script [--timeout SECONDS] FILE_OR_FOLDER...\n");
+    std::fprintf(stderr, "usage: fuzz_replay fields|scene|script|rig [--timeout SECONDS] FILE_OR_FOLDER...\n");
     return 1;
   }
   const std::string target = argv[1];
-  if (target != "fields" && target != "scene" && target != "script") {
+  if (target != "fields" && target != "scene" && target != "script" && target != "rig") {
     std::fprintf(stderr, "fuzz_replay: unknown target '%s'\n", target.c_str());
     return 1;
   }
@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
           pandora::fuzz::FieldsTarget(data, bytes.size());
         else if (target == "scene")
           pandora::fuzz::SceneTarget(data, bytes.size());
+        else if (target == "rig")
+          pandora::fuzz::RigTarget(data, bytes.size());
         else
           pandora::fuzz::ScriptTarget(data, bytes.size());
       } catch (const pandora::InputError&) {

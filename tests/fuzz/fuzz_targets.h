@@ -20,4 +20,8 @@ void SceneTarget(const std::uint8_t* data, std::size_t size);
 /// Bytes as a viewer script (`pandora view --script`): viewer::ParseScript, parse and validate only.
 void ScriptTarget(const std::uint8_t* data, std::size_t size);
 
+/// Bytes as a calibrated rig (`pandora import-rig`): the first byte picks OpenCV YAML (even) or a
+/// COLMAP model (odd; cameras.txt, then "\n@images\n", then images.txt); every value read finite.
+void RigTarget(const std::uint8_t* data, std::size_t size);
+
 }  // namespace pandora::fuzz

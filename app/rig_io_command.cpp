@@ -1,0 +1,102 @@
+// `pandora export-rig` and `pandora import-rig` (issue 14, points 2 and 3; docs/tool-chain.md):
+// the rig in reconstruction tools' formats, and a calibrated rig back into the scene file.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "analysis/error.h"
+#include "analysis/rig_formats.h"
+#include "analysis/scene.h"
+#include "app/commands.h"
+#include "app/output.h"
+#include "suggest/rig_import.h"
+
+namespace pandora::app {
+
+int RunExportRig(const ExportRigArgs& args) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string& f = args.format;
+  if (f != "opencv" && f != "colmap" && f != "gltf" && f != "sheet")
+    throw InputError("--format", "", "unknown format '" + f + "'", "opencv, colmap, gltf or sheet");
+  if (args.out.empty()) throw InputError("--out", "", "no output given");
+  LoadOptions load;
+  load.load_meshes = f == "gltf";
+  const Scene scene = LoadScene(args.scene, load);
+  const Rig& rig = WithFlagNames({{"--rig", "--rig"}}, [&]() -> const Rig& {
+    try {
+      return scene.FindRig(args.rig);
+    } catch (const InputError& e) {
+      throw InputError("--rig", "", e.reason(), e.hint());
+    }
+  });
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  std::vector<std::string> written;
+  if (f == "colmap") {
+    const ColmapText model = RigToColmap(rig);
+    const std::filesystem::path dir(args.out);
+    for (const auto& [name, text] : {std::pair<std::string, const std::string*>{"cameras.txt", &model.cameras},
+                                     {"images.txt", &model.images},
+                                     {"points3D.txt", &model.points3d}}) {
+      output.Write((dir / name).string(), "--out", *text);
+      written.push_back((dir / name).string());
+    }
+  } else {
+    std::string bytes;
+    if (f == "opencv") {
+      try {
+        bytes = RigToOpenCvYaml(rig);
+      } catch (const InputError& e) {
+        throw InputError(args.scene, "", e.reason(), e.hint());
+      }
+    } else if (f == "gltf") {
+      // A .glb name gets binary glTF; any other name the .gltf JSON with the buffer embedded.
+      const std::string ext = std::filesystem::path(args.out).extension().string();
+      bytes = SceneToGltf(scene, rig, ext == ".glb" || ext == ".GLB");
+    } else {
+      bytes = RigToSheetCsv(rig);
+    }
+    output.Write(args.out, "--out", bytes);
+    written.push_back(args.out);
+  }
+  output.Commit();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!args.quiet) {
+    std::printf("rig %s: %zu cameras as %s\n", rig.name.c_str(), rig.cameras.size(), f.c_str());
+    for (const std::string& w : written) std::printf("wrote %s\n", w.c_str());
+    std::printf("(%.3f s)\n", seconds);
+  }
+  return 0;
+}
+
+int RunImportRig(const ImportRigArgs& args) {
+  if (args.format != "opencv" && args.format != "colmap")
+    throw InputError("--from", "", "unknown format '" + args.format + "'", "opencv or colmap, e.g. --from opencv rig.yml");
+  RigImportOptions options;
+  options.scene = args.scene;
+  options.format = args.format;
+  options.from = args.from;
+  options.rig = args.rig;
+  options.as = args.as;
+  const RigImportResult r = ImportRig(options);
+  if (!args.quiet) {
+    std::printf("%s rig '%s' in %s (%zu cameras); backup %s\n", r.new_rig ? "added" : "updated",
+                r.rig_written.c_str(), r.scene_path.c_str(), r.differences.size(), r.backup_path.c_str());
+    bool any = false;
+    for (const RigImportDifference& d : r.differences) any = any || d.in_design;
+    if (any) {
+      std::printf("against the design rig '%s':\n%-16s %12s %11s %12s %12s\n", args.rig.c_str(), "camera",
+                  "moved_mm", "turned_deg", "fx_design", "fx_calib");
+      for (const RigImportDifference& d : r.differences) {
+        if (d.in_design)
+          std::printf("%-16s %12.3f %11.4f %12.2f %12.2f\n", d.id.c_str(), d.moved_m * 1000.0,
+                      d.turned_deg, d.fx_design, d.fx_imported);
+        else
+          std::printf("%-16s not in the design rig\n", d.id.c_str());
+      }
+    }
+  }
+  return 0;
+}
+
+}  // namespace pandora::app
