@@ -408,8 +408,8 @@ TEST(GlRenderer, KeepsMapsWhileCamerasStayAndRedrawsOnlyMovedOnes) {
 // 0.56 % of all; colours where they agree by 5e-7 and 2.9e-6 on average. That is more than the
 // perspective views' 0.0000 %: the disagreement grows with the eye's distance (the same elevation
 // with the eye 50 and 5 scene sizes away, field of view scaled to the same framing: 0.0023 % and
-// 0.0005 %) and stayed the same when the GPU's depth test was made exact, so it is where nearly
-// coincident surfaces (capsules through capsules) are ordered by the CPU's float ray at 3.7 km.
+// 0.0005 %) and stayed the same when the GPU's depth test was made exact (it was float depth at
+// 3.7 km); the differing pixels are bands on the staff's capsule arms, not yet traced to one side.
 // Bounds: 2x and 1.4x the elevation's measures. Drawn without the cut, the GPU's pictures differ
 // from the CPU's cut ones on 0.95 % (plan) and 2.5 % (elevation) of all pixels: over the bound.
 constexpr double kPlanMaxMaskShare = 0.0015;    // of the compared pixels
