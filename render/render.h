@@ -50,7 +50,9 @@ struct RenderView {
   /// image scaled to width x height). from/at/up/fov_deg are then ignored.
   int camera = -1;
   /// Main view: nothing nearer than this distance along the optical axis is drawn (a plan's cut
-  /// through the ceiling, an elevation's section); 0: none.
+  /// through the ceiling, an elevation's section); 0: none. Primary rays start on that plane (the
+  /// origin moved there in double, so a far eye costs no float precision); the GPU renderer
+  /// discards fragments nearer than it.
   double clip_near = 0;
 };
 
