@@ -130,9 +130,7 @@ int RunRender(const RenderArgs& args) {
     const std::string side = Lower(args.plan);
     const Aabb& region = scene.study.region.box;
     double cut = args.cut;
-    if (std::isnan(cut))
-      cut = side == "plan" ? region.max.z() : side == "north" ? region.max.y() : side == "south" ? region.min.y()
-            : side == "east" ? region.max.x() : region.min.x();
+    if (std::isnan(cut)) cut = PlanDefaultCut(region, side);
     const std::optional<RenderView> plan = PlanView(scene.ContentBounds(), side, w, h, cut, &plan_scale);
     if (!plan)
       throw InputError("--elevation", "", "unknown side '" + args.plan + "'", "use north, south, east or west (or --plan)");

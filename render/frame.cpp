@@ -664,7 +664,12 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   primary_owner.clear();
   for (int i = 0; i < int(s.size()); ++i) {
     if (s[i].d.squaredNorm() == 0) continue;
-    primary.push_back(Ray{rays.eye(), s[i].d, rays.NearT(s[i].d), kInf});
+    // A cut view's ray starts on the cut plane itself (origin moved there in double), not at the
+    // eye with tnear: Embree's float origin and t at an eye kilometres away (a plan's) would pick
+    // the wrong one of two triangles a fraction of a millimetre apart. SetHit recomputes the hit
+    // from the eye in double either way.
+    const double t0 = rays.NearT(s[i].d);
+    primary.push_back(Ray{Vec3(rays.eye() + t0 * s[i].d), s[i].d, 0.0, kInf});
     primary_owner.push_back(i);
   }
   primary_hits.resize(primary.size());
@@ -675,7 +680,11 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       record->primary_rays.insert(record->primary_rays.end(), primary.begin(), primary.end());
   }
   for (std::size_t k = 0; k < primary.size(); ++k)
-    if (primary_hits[k]) SetHit(rays.eye(), *primary_hits[k], scene.mesh, &s[primary_owner[k]]);
+    if (primary_hits[k]) {
+      RayHit h = *primary_hits[k];
+      h.t += rays.NearT(s[primary_owner[k]].d);  // from the eye
+      SetHit(rays.eye(), h, scene.mesh, &s[primary_owner[k]]);
+    }
   // Cameras that cannot see any of the group's hit points skip it (FrustumCuller is conservative).
   Aabb box;
   for (const Sample& smp : s)
@@ -1005,9 +1014,12 @@ std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
                             std::to_string(m.height) + " image");
   internal::Sample smp;
   if (!m.rays.Center(x, y, &smp.d, nullptr, nullptr)) return std::nullopt;
-  const auto hit = m.scene.caster->Intersect(Ray{m.rays.eye(), smp.d, m.rays.NearT(smp.d), internal::kInf});
+  const double t0 = m.rays.NearT(smp.d);  // from the cut plane, as the frame's rays
+  const auto hit = m.scene.caster->Intersect(Ray{Vec3(m.rays.eye() + t0 * smp.d), smp.d, 0.0, internal::kInf});
   if (!hit) return std::nullopt;
-  internal::SetHit(m.rays.eye(), *hit, m.scene.mesh, &smp);
+  RayHit h = *hit;
+  h.t += t0;  // from the eye
+  internal::SetHit(m.rays.eye(), h, m.scene.mesh, &smp);
   const double lift = 0.1 * m.tester.epsilon();  // as FrameRenderer
   PixelPick pick;
   pick.point = smp.X;

@@ -69,6 +69,15 @@ std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, 
   return v;
 }
 
+double PlanDefaultCut(const Aabb& region, const std::string& side) {
+  if (side == "plan") return region.max.z();
+  if (side == "north") return region.max.y();
+  if (side == "south") return region.min.y();
+  if (side == "east") return region.max.x();
+  if (side == "west") return region.min.x();
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
 RenderView ViewFromScene(const View& view, int width, int height, double default_fov_deg) {
   RenderView v;
   v.from = view.from;

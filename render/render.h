@@ -50,7 +50,9 @@ struct RenderView {
   /// image scaled to width x height). from/at/up/fov_deg are then ignored.
   int camera = -1;
   /// Main view: nothing nearer than this distance along the optical axis is drawn (a plan's cut
-  /// through the ceiling, an elevation's section); 0: none.
+  /// through the ceiling, an elevation's section); 0: none. Primary rays start on that plane (the
+  /// origin moved there in double, so a far eye costs no float precision); the GPU renderer
+  /// discards fragments nearer than it.
   double clip_near = 0;
 };
 
@@ -67,6 +69,10 @@ RenderView ViewFromScene(const View& view, int width, int height, double default
 inline constexpr double kPlanDistance = 500.0;
 std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width, int height,
                                    double cut, double* metres_per_pixel = nullptr);
+/// The default cut of a plan or elevation of a study region `region` (`pandora render --plan`, the
+/// viewer's Plan and Elevation views): a plan at the region's top, an elevation at the region's
+/// face on its side (north: max y, south: min y, east: max x, west: min x). NaN for an unknown side.
+double PlanDefaultCut(const Aabb& region, const std::string& side);
 
 /// How the surfaces themselves look under the projected light.
 enum class Surface {

@@ -47,18 +47,21 @@ layout(location = 2) in vec3 albedo;
 layout(location = 3) in vec2 tag;  // object index, drawn-edge bits (bit i: edge opposite vertex i)
 layout(location = 4) in vec2 uv;   // texture coordinate (v = 0: the texture's bottom row)
 uniform mat3 view_R;   // camera_from_world rotation of the eye (OpenCV frame: y down, z forward)
-uniform vec3 view_t;   // camera-frame position of the scene's centre
-uniform vec4 proj;     // 2f/W, 2f/H, A, B: clip = (proj.x x, proj.y y, A z + B, z)
+uniform vec3 view_t;   // camera-frame position of the scene's centre, less (0, 0, view_d0)
+uniform float view_d0; // the near plane's depth: z is kept relative to it (precision far away)
+uniform vec4 proj;     // 2f/W, 2f/H, A, B': clip = (proj.x x, proj.y y, A z + B', z + d0)
 out vec3 v_position;
+out float v_z;         // depth beyond the near plane, m (the fragment's depth and the cut)
 flat out vec3 v_normal;
 flat out vec3 v_albedo;
 flat out vec2 v_tag;
 out vec3 v_bary;
 out vec2 v_uv;
 void main() {
-  vec3 c = view_R * position + view_t;
+  vec3 c = view_R * position + view_t;  // c.z: depth less view_d0
   v_uv = uv;
-  gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z);
+  v_z = c.z;
+  gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z + view_d0);
   v_position = position;
   v_normal = normal;
   v_albedo = albedo;
@@ -75,6 +78,8 @@ flat in vec3 v_albedo;
 flat in vec2 v_tag;
 in vec3 v_bary;
 in vec2 v_uv;
+in float v_z;
+uniform vec2 depth_map;  // the cut's v_z (nothing nearer is drawn), 1 / (far - near)
 uniform vec3 eye;
 uniform int textured;         // 1: albedo times the texture (bilinear, repeat, filtered in linear)
 uniform sampler2D albedo_tex; // sRGB8: decoded to linear before filtering, as the CPU's texels
@@ -84,6 +89,10 @@ layout(location = 0) out vec4 g_position;  // xyz, 1 (-1: no surface)
 layout(location = 1) out vec4 g_normal;    // turned towards the eye; w: edge coverage
 layout(location = 2) out vec4 g_albedo;    // w: object index
 void main() {
+  // RenderView::clip_near, and the depth linear in v_z: an eye far away (plans) keeps the depth
+  // test's precision, (far - near) / 2^24, instead of float's at the eye's distance.
+  if (v_z < depth_map.x) discard;
+  gl_FragDepth = clamp(v_z * depth_map.y, 0.0, 1.0);
   vec3 n = v_normal;
   if (dot(n, v_position - eye) > 0.0) n = -n;
   // Coverage by the drawn edges as render/frame.cpp: LineCoverage(|lambda_i| / |grad lambda_i|)
@@ -1045,7 +1054,13 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     const Eigen::Vector4d bounds(-0.5 * W / f, 0.5 * W / f, -0.5 * H / f, 0.5 * H / f);
     auto range = DepthRangeInPyramid(m.mesh, cfw, bounds);
     if (!(range.first <= range.second)) range = {1.0, 2.0};  // nothing in view: any range
+    // The depth range spans the content in view (an eye 500 scene sizes away: far / near ~ 1.002).
+    // Depths are taken relative to the near plane in the shaders and the depth test's value is
+    // linear in them, so its resolution is (far - near) / 2^24 however far the eye stands. The
+    // cut (RenderView::clip_near, a plan's) is a discard at that depth, as the CPU starts its rays
+    // on the cut plane.
     const auto [near, far] = PadRange(range);
+    const double cut_rel = view.clip_near > 0 ? view.clip_near - near : -1.0;
     const Eigen::Vector2d ab = DepthCoefficients(near, far);
     glBindFramebuffer(GL_FRAMEBUFFER, m.g_fbo);
     const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
@@ -1062,9 +1077,11 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glDisable(GL_CULL_FACE);
     glUseProgram(m.gbuffer_program);
     SetMat3(m.gbuffer_program, "view_R", eye_R);
-    SetVec3(m.gbuffer_program, "view_t", eye_R * (m.origin - view.from));
+    SetVec3(m.gbuffer_program, "view_t", eye_R * (m.origin - view.from) - Vec3(0, 0, near));
+    glUniform1f(Loc(m.gbuffer_program, "view_d0"), float(near));
     glUniform4f(Loc(m.gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
-                float(ab(1)));
+                float(ab(0) * near + ab(1)));
+    glUniform2f(Loc(m.gbuffer_program, "depth_map"), float(cut_rel), float(1.0 / (far - near)));
     SetVec3(m.gbuffer_program, "eye", eye_rel);
     glUniform1i(Loc(m.gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
     glUniform1f(Loc(m.gbuffer_program, "line_width"), float(options.line_width_px));

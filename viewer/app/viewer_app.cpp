@@ -283,11 +283,12 @@ struct ViewerApp::Impl {
     UploadAllTrace();
     RenderView view = model.MainView();
     char key[512];
-    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g",
+    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g %.17g %.17g %.17g %.17g",
                   static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
                   view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
                   int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
-                  int(model.display.surface), shadow_map_size, model.ptz_trace.c_str(), model.ptz_trace_s);
+                  int(model.display.surface), shadow_map_size, model.ptz_trace.c_str(), model.ptz_trace_s,
+                  view.clip_near, view.up.x(), view.up.y(), view.up.z());
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
     const std::int64_t rig_version = model.session().rig().version();
@@ -757,7 +758,7 @@ struct ViewerApp::Impl {
     const ImGuiIO& io = ImGui::GetIO();
     const double x = input.x, y = input.y;
     if (drag == Drag::kNone) hover_handle = mouse_free ? HandleAt(x, y) : -1;
-    if (mouse_free && io.MouseWheel != 0) model.view.Dolly(io.MouseWheel);
+    if (mouse_free && io.MouseWheel != 0) model.Dolly(io.MouseWheel);  // magnifies a plan
     const bool left = input.down[0], right = input.down[1] || input.down[2];
     if (drag == Drag::kNone && mouse_free && (left || right)) {
       press_x = last_x = x;
@@ -780,8 +781,8 @@ struct ViewerApp::Impl {
     last_x = x;
     last_y = y;
     if (drag == Drag::kClick && std::hypot(x - press_x, y - press_y) > 3) drag = Drag::kOrbit;
-    if (drag == Drag::kOrbit) model.view.Orbit(dx, dy);
-    if (drag == Drag::kPan) model.view.Pan(dx, dy, model.width);
+    if (drag == Drag::kOrbit) model.Orbit(dx, dy);  // leaves a plan or elevation
+    if (drag == Drag::kPan) model.Pan(dx, dy);      // within a plan: the drawing follows the cursor
     if ((drag == Drag::kAxis || drag == Drag::kRing) && (dx != 0 || dy != 0)) DragGizmo(x, y);
     if (!left && !right) {  // released
       if (drag == Drag::kClick) Click(x, y);
@@ -893,15 +894,16 @@ struct ViewerApp::Impl {
       else if (input.ctrl && key == GLFW_KEY_Y) Do(Make(Action::Kind::kRedo));
       else if (input.ctrl && key == GLFW_KEY_S) Do(Make(Action::Kind::kSave));
       else if (key == GLFW_KEY_ESCAPE) station.clear(), Do(Make(Action::Kind::kSelect));
-      else if (key == GLFW_KEY_F) model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
+      else if (key == GLFW_KEY_F) model.plan.clear(), model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
     }
     input.pressed.clear();
     // Fly with W A S D Q E while the right button is held.
     if (input.down[1] && !ImGui::GetIO().WantCaptureKeyboard) {
+      const Vec3 fly(input.keys[GLFW_KEY_D] - input.keys[GLFW_KEY_A], input.keys[GLFW_KEY_E] - input.keys[GLFW_KEY_Q],
+                     input.keys[GLFW_KEY_W] - input.keys[GLFW_KEY_S]);
+      if (fly != Vec3::Zero()) model.LeavePlan();  // flying is 3D
       const double step = 0.02 * model.view.distance;
-      model.view.Fly(step * (input.keys[GLFW_KEY_D] - input.keys[GLFW_KEY_A]),
-                     step * (input.keys[GLFW_KEY_E] - input.keys[GLFW_KEY_Q]),
-                     step * (input.keys[GLFW_KEY_W] - input.keys[GLFW_KEY_S]));
+      model.view.Fly(step * fly.x(), step * fly.y(), step * fly.z());
     }
   }
 
@@ -921,6 +923,7 @@ struct ViewerApp::Impl {
     if (!active) return;
     const double dt = std::clamp(frame_seconds, 1e-3, 0.1);
     if (Primary() < 0) {
+      model.LeavePlan();
       model.view.Fly(dt * 1.5 * StickCurve(g.left_x), 0, -dt * 1.5 * StickCurve(g.left_y));
       model.view.Look(-dt * 60 * StickCurve(g.right_x), -dt * 60 * StickCurve(g.right_y));
       return;
@@ -947,6 +950,28 @@ struct ViewerApp::Impl {
     if (ImGui::Button("Save")) Do(Make(Action::Kind::kSave));
     ImGui::SameLine();
     ImGui::TextDisabled("%zu unsaved", edit.Unsaved().size());
+    // The proposal views of `pandora render --plan` / `--elevation SIDE` (docs/viewer.md).
+    auto plan_button = [&](const char* label, const char* view, const char* side) {
+      const bool on = model.plan == (side[0] ? side : "plan");
+      if (on) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyleColorVec4(ImGuiCol_ButtonActive));
+      if (ImGui::SmallButton(label)) {
+        Action a = Make(Action::Kind::kView);
+        a.text = view;
+        a.text2 = side;
+        Do(a);
+      }
+      if (on) ImGui::PopStyleColor();
+    };
+    plan_button("Plan", "plan", "");
+    ImGui::SameLine();
+    ImGui::TextUnformatted("Elevation");
+    for (const char* side : {"north", "south", "east", "west"}) {
+      ImGui::SameLine();
+      const char label[2] = {char(side[0] - 'a' + 'A'), 0};
+      ImGui::PushID(side);
+      plan_button(label, "elevation", side);
+      ImGui::PopID();
+    }
     ImGui::Separator();
     for (int c = 0; c < int(rig.cameras.size()); ++c) {
       const Camera& cam = rig.cameras[c];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 #include <nlohmann/json.hpp>
 
 #include "analysis/error.h"
@@ -86,6 +87,7 @@ void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, 
   options.layers = false;
   options.pixel_sigma = model.scene().study.pixel_sigma;
   RenderView view = model.MainView();
+  if (camera < 0 && !model.plan.empty()) options.overlays.labels = true;  // camera ids, as render --plan
   if (camera >= 0) {
     // The camera's own image, scaled to fit the main view's size.
     const CameraModel& m = model.rig().cameras[camera].model;
@@ -145,6 +147,59 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
 }
 
 ViewerModel::~ViewerModel() = default;
+
+RenderView ViewerModel::MainView() const {
+  if (plan.empty()) return view.ToRenderView(width, height);
+  RenderView v = *PlanView(scene().ContentBounds(), plan, width, height,
+                           PlanDefaultCut(scene().study.region.box, plan));
+  // Panning moves eye and target in the picture's plane: the distance to the cut stays.
+  v.from += plan_offset;
+  v.at += plan_offset;
+  v.fov_deg = 2.0 * std::atan(std::tan(0.5 * v.fov_deg * M_PI / 180.0) / plan_zoom) * 180.0 / M_PI;
+  return v;
+}
+
+void ViewerModel::SetPlan(const std::string& side) {
+  if (std::isnan(PlanDefaultCut(scene().study.region.box, side)))
+    throw std::invalid_argument("SetPlan: unknown side '" + side + "'");
+  plan = side;
+  plan_offset = Vec3::Zero();
+  plan_zoom = 1;
+}
+
+void ViewerModel::LeavePlan() {
+  if (plan.empty()) return;
+  const Aabb bounds = scene().ContentBounds();
+  OrbitView o = OrbitView::Framing(bounds, view.fov_deg);
+  o.target = bounds.center() + plan_offset;
+  // The eye on the plan's side: yaw from +x towards +y of the eye's direction from the target.
+  o.pitch_deg = plan == "plan" ? 89.0 : 0.0;
+  o.yaw_deg = plan == "north" ? 90.0 : plan == "east" ? 0.0 : plan == "west" ? 180.0 : -90.0;
+  view = o;
+  plan.clear();
+}
+
+void ViewerModel::Orbit(double dx_px, double dy_px) {
+  LeavePlan();
+  view.Orbit(dx_px, dy_px);
+}
+
+void ViewerModel::Pan(double dx_px, double dy_px) {
+  if (plan.empty()) return view.Pan(dx_px, dy_px, width);
+  const RenderView v = MainView();
+  const Vec3 forward = (v.at - v.from).normalized();
+  const Vec3 right = forward.cross(v.up).normalized();
+  const Vec3 up = right.cross(forward);
+  // The scale at the framed centre: the picture is orthographic to 1 / kPlanDistance.
+  const double metres_per_px =
+      2.0 * (v.at - v.from).norm() * std::tan(0.5 * v.fov_deg * M_PI / 180.0) / std::max(width, 1);
+  plan_offset += metres_per_px * (-dx_px * right + dy_px * up);
+}
+
+void ViewerModel::Dolly(double steps) {
+  if (plan.empty()) return view.Dolly(steps);
+  plan_zoom = std::clamp(plan_zoom / std::pow(0.85, steps), 1e-2, 1e4);
+}
 
 int ViewerModel::CameraIndex(const std::string& id, const Action& action) const {
   const int c = rig().FindCamera(id);
@@ -446,6 +501,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       break;
     }
     case Kind::kView: {
+      if (a.text == "plan" || a.text == "elevation") {
+        SetPlan(a.text == "plan" ? "plan" : a.text2);
+        break;
+      }
       const auto it = scene().views.find(a.text);
       if (it == scene().views.end()) {
         std::string names;
@@ -454,19 +513,21 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
                          names.empty() ? "the scene defines no views" : "views: " + names);
       }
       const RenderView v = ViewFromScene(it->second, width, height, 50.0);
+      plan.clear();
       view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
       break;
     }
     case Kind::kOrbit:
-      view.Orbit(a.a.x(), a.a.y());
+      Orbit(a.a.x(), a.a.y());
       break;
     case Kind::kPan:
-      view.Pan(a.a.x(), a.a.y(), width);
+      Pan(a.a.x(), a.a.y());
       break;
     case Kind::kDolly:
-      view.Dolly(a.number);
+      Dolly(a.number);
       break;
     case Kind::kEye:
+      plan.clear();
       view = OrbitView::FromLookAt(a.a, a.b, a.number);
       break;
     case Kind::kLight:
@@ -731,6 +792,7 @@ nlohmann::json ViewerModel::StateJson() const {
   });
   json j = {{"rig", rig().name},
             {"ptz_trace", ptz_trace},
+            {"plan", plan},  // "": the orbit view; else the plan or elevation side
             {"rig_version", edit.version()},
             {"undo", edit.undo_label()},
             {"redo", edit.redo_label()},

@@ -100,8 +100,29 @@ class ViewerModel {
   /// `all` (may be null) receives the "all" traces for RenderOptions::ptz_all.
   Rig TracedRig(std::vector<RenderOptions::PtzTrace>* all) const;
 
+  /// The main view as a plan or elevation (docs/viewer.md, "Plans and elevations"): "" (none: the
+  /// orbit view `view`), "plan", "north", "south", "east" or "west". The main view is then
+  /// PlanView of the scene's content bounds, cut at PlanDefaultCut of the study region (as
+  /// `pandora render --plan` / `--elevation SIDE`), moved by plan_offset (world metres, in the
+  /// picture's plane) and magnified plan_zoom times.
+  std::string plan;
+  Vec3 plan_offset = Vec3::Zero();
+  double plan_zoom = 1;
+  /// Sets the plan or elevation `side` ("plan", "north", ...), framed afresh (no offset, zoom 1).
+  /// Throws std::invalid_argument for an unknown side.
+  void SetPlan(const std::string& side);
+  /// Leaves the plan mode: the orbit view then looks the same way at the content's centre (from a
+  /// framing distance, perspective again). Nothing when not in it.
+  void LeavePlan();
+  /// Navigation that knows the plan mode: orbit leaves it (a plan is not a 3D view); pan moves the
+  /// drawing under the cursor and dolly magnifies it (x 1 / 0.85 a step), staying orthographic and
+  /// cut. Outside the plan mode, OrbitView's Orbit, Pan and Dolly.
+  void Orbit(double dx_px, double dy_px);
+  void Pan(double dx_px, double dy_px);
+  void Dolly(double steps);
+
   /// The main view as the renderer takes it.
-  RenderView MainView() const { return view.ToRenderView(width, height); }
+  RenderView MainView() const;
   /// The state as JSON, for `pandora view --log`: rig version, undo label, selection, cameras'
   /// poses, fields (version, shares seen by at least 1, 2, ... cameras, sigma_max median), the pending suggestion.
   nlohmann::json StateJson() const;

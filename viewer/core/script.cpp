@@ -283,8 +283,12 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       if (!a.flag) a.number = e.Number("value", -1e30, 1e30);
       break;
     case Kind::kView:
-      e.Keys({"view"});
+      // "plan" and "elevation" (with "side") are the orthographic proposal views; any other name
+      // is one of the scene's views.
+      e.Keys({"view", "side"});
       a.text = e.String("view");
+      if (a.text == "elevation") a.text2 = e.OneOf("side", {"north", "south", "east", "west"});
+      else if (e.Has("side")) e.Fail("side", "only with \"view\": \"elevation\"");
       break;
     case Kind::kOrbit:
     case Kind::kPan:

@@ -25,6 +25,8 @@
 ///      {"slice": "coverage", "axis": "z", "at": 1.0},   // "slice": "" hides it
 ///      {"iso": "sigma_max", "value": 2.0},              // "iso": "" hides it
 ///      {"view": "overview"}, {"orbit": [dx, dy]}, {"pan": [dx, dy]}, {"dolly": 2},
+///      {"view": "plan"}, {"view": "elevation", "side": "south"},  // orthographic, cut (pan and
+///                                                      // dolly stay in it, orbit leaves it)
 ///      {"eye": [x, y, z], "at": [x, y, z]},
 ///      {"light": "grid", "grid": 16, "brightness": 0.5, "surface": "material"},
 ///      {"wait": "fields"},                              // or "suggest", "render"

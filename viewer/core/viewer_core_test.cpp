@@ -898,3 +898,73 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
 
 }  // namespace
 }  // namespace pandora::viewer
+
+namespace pandora::viewer {
+namespace {
+
+// The Plan and Elevation views (docs/viewer.md, "Plans and elevations"): the main view is
+// `pandora render --plan`'s PlanView with the same default cut; pan and dolly stay in it, orbit
+// leaves it.
+TEST(ViewerModel, PlanAndElevationViewsAreRenderPlansAndPanWithinThem) {
+  ExpectScriptError(R"([{"view": "elevation"}])", "$[0].side");
+  ExpectScriptError(R"([{"view": "elevation", "side": "up"}])", "$[0].side");
+  ExpectScriptError(R"([{"view": "plan", "side": "north"}])", "$[0].side");
+  ViewerOptions options;
+  options.fields = {"coverage"};
+  options.width = 320;
+  options.height = 180;
+  ViewerModel m(session::Study::Load("examples/trauma_room/scene.json"), options);
+  auto run = [&](const std::string& text) { m.Run(ParseScript(text, "s.json"), nullptr); };
+  const Aabb bounds = m.scene().ContentBounds();
+  const Aabb& region = m.scene().study.region.box;
+  auto expect_view = [&](const RenderView& want) {
+    const RenderView v = m.MainView();
+    EXPECT_LT((v.from - want.from).norm(), 1e-9);
+    EXPECT_LT((v.at - want.at).norm(), 1e-9);
+    EXPECT_LT((v.up - want.up).norm(), 1e-12);
+    EXPECT_NEAR(v.fov_deg, want.fov_deg, 1e-12);
+    EXPECT_NEAR(v.clip_near, want.clip_near, 1e-9);
+    EXPECT_EQ(v.width, 320);
+  };
+  run(R"([{"view": "plan"}])");
+  EXPECT_EQ(m.plan, "plan");
+  EXPECT_EQ(m.StateJson()["plan"], "plan");
+  expect_view(*PlanView(bounds, "plan", 320, 180, region.max.z()));
+  // The cut at the region's top: the eye's distance to the plane z = region top.
+  EXPECT_NEAR(m.MainView().clip_near, m.MainView().from.z() - region.max.z(), 1e-9);
+  run(R"([{"view": "elevation", "side": "south"}])");
+  EXPECT_EQ(m.plan, "south");
+  expect_view(*PlanView(bounds, "south", 320, 180, region.min.y()));
+  EXPECT_NEAR(m.MainView().clip_near, region.min.y() - m.MainView().from.y(), 1e-9);
+
+  // Pan: the point under the cursor (on the plane through the framed centre) follows it, to 1 um.
+  run(R"([{"view": "plan"}])");
+  auto on_plane = [&](double x, double y) {
+    const RenderView v = m.MainView();
+    const Ray r = *PixelRay(m.rig(), v, x, y);
+    const double t = (bounds.center().z() - r.origin.z()) / r.direction.z();
+    return Vec3(r.origin + t * r.direction);
+  };
+  const Vec3 before = on_plane(100, 60);
+  run(R"([{"pan": [40, -25]}])");
+  EXPECT_EQ(m.plan, "plan");
+  EXPECT_LT((on_plane(140, 35) - before).norm(), 1e-6);
+  EXPECT_NEAR(m.MainView().clip_near, m.MainView().from.z() - region.max.z(), 1e-9);  // cut kept
+  // Dolly magnifies: the half field's tangent x 0.85^2, the eye and the cut stay.
+  const RenderView panned = m.MainView();
+  run(R"([{"dolly": 2}])");
+  EXPECT_NEAR(std::tan(0.5 * m.MainView().fov_deg * kDeg), 0.85 * 0.85 * std::tan(0.5 * panned.fov_deg * kDeg), 1e-12);
+  EXPECT_LT((m.MainView().from - panned.from).norm(), 1e-9);
+  // Orbit leaves the plan for a perspective view from above the panned centre, then turns.
+  run(R"([{"orbit": [0, 0]}])");
+  EXPECT_EQ(m.plan, "");
+  EXPECT_EQ(m.MainView().clip_near, 0);
+  EXPECT_GT(m.view.Forward().dot(-Vec3::UnitZ()), 0.999);
+  EXPECT_LT((m.view.target.head<2>() - panned.at.head<2>()).norm(), 1e-9);
+  // A named view leaves it too.
+  run(R"([{"view": "plan"}, {"view": "overview"}])");
+  EXPECT_EQ(m.plan, "");
+}
+
+}  // namespace
+}  // namespace pandora::viewer
