@@ -17,6 +17,10 @@ import argparse
 import sys
 
 import bpy
+import numpy
+
+if not hasattr(numpy, "bool"):  # Blender 3.4's glTF importer uses numpy.bool, gone in numpy 1.24
+    numpy.bool = bool
 
 VIRIDIS = [(0.0, (0.267, 0.005, 0.329)), (0.25, (0.229, 0.322, 0.546)), (0.5, (0.128, 0.567, 0.551)),
            (0.75, (0.369, 0.789, 0.383)), (1.0, (0.993, 0.906, 0.144))]
@@ -108,6 +112,9 @@ def volume_material(obj, field, vmax):
     links.new(attr.outputs["Fac"], norm.inputs[0])
     links.new(norm.outputs["Value"], ramp.inputs["Fac"])
     links.new(ramp.outputs["Color"], shader.inputs["Color"])
+    # The field glows in its colour, so it reads without lights in the room.
+    links.new(ramp.outputs["Color"], shader.inputs["Emission Color"])
+    shader.inputs["Emission Strength"].default_value = 1.0
     links.new(norm.outputs["Value"], density.inputs[0])
     links.new(density.outputs["Value"], shader.inputs["Density"])
     links.new(shader.outputs["Volume"], out.inputs["Volume"])
@@ -147,6 +154,7 @@ def main():
         scene.render.engine = "CYCLES"
         scene.cycles.samples = args.samples
         scene.cycles.device = "CPU"
+        scene.cycles.use_denoising = False  # Debian's Blender is built without OpenImageDenoise
         scene.render.resolution_x, scene.render.resolution_y = w, h
         scene.render.filepath = args.render
         bpy.ops.render.render(write_still=True)
