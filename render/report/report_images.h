@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "analysis/text.h"  // Base64
+
 #include "analysis/color.h"
 #include "render/render.h"
 #include "volume/slice.h"
@@ -41,9 +43,6 @@ std::string PngBytes(const Image& image);
 /// PNG bytes of `raster` (8-bit sRGB): converted to linear RGB (the inverse sRGB curve, so WritePng's
 /// encoding gives the same 8-bit values back) and written by PngBytes.
 std::string EncodePng(const Raster& raster);
-
-/// Standard base64 (RFC 4648, with padding).
-std::string Base64(const std::string& bytes);
 
 /// "data:MIME;base64,..." of `bytes`.
 std::string DataUri(const std::string& mime, const std::string& bytes);
