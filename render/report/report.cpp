@@ -26,6 +26,7 @@
 #include "render/report/time_section.h"
 #include "render/report/robustness_section.h"
 #include "render/report/plot.h"
+#include "analysis/rig_formats.h"
 #include "render/report/report_images.h"
 
 #ifndef PANDORA_VERSION
@@ -601,6 +602,52 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
   {
     std::vector<std::string> cells;
     for (const RigReport& r : reports) cells.push_back("<div class=\"scroll\">" + CameraTable(r, study) + "</div>");
+    body << RigRow(cells);
+  }
+
+  // The installation sheet: what an installer needs per camera, with the CSV to download
+  // (analysis/rig_formats.h RigToSheetCsv, the same as `pandora export-rig --format sheet`).
+  body << "<h2 id=\"sheet\">Installation sheet</h2>\n<p class=\"note\">Mount point (the centre of "
+          "projection) in centimetres, pan, tilt and roll in degrees (the scene file's euler_deg: pan "
+          "about +z from +x, tilt up from horizontal, roll about the optical axis), lens and "
+          "resolution. The link holds the whole sheet as CSV.</p>\n"
+       << RigRow(heads);
+  {
+    std::vector<std::string> cells;
+    for (const RigReport& r : reports) {
+      const std::string csv = RigToSheetCsv(r.rig);
+      // The CSV's rows as a table (fields may be quoted: "a, b" and "" inside quotes).
+      std::string table = "<table class=\"sheet\">";
+      std::size_t line = 0;
+      for (std::size_t at = 0; at < csv.size();) {
+        const std::size_t end = csv.find('\n', at);
+        const std::string row = csv.substr(at, end - at);
+        at = end == std::string::npos ? csv.size() : end + 1;
+        std::vector<std::string> fields(1);
+        bool quoted = false;
+        for (std::size_t i = 0; i < row.size(); ++i) {
+          const char ch = row[i];
+          if (quoted && ch == '"' && i + 1 < row.size() && row[i + 1] == '"') {
+            fields.back() += '"';
+            ++i;
+          } else if (ch == '"') {
+            quoted = !quoted;
+          } else if (ch == ',' && !quoted) {
+            fields.emplace_back();
+          } else {
+            fields.back() += ch;
+          }
+        }
+        const char* cell = line++ == 0 ? "th" : "td";
+        table += "<tr>";
+        for (const std::string& f : fields) table += std::string("<") + cell + ">" + HtmlEscape(f) + "</" + cell + ">";
+        table += "</tr>";
+      }
+      table += "</table>";
+      cells.push_back("<div class=\"scroll\">" + table + "</div><p><a download=\"" + HtmlEscape(r.rig.name) +
+                      "_sheet.csv\" href=\"" + DataUri("text/csv", csv) + "\">" + HtmlEscape(r.rig.name) +
+                      "_sheet.csv</a></p>");
+    }
     body << RigRow(cells);
   }
 

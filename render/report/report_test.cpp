@@ -4,6 +4,9 @@
 #include "render/report/report.h"
 
 #include <gtest/gtest.h>
+
+#include "analysis/rig_formats.h"
+#include "render/report/report_images.h"
 #include <unistd.h>
 
 #include <cmath>
@@ -227,6 +230,12 @@ TEST_F(ReportOnRoom, PageHasOneImagePerFigure) {
   // 2 histograms x 2.
   EXPECT_EQ(file.images, 2 + 9 + 3 + 12 + 4);
   EXPECT_NE(page.find("<h2 id=\"plan\">Plan</h2>"), std::string::npos);
+  // The installation sheet: each rig's CSV link is export-rig's sheet, byte for byte.
+  for (const Rig& rig : scene_->rigs) {
+    const std::string uri = DataUri("text/csv", RigToSheetCsv(rig));
+    EXPECT_NE(page.find("download=\"" + rig.name + "_sheet.csv\" href=\"" + uri + "\""), std::string::npos) << rig.name;
+  }
+  EXPECT_NE(page.find("<th>x_cm</th>"), std::string::npos);
   std::size_t imgs = 0;
   for (std::size_t p = page.find("<img "); p != std::string::npos; p = page.find("<img ", p + 1)) ++imgs;
   EXPECT_EQ(imgs, std::size_t(file.images));
