@@ -179,6 +179,16 @@ bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const V
   return true;
 }
 
+bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment, std::int64_t* rays) {
+  const double distance = segment.t_far;
+  const double eps = tester.Tolerance(camera, distance);
+  segment.t_near = eps;
+  segment.t_far = distance - eps;
+  if (!(segment.t_far > segment.t_near)) return false;  // too short to hold an occluder
+  if (rays) ++*rays;
+  return tester.caster().Occluded(segment);
+}
+
 PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from, double min_px_per_m)
     : base_(base), head_(head), from_(from), min_px_per_m_(min_px_per_m) {
   const double pan_span = head.ContinuousPan()

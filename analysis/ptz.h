@@ -14,6 +14,7 @@
 ///
 /// Light header (Eigen only).
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@ namespace pandora {
 
 struct Camera;
 class RayCaster;
+class VisibilityTester;
 
 /// A pan / tilt / zoom setting. Angles in degrees relative to home; `focal` in pixels (fx; fy
 /// scales with it).
@@ -109,6 +111,10 @@ struct PtzHead {
 /// segment from the setting's centre to X, `epsilon` short of both ends.
 bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const Vec3& X, double min_px_per_m = 0,
              const Vec3* normal = nullptr, Ray* segment = nullptr, double epsilon = 0);
+
+/// Whether `segment` (from PtzSees, untrimmed) is blocked, with the occlusion tolerance of rig
+/// camera `camera` at both ends (VisibilityTester::Tolerance); `rays` (when given) counts the cast.
+bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment, std::int64_t* rays = nullptr);
 
 /// The intervals of a tour's period during which a point is watched: `sees` (a setting -> bool
 /// test, e.g. PtzSees plus occlusion) is evaluated once per dwell and along each move every

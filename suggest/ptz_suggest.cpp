@@ -113,15 +113,7 @@ bool PtzPointJudge::Sees(std::size_t i, const PtzState& s) const {
   if (!PtzSees(camera(), head(), s, points_[i], min_px_per_m_, nullptr, &r)) return false;
   const bool fixed_centre = head().offset.isZero(0.0);
   if (fixed_centre && pivot_clear_[i] >= 0) return pivot_clear_[i] == 1;
-  const double distance = r.t_far;
-  const double eps = tester_.Tolerance(camera_, distance);
-  r.t_near = eps;
-  r.t_far = distance - eps;
-  bool clear = true;
-  if (r.t_far > r.t_near) {
-    ++rays_;
-    clear = !tester_.caster().Occluded(r);
-  }
+  const bool clear = !PtzSegmentOccluded(tester_, camera_, r, &rays_);
   if (fixed_centre) pivot_clear_[i] = clear ? 1 : 0;
   return clear;
 }

@@ -20,22 +20,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The segment `s` with the tester's occlusion tolerance at both ends; false when it is too short
-// to hold an occluder.
-bool Trim(const VisibilityTester& tester, int camera, Ray* s) {
-  const double distance = s->t_far;
-  const double eps = tester.Tolerance(camera, distance);
-  s->t_near = eps;
-  s->t_far = distance - eps;
-  return s->t_far > s->t_near;
-}
-
-bool Occluded(const VisibilityTester& tester, int camera, Ray s, std::int64_t* rays) {
-  if (!Trim(tester, camera, &s)) return false;
-  if (rays) ++*rays;
-  return tester.caster().Occluded(s);
-}
-
 std::string Percent(double share) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f%%", 100.0 * share);
@@ -66,7 +50,7 @@ double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, d
   if (!std::isfinite(t)) return kInf;
   Ray s;
   if (!reach.Reachable(X, t, nullptr, &s)) return kInf;
-  if (!Occluded(tester, camera, s, rays)) return t;
+  if (!PtzSegmentOccluded(tester, camera, s, rays)) return t;
   // The pivot is the centre of every setting: blocked from one, blocked from all.
   if (head.offset.isZero(0.0)) return kInf;
   // The centre moves with the setting: try the best pose with no time limit, then bisect on the
@@ -74,7 +58,7 @@ double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, d
   const double T = reach.MaxTime();
   auto seen = [&](double time) {
     Ray r;
-    return reach.Reachable(X, time, nullptr, &r) && !Occluded(tester, camera, r, rays);
+    return reach.Reachable(X, time, nullptr, &r) && !PtzSegmentOccluded(tester, camera, r, rays);
   };
   if (!seen(T)) return kInf;
   double lo = t, hi = T;
@@ -95,10 +79,10 @@ PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera, const std::vec
     Ray r;
     if (!PtzSees(base, head, s, X, min_px_per_m, nullptr, &r)) return false;
     if (fixed_centre) {
-      if (pivot_blocked < 0) pivot_blocked = Occluded(tester, camera, r, rays) ? 1 : 0;
+      if (pivot_blocked < 0) pivot_blocked = PtzSegmentOccluded(tester, camera, r, rays) ? 1 : 0;
       return pivot_blocked == 0;
     }
-    return !Occluded(tester, camera, r, rays);
+    return !PtzSegmentOccluded(tester, camera, r, rays);
   };
   return WatchTour(head, base, legs, sees);
 }
