@@ -7,8 +7,12 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,46 +25,15 @@
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
+#include "volume/ptz_fields.h"
 #include "volume/summary.h"
+#include "volume/vdb_io.h"
+#include "python/bindings.h"
 
-namespace py = pybind11;
 using namespace pandora;
+using namespace pandora::python;
 
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// A loaded scene: the study (scene, text, ray caster) shared by the rigs and fields made from it.
-struct PyScene {
-  std::shared_ptr<const session::Study> study;
-  const Scene& scene() const { return study->scene(); }
-};
-
-// A rig the script may change (a copy of the file's).
-struct PyRig {
-  std::shared_ptr<const session::Study> study;
-  Rig rig;
-
-  int Index(const std::string& id) const {
-    const int c = rig.FindCamera(id);
-    if (c < 0) throw InputError(study->scene().path, "", "no camera '" + id + "' in rig '" + rig.name + "'");
-    return c;
-  }
-};
-
-struct PyFields {
-  std::shared_ptr<const session::Study> study;
-  std::shared_ptr<Fields> fields;
-  std::vector<std::string> names;
-  nlohmann::json summary;
-};
-
-openvdb::FloatGrid::ConstPtr FloatGrid(const PyFields& f, const std::string& name) {
-  const Fields::Impl& g = f.fields->impl();
-  if (auto grid = g.Float(name)) return grid;
-  if (auto it = g.extra.find(name); it != g.extra.end()) return it->second;
-  return nullptr;
-}
+namespace pandora::python {
 
 py::array_t<double> Vec3Array(const Vec3& v) {
   py::array_t<double> a(3);
@@ -80,7 +53,48 @@ std::vector<Vec3> Points(const py::array_t<double, py::array::c_style | py::arra
   return out;
 }
 
+py::object JsonToPython(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+
+}  // namespace pandora::python
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct PyFields {
+  std::shared_ptr<const session::Study> study;
+  std::shared_ptr<Fields> fields;
+  std::vector<std::string> names;
+  nlohmann::json summary;
+  std::string rig_name, rig_json;  // the rig evaluated (metadata of write())
+};
+
+std::string VoxelText(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.12g", v);
+  return b;
+}
+
+openvdb::FloatGrid::ConstPtr FloatGrid(const PyFields& f, const std::string& name) {
+  const Fields::Impl& g = f.fields->impl();
+  if (auto grid = g.Float(name)) return grid;
+  if (auto it = g.extra.find(name); it != g.extra.end()) return it->second;
+  return nullptr;
+}
+
 double SigmaOf(const Scene& scene, const Camera& c) { return c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma; }
+
+// An output path that is one of the scene's input files (the scene, a mesh, ...) is refused.
+void RefuseInputPath(const Scene& scene, const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(path, ec);
+  for (const auto& [input, kind] : scene.InputFiles()) {
+    std::error_code e2;
+    if (!ec && out == fs::weakly_canonical(input, e2))
+      throw InputError(path, "", what + " would replace the " + kind + " " + input, "write it somewhere else");
+  }
+}
 
 }  // namespace
 
@@ -113,30 +127,36 @@ PYBIND11_MODULE(pandora, m) {
         const Aabb& b = s.scene().study.region.box;
         return py::make_tuple(Vec3Array(b.min), Vec3Array(b.max));
       })
-      .def("rig", [](const PyScene& s, const std::string& name) {
-        const Scene& scene = s.scene();
-        if (name.empty()) return PyRig{s.study, scene.rigs.at(0)};
-        for (const Rig& r : scene.rigs)
-          if (r.name == name) return PyRig{s.study, r};
-        throw InputError(scene.path, "$.rigs", "no rig called '" + name + "'");
-      }, py::arg("name") = "", "A copy of the rig (the first one by default) that the script may change.");
+      .def("rig", [](const PyScene& s, const std::string& name, const std::vector<std::string>& disable) {
+        session::SessionOptions o;
+        o.rig = name;
+        o.rig_option = "rig";
+        o.disable = disable;
+        o.disable_option = "disable";
+        o.fields.fields = {"coverage"};
+        o.fields.scene_path = s.scene().path;
+        o.incremental = false;
+        return PyRig{s.study, std::make_shared<session::Session>(s.study, std::move(o))};
+      }, py::arg("name") = "", py::arg("disable") = std::vector<std::string>{},
+         "The rig `name` (the first by default) to edit: moves are undoable and reach the scene file "
+         "only through save() or an accepted suggestion. `disable`: camera ids left out (not an edit).");
 
   m.def("load_scene", [](const std::string& path) { return PyScene{session::Study::Load(path)}; },
         py::arg("path"), "Reads and checks a scene file (meshes, rigs, study); raises pandora.InputError.");
 
-  py::class_<PyRig>(m, "Rig", "A rig of cameras (a copy: changing it does not change the file).")
-      .def_property_readonly("name", [](const PyRig& r) { return r.rig.name; })
+  py::class_<PyRig> rig(m, "Rig", "A rig of cameras being edited (undo, redo, save with a backup).");
+  rig.def_property_readonly("name", [](const PyRig& r) { return r.rig().name; })
       .def_property_readonly("ids", [](const PyRig& r) {
         std::vector<std::string> ids;
-        for (const Camera& c : r.rig.cameras) ids.push_back(c.id);
+        for (const Camera& c : r.rig().cameras) ids.push_back(c.id);
         return ids;
       })
-      .def("position", [](const PyRig& r, const std::string& id) { return Vec3Array(r.rig.cameras[r.Index(id)].center()); })
+      .def("position", [](const PyRig& r, const std::string& id) { return Vec3Array(r.rig().cameras[r.Index(id)].center()); })
       .def("rotation", [](const PyRig& r, const std::string& id) -> Mat3 {
-        return r.rig.cameras[r.Index(id)].world_from_camera.linear();
+        return r.rig().cameras[r.Index(id)].world_from_camera.linear();
       }, "world_from_camera rotation (columns: image x right, y down, optical axis).")
       .def("intrinsics", [](const PyRig& r, const std::string& id) {
-        const Camera& c = r.rig.cameras[r.Index(id)];
+        const Camera& c = r.rig().cameras[r.Index(id)];
         const Intrinsics& k = c.model.intrinsics();
         py::dict d;
         d["width"] = k.width;
@@ -148,18 +168,41 @@ PYBIND11_MODULE(pandora, m) {
         d["model"] = k.model == LensModel::kPinhole ? "pinhole" : k.model == LensModel::kBrownConrady ? "brown_conrady" : "fisheye";
         d["k"] = std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
         d["enabled"] = c.enabled;
+        d["ptz"] = bool(c.ptz);
         return d;
       })
       .def("move", [](PyRig& r, const std::string& id, const Vec3& position, const Vec3& look_at, const Vec3& up) {
-        Camera& c = r.rig.cameras[r.Index(id)];
-        if (c.ptz) throw InputError("move", "", "camera '" + id + "' is a PTZ camera: its pose is its head's setting");
+        const int index = r.Index(id);
+        if (r.rig().cameras[index].ptz)
+          throw InputError("move", "", "camera '" + id + "' is a PTZ camera: its pose is its head's setting", "use set_ptz");
         if (!position.allFinite() || !look_at.allFinite()) throw InputError("move", "", "not a finite position");
         const auto pose = LookAt(position, look_at, up);
         if (!pose) throw InputError("move", "", "look_at equals the position, or up is parallel to the view");
-        c.world_from_camera = *pose;
+        r.session->rig().SetPose(index, *pose);
       }, py::arg("id"), py::arg("position"), py::arg("look_at"), py::arg("up") = Vec3(0, 0, 1),
-         "Places camera `id` at `position` looking at `look_at` (metres, world frame).")
-      .def("set_enabled", [](PyRig& r, const std::string& id, bool on) { r.rig.cameras[r.Index(id)].enabled = on; });
+         "Places camera `id` at `position` looking at `look_at` (metres, world frame). One undo step.")
+      .def("set_pose", [](PyRig& r, const std::string& id, const Vec3& position, const Mat3& rotation) {
+        const int index = r.Index(id);
+        if (r.rig().cameras[index].ptz)
+          throw InputError("set_pose", "", "camera '" + id + "' is a PTZ camera: its pose is its head's setting", "use set_ptz");
+        if (!position.allFinite() || !rotation.allFinite()) throw InputError("set_pose", "", "not finite");
+        if ((rotation.transpose() * rotation - Mat3::Identity()).norm() > 1e-9 || rotation.determinant() < 0)
+          throw InputError("set_pose", "rotation", "not a rotation matrix (orthonormal to 1e-9, determinant +1)");
+        Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+        pose.linear() = rotation;
+        pose.translation() = position;
+        r.session->rig().SetPose(index, pose);
+      }, py::arg("id"), py::arg("position"), py::arg("rotation"),
+         "Sets camera `id`'s centre (metres) and world_from_camera rotation (3x3). One undo step.")
+      .def("set_enabled", [](PyRig& r, const std::string& id, bool on) { r.session->rig().SetEnabled(r.Index(id), on); },
+           py::arg("id"), py::arg("enabled"), "Switches a camera on or off (a what-if: save() does not write it).")
+      .def("undo", [](PyRig& r) { return r.session->rig().Undo(); }, "Undoes the last edit; False when there is none.")
+      .def("redo", [](PyRig& r) { return r.session->rig().Redo(); }, "Redoes the last undone edit; False when there is none.")
+      .def_property_readonly("unsaved", [](const PyRig& r) {
+        std::vector<std::string> ids;
+        for (int c : r.session->rig().Unsaved()) ids.push_back(r.rig().cameras[c].id);
+        return ids;
+      }, "Ids of the cameras that differ from the scene file.");
 
   py::class_<PyFields>(m, "Fields", "Evaluated fields over the study region (sparse OpenVDB grids).")
       .def_property_readonly("names", [](const PyFields& f) { return f.names; })
@@ -215,35 +258,54 @@ PYBIND11_MODULE(pandora, m) {
         else
           throw InputError("dense", "", "no field '" + name + "' was evaluated");
         return out;
-      }, py::arg("name"));
+      }, py::arg("name"))
+      .def("write", [](const PyFields& f, const std::string& path) {
+        const Scene& scene = f.study->scene();
+        RefuseInputPath(scene, path, "fields.vdb");
+        const std::map<std::string, std::string> meta{
+            {"units", "m"}, {"tool", "pandora (python)"}, {"scene_file", scene.path},
+            {"scene_sha256", scene.sha256}, {"rig_name", f.rig_name}, {"rig", f.rig_json}, {"voxel_size_m", VoxelText(scene.study.voxel_size)}};
+        py::gil_scoped_release release;
+        WriteFieldsVdb(*f.fields, path, meta);
+      }, py::arg("path"), "Writes the grids as `pandora analyze` writes fields.vdb (atomically; never over an input).");
 
   m.def("evaluate", [](const PyScene& s, const PyRig& r, std::vector<std::string> fields) {
     const Scene& scene = s.scene();
+    const Rig rig = r.rig();  // a copy: the evaluation runs without the GIL
     FieldOptions o;
     o.fields = fields.empty() ? scene.study.fields : fields;
     o.scene_path = scene.path;
     o.memory_budget_bytes = scene.study.memory_budget_bytes;
     PyFields out;
     out.study = s.study;
+    std::optional<PtzFieldsSummary> ptz;
     {
       py::gil_scoped_release release;
-      out.fields = std::make_shared<Fields>(EvaluateFields(scene, r.rig, s.study->caster(), o));
+      out.fields = std::make_shared<Fields>(EvaluateFields(scene, rig, s.study->caster(), o));
+      // PTZ cameras: reach times and tours over the region (docs/ptz.md), as `pandora analyze`.
+      if (RigHasPtz(rig) && out.fields->impl().coverage)
+        ptz = EvaluatePtzFields(scene, rig, s.study->caster(), *out.fields, out.fields.get());
     }
     out.names = o.fields;
-    out.summary = MakeSummary(scene, r.rig, *out.fields, o.fields, 0);
+    for (const auto& [name, grid] : out.fields->impl().extra) out.names.push_back(name);
+    out.summary = MakeSummary(scene, rig, *out.fields, o.fields, 0);
+    if (ptz) out.summary["ptz"] = *ptz;
+    out.rig_name = rig.name;
+    out.rig_json = RigToJson(rig).dump();
     return out;
   }, py::arg("scene"), py::arg("rig"), py::arg("fields") = std::vector<std::string>{},
-     "Evaluates the fields (default: the study's) for the rig's enabled cameras.");
+     "Evaluates the fields (default: the study's) for the rig's enabled cameras; with PTZ cameras also "
+     "their reach-time and tour fields.");
 
   m.def("visibility", [](const PyScene& s, const PyRig& r, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
     const std::vector<Vec3> X = Points(points);
-    const VisibilityTester tester(r.rig.cameras, s.study->caster(), s.scene().ContentBounds().diagonal());
-    const std::size_t C = r.rig.cameras.size();
+    const VisibilityTester tester(r.rig().cameras, s.study->caster(), s.scene().ContentBounds().diagonal());
+    const std::size_t C = r.rig().cameras.size();
     py::array_t<bool> out({X.size(), C});
     auto O = out.mutable_unchecked<2>();
     for (std::size_t i = 0; i < X.size(); ++i)
       for (std::size_t c = 0; c < C; ++c)
-        O(i, c) = r.rig.cameras[c].enabled && tester.Test(int(c), X[i]) == ViewResult::kSeen;
+        O(i, c) = r.rig().cameras[c].enabled && tester.Test(int(c), X[i]) == ViewResult::kSeen;
     return out;
   }, py::arg("scene"), py::arg("rig"), py::arg("points"),
      "(N, C) booleans: camera c sees point i (image, range, occlusion; the field evaluation's rules).");
@@ -251,17 +313,17 @@ PYBIND11_MODULE(pandora, m) {
   m.def("covariance", [](const PyScene& s, const PyRig& r, const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
     const Scene& scene = s.scene();
     const std::vector<Vec3> X = Points(points);
-    const VisibilityTester tester(r.rig.cameras, s.study->caster(), scene.ContentBounds().diagonal());
+    const VisibilityTester tester(r.rig().cameras, s.study->caster(), scene.ContentBounds().diagonal());
     py::array_t<double> out({X.size(), std::size_t(3), std::size_t(3)});
     auto O = out.mutable_unchecked<3>();
     for (std::size_t i = 0; i < X.size(); ++i) {
       Mat3 J = Mat3::Zero();
       int cameras = 0;
-      for (std::size_t c = 0; c < r.rig.cameras.size(); ++c) {
-        if (!r.rig.cameras[c].enabled) continue;
+      for (std::size_t c = 0; c < r.rig().cameras.size(); ++c) {
+        if (!r.rig().cameras[c].enabled) continue;
         Mat23 A;
         if (tester.Test(int(c), X[i], nullptr, &A) != ViewResult::kSeen) continue;
-        const double sigma = SigmaOf(scene, r.rig.cameras[c]);
+        const double sigma = SigmaOf(scene, r.rig().cameras[c]);
         J += A.transpose() * A / (sigma * sigma);
         ++cameras;
       }
@@ -294,11 +356,13 @@ PYBIND11_MODULE(pandora, m) {
     Image image;
     {
       py::gil_scoped_release release;
-      image = Render(scene, r.rig, s.study->caster(), v, o);
+      image = Render(scene, r.rig(), s.study->caster(), v, o);
     }
     py::array_t<float> out({std::size_t(image.height), std::size_t(image.width), std::size_t(3)});
     std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
     return out;
   }, py::arg("scene"), py::arg("rig"), py::arg("view") = "", py::arg("width") = 640, py::arg("height") = 400,
      py::arg("plan") = "", "The projective-light render as an (H, W, 3) float32 linear RGB array.");
+
+  BindSuggest(m, rig);
 }

@@ -227,4 +227,9 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
   return result;
 }
 
+void Session::MarkSaved(std::string text) {
+  saved_text_ = std::move(text);
+  rig_.MarkSaved();
+}
+
 }  // namespace pandora::session

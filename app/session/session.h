@@ -125,6 +125,10 @@ class Session {
   /// lens = the current zoom, and its "ptz" block's pan_deg / tilt_deg (after a re-centre also the
   /// shifted ranges and presets) through ReplacePtzHeads; the rest of its block keeps its text.
   SaveResult Save(bool force = false, const std::vector<StationMove>& stations = {});
+  /// The scene file now holds `text` and the edited rig as it is now is what it says (an accept
+  /// written outside the session, e.g. by AcceptSuggestion after ApplySuggestion): the rig counts as
+  /// saved and the next Save compares the file on disk with `text`.
+  void MarkSaved(std::string text);
 
  private:
   std::shared_ptr<const Study> study_;

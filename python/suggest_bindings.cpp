@@ -1,0 +1,588 @@
+// `import pandora`, suggest and accept (docs/python.md): camera nudges (the same options and checks
+// as `pandora suggest`), PTZ preset and tour suggestions, accept into the scene file (the same code
+// as `pandora accept`: backup, read-back check), and the rig's PTZ settings and save().
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "analysis/atomic_file.h"
+#include "analysis/camera.h"
+#include "analysis/input_file.h"
+#include "analysis/motion.h"
+#include "analysis/ptz.h"
+#include "analysis/visibility.h"
+#include "app/commands.h"
+#include "app/suggest_options.h"
+#include "python/bindings.h"
+#include "suggest/ptz_suggest.h"
+#include "suggest/suggest.h"
+#include "suggest/suggestion_file.h"
+#include "suggest/suggestion_text.h"
+
+namespace pandora::python {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A suggestion for the rig it was made on (camera nudges or a PTZ controller change).
+struct PySuggestion {
+  std::shared_ptr<const session::Study> study;
+  std::shared_ptr<session::Session> session;
+  std::string kind;  // "cameras", "ptz_preset", "ptz_tour"
+  std::string json;  // the suggestion file's text
+  bool improved = false;
+  std::string message;
+  bool from_unsaved_rig = false;  // the rig had edits the scene file lacks when it was made
+  std::optional<Suggestion> cameras;
+  std::optional<PtzPresetSuggestion> preset;
+  std::optional<PtzTourSuggestion> tour;
+  int ptz_camera = -1, ptz_preset = -1;
+};
+
+// `pandora suggest`'s option names in errors become the keyword arguments' ("--max-move" -> "max_move").
+std::string Keywords(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && std::islower(static_cast<unsigned char>(text[i + 2]))) {
+      std::string word;
+      for (i += 2; i < text.size() && (std::islower(static_cast<unsigned char>(text[i])) || text[i] == '-'); ++i)
+        word += text[i] == '-' ? '_' : text[i];
+      if (word == "max_rotate" || word == "snap_rotate") word += "_deg";
+      out += word;
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
+}
+
+[[noreturn]] void RethrowWithKeyword(const InputError& e) {
+  throw InputError(Keywords(e.file()), e.json_path(), Keywords(e.reason()), Keywords(e.hint()));
+}
+
+std::string Num(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+std::string Join(const std::vector<double>& v) {
+  std::string out;
+  for (double x : v) out += (out.empty() ? "" : ",") + Num(x);
+  return out;
+}
+
+// A number, or a list of numbers (one per selected camera) -> "a" or "a,b,c".
+std::string NumberOrList(const py::handle& value, const char* name) {
+  if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) return Num(value.cast<double>());
+  try {
+    return Join(value.cast<std::vector<double>>());
+  } catch (const py::cast_error&) {
+    throw InputError(name, "", "expected a number or a list of numbers (one per selected camera)");
+  }
+}
+
+// A value for every selected camera, or {id: value}, as "ID:TEXT" entries; `format` turns one value
+// into the option's text.
+template <typename F>
+std::vector<std::string> PerCameraEntries(const py::object& value, const char* name, F format) {
+  std::vector<std::string> out;
+  if (value.is_none()) return out;
+  if (py::isinstance<py::dict>(value)) {
+    for (const auto& [id, v] : value.cast<py::dict>()) out.push_back(py::str(id).cast<std::string>() + ":" + format(v));
+  } else {
+    out.push_back(format(value));
+  }
+  (void)name;
+  return out;
+}
+
+std::string Vector3Text(const py::handle& v, const char* name) {
+  std::vector<double> x;
+  try {
+    x = v.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+  }
+  if (x.size() != 3) throw InputError(name, "", "expected three numbers (a direction, metres)");
+  return Join(x);
+}
+
+std::string BoxText(const py::handle& v, const char* name) {
+  std::vector<std::vector<double>> corners;
+  try {
+    corners = v.cast<std::vector<std::vector<double>>>();
+  } catch (const py::cast_error&) {
+  }
+  if (corners.size() != 2 || corners[0].size() != 3 || corners[1].size() != 3)
+    throw InputError(name, "", "expected a box as (min corner, max corner), metres");
+  return Join({corners[0][0], corners[0][1], corners[0][2], corners[1][0], corners[1][1], corners[1][2]});
+}
+
+std::string RangeText(const py::handle& v, const char* name) {
+  std::vector<double> x;
+  try {
+    x = v.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+  }
+  if (x.size() != 2) throw InputError(name, "", "expected (min, max) degrees");
+  return Join(x);
+}
+
+py::dict MetricsDict(const Metrics& m) {
+  py::dict d;
+  d["objective"] = m.objective;
+  d["coverage_k"] = m.coverage_k;
+  d["coverage2"] = m.coverage2;
+  d["sigma_p50_mm"] = m.sigma_p50;
+  d["sigma_p90_mm"] = m.sigma_p90;
+  d["sigma_p95_mm"] = m.sigma_p95;
+  d["sigma_mean_mm"] = m.sigma_mean;
+  d["untriangulable"] = m.untriangulable;
+  d["min_resolution_px_per_m"] = m.min_resolution;
+  if (m.n1) {
+    d["n1_coverage_k"] = m.n1->coverage_k;
+    d["n1_worst_camera"] = m.n1->worst_camera;
+  }
+  if (m.calibration) d["calibration_weakest"] = m.calibration->weakest;
+  return d;
+}
+
+Eigen::Matrix4d Matrix(const Eigen::Isometry3d& pose) { return pose.matrix(); }
+
+// The targets of a suggestion: the study region's or a named region's points, and/or surfaces.
+std::vector<TargetPoint> Targets(const Scene& scene, int points, const std::vector<std::string>& surfaces,
+                                 bool with_region, const std::string& region_name, std::uint64_t seed) {
+  if (points < 1 || points > 1000000) throw InputError("points", "", "must be in [1, 1000000]");
+  if (region_name.empty()) return SampleTargets(scene, points, surfaces, with_region, seed);
+  std::string names;
+  for (const auto& [name, r] : scene.study.regions) {
+    names += (names.empty() ? "" : ", ") + name;
+    if (name == region_name) {
+      Scene sub = scene;
+      sub.study.region = r;
+      return SampleTargets(sub, points, surfaces, with_region, seed);
+    }
+  }
+  throw InputError("target_region", "", "no region '" + region_name + "' in the study",
+                   "study.regions: " + (names.empty() ? std::string("none") : names));
+}
+
+// The PTZ camera `id` of the rig (enabled, with a head), or an InputError naming `option`.
+int PtzCamera(const Rig& rig, const char* option, const std::string& id) {
+  const int c = rig.FindCamera(id);
+  std::string ptz;
+  for (const Camera& cam : rig.cameras)
+    if (cam.ptz && cam.enabled) ptz += (ptz.empty() ? "" : ", ") + cam.id;
+  const std::string hint = "PTZ cameras: " + (ptz.empty() ? std::string("none") : ptz);
+  if (c < 0) throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", hint);
+  if (!rig.cameras[c].ptz) throw InputError(option, "", "camera '" + id + "' has no PTZ head", hint);
+  if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
+  return c;
+}
+
+// A scene's input file (the scene, a mesh) may not be an output.
+void RefuseInput(const Scene& scene, const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code e1;
+  const fs::path out = fs::weakly_canonical(path, e1);
+  for (const auto& [input, kind] : scene.InputFiles()) {
+    std::error_code e2;
+    if (!e1 && out == fs::weakly_canonical(input, e2))
+      throw InputError(path, "", what + " would replace the " + kind + " " + input, "write it somewhere else");
+  }
+}
+
+// Applies a suggestion to its rig in memory as one undo step: `subset` (the accepted cameras of a
+// camera suggestion) or the PTZ preset / tour.
+void ApplyInMemory(PySuggestion& s, const Suggestion* subset) {
+  if (subset) {
+    s.session->ApplySuggestion(*subset);
+    return;
+  }
+  const Camera& c = s.session->rig().rig().cameras.at(s.ptz_camera);
+  auto head = std::make_shared<PtzHead>(*c.ptz);
+  std::string label;
+  if (s.preset) {
+    if (c.ptz->presets.at(s.ptz_preset).state.pan_deg != s.preset->before.pan_deg ||
+        c.ptz->presets.at(s.ptz_preset).state.tilt_deg != s.preset->before.tilt_deg ||
+        c.ptz->presets.at(s.ptz_preset).state.focal != s.preset->before.focal)
+      throw InputError(s.study->scene().path, "", "preset '" + s.preset->preset + "' changed since the suggestion",
+                       "ask for a new suggestion");
+    head->presets.at(s.ptz_preset).state = s.preset->after;
+    label = "suggested preset " + s.preset->preset;
+  } else {
+    if (c.ptz->tour.size() != s.tour->after.size())
+      throw InputError(s.study->scene().path, "", "the tour changed since the suggestion", "ask for a new suggestion");
+    head->tour.clear();
+    for (int stop : s.tour->after) head->tour.push_back(c.ptz->tour.at(stop));
+    label = "suggested tour order";
+  }
+  Camera after = c;
+  after.ptz = std::move(head);
+  s.session->rig().Apply({label, {{s.ptz_camera, c, after}}});
+}
+
+py::dict AcceptDict(const AcceptResult& r) {
+  py::dict d;
+  d["scene_path"] = r.scene_path;
+  d["backup_path"] = r.backup_path;
+  d["accepted"] = r.accepted;
+  d["notes"] = r.notes;
+  return d;
+}
+
+// Accepts suggestion file text through AcceptSuggestion (the `pandora accept` code) from a private
+// temporary file, removed afterwards.
+AcceptResult AcceptText(const std::string& text, const AcceptOptions& options) {
+  namespace fs = std::filesystem;
+  std::random_device rd;
+  const fs::path dir = fs::temp_directory_path() /
+                       ("pandora-accept-" + std::to_string(rd()) + "-" + std::to_string(rd()));
+  fs::create_directory(dir);
+  const std::string path = (dir / "suggestion.json").string();
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{dir};
+  WriteFileAtomically(path, text);
+  try {
+    return AcceptSuggestion(path, options);
+  } catch (const InputError& e) {
+    if (e.file() != path) throw;
+    throw InputError("suggestion", e.json_path(), e.reason(), e.hint());
+  }
+}
+
+}  // namespace
+
+void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
+  // ---- PTZ settings of a rig camera, and save ---------------------------------------------------
+  rig.def("ptz", [](const PyRig& r, const std::string& id) {
+       const Camera& c = r.rig().cameras[r.Index(id)];
+       if (!c.ptz) throw InputError("ptz", "", "camera '" + id + "' has no PTZ head");
+       const PtzHead& h = *c.ptz;
+       const Intrinsics& k = c.model.intrinsics();
+       auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) * 180 / kPi; };
+       py::dict d;
+       d["pan_deg"] = h.current.pan_deg;
+       d["tilt_deg"] = h.current.tilt_deg;
+       d["hfov_deg"] = hfov(h.current.focal);
+       d["pan_range_deg"] = py::make_tuple(h.pan_min_deg, h.pan_max_deg);
+       d["tilt_range_deg"] = py::make_tuple(h.tilt_min_deg, h.tilt_max_deg);
+       d["hfov_range_deg"] = py::make_tuple(hfov(h.focal_max), hfov(h.focal_min));
+       d["pivot"] = Vec3Array(h.home.translation());
+       py::list presets;
+       for (const PtzPreset& p : h.presets) {
+         py::dict q;
+         q["name"] = p.name;
+         q["pan_deg"] = p.state.pan_deg;
+         q["tilt_deg"] = p.state.tilt_deg;
+         q["hfov_deg"] = hfov(p.state.focal);
+         presets.append(q);
+       }
+       d["presets"] = presets;
+       py::list tour;
+       for (const PtzTourStop& s : h.tour) {
+         py::dict q;
+         q["preset"] = h.presets[s.preset].name;
+         q["dwell_s"] = s.dwell_s;
+         tour.append(q);
+       }
+       d["tour"] = tour;
+       return d;
+     }, py::arg("id"), "A PTZ camera's setting (pan, tilt, hfov), ranges, presets and tour.")
+      .def("set_ptz", [](PyRig& r, const std::string& id, std::optional<double> pan_deg, std::optional<double> tilt_deg,
+                         std::optional<double> hfov_deg, const std::string& preset) {
+        const int index = r.Index(id);
+        const Camera& c = r.rig().cameras[index];
+        if (!c.ptz) throw InputError("set_ptz", "", "camera '" + id + "' has no PTZ head", "move() places a fixed camera");
+        PtzState s = c.ptz->current;
+        if (!preset.empty()) {
+          bool found = false;
+          for (const PtzPreset& p : c.ptz->presets)
+            if (p.name == preset) s = p.state, found = true;
+          if (!found) throw InputError("set_ptz", "preset", "camera '" + id + "' has no preset '" + preset + "'");
+        }
+        for (const auto& [v, name] : {std::pair{pan_deg, "pan_deg"}, {tilt_deg, "tilt_deg"}, {hfov_deg, "hfov_deg"}})
+          if (v && !std::isfinite(*v)) throw InputError("set_ptz", name, "not a finite angle");
+        if (pan_deg) s.pan_deg = *pan_deg;
+        if (tilt_deg) s.tilt_deg = *tilt_deg;
+        if (hfov_deg) {
+          if (!(*hfov_deg > 0 && *hfov_deg < 360)) throw InputError("set_ptz", "hfov_deg", "must be in (0, 360) degrees");
+          const Intrinsics& k = c.model.intrinsics();
+          s.focal = FocalFromHfov(*hfov_deg * kPi / 180, k.width, k.model);
+        }
+        r.session->SetPtzState(index, s);  // clamped to the head's ranges
+      }, py::arg("id"), py::arg("pan_deg") = py::none(), py::arg("tilt_deg") = py::none(),
+         py::arg("hfov_deg") = py::none(), py::arg("preset") = "",
+         "Points PTZ camera `id` (a preset's setting, then the given angles; clamped to its ranges). One undo step.")
+      .def("save", [](PyRig& r, bool force) {
+        const session::SaveResult s = r.session->Save(force);
+        py::dict d;
+        d["scene_path"] = s.scene_path;
+        d["backup_path"] = s.backup_path;
+        d["saved"] = s.saved;
+        d["notes"] = s.notes;
+        return d;
+      }, py::arg("force") = false,
+         "Writes the edited cameras' poses and zooms (PTZ: pan, tilt, zoom) into the scene file, keeping "
+         "the previous file as a backup; refuses when the file changed since it was loaded (unless force).");
+
+  // ---- Suggestions -----------------------------------------------------------------------------
+  py::class_<PySuggestion>(m, "Suggestion", "A suggestion: look at it, apply it to the rig, save it, or accept it.")
+      .def_property_readonly("kind", [](const PySuggestion& s) { return s.kind; })
+      .def_property_readonly("improved", [](const PySuggestion& s) { return s.improved; })
+      .def_property_readonly("message", [](const PySuggestion& s) { return s.message; })
+      .def_property_readonly("before", [](const PySuggestion& s) -> py::object {
+        if (s.cameras) return MetricsDict(s.cameras->before);
+        return JsonToPython(s.json)["ptz"]["before"];
+      }, "The exact measures at the start (camera nudges) or the PTZ measures before.")
+      .def_property_readonly("after", [](const PySuggestion& s) -> py::object {
+        if (s.cameras) return MetricsDict(s.cameras->after);
+        return JsonToPython(s.json)["ptz"]["after"];
+      })
+      .def_property_readonly("cameras", [](const PySuggestion& s) {
+        py::list out;
+        if (!s.cameras) return out;
+        for (const CameraChange& c : s.cameras->cameras) {
+          py::dict d;
+          d["id"] = c.id;
+          d["before"] = Matrix(c.before);
+          d["after"] = Matrix(c.after);
+          d["move_m"] = c.move_m;
+          d["rotate_deg"] = c.rotate_deg;
+          d["hfov_before_deg"] = c.hfov_before_deg;
+          d["hfov_after_deg"] = c.hfov_after_deg;
+          d["note"] = c.note;
+          out.append(d);
+        }
+        return out;
+      }, "Per selected camera: world_from_camera 4x4 before and after, the move, the turn, the zoom.")
+      .def("to_dict", [](const PySuggestion& s) { return JsonToPython(s.json); }, "The suggestion file, as a dict.")
+      .def("__str__", [](const PySuggestion& s) { return s.message; })
+      .def("save", [](const PySuggestion& s, const std::string& path) {
+        RefuseInput(s.study->scene(), path, "the suggestion file");
+        WriteFileAtomically(path, s.json);
+      }, py::arg("path"), "Writes the suggestion file (`pandora accept PATH` takes it), atomically.")
+      .def("apply", [](PySuggestion& s) {
+        if (!s.improved) throw InputError("apply", "", "the suggestion offers no improvement; nothing to apply");
+        ApplyInMemory(s, s.cameras ? &*s.cameras : nullptr);
+      }, "Applies the suggestion to the rig in memory (one undo step); nothing is written.")
+      .def("accept", [](PySuggestion& s, std::vector<std::string> cameras, bool force) {
+        const Scene& scene = s.study->scene();
+        if (!s.improved) throw InputError(scene.path, "", "the suggestion offers no improvement; nothing to accept");
+        if (s.from_unsaved_rig)
+          throw InputError(scene.path, "", "the suggestion was made on a rig with unsaved edits",
+                           "apply() it and save() the rig, which writes those edits too");
+        if (!s.session->rig().Unsaved().empty())
+          throw InputError(scene.path, "", "the rig has unsaved edits since the suggestion",
+                           "save() or undo() them first");
+        AcceptOptions options;
+        options.cameras = cameras;
+        options.force = force;
+        // In memory first (refused when a camera moved since), then the file; a failure undoes both.
+        Suggestion accepted;
+        if (s.cameras) {
+          accepted = *s.cameras;
+          if (!cameras.empty()) {
+            accepted.cameras.clear();
+            for (const CameraChange& c : s.cameras->cameras)
+              for (const std::string& id : cameras)
+                if (c.id == id) accepted.cameras.push_back(c);
+          }
+        }
+        const std::int64_t version = s.session->rig().version();
+        if (!s.cameras || !accepted.cameras.empty()) ApplyInMemory(s, s.cameras ? &accepted : nullptr);
+        AcceptResult result;
+        try {
+          result = AcceptText(s.json, options);
+        } catch (...) {
+          if (s.session->rig().version() != version) s.session->rig().Undo();
+          throw;
+        }
+        s.session->MarkSaved(ReadInputFile(result.scene_path, 64u << 20, "scene file"));
+        return AcceptDict(result);
+      }, py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
+         "Writes the suggestion into the scene file as `pandora accept` does (backup, read-back check) and "
+         "applies it to the rig; `cameras`: only these ids (camera nudges).");
+
+  m.def("suggest", [](const PyScene& sc, PyRig& r, std::vector<std::string> cameras, const std::string& objective,
+                      int points, std::vector<std::string> target_surfaces, bool with_region, bool over_time,
+                      const py::object& max_move, const py::object& max_rotate_deg, const py::object& hfov_range,
+                      const py::object& rail, const py::object& plane, const py::object& mount_box,
+                      const std::vector<py::object>& keep_out, double clearance, double snap_move,
+                      double snap_rotate_deg, int outer_iterations, std::uint64_t seed) {
+    const Scene& scene = sc.scene();
+    if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
+    if (cameras.empty()) throw InputError("cameras", "", "which cameras may move?", "give cameras=[ids]");
+    app::SuggestArgs a;
+    a.scene = scene.path;
+    for (const std::string& id : cameras) a.cameras += (a.cameras.empty() ? "" : ",") + id;
+    a.objective = objective;
+    a.points = points;
+    a.target_surfaces = target_surfaces;
+    a.with_region = with_region;
+    a.over_time = over_time;
+    a.clearance = clearance;
+    a.snap_move = snap_move;
+    a.snap_rotate = snap_rotate_deg;
+    a.outer_iterations = outer_iterations;
+    a.seed = seed;
+    SuggestOptions options;
+    std::vector<TargetPoint> targets;
+    std::unique_ptr<RigidPartsRayCaster> parts;
+    std::vector<std::unique_ptr<RayCaster>> sample_casters;
+    try {
+      a.max_move = NumberOrList(max_move, "--max-move");
+      a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
+      a.hfov_range = PerCameraEntries(hfov_range, "--hfov-range", [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
+      a.rail = PerCameraEntries(rail, "--rail", [](const py::handle& v) { return Vector3Text(v, "--rail"); });
+      a.plane = PerCameraEntries(plane, "--plane", [](const py::handle& v) { return Vector3Text(v, "--plane"); });
+      a.mount_box = PerCameraEntries(mount_box, "--mount-box", [](const py::handle& v) { return BoxText(v, "--mount-box"); });
+      for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "--keep-out"));
+      if (!(outer_iterations >= 1 && outer_iterations <= 100)) throw InputError("--outer-iterations", "", "must be in [1, 100]");
+      if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
+        throw InputError("--clearance", "", "snap_move, snap_rotate_deg and clearance must be >= 0");
+      options = app::SuggestOptionsFromArgs(a, scene, r.rig());
+      if (over_time) {
+        if (!target_surfaces.empty())
+          throw InputError("--over-time", "", "takes the study's targets; target_surfaces is for a static scene");
+        const std::vector<TimeSample> samples = scene.TimeSamples();
+        targets = SampleTimeTargets(scene, samples, points, seed);
+        parts = MakeSceneParts(scene);
+        for (const TimeSample& s : samples) {
+          sample_casters.push_back(CasterAtSample(*parts, scene, s));
+          options.sample_casters.push_back(sample_casters.back().get());
+        }
+      } else {
+        targets = Targets(scene, points, target_surfaces, with_region, "", seed);
+      }
+    } catch (const InputError& e) {
+      RethrowWithKeyword(e);
+    }
+    PySuggestion out;
+    out.study = sc.study;
+    out.session = r.session;
+    out.kind = "cameras";
+    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+    {
+      py::gil_scoped_release release;
+      out.cameras = r.session->Suggest(targets, options);
+    }
+    out.improved = out.cameras->improved;
+    out.message = out.cameras->message;
+    out.json = SuggestionToJson(*out.cameras, scene, r.rig(), options);
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("cameras"), py::arg("objective") = "coverage2",
+     py::arg("points") = 1500, py::arg("target_surfaces") = std::vector<std::string>{}, py::arg("with_region") = false,
+     py::arg("over_time") = false, py::arg("max_move") = py::float_(0.3), py::arg("max_rotate_deg") = py::float_(10.0),
+     py::arg("hfov_range") = py::none(), py::arg("rail") = py::none(), py::arg("plane") = py::none(),
+     py::arg("mount_box") = py::none(), py::arg("keep_out") = std::vector<py::object>{}, py::arg("clearance") = 0.1,
+     py::arg("snap_move") = 0.0, py::arg("snap_rotate_deg") = 0.0, py::arg("outer_iterations") = 4, py::arg("seed") = 1,
+     "Nudges the `cameras` of `rig` within the limits to improve `objective` over target points, as "
+     "`pandora suggest` does (docs/suggest.md). Per-camera limits: a value for all, a list in `cameras` "
+     "order, or for hfov_range / rail / plane / mount_box a dict {id: value}.");
+
+  auto ptz_common = [](const PyScene& sc, PyRig& r, const char* option, const std::string& id, int points,
+                       const std::string& target_region, const std::vector<std::string>& surfaces, bool with_region,
+                       std::uint64_t seed, int* camera, std::vector<Vec3>* xyz) {
+    if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
+    *camera = PtzCamera(r.rig(), option, id);
+    for (const TargetPoint& t : Targets(sc.scene(), points, surfaces, with_region, target_region, seed)) xyz->push_back(t.p);
+  };
+
+  m.def("suggest_ptz_preset", [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera, const std::string& preset,
+                                           int points, const std::string& target_region,
+                                           std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
+    int c = -1;
+    std::vector<Vec3> xyz;
+    ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region, seed, &c, &xyz);
+    const PtzHead& head = *r.rig().cameras[c].ptz;
+    int p = -1;
+    std::string names;
+    for (std::size_t i = 0; i < head.presets.size(); ++i) {
+      names += (names.empty() ? "" : ", ") + head.presets[i].name;
+      if (head.presets[i].name == preset) p = int(i);
+    }
+    if (p < 0) throw InputError("preset", "", "camera '" + camera + "' has no preset '" + preset + "'", "its presets: " + names);
+    PySuggestion out;
+    out.study = sc.study;
+    out.session = r.session;
+    out.kind = "ptz_preset";
+    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+    out.ptz_camera = c;
+    out.ptz_preset = p;
+    {
+      py::gil_scoped_release release;
+      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal());
+      out.preset = SuggestPtzPreset(tester, c, p, xyz, sc.scene().study.ptz.min_px_per_m);
+    }
+    out.improved = out.preset->improved();
+    out.message = camera + " preset " + preset + ": sees " + std::to_string(out.preset->seen_before) + " -> " +
+                  std::to_string(out.preset->seen_after) + " of " + std::to_string(out.preset->points) + " target points";
+    out.json = PtzPresetSuggestionToJson(*out.preset, sc.scene(), r.rig());
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("preset"), py::arg("points") = 1500,
+     py::arg("target_region") = "", py::arg("target_surfaces") = std::vector<std::string>{},
+     py::arg("with_region") = false, py::arg("seed") = 1,
+     "The pan, tilt and zoom of a PTZ camera's preset that see the most target points at the study's "
+     "PTZ density target (docs/ptz.md); `target_region`: one of study.regions.");
+
+  m.def("suggest_ptz_tour", [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera, const std::string& objective,
+                                         int points, const std::string& target_region,
+                                         std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
+    if (objective != "mean" && objective != "max")
+      throw InputError("objective", "", "unknown tour objective '" + objective + "'", "use mean or max");
+    int c = -1;
+    std::vector<Vec3> xyz;
+    ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region, seed, &c, &xyz);
+    if (r.rig().cameras[c].ptz->tour.size() < 3)
+      throw InputError("camera", "", "camera '" + camera + "' has fewer than 3 tour stops: every order is the same cycle");
+    PySuggestion out;
+    out.study = sc.study;
+    out.session = r.session;
+    out.kind = "ptz_tour";
+    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+    out.ptz_camera = c;
+    {
+      py::gil_scoped_release release;
+      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal());
+      out.tour = SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m,
+                                objective == "max" ? TourObjective::kMax : TourObjective::kMean);
+    }
+    out.improved = out.tour->improved();
+    char line[256];
+    std::snprintf(line, sizeof line, "%s tour: longest gap %.2f -> %.2f s, mean longest gap %.2f -> %.2f s",
+                  camera.c_str(), out.tour->gap_max_before, out.tour->gap_max_after, out.tour->gap_mean_before,
+                  out.tour->gap_mean_after);
+    out.message = line;
+    out.json = PtzTourSuggestionToJson(*out.tour, sc.scene(), r.rig());
+    return out;
+  }, py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("objective") = "mean", py::arg("points") = 1500,
+     py::arg("target_region") = "", py::arg("target_surfaces") = std::vector<std::string>{},
+     py::arg("with_region") = false, py::arg("seed") = 1,
+     "The order of a PTZ camera's tour stops that minimises the mean (or max) longest unwatched gap.");
+
+  m.def("accept", [](const std::string& path, std::vector<std::string> cameras, bool force) {
+    AcceptOptions options;
+    options.cameras = cameras;
+    options.force = force;
+    return AcceptDict(AcceptSuggestion(path, options));
+  }, py::arg("path"), py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
+     "`pandora accept PATH`: writes a saved suggestion file into its scene file (backup kept).");
+}
+
+}  // namespace pandora::python
