@@ -15,9 +15,11 @@
 #include "analysis/surface_targets.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
+#include "app/mpi_session.h"
 #include "app/session/session.h"
 #include "app/output.h"
 #include "volume/fields.h"
+#include "volume/fields_transfer.h"
 #include "volume/robustness.h"
 #include "volume/summary.h"
 #include "volume/pixel_targets.h"
@@ -64,6 +66,10 @@ double CheckPositiveOption(const char* option, double value, const char* unit) {
 }
 
 int RunAnalyze(const AnalyzeArgs& args) {
+  // Under mpirun every process runs this; rank 0 alone prints, stages and writes (docs/scale.md).
+  const MpiSession mpi(args.mpi);
+  const bool root = mpi.rank() == 0;
+  const bool quiet = args.quiet || !root;
   // The study, with --voxel-size applied, and the rig, through the session layer.
   const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
   const Scene& scene = study->scene();
@@ -84,20 +90,64 @@ int RunAnalyze(const AnalyzeArgs& args) {
     CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
     options.memory_budget_option = "--memory-budget";
   }
-  ProgressBar bar("analyze " + study->FindRig(args.rig, "--rig").name, !args.quiet);
+  options.partition_count = mpi.size();
+  options.partition_rank = mpi.rank();
+  ProgressBar bar("analyze " + study->FindRig(args.rig, "--rig").name +
+                      (mpi.active() ? " (rank 0 of " + std::to_string(mpi.size()) + ")" : ""),
+                  !quiet);
   options.progress = [&bar](double f) { bar.Update(f); };
   session::Session session(study, so);
   const Rig& rig = session.rig().rig();
-  // Both outputs appear together (summary.json last), or neither does.
+  // Both outputs appear together (summary.json last), or neither does. Under MPI every process
+  // learns whether rank 0 could stage them before any evaluates (a failure on one rank must not
+  // leave the others waiting).
   const std::filesystem::path out(args.out);
   OutputTransaction output;
-  AddSceneInputs(output, scene);
-  const std::string vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
-  const std::string summary_path = output.Stage((out / "summary.json").string(), "--out");
+  std::string vdb_path, summary_path;
+  std::exception_ptr failure;
+  if (root) {
+    try {
+      AddSceneInputs(output, scene);
+      vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
+      summary_path = output.Stage((out / "summary.json").string(), "--out");
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  if (!mpi.AllOk(!failure)) {
+    if (failure) std::rethrow_exception(failure);
+    return 2;  // rank 0 printed why
+  }
 
-  session.UpdateFields();
+  try {
+    session.UpdateFields();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  if (!mpi.AllOk(!failure)) {
+    if (failure && root) std::rethrow_exception(failure);
+    return 2;
+  }
   Fields fields = session.TakeFields();
   bar.Finish();
+  // The partitions meet at rank 0: grids merged, statistics added (volume/fields_transfer.h).
+  nlohmann::json mpi_summary;
+  if (mpi.active()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const nlohmann::json mine{{"seconds", fields.stats.seconds},
+                              {"rays", fields.stats.rays},
+                              {"point_camera_tests", fields.stats.point_camera_tests}};
+    const std::vector<std::string> parts = mpi.GatherToRoot(mine.dump() + '\n' + SerializePartialFields(fields));
+    if (!root) return 0;
+    mpi_summary = {{"ranks", mpi.size()}, {"per_rank", nlohmann::json::array()}};
+    mpi_summary["per_rank"].push_back(mine);
+    for (std::size_t r = 1; r < parts.size(); ++r) {
+      const std::size_t newline = parts[r].find('\n');
+      mpi_summary["per_rank"].push_back(nlohmann::json::parse(parts[r].substr(0, newline)));
+      MergePartialFields(parts[r].substr(newline + 1), &fields);
+    }
+    mpi_summary["merge_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   // Moving objects: the fields at every time sample; surface targets at each (docs/time.md).
   std::optional<TimeSummary> time;
   std::vector<SurfaceTargetResult> targets;
@@ -110,6 +160,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
     for (const TimeSample& s : samples) sample_labels.push_back(s.label);
     if (!samples.empty()) {
       FieldOptions over_time = options;
+      over_time.partition_count = 1;  // rank 0 evaluates the time samples whole (docs/scale.md)
+      over_time.partition_rank = 0;
       // The per-camera sets of every sample are not kept: coverage and the uncertainty fields are.
       over_time.fields.erase(std::remove(over_time.fields.begin(), over_time.fields.end(), "cameras"),
                              over_time.fields.end());
@@ -153,6 +205,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   if (RigHasPtz(rig)) typed.ptz = EvaluatePtzFields(scene, rig, caster, fields, &fields);
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
+  if (mpi.active()) summary["mpi"] = mpi_summary;
   std::map<std::string, std::string> meta{
       {"run_id", output.run_id()},
       {"units", "m"},

@@ -25,6 +25,9 @@ struct AnalyzeArgs {
   std::string fields;     ///< Comma-separated; empty: the scene's study.fields.
   double memory_budget_mb = kUnset;  ///< MiB; kUnset: the scene's study.memory_budget_mb.
   bool quiet = false;
+  /// `--mpi`: one of the processes of `mpirun -n N pandora analyze ...` (docs/scale.md): each
+  /// evaluates its partition of the blocks, rank 0 merges them and writes the outputs.
+  bool mpi = false;
 };
 int RunAnalyze(const AnalyzeArgs& args);
 

@@ -20,6 +20,7 @@
 
 #include "analysis/error.h"
 #include "app/commands.h"
+#include "app/mpi_session.h"
 
 #ifndef PANDORA_VERSION
 #define PANDORA_VERSION "dev"
@@ -184,6 +185,7 @@ int main(int argc, char** argv) {
       ->check(Number(0, HUGE_VAL, "MiB", false, true));
   a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
+  a->add_flag("--mpi", analyze.mpi, "Under mpirun: split the blocks over the processes; rank 0 writes (docs/scale.md)");
 
   BenchArgs bench;
   CLI::App* b = app.add_subcommand("bench", "Time field evaluation against a raw Embree loop over the same rays");
@@ -429,7 +431,7 @@ int main(int argc, char** argv) {
     if (*ac) return RunAccept(accept);
     if (*rg) return RunRig(rig_args);
   } catch (const pandora::InputError& e) {
-    std::fprintf(stderr, "pandora: error: %s\n", e.what());
+    if (!pandora::app::MpiQuietErrors()) std::fprintf(stderr, "pandora: error: %s\n", e.what());
     return 2;
   } catch (const std::bad_alloc&) {
     // Budgets are checked before the work starts; this is what is left: another process took the

@@ -10,6 +10,8 @@ PACKAGES=(
   libopenexr-dev openexr libpng-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
   chromium libxml2-utils jq python3-openvdb
+  # pandora analyze --mpi and its tests (docs/scale.md).
+  libopenmpi-dev openmpi-bin
   # python/ (import pandora) and its tests.
   pybind11-dev python3-dev python3-numpy python3-pytest
   # viewer/ (the only code that links GL): window, GL loader, UI; headless tests under Xvfb with

@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "analysis/error.h"
 
@@ -226,6 +228,29 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   }
   if (stats) *stats = s;
   return blocks;
+}
+
+std::vector<std::uint8_t> PartitionBlocks(const std::vector<Block>& blocks,
+                                          const std::vector<std::vector<std::int32_t>>& candidates,
+                                          int count, int rank) {
+  if (count < 1 || rank < 0 || rank >= count) throw std::logic_error("PartitionBlocks: bad partition");
+  // Cost of a block: its (voxel, candidate camera) pairs plus a constant for the block's own work
+  // (deriving, leaves), so culled blocks are spread too.
+  std::vector<std::pair<std::int64_t, std::size_t>> cost(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    cost[b] = {std::int64_t(blocks[b].free_voxels) * std::int64_t(candidates[b].size() + 1) + 64, b};
+  std::sort(cost.begin(), cost.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  // Largest first, each to the least loaded partition (ties: the lowest index): deterministic.
+  std::vector<std::int64_t> load(count, 0);
+  std::vector<std::uint8_t> mine(blocks.size(), 0);
+  for (const auto& [c, b] : cost) {
+    const int to = int(std::min_element(load.begin(), load.end()) - load.begin());
+    load[to] += c;
+    if (to == rank) mine[b] = 1;
+  }
+  return mine;
 }
 
 }  // namespace pandora

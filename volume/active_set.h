@@ -91,4 +91,13 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
                                   const InsideMesh* region_mesh, const FrustumCuller& culler,
                                   int camera_count, ActiveSetStats* stats);
 
+/// The blocks partition `rank` of `count` evaluates (FieldOptions::partition_count): blocks sorted
+/// by cost (free voxels times (candidate cameras + 1), plus 64), largest first, each given to the
+/// least loaded partition so far (longest-processing-time scheduling: the largest load is within
+/// 4/3 of the best possible). Every process computes the same partition. std::logic_error for a
+/// bad `count` or `rank`.
+std::vector<std::uint8_t> PartitionBlocks(const std::vector<Block>& blocks,
+                                          const std::vector<std::vector<std::int32_t>>& candidates,
+                                          int count, int rank);
+
 }  // namespace pandora

@@ -13,6 +13,7 @@
 #include "analysis/primitives.h"
 #include "tests/fixtures.h"
 #include "volume/fields.h"
+#include "volume/fields_transfer.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
@@ -300,6 +301,86 @@ TEST(FieldEvaluator, AThousandCameras) {
   rig.cameras[500].world_from_camera.translation() += Vec3(0.3, 0, 0);
   evaluator.Update(rig);
   ExpectSameFields(evaluator.fields(), EvaluateFields(scene, rig, *caster, options), "moved");
+}
+
+// A distributed evaluation (`pandora analyze --mpi`): every partition of 1..7 evaluated alone,
+// serialized and merged into partition 0's fields gives the single-process fields voxel for voxel,
+// bit for bit, with the same topology and statistics (the sigma lists as multisets: the merge
+// joins them partition by partition). Each block is evaluated by exactly one partition, and the
+// largest partition's cost is within the longest-processing-time bound of 4/3 of the best.
+void ExpectPartitionsMergeToTheWhole(const Scene& scene, const Rig& rig, const std::vector<std::string>& names) {
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = names;
+  Fields whole = EvaluateFields(scene, rig, *caster, options);
+  std::sort(whole.stats.sigma_max_mm.begin(), whole.stats.sigma_max_mm.end());
+  std::sort(whole.stats.sigma_max_steady_mm.begin(), whole.stats.sigma_max_steady_mm.end());
+  for (int count = 1; count <= 7; ++count) {
+    SCOPED_TRACE(std::to_string(count) + " partitions");
+    options.partition_count = count;
+    options.partition_rank = 0;
+    Fields merged = EvaluateFields(scene, rig, *caster, options);
+    std::int64_t rays = merged.stats.rays;
+    for (int rank = 1; rank < count; ++rank) {
+      options.partition_rank = rank;
+      const Fields part = EvaluateFields(scene, rig, *caster, options);
+      rays += part.stats.rays;
+      MergePartialFields(SerializePartialFields(part), &merged);
+    }
+    EXPECT_EQ(merged.stats.rays, rays);
+    std::sort(merged.stats.sigma_max_mm.begin(), merged.stats.sigma_max_mm.end());
+    std::sort(merged.stats.sigma_max_steady_mm.begin(), merged.stats.sigma_max_steady_mm.end());
+    ExpectSameFields(merged, whole, "merged");
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+  const Fields part = EvaluateFields(scene, rig, *caster, options);
+  EXPECT_THROW(MergePartialFields("not a partition", const_cast<Fields*>(&part)), std::runtime_error);
+  std::string cut = SerializePartialFields(part);
+  cut.resize(cut.size() / 2);
+  EXPECT_THROW(MergePartialFields(cut, const_cast<Fields*>(&part)), std::runtime_error);
+}
+
+TEST(FieldEvaluator, PartitionsMergeToTheWholeOnASyntheticScene) {
+  const Scene scene = SyntheticScene();
+  ExpectPartitionsMergeToTheWhole(scene, scene.rigs[0], FieldNames());
+}
+
+TEST(FieldEvaluator, PartitionsMergeToTheWholeOnTheTraumaRoom) {
+  Scene scene = LoadScene("examples/trauma_room/scene.json");
+  scene.study.voxel_size = 0.008;
+  ExpectPartitionsMergeToTheWhole(scene, scene.FindRig("octagon"), scene.study.fields);
+}
+
+TEST(FieldEvaluator, PartitionBlocksCoversEveryBlockOnceWithinTheLptBound) {
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<Block> blocks(1 + rng() % 300);
+    std::vector<std::vector<std::int32_t>> candidates(blocks.size());
+    std::int64_t total = 0, largest = 0;
+    std::vector<std::int64_t> cost(blocks.size());
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      blocks[b].free_voxels = 1 + int(rng() % 512);
+      candidates[b].resize(rng() % 3 == 0 ? 0 : rng() % 24);
+      cost[b] = std::int64_t(blocks[b].free_voxels) * std::int64_t(candidates[b].size() + 1) + 64;
+      total += cost[b];
+      largest = std::max(largest, cost[b]);
+    }
+    const int count = 1 + int(rng() % 8);
+    std::vector<int> owners(blocks.size(), 0);
+    std::int64_t worst = 0;
+    for (int rank = 0; rank < count; ++rank) {
+      const std::vector<std::uint8_t> mine = PartitionBlocks(blocks, candidates, count, rank);
+      std::int64_t load = 0;
+      for (std::size_t b = 0; b < blocks.size(); ++b)
+        if (mine[b]) ++owners[b], load += cost[b];
+      worst = std::max(worst, load);
+    }
+    for (int o : owners) ASSERT_EQ(o, 1);
+    const double best_bound = std::max(double(total) / count, double(largest));
+    EXPECT_LE(double(worst), 4.0 / 3.0 * best_bound + 1e-9) << trial;
+  }
+  EXPECT_THROW(PartitionBlocks({}, {}, 0, 0), std::logic_error);
+  EXPECT_THROW(PartitionBlocks({}, {}, 2, 2), std::logic_error);
 }
 
 }  // namespace

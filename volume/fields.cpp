@@ -341,6 +341,7 @@ struct FieldEvaluator::State {
 
   std::vector<Block> blocks;  // the active set (free voxels; Block::cameras unused)
   std::vector<BlockState> states;
+  std::vector<std::uint8_t> owned;  // with a partition: the blocks this process evaluates
   ActiveSetStats active_stats;
   double active_set_seconds = 0;
   Rig rig;  // as of the last update
@@ -919,7 +920,7 @@ void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled
       st->per_camera_seen[e.camera] += e.seen;
       st->rays += e.rays;
     }
-    st->point_camera_tests += blocks[b].free_voxels * enabled;
+    if (owned.empty() || owned[b]) st->point_camera_tests += blocks[b].free_voxels * enabled;
   }
 }
 
@@ -1095,6 +1096,12 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       dirty_block[b] = dirty;
     }
   });
+  if (opt.partition_count > 1) {
+    if (S.evaluated || S.keep)
+      throw std::logic_error("FieldEvaluator: a partitioned evaluation is one full update without kept state");
+    S.owned = PartitionBlocks(S.blocks, candidates, opt.partition_count, opt.partition_rank);
+    for (std::size_t b = 0; b < S.blocks.size(); ++b) dirty_block[b] &= S.owned[b];
+  }
   std::vector<std::size_t> dirty;
   for (std::size_t b = 0; b < S.blocks.size(); ++b)
     if (dirty_block[b]) dirty.push_back(b);

@@ -49,6 +49,13 @@ struct FieldOptions {
   /// Set when the memory budget came from a command-line option (its name): an over-budget error
   /// then blames that option, unless the voxel size came from an option too.
   std::string memory_budget_option;
+  /// Distributed evaluation (`pandora analyze --mpi`, docs/scale.md): this process evaluates only
+  /// the blocks of partition `partition_rank` of `partition_count`, a static load balance that every
+  /// process computes alike (blocks by estimated cost, free voxels times candidate cameras, largest
+  /// first, each to the least loaded partition). The other blocks' voxels stay inactive and out of
+  /// the statistics until MergePartialFields (volume/fields_transfer.h) adds them. For one full
+  /// evaluation (EvaluateFields, or an evaluator without kept state); 1: every block.
+  int partition_count = 1, partition_rank = 0;
 };
 
 /// Counts and timing of one evaluation.

@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""The growth table of docs/performance.md (issue 15): time and peak memory of `pandora analyze` on
+generated large stages (bench/large_stage.py) against region voxels, cameras, triangles and
+threads, one quantity varied at a time around a base case, with the exponent of a least-squares
+power law fitted to each series (time ~ N^b).
+
+    python3 bench/growth.py [--pandora build/pandora] [--work /tmp/pandora-growth] [--quick]
+                            [--json growth.json]
+
+Each run is `pandora analyze` under /usr/bin/time (wall seconds, peak resident memory); the field
+evaluation's own seconds, rays and region voxels come from its summary.json. Prints a Markdown
+table and the fitted exponents.
+"""
+import argparse
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+HERE = pathlib.Path(__file__).resolve().parent
+
+
+def run(pandora, work, name, triangles, cameras, voxel, threads, fields):
+    scene = work / f"{name}.json"
+    subprocess.run([sys.executable, str(HERE / "large_stage.py"), str(scene), "--triangles", str(triangles),
+                    "--cameras", str(cameras), "--voxel", str(voxel)], check=True, capture_output=True)
+    out = work / f"{name}.out"
+    timed = subprocess.run(["/usr/bin/time", "-f", "%e %M", pandora, "analyze", str(scene), "--out", str(out),
+                            "--threads", str(threads), "--fields", fields, "--quiet"],
+                           capture_output=True, text=True)
+    if timed.returncode != 0:
+        raise SystemExit(f"{name}: pandora analyze failed: {timed.stderr.strip()}")
+    wall, rss_kb = timed.stderr.strip().splitlines()[-1].split()
+    summary = json.loads((out / "summary.json").read_text())
+    row = {
+        "name": name, "triangles": triangles, "cameras": cameras, "voxel_m": voxel, "threads": threads,
+        "region_voxels": summary["region_voxels"], "rays": summary["timing"]["rays"],
+        "field_s": summary["timing"]["seconds"], "wall_s": float(wall), "peak_mb": int(rss_kb) / 1024,
+        "vdb_mb": (out / "fields.vdb").stat().st_size / 2**20,
+    }
+    print(f"  {name}: {row['region_voxels']} voxels, {cameras} cameras, ~{triangles} triangles, {threads} threads: "
+          f"fields {row['field_s']:.2f} s, wall {row['wall_s']:.2f} s, peak {row['peak_mb']:.0f} MB", flush=True)
+    return row
+
+
+def fit(xs, ys):
+    """Least-squares b of y = a x^b."""
+    lx = [math.log(x) for x in xs]
+    ly = [math.log(y) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    den = sum((x - mx) ** 2 for x in lx)
+    return sum((x - mx) * (y - my) for x, y in zip(lx, ly)) / den if den > 0 else float("nan")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--pandora", default="build/pandora")
+    ap.add_argument("--work", default="/tmp/pandora-growth")
+    ap.add_argument("--fields", default="coverage,cameras,resolution,sigma_max")
+    ap.add_argument("--quick", action="store_true", help="smaller series (a smoke run)")
+    ap.add_argument("--json", help="also write the rows and exponents here")
+    a = ap.parse_args()
+    work = pathlib.Path(a.work)
+    work.mkdir(parents=True, exist_ok=True)
+    base = dict(triangles=300000, cameras=24, voxel=0.06, threads=os.cpu_count() or 1)
+    series = {
+        "voxels": ("region_voxels", [dict(base, voxel=v) for v in ((0.12, 0.08) if a.quick else (0.12, 0.09, 0.06, 0.045, 0.035))]),
+        "cameras": ("cameras", [dict(base, cameras=c) for c in ((6, 12) if a.quick else (6, 12, 24, 48))]),
+        "triangles": ("triangles", [dict(base, triangles=t) for t in ((10000, 100000) if a.quick else (10000, 100000, 300000, 1000000))]),
+        "threads": ("threads", [dict(base, threads=t) for t in sorted({1, base["threads"]})]),
+    }
+    rows, exponents = [], {}
+    for label, (key, cases) in series.items():
+        print(f"{label}:", flush=True)
+        got = [run(a.pandora, work, f"{label}_{i}", c["triangles"], c["cameras"], c["voxel"], c["threads"], a.fields)
+               for i, c in enumerate(cases)]
+        for r in got:
+            r["series"] = label
+        rows += got
+        xs = [r[key] for r in got]
+        exponents[label] = {"field_s": fit(xs, [r["field_s"] for r in got]),
+                            "wall_s": fit(xs, [r["wall_s"] for r in got]),
+                            "peak_mb": fit(xs, [r["peak_mb"] for r in got])}
+    print()
+    print("| Series | Region voxels | Cameras | Triangles (asked) | Threads | Rays | Fields (s) | Wall (s) | Peak (MB) | fields.vdb (MB) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['series']} | {r['region_voxels']:,} | {r['cameras']} | {r['triangles']:,} | {r['threads']} | {r['rays']:,} | "
+              f"{r['field_s']:.2f} | {r['wall_s']:.2f} | {r['peak_mb']:.0f} | {r['vdb_mb']:.1f} |")
+    print()
+    print("| Against | Field time exponent | Wall time exponent | Peak memory exponent |")
+    print("|---|---|---|---|")
+    for label, e in exponents.items():
+        print(f"| {label} | {e['field_s']:.2f} | {e['wall_s']:.2f} | {e['peak_mb']:.2f} |")
+    if a.json:
+        pathlib.Path(a.json).write_text(json.dumps({"rows": rows, "exponents": exponents}, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()

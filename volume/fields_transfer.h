@@ -1,0 +1,25 @@
+#pragma once
+/// \file fields_transfer.h
+/// The fields of one partition of a distributed evaluation (FieldOptions::partition_count,
+/// `pandora analyze --mpi`, docs/scale.md) as bytes, and their merge into another partition's: the
+/// grids' leaves and tiles (the partitions' blocks are disjoint) and the statistics (counts summed,
+/// histograms added, sigma lists joined). Merging every partition into partition 0's fields gives
+/// the single-process fields voxel for voxel and the same statistics but for the timings. Light
+/// header (no OpenVDB).
+
+#include <string>
+
+#include "volume/fields.h"
+
+namespace pandora {
+
+/// The grids (coverage, the float fields, the per-camera sets) and the statistics of `fields`.
+std::string SerializePartialFields(const Fields& fields);
+
+/// Adds the partition in `bytes` (SerializePartialFields of a partition of the same evaluation) to
+/// `fields`: grids merged (voxels and tiles of `bytes` where `fields` has none), statistics added;
+/// the active-set statistics and timings of `fields` stay. Throws std::runtime_error when the bytes
+/// are not a partition of the same fields (other grids, camera count or lattice).
+void MergePartialFields(const std::string& bytes, Fields* fields);
+
+}  // namespace pandora
