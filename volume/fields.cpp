@@ -976,8 +976,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
 
   // The active set without cameras: which voxels are free region voxels (solids and the region
   // mesh are classified once; cameras are culled per update).
-  std::vector<std::unique_ptr<InsideMesh>> solid_meshes;
-  std::vector<const InsideMesh*> solids;
+  std::vector<const SceneObject*> solid_objects;
   for (const SceneObject& o : scene.objects) {
     if (!o.solid || o.mesh.triangles.empty()) continue;
     // Solids that cannot contain a region voxel cost nothing.
@@ -985,9 +984,16 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
     if ((b.max.array() < study.region.box.min.array()).any() ||
         (b.min.array() > study.region.box.max.array()).any())
       continue;
-    solid_meshes.push_back(std::make_unique<InsideMesh>(o.mesh));
-    solids.push_back(solid_meshes.back().get());
+    solid_objects.push_back(&o);
   }
+  // Their search trees are built in parallel (a crowd of finely tessellated people: ~100 trees).
+  std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
+  });
+  std::vector<const InsideMesh*> solids;
+  for (const auto& m : solid_meshes) solids.push_back(m.get());
   std::unique_ptr<InsideMesh> region_mesh;
   if (study.region.kind == Region::Kind::kMesh)
     region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
