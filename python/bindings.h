@@ -42,6 +42,9 @@ py::array_t<double> Vec3Array(const Vec3& v);
 // (N, 3) metres -> points; InputError("points", "[i]") for a non-finite one.
 std::vector<Vec3> Points(const py::array_t<double, py::array::c_style | py::array::forcecast>& points);
 
+// Refuses (InputError) an output `path` that is one of the scene's input files (the scene, a mesh).
+void RefuseInputPath(const Scene& scene, const std::string& path, const std::string& what);
+
 // A JSON text as Python objects (json.loads).
 py::object JsonToPython(const std::string& text);
 

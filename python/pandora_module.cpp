@@ -55,6 +55,19 @@ std::vector<Vec3> Points(const py::array_t<double, py::array::c_style | py::arra
 
 py::object JsonToPython(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
+// An output path that is one of the scene's input files (the scene, a mesh, ...) is refused.
+void RefuseInputPath(const Scene& scene, const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(path, ec);
+  for (const auto& [input, kind] : scene.InputFiles()) {
+    std::error_code e2;
+    if (!ec && out == fs::weakly_canonical(input, e2))
+      throw InputError(path, "", what + " would replace the " + kind + " " + input, "write it somewhere else");
+  }
+}
+
+
 }  // namespace pandora::python
 
 namespace {
@@ -83,18 +96,6 @@ openvdb::FloatGrid::ConstPtr FloatGrid(const PyFields& f, const std::string& nam
 }
 
 double SigmaOf(const Scene& scene, const Camera& c) { return c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma; }
-
-// An output path that is one of the scene's input files (the scene, a mesh, ...) is refused.
-void RefuseInputPath(const Scene& scene, const std::string& path, const std::string& what) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path out = fs::weakly_canonical(path, ec);
-  for (const auto& [input, kind] : scene.InputFiles()) {
-    std::error_code e2;
-    if (!ec && out == fs::weakly_canonical(input, e2))
-      throw InputError(path, "", what + " would replace the " + kind + " " + input, "write it somewhere else");
-  }
-}
 
 }  // namespace
 

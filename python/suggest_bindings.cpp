@@ -107,35 +107,33 @@ std::vector<std::string> PerCameraEntries(const py::object& value, const char* n
   return out;
 }
 
-std::string Vector3Text(const py::handle& v, const char* name) {
+// `n` numbers from a Python sequence, or InputError(name, reason).
+std::vector<double> Numbers(const py::handle& v, std::size_t n, const char* name, const char* reason) {
   std::vector<double> x;
   try {
     x = v.cast<std::vector<double>>();
   } catch (const py::cast_error&) {
   }
-  if (x.size() != 3) throw InputError(name, "", "expected three numbers (a direction, metres)");
-  return Join(x);
+  if (x.size() != n) throw InputError(name, "", reason);
+  return x;
+}
+
+std::string Vector3Text(const py::handle& v, const char* name) {
+  return Join(Numbers(v, 3, name, "expected three numbers (a direction, metres)"));
 }
 
 std::string BoxText(const py::handle& v, const char* name) {
-  std::vector<std::vector<double>> corners;
-  try {
-    corners = v.cast<std::vector<std::vector<double>>>();
-  } catch (const py::cast_error&) {
-  }
-  if (corners.size() != 2 || corners[0].size() != 3 || corners[1].size() != 3)
-    throw InputError(name, "", "expected a box as (min corner, max corner), metres");
-  return Join({corners[0][0], corners[0][1], corners[0][2], corners[1][0], corners[1][1], corners[1][2]});
+  const char* reason = "expected a box as (min corner, max corner), metres";
+  if (!py::isinstance<py::sequence>(v) || py::len(v) != 2) throw InputError(name, "", reason);
+  const py::sequence corners = py::reinterpret_borrow<py::sequence>(v);
+  std::vector<double> box = Numbers(corners[0], 3, name, reason);
+  const std::vector<double> max = Numbers(corners[1], 3, name, reason);
+  box.insert(box.end(), max.begin(), max.end());
+  return Join(box);
 }
 
 std::string RangeText(const py::handle& v, const char* name) {
-  std::vector<double> x;
-  try {
-    x = v.cast<std::vector<double>>();
-  } catch (const py::cast_error&) {
-  }
-  if (x.size() != 2) throw InputError(name, "", "expected (min, max) degrees");
-  return Join(x);
+  return Join(Numbers(v, 2, name, "expected (min, max) degrees"));
 }
 
 py::dict MetricsDict(const Metrics& m) {
@@ -188,18 +186,6 @@ int PtzCamera(const Rig& rig, const char* option, const std::string& id) {
   if (!rig.cameras[c].ptz) throw InputError(option, "", "camera '" + id + "' has no PTZ head", hint);
   if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
   return c;
-}
-
-// A scene's input file (the scene, a mesh) may not be an output.
-void RefuseInput(const Scene& scene, const std::string& path, const std::string& what) {
-  namespace fs = std::filesystem;
-  std::error_code e1;
-  const fs::path out = fs::weakly_canonical(path, e1);
-  for (const auto& [input, kind] : scene.InputFiles()) {
-    std::error_code e2;
-    if (!e1 && out == fs::weakly_canonical(input, e2))
-      throw InputError(path, "", what + " would replace the " + kind + " " + input, "write it somewhere else");
-  }
 }
 
 // Applies a suggestion to its rig in memory as one undo step: `subset` (the accepted cameras of a
@@ -374,7 +360,7 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
       .def("to_dict", [](const PySuggestion& s) { return JsonToPython(s.json); }, "The suggestion file, as a dict.")
       .def("__str__", [](const PySuggestion& s) { return s.message; })
       .def("save", [](const PySuggestion& s, const std::string& path) {
-        RefuseInput(s.study->scene(), path, "the suggestion file");
+        RefuseInputPath(s.study->scene(), path, "the suggestion file");
         WriteFileAtomically(path, s.json);
       }, py::arg("path"), "Writes the suggestion file (`pandora accept PATH` takes it), atomically.")
       .def("apply", [](PySuggestion& s) {
