@@ -217,7 +217,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
       {"rig", RigToJson(rig).dump()},
       {"voxel_size_m", FormatNumber(scene.study.voxel_size)},
   };
-  WriteFieldsVdb(fields, vdb_path, meta);
+  WriteFieldsVdb(std::move(fields), vdb_path, meta);  // the last use: consumed to keep the peak down
   WriteFileAtomically(summary_path, summary.dump(2) + "\n");
   output.Commit();
   if (!args.quiet) {

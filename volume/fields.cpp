@@ -300,6 +300,12 @@ struct BlockState {
   std::int64_t seen = 0, triangulable = 0, unobservable = 0;
   std::vector<float> sigma_list, steady_list;  // triangulable voxels in ascending offset
   std::vector<Ray> rays;                       // with record_rays
+  // Without kept state the entries go as soon as the block is derived; what the statistics need
+  // of them stays: per camera that cast rays here, its rays and seen voxels (ascending camera).
+  struct CameraCount {
+    std::int32_t camera = 0, rays = 0, seen = 0;
+  };
+  std::vector<CameraCount> counts;
 };
 
 // What a rig needs per camera during an update.
@@ -920,6 +926,10 @@ void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled
       st->per_camera_seen[e.camera] += e.seen;
       st->rays += e.rays;
     }
+    for (const BlockState::CameraCount& e : s.counts) {
+      st->per_camera_seen[e.camera] += e.seen;
+      st->rays += e.rays;
+    }
     if (owned.empty() || owned[b]) st->point_camera_tests += blocks[b].free_voxels * enabled;
   }
 }
@@ -1192,12 +1202,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         leaves[i].visible.emplace_back(e.camera, leaf);
       }
     if (!S.keep) {
-      // One evaluation only: keep the summary, drop per-pair data and caches.
-      for (CameraEntry& e : cast[i]) {
-        std::vector<double>().swap(e.information);
-        std::vector<std::uint8_t>().swap(e.band);
-        std::vector<float>().swap(e.density);
-      }
+      // One evaluation only: keep the summary (the per-camera counts), drop the entries, the
+      // per-pair data and the caches now, block by block, so that they never add up.
+      BlockState& n = in_place ? old : next[i];
+      n.counts.clear();
+      for (const CameraEntry& e : cast[i]) n.counts.push_back({e.camera, e.rays, e.seen});
+      std::sort(n.counts.begin(), n.counts.end(),
+                [](const BlockState::CameraCount& a, const BlockState::CameraCount& b) { return a.camera < b.camera; });
+      std::vector<CameraEntry>().swap(cast[i]);
       std::vector<std::int32_t>().swap(next[i].coverage);
       std::vector<std::uint8_t>().swap(next[i].status);
       std::vector<float>().swap(next[i].sigma_max);
@@ -1319,6 +1331,9 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   update.dirty_voxels = dirty_voxels;
   for (const auto& c : cast)
     for (const CameraEntry& e : c) update.rays += e.rays;
+  if (!S.keep)  // the entries went block by block; their counts stayed
+    for (std::size_t b : dirty)
+      for (const BlockState::CameraCount& e : S.states[b].counts) update.rays += e.rays;
   FieldStats& st = S.fields.stats;
   const double estimated = st.estimated_bytes;
   S.Totals(&st, new_count, rd.enabled);

@@ -202,16 +202,73 @@ std::string TypeWord(const std::string& tree_type) {
 
 }  // namespace
 
+namespace {
+
+// The coverage grid as floats, made leaf by leaf from the integer grid, which loses each leaf as its
+// float copy is made (the converting copy of the whole tree would hold both at once). Active tiles
+// keep their level and value; voxel values and masks are copied as they are.
+openvdb::FloatGrid::Ptr TakeCoverageAsFloat(openvdb::Int32Grid& grid) {
+  using IntLeaf = openvdb::Int32Tree::LeafNodeType;
+  using FloatLeafT = openvdb::FloatTree::LeafNodeType;
+  openvdb::Int32Tree& src = grid.tree();
+  auto out = openvdb::FloatGrid::create(static_cast<float>(src.background()));
+  openvdb::FloatTree& dst = out->tree();
+  for (auto it = src.cbeginValueOn(); it; ++it) {
+    if (it.isVoxelValue()) continue;
+    openvdb::CoordBBox box;
+    it.getBoundingBox(box);
+    dst.addTile(it.getLevel(), box.min(), static_cast<float>(*it), true);
+  }
+  std::vector<openvdb::Coord> origins;
+  for (auto leaf = src.cbeginLeaf(); leaf; ++leaf) origins.push_back(leaf->origin());
+  for (const openvdb::Coord& origin : origins) {
+    std::unique_ptr<IntLeaf> leaf(src.stealNode<IntLeaf>(origin, src.background(), false));
+    auto* copy = new FloatLeafT(origin, static_cast<float>(src.background()), false);
+    for (openvdb::Index i = 0; i < IntLeaf::SIZE; ++i) copy->setValueOnly(i, static_cast<float>(leaf->getValue(i)));
+    copy->setValueMask(leaf->getValueMask());
+    dst.addLeaf(copy);
+  }
+  return out;
+}
+
+void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage, const std::string& path,
+                        const std::map<std::string, std::string>& metadata);
+
+}  // namespace
+
+void WriteFieldsVdb(Fields&& fields, const std::string& path, const std::map<std::string, std::string>& metadata) {
+  InitializeOpenVdb();
+  Fields::Impl& g = fields.impl();
+  openvdb::FloatGrid::Ptr coverage;
+  if (g.coverage) {
+    openvdb::math::Transform::Ptr transform = ExactCopy(g.coverage->transform());
+    coverage = TakeCoverageAsFloat(*g.coverage);
+    coverage->setTransform(transform);
+    g.coverage.reset();
+  }
+  WriteFieldsVdbWith(fields, coverage, path, metadata);
+}
+
 void WriteFieldsVdb(const Fields& fields, const std::string& path,
                     const std::map<std::string, std::string>& metadata) {
   InitializeOpenVdb();
   const Fields::Impl& g = fields.impl();
-  openvdb::GridPtrVec grids;
+  openvdb::FloatGrid::Ptr coverage;
   if (g.coverage) {
-    auto coverage =
-        openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(g.coverage->tree()));
-    coverage->setName(kCoverageGrid);
+    coverage = openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(g.coverage->tree()));
     coverage->setTransform(ExactCopy(g.coverage->transform()));
+  }
+  WriteFieldsVdbWith(fields, coverage, path, metadata);
+}
+
+namespace {
+
+void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage, const std::string& path,
+                        const std::map<std::string, std::string>& metadata) {
+  const Fields::Impl& g = fields.impl();
+  openvdb::GridPtrVec grids;
+  if (coverage) {
+    coverage->setName(kCoverageGrid);
     grids.push_back(coverage);
   }
   for (const std::string& name : FieldNames())
@@ -258,6 +315,8 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
   }
   CommitTemporary(path);
 }
+
+}  // namespace
 
 Fields ReadFieldsVdb(const std::string& path, FieldsProvenance* provenance) {
   return ReadFieldsVdbBytes(ReadVdbFileBytes(path), path, provenance);

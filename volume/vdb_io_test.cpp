@@ -175,6 +175,21 @@ TEST(VdbIo, RoundTripOfEveryGridKindIsExact) {
   EXPECT_FALSE((*f.impl().coverage)["rig"]);
 }
 
+// What `pandora analyze` writes: the fields consumed, the coverage grid converted leaf by leaf.
+// It reads back as the const writer's file of the same fields does (every grid, the coverage tile
+// included), and the consumed fields lose their coverage grid.
+TEST(VdbIo, ConsumingWriterWritesTheSameFile) {
+  const auto meta = RigMetadata(64);
+  const fs::path a = TempDir() / "const.vdb", b = TempDir() / "consumed.vdb";
+  const Fields f = MakeFields();
+  WriteFieldsVdb(f, a.string(), meta);
+  Fields g = MakeFields();
+  WriteFieldsVdb(std::move(g), b.string(), meta);
+  ExpectSameFields(ReadFieldsVdb(a.string()), ReadFieldsVdb(b.string()));
+  ExpectSameFields(f, ReadFieldsVdb(b.string()));
+  EXPECT_FALSE(g.impl().coverage);  // NOLINT(bugprone-use-after-move): the writer's documented effect
+}
+
 TEST(VdbIo, OneBoolGridPerCameraNamedByItsEncodedId) {
   const Fields f = MakeFields();
   const auto meta = RigMetadata(64);
