@@ -291,8 +291,21 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     for (std::size_t c = 0; c < camera_count; ++c) {
       for (int t = 0; t < 4; ++t) exactly[c][t] += p.exactly[c][t];
       seen[c] += p.seen[c];
+    }
+  }
+  // The per-camera lists hold about 12 bytes per (triangulable voxel, camera that sees it): joined
+  // camera by camera, each thread's part freed as soon as it is copied, so that they are never
+  // held twice (a camera's list at most).
+  for (std::size_t c = 0; c < camera_count; ++c) {
+    std::size_t n_removed = 0, n_added = 0;
+    for (const Partial& p : partials) n_removed += p.removed[c].size(), n_added += p.added[c].size();
+    removed[c].reserve(n_removed);
+    added[c].reserve(n_added);
+    for (Partial& p : partials) {
       removed[c].insert(removed[c].end(), p.removed[c].begin(), p.removed[c].end());
       added[c].insert(added[c].end(), p.added[c].begin(), p.added[c].end());
+      std::vector<std::int64_t>().swap(p.removed[c]);
+      std::vector<float>().swap(p.added[c]);
     }
   }
   const std::int64_t region = table.region_voxels;
