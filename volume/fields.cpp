@@ -1354,8 +1354,16 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
                           int camera_count) {
   const double voxels = static_cast<double>(lattice.voxel_count());
   const double blocks = voxels / 512.0 + 1.0;
-  // Active-set pass: one Block record per 8^3 block, a 512-byte mask where a block is partial.
-  double bytes = blocks * (sizeof(Block) + 512.0 + sizeof(BlockState));
+  // Per 8^3 block while it is evaluated: its Block record and a 512-byte mask where it is partial,
+  // its state and the next one (both arrays live until the serial phase), its new leaves' record,
+  // and the heap behind their vectors (candidate lists twice, histogram, per-camera counts, with
+  // the allocator's headers), plus 15 % for the allocator's rounding. Measured against the
+  // 10^9-voxel hall of docs/scale.md (coverage alone): 8.22 bytes per voxel at the peak, this
+  // estimate 8.6.
+  const double per_block = sizeof(Block) + 512.0 + 2.0 * sizeof(BlockState) + sizeof(BlockLeaves) + 256.0 +
+                           (2.0 * sizeof(std::int32_t) + sizeof(std::int64_t) + sizeof(BlockState::CameraCount)) *
+                               camera_count;
+  double bytes = blocks * 1.15 * per_block;
   for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
   return bytes + 64.0 * camera_count;
 }
