@@ -32,7 +32,41 @@ std::vector<std::size_t> Targets(const char* option, const std::string& entry, c
   return which;
 }
 
+std::string Names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out.empty() ? "none" : out;
+}
+
 }  // namespace
+
+int PtzCameraOption(const Rig& rig, const std::string& option, const std::string& id) {
+  const int c = rig.FindCamera(id);
+  std::vector<std::string> ptz;
+  for (const Camera& cam : rig.cameras)
+    if (cam.ptz && cam.enabled) ptz.push_back(cam.id);
+  if (c < 0) throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "PTZ cameras: " + Names(ptz));
+  if (!rig.cameras[c].ptz)
+    throw InputError(option, "", "camera '" + id + "' has no PTZ head", "PTZ cameras: " + Names(ptz));
+  if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
+  return c;
+}
+
+std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::string& option, const std::string& region,
+                                               int points, const std::vector<std::string>& surfaces, bool with_region,
+                                               std::uint64_t seed) {
+  if (region.empty()) return SampleTargets(scene, points, surfaces, with_region, seed);
+  std::vector<std::string> names;
+  for (const auto& [name, r] : scene.study.regions) {
+    names.push_back(name);
+    if (name == region) {
+      Scene sub = scene;
+      sub.study.region = r;
+      return SampleTargets(sub, points, surfaces, with_region, seed);
+    }
+  }
+  throw InputError(option, "", "no region '" + region + "' in the study", "study.regions: " + Names(names));
+}
 
 session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
   session::SessionOptions o;

@@ -27,19 +27,6 @@ std::string Names(const std::vector<std::string>& names) {
   return out.empty() ? "none" : out;
 }
 
-// The PTZ camera named by `id` in `rig` (enabled, with a head), or a one-line error on `option`.
-int PtzCamera(const Rig& rig, const std::string& option, const std::string& id) {
-  const int c = rig.FindCamera(id);
-  std::vector<std::string> ptz;
-  for (const Camera& cam : rig.cameras)
-    if (cam.ptz && cam.enabled) ptz.push_back(cam.id);
-  if (c < 0) throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "PTZ cameras: " + Names(ptz));
-  if (!rig.cameras[c].ptz)
-    throw InputError(option, "", "camera '" + id + "' has no PTZ head", "PTZ cameras: " + Names(ptz));
-  if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
-  return c;
-}
-
 std::string AtDensity(double px) {
   if (!(px > 0)) return "";
   char b[64];
@@ -72,7 +59,7 @@ int RunSuggestPtz(const SuggestArgs& args) {
     preset_name = id.substr(colon + 1);
     id = id.substr(0, colon);
   }
-  const int camera = PtzCamera(rig, option, id);
+  const int camera = PtzCameraOption(rig, option, id);
   const PtzHead& head = *rig.cameras[camera].ptz;
   int preset = -1;
   if (preset_mode) {
@@ -88,23 +75,8 @@ int RunSuggestPtz(const SuggestArgs& args) {
                                      " tour stops: with fewer than 3 every order is the same cycle");
   }
   // The target points: the study region's (or a named region's), or surfaces.
-  std::vector<TargetPoint> targets;
-  if (!args.target_region.empty()) {
-    std::vector<std::string> names;
-    const Region* region = nullptr;
-    for (const auto& [name, r] : scene.study.regions) {
-      names.push_back(name);
-      if (name == args.target_region) region = &r;
-    }
-    if (!region)
-      throw InputError("--target-region", "", "no region '" + args.target_region + "' in the study",
-                       "study.regions: " + Names(names));
-    Scene sub = scene;
-    sub.study.region = *region;
-    targets = SampleTargets(sub, args.points, args.target_surfaces, args.with_region, args.seed);
-  } else {
-    targets = SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
-  }
+  const std::vector<TargetPoint> targets = SampleTargetsInRegion(
+      scene, "--target-region", args.target_region, args.points, args.target_surfaces, args.with_region, args.seed);
   std::vector<Vec3> points;
   for (const TargetPoint& t : targets) points.push_back(t.p);
   const VisibilityTester tester(rig.cameras, session.study().caster(), scene.ContentBounds().diagonal());

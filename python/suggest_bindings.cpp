@@ -95,7 +95,7 @@ std::string NumberOrList(const py::handle& value, const char* name) {
 // A value for every selected camera, or {id: value}, as "ID:TEXT" entries; `format` turns one value
 // into the option's text.
 template <typename F>
-std::vector<std::string> PerCameraEntries(const py::object& value, const char* name, F format) {
+std::vector<std::string> PerCameraEntries(const py::object& value, F format) {
   std::vector<std::string> out;
   if (value.is_none()) return out;
   if (py::isinstance<py::dict>(value)) {
@@ -103,7 +103,6 @@ std::vector<std::string> PerCameraEntries(const py::object& value, const char* n
   } else {
     out.push_back(format(value));
   }
-  (void)name;
   return out;
 }
 
@@ -157,35 +156,11 @@ py::dict MetricsDict(const Metrics& m) {
 
 Eigen::Matrix4d Matrix(const Eigen::Isometry3d& pose) { return pose.matrix(); }
 
-// The targets of a suggestion: the study region's or a named region's points, and/or surfaces.
+// The target points of a suggestion: the study region's or a named region's, and/or surfaces.
 std::vector<TargetPoint> Targets(const Scene& scene, int points, const std::vector<std::string>& surfaces,
                                  bool with_region, const std::string& region_name, std::uint64_t seed) {
   if (points < 1 || points > 1000000) throw InputError("points", "", "must be in [1, 1000000]");
-  if (region_name.empty()) return SampleTargets(scene, points, surfaces, with_region, seed);
-  std::string names;
-  for (const auto& [name, r] : scene.study.regions) {
-    names += (names.empty() ? "" : ", ") + name;
-    if (name == region_name) {
-      Scene sub = scene;
-      sub.study.region = r;
-      return SampleTargets(sub, points, surfaces, with_region, seed);
-    }
-  }
-  throw InputError("target_region", "", "no region '" + region_name + "' in the study",
-                   "study.regions: " + (names.empty() ? std::string("none") : names));
-}
-
-// The PTZ camera `id` of the rig (enabled, with a head), or an InputError naming `option`.
-int PtzCamera(const Rig& rig, const char* option, const std::string& id) {
-  const int c = rig.FindCamera(id);
-  std::string ptz;
-  for (const Camera& cam : rig.cameras)
-    if (cam.ptz && cam.enabled) ptz += (ptz.empty() ? "" : ", ") + cam.id;
-  const std::string hint = "PTZ cameras: " + (ptz.empty() ? std::string("none") : ptz);
-  if (c < 0) throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", hint);
-  if (!rig.cameras[c].ptz) throw InputError(option, "", "camera '" + id + "' has no PTZ head", hint);
-  if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
-  return c;
+  return app::SampleTargetsInRegion(scene, "target_region", region_name, points, surfaces, with_region, seed);
 }
 
 // Applies a suggestion to its rig in memory as one undo step: `subset` (the accepted cameras of a
@@ -434,10 +409,10 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
     try {
       a.max_move = NumberOrList(max_move, "--max-move");
       a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
-      a.hfov_range = PerCameraEntries(hfov_range, "--hfov-range", [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
-      a.rail = PerCameraEntries(rail, "--rail", [](const py::handle& v) { return Vector3Text(v, "--rail"); });
-      a.plane = PerCameraEntries(plane, "--plane", [](const py::handle& v) { return Vector3Text(v, "--plane"); });
-      a.mount_box = PerCameraEntries(mount_box, "--mount-box", [](const py::handle& v) { return BoxText(v, "--mount-box"); });
+      a.hfov_range = PerCameraEntries(hfov_range, [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
+      a.rail = PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "--rail"); });
+      a.plane = PerCameraEntries(plane, [](const py::handle& v) { return Vector3Text(v, "--plane"); });
+      a.mount_box = PerCameraEntries(mount_box, [](const py::handle& v) { return BoxText(v, "--mount-box"); });
       for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "--keep-out"));
       if (!(outer_iterations >= 1 && outer_iterations <= 100)) throw InputError("--outer-iterations", "", "must be in [1, 100]");
       if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
@@ -486,7 +461,7 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
                        const std::string& target_region, const std::vector<std::string>& surfaces, bool with_region,
                        std::uint64_t seed, int* camera, std::vector<Vec3>* xyz) {
     if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
-    *camera = PtzCamera(r.rig(), option, id);
+    *camera = app::PtzCameraOption(r.rig(), option, id);
     for (const TargetPoint& t : Targets(sc.scene(), points, surfaces, with_region, target_region, seed)) xyz->push_back(t.p);
   };
 
