@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace pandora {
@@ -18,6 +19,21 @@ void RayCaster::OccludedBatch(const std::vector<Ray>& rays, std::vector<uint8_t>
 
 void RayCaster::OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const {
   for (std::size_t i = 0; i < count; ++i) occluded[i] = Occluded(rays[i]) ? 1 : 0;
+}
+
+void RayCaster::OccludedFan(const Fan& fan, std::size_t count, uint8_t* occluded) const {
+  Ray rays[256];
+  for (std::size_t start = 0; start < count; start += 256) {
+    const std::size_t n = std::min<std::size_t>(256, count - start);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = fan.at(start + i);
+      rays[i].origin = fan.origin;
+      rays[i].direction = Vec3(fan.dx[k], fan.dy[k], fan.dz[k]);
+      rays[i].t_near = fan.t_near[k];
+      rays[i].t_far = fan.t_far[k];
+    }
+    OccludedPacket(rays, n, occluded + start);
+  }
 }
 
 void RayCaster::IntersectPacket(const Ray* rays, std::size_t count,

@@ -45,6 +45,23 @@ class RayCaster {
   /// voxels): Embree traces them as SIMD packets (16, 8 or 4 wide, whichever the CPU runs natively).
   virtual void OccludedPacket(const Ray* rays, std::size_t count, uint8_t* occluded) const;
 
+  /// Rays from one origin (a camera's centre), the rest of each ray in arrays: what OccludedFan
+  /// traces.
+  struct Fan {
+    Vec3 origin = Vec3::Zero();
+    const double* dx = nullptr;  ///< unit directions
+    const double* dy = nullptr;
+    const double* dz = nullptr;
+    const double* t_near = nullptr;
+    const double* t_far = nullptr;
+    /// When given, ray k is element index[k] of the arrays (else element k).
+    const std::int16_t* index = nullptr;
+    std::size_t at(std::size_t k) const { return index ? std::size_t(index[k]) : k; }
+  };
+  /// OccludedPacket() for `count` rays of one fan: the same answers as OccludedPacket on the same
+  /// rays, without building Ray structs (Embree fills its packets straight from the arrays).
+  virtual void OccludedFan(const Fan& fan, std::size_t count, uint8_t* occluded) const;
+
   /// Intersect() for `count` rays on the calling thread into hits[0..count). Neighbouring rays in the
   /// array should be coherent (for example, a row of pixels): Embree traces them as SIMD packets.
   virtual void IntersectPacket(const Ray* rays, std::size_t count, std::optional<RayHit>* hits) const;

@@ -314,6 +314,52 @@ class EmbreeRayCaster final : public RayCaster {
     }
   }
 
+  void OccludedFan(const Fan& fan, std::size_t count, uint8_t* occluded) const override {
+    switch (packet_width_) {
+      case 16: return TraceFan<16>(fan, count, occluded);
+      case 8: return TraceFan<8>(fan, count, occluded);
+      case 4: return TraceFan<4>(fan, count, occluded);
+      default: RayCaster::OccludedFan(fan, count, occluded);
+    }
+  }
+
+  // Packets of W filled from the fan's arrays, converted as Fill() converts a Ray (so the same
+  // floats as OccludedPacket on the same rays); the origin and constant fields once.
+  template <int W>
+  void TraceFan(const Fan& fan, std::size_t count, uint8_t* occluded) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(64) typename Packet<W>::Type packet;
+    alignas(64) int valid[W];
+    const Vec3 o = fan.origin - offset_;
+    for (int lane = 0; lane < W; ++lane) {
+      packet.org_x[lane] = static_cast<float>(o.x());
+      packet.org_y[lane] = static_cast<float>(o.y());
+      packet.org_z[lane] = static_cast<float>(o.z());
+      packet.time[lane] = 0.0f;
+      packet.mask[lane] = 0xFFFFFFFFu;
+      packet.id[lane] = 0;
+      packet.flags[lane] = 0;
+    }
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    for (std::size_t start = 0; start < count; start += W) {
+      const int n = static_cast<int>(std::min<std::size_t>(W, count - start));
+      for (int lane = 0; lane < W; ++lane) {
+        const std::size_t k = fan.at(start + std::min(lane, n - 1));
+        valid[lane] = lane < n ? -1 : 0;
+        packet.dir_x[lane] = static_cast<float>(fan.dx[k]);
+        packet.dir_y[lane] = static_cast<float>(fan.dy[k]);
+        packet.dir_z[lane] = static_cast<float>(fan.dz[k]);
+        packet.tnear[lane] = static_cast<float>(fan.t_near[k]);
+        packet.tfar[lane] = fan.t_far[k] == kInf ? std::numeric_limits<float>::infinity()
+                                                 : static_cast<float>(fan.t_far[k]);
+      }
+      Packet<W>::Occluded(valid, scene_, &context, &packet);
+      for (int lane = 0; lane < n; ++lane) occluded[start + lane] = packet.tfar[lane] < 0.0f;
+    }
+  }
+
   // Traces already converted rays in packets of W (the last one partly valid).
   template <int W>
   void TraceConverted(const RTCRay* rays, std::size_t count, uint8_t* occluded) const {

@@ -2,6 +2,7 @@
 // reference on randomized scenes (>= 10^4 point-camera pairs).
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
 #include "analysis/visibility.h"
@@ -67,6 +68,81 @@ TEST(Visibility, PixelDensityMatchesPinholeClosedForm) {
   const double Z = 2.0, x = 0.6;
   ASSERT_EQ(vis.Test(0, Vec3(x * Z, Z, 0), nullptr, &J), ViewResult::kSeen);
   EXPECT_NEAR(PixelDensity(J), f / Z * std::pow(1 + x * x, 0.25), 1e-9 * f);
+}
+
+// The vectorised batch test against the one-point test, bit for bit: random cameras of every lens
+// (strong Brown-Conrady distortion that folds, fisheye through the one-point fallback, a disabled
+// camera, a working range) and random points around them, in front, behind, beyond the image and
+// the range, and near the image's edges.
+TEST(Visibility, BatchTestGivesTheOnePointBits) {
+  const TriangleMesh none;
+  const auto caster = MakeEmbreeRayCaster(none);
+  std::mt19937 rng(20261124);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Camera> cams;
+  for (int c = 0; c < 12; ++c) {
+    const Vec3 position(3 * u(rng), 3 * u(rng), 1 + u(rng));
+    const LensModel lens = c % 4 == 3 ? LensModel::kFisheye
+                           : c % 4 == 0 ? LensModel::kPinhole
+                                        : LensModel::kBrownConrady;
+    Camera cam = testing::TestCamera("c" + std::to_string(c), position, Vec3(u(rng), u(rng), 0),
+                                     lens == LensModel::kFisheye ? 180 : 40 + 60 * (u(rng) + 1), 640,
+                                     480, lens, Vec3(0, 0, 1));
+    cam = testing::WithIntrinsics(cam, [&](Intrinsics& k) {
+      if (k.model == LensModel::kBrownConrady) {
+        k.k1 = (c % 3 == 1 ? -0.4 : 0.1) * (u(rng) + 1);  // c % 3 == 1: barrel that folds back
+        k.k2 = 0.1 * u(rng);
+        k.k3 = 0.01 * u(rng);
+        k.p1 = 0.002 * u(rng);
+        k.p2 = 0.002 * u(rng);
+      }
+      k.cx += 20 * u(rng);
+    });
+    cam.near = c % 2 ? 0.3 : 0.0;
+    cam.far = c % 5 == 1 ? 3.0 : std::numeric_limits<double>::infinity();
+    cam.enabled = c != 6;
+    cams.push_back(cam);
+  }
+  const VisibilityTester vis(cams, *caster, 10.0);
+  int seen_total = 0, compared = 0;
+  for (int round = 0; round < 40; ++round) {
+    const int n = 1 + static_cast<int>((u(rng) + 1) * 255.5);  // 1..512
+    std::vector<double> x(n), y(n), z(n);
+    for (int i = 0; i < n; ++i) {
+      x[i] = 4 * u(rng);
+      y[i] = 4 * u(rng);
+      z[i] = 1.5 * u(rng) + 0.5;
+    }
+    for (int c = 0; c < int(cams.size()); ++c) {
+      auto batch = std::make_unique<VisibilityTester::GeometryBatch>();
+      vis.TestGeometryBatch(c, n, x.data(), y.data(), z.data(), batch.get());
+      const int m = batch->count;
+      int k = 0;
+      for (int i = 0; i < n; ++i) {
+        Ray segment;
+        Mat23 J;
+        const ViewResult r =
+            vis.TestGeometryCameraFrame(c, Vec3(x[i], y[i], z[i]), nullptr, &segment, &J);
+        ++compared;
+        if (r != ViewResult::kSeen) continue;
+        ASSERT_LT(k, m) << "camera " << c << " point " << i;
+        ASSERT_EQ(batch->index[k], i) << "camera " << c;
+        // Bit for bit (== on doubles, NaN excluded by construction).
+        const Ray got = batch->segment(k);
+        EXPECT_TRUE(got.origin == segment.origin && got.direction == segment.direction &&
+                    got.t_near == segment.t_near && got.t_far == segment.t_far)
+            << "camera " << c << " point " << i;
+        EXPECT_TRUE(batch->jacobian(k) == J) << "camera " << c << " point " << i << "\n"
+                                             << batch->jacobian(k) << "\n" << J;
+        ++k;
+      }
+      EXPECT_EQ(k, m) << "camera " << c;
+      seen_total += m;
+    }
+  }
+  EXPECT_GT(compared, 50000);
+  EXPECT_GT(seen_total, compared / 20);   // enough seen points to compare their values
+  EXPECT_LT(seen_total, compared / 2);    // and enough rejected ones
 }
 
 // The acceptance test: 10^4+ random point-camera pairs, Embree against brute force, no

@@ -4,9 +4,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -137,12 +139,29 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   std::vector<std::uint8_t> keep(all.size(), 0);
   const double h = lattice.voxel_size;
 
-  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_count, 4), [&](const auto& range) {
-    for (std::int64_t b = range.begin(); b != range.end(); ++b) {
+  // By columns of blocks (bx, by), bottom to top: a mesh's crossings along a voxel column are
+  // searched once for the whole column of blocks (InsideMesh::ColumnAt) and reused by each block
+  // that needs them.
+  const std::int64_t block_columns = std::int64_t(nb.x()) * nb.y();
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_columns, 1), [&](const auto& range) {
+    for (std::int64_t bc = range.begin(); bc != range.end(); ++bc) {
+    // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block column.
+    std::vector<std::vector<std::optional<InsideMesh::Column>>> columns(solids.size() + 1);
+    const auto column = [&](std::size_t mesh, int x, int y) -> const InsideMesh::Column& {
+      std::vector<std::optional<InsideMesh::Column>>& c = columns[mesh];
+      if (c.empty()) c.resize(64);
+      std::optional<InsideMesh::Column>& slot = c[8 * (x & 7) + (y & 7)];
+      if (!slot) {
+        const Vec3 foot = lattice.Center(x, y, 0);
+        slot = (mesh < solids.size() ? solids[mesh] : region_mesh)->ColumnAt(foot.x(), foot.y());
+      }
+      return *slot;
+    };
+    for (int bz = 0; bz < nb.z(); ++bz) {
+      const std::int64_t b = bc * nb.z() + bz;
       Block& block = all[b];
-      const int bx = static_cast<int>(b / (std::int64_t(nb.y()) * nb.z()));
-      const int by = static_cast<int>((b / nb.z()) % nb.y());
-      const int bz = static_cast<int>(b % nb.z());
+      const int bx = static_cast<int>(bc / nb.y());
+      const int by = static_cast<int>(bc % nb.y());
       block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
       const Eigen::Vector3i last =
           (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
@@ -166,9 +185,9 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
       if (region_class == InsideMesh::BoxClass::kOutside) continue;
       // Solids.
       bool all_solid = false;
-      std::vector<const InsideMesh*> crossing;
-      for (const InsideMesh* s : solids) {
-        const InsideMesh::BoxClass c = s->Classify(box);
+      std::vector<std::size_t> crossing;
+      for (std::size_t s = 0; s < solids.size(); ++s) {
+        const InsideMesh::BoxClass c = solids[s]->Classify(box);
         if (c == InsideMesh::BoxClass::kInside) {
           all_solid = true;
           break;
@@ -183,25 +202,40 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         (all_solid ? block.solid_voxels : block.free_voxels) = n_vox;
       } else {
         block.mask.assign(512, 0);
+        // Column by column along z: one search of each crossing mesh per column (its crossings'
+        // parity, InsideMesh::InsideColumn) rather than one per voxel.
+        const int nz = last.z() - block.origin.z() + 1;
+        std::array<double, 8> zs;
+        std::array<unsigned char, 8> in_region, in_solid, in_this;
         for (int x = block.origin.x(); x <= last.x(); ++x)
-          for (int y = block.origin.y(); y <= last.y(); ++y)
-            for (int z = block.origin.z(); z <= last.z(); ++z) {
-              const Vec3 p = lattice.Center(x, y, z);
-              if (region_class == InsideMesh::BoxClass::kCrossing &&
-                  !(region.kind == Region::Kind::kMesh ? region_mesh->Inside(p)
-                                                       : region_box.Contains(p)))
-                continue;
-              bool inside_solid = all_solid;
-              for (std::size_t s = 0; !inside_solid && s < crossing.size(); ++s)
-                inside_solid = crossing[s]->Inside(p);
-              if (inside_solid) {
+          for (int y = block.origin.y(); y <= last.y(); ++y) {
+            for (int k = 0; k < nz; ++k) zs[k] = lattice.Center(x, y, block.origin.z() + k).z();
+            in_region.fill(1);
+            if (region_class == InsideMesh::BoxClass::kCrossing) {
+              if (region.kind == Region::Kind::kMesh) {
+                region_mesh->InsideOnColumn(column(solids.size(), x, y), zs.data(), nz,
+                                            in_region.data());
+              } else {
+                for (int k = 0; k < nz; ++k)
+                  in_region[k] = region_box.Contains(lattice.Center(x, y, block.origin.z() + k));
+              }
+            }
+            in_solid.fill(all_solid ? 1 : 0);
+            for (std::size_t s = 0; !all_solid && s < crossing.size(); ++s) {
+              solids[crossing[s]]->InsideOnColumn(column(crossing[s], x, y), zs.data(), nz,
+                                                  in_this.data());
+              for (int k = 0; k < nz; ++k) in_solid[k] |= in_this[k];
+            }
+            for (int k = 0; k < nz; ++k) {
+              if (!in_region[k]) continue;
+              if (in_solid[k]) {
                 ++block.solid_voxels;
               } else {
-                block.mask[Block::Offset(x - block.origin.x(), y - block.origin.y(),
-                                         z - block.origin.z())] = 1;
+                block.mask[Block::Offset(x - block.origin.x(), y - block.origin.y(), k)] = 1;
                 ++block.free_voxels;
               }
             }
+          }
         if (block.free_voxels == n_vox) std::vector<std::uint8_t>().swap(block.mask);
       }
       if (block.free_voxels == 0 && block.solid_voxels == 0) continue;
@@ -212,6 +246,7 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
       const Aabb padded = BlockCentreBox(lattice, block);
       for (int c = 0; c < camera_count; ++c)
         if (culler.MayIntersect(c, padded)) block.cameras.push_back(c);
+    }
     }
   });
 

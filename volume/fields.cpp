@@ -365,7 +365,15 @@ struct FieldEvaluator::State {
   State(const Scene& s, const RayCaster& c) : scene(s), caster(c) {}
 
   RigData Prepare(const Rig& rig) const;
-  void Cast(const Block& block, int camera, const RigData& rd, CameraEntry* entry,
+  // A block's free voxels (x, y, z loops, so offsets ascend): their centres in three arrays for
+  // the vectorised geometric test, and their offsets in the block.
+  struct BlockPoints {
+    int count = 0;
+    alignas(64) std::array<double, 512> x, y, z;
+    std::array<std::int16_t, 512> offset;
+  };
+  void Points(const Block& block, BlockPoints* points) const;
+  void Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
             std::vector<Ray>* rays) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
@@ -424,33 +432,37 @@ RigData FieldEvaluator::State::Prepare(const Rig& r) const {
   return rd;
 }
 
-// Camera `camera`'s view of `block`: the geometric tests first, then the surviving segments traced
-// together as coherent packets (one origin, neighbouring directions).
-void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& rd,
-                                 CameraEntry* entry, std::vector<Ray>* rays) const {
-  std::array<Ray, 512> segments;
-  std::array<std::int16_t, 512> where;
-  std::array<Mat23, 512> jacobian;  // camera frame
-  std::array<std::uint8_t, 512> occluded;
+void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) const {
   const VoxelLattice& lattice = fields.lattice;
-  std::size_t n = 0;
+  int n = 0;
   for (int x = 0; x < block.extent.x(); ++x)
     for (int y = 0; y < block.extent.y(); ++y)
       for (int z = 0; z < block.extent.z(); ++z) {
         if (!block.IsFree(x, y, z)) continue;
         const Vec3 p =
             lattice.Center(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z);
-        // The Jacobian stays in the camera frame: pixel density is rotation invariant, and the
-        // information takes the rotation in AddCameraInformation.
-        if (rd.tester->TestGeometryCameraFrame(camera, p, nullptr, &segments[n],
-                                               want_jacobian ? &jacobian[n] : nullptr) !=
-            ViewResult::kSeen)
-          continue;
-        where[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
+        points->x[n] = p.x();
+        points->y[n] = p.y();
+        points->z[n] = p.z();
+        points->offset[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
         ++n;
       }
-  caster.OccludedPacket(segments.data(), n, occluded.data());
-  if (rays) rays->insert(rays->end(), segments.begin(), segments.begin() + n);
+  points->count = n;
+}
+
+// Camera `camera`'s view of a block: the geometric tests first (vectorised over the block's free
+// voxels), then the segments in view traced together as coherent packets (one origin,
+// neighbouring directions) straight from the test's arrays.
+void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const RigData& rd,
+                                 CameraEntry* entry, std::vector<Ray>* rays) const {
+  std::array<std::uint8_t, 512> occluded;
+  thread_local VisibilityTester::GeometryBatch batch;  // 46 kB: not on the worker's stack
+  rd.tester->TestGeometryBatch(camera, points.count, points.x.data(), points.y.data(),
+                               points.z.data(), &batch);
+  const std::size_t n = static_cast<std::size_t>(batch.count);
+  caster.OccludedFan(batch.fan(), n, occluded.data());
+  if (rays)
+    for (std::size_t i = 0; i < n; ++i) rays->push_back(batch.segment(int(i)));
   entry->camera = camera;
   entry->rays = static_cast<std::int32_t>(n);
   std::size_t visible = 0;
@@ -463,12 +475,14 @@ void FieldEvaluator::State::Cast(const Block& block, int camera, const RigData& 
   // Offsets come in ascending order (x, y, z loops, Offset = 64 x + 8 y + z).
   for (std::size_t i = 0; i < n; ++i) {
     if (occluded[i]) continue;
-    SetBit(entry->bits, where[i]);
+    SetBit(entry->bits, points.offset[batch.index[i]]);
     ++entry->seen;
-    if (want_resolution) entry->density.push_back(static_cast<float>(PixelDensity(jacobian[i])));
+    if (!want_jacobian) continue;
+    const Mat23 jacobian = batch.jacobian(int(i));
+    if (want_resolution) entry->density.push_back(static_cast<float>(PixelDensity(jacobian)));
     if (want_information) {
       double contribution[6] = {0, 0, 0, 0, 0, 0};
-      AddCameraInformation(jacobian[i], rd.whitened[camera].data(), contribution);
+      AddCameraInformation(jacobian, rd.whitened[camera].data(), contribution);
       entry->information.insert(entry->information.end(), contribution, contribution + 6);
       entry->band.push_back(Band(contribution));
     }
@@ -1238,10 +1252,13 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       }
       const std::size_t b = dirty[i];
       // The changed cameras that may see the block now.
+      thread_local State::BlockPoints points;
+      points.count = -1;
       for (int c : changed)
         if (std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
+          if (points.count < 0) S.Points(S.blocks[b], &points);
           cast[i].emplace_back();
-          S.Cast(S.blocks[b], c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
+          S.Cast(points, c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
         }
       if (!in_place) derive(i);
       report(0.0);
