@@ -47,6 +47,7 @@ int RunIncrementalBench(const BenchArgs& args) {
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
   FieldOptions options;
+  options.solid_trees = &study->solid_trees();
   options.scene_path = scene.path;
   if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
   options.fields = scene.study.fields;  // the study's own workload

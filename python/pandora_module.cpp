@@ -274,6 +274,7 @@ PYBIND11_MODULE(pandora, m) {
     const Scene& scene = s.scene();
     const Rig rig = r.rig();  // a copy: the evaluation runs without the GIL
     FieldOptions o;
+    o.solid_trees = &s.study->solid_trees();
     o.fields = fields.empty() ? scene.study.fields : fields;
     o.scene_path = scene.path;
     o.memory_budget_bytes = scene.study.memory_budget_bytes;

@@ -15,6 +15,7 @@
 #include "volume/fields.h"
 #include "volume/fields_transfer.h"
 #include "volume/fields_vdb.h"
+#include "volume/solid_trees.h"
 
 namespace pandora {
 namespace {
@@ -185,6 +186,38 @@ void RunRandomEdits(const Scene& scene, const Rig& start, int steps, std::uint64
   }
   std::printf("%s: %d edits, re-derived %.1f %% of the voxels a full evaluation computes\n",
               scene.path.c_str(), steps, 100.0 * double(dirty_voxels) / double(full_voxels));
+}
+
+// A study's kept solid trees (volume/solid_trees.h) give the fields an evaluation building its own
+// gives, bit for bit, at two voxel sizes (the trees built once, then reused); a scene whose solid
+// moved is not served from them.
+TEST(FieldEvaluator, KeptSolidTreesGiveTheSameFields) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const SolidTrees trees(scene);
+  FieldOptions own;
+  own.fields = {"coverage", "cameras", "resolution", "sigma_max"};
+  FieldOptions kept = own;
+  kept.solid_trees = &trees;
+  int solids = 0;
+  for (const SceneObject& o : scene.objects) solids += o.solid ? 1 : 0;
+  ASSERT_GE(solids, 2);
+  for (double factor : {1.0, 0.5}) {
+    Scene copy = scene;  // another voxel size: a copy, the same meshes
+    copy.study.voxel_size *= factor;
+    const Fields a = EvaluateFields(copy, copy.rigs[0], *caster, own);
+    const Fields b = EvaluateFields(copy, copy.rigs[0], *caster, kept);
+    ExpectSameFields(b, a, "voxel x" + std::to_string(factor));
+    EXPECT_EQ(a.stats.active_set.solid_voxels, b.stats.active_set.solid_voxels);
+    EXPECT_GT(b.stats.active_set.solid_voxels, 0);
+    EXPECT_EQ(trees.built(), solids);  // built by the first evaluation, reused by the second
+  }
+  Scene moved = scene;
+  for (SceneObject& o : moved.objects)
+    if (o.solid) {
+      for (Vec3& v : o.mesh.vertices) v += Vec3(0.01, 0, 0);
+      EXPECT_EQ(trees.Object(moved, std::size_t(&o - moved.objects.data())), nullptr);
+    }
 }
 
 TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnASyntheticScene) {

@@ -1,4 +1,5 @@
 #include "volume/fields.h"
+#include "volume/solid_trees.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
@@ -1010,20 +1011,31 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
       continue;
     solid_objects.push_back(&o);
   }
-  // Their search trees are built in parallel (a crowd of finely tessellated people: ~100 trees).
+  // Their search trees: the study's kept ones (built at first use), else built here, in parallel
+  // (a crowd of finely tessellated people: ~100 trees).
   std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
+  std::vector<const InsideMesh*> solids(solid_objects.size(), nullptr);
+  const SolidTrees* kept = S.options.solid_trees;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i)
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      if (kept) solids[i] = kept->Object(scene, std::size_t(solid_objects[i] - scene.objects.data()));
+      if (solids[i]) continue;
       solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
+      solids[i] = solid_meshes[i].get();
+    }
   });
-  std::vector<const InsideMesh*> solids;
-  for (const auto& m : solid_meshes) solids.push_back(m.get());
-  std::unique_ptr<InsideMesh> region_mesh;
-  if (study.region.kind == Region::Kind::kMesh)
-    region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
+  std::unique_ptr<InsideMesh> own_region_mesh;
+  const InsideMesh* region_mesh = nullptr;
+  if (study.region.kind == Region::Kind::kMesh) {
+    if (kept) region_mesh = kept->RegionMesh(scene);
+    if (!region_mesh) {
+      own_region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
+      region_mesh = own_region_mesh.get();
+    }
+  }
   const FrustumCuller no_cameras(std::vector<Camera>{});
-  S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh.get(), no_cameras,
-                            0, &S.active_stats);
+  S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
+                            &S.active_stats);
   S.active_set_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

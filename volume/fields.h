@@ -16,6 +16,8 @@
 
 namespace pandora {
 
+class SolidTrees;
+
 /// The fields (names from FieldNames(), analysis/scene.h):
 ///  - "coverage"   Int32: number of cameras that see the voxel centre. Active on every free region
 ///                 voxel (0 where none sees it); culled blocks are stored as constant tiles.
@@ -56,6 +58,9 @@ struct FieldOptions {
   /// the statistics until MergePartialFields (volume/fields_transfer.h) adds them. For one full
   /// evaluation (EvaluateFields, or an evaluator without kept state); 1: every block.
   int partition_count = 1, partition_rank = 0;
+  /// The scene's solid and region-mesh search trees, kept between evaluations (a study's,
+  /// volume/solid_trees.h); nullptr: the evaluation builds the ones it needs and drops them.
+  const SolidTrees* solid_trees = nullptr;
 };
 
 /// Counts and timing of one evaluation.

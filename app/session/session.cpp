@@ -16,6 +16,7 @@ Session::Session(std::shared_ptr<const Study> study, SessionOptions options)
       rig_(DisableCameras(study_->FindRig(options_.rig, options_.rig_option), options_.disable,
                           options_.disable_option)),
       saved_text_(study_->text()) {
+  if (!options_.fields.solid_trees) options_.fields.solid_trees = &study_->solid_trees();
   evaluator_ = std::make_unique<FieldEvaluator>(study_->scene(), study_->caster(), options_.fields,
                                                 options_.incremental);
 }

@@ -13,6 +13,7 @@ std::shared_ptr<const Study> Study::Load(const std::string& path,
   study->scene_ = ParseScene(study->text_, path);
   if (adjust) adjust(study->scene_);
   study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
+  study->solid_trees_ = std::make_unique<SolidTrees>(study->scene_);
   return study;
 }
 
@@ -21,6 +22,7 @@ std::shared_ptr<const Study> Study::FromScene(Scene scene, std::string text) {
   study->scene_ = std::move(scene);
   study->text_ = std::move(text);
   study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
+  study->solid_trees_ = std::make_unique<SolidTrees>(study->scene_);
   return study;
 }
 

@@ -13,6 +13,7 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "render/prepared_scene.h"
+#include "volume/solid_trees.h"
 
 namespace pandora::session {
 
@@ -32,6 +33,9 @@ class Study {
   /// The scene file's bytes as loaded (their SHA-256 is scene().sha256).
   const std::string& text() const { return text_; }
   const RayCaster& caster() const { return *caster_; }
+  /// The search trees of the scene's solids and region mesh, built at first use and kept
+  /// (volume/solid_trees.h); FieldOptions::solid_trees.
+  const SolidTrees& solid_trees() const { return *solid_trees_; }
   /// The scene prepared for the renderer over the same ray caster (no second BVH), built at first
   /// use, once, thread-safely.
   const PreparedScene& prepared() const;
@@ -45,6 +49,7 @@ class Study {
   Scene scene_;
   std::string text_;
   std::unique_ptr<RayCaster> caster_;
+  std::unique_ptr<SolidTrees> solid_trees_;
   mutable std::once_flag prepared_once_;
   mutable std::unique_ptr<PreparedScene> prepared_;
 };
