@@ -145,108 +145,108 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   const std::int64_t block_columns = std::int64_t(nb.x()) * nb.y();
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_columns, 1), [&](const auto& range) {
     for (std::int64_t bc = range.begin(); bc != range.end(); ++bc) {
-    // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block column.
-    std::vector<std::vector<std::optional<InsideMesh::Column>>> columns(solids.size() + 1);
-    const auto column = [&](std::size_t mesh, int x, int y) -> const InsideMesh::Column& {
-      std::vector<std::optional<InsideMesh::Column>>& c = columns[mesh];
-      if (c.empty()) c.resize(64);
-      std::optional<InsideMesh::Column>& slot = c[8 * (x & 7) + (y & 7)];
-      if (!slot) {
-        const Vec3 foot = lattice.Center(x, y, 0);
-        slot = (mesh < solids.size() ? solids[mesh] : region_mesh)->ColumnAt(foot.x(), foot.y());
-      }
-      return *slot;
-    };
-    for (int bz = 0; bz < nb.z(); ++bz) {
-      const std::int64_t b = bc * nb.z() + bz;
-      Block& block = all[b];
-      const int bx = static_cast<int>(bc / nb.y());
-      const int by = static_cast<int>(bc % nb.y());
-      block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
-      const Eigen::Vector3i last =
-          (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
-      // Box of the voxel centres of this block (only centres are evaluated).
-      Aabb box;
-      box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
-      box.Extend(lattice.Center(last.x(), last.y(), last.z()));
-
-      // Region. A box region's last voxel centres can lie up to half a voxel beyond its max (the
-      // lattice rounds the extent up): such blocks test each centre against the box.
-      InsideMesh::BoxClass region_class = InsideMesh::BoxClass::kInside;
-      const double slack = 1e-9 * h;
-      Aabb region_box = region.box;
-      region_box.min -= Vec3::Constant(slack);
-      region_box.max += Vec3::Constant(slack);
-      if (region.kind == Region::Kind::kMesh) {
-        region_class = region_mesh->Classify(box);
-      } else if (!region_box.Contains(box.max)) {
-        region_class = InsideMesh::BoxClass::kCrossing;
-      }
-      if (region_class == InsideMesh::BoxClass::kOutside) continue;
-      // Solids.
-      bool all_solid = false;
-      std::vector<std::size_t> crossing;
-      for (std::size_t s = 0; s < solids.size(); ++s) {
-        const InsideMesh::BoxClass c = solids[s]->Classify(box);
-        if (c == InsideMesh::BoxClass::kInside) {
-          all_solid = true;
-          break;
+      // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block column.
+      std::vector<std::vector<std::optional<InsideMesh::Column>>> columns(solids.size() + 1);
+      const auto column = [&](std::size_t mesh, int x, int y) -> const InsideMesh::Column& {
+        std::vector<std::optional<InsideMesh::Column>>& c = columns[mesh];
+        if (c.empty()) c.resize(64);
+        std::optional<InsideMesh::Column>& slot = c[8 * (x & 7) + (y & 7)];
+        if (!slot) {
+          const Vec3 foot = lattice.Center(x, y, 0);
+          slot = (mesh < solids.size() ? solids[mesh] : region_mesh)->ColumnAt(foot.x(), foot.y());
         }
-        if (c == InsideMesh::BoxClass::kCrossing) crossing.push_back(s);
-      }
+        return *slot;
+      };
+      for (int bz = 0; bz < nb.z(); ++bz) {
+        const std::int64_t b = bc * nb.z() + bz;
+        Block& block = all[b];
+        const int bx = static_cast<int>(bc / nb.y());
+        const int by = static_cast<int>(bc % nb.y());
+        block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
+        const Eigen::Vector3i last =
+            (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
+        // Box of the voxel centres of this block (only centres are evaluated).
+        Aabb box;
+        box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
+        box.Extend(lattice.Center(last.x(), last.y(), last.z()));
 
-      block.extent = last - block.origin + Eigen::Vector3i::Ones();
-      const std::int64_t n_vox = std::int64_t(block.extent.x()) * block.extent.y() * block.extent.z();
-      if (region_class == InsideMesh::BoxClass::kInside && crossing.empty()) {
-        // Fast path: the whole block is one thing, no per-voxel test.
-        (all_solid ? block.solid_voxels : block.free_voxels) = n_vox;
-      } else {
-        block.mask.assign(512, 0);
-        // Column by column along z: one search of each crossing mesh per column (its crossings'
-        // parity, InsideMesh::InsideColumn) rather than one per voxel.
-        const int nz = last.z() - block.origin.z() + 1;
-        std::array<double, 8> zs;
-        std::array<unsigned char, 8> in_region, in_solid, in_this;
-        for (int x = block.origin.x(); x <= last.x(); ++x)
-          for (int y = block.origin.y(); y <= last.y(); ++y) {
-            for (int k = 0; k < nz; ++k) zs[k] = lattice.Center(x, y, block.origin.z() + k).z();
-            in_region.fill(1);
-            if (region_class == InsideMesh::BoxClass::kCrossing) {
-              if (region.kind == Region::Kind::kMesh) {
-                region_mesh->InsideOnColumn(column(solids.size(), x, y), zs.data(), nz,
-                                            in_region.data());
-              } else {
-                for (int k = 0; k < nz; ++k)
-                  in_region[k] = region_box.Contains(lattice.Center(x, y, block.origin.z() + k));
-              }
-            }
-            in_solid.fill(all_solid ? 1 : 0);
-            for (std::size_t s = 0; !all_solid && s < crossing.size(); ++s) {
-              solids[crossing[s]]->InsideOnColumn(column(crossing[s], x, y), zs.data(), nz,
-                                                  in_this.data());
-              for (int k = 0; k < nz; ++k) in_solid[k] |= in_this[k];
-            }
-            for (int k = 0; k < nz; ++k) {
-              if (!in_region[k]) continue;
-              if (in_solid[k]) {
-                ++block.solid_voxels;
-              } else {
-                block.mask[Block::Offset(x - block.origin.x(), y - block.origin.y(), k)] = 1;
-                ++block.free_voxels;
-              }
-            }
+        // Region. A box region's last voxel centres can lie up to half a voxel beyond its max (the
+        // lattice rounds the extent up): such blocks test each centre against the box.
+        InsideMesh::BoxClass region_class = InsideMesh::BoxClass::kInside;
+        const double slack = 1e-9 * h;
+        Aabb region_box = region.box;
+        region_box.min -= Vec3::Constant(slack);
+        region_box.max += Vec3::Constant(slack);
+        if (region.kind == Region::Kind::kMesh) {
+          region_class = region_mesh->Classify(box);
+        } else if (!region_box.Contains(box.max)) {
+          region_class = InsideMesh::BoxClass::kCrossing;
+        }
+        if (region_class == InsideMesh::BoxClass::kOutside) continue;
+        // Solids.
+        bool all_solid = false;
+        std::vector<std::size_t> crossing;
+        for (std::size_t s = 0; s < solids.size(); ++s) {
+          const InsideMesh::BoxClass c = solids[s]->Classify(box);
+          if (c == InsideMesh::BoxClass::kInside) {
+            all_solid = true;
+            break;
           }
-        if (block.free_voxels == n_vox) std::vector<std::uint8_t>().swap(block.mask);
+          if (c == InsideMesh::BoxClass::kCrossing) crossing.push_back(s);
+        }
+
+        block.extent = last - block.origin + Eigen::Vector3i::Ones();
+        const std::int64_t n_vox = std::int64_t(block.extent.x()) * block.extent.y() * block.extent.z();
+        if (region_class == InsideMesh::BoxClass::kInside && crossing.empty()) {
+          // Fast path: the whole block is one thing, no per-voxel test.
+          (all_solid ? block.solid_voxels : block.free_voxels) = n_vox;
+        } else {
+          block.mask.assign(512, 0);
+          // Column by column along z: one search of each crossing mesh per column (its crossings'
+          // parity, InsideMesh::InsideColumn) rather than one per voxel.
+          const int nz = last.z() - block.origin.z() + 1;
+          std::array<double, 8> zs;
+          std::array<unsigned char, 8> in_region, in_solid, in_this;
+          for (int x = block.origin.x(); x <= last.x(); ++x)
+            for (int y = block.origin.y(); y <= last.y(); ++y) {
+              for (int k = 0; k < nz; ++k) zs[k] = lattice.Center(x, y, block.origin.z() + k).z();
+              in_region.fill(1);
+              if (region_class == InsideMesh::BoxClass::kCrossing) {
+                if (region.kind == Region::Kind::kMesh) {
+                  region_mesh->InsideOnColumn(column(solids.size(), x, y), zs.data(), nz,
+                                              in_region.data());
+                } else {
+                  for (int k = 0; k < nz; ++k)
+                    in_region[k] = region_box.Contains(lattice.Center(x, y, block.origin.z() + k));
+                }
+              }
+              in_solid.fill(all_solid ? 1 : 0);
+              for (std::size_t s = 0; !all_solid && s < crossing.size(); ++s) {
+                solids[crossing[s]]->InsideOnColumn(column(crossing[s], x, y), zs.data(), nz,
+                                                    in_this.data());
+                for (int k = 0; k < nz; ++k) in_solid[k] |= in_this[k];
+              }
+              for (int k = 0; k < nz; ++k) {
+                if (!in_region[k]) continue;
+                if (in_solid[k]) {
+                  ++block.solid_voxels;
+                } else {
+                  block.mask[Block::Offset(x - block.origin.x(), y - block.origin.y(), k)] = 1;
+                  ++block.free_voxels;
+                }
+              }
+            }
+          if (block.free_voxels == n_vox) std::vector<std::uint8_t>().swap(block.mask);
+        }
+        if (block.free_voxels == 0 && block.solid_voxels == 0) continue;
+        keep[b] = 1;
+        block.full = block.mask.empty() && n_vox == 512;
+        if (block.free_voxels == 0) continue;
+        // Cameras: the box padded by round-off only.
+        const Aabb padded = BlockCentreBox(lattice, block);
+        for (int c = 0; c < camera_count; ++c)
+          if (culler.MayIntersect(c, padded)) block.cameras.push_back(c);
       }
-      if (block.free_voxels == 0 && block.solid_voxels == 0) continue;
-      keep[b] = 1;
-      block.full = block.mask.empty() && n_vox == 512;
-      if (block.free_voxels == 0) continue;
-      // Cameras: the box padded by round-off only.
-      const Aabb padded = BlockCentreBox(lattice, block);
-      for (int c = 0; c < camera_count; ++c)
-        if (culler.MayIntersect(c, padded)) block.cameras.push_back(c);
-    }
     }
   });
 
