@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
 
   AccuracyArgs accuracy;
   CLI::App* acc = app.add_subcommand(
-      "accuracy", "Error against run time: voxel size, Monte Carlo trials, steady-state solvers");
+      "accuracy", "Error against run time: voxel size, Monte Carlo trials, steady-state solvers, coarse-to-fine");
   acc->add_option("scene", accuracy.scene, "Scene file (JSON)")->required();
   acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
   acc->add_option("--disable", accuracy.disable, "Camera ids to disable for this run, comma-separated or repeated (what the rig loses when they fail)")->delimiter(',');

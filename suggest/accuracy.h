@@ -7,7 +7,9 @@
 ///   (b) Monte Carlo: the sample covariance of Ceres triangulations of noisy pixels against the
 ///       closed-form prediction J^-1, with the prediction's own cost (RunMonteCarloStudy);
 ///   (c) steady state: the closed form, doubling and plain Riccati iteration in double against the
-///       long-double reference (analysis/uncertainty_reference.h) (RunSteadyStudy).
+///       long-double reference (analysis/uncertainty_reference.h) (RunSteadyStudy);
+///   (e) coarse-to-fine: a coarse evaluation refined where the field changes, against the full
+///       evaluation at the study's voxel size (RunRefineStudy, refine_study.cpp).
 /// Each returns a typed result (rows and notes); render/report/accuracy_tables.h turns them into the
 /// tables, CSV files and plots. Timings are wall times on this machine.
 ///
@@ -169,5 +171,40 @@ struct SteadyStudy {
 /// against SteadyPositionVarianceLong.
 SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& monte_carlo,
                            const AccuracyOptions& options);
+
+// ---------------------------------------------------------------------------------------------
+// (e) Coarse-to-fine evaluation.
+
+/// One coarse voxel size and refinement tolerance.
+struct RefineRow {
+  int factor = 2;          ///< Coarse voxel = factor x the study's voxel size.
+  double tolerance = 0.1;  ///< Relative sigma_max difference between neighbours that refines.
+  double coarse_seconds = 0, refine_seconds = 0;  ///< The coarse and the refining evaluations.
+  std::int64_t refined_voxels = 0;  ///< Study-size voxels evaluated by the refining pass.
+  /// Against the full evaluation at the study's size, over its region voxels: the share whose
+  /// coverage count differs (or that the result lacks), %; the relative sigma_max error over the
+  /// voxels triangulable in both (median, 99th percentile, largest), %; and the voxels triangulable
+  /// in one and not the other.
+  double coverage_wrong_pct = 0;
+  double class_wrong_pct = 0;  ///< ... whose class 0, 1, 2, >= 3 cameras differs, %.
+  double sigma_p50_pct = 0, sigma_p99_pct = 0, sigma_max_pct = 0;
+  std::int64_t triangulable_mismatch = 0;
+};
+
+struct RefineStudy {
+  double voxel_size = 0;          ///< The study's (the reference's), metres.
+  double reference_seconds = 0;   ///< The full evaluation at that size (best of up to 3).
+  std::int64_t reference_voxels = 0, reference_triangulable = 0;
+  std::vector<RefineRow> rows;
+  std::vector<std::string> notes;
+};
+
+/// Coarse-to-fine: evaluates coverage and sigma_max at `factor` times the study's voxel size, marks
+/// the coarse cells where the field changes (a neighbour among the 26 differs in its coverage class
+/// 0, 1, 2, >= 3 or in triangulability, or in sigma_max by more than `tolerance` relative, or lies outside the region
+/// or in a solid), evaluates the study-size voxels of those cells only (FieldOptions::voxel_filter:
+/// exact values there) and gives every other voxel its coarse cell's values; then compares with the
+/// full evaluation at the study's size. Rows for factors 2 and 4, tolerances 0.02 and 0.1.
+RefineStudy RunRefineStudy(const Scene& scene, const Rig& rig, const RayCaster& caster);
 
 }  // namespace pandora

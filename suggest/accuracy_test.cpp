@@ -104,6 +104,41 @@ TEST(PredictUncertainty, RingOfCamerasClosedForm) {
   EXPECT_NEAR(u.sigma_max, 1 / std::sqrt(diagonal.minCoeff()), 1e-12 * u.sigma_max);
 }
 
+// Coarse-to-fine: the rows, counts and invariants (the exactness of the refined voxels themselves
+// is FieldEvaluator.VoxelFilterEvaluatesExactlyTheKeptVoxels). A finer study voxel (5 cm, 20^3)
+// gives the coarse passes cells of 10 and 20 cm.
+TEST(RefineStudy, RowsCountsAndInvariants) {
+  Scene scene = RingRoom();
+  scene.study.voxel_size = 0.05;
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const RefineStudy study = RunRefineStudy(scene, scene.rigs[0], *caster);
+  EXPECT_EQ(study.reference_voxels, 8000);  // 20^3
+  EXPECT_GT(study.reference_triangulable, 0);
+  EXPECT_GT(study.reference_seconds, 0);
+  ASSERT_EQ(study.rows.size(), 4u);
+  const int factors[4] = {2, 2, 4, 4};
+  const double tolerances[4] = {0.02, 0.1, 0.02, 0.1};
+  for (int r = 0; r < 4; ++r) {
+    const RefineRow& row = study.rows[r];
+    EXPECT_EQ(row.factor, factors[r]);
+    EXPECT_EQ(row.tolerance, tolerances[r]);
+    EXPECT_GT(row.refined_voxels, 0);  // at least the region's edge
+    EXPECT_LE(row.refined_voxels, study.reference_voxels);
+    EXPECT_LE(row.class_wrong_pct, row.coverage_wrong_pct);
+    EXPECT_LE(row.sigma_p50_pct, row.sigma_p99_pct);
+    EXPECT_LE(row.sigma_p99_pct, row.sigma_max_pct);
+    if (row.refined_voxels == study.reference_voxels) {  // everything exact
+      EXPECT_EQ(row.coverage_wrong_pct, 0);
+      EXPECT_EQ(row.sigma_max_pct, 0);
+      EXPECT_EQ(row.triangulable_mismatch, 0);
+    }
+  }
+  // A larger tolerance refines no more cells.
+  EXPECT_LE(study.rows[1].refined_voxels, study.rows[0].refined_voxels);
+  EXPECT_LE(study.rows[3].refined_voxels, study.rows[2].refined_voxels);
+  EXPECT_EQ(scene.study.voxel_size, 0.05);  // the caller's scene is left alone
+}
+
 TEST(VoxelStudy, SizesCountsAndTheReference) {
   Scene scene = RingRoom();
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());

@@ -220,6 +220,48 @@ TEST(FieldEvaluator, KeptSolidTreesGiveTheSameFields) {
     }
 }
 
+// A voxel filter (coarse-to-fine refinement) evaluates exactly the voxels it keeps, with the
+// values the full evaluation gives them, and nothing else.
+TEST(FieldEvaluator, VoxelFilterEvaluatesExactlyTheKeptVoxels) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions all;
+  all.fields = {"coverage", "resolution", "sigma_max", "triangulation_angle"};
+  FieldOptions some = all;
+  some.voxel_filter = [](int i, int j, int k) { return (i / 3 + j / 5 + k) % 4 == 0 || i < 6; };
+  const Fields full = EvaluateFields(scene, scene.rigs[0], *caster, all);
+  const Fields part = EvaluateFields(scene, scene.rigs[0], *caster, some);
+  const Fields::Impl& a = full.impl();
+  const Fields::Impl& b = part.impl();
+  auto full_cov = a.coverage->getConstAccessor();
+  std::int64_t kept = 0, in_full = 0;
+  ForEachActiveVoxel(*b.coverage, [&](const openvdb::Coord& c, std::int32_t v) {
+    ASSERT_TRUE(some.voxel_filter(c.x(), c.y(), c.z()));
+    ASSERT_TRUE(full_cov.isValueOn(c));
+    EXPECT_EQ(v, full_cov.getValue(c));
+    ++kept;
+  });
+  ForEachActiveVoxel(*a.coverage, [&](const openvdb::Coord& c, std::int32_t) {
+    in_full += some.voxel_filter(c.x(), c.y(), c.z()) ? 1 : 0;
+  });
+  EXPECT_EQ(kept, in_full);
+  EXPECT_GT(kept, 1000);
+  EXPECT_EQ(part.stats.active_set.region_voxels, kept);
+  for (const char* name : {"resolution", "sigma_max", "triangulation_angle"}) {
+    auto full_acc = a.Float(name)->getConstAccessor();
+    std::int64_t n = 0, expected = 0;
+    ForEachActiveVoxel(*b.Float(name), [&](const openvdb::Coord& c, float v) {
+      ASSERT_TRUE(full_acc.isValueOn(c)) << name;
+      EXPECT_EQ(v, full_acc.getValue(c)) << name;
+      ++n;
+    });
+    ForEachActiveVoxel(*a.Float(name), [&](const openvdb::Coord& c, float) {
+      expected += some.voxel_filter(c.x(), c.y(), c.z()) ? 1 : 0;
+    });
+    EXPECT_EQ(n, expected) << name;
+  }
+}
+
 TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnASyntheticScene) {
   const Scene scene = SyntheticScene();
   RunRandomEdits(scene, scene.rigs[0], 200, 1);

@@ -1036,6 +1036,36 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   const FrustumCuller no_cameras(std::vector<Camera>{});
   S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
                             &S.active_stats);
+  if (opt.voxel_filter) {
+    // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4), [&](const auto& range) {
+      for (std::size_t b = range.begin(); b != range.end(); ++b) {
+        Block& block = S.blocks[b];
+        const bool was_full = block.mask.empty();  // every voxel within the extent free
+        if (was_full) block.mask.assign(512, 0);
+        block.free_voxels = 0;
+        for (int x = 0; x < block.extent.x(); ++x)
+          for (int y = 0; y < block.extent.y(); ++y)
+            for (int z = 0; z < block.extent.z(); ++z) {
+              std::uint8_t& m = block.mask[Block::Offset(x, y, z)];
+              if (was_full) m = 1;
+              if (m && !opt.voxel_filter(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z))
+                m = 0;
+              block.free_voxels += m;
+            }
+        block.full = false;
+      }
+    });
+    std::vector<Block> kept_blocks;
+    S.active_stats.region_voxels = 0;
+    for (Block& block : S.blocks) {
+      if (block.free_voxels == 0) continue;
+      S.active_stats.region_voxels += block.free_voxels;
+      kept_blocks.push_back(std::move(block));
+    }
+    S.blocks = std::move(kept_blocks);
+    S.active_stats.blocks = static_cast<std::int64_t>(S.blocks.size());
+  }
   S.active_set_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -58,6 +58,11 @@ struct FieldOptions {
   /// the statistics until MergePartialFields (volume/fields_transfer.h) adds them. For one full
   /// evaluation (EvaluateFields, or an evaluator without kept state); 1: every block.
   int partition_count = 1, partition_rank = 0;
+  /// Coarse-to-fine refinement (suggest/accuracy.h RunRefineStudy): when set, only the lattice
+  /// voxels (i, j, k) it returns true for are evaluated; the others stay inactive and out of the
+  /// statistics. The evaluated voxels get exactly the values a full evaluation gives them. Called
+  /// once per free region voxel while the active set is built, from worker threads.
+  std::function<bool(int i, int j, int k)> voxel_filter;
   /// The scene's solid and region-mesh search trees, kept between evaluations (a study's,
   /// volume/solid_trees.h); nullptr: the evaluation builds the ones it needs and drops them.
   const SolidTrees* solid_trees = nullptr;

@@ -226,6 +226,64 @@ AccuracySection MonteCarloSection(const MonteCarloStudy& mc, int threads) {
   return section;
 }
 
+AccuracySection RefineSection(const RefineStudy& st) {
+  AccuracySection section;
+  section.title = "(e) Coarse-to-fine evaluation against the full one at the study's voxel size";
+  section.csv_name = "accuracy_refine.csv";
+  section.svg_name = "accuracy_refine.svg";
+  section.notes = st.notes;
+  section.notes.insert(section.notes.begin(),
+                       Format("reference: the full evaluation at %s, %lld region voxels (%lld "
+                              "triangulable), %.3g s",
+                              Millimetres(st.voxel_size).c_str(), (long long)st.reference_voxels,
+                              (long long)st.reference_triangulable, st.reference_seconds));
+  const std::vector<std::string> header{"coarse_voxel_m", "factor", "tolerance", "coarse_seconds",
+                                        "refine_seconds", "time_ratio", "refined_voxels",
+                                        "refined_share", "coverage_wrong_pct", "coverage_class_wrong_pct", "sigma_max_err_p50_pct",
+                                        "sigma_max_err_p99_pct", "sigma_max_err_max_pct",
+                                        "triangulable_mismatch"};
+  section.table = Table({"coarse", "tol", "refined", "time (s)", "x full", "count wrong %",
+                         "class wrong %", "σmax err p50 %", "p99 %", "max %", "triang. mismatch"});
+  std::vector<std::vector<std::string>> csv;
+  LogLogPlot plot;
+  plot.title = "Coarse-to-fine: error against run time";
+  plot.x_label = "coarse + refining evaluation (s)";
+  plot.y_label = "error against the full evaluation (%)";
+  plot.note = "zero errors are not drawn (log axis)";
+  std::vector<PlotSeries> series(2);
+  series[0].label = "coverage class wrong (% of voxels)";
+  series[1].label = "σmax error p99 (%)";
+  for (auto& s : series) s.line = false;
+  for (const RefineRow& r : st.rows) {
+    const double seconds = r.coarse_seconds + r.refine_seconds;
+    const double ratio = seconds / st.reference_seconds;
+    const double share = double(r.refined_voxels) / double(std::max<std::int64_t>(1, st.reference_voxels));
+    csv.push_back({CsvNumber(r.factor * st.voxel_size), std::to_string(r.factor), CsvNumber(r.tolerance),
+                   CsvNumber(r.coarse_seconds), CsvNumber(r.refine_seconds), CsvNumber(ratio),
+                   std::to_string(r.refined_voxels), CsvNumber(share), CsvNumber(r.coverage_wrong_pct),
+                   CsvNumber(r.class_wrong_pct), CsvNumber(r.sigma_p50_pct), CsvNumber(r.sigma_p99_pct), CsvNumber(r.sigma_max_pct),
+                   std::to_string(r.triangulable_mismatch)});
+    section.table.AddRow({Millimetres(r.factor * st.voxel_size), Format("%g", r.tolerance),
+                          Format("%.0f%%", 100 * share), Format("%.3g", seconds), Format("%.2f", ratio),
+                          Format("%.3f", r.coverage_wrong_pct), Format("%.3f", r.class_wrong_pct),
+                          Format("%.3f", r.sigma_p50_pct),
+                          Format("%.2f", r.sigma_p99_pct), Format("%.1f", r.sigma_max_pct),
+                          std::to_string(r.triangulable_mismatch)});
+    const std::string label = Format("%dx, %g", r.factor, r.tolerance);
+    series[0].x.push_back(seconds);
+    series[0].y.push_back(r.class_wrong_pct);
+    series[0].point_labels.push_back(label);
+    series[1].x.push_back(seconds);
+    series[1].y.push_back(r.sigma_p99_pct);
+    series[1].point_labels.push_back("");
+  }
+  plot.series = series;
+  plot.vertical_lines.push_back({st.reference_seconds, "full evaluation"});
+  section.csv = CsvText(header, csv);
+  section.svg = RenderLogLogSvg(plot);
+  return section;
+}
+
 AccuracySection SteadySection(const SteadyStudy& st) {
   AccuracySection section;
   section.title = "(c) Steady-state solvers (per voxel: three axes)";

@@ -38,6 +38,9 @@ AccuracySection MonteCarloSection(const MonteCarloStudy& study, int threads);
 /// (c) accuracy_steady.{csv,svg}: per case and solver the iterations, time per voxel and error.
 AccuracySection SteadySection(const SteadyStudy& study);
 
+/// (e) accuracy_refine.{csv,svg}: per coarse size and tolerance the share of voxels refined, the
+/// time against the full evaluation, the voxels whose coverage is wrong and the sigma_max errors.
+AccuracySection RefineSection(const RefineStudy& study);
 /// "# pandora accuracy: SCENE, rig RIG" and a blank line: the head of accuracy_tables.md.
 std::string AccuracyTablesHeading(const std::string& scene_path, const std::string& rig);
 
