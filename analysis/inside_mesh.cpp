@@ -80,6 +80,11 @@ InsideMesh::Column InsideMesh::ColumnAt(double x, double y) const {
   std::vector<Primitive::Id> faces;
   impl_->tree.all_intersected_primitives(line, std::back_inserter(faces));
   const Kernel::Point_2 q(x, y);
+  const auto degenerate = [&column] {
+    column.degenerate = true;
+    column.crossings.clear();
+    return column;
+  };
   for (const Primitive::Id f : faces) {
     std::array<Point, 3> v;
     int k = 0;
@@ -90,11 +95,7 @@ InsideMesh::Column InsideMesh::ColumnAt(double x, double y) const {
                             o2 = CGAL::orientation(c, a, q);
     // Through an edge or a vertex in projection (or in a vertical face's plane): the parity along
     // this line is ambiguous; Side_of_triangle_mesh's own degeneracy handling decides.
-    if (o0 == CGAL::COLLINEAR || o1 == CGAL::COLLINEAR || o2 == CGAL::COLLINEAR) {
-      column.degenerate = true;
-      column.crossings.clear();
-      return column;
-    }
+    if (o0 == CGAL::COLLINEAR || o1 == CGAL::COLLINEAR || o2 == CGAL::COLLINEAR) return degenerate();
     if (o0 != o1 || o1 != o2) continue;  // the line passes beside the face
     Column::Crossing crossing;
     crossing.a = Vec3(v[0].x(), v[0].y(), v[0].z());
@@ -105,11 +106,7 @@ InsideMesh::Column InsideMesh::ColumnAt(double x, double y) const {
     const Vec3 n = (crossing.b - crossing.a).cross(crossing.c - crossing.a);
     // A face within 1e-6 rad of vertical: its rounded height could miss by more than the margin
     // below; ask Inside() per point.
-    if (!(std::abs(n.z()) > 1e-6 * n.norm())) {
-      column.degenerate = true;
-      column.crossings.clear();
-      return column;
-    }
+    if (!(std::abs(n.z()) > 1e-6 * n.norm())) return degenerate();
     crossing.z = crossing.a.z() - (n.x() * (x - crossing.a.x()) + n.y() * (y - crossing.a.y())) / n.z();
     column.crossings.push_back(crossing);
   }

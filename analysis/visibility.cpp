@@ -92,8 +92,8 @@ struct BatchCamera {
 using GeometryBatch = VisibilityTester::GeometryBatch;
 
 // Per point: the tests of TestGeometryCameraFrame (range, projection, image), the occlusion
-// segment and the camera-frame Jacobian, into out's arrays at the point's index (compacted by the
-// caller). Every expression is written as the one-point path evaluates it (its 3x3 product and
+// segment and the camera-frame Jacobian, into out's arrays at the point's index (the caller lists
+// the points that pass in out->index). Every expression is written as the one-point path evaluates it (its 3x3 product and
 // Eigen's norm summed left to right, BcDistort, CameraModel::Project, Tolerance), so a lane gives
 // the bits of the one-point test; the lanes are independent, without branches (ints combined
 // with &, not &&), and vectorise. No FMA contraction: the AVX2 clone does not enable FMA.

@@ -114,7 +114,7 @@ int RunAccuracy(const AccuracyArgs& args) {
   const MonteCarloStudy monte_carlo = RunMonteCarloStudy(scene, rig, *caster, options);
   emit(report::MonteCarloSection(monte_carlo, threads));
   emit(report::SteadySection(RunSteadyStudy(scene, monte_carlo, options)));
-  emit(report::RefineSection(RunRefineStudy(scene, rig, *caster)));
+  emit(report::RefineSection(RunRefineStudy(scene, rig, *caster, &study->solid_trees())));
   if (args.gpu) emit(GpuStudy(scene, rig, args.quick));
 
   WriteFileAtomically(tables_path, markdown);

@@ -28,6 +28,8 @@
 
 namespace pandora {
 
+class SolidTrees;
+
 /// Sizes of the studies. The defaults are the full study; Quick() the short one the tests run.
 struct AccuracyOptions {
   /// Voxel sizes as multiples of the study's voxel_size, coarse to fine; the last evaluated is the
@@ -205,6 +207,8 @@ struct RefineStudy {
 /// or in a solid), evaluates the study-size voxels of those cells only (FieldOptions::voxel_filter:
 /// exact values there) and gives every other voxel its coarse cell's values; then compares with the
 /// full evaluation at the study's size. Rows for factors 2 and 4, tolerances 0.02 and 0.1.
-RefineStudy RunRefineStudy(const Scene& scene, const Rig& rig, const RayCaster& caster);
+/// `solid_trees` (a study's, may be null): the solids' search trees, kept between the evaluations.
+RefineStudy RunRefineStudy(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                           const SolidTrees* solid_trees = nullptr);
 
 }  // namespace pandora

@@ -72,15 +72,16 @@ double Percentile(std::vector<double> v, double q) {
 
 }  // namespace
 
-RefineStudy RunRefineStudy(const Scene& scene_in, const Rig& rig, const RayCaster& caster) {
+RefineStudy RunRefineStudy(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                           const SolidTrees* solid_trees) {
   RefineStudy study;
-  Scene scene = scene_in;
   const double h = scene.study.voxel_size;
   study.voxel_size = h;
   FieldOptions options;
   options.fields = {"coverage", "sigma_max"};
   options.scene_path = scene.path;
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
+  options.solid_trees = solid_trees;  // built once for the nine evaluations
 
   // The reference: the full evaluation at the study's size (best of up to 3 within ~1 s).
   std::optional<Fields> reference;

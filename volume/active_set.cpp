@@ -143,6 +143,9 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   // searched once for the whole column of blocks (InsideMesh::ColumnAt) and reused by each block
   // that needs them.
   const std::int64_t block_columns = std::int64_t(nb.x()) * nb.y();
+  Aabb region_box = region.box;  // padded by round-off
+  region_box.min -= Vec3::Constant(1e-9 * h);
+  region_box.max += Vec3::Constant(1e-9 * h);
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_columns, 1), [&](const auto& range) {
     for (std::int64_t bc = range.begin(); bc != range.end(); ++bc) {
       // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block column.
@@ -157,11 +160,11 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         }
         return *slot;
       };
+      const int bx = static_cast<int>(bc / nb.y());
+      const int by = static_cast<int>(bc % nb.y());
       for (int bz = 0; bz < nb.z(); ++bz) {
         const std::int64_t b = bc * nb.z() + bz;
         Block& block = all[b];
-        const int bx = static_cast<int>(bc / nb.y());
-        const int by = static_cast<int>(bc % nb.y());
         block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
         const Eigen::Vector3i last =
             (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
@@ -173,10 +176,6 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         // Region. A box region's last voxel centres can lie up to half a voxel beyond its max (the
         // lattice rounds the extent up): such blocks test each centre against the box.
         InsideMesh::BoxClass region_class = InsideMesh::BoxClass::kInside;
-        const double slack = 1e-9 * h;
-        Aabb region_box = region.box;
-        region_box.min -= Vec3::Constant(slack);
-        region_box.max += Vec3::Constant(slack);
         if (region.kind == Region::Kind::kMesh) {
           region_class = region_mesh->Classify(box);
         } else if (!region_box.Contains(box.max)) {
@@ -203,7 +202,7 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         } else {
           block.mask.assign(512, 0);
           // Column by column along z: one search of each crossing mesh per column (its crossings'
-          // parity, InsideMesh::InsideColumn) rather than one per voxel.
+          // parity, InsideMesh::InsideOnColumn) rather than one per voxel.
           const int nz = last.z() - block.origin.z() + 1;
           std::array<double, 8> zs;
           std::array<unsigned char, 8> in_region, in_solid, in_this;

@@ -1041,18 +1041,17 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4), [&](const auto& range) {
       for (std::size_t b = range.begin(); b != range.end(); ++b) {
         Block& block = S.blocks[b];
-        const bool was_full = block.mask.empty();  // every voxel within the extent free
-        if (was_full) block.mask.assign(512, 0);
+        std::vector<std::uint8_t> mask(512, 0);
         block.free_voxels = 0;
         for (int x = 0; x < block.extent.x(); ++x)
           for (int y = 0; y < block.extent.y(); ++y)
-            for (int z = 0; z < block.extent.z(); ++z) {
-              std::uint8_t& m = block.mask[Block::Offset(x, y, z)];
-              if (was_full) m = 1;
-              if (m && !opt.voxel_filter(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z))
-                m = 0;
-              block.free_voxels += m;
-            }
+            for (int z = 0; z < block.extent.z(); ++z)
+              if (block.IsFree(x, y, z) &&
+                  opt.voxel_filter(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z)) {
+                mask[Block::Offset(x, y, z)] = 1;
+                ++block.free_voxels;
+              }
+        block.mask = std::move(mask);
         block.full = false;
       }
     });
