@@ -1,9 +1,11 @@
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
@@ -24,6 +26,7 @@
 #include "volume/summary.h"
 #include "volume/pixel_targets.h"
 #include "volume/time_fields.h"
+#include "volume/value_spill.h"
 #include "volume/vdb_io.h"
 
 #ifndef PANDORA_VERSION
@@ -57,6 +60,39 @@ std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& field
   return fields;
 }
 
+// The field options of `pandora analyze`: the study's, with --fields and --memory-budget applied.
+FieldOptions AnalyzeFieldOptions(const AnalyzeArgs& args, const Scene& scene) {
+  FieldOptions options;
+  options.scene_path = scene.path;
+  if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
+  options.fields = scene.study.fields;
+  if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
+  options.memory_budget_bytes = scene.study.memory_budget_bytes;
+  if (!std::isnan(args.memory_budget_mb)) {
+    options.memory_budget_bytes =
+        CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
+    CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
+    options.memory_budget_option = "--memory-budget";
+  }
+  return options;
+}
+
+// The metadata of fields.vdb and of every streamed tile.
+std::map<std::string, std::string> FieldsMetadata(const Scene& scene, const Rig& rig,
+                                                  const std::string& run_id) {
+  return {
+      {"run_id", run_id},
+      {"units", "m"},
+      {"tool", "pandora"},
+      {"tool_version", PANDORA_VERSION},
+      {"scene_file", scene.path},
+      {"scene_sha256", scene.sha256},
+      {"rig_name", rig.name},
+      {"rig", RigToJson(rig).dump()},
+      {"voxel_size_m", FormatNumber(scene.study.voxel_size)},
+  };
+}
+
 }  // namespace
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
@@ -66,6 +102,9 @@ double CheckPositiveOption(const char* option, double value, const char* unit) {
 }
 
 int RunAnalyze(const AnalyzeArgs& args) {
+  if (args.stream) return RunStreamedAnalyze(args);
+  if (!std::isnan(args.tile_size))
+    throw InputError("--tile-size", "", "applies to a streamed run only", "add --stream");
   // Under mpirun every process runs this; rank 0 alone prints, stages and writes (docs/scale.md).
   const MpiSession mpi(args.mpi);
   const bool root = mpi.rank() == 0;
@@ -78,18 +117,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   so.rig_option = "--rig";
   so.disable = args.disable;
   so.incremental = false;  // one evaluation: no per-pair state
+  so.fields = AnalyzeFieldOptions(args, scene);
   FieldOptions& options = so.fields;
-  options.scene_path = scene.path;
-  if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
-  options.fields = scene.study.fields;
-  if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
-  options.memory_budget_bytes = scene.study.memory_budget_bytes;
-  if (!std::isnan(args.memory_budget_mb)) {
-    options.memory_budget_bytes =
-        CheckPositiveOption("--memory-budget", args.memory_budget_mb, "MiB") * 1024.0 * 1024.0;
-    CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
-    options.memory_budget_option = "--memory-budget";
-  }
   options.partition_count = mpi.size();
   options.partition_rank = mpi.rank();
   ProgressBar bar("analyze " + study->FindRig(args.rig, "--rig").name +
@@ -206,23 +235,320 @@ int RunAnalyze(const AnalyzeArgs& args) {
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   if (mpi.active()) summary["mpi"] = mpi_summary;
-  std::map<std::string, std::string> meta{
-      {"run_id", output.run_id()},
-      {"units", "m"},
-      {"tool", "pandora"},
-      {"tool_version", PANDORA_VERSION},
-      {"scene_file", scene.path},
-      {"scene_sha256", scene.sha256},
-      {"rig_name", rig.name},
-      {"rig", RigToJson(rig).dump()},
-      {"voxel_size_m", FormatNumber(scene.study.voxel_size)},
-  };
-  WriteFieldsVdb(std::move(fields), vdb_path, meta);  // the last use: consumed to keep the peak down
+  WriteFieldsVdb(std::move(fields), vdb_path, FieldsMetadata(scene, rig, output.run_id()));  // the last use: consumed to keep the peak down
   WriteFileAtomically(summary_path, summary.dump(2) + "\n");
   output.Commit();
   if (!args.quiet) {
     std::fputs(FormatSummary(typed).c_str(), stdout);
     std::printf("wrote %s and %s\n", (out / "fields.vdb").c_str(), (out / "summary.json").c_str());
+    std::fflush(stdout);
+    for (const Warning& w : warnings)
+      std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
+  }
+  return 0;
+}
+
+}  // namespace pandora::app
+
+namespace pandora::app {
+namespace {
+
+// What a streamed run cannot compute: the analyses that need the whole fields at once. Each refused
+// with one line naming where the study (or --fields) asks for it.
+void CheckStreamable(const AnalyzeArgs& args, const Scene& scene, const Rig& rig,
+                     const std::vector<std::string>& fields) {
+  const std::string hint = "run without --stream (at a voxel size the memory budget allows), or leave it out";
+  const auto refuse = [&](const std::string& file, const std::string& path, const std::string& what) {
+    throw InputError(file, path, what + " needs the whole fields in memory and is not computed by a streamed run (--stream)", hint);
+  };
+  if (std::find(fields.begin(), fields.end(), "cameras") != fields.end())
+    throw InputError(args.fields.empty() ? scene.path : "--fields", args.fields.empty() ? "$.study.fields" : "",
+                     "the field 'cameras' (per-camera grids, N-1 criticality) is not computed by a streamed run (--stream)",
+                     "ask for the others, e.g. --fields coverage,resolution,sigma_max");
+  if (RigHasPtz(rig)) refuse(scene.path, "$.rigs", "the PTZ fields of rig '" + rig.name + "'");
+  if (scene.Animated()) refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions", "moving objects' fields over time");
+  if (!scene.study.regions.empty()) refuse(scene.path, "$.study.regions", "the named sub-regions' summary");
+  if (!scene.study.pixel_targets.empty()) refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
+  if (scene.study.dori) refuse(scene.path, "$.study.dori", "the DORI classes");
+}
+
+std::string Triple(const Eigen::Vector3i& v) {
+  return std::to_string(v.x()) + "," + std::to_string(v.y()) + "," + std::to_string(v.z());
+}
+
+void AddCounts(std::vector<std::int64_t>* into, const std::vector<std::int64_t>& counts) {
+  into->resize(std::max(into->size(), counts.size()), 0);
+  for (std::size_t i = 0; i < counts.size(); ++i) (*into)[i] += counts[i];
+}
+
+// The additive part of FieldStats, to send to rank 0 and add up there.
+nlohmann::json StatsToJson(const FieldStats& s) {
+  return {{"region_voxels", s.active_set.region_voxels}, {"solid_voxels", s.active_set.solid_voxels},
+          {"blocks", s.active_set.blocks}, {"culled_blocks", s.active_set.culled_blocks},
+          {"seen", s.seen_voxels}, {"triangulable", s.triangulable_voxels},
+          {"unobservable", s.unobservable_voxels}, {"tests", s.point_camera_tests}, {"rays", s.rays},
+          {"seconds", s.seconds}, {"cpu_seconds", s.cpu_seconds}, {"active_set_seconds", s.active_set_seconds},
+          {"histogram", s.coverage_histogram}, {"per_camera", s.per_camera_seen}};
+}
+
+void AddStats(FieldStats* s, const nlohmann::json& j) {
+  s->active_set.region_voxels += j.at("region_voxels").get<std::int64_t>();
+  s->active_set.solid_voxels += j.at("solid_voxels").get<std::int64_t>();
+  s->active_set.blocks += j.at("blocks").get<std::int64_t>();
+  s->active_set.culled_blocks += j.at("culled_blocks").get<std::int64_t>();
+  s->seen_voxels += j.at("seen").get<std::int64_t>();
+  s->triangulable_voxels += j.at("triangulable").get<std::int64_t>();
+  s->unobservable_voxels += j.at("unobservable").get<std::int64_t>();
+  s->point_camera_tests += j.at("tests").get<std::int64_t>();
+  s->rays += j.at("rays").get<std::int64_t>();
+  // The tiles run one after another: their times add up (across processes, the slowest would be
+  // the wall time; the sum is the work).
+  s->seconds += j.at("seconds").get<double>();
+  s->cpu_seconds += j.at("cpu_seconds").get<double>();
+  s->active_set_seconds += j.at("active_set_seconds").get<double>();
+  AddCounts(&s->coverage_histogram, j.at("histogram").get<std::vector<std::int64_t>>());
+  AddCounts(&s->per_camera_seen, j.at("per_camera").get<std::vector<std::int64_t>>());
+}
+
+// Every process's `counts` (`size` of them), summed at rank 0 (empty on the others).
+std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi, const std::vector<std::int64_t>& counts,
+                                          std::size_t size) {
+  const std::vector<std::string> parts =
+      mpi.GatherToRoot(std::string(reinterpret_cast<const char*>(counts.data()), counts.size() * 8));
+  std::vector<std::int64_t> sum(parts.empty() ? 0 : size, 0);
+  for (const std::string& p : parts)
+    for (std::size_t i = 0; i < size && i < p.size() / 8; ++i) {
+      std::int64_t v;
+      std::memcpy(&v, p.data() + 8 * i, 8);
+      sum[i] += v;
+    }
+  return sum;
+}
+
+double PeakRssMiB() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // KiB on Linux
+}
+
+}  // namespace
+
+int RunStreamedAnalyze(const AnalyzeArgs& args) {
+  // Under mpirun every process evaluates its share of the tiles and writes them itself (into rank
+  // 0's staging folder: the processes share a file system); rank 0 adds up the statistics and
+  // writes the summary (docs/scale.md).
+  const MpiSession mpi(args.mpi);
+  const bool root = mpi.rank() == 0;
+  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+  const Scene& scene = study->scene();
+  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
+  FieldOptions options = AnalyzeFieldOptions(args, scene);
+  options.solid_trees = &study->solid_trees();
+  CheckStreamable(args, scene, rig, options.fields);
+  const double tile_side =
+      std::isnan(args.tile_size) ? 0.0 : CheckPositiveOption("--tile-size", args.tile_size, "metres");
+  const VoxelLattice lattice =
+      MakeLattice(scene.study.region.box, scene.study.voxel_size,
+                  options.voxel_size_option.empty() ? scene.path : options.voxel_size_option,
+                  options.voxel_size_option.empty() ? "$.study.voxel_size" : "");
+  const std::vector<BlockColumns> tiles =
+      PlanTiles(lattice, options.fields, options.memory_budget_bytes, tile_side);
+  constexpr std::size_t kMostTiles = 10000;
+  if (tiles.size() > kMostTiles)
+    throw InputError(std::isnan(args.tile_size) ? options.memory_budget_option : "--tile-size", "",
+                     "the region would stream in " + std::to_string(tiles.size()) + " tiles, over " +
+                         std::to_string(kMostTiles),
+                     "raise the memory budget, or use larger tiles or a coarser voxel size");
+
+  // Every tile and the summary appear together (summary.json last), or none does.
+  const std::filesystem::path out(args.out);
+  OutputTransaction output;
+  std::vector<std::string> tile_files, tile_paths;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    char name[32];
+    std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
+    tile_files.push_back(name);
+  }
+  std::string summary_path, staged;
+  std::exception_ptr failure;
+  if (root) {
+    try {
+      AddSceneInputs(output, scene);
+      for (const std::string& name : tile_files) {
+        tile_paths.push_back(output.Stage((out / name).string(), "--out"));
+        staged += tile_paths.back() + '\n';
+      }
+      summary_path = output.Stage((out / "summary.json").string(), "--out");
+      staged += output.run_id();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  if (!mpi.AllOk(!failure)) {
+    if (failure) std::rethrow_exception(failure);
+    return 2;  // rank 0 printed why
+  }
+  // The staged paths and the run id, from rank 0 to every process.
+  std::string run_id = output.run_id();
+  if (mpi.active()) {
+    std::istringstream lines(mpi.Broadcast(staged));
+    tile_paths.assign(tiles.size(), {});
+    for (std::string& path : tile_paths) std::getline(lines, path);
+    std::getline(lines, run_id);
+  }
+
+  const bool want_resolution =
+      std::find(options.fields.begin(), options.fields.end(), "resolution") != options.fields.end();
+  const std::map<std::string, std::string> meta = FieldsMetadata(scene, rig, run_id);
+  // This process's tiles (every size-th), their statistics added up, the values behind the
+  // summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
+  const std::string spill_folder = std::filesystem::path(tile_paths[0]).parent_path().string();
+  std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
+  FieldStats total;
+  nlohmann::json tile_list = nlohmann::json::array();
+  double most_estimated = 0;
+  std::vector<std::size_t> mine;
+  for (std::size_t t = std::size_t(mpi.rank()); t < tiles.size(); t += std::size_t(mpi.size())) mine.push_back(t);
+  ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
+                      (mpi.active() ? ", rank 0 of " + std::to_string(mpi.size()) : "") + ")",
+                  !(args.quiet || !root));
+  try {
+    for (auto& spill : spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const std::size_t t = mine[i];
+      FieldOptions o = options;
+      o.tile = tiles[t];
+      o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
+      Fields f = EvaluateFields(scene, rig, study->caster(), o);
+      FieldStats& st = f.stats;
+      total.active_set.region_voxels += st.active_set.region_voxels;
+      total.active_set.solid_voxels += st.active_set.solid_voxels;
+      total.active_set.blocks += st.active_set.blocks;
+      total.active_set.culled_blocks += st.active_set.culled_blocks;
+      total.seen_voxels += st.seen_voxels;
+      total.triangulable_voxels += st.triangulable_voxels;
+      total.unobservable_voxels += st.unobservable_voxels;
+      total.point_camera_tests += st.point_camera_tests;
+      total.rays += st.rays;
+      total.seconds += st.seconds;
+      total.cpu_seconds += st.cpu_seconds;
+      total.active_set_seconds += st.active_set_seconds;
+      most_estimated = std::max(most_estimated, st.estimated_bytes);
+      AddCounts(&total.coverage_histogram, st.coverage_histogram);
+      AddCounts(&total.per_camera_seen, st.per_camera_seen);
+      if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
+      spills[1]->Append(st.sigma_max_mm);
+      spills[2]->Append(st.sigma_max_steady_mm);
+      std::vector<float>().swap(st.sigma_max_mm);
+      std::vector<float>().swap(st.sigma_max_steady_mm);
+      const Eigen::Vector3i lo = tiles[t].VoxelMin(), end = tiles[t].VoxelEnd(lattice);
+      std::map<std::string, std::string> tile_meta = meta;
+      tile_meta["tile"] = std::to_string(t) + " of " + std::to_string(tiles.size());
+      tile_meta["tile_voxel_min"] = Triple(lo);
+      tile_meta["tile_voxel_end"] = Triple(end);
+      tile_list.push_back({{"index", t},
+                           {"file", tile_files[t]},
+                           {"voxel_min", {lo.x(), lo.y(), lo.z()}},
+                           {"voxel_end", {end.x(), end.y(), end.z()}},
+                           {"region_voxels", st.active_set.region_voxels},
+                           {"seen_voxels", st.seen_voxels},
+                           {"seconds", st.seconds},
+                           {"rank", mpi.rank()}});
+      WriteFieldsVdb(std::move(f), tile_paths[t], tile_meta);  // then dropped: one tile at a time
+    }
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  if (!mpi.AllOk(!failure)) {
+    if (failure && root) std::rethrow_exception(failure);
+    return 2;
+  }
+  bar.Finish();
+
+  // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
+  // spilled values by two rounds of summed counts (only the counts travel).
+  const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
+                            {"estimated", most_estimated}, {"peak_rss_mib", PeakRssMiB()}};
+  const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
+  nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
+  if (root) {
+    total = FieldStats{};
+    for (const std::string& p : parts) {
+      const nlohmann::json j = nlohmann::json::parse(p);
+      AddStats(&total, j.at("stats"));
+      for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
+      most_estimated = std::max(most_estimated, j.at("estimated").get<double>());
+      peak_rss.push_back(j.at("peak_rss_mib"));
+    }
+    std::sort(all_tiles.begin(), all_tiles.end(),
+              [](const auto& a, const auto& b) { return a.at("index") < b.at("index"); });
+  }
+  const auto percentiles = [&](const ValueSpill& spill, const std::vector<double>& p) {
+    const PercentileBins selection =
+        SelectPercentileBins(SumCountsAtRoot(mpi, spill.HighCounts(), 1 << 16), p);
+    PercentileBins shared;
+    shared.inside = selection.inside;
+    std::string bins(reinterpret_cast<const char*>(selection.bins.data()), selection.bins.size() * 4);
+    bins = mpi.Broadcast(bins);
+    shared.bins.resize(bins.size() / 4);
+    std::memcpy(shared.bins.data(), bins.data(), bins.size());
+    return ResolvePercentiles(selection, SumCountsAtRoot(mpi, spill.LowCounts(shared.bins), shared.bins.size() << 16),
+                              p.size());
+  };
+  const auto count_at_most = [&](const ValueSpill& spill, double limit) {
+    const std::vector<std::int64_t> sum = SumCountsAtRoot(mpi, {spill.CountAtMost(limit)}, 1);
+    return sum.empty() ? std::int64_t(0) : sum[0];  // rank 0's; the others' are not used
+  };
+  const std::vector<std::optional<double>> resolution_p = percentiles(*spills[0], {10, 50, 90});
+  const std::vector<std::optional<double>> sigma_p = percentiles(*spills[1], {50, 90, 99});
+  const std::vector<std::optional<double>> steady_p = percentiles(*spills[2], {50, 90, 99});
+  const double limit = scene.study.max_sigma_mm.value_or(0.0);
+  const std::int64_t sigma_meets = count_at_most(*spills[1], limit);
+  const std::int64_t steady_meets = count_at_most(*spills[2], limit);
+  if (!root) return 0;
+
+  Fields merged;
+  merged.lattice = lattice;
+  merged.stats = std::move(total);
+  const int threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  RigCheckOptions check;
+  check.visible_voxels = merged.stats.per_camera_seen;
+  const std::vector<Warning> warnings = CheckRig(scene, rig, study->caster(), check);
+  Summary typed = Summarize(scene, rig, merged, options.fields, threads, warnings);
+  // The percentiles and shares from the spilled values: the same nearest ranks over the same
+  // multisets as an in-memory run.
+  if (want_resolution) typed.resolution_px_per_m = ResolutionPercentiles{resolution_p[0], resolution_p[1], resolution_p[2]};
+  if (typed.uncertainty) {
+    UncertaintySummary& u = *typed.uncertainty;
+    const std::int64_t region = merged.stats.active_set.region_voxels;
+    const auto share = [region](std::int64_t n) { return region > 0 ? double(n) / double(region) : 0.0; };
+    u.sigma_max_mm = SigmaPercentiles{sigma_p[0], sigma_p[1], sigma_p[2]};
+    if (u.max_sigma_mm) u.meets_max_sigma = share(sigma_meets);
+    if (u.motion) {
+      u.sigma_max_steady_mm = SigmaPercentiles{steady_p[0], steady_p[1], steady_p[2]};
+      if (u.max_sigma_mm) u.meets_max_sigma_steady = share(steady_meets);
+    }
+  }
+  if (scene.study.targets)
+    typed.targets = EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());
+  if (scene.study.calibration)
+    typed.calibration = SimulateCalibration(scene, rig, study->caster(), *scene.study.calibration);
+  nlohmann::json summary = typed;
+  summary["run_id"] = run_id;
+  summary["stream"] = {{"tiles", all_tiles},
+                       {"tile_count", tiles.size()},
+                       {"ranks", mpi.size()},
+                       {"memory_budget_mib", options.memory_budget_bytes / 1048576.0},
+                       {"largest_tile_estimate_mib", most_estimated / 1048576.0},
+                       {"peak_rss_mib", peak_rss}};
+  WriteFileAtomically(summary_path, summary.dump(2) + "\n");
+  output.Commit();
+  if (!args.quiet) {
+    std::fputs(FormatSummary(typed).c_str(), stdout);
+    std::printf("wrote %zu tiles in %s and %s (peak memory %.0f MiB%s)\n", tiles.size(),
+                (out / "fields").c_str(), (out / "summary.json").c_str(), PeakRssMiB(),
+                mpi.active() ? " on rank 0" : "");
     std::fflush(stdout);
     for (const Warning& w : warnings)
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());

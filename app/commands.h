@@ -28,8 +28,16 @@ struct AnalyzeArgs {
   /// `--mpi`: one of the processes of `mpirun -n N pandora analyze ...` (docs/scale.md): each
   /// evaluates its partition of the blocks, rank 0 merges them and writes the outputs.
   bool mpi = false;
+  /// `--stream`: evaluate and write the region tile by tile (whole columns of 8^3 blocks), each
+  /// tile's fields written to fields/tile_NNNN.vdb and dropped before the next, so the peak memory
+  /// is one tile's, within the budget (docs/scale.md). `tile_size`: the tiles' side in metres;
+  /// kUnset: as few tiles as the memory budget allows.
+  bool stream = false;
+  double tile_size = kUnset;
 };
 int RunAnalyze(const AnalyzeArgs& args);
+/// `pandora analyze --stream` (RunAnalyze calls it for --stream).
+int RunStreamedAnalyze(const AnalyzeArgs& args);
 
 struct BenchArgs {
   std::string scene;

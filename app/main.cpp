@@ -186,6 +186,10 @@ int main(int argc, char** argv) {
   a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
   a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
   a->add_flag("--mpi", analyze.mpi, "Under mpirun: split the blocks over the processes; rank 0 writes (docs/scale.md)");
+  a->add_flag("--stream", analyze.stream,
+              "Evaluate and write the region tile by tile within the memory budget: fields/tile_NNNN.vdb (docs/scale.md)");
+  a->add_option("--tile-size", analyze.tile_size, "With --stream: the tiles' side in metres (default: as few tiles as the budget allows)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
 
   BenchArgs bench;
   CLI::App* b = app.add_subcommand("bench", "Time field evaluation against a raw Embree loop over the same rays");

@@ -75,6 +75,19 @@ std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) cons
   return out;
 }
 
+std::string MpiSession::Broadcast(const std::string& bytes) const {
+  if (!active_) return bytes;
+  std::int64_t n = rank_ == 0 ? static_cast<std::int64_t>(bytes.size()) : 0;
+  MPI_Bcast(&n, 1, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  std::string out = rank_ == 0 ? bytes : std::string(static_cast<std::size_t>(n), '\0');
+  constexpr std::size_t kPiece = std::size_t(1) << 30;
+  for (std::size_t at = 0; at < out.size(); at += kPiece) {
+    const int len = static_cast<int>(std::min(kPiece, out.size() - at));
+    MPI_Bcast(out.data() + at, len, MPI_BYTE, 0, MPI_COMM_WORLD);
+  }
+  return out;
+}
+
 #else
 
 bool MpiAvailable() { return false; }
@@ -90,6 +103,8 @@ MpiSession::~MpiSession() = default;
 bool MpiSession::AllOk(bool ok) const { return ok; }
 
 std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) const { return {bytes}; }
+
+std::string MpiSession::Broadcast(const std::string& bytes) const { return bytes; }
 
 #endif
 

@@ -28,6 +28,9 @@ class MpiSession {
   /// A collective: every process gives its bytes; rank 0 gets them all, index = rank (its own
   /// included), the others get an empty vector. Any size (sent in pieces below 1 GiB).
   std::vector<std::string> GatherToRoot(const std::string& bytes) const;
+  /// A collective: rank 0's `bytes` on every process (the others' arguments are ignored). Returns
+  /// `bytes` at once without MPI.
+  std::string Broadcast(const std::string& bytes) const;
 
  private:
   bool active_ = false;

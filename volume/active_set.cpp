@@ -132,9 +132,19 @@ Aabb BlockCentreBox(const VoxelLattice& lattice, const Block& block) {
 std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& region,
                                   const std::vector<const InsideMesh*>& solids,
                                   const InsideMesh* region_mesh, const FrustumCuller& culler,
-                                  int camera_count, ActiveSetStats* stats) {
+                                  int camera_count, ActiveSetStats* stats, const BlockColumns* tile) {
   const Eigen::Vector3i nb = (lattice.dims + Eigen::Vector3i::Constant(7)) / 8;
-  const std::int64_t block_count = std::int64_t(nb.x()) * nb.y() * nb.z();
+  // The columns to build: all, or the tile's (clipped to the lattice).
+  BlockColumns cols{0, nb.x(), 0, nb.y()};
+  if (tile) {
+    cols.x0 = std::clamp(tile->x0, 0, nb.x());
+    cols.x1 = std::clamp(tile->x1, cols.x0, nb.x());
+    cols.y0 = std::clamp(tile->y0, 0, nb.y());
+    cols.y1 = std::clamp(tile->y1, cols.y0, nb.y());
+  }
+  const int cols_y = cols.y1 - cols.y0;
+  const std::int64_t block_columns = std::int64_t(cols.x1 - cols.x0) * cols_y;
+  const std::int64_t block_count = block_columns * nb.z();
   std::vector<Block> all(static_cast<std::size_t>(block_count));
   std::vector<std::uint8_t> keep(all.size(), 0);
   const double h = lattice.voxel_size;
@@ -142,7 +152,6 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   // By columns of blocks (bx, by), bottom to top: a mesh's crossings along a voxel column are
   // searched once for the whole column of blocks (InsideMesh::ColumnAt) and reused by each block
   // that needs them.
-  const std::int64_t block_columns = std::int64_t(nb.x()) * nb.y();
   Aabb region_box = region.box;  // padded by round-off
   region_box.min -= Vec3::Constant(1e-9 * h);
   region_box.max += Vec3::Constant(1e-9 * h);
@@ -160,8 +169,8 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         }
         return *slot;
       };
-      const int bx = static_cast<int>(bc / nb.y());
-      const int by = static_cast<int>(bc % nb.y());
+      const int bx = cols.x0 + static_cast<int>(bc / cols_y);
+      const int by = cols.y0 + static_cast<int>(bc % cols_y);
       for (int bz = 0; bz < nb.z(); ++bz) {
         const std::int64_t b = bc * nb.z() + bz;
         Block& block = all[b];

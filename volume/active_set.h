@@ -4,6 +4,7 @@
 /// size of an OpenVDB leaf). Whole blocks outside every camera's frustum or working range, outside the
 /// region, or inside a solid are decided before any ray is cast. No OpenVDB here: plain geometry.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -84,12 +85,26 @@ struct ActiveSetStats {
   std::int64_t culled_blocks = 0;  ///< Of those, blocks no camera can see (no ray cast there).
 };
 
+/// A rectangle of block columns: the blocks (bx, by, any bz) with x0 <= bx < x1 and y0 <= by < y1,
+/// bx, by counting 8^3 blocks along the lattice's x and y. A streamed evaluation (`pandora analyze
+/// --stream`, docs/scale.md) evaluates the region tile by tile, each a rectangle of whole columns.
+struct BlockColumns {
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  /// The lattice's voxels these columns hold (clipped to the lattice).
+  Eigen::Vector3i VoxelMin() const { return {8 * x0, 8 * y0, 0}; }
+  Eigen::Vector3i VoxelEnd(const VoxelLattice& lattice) const {
+    return {std::min(8 * x1, lattice.dims.x()), std::min(8 * y1, lattice.dims.y()), lattice.dims.z()};
+  }
+};
+
 /// Splits the lattice into blocks, classifies them against the region (box or mesh) and the solids,
-/// and culls cameras per block. Runs in parallel.
+/// and culls cameras per block. Runs in parallel. With `tile`, only the blocks of those columns
+/// (clipped to the lattice).
 std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& region,
                                   const std::vector<const InsideMesh*>& solids,
                                   const InsideMesh* region_mesh, const FrustumCuller& culler,
-                                  int camera_count, ActiveSetStats* stats);
+                                  int camera_count, ActiveSetStats* stats,
+                                  const BlockColumns* tile = nullptr);
 
 /// The blocks partition `rank` of `count` evaluates (FieldOptions::partition_count): blocks sorted
 /// by cost (free voxels times (candidate cameras + 1), plus 64), largest first, each given to the

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <atomic>
 #include <cstdio>
 #include <random>
@@ -260,6 +261,102 @@ TEST(FieldEvaluator, VoxelFilterEvaluatesExactlyTheKeptVoxels) {
     });
     EXPECT_EQ(n, expected) << name;
   }
+}
+
+// A streamed evaluation (`pandora analyze --stream`): the tiles PlanTiles makes cover every block
+// column once, each tile's voxels get the full evaluation's values, no voxel is in two tiles, and
+// the tiles' statistics add up to the full evaluation's (the sigma_max lists as multisets).
+TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions all;
+  all.fields = {"coverage", "resolution", "sigma_max", "triangulation_angle"};
+  const Fields full = EvaluateFields(scene, scene.rigs[0], *caster, all);
+  const VoxelLattice& lattice = full.lattice;
+  const int nbx = (lattice.dims.x() + 7) / 8, nby = (lattice.dims.y() + 7) / 8;
+  ASSERT_GT(nbx * nby, 4);
+
+  // Budget mode: a budget of a few columns gives several tiles, each within half of it.
+  VoxelLattice column = lattice;
+  column.dims = Eigen::Vector3i(8, 8, lattice.dims.z());
+  const double per_column = EstimateFieldBytes(column, all.fields, 0);
+  const std::vector<BlockColumns> by_budget = PlanTiles(lattice, all.fields, 2 * 3.5 * per_column, 0);
+  EXPECT_GE(by_budget.size(), std::size_t(nbx * nby / 3));
+  EXPECT_EQ(PlanTiles(lattice, all.fields, 1e15, 0).size(), 1u);  // all fits: one tile
+  for (const int most : {3, 9}) {  // columns per tile: the budget's 3.5, or 3 x 3 blocks of side
+    const std::vector<BlockColumns> tiles =
+        most == 3 ? by_budget : PlanTiles(lattice, all.fields, 0, 3 * 8 * lattice.voxel_size);
+    std::vector<int> seen(nbx * nby, 0);
+    for (const BlockColumns& t : tiles) {
+      EXPECT_LE((t.x1 - t.x0) * (t.y1 - t.y0), most);
+      for (int x = t.x0; x < t.x1; ++x)
+        for (int y = t.y0; y < t.y1; ++y) ++seen[x * nby + y];
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), nbx * nby);
+  }
+
+  const std::vector<BlockColumns> tiles = PlanTiles(lattice, all.fields, 0, 3 * 8 * lattice.voxel_size);
+  ASSERT_GT(tiles.size(), 2u);
+  FieldStats sum;
+  std::map<std::string, std::int64_t> voxels;
+  std::vector<float> sigma;
+  for (const BlockColumns& tile : tiles) {
+    FieldOptions options = all;
+    options.tile = tile;
+    const Fields part = EvaluateFields(scene, scene.rigs[0], *caster, options);
+    const Fields::Impl& a = full.impl();
+    const Fields::Impl& b = part.impl();
+    const auto inside = [&](const openvdb::Coord& c) {
+      return c.x() >= 8 * tile.x0 && c.x() < 8 * tile.x1 && c.y() >= 8 * tile.y0 && c.y() < 8 * tile.y1;
+    };
+    auto full_cov = a.coverage->getConstAccessor();
+    ForEachActiveVoxel(*b.coverage, [&](const openvdb::Coord& c, std::int32_t v) {
+      ASSERT_TRUE(inside(c));
+      ASSERT_TRUE(full_cov.isValueOn(c));
+      EXPECT_EQ(v, full_cov.getValue(c));
+      ++voxels["coverage"];
+    });
+    for (const char* name : {"resolution", "sigma_max", "triangulation_angle"}) {
+      auto full_acc = a.Float(name)->getConstAccessor();
+      ForEachActiveVoxel(*b.Float(name), [&](const openvdb::Coord& c, float v) {
+        ASSERT_TRUE(inside(c)) << name;
+        ASSERT_TRUE(full_acc.isValueOn(c)) << name;
+        EXPECT_EQ(v, full_acc.getValue(c)) << name;
+        ++voxels[name];
+      });
+    }
+    const FieldStats& st = part.stats;
+    sum.active_set.region_voxels += st.active_set.region_voxels;
+    sum.active_set.solid_voxels += st.active_set.solid_voxels;
+    sum.active_set.blocks += st.active_set.blocks;
+    sum.seen_voxels += st.seen_voxels;
+    sum.triangulable_voxels += st.triangulable_voxels;
+    sum.rays += st.rays;
+    sum.point_camera_tests += st.point_camera_tests;
+    sum.coverage_histogram.resize(std::max(sum.coverage_histogram.size(), st.coverage_histogram.size()));
+    for (std::size_t k = 0; k < st.coverage_histogram.size(); ++k) sum.coverage_histogram[k] += st.coverage_histogram[k];
+    sum.per_camera_seen.resize(std::max(sum.per_camera_seen.size(), st.per_camera_seen.size()));
+    for (std::size_t c = 0; c < st.per_camera_seen.size(); ++c) sum.per_camera_seen[c] += st.per_camera_seen[c];
+    sigma.insert(sigma.end(), st.sigma_max_mm.begin(), st.sigma_max_mm.end());
+  }
+  const FieldStats& st = full.stats;
+  EXPECT_EQ(voxels["coverage"], std::int64_t(full.impl().coverage->activeVoxelCount()));
+  for (const char* name : {"resolution", "sigma_max", "triangulation_angle"})
+    EXPECT_EQ(voxels[name], std::int64_t(full.impl().Float(name)->activeVoxelCount())) << name;
+  EXPECT_EQ(sum.active_set.region_voxels, st.active_set.region_voxels);
+  EXPECT_EQ(sum.active_set.solid_voxels, st.active_set.solid_voxels);
+  EXPECT_EQ(sum.active_set.blocks, st.active_set.blocks);
+  EXPECT_EQ(sum.seen_voxels, st.seen_voxels);
+  EXPECT_EQ(sum.triangulable_voxels, st.triangulable_voxels);
+  EXPECT_GT(sum.triangulable_voxels, 1000);
+  EXPECT_EQ(sum.rays, st.rays);
+  EXPECT_EQ(sum.point_camera_tests, st.point_camera_tests);
+  EXPECT_EQ(sum.coverage_histogram, st.coverage_histogram);
+  EXPECT_EQ(sum.per_camera_seen, st.per_camera_seen);
+  std::vector<float> expected = st.sigma_max_mm;
+  std::sort(sigma.begin(), sigma.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(sigma, expected);
 }
 
 TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnASyntheticScene) {

@@ -969,13 +969,16 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   const std::string size_file = opt.voxel_size_option.empty() ? S.file : opt.voxel_size_option;
   const std::string size_path = opt.voxel_size_option.empty() ? "$.study.voxel_size" : "";
   S.fields.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
-  const double estimate = EstimateFieldBytes(S.fields.lattice, opt.fields, 0);
+  VoxelLattice estimated = S.fields.lattice;  // a tile's own box when streamed
+  if (opt.tile) estimated.dims = (opt.tile->VoxelEnd(estimated) - opt.tile->VoxelMin()).cwiseMax(0);
+  const double estimate = EstimateFieldBytes(estimated, opt.fields, 0);
   S.fields.stats.estimated_bytes = estimate;
   if (estimate > opt.memory_budget_bytes) {
     // Memory scales with 1/h^3: the smallest voxel size that fits.
     const double h_min = study.voxel_size * std::cbrt(estimate / opt.memory_budget_bytes) * 1.01;
     std::ostringstream reason, hint;
-    reason << "the region needs about " << std::llround(estimate / 1048576.0)
+    reason << (opt.tile ? "one streamed tile of the region needs about " : "the region needs about ")
+           << std::llround(estimate / 1048576.0)
            << " MiB at voxel size " << study.voxel_size << " m, over the budget of "
            << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
@@ -1035,7 +1038,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   }
   const FrustumCuller no_cameras(std::vector<Camera>{});
   S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
-                            &S.active_stats);
+                            &S.active_stats, opt.tile ? &*opt.tile : nullptr);
   if (opt.voxel_filter) {
     // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4), [&](const auto& range) {
@@ -1424,6 +1427,34 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
   double bytes = blocks * 1.15 * per_block;
   for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
   return bytes + 64.0 * camera_count;
+}
+
+std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice, const std::vector<std::string>& fields,
+                                    double budget_bytes, double tile_side) {
+  const int nbx = (lattice.dims.x() + 7) / 8, nby = (lattice.dims.y() + 7) / 8;
+  int sx = 1, sy = 1;  // tile size in block columns
+  if (tile_side > 0) {
+    const double blocks = tile_side / (8.0 * lattice.voxel_size);
+    sx = sy = static_cast<int>(std::clamp(std::round(blocks), 1.0, double(std::max(nbx, nby))));
+  } else {
+    VoxelLattice column = lattice;
+    column.dims = Eigen::Vector3i(8, 8, lattice.dims.z());
+    const double per_column = EstimateFieldBytes(column, fields, 0);
+    const double columns = std::max(1.0, std::floor(0.5 * budget_bytes / per_column));
+    if (columns >= double(nbx) * nby) {
+      sx = nbx;
+      sy = nby;
+    } else {
+      // As square as the lattice allows: a side of sqrt(columns), the other side filling the rest.
+      sx = std::clamp(static_cast<int>(std::sqrt(columns)), 1, nbx);
+      sy = std::clamp(static_cast<int>(columns / sx), 1, nby);
+      if (sy == nby) sx = std::clamp(static_cast<int>(columns / sy), 1, nbx);
+    }
+  }
+  std::vector<BlockColumns> tiles;
+  for (int x = 0; x < nbx; x += sx)
+    for (int y = 0; y < nby; y += sy) tiles.push_back({x, std::min(x + sx, nbx), y, std::min(y + sy, nby)});
+  return tiles;
 }
 
 Fields EvaluateFields(const Scene& scene, const Rig& rig, const RayCaster& caster,

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,11 @@ struct FieldOptions {
   /// statistics. The evaluated voxels get exactly the values a full evaluation gives them. Called
   /// once per free region voxel while the active set is built, from worker threads.
   std::function<bool(int i, int j, int k)> voxel_filter;
+  /// A streamed evaluation's tile (`pandora analyze --stream`, docs/scale.md): when set, only the
+  /// blocks of these block columns are evaluated, the rest of the region stays inactive and out of
+  /// the statistics; the memory estimate is the tile's. Every evaluated voxel gets exactly the
+  /// values of a full evaluation, so the tiles' union is the full evaluation's fields.
+  std::optional<BlockColumns> tile;
   /// The scene's solid and region-mesh search trees, kept between evaluations (a study's,
   /// volume/solid_trees.h); nullptr: the evaluation builds the ones it needs and drops them.
   const SolidTrees* solid_trees = nullptr;
@@ -113,6 +119,15 @@ class Fields {
 /// buffers), in bytes.
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count);
+
+/// The tiles of a streamed evaluation (`pandora analyze --stream`, docs/scale.md): rectangles of
+/// whole block columns that cover the lattice's columns once, row by row along y, then x. With
+/// `tile_side` > 0 (metres) each tile is that wide (rounded to whole 8-voxel blocks, at least one);
+/// otherwise the tiles are as few and as square as keep each one's EstimateFieldBytes within half
+/// of `budget_bytes` (the other half for the scene, its BVH and search trees, and writing). A
+/// single column over that target still makes a tile of its own (the evaluation then refuses it).
+std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice, const std::vector<std::string>& fields,
+                                    double budget_bytes, double tile_side);
 
 /// What one FieldEvaluator::Update did.
 struct FieldUpdate {

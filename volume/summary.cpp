@@ -43,8 +43,7 @@ std::optional<double> NearestRankPercentile(std::vector<float> values, double p)
   return values[rank - 1];
 }
 
-std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, const std::string& name,
-                                                        const std::vector<int>& percentiles) {
+std::vector<float> GridActiveValues(const Fields& fields, const std::string& name) {
   std::vector<float> values;
   if (const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name)) {
     values.reserve(grid->activeVoxelCount());
@@ -55,6 +54,12 @@ std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, co
         values.insert(values.end(), it.getVoxelCount(), *it);
     }
   }
+  return values;
+}
+
+std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, const std::string& name,
+                                                        const std::vector<int>& percentiles) {
+  const std::vector<float> values = GridActiveValues(fields, name);
   std::vector<std::optional<double>> out;
   for (int p : percentiles) out.push_back(NearestRankPercentile(values, p));
   return out;

@@ -166,6 +166,10 @@ nlohmann::json MakeSummary(const Scene& scene, const Rig& rig, const Fields& fie
 /// is. Lines end in '\n'.
 std::string FormatSummary(const Summary& summary);
 
+/// The active values of the float grid `name` of `fields` (tiles once per voxel they cover), in
+/// the grid's order; empty when the grid is missing.
+std::vector<float> GridActiveValues(const Fields& fields, const std::string& name);
+
 /// Nearest-rank percentiles of the active values of the float grid `name` of `fields` (tiles count
 /// once per voxel they cover), one per entry of `percentiles` (each in [0, 100]); nullopt values
 /// when the grid is missing or has no active value.

@@ -9,12 +9,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <random>
 
 #include "analysis/primitives.h"
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "tests/fixtures.h"
 #include "volume/active_set.h"
+#include "volume/value_spill.h"
 
 namespace pandora {
 namespace {
@@ -28,6 +31,63 @@ TEST(NearestRankPercentile, KnownLists) {
   EXPECT_EQ(*NearestRankPercentile(v, 100), 10.0);
   EXPECT_EQ(*NearestRankPercentile({0.25f}, 50), 0.25);
   EXPECT_FALSE(NearestRankPercentile({}, 50));
+}
+
+// A streamed run's percentiles (volume/value_spill.h) equal NearestRankPercentile over the same
+// values: 700,000 values (three read chunks) appended in uneven pieces, with many ties, values that
+// share their upper 16 bits, negatives, both zeros and a wide range of magnitudes.
+TEST(ValueSpill, EqualsNearestRankPercentileAndCounts) {
+  ValueSpill empty(std::filesystem::temp_directory_path().string(), "test");
+  EXPECT_EQ(empty.size(), 0);
+  EXPECT_FALSE(empty.Percentiles({50})[0]);
+  EXPECT_EQ(empty.CountAtMost(1.0), 0);
+
+  std::mt19937_64 rng(7);
+  std::vector<float> all;
+  ValueSpill spill(std::filesystem::temp_directory_path().string(), "test");
+  // The same values split over two spills (two processes of `--stream --mpi`).
+  ValueSpill part_a(std::filesystem::temp_directory_path().string(), "test");
+  ValueSpill part_b(std::filesystem::temp_directory_path().string(), "test");
+  std::size_t piece = 1;
+  while (all.size() < 700000) {
+    std::vector<float> part;
+    for (std::size_t i = 0; i < piece; ++i) {
+      const int kind = int(rng() % 5);
+      float v = 0;
+      if (kind == 0) v = float(rng() % 40) * 0.25f;                   // ties
+      if (kind == 1) v = 1.0f + float(rng() % 1000) * 1e-7f;         // same upper 16 bits
+      if (kind == 2) v = std::ldexp(float(rng() % 1000 + 1), int(rng() % 60) - 30);  // magnitudes
+      if (kind == 3) v = -float(rng() % 1000) * 0.125f;              // negatives
+      if (kind == 4) v = (rng() % 2) ? 0.0f : -0.0f;                 // both zeros
+      part.push_back(v);
+    }
+    spill.Append(part);
+    (piece % 2 ? part_a : part_b).Append(part);
+    all.insert(all.end(), part.begin(), part.end());
+    piece = piece * 3 + 1;
+  }
+  ASSERT_EQ(spill.size(), std::int64_t(all.size()));
+  const std::vector<double> ps{0, 0.001, 1, 10, 33.3, 50, 90, 99, 99.99, 100};
+  const std::vector<std::optional<double>> got = spill.Percentiles(ps);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    SCOPED_TRACE(ps[i]);
+    ASSERT_TRUE(got[i]);
+    EXPECT_EQ(*got[i], *NearestRankPercentile(all, ps[i]));
+  }
+  // Counts summed over the parts select and resolve the same values.
+  const auto add = [](std::vector<std::int64_t> x, const std::vector<std::int64_t>& y) {
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] += y[i];
+    return x;
+  };
+  const PercentileBins selection = SelectPercentileBins(add(part_a.HighCounts(), part_b.HighCounts()), ps);
+  const std::vector<std::optional<double>> merged = ResolvePercentiles(
+      selection, add(part_a.LowCounts(selection.bins), part_b.LowCounts(selection.bins)), ps.size());
+  for (std::size_t i = 0; i < ps.size(); ++i) EXPECT_EQ(merged[i], got[i]) << ps[i];
+  EXPECT_GT(part_a.size(), 1000);
+  EXPECT_GT(part_b.size(), 1000);
+  for (double limit : {-1e9, -3.0, 0.0, 1.0000001, 2.5, 1e9})
+    EXPECT_EQ(spill.CountAtMost(limit),
+              std::count_if(all.begin(), all.end(), [&](float v) { return double(v) <= limit; }));
 }
 
 // The box room with a solid cube in the middle of a 1 m region at 0.1 m voxels, a ring of six

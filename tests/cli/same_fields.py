@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Exit 0 when two fields.vdb files hold the same grids voxel for voxel (names, active voxels,
 values bit for bit, tiles expanded) and two summary.json files agree but for timings, run ids and
-the MPI block; else print the first difference and exit 1.
+the MPI and stream blocks; else print the first difference and exit 1. A streamed run's folder
+(`pandora analyze --stream`: no fields.vdb, the tiles listed in summary.json) counts as the union of
+its tiles, which must not share a voxel.
 
     same_fields.py A_DIR B_DIR
 """
@@ -11,7 +13,7 @@ import sys
 
 import pyopenvdb as vdb
 
-TIMING_KEYS = {"seconds", "merge_seconds", "parts_seconds", "run_id", "timing", "mpi", "cpu_seconds"}
+TIMING_KEYS = {"seconds", "merge_seconds", "parts_seconds", "run_id", "timing", "mpi", "cpu_seconds", "stream"}
 
 
 def voxels(grid):
@@ -35,15 +37,31 @@ def strip(x):
     return x
 
 
+def load(folder):
+    """{grid name: {voxel: value}} of a folder's fields.vdb, or of the union of its streamed tiles."""
+    summary = json.load(open(f"{folder}/summary.json"))
+    if "stream" not in summary:
+        return {g.name: voxels(g) for g in vdb.readAll(f"{folder}/fields.vdb")[0]}
+    out = {}
+    for tile in summary["stream"]["tiles"]:
+        for g in vdb.readAll(f"{folder}/{tile['file']}")[0]:
+            mine = voxels(g)
+            into = out.setdefault(g.name, {})
+            both = set(mine) & set(into)
+            if both:
+                sys.exit(f"grid {g.name}: voxel {next(iter(both))} in two tiles")
+            into.update(mine)
+    return out
+
+
 def main():
     a_dir, b_dir = sys.argv[1], sys.argv[2]
-    a = {g.name: g for g in vdb.readAll(f"{a_dir}/fields.vdb")[0]}
-    b = {g.name: g for g in vdb.readAll(f"{b_dir}/fields.vdb")[0]}
+    a, b = load(a_dir), load(b_dir)
     if sorted(a) != sorted(b):
         sys.exit(f"grids differ: {sorted(a)} vs {sorted(b)}")
     total = 0
     for name in sorted(a):
-        va, vb = voxels(a[name]), voxels(b[name])
+        va, vb = a[name], b[name]
         if va != vb:
             diff = next(k for k in set(va) | set(vb) if va.get(k) != vb.get(k))
             sys.exit(f"grid {name} differs at {diff}: {va.get(diff)} vs {vb.get(diff)}")

@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# `pandora analyze --stream` (docs/scale.md): the region evaluated and written tile by tile gives the
+# in-memory run's fields voxel for voxel (the union of the tiles, no voxel in two) and its summary
+# but for timings, with tiles of a given side and with tiles sized by a small memory budget; every
+# tile listed in the summary exists and says which part of the lattice it holds; what a streamed
+# run cannot compute is refused with one line and exit 2, writing nothing.
+# With MPI (the last argument "mpi"), `mpirun -n 2 ... --stream --mpi` gives the same files.
+# Usage: check_stream.sh PANDORA PYTHON SCENE WORK_DIR FIELDS TILE_SIZE BUDGET_MIB [mpi]
+set -u
+pandora=$1; python=$2; scene=$3; work=$4; fields=$5; tile=$6; budget=$7; with_mpi=${8:-}
+here=$(cd "$(dirname "$0")" && pwd)
+fail() { echo "FAIL: $*"; exit 1; }
+rm -rf "$work"; mkdir -p "$work"
+"$pandora" analyze "$scene" --fields "$fields" --out "$work/memory" --quiet || fail "in-memory analyze exit $?"
+"$pandora" analyze "$scene" --fields "$fields" --out "$work/sized" --stream --tile-size "$tile" --quiet \
+  || fail "--stream --tile-size exit $?"
+"$pandora" analyze "$scene" --fields "$fields" --out "$work/budget" --stream --memory-budget "$budget" --quiet \
+  || fail "--stream --memory-budget exit $?"
+runs="sized budget"
+# Under mpirun (when installed): two processes share the tiles, each writes its own; the same files.
+if [ "$with_mpi" = mpi ] && command -v mpirun >/dev/null; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+  mpirun -n 2 "$pandora" analyze "$scene" --fields "$fields" --out "$work/mpi" --stream --tile-size "$tile" \
+    --mpi --threads 1 --quiet > "$work/mpi.log" 2>&1 || fail "mpirun -n 2 --stream exit $?: $(tail -5 "$work/mpi.log")"
+  runs="$runs mpi"
+fi
+for run in $runs; do
+  [ ! -e "$work/$run/fields.vdb" ] || fail "$run: a streamed run wrote fields.vdb"
+  "$python" "$here/same_fields.py" "$work/memory" "$work/$run" || fail "$run: streamed differs from in-memory"
+  "$python" - "$work/$run" <<'PY' || fail "$run: tiles"
+import json, os, sys
+import pyopenvdb as vdb
+folder = sys.argv[1]
+s = json.load(open(f"{folder}/summary.json"))
+st = s["stream"]
+tiles = st["tiles"]
+assert st["tile_count"] == len(tiles) > 1, st["tile_count"]
+assert sorted(os.listdir(f"{folder}/fields")) == sorted(os.path.basename(t["file"]) for t in tiles)
+assert sum(t["region_voxels"] for t in tiles) == s["region_voxels"]
+assert sum(t["seen_voxels"] for t in tiles) == s["active_voxels"]
+if folder.endswith("budget"):  # tiles sized by the budget: each estimate within half of it
+    assert st["largest_tile_estimate_mib"] <= st["memory_budget_mib"] / 2, st
+if folder.endswith("mpi"):  # both processes wrote tiles
+    assert st["ranks"] == 2 and sorted({t["rank"] for t in tiles}) == [0, 1], st
+for i, t in enumerate(tiles):
+    meta = vdb.readAllGridMetadata(f"{folder}/{t['file']}")[0]
+    assert meta["tile"] == f"{i} of {len(tiles)}", meta["tile"]
+    assert meta["tile_voxel_min"] == ",".join(map(str, t["voxel_min"])), meta
+    assert meta["run_id"] == s["run_id"]
+PY
+done
+# Refused: what needs the whole fields, and options that do not go together. One line, exit 2,
+# nothing written.
+expect_refusal() {
+  local what=$1; shift
+  local err code
+  err=$("$pandora" analyze "$scene" --out "$work/refused" "$@" 2>&1 >/dev/null); code=$?
+  [ "$code" -eq 2 ] || fail "$what: exit $code, expected 2 ($err)"
+  [ "$(printf '%s\n' "$err" | wc -l)" -eq 1 ] || fail "$what: expected one line, got: $err"
+  printf '%s\n' "$err" | grep -q -- "$what" || fail "expected '$what' in: $err"
+  [ ! -e "$work/refused" ] || fail "$what: wrote $work/refused"
+}
+expect_refusal "--fields" --stream --fields coverage,cameras
+expect_refusal "--tile-size" --tile-size 1
+expect_refusal "--tile-size" --stream --tile-size -1 --fields coverage
+# The scene with a named sub-region, pixel-size targets or DORI classes: each refused by name.
+for extra in 'regions|{"regions": {"middle": {"box": {"min": [-10, -10, -10], "max": [10, 10, 10]}}}}' \
+             'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}' \
+             'dori|{"dori": true}'; do
+  key=${extra%%|*}
+  "$python" - "$scene" "$work/with_$key.json" "${extra#*|}" <<'PY' || fail "writing the $key scene"
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["study"].update(json.loads(sys.argv[3]))
+json.dump(s, open(sys.argv[2], "w"))
+PY
+  # (pixel targets need the cameras field, which a streamed run refuses first)
+  [ "$key" = pixel_targets ] || "$pandora" analyze "$work/with_$key.json" --fields coverage,resolution \
+    --out "$work/refused" --quiet || fail "the $key scene does not analyze in memory"
+  rm -rf "$work/refused"
+  err=$("$pandora" analyze "$work/with_$key.json" --fields coverage,resolution --out "$work/refused" --stream 2>&1 >/dev/null); code=$?
+  [ "$code" -eq 2 ] && [ "$(printf '%s\n' "$err" | wc -l)" -eq 1 ] || fail "$key: exit $code: $err"
+  printf '%s\n' "$err" | grep -qF "\$.study.$key" || fail "$key: not named in: $err"
+  [ ! -e "$work/refused" ] || fail "$key: wrote $work/refused"
+done
+echo "stream: tiles equal the in-memory run"
