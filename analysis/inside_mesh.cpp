@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <iterator>
 #include <vector>
 #include <stdexcept>
@@ -30,9 +31,74 @@ using Side = CGAL::Side_of_triangle_mesh<Mesh, Kernel, CGAL::Default, Tree>;
 
 }  // namespace
 
+// The faces bucketed by their bounding boxes over a uniform grid of the mesh's (x, y) extent, for
+// ColumnAt: a vertical line looks at its cell's faces only. A face is in every cell its (x, y)
+// bounding box meets; cells are found with the same rounded expression for boxes and lines, and
+// rounding is monotone, so a line's cell holds every face whose closed box contains the line.
+struct ColumnGrid {
+  double x0 = 0, y0 = 0, cw = 1, ch = 1;
+  int nx = 1, ny = 1;
+  std::vector<std::uint32_t> start;  // per cell, into faces; nx * ny + 1
+  std::vector<std::uint32_t> faces;
+  std::vector<std::array<Point, 3>> corners;  // per face
+
+  int Cell(double v, double v0, double w, int n) const {
+    return static_cast<int>(std::clamp(std::floor((v - v0) / w), 0.0, double(n - 1)));
+  }
+  int CellX(double x) const { return Cell(x, x0, cw, nx); }
+  int CellY(double y) const { return Cell(y, y0, ch, ny); }
+
+  void Build(const Mesh& mesh, const Aabb& bounds) {
+    corners.clear();
+    for (const auto f : CGAL::faces(mesh)) {
+      std::array<Point, 3> v;
+      int k = 0;
+      for (const auto vertex : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+        if (k < 3) v[k++] = mesh.point(vertex);
+      corners.push_back(v);
+    }
+    const double n = static_cast<double>(corners.size());
+    const double wx = bounds.max.x() - bounds.min.x(), wy = bounds.max.y() - bounds.min.y();
+    x0 = bounds.min.x();
+    y0 = bounds.min.y();
+    // About one face per cell (a closed surface projects onto its footprint twice), at most 1024
+    // cells a side; coarser while large faces would fill too many cells.
+    double cells = std::max(1.0, n);
+    for (;;) {
+      const double aspect = wy > 0 && wx > 0 ? wx / wy : 1.0;
+      nx = wx > 0 ? static_cast<int>(std::clamp(std::round(std::sqrt(cells * aspect)), 1.0, 1024.0)) : 1;
+      ny = wy > 0 ? static_cast<int>(std::clamp(std::round(std::sqrt(cells / aspect)), 1.0, 1024.0)) : 1;
+      cw = wx > 0 ? wx / nx : 1.0;
+      ch = wy > 0 ? wy / ny : 1.0;
+      std::size_t entries = 0;
+      for (const auto& v : corners) {
+        const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
+        const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
+        entries += std::size_t(CellX(x_hi) - CellX(x_lo) + 1) * std::size_t(CellY(y_hi) - CellY(y_lo) + 1);
+      }
+      if (entries <= 16 * corners.size() + 4096 || (nx == 1 && ny == 1)) break;
+      cells /= 4;
+    }
+    start.assign(std::size_t(nx) * ny + 1, 0);
+    const auto each_cell = [&](const std::array<Point, 3>& v, auto&& fn) {
+      const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
+      const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
+      for (int i = CellX(x_lo); i <= CellX(x_hi); ++i)
+        for (int j = CellY(y_lo); j <= CellY(y_hi); ++j) fn(std::size_t(i) * ny + j);
+    };
+    for (const auto& v : corners) each_cell(v, [&](std::size_t c) { ++start[c + 1]; });
+    for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
+    faces.assign(start.back(), 0);
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < corners.size(); ++f)
+      each_cell(corners[f], [&](std::size_t c) { faces[fill[c]++] = static_cast<std::uint32_t>(f); });
+  }
+};
+
 struct InsideMesh::Impl {
   Mesh mesh;
   Tree tree;
+  ColumnGrid columns;
   // Side_of_triangle_mesh keeps mutable state (a random generator for degenerate rays), so each
   // thread uses its own, all sharing the one tree.
   mutable tbb::enumerable_thread_specific<std::unique_ptr<Side>> sides;
@@ -58,6 +124,7 @@ InsideMesh::InsideMesh(const TriangleMesh& closed_mesh) : impl_(std::make_unique
   impl_->tree.insert(CGAL::faces(impl_->mesh).first, CGAL::faces(impl_->mesh).second, impl_->mesh);
   impl_->tree.build();
   bounds_ = closed_mesh.Bounds();
+  impl_->columns.Build(impl_->mesh, bounds_);
 }
 
 InsideMesh::~InsideMesh() = default;
@@ -74,29 +141,27 @@ InsideMesh::Column InsideMesh::ColumnAt(double x, double y) const {
   if (!(x >= bounds_.min.x() && x <= bounds_.max.x() && y >= bounds_.min.y() && y <= bounds_.max.y()))
     return column;
   column.outside = false;
-  // The vertical segment through the whole mesh; every face it meets.
-  const double pad = 1 + (bounds_.max.z() - bounds_.min.z());
-  const Kernel::Segment_3 line(Point(x, y, bounds_.min.z() - pad), Point(x, y, bounds_.max.z() + pad));
-  std::vector<Primitive::Id> faces;
-  impl_->tree.all_intersected_primitives(line, std::back_inserter(faces));
+  // The faces whose (x, y) bounding box may hold the line: its cell's (ColumnGrid).
+  const ColumnGrid& grid = impl_->columns;
+  const std::size_t cell = std::size_t(grid.CellX(x)) * grid.ny + grid.CellY(y);
   const Kernel::Point_2 q(x, y);
   const auto degenerate = [&column] {
     column.degenerate = true;
     column.crossings.clear();
     return column;
   };
-  for (const Primitive::Id f : faces) {
-    std::array<Point, 3> v;
-    int k = 0;
-    for (const auto vertex : CGAL::vertices_around_face(impl_->mesh.halfedge(f), impl_->mesh))
-      if (k < 3) v[k++] = impl_->mesh.point(vertex);
+  for (std::uint32_t i = grid.start[cell]; i < grid.start[cell + 1]; ++i) {
+    const std::array<Point, 3>& v = grid.corners[grid.faces[i]];
     const Kernel::Point_2 a(v[0].x(), v[0].y()), b(v[1].x(), v[1].y()), c(v[2].x(), v[2].y());
     const CGAL::Orientation o0 = CGAL::orientation(a, b, q), o1 = CGAL::orientation(b, c, q),
                             o2 = CGAL::orientation(c, a, q);
+    // Strictly on both sides of the face's edges: the line passes beside the face (exact).
+    const bool left = o0 == CGAL::LEFT_TURN || o1 == CGAL::LEFT_TURN || o2 == CGAL::LEFT_TURN;
+    const bool right = o0 == CGAL::RIGHT_TURN || o1 == CGAL::RIGHT_TURN || o2 == CGAL::RIGHT_TURN;
+    if (left && right) continue;
     // Through an edge or a vertex in projection (or in a vertical face's plane): the parity along
     // this line is ambiguous; Side_of_triangle_mesh's own degeneracy handling decides.
     if (o0 == CGAL::COLLINEAR || o1 == CGAL::COLLINEAR || o2 == CGAL::COLLINEAR) return degenerate();
-    if (o0 != o1 || o1 != o2) continue;  // the line passes beside the face
     Column::Crossing crossing;
     crossing.a = Vec3(v[0].x(), v[0].y(), v[0].z());
     crossing.b = Vec3(v[1].x(), v[1].y(), v[1].z());

@@ -1254,9 +1254,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         if (e.seen == 0) continue;
         const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
         auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
-        for (int w = 0; w < kWords; ++w)
-          for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
-            leaf->setValueOn(64 * w + __builtin_ctzll(bits), true);
+        // Word by word: the leaf's value mask and its values are both these bits (OpenVDB's
+        // 512-bit masks number voxels as Block::Offset does).
+        openvdb::BoolTree::LeafNodeType::NodeMaskType& mask = leaf->getValueMask();
+        auto* values = leaf->buffer().data();
+        for (int w = 0; w < kWords; ++w) {
+          mask.getWord<openvdb::Index64>(w) = e.bits[w];
+          values[w] = e.bits[w];
+        }
         leaves[i].visible.emplace_back(e.camera, leaf);
       }
     if (!S.keep) {
@@ -1335,52 +1340,76 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     g.visible.resize(new_count);
     for (std::size_t c = had; c < g.visible.size(); ++c) MakeGrid(g.visible[c], "visible", g.transform);
   }
-  for (std::size_t b = 0; b < S.blocks.size(); ++b) S.states[b].candidates = std::move(candidates[b]);
-  for (std::size_t i = 0; i < dirty.size(); ++i) {
-    const std::size_t b = dirty[i];
-    const Block& block = S.blocks[b];
-    const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
-    BlockState& s = S.states[b];
-    BlockLeaves& l = leaves[i];
-    if (l.coverage_tile) g.coverage->tree().addTile(1, origin, 0, true);
-    if (l.coverage && l.coverage_owned) g.coverage->tree().addLeaf(l.coverage);
-    for (int f = 0; f < kFloatFieldCount; ++f) {
-      if (!S.want_float[f]) continue;
+  // Each grid's leaves go in by a task of their own (the trees are independent), then the states.
+  std::vector<std::function<void()>> grid_tasks;
+  const auto origin_of = [&](std::size_t i) {
+    const Block& block = S.blocks[dirty[i]];
+    return openvdb::Coord(block.origin.x(), block.origin.y(), block.origin.z());
+  };
+  grid_tasks.emplace_back([&] {
+    for (std::size_t i = 0; i < dirty.size(); ++i) {
+      BlockLeaves& l = leaves[i];
+      if (l.coverage_tile) g.coverage->tree().addTile(1, origin_of(i), 0, true);
+      if (l.coverage && l.coverage_owned) g.coverage->tree().addLeaf(l.coverage);
+    }
+  });
+  for (int f = 0; f < kFloatFieldCount; ++f) {
+    if (!S.want_float[f]) continue;
+    grid_tasks.emplace_back([&, f] {
       openvdb::FloatTree& tree = S.float_grids[f]->tree();
-      if (l.floats[f] && l.float_owned[f])
-        tree.addLeaf(l.floats[f]);
-      else if (l.floats[f])
-        ;  // rewritten in place
-      else if (l.remove_float[f] && tree.probeConstLeaf(origin))
-        tree.addTile(1, origin, 0.0f, false);
-    }
-    if (S.want_cameras) {
-      // The changed cameras' old leaves go, their new ones come.
-      for (const CameraEntry& e : s.entries)
-        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0) {
-          openvdb::BoolTree& tree = g.visible[e.camera]->tree();
-          if (tree.probeConstLeaf(origin)) tree.addTile(1, origin, false, false);
-        }
-      for (auto& [c, leaf] : l.visible) g.visible[c]->tree().addLeaf(leaf);
-    }
-    // Entries: the kept ones and the re-cast ones, in camera order.
-    std::vector<CameraEntry> entries;
-    entries.reserve(s.entries.size() + cast[i].size());
-    for (CameraEntry& e : s.entries)
-      if (!is_changed[e.camera]) entries.push_back(std::move(e));
-    for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));
-    std::sort(entries.begin(), entries.end(),
-              [](const CameraEntry& a, const CameraEntry& b) { return a.camera < b.camera; });
-    BlockState& n = next[i];
-    if (!n.histogram.empty() || s.coverage.empty()) {
-      n.candidates = std::move(s.candidates);
-      n.entries = std::move(entries);
-      s = std::move(n);
-    } else {
-      s.entries = std::move(entries);  // nothing seen changed: caches and summary stay
-      s.rays = std::move(n.rays);
-    }
+      for (std::size_t i = 0; i < dirty.size(); ++i) {
+        BlockLeaves& l = leaves[i];
+        if (l.floats[f] && l.float_owned[f])
+          tree.addLeaf(l.floats[f]);
+        else if (l.floats[f])
+          ;  // rewritten in place
+        else if (l.remove_float[f] && tree.probeConstLeaf(origin_of(i)))
+          tree.addTile(1, origin_of(i), 0.0f, false);
+      }
+    });
   }
+  // Per camera: the blocks where a changed camera's old leaf goes, and its new leaves.
+  std::vector<std::vector<std::size_t>> camera_removed(S.want_cameras ? new_count : 0);
+  std::vector<std::vector<openvdb::BoolTree::LeafNodeType*>> camera_added(camera_removed.size());
+  if (S.want_cameras) {
+    for (std::size_t i = 0; i < dirty.size(); ++i) {
+      for (const CameraEntry& e : S.states[dirty[i]].entries)
+        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0) camera_removed[e.camera].push_back(i);
+      for (auto& [camera, leaf] : leaves[i].visible) camera_added[camera].push_back(leaf);
+    }
+    for (int c = 0; c < new_count; ++c)
+      if (!camera_removed[c].empty() || !camera_added[c].empty())
+        grid_tasks.emplace_back([&, c] {
+          openvdb::BoolTree& tree = g.visible[c]->tree();
+          for (std::size_t i : camera_removed[c])
+            if (tree.probeConstLeaf(origin_of(i))) tree.addTile(1, origin_of(i), false, false);
+          for (auto* leaf : camera_added[c]) tree.addLeaf(leaf);
+        });
+  }
+  tbb::parallel_for(std::size_t(0), grid_tasks.size(), [&](std::size_t t) { grid_tasks[t](); });
+  for (std::size_t b = 0; b < S.blocks.size(); ++b) S.states[b].candidates = std::move(candidates[b]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 16), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      BlockState& s = S.states[dirty[i]];
+      // Entries: the kept ones and the re-cast ones, in camera order.
+      std::vector<CameraEntry> entries;
+      entries.reserve(s.entries.size() + cast[i].size());
+      for (CameraEntry& e : s.entries)
+        if (!is_changed[e.camera]) entries.push_back(std::move(e));
+      for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));
+      std::sort(entries.begin(), entries.end(),
+                [](const CameraEntry& a, const CameraEntry& b) { return a.camera < b.camera; });
+      BlockState& n = next[i];
+      if (!n.histogram.empty() || s.coverage.empty()) {
+        n.candidates = std::move(s.candidates);
+        n.entries = std::move(entries);
+        s = std::move(n);
+      } else {
+        s.entries = std::move(entries);  // nothing seen changed: caches and summary stay
+        s.rays = std::move(n.rays);
+      }
+    }
+  });
   if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
   if (S.evaluated) {
     for (auto& [name, grid] : g.floats) openvdb::tools::pruneInactive(grid->tree());
