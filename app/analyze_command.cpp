@@ -276,11 +276,6 @@ std::string Triple(const Eigen::Vector3i& v) {
   return std::to_string(v.x()) + "," + std::to_string(v.y()) + "," + std::to_string(v.z());
 }
 
-void AddCounts(std::vector<std::int64_t>* into, const std::vector<std::int64_t>& counts) {
-  into->resize(std::max(into->size(), counts.size()), 0);
-  for (std::size_t i = 0; i < counts.size(); ++i) (*into)[i] += counts[i];
-}
-
 // The additive part of FieldStats, to send to rank 0 and add up there.
 nlohmann::json StatsToJson(const FieldStats& s) {
   return {{"region_voxels", s.active_set.region_voxels}, {"solid_voxels", s.active_set.solid_voxels},
@@ -292,22 +287,23 @@ nlohmann::json StatsToJson(const FieldStats& s) {
 }
 
 void AddStats(FieldStats* s, const nlohmann::json& j) {
-  s->active_set.region_voxels += j.at("region_voxels").get<std::int64_t>();
-  s->active_set.solid_voxels += j.at("solid_voxels").get<std::int64_t>();
-  s->active_set.blocks += j.at("blocks").get<std::int64_t>();
-  s->active_set.culled_blocks += j.at("culled_blocks").get<std::int64_t>();
-  s->seen_voxels += j.at("seen").get<std::int64_t>();
-  s->triangulable_voxels += j.at("triangulable").get<std::int64_t>();
-  s->unobservable_voxels += j.at("unobservable").get<std::int64_t>();
-  s->point_camera_tests += j.at("tests").get<std::int64_t>();
-  s->rays += j.at("rays").get<std::int64_t>();
-  // The tiles run one after another: their times add up (across processes, the slowest would be
-  // the wall time; the sum is the work).
-  s->seconds += j.at("seconds").get<double>();
-  s->cpu_seconds += j.at("cpu_seconds").get<double>();
-  s->active_set_seconds += j.at("active_set_seconds").get<double>();
-  AddCounts(&s->coverage_histogram, j.at("histogram").get<std::vector<std::int64_t>>());
-  AddCounts(&s->per_camera_seen, j.at("per_camera").get<std::vector<std::int64_t>>());
+  FieldStats part;
+  part.active_set.region_voxels = j.at("region_voxels").get<std::int64_t>();
+  part.active_set.solid_voxels = j.at("solid_voxels").get<std::int64_t>();
+  part.active_set.blocks = j.at("blocks").get<std::int64_t>();
+  part.active_set.culled_blocks = j.at("culled_blocks").get<std::int64_t>();
+  part.seen_voxels = j.at("seen").get<std::int64_t>();
+  part.triangulable_voxels = j.at("triangulable").get<std::int64_t>();
+  part.unobservable_voxels = j.at("unobservable").get<std::int64_t>();
+  part.point_camera_tests = j.at("tests").get<std::int64_t>();
+  part.rays = j.at("rays").get<std::int64_t>();
+  // Across processes the sum of the times is the work (the slowest would be the wall time).
+  part.seconds = j.at("seconds").get<double>();
+  part.cpu_seconds = j.at("cpu_seconds").get<double>();
+  part.active_set_seconds = j.at("active_set_seconds").get<double>();
+  part.coverage_histogram = j.at("histogram").get<std::vector<std::int64_t>>();
+  part.per_camera_seen = j.at("per_camera").get<std::vector<std::int64_t>>();
+  AddFieldStats(s, part);
 }
 
 // Every process's `counts` (`size` of them), summed at rank 0 (empty on the others).
@@ -421,26 +417,12 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
       Fields f = EvaluateFields(scene, rig, study->caster(), o);
       FieldStats& st = f.stats;
-      total.active_set.region_voxels += st.active_set.region_voxels;
-      total.active_set.solid_voxels += st.active_set.solid_voxels;
-      total.active_set.blocks += st.active_set.blocks;
-      total.active_set.culled_blocks += st.active_set.culled_blocks;
-      total.seen_voxels += st.seen_voxels;
-      total.triangulable_voxels += st.triangulable_voxels;
-      total.unobservable_voxels += st.unobservable_voxels;
-      total.point_camera_tests += st.point_camera_tests;
-      total.rays += st.rays;
-      total.seconds += st.seconds;
-      total.cpu_seconds += st.cpu_seconds;
-      total.active_set_seconds += st.active_set_seconds;
-      most_estimated = std::max(most_estimated, st.estimated_bytes);
-      AddCounts(&total.coverage_histogram, st.coverage_histogram);
-      AddCounts(&total.per_camera_seen, st.per_camera_seen);
       if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
       spills[1]->Append(st.sigma_max_mm);
       spills[2]->Append(st.sigma_max_steady_mm);
-      std::vector<float>().swap(st.sigma_max_mm);
+      std::vector<float>().swap(st.sigma_max_mm);  // spilled: not kept in memory
       std::vector<float>().swap(st.sigma_max_steady_mm);
+      AddFieldStats(&total, st);
       const Eigen::Vector3i lo = tiles[t].VoxelMin(), end = tiles[t].VoxelEnd(lattice);
       std::map<std::string, std::string> tile_meta = meta;
       tile_meta["tile"] = std::to_string(t) + " of " + std::to_string(tiles.size());
@@ -467,6 +449,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
 
   // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
   // spilled values by two rounds of summed counts (only the counts travel).
+  most_estimated = total.estimated_bytes;
   const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
                             {"estimated", most_estimated}, {"peak_rss_mib", PeakRssMiB()}};
   const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());

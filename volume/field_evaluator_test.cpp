@@ -299,7 +299,6 @@ TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
   ASSERT_GT(tiles.size(), 2u);
   FieldStats sum;
   std::map<std::string, std::int64_t> voxels;
-  std::vector<float> sigma;
   for (const BlockColumns& tile : tiles) {
     FieldOptions options = all;
     options.tile = tile;
@@ -326,19 +325,9 @@ TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
       });
     }
     const FieldStats& st = part.stats;
-    sum.active_set.region_voxels += st.active_set.region_voxels;
-    sum.active_set.solid_voxels += st.active_set.solid_voxels;
-    sum.active_set.blocks += st.active_set.blocks;
-    sum.seen_voxels += st.seen_voxels;
-    sum.triangulable_voxels += st.triangulable_voxels;
-    sum.rays += st.rays;
-    sum.point_camera_tests += st.point_camera_tests;
-    sum.coverage_histogram.resize(std::max(sum.coverage_histogram.size(), st.coverage_histogram.size()));
-    for (std::size_t k = 0; k < st.coverage_histogram.size(); ++k) sum.coverage_histogram[k] += st.coverage_histogram[k];
-    sum.per_camera_seen.resize(std::max(sum.per_camera_seen.size(), st.per_camera_seen.size()));
-    for (std::size_t c = 0; c < st.per_camera_seen.size(); ++c) sum.per_camera_seen[c] += st.per_camera_seen[c];
-    sigma.insert(sigma.end(), st.sigma_max_mm.begin(), st.sigma_max_mm.end());
+    AddFieldStats(&sum, st);
   }
+  std::vector<float>& sigma = sum.sigma_max_mm;
   const FieldStats& st = full.stats;
   EXPECT_EQ(voxels["coverage"], std::int64_t(full.impl().coverage->activeVoxelCount()));
   for (const char* name : {"resolution", "sigma_max", "triangulation_angle"})

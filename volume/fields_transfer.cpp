@@ -1,5 +1,7 @@
 #include "volume/fields_transfer.h"
 
+#include <algorithm>
+
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
@@ -69,6 +71,31 @@ void MergeTree(const GridPtr& into, openvdb::GridBase::Ptr from, const std::stri
 }
 
 }  // namespace
+
+void AddFieldStats(FieldStats* into, const FieldStats& part) {
+  const auto add = [](std::vector<std::int64_t>* a, const std::vector<std::int64_t>& b) {
+    a->resize(std::max(a->size(), b.size()), 0);
+    for (std::size_t i = 0; i < b.size(); ++i) (*a)[i] += b[i];
+  };
+  into->active_set.region_voxels += part.active_set.region_voxels;
+  into->active_set.solid_voxels += part.active_set.solid_voxels;
+  into->active_set.blocks += part.active_set.blocks;
+  into->active_set.culled_blocks += part.active_set.culled_blocks;
+  into->seen_voxels += part.seen_voxels;
+  into->triangulable_voxels += part.triangulable_voxels;
+  into->unobservable_voxels += part.unobservable_voxels;
+  into->point_camera_tests += part.point_camera_tests;
+  into->rays += part.rays;
+  add(&into->coverage_histogram, part.coverage_histogram);
+  add(&into->per_camera_seen, part.per_camera_seen);
+  into->sigma_max_mm.insert(into->sigma_max_mm.end(), part.sigma_max_mm.begin(), part.sigma_max_mm.end());
+  into->sigma_max_steady_mm.insert(into->sigma_max_steady_mm.end(), part.sigma_max_steady_mm.begin(),
+                                   part.sigma_max_steady_mm.end());
+  into->seconds += part.seconds;
+  into->cpu_seconds += part.cpu_seconds;
+  into->active_set_seconds += part.active_set_seconds;
+  into->estimated_bytes = std::max(into->estimated_bytes, part.estimated_bytes);
+}
 
 std::string SerializePartialFields(const Fields& fields) {
   const FieldStats& s = fields.stats;
