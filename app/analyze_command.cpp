@@ -269,7 +269,6 @@ void CheckStreamable(const AnalyzeArgs& args, const Scene& scene, const Rig& rig
   if (scene.Animated()) refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions", "moving objects' fields over time");
   if (!scene.study.regions.empty()) refuse(scene.path, "$.study.regions", "the named sub-regions' summary");
   if (!scene.study.pixel_targets.empty()) refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
-  if (scene.study.dori) refuse(scene.path, "$.study.dori", "the DORI classes");
 }
 
 std::string Triple(const Eigen::Vector3i& v) {
@@ -401,6 +400,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   const std::string spill_folder = std::filesystem::path(tile_paths[0]).parent_path().string();
   std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
   FieldStats total;
+  DoriSummary dori;
   nlohmann::json tile_list = nlohmann::json::array();
   double most_estimated = 0;
   std::vector<std::size_t> mine;
@@ -417,6 +417,12 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
       Fields f = EvaluateFields(scene, rig, study->caster(), o);
       FieldStats& st = f.stats;
+      // DORI classes: the tile's grid, and its counts added up (the shares at the end).
+      if (scene.study.dori) {
+        const DoriSummary d = EvaluateDori(scene, f, &f);
+        dori.voxels += d.voxels;
+        for (int k = 0; k < 4; ++k) dori.reached[k] += d.reached[k];
+      }
       if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
       spills[1]->Append(st.sigma_max_mm);
       spills[2]->Append(st.sigma_max_steady_mm);
@@ -451,14 +457,19 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   // spilled values by two rounds of summed counts (only the counts travel).
   most_estimated = total.estimated_bytes;
   const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
+                            {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
                             {"estimated", most_estimated}, {"peak_rss_mib", PeakRssMiB()}};
   const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
   nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
   if (root) {
     total = FieldStats{};
+    dori = DoriSummary{};
     for (const std::string& p : parts) {
       const nlohmann::json j = nlohmann::json::parse(p);
       AddStats(&total, j.at("stats"));
+      const auto counts = j.at("dori").get<std::vector<std::int64_t>>();
+      dori.voxels += counts.at(0);
+      for (int k = 0; k < 4; ++k) dori.reached[k] += counts.at(1 + k);
       for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
       most_estimated = std::max(most_estimated, j.at("estimated").get<double>());
       peak_rss.push_back(j.at("peak_rss_mib"));
@@ -512,6 +523,10 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       u.sigma_max_steady_mm = SigmaPercentiles{steady_p[0], steady_p[1], steady_p[2]};
       if (u.max_sigma_mm) u.meets_max_sigma_steady = share(steady_meets);
     }
+  }
+  if (scene.study.dori) {
+    dori.SetShares();
+    typed.dori = dori;
   }
   if (scene.study.targets)
     typed.targets = EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());

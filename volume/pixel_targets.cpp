@@ -85,7 +85,8 @@ DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids
     throw InputError(scene.path, "$.study.dori", "DORI classes need the coverage and resolution fields",
                      "add \"coverage\" and \"resolution\" to the study's fields");
   DoriSummary s;
-  std::int64_t total = 0, reached[4] = {0, 0, 0, 0};
+  std::int64_t& total = s.voxels;
+  std::int64_t* reached = s.reached;
   openvdb::FloatGrid::Ptr grid;
   if (grids) {
     grid = openvdb::FloatGrid::create(0.0f);
@@ -100,11 +101,7 @@ DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids
       if (d >= kDoriPxPerM[k]) cls = k + 1, ++reached[k];
     if (grid) grid->tree().setValue(c, float(cls));
   });
-  const double n = total > 0 ? double(total) : 1.0;
-  s.detection = reached[0] / n;
-  s.observation = reached[1] / n;
-  s.recognition = reached[2] / n;
-  s.identification = reached[3] / n;
+  s.SetShares();
   if (grid) {
     grid->pruneGrid();
     grids->impl().extra["dori"] = grid;

@@ -30,6 +30,18 @@ struct DoriSummary {
   /// Share of the free region voxels whose best density reaches detection (25 px/m), observation
   /// (62.5), recognition (125), identification (250).
   double detection = 0, observation = 0, recognition = 0, identification = 0;
+  /// The counts behind the shares: free region voxels, and those reaching each class (a streamed
+  /// run adds its tiles' counts; not in summary.json).
+  std::int64_t voxels = 0;
+  std::int64_t reached[4] = {0, 0, 0, 0};
+  /// The shares from the counts.
+  void SetShares() {
+    const double n = voxels > 0 ? double(voxels) : 1.0;
+    detection = reached[0] / n;
+    observation = reached[1] / n;
+    recognition = reached[2] / n;
+    identification = reached[3] / n;
+  }
 };
 
 /// The EN 62676-4 thresholds, px/m.

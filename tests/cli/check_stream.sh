@@ -3,7 +3,7 @@
 # in-memory run's fields voxel for voxel (the union of the tiles, no voxel in two) and its summary
 # but for timings, with tiles of a given side and with tiles sized by a small memory budget; every
 # tile listed in the summary exists and says which part of the lattice it holds; what a streamed
-# run cannot compute is refused with one line and exit 2, writing nothing.
+# run cannot compute is refused with one line and exit 2, writing nothing; DORI classes stream too.
 # With MPI (the last argument "mpi"), `mpirun -n 2 ... --stream --mpi` gives the same files.
 # Usage: check_stream.sh PANDORA PYTHON SCENE WORK_DIR FIELDS TILE_SIZE BUDGET_MIB [mpi]
 set -u
@@ -63,10 +63,9 @@ expect_refusal() {
 expect_refusal "--fields" --stream --fields coverage,cameras
 expect_refusal "--tile-size" --tile-size 1
 expect_refusal "--tile-size" --stream --tile-size -1 --fields coverage
-# The scene with a named sub-region, pixel-size targets or DORI classes: each refused by name.
+# The scene with a named sub-region or pixel-size targets: each refused by name.
 for extra in 'regions|{"regions": {"middle": {"box": {"min": [-10, -10, -10], "max": [10, 10, 10]}}}}' \
-             'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}' \
-             'dori|{"dori": true}'; do
+             'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}'; do
   key=${extra%%|*}
   "$python" - "$scene" "$work/with_$key.json" "${extra#*|}" <<'PY' || fail "writing the $key scene"
 import json, sys
@@ -83,4 +82,17 @@ PY
   printf '%s\n' "$err" | grep -qF "\$.study.$key" || fail "$key: not named in: $err"
   [ ! -e "$work/refused" ] || fail "$key: wrote $work/refused"
 done
+# DORI classes stream: each tile holds its part of the "dori" grid, the shares add up exactly.
+"$python" - "$scene" "$work/with_dori.json" <<'PY' || fail "writing the DORI scene"
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["study"]["dori"] = True
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution --out "$work/dori_memory" --quiet || fail "DORI in memory"
+"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution --out "$work/dori_stream" --stream \
+  --tile-size "$tile" --quiet || fail "DORI streamed"
+"$python" "$here/same_fields.py" "$work/dori_memory" "$work/dori_stream" || fail "DORI: streamed differs from in-memory"
+"$python" -c "import json,sys; d=json.load(open(sys.argv[1]))['dori']; assert 0 < d['detection'] <= 1, d" \
+  "$work/dori_stream/summary.json" || fail "DORI: no detection share"
 echo "stream: tiles equal the in-memory run"
