@@ -267,7 +267,6 @@ void CheckStreamable(const AnalyzeArgs& args, const Scene& scene, const Rig& rig
                      "ask for the others, e.g. --fields coverage,resolution,sigma_max");
   if (RigHasPtz(rig)) refuse(scene.path, "$.rigs", "the PTZ fields of rig '" + rig.name + "'");
   if (scene.Animated()) refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions", "moving objects' fields over time");
-  if (!scene.study.regions.empty()) refuse(scene.path, "$.study.regions", "the named sub-regions' summary");
   if (!scene.study.pixel_targets.empty()) refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
 }
 
@@ -303,6 +302,12 @@ void AddStats(FieldStats* s, const nlohmann::json& j) {
   part.coverage_histogram = j.at("histogram").get<std::vector<std::int64_t>>();
   part.per_camera_seen = j.at("per_camera").get<std::vector<std::int64_t>>();
   AddFieldStats(s, part);
+}
+
+nlohmann::json RegionCountsToJson(const std::vector<RegionCounts>& regions) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RegionCounts& r : regions) out.push_back({r.voxels, r.ge[0], r.ge[1], r.ge[2]});
+  return out;
 }
 
 // Every process's `counts` (`size` of them), summed at rank 0 (empty on the others).
@@ -401,6 +406,10 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
   FieldStats total;
   DoriSummary dori;
+  // The named sub-regions: counts added up, values spilled (density, sigma_max per region).
+  const std::size_t region_count = scene.study.regions.size();
+  std::vector<RegionCounts> regions(region_count);
+  std::vector<std::unique_ptr<ValueSpill>> region_spills(2 * region_count);
   nlohmann::json tile_list = nlohmann::json::array();
   double most_estimated = 0;
   std::vector<std::size_t> mine;
@@ -410,6 +419,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
                   !(args.quiet || !root));
   try {
     for (auto& spill : spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
+    for (auto& spill : region_spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
     for (std::size_t i = 0; i < mine.size(); ++i) {
       const std::size_t t = mine[i];
       FieldOptions o = options;
@@ -422,6 +432,13 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
         const DoriSummary d = EvaluateDori(scene, f, &f);
         dori.voxels += d.voxels;
         for (int k = 0; k < 4; ++k) dori.reached[k] += d.reached[k];
+      }
+      const std::vector<RegionCounts> tile_regions = CountRegions(scene, f);
+      for (std::size_t r = 0; r < tile_regions.size(); ++r) {
+        regions[r].voxels += tile_regions[r].voxels;
+        for (int k = 0; k < 3; ++k) regions[r].ge[k] += tile_regions[r].ge[k];
+        region_spills[2 * r]->Append(tile_regions[r].densities);
+        region_spills[2 * r + 1]->Append(tile_regions[r].sigmas);
       }
       if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
       spills[1]->Append(st.sigma_max_mm);
@@ -458,18 +475,25 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   most_estimated = total.estimated_bytes;
   const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
                             {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
+                            {"regions", RegionCountsToJson(regions)},
                             {"estimated", most_estimated}, {"peak_rss_mib", PeakRssMiB()}};
   const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
   nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
   if (root) {
     total = FieldStats{};
     dori = DoriSummary{};
+    regions.assign(region_count, RegionCounts{});
     for (const std::string& p : parts) {
       const nlohmann::json j = nlohmann::json::parse(p);
       AddStats(&total, j.at("stats"));
       const auto counts = j.at("dori").get<std::vector<std::int64_t>>();
       dori.voxels += counts.at(0);
       for (int k = 0; k < 4; ++k) dori.reached[k] += counts.at(1 + k);
+      const auto& rs = j.at("regions");
+      for (std::size_t r = 0; r < region_count; ++r) {
+        regions[r].voxels += rs.at(r).at(0).get<std::int64_t>();
+        for (int k = 0; k < 3; ++k) regions[r].ge[k] += rs.at(r).at(1 + k).get<std::int64_t>();
+      }
       for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
       most_estimated = std::max(most_estimated, j.at("estimated").get<double>());
       peak_rss.push_back(j.at("peak_rss_mib"));
@@ -499,6 +523,17 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   const double limit = scene.study.max_sigma_mm.value_or(0.0);
   const std::int64_t sigma_meets = count_at_most(*spills[1], limit);
   const std::int64_t steady_meets = count_at_most(*spills[2], limit);
+  // Each region's percentiles, and how many of its voxels have a sigma_max (every process's spill).
+  std::vector<RegionSummary> region_summaries;
+  const bool has_sigma = std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
+  for (std::size_t r = 0; r < region_count; ++r) {
+    const auto p10 = percentiles(*region_spills[2 * r], {10});
+    const auto sigma_p = percentiles(*region_spills[2 * r + 1], {50, 90});
+    // Every value at most +infinity: the count of the spilled sigmas.
+    const std::int64_t sigma_count = count_at_most(*region_spills[2 * r + 1], HUGE_VAL);
+    region_summaries.push_back(FinishRegion(scene.study.regions[r].first, regions[r], want_resolution,
+                                            has_sigma, sigma_count, p10[0], sigma_p[0], sigma_p[1]));
+  }
   if (!root) return 0;
 
   Fields merged;
@@ -528,6 +563,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
     dori.SetShares();
     typed.dori = dori;
   }
+  typed.regions = std::move(region_summaries);
   if (scene.study.targets)
     typed.targets = EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());
   if (scene.study.calibration)

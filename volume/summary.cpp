@@ -74,8 +74,8 @@ nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,
   return j;
 }
 
-std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fields) {
-  std::vector<RegionSummary> out;
+std::vector<RegionCounts> CountRegions(const Scene& scene, const Fields& fields) {
+  std::vector<RegionCounts> out;
   const Fields::Impl& g = fields.impl();
   if (scene.study.regions.empty() || !g.coverage) return out;
   const openvdb::FloatGrid::Ptr sigma = g.Float("sigma_max"), resolution = g.Float("resolution");
@@ -83,10 +83,7 @@ std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fi
     std::unique_ptr<InsideMesh> inside;
     if (region.kind == Region::Kind::kMesh && !region.mesh.triangles.empty())
       inside = std::make_unique<InsideMesh>(region.mesh);
-    RegionSummary r;
-    r.name = name;
-    std::int64_t ge[3] = {0, 0, 0};
-    std::vector<float> sigmas, densities;
+    RegionCounts r;
     auto sa = sigma ? std::optional(sigma->getConstAccessor()) : std::nullopt;
     auto ra = resolution ? std::optional(resolution->getConstAccessor()) : std::nullopt;
     ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int n) {
@@ -94,21 +91,45 @@ std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fi
       const Vec3 p(w.x(), w.y(), w.z());
       if (!region.box.Contains(p) || (inside && !inside->Inside(p))) return;
       ++r.voxels;
-      for (int k = 0; k < 3; ++k) ge[k] += n >= k + 1;
-      if (sa && sa->isValueOn(c)) sigmas.push_back(sa->getValue(c));
-      if (ra && ra->isValueOn(c)) densities.push_back(ra->getValue(c));
+      for (int k = 0; k < 3; ++k) r.ge[k] += n >= k + 1;
+      if (sa && sa->isValueOn(c)) r.sigmas.push_back(sa->getValue(c));
+      if (ra && ra->isValueOn(c)) r.densities.push_back(ra->getValue(c));
     });
-    const double n = r.voxels > 0 ? double(r.voxels) : 1.0;
-    r.ge1 = ge[0] / n;
-    r.ge2 = ge[1] / n;
-    r.ge3 = ge[2] / n;
-    if (resolution) r.resolution_p10 = NearestRankPercentile(densities, 10);
-    if (sigma) {
-      r.triangulable = double(sigmas.size()) / n;
-      r.sigma_max_p50 = NearestRankPercentile(sigmas, 50);
-      r.sigma_max_p90 = NearestRankPercentile(sigmas, 90);
-    }
-    out.push_back(r);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+RegionSummary FinishRegion(const std::string& name, const RegionCounts& counts, bool has_resolution,
+                           bool has_sigma, std::int64_t sigma_count, std::optional<double> resolution_p10,
+                           std::optional<double> sigma_p50, std::optional<double> sigma_p90) {
+  RegionSummary r;
+  r.name = name;
+  r.voxels = counts.voxels;
+  const double n = r.voxels > 0 ? double(r.voxels) : 1.0;
+  r.ge1 = counts.ge[0] / n;
+  r.ge2 = counts.ge[1] / n;
+  r.ge3 = counts.ge[2] / n;
+  if (has_resolution) r.resolution_p10 = resolution_p10;
+  if (has_sigma) {
+    r.triangulable = double(sigma_count) / n;
+    r.sigma_max_p50 = sigma_p50;
+    r.sigma_max_p90 = sigma_p90;
+  }
+  return r;
+}
+
+std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fields) {
+  std::vector<RegionSummary> out;
+  const std::vector<RegionCounts> counts = CountRegions(scene, fields);
+  const Fields::Impl& g = fields.impl();
+  const bool has_resolution = g.Float("resolution") != nullptr, has_sigma = g.Float("sigma_max") != nullptr;
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const RegionCounts& r = counts[i];
+    out.push_back(FinishRegion(scene.study.regions[i].first, r, has_resolution, has_sigma,
+                               static_cast<std::int64_t>(r.sigmas.size()),
+                               NearestRankPercentile(r.densities, 10), NearestRankPercentile(r.sigmas, 50),
+                               NearestRankPercentile(r.sigmas, 90)));
   }
   return out;
 }

@@ -93,6 +93,21 @@ struct RegionSummary {
 /// The named sub-regions of `scene`'s study over `fields`.
 std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fields);
 
+/// What SummarizeRegions reads of one region, before its percentiles: a streamed run adds these up
+/// tile by tile (its sigma and density values spilled, volume/value_spill.h).
+struct RegionCounts {
+  std::int64_t voxels = 0;
+  std::int64_t ge[3] = {0, 0, 0};
+  std::vector<float> sigmas, densities;  ///< sigma_max and resolution of its voxels that have them
+};
+/// The counts and values of each of the study's regions over `fields`, in study order.
+std::vector<RegionCounts> CountRegions(const Scene& scene, const Fields& fields);
+/// A region's summary from its counts; `resolution_p10`, `sigma_p50`, `sigma_p90`: the percentiles
+/// of its values (nullopt when none), used when the fields had `has_resolution` / `has_sigma`.
+RegionSummary FinishRegion(const std::string& name, const RegionCounts& counts, bool has_resolution,
+                           bool has_sigma, std::int64_t sigma_count, std::optional<double> resolution_p10,
+                           std::optional<double> sigma_p50, std::optional<double> sigma_p90);
+
 /// Everything summary.json holds, typed.
 struct Summary {
   std::string scene, scene_sha256;  ///< Scene::path and Scene::sha256.

@@ -3,7 +3,7 @@
 # in-memory run's fields voxel for voxel (the union of the tiles, no voxel in two) and its summary
 # but for timings, with tiles of a given side and with tiles sized by a small memory budget; every
 # tile listed in the summary exists and says which part of the lattice it holds; what a streamed
-# run cannot compute is refused with one line and exit 2, writing nothing; DORI classes stream too.
+# run cannot compute is refused with one line and exit 2, writing nothing; DORI classes and named sub-regions stream too.
 # With MPI (the last argument "mpi"), `mpirun -n 2 ... --stream --mpi` gives the same files.
 # Usage: check_stream.sh PANDORA PYTHON SCENE WORK_DIR FIELDS TILE_SIZE BUDGET_MIB [mpi]
 set -u
@@ -63,9 +63,8 @@ expect_refusal() {
 expect_refusal "--fields" --stream --fields coverage,cameras
 expect_refusal "--tile-size" --tile-size 1
 expect_refusal "--tile-size" --stream --tile-size -1 --fields coverage
-# The scene with a named sub-region or pixel-size targets: each refused by name.
-for extra in 'regions|{"regions": {"middle": {"box": {"min": [-10, -10, -10], "max": [10, 10, 10]}}}}' \
-             'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}'; do
+# The scene with pixel-size targets: refused by name.
+for extra in 'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}'; do
   key=${extra%%|*}
   "$python" - "$scene" "$work/with_$key.json" "${extra#*|}" <<'PY' || fail "writing the $key scene"
 import json, sys
@@ -82,17 +81,38 @@ PY
   printf '%s\n' "$err" | grep -qF "\$.study.$key" || fail "$key: not named in: $err"
   [ ! -e "$work/refused" ] || fail "$key: wrote $work/refused"
 done
-# DORI classes stream: each tile holds its part of the "dori" grid, the shares add up exactly.
+# DORI classes and named sub-regions stream: each tile holds its part of the "dori" grid, the
+# shares add up exactly, the regions' percentiles come from the spilled values. Two regions: one
+# box around the region's middle, one the region's lower half (numbers from the scene's region).
 "$python" - "$scene" "$work/with_dori.json" <<'PY' || fail "writing the DORI scene"
 import json, sys
 s = json.load(open(sys.argv[1]))
+box = s["study"]["region"]["box"]
+lo, hi = box["min"], box["max"]
+mid = [(a + b) / 2 for a, b in zip(lo, hi)]
+quarter = [(b - a) / 4 for a, b in zip(lo, hi)]
 s["study"]["dori"] = True
+s["study"]["regions"] = {
+    "middle": {"box": {"min": [m - q for m, q in zip(mid, quarter)], "max": [m + q for m, q in zip(mid, quarter)]}},
+    "lower": {"box": {"min": lo, "max": [hi[0], hi[1], mid[2]]}},
+}
 json.dump(s, open(sys.argv[2], "w"))
 PY
-"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution --out "$work/dori_memory" --quiet || fail "DORI in memory"
-"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution --out "$work/dori_stream" --stream \
+"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution,sigma_max --out "$work/dori_memory" --quiet || fail "DORI in memory"
+"$pandora" analyze "$work/with_dori.json" --fields coverage,resolution,sigma_max --out "$work/dori_stream" --stream \
   --tile-size "$tile" --quiet || fail "DORI streamed"
 "$python" "$here/same_fields.py" "$work/dori_memory" "$work/dori_stream" || fail "DORI: streamed differs from in-memory"
-"$python" -c "import json,sys; d=json.load(open(sys.argv[1]))['dori']; assert 0 < d['detection'] <= 1, d" \
-  "$work/dori_stream/summary.json" || fail "DORI: no detection share"
+if [ "$with_mpi" = mpi ] && command -v mpirun >/dev/null; then
+  mpirun -n 2 "$pandora" analyze "$work/with_dori.json" --fields coverage,resolution,sigma_max --out "$work/dori_mpi" \
+    --stream --tile-size "$tile" --mpi --threads 1 --quiet > "$work/dori_mpi.log" 2>&1 \
+    || fail "DORI under mpirun exit $?: $(tail -5 "$work/dori_mpi.log")"
+  "$python" "$here/same_fields.py" "$work/dori_memory" "$work/dori_mpi" || fail "DORI: mpirun differs from in-memory"
+fi
+"$python" -c "
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert 0 < s['dori']['detection'] <= 1, s['dori']
+assert sorted(r['name'] for r in s['regions']) == ['lower', 'middle'] and all(r['voxels'] > 0 for r in s['regions']), s['regions']
+assert all(r['sigma_max_p50_mm'] is not None and r['resolution_p10_px_per_m'] is not None for r in s['regions']), s['regions']
+" "$work/dori_stream/summary.json" || fail "DORI and regions: shares and percentiles"
 echo "stream: tiles equal the in-memory run"
