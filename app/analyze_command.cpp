@@ -354,11 +354,15 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   const std::vector<BlockColumns> tiles =
       PlanTiles(lattice, options.fields, options.memory_budget_bytes, tile_side);
   constexpr std::size_t kMostTiles = 10000;
-  if (tiles.size() > kMostTiles)
-    throw InputError(std::isnan(args.tile_size) ? options.memory_budget_option : "--tile-size", "",
+  if (tiles.size() > kMostTiles) {
+    // Blame what sized the tiles: --tile-size, --memory-budget, or the scene's budget.
+    const bool by_side = !std::isnan(args.tile_size), by_option = !options.memory_budget_option.empty();
+    throw InputError(by_side ? "--tile-size" : by_option ? options.memory_budget_option : scene.path,
+                     by_side || by_option ? "" : "$.study.memory_budget_mb",
                      "the region would stream in " + std::to_string(tiles.size()) + " tiles, over " +
                          std::to_string(kMostTiles),
                      "raise the memory budget, or use larger tiles or a coarser voxel size");
+  }
 
   // Every tile and the summary appear together (summary.json last), or none does.
   const std::filesystem::path out(args.out);

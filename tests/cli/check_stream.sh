@@ -63,6 +63,7 @@ expect_refusal() {
 expect_refusal "--fields" --stream --fields coverage,cameras
 expect_refusal "--tile-size" --tile-size 1
 expect_refusal "--tile-size" --stream --tile-size -1 --fields coverage
+expect_refusal "tiles, over 10000" --stream --tile-size 1e-9 --voxel-size 0.0002 --fields coverage
 # The scene with pixel-size targets: refused by name.
 for extra in 'pixel_targets|{"pixel_targets": [{"name": "face", "size_m": 0.16, "min_px": 80}]}'; do
   key=${extra%%|*}
