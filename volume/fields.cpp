@@ -27,6 +27,9 @@
 
 namespace pandora {
 
+// EstimateFieldBytes for a number of voxels (the blocks that hold free voxels, or a box's).
+double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count);
+
 Fields::Fields() : impl_(std::make_unique<Impl>()) {}
 Fields::~Fields() = default;
 Fields::Fields(Fields&&) noexcept = default;
@@ -971,9 +974,25 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   S.fields.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
   VoxelLattice estimated = S.fields.lattice;  // a tile's own box when streamed
   if (opt.tile) estimated.dims = (opt.tile->VoxelEnd(estimated) - opt.tile->VoxelMin()).cwiseMax(0);
-  const double estimate = EstimateFieldBytes(estimated, opt.fields, 0);
-  S.fields.stats.estimated_bytes = estimate;
-  if (estimate > opt.memory_budget_bytes) {
+  // Solids that cannot contain a region voxel cost nothing.
+  std::vector<const SceneObject*> solid_objects;
+  for (const SceneObject& o : scene.objects) {
+    if (!o.solid || o.mesh.triangles.empty()) continue;
+    const Aabb b = o.mesh.Bounds();
+    if ((b.max.array() < study.region.box.min.array()).any() ||
+        (b.min.array() > study.region.box.max.array()).any())
+      continue;
+    solid_objects.push_back(&o);
+  }
+  // The memory budget, against the voxels that hold fields: the blocks with free voxels. Known
+  // before anything is allocated for a box region no solid meets (its box); otherwise checked in
+  // two steps: what building the active set needs (a record and a mask per block of the box)
+  // before, the fields' estimate from the blocks it keeps after (a mesh region or large solids can
+  // leave most of the box out).
+  const bool sparse = study.region.kind == Region::Kind::kMesh || !solid_objects.empty();
+  const auto check_budget = [&](double estimate) {
+    S.fields.stats.estimated_bytes = estimate;
+    if (estimate <= opt.memory_budget_bytes) return;
     // Memory scales with 1/h^3: the smallest voxel size that fits.
     const double h_min = study.voxel_size * std::cbrt(estimate / opt.memory_budget_bytes) * 1.01;
     std::ostringstream reason, hint;
@@ -986,7 +1005,10 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
     if (opt.voxel_size_option.empty() && !opt.memory_budget_option.empty())
       throw InputError(opt.memory_budget_option, "", reason.str(), hint.str());
     throw InputError(size_file, size_path, reason.str(), hint.str());
-  }
+  };
+  const double box_voxels = static_cast<double>(estimated.voxel_count());
+  check_budget(sparse ? (box_voxels / 512.0 + 1.0) * (sizeof(Block) + 513.0)
+                      : EstimateBytesForVoxels(box_voxels, opt.fields, 0));
 
   S.want_coverage = Wants(opt.fields, "coverage");
   S.want_cameras = Wants(opt.fields, "cameras");
@@ -1004,16 +1026,6 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
 
   // The active set without cameras: which voxels are free region voxels (solids and the region
   // mesh are classified once; cameras are culled per update).
-  std::vector<const SceneObject*> solid_objects;
-  for (const SceneObject& o : scene.objects) {
-    if (!o.solid || o.mesh.triangles.empty()) continue;
-    // Solids that cannot contain a region voxel cost nothing.
-    const Aabb b = o.mesh.Bounds();
-    if ((b.max.array() < study.region.box.min.array()).any() ||
-        (b.min.array() > study.region.box.max.array()).any())
-      continue;
-    solid_objects.push_back(&o);
-  }
   // Their search trees: the study's kept ones (built at first use), else built here, in parallel
   // (a crowd of finely tessellated people: ~100 trees).
   std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
@@ -1039,6 +1051,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   const FrustumCuller no_cameras(std::vector<Camera>{});
   S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
                             &S.active_stats, opt.tile ? &*opt.tile : nullptr);
+  if (sparse) check_budget(EstimateBytesForVoxels(512.0 * double(S.blocks.size()), opt.fields, 0));
   if (opt.voxel_filter) {
     // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4), [&](const auto& range) {
@@ -1442,7 +1455,10 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
 
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count) {
-  const double voxels = static_cast<double>(lattice.voxel_count());
+  return EstimateBytesForVoxels(static_cast<double>(lattice.voxel_count()), fields, camera_count);
+}
+
+double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count) {
   const double blocks = voxels / 512.0 + 1.0;
   // Per 8^3 block while it is evaluated: its Block record and a 512-byte mask where it is partial,
   // its state and the next one (both arrays live until the serial phase), its new leaves' record,

@@ -355,6 +355,37 @@ TEST(Fields, MemoryBudgetIsCheckedBeforeAllocating) {
   EXPECT_GT(EstimateFieldBytes(lat, {"coverage"}, 5), 1e12);
 }
 
+// The budget counts the blocks that hold free voxels: a solid filling most of the region leaves
+// most of its box out, so a budget below the box's estimate but above the kept blocks' passes, and
+// one below the kept blocks' is refused naming the voxel size.
+TEST(Fields, MemoryBudgetCountsTheBlocksWithFreeVoxels) {
+  Scene scene = TestScene();
+  scene.study.voxel_size = 0.02;
+  // x from -1.3 to 0.7 over the whole region in y and z: free only for x > 0.7 (3 of 13 block columns).
+  scene.objects.push_back(Object("block", MakeBox(Vec3(2.0, 2.6, 1.8)), Vec3(-0.3, 0, 0.15), true));
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage", "resolution"};
+  const VoxelLattice lattice = MakeLattice(scene.study.region.box, scene.study.voxel_size, "x");
+  const double box = EstimateFieldBytes(lattice, options.fields, 0);
+  options.memory_budget_bytes = 1e12;
+  const Fields all = EvaluateFields(scene, scene.rigs[0], *caster, options);
+  const double kept = all.stats.estimated_bytes;
+  EXPECT_LT(kept, 0.5 * box);  // most of the box is inside the block
+  EXPECT_GT(kept, 512.0 * all.stats.active_set.blocks * 8.0);  // at least the two grids' bytes
+  options.memory_budget_bytes = 0.5 * (kept + box);
+  const Fields fits = EvaluateFields(scene, scene.rigs[0], *caster, options);
+  EXPECT_EQ(fits.stats.active_set.region_voxels, all.stats.active_set.region_voxels);
+  options.memory_budget_bytes = 0.9 * kept;
+  try {
+    EvaluateFields(scene, scene.rigs[0], *caster, options);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.json_path(), "$.study.voxel_size");
+    EXPECT_NE(std::string(e.what()).find("over the budget"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Fields, VdbRoundTrip) {
   const Scene scene = TestScene();
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
