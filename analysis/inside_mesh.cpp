@@ -47,6 +47,12 @@ struct ColumnGrid {
   }
   int CellX(double x) const { return Cell(x, x0, cw, nx); }
   int CellY(double y) const { return Cell(y, y0, ch, ny); }
+  // The cells a face's (x, y) bounding box meets: columns i0..i1, rows j0..j1.
+  std::array<int, 4> CellRange(const std::array<Point, 3>& v) const {
+    const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
+    const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
+    return {CellX(x_lo), CellX(x_hi), CellY(y_lo), CellY(y_hi)};
+  }
 
   void Build(const Mesh& mesh, const Aabb& bounds) {
     corners.clear();
@@ -72,19 +78,17 @@ struct ColumnGrid {
       ch = wy > 0 ? wy / ny : 1.0;
       std::size_t entries = 0;
       for (const auto& v : corners) {
-        const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
-        const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
-        entries += std::size_t(CellX(x_hi) - CellX(x_lo) + 1) * std::size_t(CellY(y_hi) - CellY(y_lo) + 1);
+        const auto [i0, i1, j0, j1] = CellRange(v);
+        entries += std::size_t(i1 - i0 + 1) * std::size_t(j1 - j0 + 1);
       }
       if (entries <= 16 * corners.size() + 4096 || (nx == 1 && ny == 1)) break;
       cells /= 4;
     }
     start.assign(std::size_t(nx) * ny + 1, 0);
     const auto each_cell = [&](const std::array<Point, 3>& v, auto&& fn) {
-      const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
-      const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
-      for (int i = CellX(x_lo); i <= CellX(x_hi); ++i)
-        for (int j = CellY(y_lo); j <= CellY(y_hi); ++j) fn(std::size_t(i) * ny + j);
+      const auto [i0, i1, j0, j1] = CellRange(v);
+      for (int i = i0; i <= i1; ++i)
+        for (int j = j0; j <= j1; ++j) fn(std::size_t(i) * ny + j);
     };
     for (const auto& v : corners) each_cell(v, [&](std::size_t c) { ++start[c + 1]; });
     for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];

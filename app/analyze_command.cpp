@@ -281,7 +281,7 @@ nlohmann::json StatsToJson(const FieldStats& s) {
           {"seen", s.seen_voxels}, {"triangulable", s.triangulable_voxels},
           {"unobservable", s.unobservable_voxels}, {"tests", s.point_camera_tests}, {"rays", s.rays},
           {"seconds", s.seconds}, {"cpu_seconds", s.cpu_seconds}, {"active_set_seconds", s.active_set_seconds},
-          {"histogram", s.coverage_histogram}, {"per_camera", s.per_camera_seen}};
+          {"estimated", s.estimated_bytes}, {"histogram", s.coverage_histogram}, {"per_camera", s.per_camera_seen}};
 }
 
 void AddStats(FieldStats* s, const nlohmann::json& j) {
@@ -299,6 +299,7 @@ void AddStats(FieldStats* s, const nlohmann::json& j) {
   part.seconds = j.at("seconds").get<double>();
   part.cpu_seconds = j.at("cpu_seconds").get<double>();
   part.active_set_seconds = j.at("active_set_seconds").get<double>();
+  part.estimated_bytes = j.at("estimated").get<double>();  // the largest tile's is kept
   part.coverage_histogram = j.at("histogram").get<std::vector<std::int64_t>>();
   part.per_camera_seen = j.at("per_camera").get<std::vector<std::int64_t>>();
   AddFieldStats(s, part);
@@ -415,7 +416,6 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   std::vector<RegionCounts> regions(region_count);
   std::vector<std::unique_ptr<ValueSpill>> region_spills(2 * region_count);
   nlohmann::json tile_list = nlohmann::json::array();
-  double most_estimated = 0;
   std::vector<std::size_t> mine;
   for (std::size_t t = std::size_t(mpi.rank()); t < tiles.size(); t += std::size_t(mpi.size())) mine.push_back(t);
   ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
@@ -476,11 +476,9 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
 
   // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
   // spilled values by two rounds of summed counts (only the counts travel).
-  most_estimated = total.estimated_bytes;
   const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
                             {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
-                            {"regions", RegionCountsToJson(regions)},
-                            {"estimated", most_estimated}, {"peak_rss_mib", PeakRssMiB()}};
+                            {"regions", RegionCountsToJson(regions)}, {"peak_rss_mib", PeakRssMiB()}};
   const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
   nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
   if (root) {
@@ -499,42 +497,39 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
         for (int k = 0; k < 3; ++k) regions[r].ge[k] += rs.at(r).at(1 + k).get<std::int64_t>();
       }
       for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
-      most_estimated = std::max(most_estimated, j.at("estimated").get<double>());
       peak_rss.push_back(j.at("peak_rss_mib"));
     }
     std::sort(all_tiles.begin(), all_tiles.end(),
               [](const auto& a, const auto& b) { return a.at("index") < b.at("index"); });
   }
   const auto percentiles = [&](const ValueSpill& spill, const std::vector<double>& p) {
+    // Rank 0 selects the bins from the summed upper counts; every process counts inside them.
     const PercentileBins selection =
         SelectPercentileBins(SumCountsAtRoot(mpi, spill.HighCounts(), 1 << 16), p);
-    PercentileBins shared;
-    shared.inside = selection.inside;
-    std::string bins(reinterpret_cast<const char*>(selection.bins.data()), selection.bins.size() * 4);
-    bins = mpi.Broadcast(bins);
-    shared.bins.resize(bins.size() / 4);
-    std::memcpy(shared.bins.data(), bins.data(), bins.size());
-    return ResolvePercentiles(selection, SumCountsAtRoot(mpi, spill.LowCounts(shared.bins), shared.bins.size() << 16),
-                              p.size());
+    const std::string sent = mpi.Broadcast(
+        std::string(reinterpret_cast<const char*>(selection.bins.data()), selection.bins.size() * 4));
+    std::vector<std::uint32_t> bins(sent.size() / 4);
+    std::memcpy(bins.data(), sent.data(), sent.size());
+    return ResolvePercentiles(selection, SumCountsAtRoot(mpi, spill.LowCounts(bins), bins.size() << 16), p.size());
   };
-  const auto count_at_most = [&](const ValueSpill& spill, double limit) {
-    const std::vector<std::int64_t> sum = SumCountsAtRoot(mpi, {spill.CountAtMost(limit)}, 1);
+  const auto sum_at_root = [&](std::int64_t count) {
+    const std::vector<std::int64_t> sum = SumCountsAtRoot(mpi, {count}, 1);
     return sum.empty() ? std::int64_t(0) : sum[0];  // rank 0's; the others' are not used
   };
   const std::vector<std::optional<double>> resolution_p = percentiles(*spills[0], {10, 50, 90});
   const std::vector<std::optional<double>> sigma_p = percentiles(*spills[1], {50, 90, 99});
   const std::vector<std::optional<double>> steady_p = percentiles(*spills[2], {50, 90, 99});
-  const double limit = scene.study.max_sigma_mm.value_or(0.0);
-  const std::int64_t sigma_meets = count_at_most(*spills[1], limit);
-  const std::int64_t steady_meets = count_at_most(*spills[2], limit);
+  // The shares meeting the study's target (a pass over each file only when there is one).
+  const std::optional<double> target = scene.study.max_sigma_mm;
+  const std::int64_t sigma_meets = target ? sum_at_root(spills[1]->CountAtMost(*target)) : 0;
+  const std::int64_t steady_meets = target ? sum_at_root(spills[2]->CountAtMost(*target)) : 0;
   // Each region's percentiles, and how many of its voxels have a sigma_max (every process's spill).
   std::vector<RegionSummary> region_summaries;
   const bool has_sigma = std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
   for (std::size_t r = 0; r < region_count; ++r) {
     const auto p10 = percentiles(*region_spills[2 * r], {10});
     const auto sigma_p = percentiles(*region_spills[2 * r + 1], {50, 90});
-    // Every value at most +infinity: the count of the spilled sigmas.
-    const std::int64_t sigma_count = count_at_most(*region_spills[2 * r + 1], HUGE_VAL);
+    const std::int64_t sigma_count = sum_at_root(region_spills[2 * r + 1]->size());
     region_summaries.push_back(FinishRegion(scene.study.regions[r].first, regions[r], want_resolution,
                                             has_sigma, sigma_count, p10[0], sigma_p[0], sigma_p[1]));
   }
@@ -578,7 +573,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
                        {"tile_count", tiles.size()},
                        {"ranks", mpi.size()},
                        {"memory_budget_mib", options.memory_budget_bytes / 1048576.0},
-                       {"largest_tile_estimate_mib", most_estimated / 1048576.0},
+                       {"largest_tile_estimate_mib", merged.stats.estimated_bytes / 1048576.0},
                        {"peak_rss_mib", peak_rss}};
   WriteFileAtomically(summary_path, summary.dump(2) + "\n");
   output.Commit();

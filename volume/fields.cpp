@@ -28,7 +28,7 @@
 namespace pandora {
 
 // EstimateFieldBytes for a number of voxels (the blocks that hold free voxels, or a box's).
-double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count);
+static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count);
 
 Fields::Fields() : impl_(std::make_unique<Impl>()) {}
 Fields::~Fields() = default;
@@ -1458,7 +1458,7 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
   return EstimateBytesForVoxels(static_cast<double>(lattice.voxel_count()), fields, camera_count);
 }
 
-double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count) {
+static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count) {
   const double blocks = voxels / 512.0 + 1.0;
   // Per 8^3 block while it is evaluated: its Block record and a 512-byte mask where it is partial,
   // its state and the next one (both arrays live until the serial phase), its new leaves' record,
