@@ -23,4 +23,20 @@ void CommitTemporary(const std::string& path);
 /// leaving `path` unchanged.
 void WriteFileAtomically(const std::string& path, const std::string& text);
 
+/// An exclusive advisory lock (flock) on the folder that holds `path`, held while the object
+/// lives: every Pandora command that rewrites a user's file (accept, rig, import-rig, the viewer's
+/// Save, Python's save and accept) takes it around its check-and-replace, so two writers of one
+/// file run one after the other and the second sees the first's result. Waits for another holder
+/// (at most `timeout_s`, then throws InputError naming `path`).
+class FolderLock {
+ public:
+  explicit FolderLock(const std::string& path, double timeout_s = 60.0);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace pandora

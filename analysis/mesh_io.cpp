@@ -718,8 +718,32 @@ std::string GltfJson(const std::string& path, const std::string& extension, uint
 }
 
 void CheckGltfSkins(const std::string& path, const std::string& extension, uint64_t file_size) {
-  const nlohmann::json g = nlohmann::json::parse(GltfJson(path, extension, file_size), nullptr, false);
-  if (!g.is_object()) return;  // assimp reports what it cannot parse
+  const std::string text = GltfJson(path, extension, file_size);
+  if (text.empty()) return;  // no JSON chunk: assimp reports what it cannot parse
+  // Parsed strictly: assimp's reader takes invalid UTF-8 and the first of two equal keys, where this
+  // check would see another document (a duplicate "skins" key and invalid UTF-8 both crashed it).
+  std::vector<std::set<std::string>> keys;
+  std::string duplicate;
+  const nlohmann::json g = nlohmann::json::parse(
+      text,
+      [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+        using E = nlohmann::json::parse_event_t;
+        if (event == E::object_start) keys.emplace_back();
+        else if (event == E::object_end && !keys.empty()) keys.pop_back();
+        else if (event == E::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second &&
+                 duplicate.empty())
+          duplicate = parsed.get<std::string>();
+        return true;
+      },
+      false);
+  if (g.is_discarded()) {
+    // Not JSON at all (a binary or text file under the wrong name) is assimp's to report; JSON that
+    // starts as glTF's does is checked here.
+    if (text.find("\"asset\"") == std::string::npos) return;
+    ThrowCorrupt(path, "glTF", "its JSON is not valid (bad syntax or invalid UTF-8)");
+  }
+  if (!duplicate.empty()) ThrowCorrupt(path, "glTF", "its JSON has the key \"" + duplicate.substr(0, 40) + "\" twice in one object");
+  if (!g.is_object()) return;
   auto count = [&](const char* key) {
     const auto it = g.find(key);
     return it != g.end() && it->is_array() ? it->size() : std::size_t(0);
@@ -742,6 +766,33 @@ void CheckGltfSkins(const std::string& path, const std::string& extension, uint6
       const auto joints = skin.find("joints");
       if (joints == skin.end() || !joints->is_array() || joints->empty())
         ThrowCorrupt(path, "glTF", name + " has no joints");
+      // Assimp reads one 4x4 float matrix per joint from the accessor without bounds checks: the
+      // accessor must hold that many, inside its buffer view, inside its buffer.
+      const nlohmann::json& acc = g["accessors"][skin["inverseBindMatrices"].get<std::size_t>()];
+      const std::string what = name + "'s inverseBindMatrices accessor";
+      auto number = [&](const nlohmann::json& o, const char* key, std::uint64_t fallback) -> std::uint64_t {
+        if (!o.contains(key)) return fallback;
+        if (!o[key].is_number_unsigned()) ThrowCorrupt(path, "glTF", what + ": " + key + " is not a whole number");
+        return o[key].get<std::uint64_t>();
+      };
+      if (!acc.is_object() || acc.value("type", std::string()) != "MAT4" || number(acc, "componentType", 0) != 5126)
+        ThrowCorrupt(path, "glTF", what + " is not of 4x4 float matrices");
+      const std::uint64_t matrices = number(acc, "count", 0);
+      if (matrices < joints->size())
+        ThrowCorrupt(path, "glTF", what + " holds " + std::to_string(matrices) + " matrices for " +
+                                       std::to_string(joints->size()) + " joints");
+      if (!acc.contains("bufferView") || !index_ok(acc["bufferView"], "bufferViews"))
+        ThrowCorrupt(path, "glTF", what + " names no buffer view of the file");
+      const nlohmann::json& view = g["bufferViews"][acc["bufferView"].get<std::size_t>()];
+      if (!view.is_object() || !view.contains("buffer") || !index_ok(view["buffer"], "buffers"))
+        ThrowCorrupt(path, "glTF", what + "'s buffer view names no buffer of the file");
+      const std::uint64_t stride = std::max<std::uint64_t>(number(view, "byteStride", 64), 64);
+      const std::uint64_t need = number(acc, "byteOffset", 0) + (matrices - 1) * stride + 64;
+      const std::uint64_t view_length = number(view, "byteLength", 0);
+      const nlohmann::json& buffer = g["buffers"][view["buffer"].get<std::size_t>()];
+      if (matrices > (std::uint64_t(1) << 32) || need > view_length ||
+          number(view, "byteOffset", 0) + view_length > (buffer.is_object() ? number(buffer, "byteLength", 0) : 0))
+        ThrowCorrupt(path, "glTF", what + " reaches past the end of its buffer view or buffer");
       for (const auto& j : *joints)
         if (!index_ok(j, "nodes")) ThrowCorrupt(path, "glTF", name + " has a joint that names no node of the file");
     }

@@ -28,8 +28,25 @@ namespace fs = std::filesystem;
 constexpr const char* kStagingPrefix = ".pandora-staging-";
 constexpr const char* kJournal = "JOURNAL";
 constexpr const char* kPrimary = "PRIMARY";
+constexpr const char* kRemoved = "-";  // journal: the final path is removed, not replaced
 
 std::string ErrnoText(int error) { return std::strerror(error); }
+
+}  // namespace
+
+std::string NotARegularFile(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return "";  // nothing there (or a dangling link): a new file
+  if (S_ISREG(st.st_mode)) return "";
+  if (S_ISDIR(st.st_mode)) return "a folder";
+  if (S_ISCHR(st.st_mode)) return "a character device";
+  if (S_ISBLK(st.st_mode)) return "a block device";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
+namespace {
 
 // fsync of a file or folder by path; the errno, or 0.
 int SyncPath(const std::string& path, bool folder) {
@@ -136,6 +153,10 @@ void RollForward(const std::string& journal_path) {
   std::error_code ec;
   std::vector<fs::path> folders;
   for (const JournalEntry& e : entries) {
+    if (e.staged == kRemoved) {  // a stale output of an earlier run
+      if (fs::is_regular_file(fs::symlink_status(e.final, ec))) fs::remove(e.final, ec);
+      continue;
+    }
     if (fs::exists(e.staged, ec)) ::rename(e.staged.c_str(), e.final.c_str());
     const fs::path dir = fs::path(e.staged).parent_path();
     if (std::find(folders.begin(), folders.end(), dir) == folders.end()) folders.push_back(dir);
@@ -209,6 +230,7 @@ struct OutputTransaction::Impl {
   };
   std::vector<Input> inputs;
   std::vector<Output> outputs;
+  std::vector<std::string> removals;  // stale outputs removed at Commit()
   std::vector<Staging> stagings;
   std::vector<fs::path> created_folders;  // Deepest last.
   bool committed = false;
@@ -303,6 +325,9 @@ std::string OutputTransaction::Impl::StageImpl(const std::string& path, const st
   const fs::path final = fs::absolute(path, ec).lexically_normal();
   if (final.filename().empty() || fs::is_directory(final, ec))
     throw InputError(blame, "", "'" + path + "' names a folder, not a file", "give a file name");
+  if (const std::string kind = NotARegularFile(final.string()); !kind.empty())
+    throw InputError(blame, "", "'" + path + "' is " + kind + ", not a regular file; an output only replaces a regular file",
+                     "give the path of a file");
   if (!replacement) {
     for (const Input& in : inputs)
       if (SameFile(final, in.path))
@@ -344,6 +369,25 @@ void OutputTransaction::Write(const std::string& path, const std::string& option
   WriteNewFile(staged, bytes, mode, path);
 }
 
+void OutputTransaction::Remove(const std::string& path, const std::string& option) {
+  Impl& m = *impl_;
+  const std::string blame = option.empty() ? path : option;
+  if (m.committed) throw std::logic_error("OutputTransaction: Remove after Commit");
+  std::error_code ec;
+  const fs::path final = fs::absolute(path, ec).lexically_normal();
+  const fs::file_status st = fs::symlink_status(final, ec);
+  if (!fs::exists(st)) return;
+  if (!fs::is_regular_file(st))
+    throw InputError(blame, "", "'" + path + "' is in the way of this run's outputs and is not a regular file",
+                     "move it away, then run again");
+  for (const Impl::Input& in : m.inputs)
+    if (SameFile(final, in.path))
+      throw InputError(blame, "", "'" + path + "' is an output of an earlier run to be removed, but it is the " +
+                                      in.what + " of this one",
+                       "write the outputs to another folder");
+  m.removals.push_back(final.string());
+}
+
 void OutputTransaction::Commit() {
   Impl& m = *impl_;
   if (m.committed) return;
@@ -370,9 +414,16 @@ void OutputTransaction::Commit() {
     m.committed = true;
     return;
   }
+  // An output path that became something else than a regular file since Stage() (a device node
+  // made meanwhile) is refused before the commit point: rename() would replace it.
+  for (const Impl::Output& o : m.outputs)
+    if (const std::string kind = NotARegularFile(o.final); !kind.empty())
+      throw InputError(o.final, "", "the output path is now " + kind + ", not a regular file; nothing was written",
+                       "give the path of a file");
   // 2. The commit point: the journal, written whole under a temporary name and renamed.
   std::string journal = "pandora-journal 1\n";
   for (const Impl::Output& o : m.outputs) journal += o.staged + "\t" + o.final + "\n";
+  for (const std::string& r : m.removals) journal += std::string(kRemoved) + "\t" + r + "\n";
   const fs::path primary = m.stagings.front().staging;
   const std::string journal_tmp = (primary / "JOURNAL.tmp").string();
   const std::string journal_path = (primary / kJournal).string();
@@ -391,8 +442,9 @@ void OutputTransaction::Commit() {
                        "check the output folder's permissions");
     MaybeCrash("after-first-rename");
   }
-  for (const Impl::Staging& s : m.stagings) SyncPath(s.folder.string(), true);
   std::error_code ec;
+  for (const std::string& r : m.removals) fs::remove(r, ec);
+  for (const Impl::Staging& s : m.stagings) SyncPath(s.folder.string(), true);
   for (std::size_t i = 1; i < m.stagings.size(); ++i) fs::remove_all(m.stagings[i].staging, ec);
   fs::remove_all(primary, ec);
 }
@@ -408,6 +460,7 @@ void OutputTransaction::Abandon() noexcept {
   }
   m.stagings.clear();
   m.outputs.clear();
+  m.removals.clear();
   m.created_folders.clear();
 }
 

@@ -48,6 +48,12 @@ class OutputTransaction {
   void Write(const std::string& path, const std::string& option, const std::string& bytes,
              const std::string& mode_from = "");
 
+  /// Declares that the existing regular file `path` (an output of an earlier run that this run does
+  /// not write: a streamed run's surplus tiles) is removed when the outputs are committed, in the
+  /// same transaction (journalled, so a run killed after the commit point still removes it). Does
+  /// nothing when nothing is there; throws InputError when `path` is an input or not a regular file.
+  void Remove(const std::string& path, const std::string& option);
+
   /// Makes every staged output appear at its final path. Throws InputError when a staged file is
   /// missing or empty, or when syncing or renaming fails before the commit point (nothing changed
   /// then); failures after it are finished by RecoverOutputs.
@@ -73,6 +79,11 @@ class OutputTransaction {
 /// written are completed; other staging folders and `*.tmp-PID` files of dead processes are
 /// removed. Never throws; does nothing when `folder` cannot be read.
 void RecoverOutputs(const std::string& folder);
+
+/// What `path` is when it exists and is not a regular file (links followed): "a character
+/// device", "a folder", ...; empty when it is a regular file or nothing is there. Outputs are only
+/// ever renamed over a regular file or nothing.
+std::string NotARegularFile(const std::string& path);
 
 /// Writes `bytes` to a new file `path` created with `mode` (umask applied), checking every write,
 /// and flushes it to disk. On failure removes it and throws InputError(blame, ...).

@@ -147,6 +147,68 @@ double EffectiveFov(const CameraModel& model, int axis) {
   return std::atan2(ra.cross(rb).norm(), ra.dot(rb)) * kDeg;
 }
 
+// Valid values that are almost surely mistakes (Warning::Kind::kImplausible; rig_check.h).
+template <class CameraPath>
+void CheckPlausibleValues(const Scene& scene, const Rig& rig, const CameraPath& camera_path,
+                          std::vector<Warning>* out) {
+  auto add = [&](const std::string& path, const std::string& reason) {
+    out->push_back({Warning::Kind::kImplausible, "", path, reason});
+  };
+  auto metres = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g m", v);
+    return std::string(b);
+  };
+  const Aabb& region = scene.study.region.box;
+  if (!region.empty()) {
+    const double longest = region.size().maxCoeff();
+    if (longest < 0.25 || longest > 1e4)
+      add("$.units", "the study region is " + metres(longest) +
+                         " on its longest side: are the file's units right (a file in metres read as cm, or the reverse)?");
+    for (const auto& [name, r] : scene.study.regions) {
+      Aabb meet = r.box;
+      meet.min = meet.min.cwiseMax(region.min);
+      meet.max = meet.max.cwiseMin(region.max);
+      if ((meet.max.array() < meet.min.array()).any())
+        add("$.study.regions." + name,
+            "the region '" + name + "' lies outside the study region: it holds no voxel of it");
+    }
+  }
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const Intrinsics& k = rig.cameras[c].model.intrinsics();
+    const double hfov = HfovFromFocal(k.fx, k.width, k.model) * kDeg;
+    if (hfov < 3.2)
+      add(camera_path(c) + ".hfov_deg",
+          "camera '" + rig.cameras[c].id + "' has a field of view of " + std::to_string(hfov).substr(0, 5) +
+              " degrees: radians written as degrees (" + std::to_string(hfov * 180 / 3.14159265358979323846).substr(0, 5) +
+              " degrees)?");
+  }
+  for (std::size_t i = 0; i < scene.study.pixel_targets.size(); ++i) {
+    const PixelTarget& t = scene.study.pixel_targets[i];
+    if (t.size_m > 2.0)
+      add("$.study.pixel_targets[" + std::to_string(i) + "]",
+          "the pixel target '" + t.name + "' is " + metres(t.size_m) + " across: a marker or a face that size? (units)");
+  }
+}
+
+// Within this of a surface, a camera centre is "on" it (Warning::Kind::kOnSurface).
+constexpr double kOnSurfaceDistance = 1e-3;
+
+// The nearest surface from `p` along the 26 directions of a cube's faces, edges and corners, up to
+// `limit` (returned when nothing is nearer): exact for the axis-aligned walls of a room, and within
+// a factor 1.2 of the true distance for any plane.
+double NearestSurfaceAlong26(const RayCaster& caster, const Vec3& p, double limit) {
+  double best = limit + 1;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        if (!x && !y && !z) continue;
+        const Vec3 d = Vec3(x, y, z).normalized();
+        if (const auto hit = caster.Intersect(Ray{p, d, 0.0, limit})) best = std::min(best, hit->t);
+      }
+  return best;
+}
+
 }  // namespace
 
 const char* WarningKindName(Warning::Kind kind) {
@@ -159,6 +221,10 @@ const char* WarningKindName(Warning::Kind kind) {
       return "sees_no_region";
     case Warning::Kind::kLensDomain:
       return "lens_domain";
+    case Warning::Kind::kOnSurface:
+      return "on_surface";
+    case Warning::Kind::kImplausible:
+      return "implausible";
   }
   return "unknown";
 }
@@ -200,6 +266,7 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
   auto camera_path = [&](std::size_t c) {
     return "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
   };
+  CheckPlausibleValues(scene, rig, camera_path, &out);
   std::vector<int> triangle_object;
   const TriangleMesh all = scene.AllTriangles(&triangle_object);
   const Aabb geometry = all.Bounds();
@@ -244,14 +311,22 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
           "camera '" + cam.id + "' is inside the solid object " + ObjectName(scene, solid) +
               " (centre " + Point(centre) + " m): it sees nothing; move it out");
       placed = false;
-    } else if (enclosed && ((centre.array() < geometry.min.array() - pad).any() ||
+    } else if (NearestSurfaceAlong26(caster, centre, kOnSurfaceDistance) <= kOnSurfaceDistance) {
+      // On a wall's face (a layout set in by nothing): the fields and the renderer both take the
+      // centre's side of the surface (the segments start a tolerance away from the centre), but a
+      // real camera's body cannot be there.
+      add(Warning::Kind::kOnSurface, ".position",
+          "camera '" + cam.id + "' sits on a surface (its centre " + Point(centre) +
+              " m is within 1 mm of one): it sees what lies on its centre's side; move it off the surface");
+    }
+    if (solid < 0 && enclosed && ((centre.array() < geometry.min.array() - pad).any() ||
                             (centre.array() > geometry.max.array() + pad).any())) {
       add(Warning::Kind::kOutsideRoom, ".position",
           "camera '" + cam.id + "' is outside the modelled room: its centre " + Point(centre) +
               " m lies outside the bounds of the scene's geometry " + Point(geometry.min) + " to " +
               Point(geometry.max) + " m");
       placed = false;
-    } else if (enclosed) {
+    } else if (solid < 0 && enclosed) {
       // From the reference point towards the camera: a surface before it and nothing after it.
       const Vec3 to = centre - reference;
       const double distance = to.norm();

@@ -25,6 +25,8 @@ struct Warning {
     kOutsideRoom,   ///< The centre lies outside the walls that enclose the region.
     kSeesNoRegion,  ///< The camera sees none of the study region.
     kLensDomain,    ///< The distortion's valid (monotonic) domain ends inside the image.
+    kOnSurface,     ///< The centre lies on (within 1 mm of) a surface: its side decides what it sees.
+    kImplausible,   ///< A value of the file that is valid but almost surely a mistake (units, radians).
   };
   Kind kind = Kind::kSeesNoRegion;
   std::string camera;     ///< Camera id.
@@ -87,6 +89,11 @@ struct RigCheckOptions {
 ///    blocked by an object);
 ///  - the lens's valid domain ends inside the image (ComputeLensCoverage), with the unreachable
 ///    share of the pixels.
+/// Before the cameras, values of the file that are valid but almost surely mistakes (kImplausible):
+/// a study region under 0.25 m or over 10 km on its longest side (units: a file in metres read as
+/// cm), a field of view under 3.2 degrees (radians written as degrees), a named region that does not
+/// meet the study region, a pixel target over 2 m (a marker), a moving group that leaves the study
+/// region at every time sample.
 /// The placement warnings are the most specific: a camera inside a solid or outside the room gets
 /// no "sees none" warning on top. Never throws for a valid scene; cheap (a few thousand segments
 /// per camera).

@@ -200,9 +200,47 @@ TEST(CheckRig, NoRoomMeansNoOutside) {
   auto by = ByCamera(CheckRig(scene, scene.rigs[0], *caster));
   using K = Warning::Kind;
   EXPECT_EQ(by.count("far"), 0u);
-  // It looks away from most of the region, yet sees the part beside the block in front of it.
-  EXPECT_EQ(by.count("on_face"), 0u);
+  // It looks away from most of the region, yet sees the part beside the block in front of it; not
+  // inside the block, but on its face: warned about as such (its centre's side decides, issue 27).
+  EXPECT_EQ(by["on_face"], std::vector<K>{K::kOnSurface});
   EXPECT_EQ(by["in_block"], std::vector<K>{K::kInsideSolid});
+}
+
+// Valid values that are almost surely mistakes, each named by its JSON path: a file in metres read
+// as centimetres, a field of view in radians, a named region outside the study region, a 14 m marker.
+TEST(CheckRig, ImplausibleValuesAreWarnedAboutByPath) {
+  const std::string text = R"({
+  "units": "cm",
+  "objects": [{"name": "block", "box": {"size": [0.4, 0.4, 0.4]}, "position": [0, 0, 0.2], "solid": true}],
+  "rigs": [{"name": "r", "cameras": [
+    {"id": "a", "position": [6, 0, 1], "look_at": [0, 0, 0.3], "resolution": [640, 480], "hfov_deg": 60},
+    {"id": "rad", "position": [0, 6, 1], "look_at": [0, 0, 0.3], "resolution": [640, 480], "hfov_deg": 1.4}
+  ]}],
+  "study": {"region": {"box": {"min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0.6]}}, "voxel_size": 0.05,
+            "fields": ["coverage", "cameras"],
+            "regions": {"elsewhere": {"box": {"min": [5, 5, 0], "max": [6, 6, 1]}}},
+            "pixel_targets": [{"name": "marker", "size_m": 1400, "min_px": 4}]}
+})";
+  const Scene scene = ParseScene(text, "cm.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  std::map<std::string, std::string> by_path;
+  for (const Warning& w : CheckRig(scene, scene.rigs[0], *caster))
+    if (w.kind == Warning::Kind::kImplausible) by_path[w.json_path] = w.reason;
+  ASSERT_EQ(by_path.size(), 4u);
+  EXPECT_NE(by_path["$.units"].find("0.01 m on its longest side"), std::string::npos) << by_path["$.units"];
+  EXPECT_NE(by_path["$.rigs[0].cameras[1].hfov_deg"].find("80.21 degrees"), std::string::npos);
+  EXPECT_NE(by_path["$.study.regions.elsewhere"].find("outside the study region"), std::string::npos);
+  EXPECT_NE(by_path["$.study.pixel_targets[0]"].find("14 m across"), std::string::npos);
+  // The same file in metres, with sensible values: no such warning.
+  std::string fixed = text;
+  fixed.replace(fixed.find("\"units\": \"cm\""), 13, "\"units\": \"m\"");
+  fixed.replace(fixed.find("\"hfov_deg\": 1.4"), 15, "\"hfov_deg\": 80");
+  fixed.replace(fixed.find("[5, 5, 0]"), 9, "[0, 0, 0]");
+  fixed.replace(fixed.find("\"size_m\": 1400"), 14, "\"size_m\": 0.014");
+  const Scene good = ParseScene(fixed, "m.json");
+  const auto good_caster = MakeEmbreeRayCaster(good.AllTriangles());
+  for (const Warning& w : CheckRig(good, good.rigs[0], *good_caster))
+    EXPECT_NE(w.kind, Warning::Kind::kImplausible) << w.json_path << ": " << w.reason;
 }
 
 }  // namespace

@@ -117,6 +117,9 @@ Camera MakeCamera(const std::string& id, const std::string& name, Intrinsics k, 
   const Vec3 centre = -(r_cw.transpose() * t_cw);
   if (!(centre.cwiseAbs().maxCoeff() <= SceneLimits::kMaxCoordinate))
     fail("translation", "the camera centre lies beyond 1e7 m");
+  // Ids and names become JSON strings of the scene file: printable UTF-8 only.
+  if (const std::string bad = CheckPrintableUtf8(id); !bad.empty()) fail("id", "the camera id holds " + bad);
+  if (const std::string bad = CheckPrintableUtf8(name); !bad.empty()) fail("name", "the camera name holds " + bad);
   Camera camera;
   camera.id = id;
   camera.name = name.empty() ? id : name;
@@ -878,6 +881,8 @@ Rig ParseColmap(const std::string& cameras_text, const std::string& cameras_path
       }
     }
     if (id.empty()) fail(images_path, number, "NAME", "empty image name");
+    if (const std::string bad = CheckPrintableUtf8(id); !bad.empty())
+      fail(images_path, number, "NAME", "the image name (a camera id) holds " + bad);
     if (rig.FindCamera(id) >= 0)
       fail(images_path, number, "NAME", "two images give the camera id '" + id + "'");
     // The POINTS2D line follows directly (COLMAP reads it even when empty).

@@ -953,6 +953,10 @@ void ReadPtz(const Node& node, Camera* camera) {
     *out_hi = hi;
     if (auto n = node.Find(key)) {
       const Vec2 r = n->Vector2();
+      if (r.x() > r.y())
+        n->Fail("expected [lowest, highest] degrees, got [" + FormatNumber(r.x()) + ", " + FormatNumber(r.y()) +
+                    "]: the bounds are reversed",
+                "write [" + FormatNumber(r.y()) + ", " + FormatNumber(r.x()) + "]");
       if (!(r.x() <= 0 && r.y() >= 0))
         n->Fail("the range must hold home (0), got [" + FormatNumber(r.x()) + ", " + FormatNumber(r.y()) + "]");
       if (r.x() < lo - 1e-9 || r.y() > hi + 1e-9)
@@ -973,15 +977,22 @@ void ReadPtz(const Node& node, Camera* camera) {
     node.Get("pan_range_deg").Fail("a pan range spans at most 360 degrees",
                                    "a head that turns without end: [-180, 180]");
   range("tilt_range_deg", -90 - el0, 90 - el0, &h.tilt_min_deg, &h.tilt_max_deg);
-  auto speed = [&](const char* key, double* v) {
-    if (auto n = node.Find(key)) *v = n->Positive();
+  // Bounded so that every accepted head's reach and tour work is bounded (a head of 1e-12 deg/s
+  // once ran analyze for minutes): the slowest 0.1 deg/s (a full turn in an hour), a trace of an hour.
+  auto speed = [&](const char* key, double* v, double lo, double hi, const char* unit) {
+    if (auto n = node.Find(key)) {
+      *v = n->Positive();
+      if (!(*v >= lo && *v <= hi))
+        n->Fail("expected " + std::string(unit) + " in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "], got " +
+                FormatNumber(*v));
+    }
   };
-  speed("pan_speed_deg_s", &h.pan_speed_deg_s);
-  speed("tilt_speed_deg_s", &h.tilt_speed_deg_s);
+  speed("pan_speed_deg_s", &h.pan_speed_deg_s, 0.1, 3600, "a speed in degrees per second");
+  speed("tilt_speed_deg_s", &h.tilt_speed_deg_s, 0.1, 3600, "a speed in degrees per second");
   double zoom_pct = 50;
-  speed("zoom_speed_pct_s", &zoom_pct);
+  speed("zoom_speed_pct_s", &zoom_pct, 0.1, 10000, "a zoom speed in percent of the range per second");
   h.zoom_speed = zoom_pct / 100.0;
-  speed("trace_s", &h.trace_s);
+  speed("trace_s", &h.trace_s, 1e-3, 3600, "a trace time in seconds");
   const Intrinsics k = camera->model.intrinsics();
   auto focal = [&](const Node& n) {
     const double hfov = n.Positive();
@@ -1049,6 +1060,7 @@ void ReadPtz(const Node& node, Camera* camera) {
   if (auto n = node.Find("tour")) {
     const size_t count = n->ArraySize("an array of tour stops");
     if (count == 0) n->Fail("a tour needs at least one stop");
+    if (count > 1000) n->Fail("a tour has at most 1000 stops, got " + std::to_string(count));
     std::vector<std::string> names;
     for (const PtzPreset& p : h.presets) names.push_back(p.name);
     for (size_t i = 0; i < count; ++i) {
@@ -1061,6 +1073,7 @@ void ReadPtz(const Node& node, Camera* camera) {
       PtzTourStop t;
       t.preset = static_cast<int>(it - names.begin());
       t.dwell_s = stop.Get("dwell_s").NonNegative();
+      if (!(t.dwell_s <= 86400)) stop.Get("dwell_s").Fail("expected a dwell of at most a day (86400 s)");
       h.tour.push_back(t);
     }
   }

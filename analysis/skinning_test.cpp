@@ -329,7 +329,14 @@ TEST(Skinning, BadAnimationsNameTheirJsonPath) {
   };
   for (const auto& [from, to, says] : std::vector<std::array<std::string, 3>>{
            {"\"inverseBindMatrices\"", "\"inverseBindMatriceX\"", "no inverseBindMatrices"},
-           {"\"joints\": [\n    1,\n    2\n   ]", "\"joints\": [\n    1,\n    7\n   ]", "names no node"}}) {
+           {"\"joints\": [\n    1,\n    2\n   ]", "\"joints\": [\n    1,\n    7\n   ]", "names no node"},
+           // An outside audit's crashes (issue 27): assimp takes the first of two "skins" keys and
+           // invalid UTF-8, where the check saw another document; a matrix accessor shorter than
+           // the skin's joints was read past its buffer.
+           {"\"skins\": [", "\"skins\": [], \"skins\": [", "the key \"skins\" twice"},
+           {"\"inverseBindMatrices\"", "\"inverseBindMatrice\xff\"", "JSON is not valid"},
+           {"\"count\": 2,\n   \"type\": \"MAT4\"", "\"count\": 1,\n   \"type\": \"MAT4\"", "holds 1 matrices for 2 joints"}}) {
+    ASSERT_NE(tube.Gltf().find(from), std::string::npos) << from;
     dir.Write("still.gltf", damaged(from, to));
     for (const std::string& animation : {std::string(R"({"clip": 0})"), std::string()}) {
       std::string text = BarScene(dir, &tube, animation, animation.empty() ? "" : R"({"times": [0]})");

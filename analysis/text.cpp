@@ -49,4 +49,34 @@ std::string Base64(const std::string& bytes) {
   return out;
 }
 
+std::string CheckPrintableUtf8(const std::string& s) {
+  const auto* b = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned c = b[i];
+    if (c < 0x20 || c == 0x7f) return Format("a control character (0x%02x) at byte %zu", c, i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    int len = 0;
+    unsigned code = 0;
+    if (c >= 0xc2 && c <= 0xdf) len = 2, code = c & 0x1f;
+    else if (c >= 0xe0 && c <= 0xef) len = 3, code = c & 0x0f;
+    else if (c >= 0xf0 && c <= 0xf4) len = 4, code = c & 0x07;
+    else return Format("invalid UTF-8 at byte %zu", i);
+    if (i + len > n) return Format("invalid UTF-8 at byte %zu", i);
+    for (int k = 1; k < len; ++k) {
+      if ((b[i + k] & 0xc0) != 0x80) return Format("invalid UTF-8 at byte %zu", i);
+      code = (code << 6) | (b[i + k] & 0x3f);
+    }
+    // Overlong forms, surrogates and code points past U+10FFFF.
+    if ((len == 3 && code < 0x800) || (len == 4 && (code < 0x10000 || code > 0x10ffff)) ||
+        (code >= 0xd800 && code <= 0xdfff))
+      return Format("invalid UTF-8 at byte %zu", i);
+    i += len;
+  }
+  return "";
+}
+
 }  // namespace pandora

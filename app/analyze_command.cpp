@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "analysis/calibration.h"
@@ -77,6 +78,26 @@ FieldOptions AnalyzeFieldOptions(const AnalyzeArgs& args, const Scene& scene) {
   return options;
 }
 
+// An earlier run's outputs that this run does not replace would sit beside its summary.json as if
+// they were this run's: an in-memory run removes every streamed tile, a streamed run of n tiles
+// removes fields.vdb and tiles n and up (in the same transaction as the new outputs).
+void RemoveStaleOutputs(OutputTransaction& output, const std::filesystem::path& out, bool streamed,
+                        std::size_t tiles_written) {
+  namespace fs = std::filesystem;
+  if (streamed) output.Remove((out / "fields.vdb").string(), "--out");
+  std::error_code ec;
+  if (!fs::is_directory(out / "fields", ec)) return;
+  for (const fs::directory_entry& e : fs::directory_iterator(out / "fields", ec)) {
+    const std::string name = e.path().filename().string();
+    unsigned index = 0;
+    char tail[8] = {0};
+    if (name.size() != 13 || std::sscanf(name.c_str(), "tile_%4u.%3s", &index, tail) != 2 ||
+        std::string(tail) != "vdb")
+      continue;
+    if (!streamed || index >= tiles_written) output.Remove(e.path().string(), "--out");
+  }
+}
+
 // The metadata of fields.vdb and of every streamed tile.
 std::map<std::string, std::string> FieldsMetadata(const Scene& scene, const Rig& rig,
                                                   const std::string& run_id) {
@@ -109,44 +130,47 @@ int RunAnalyze(const AnalyzeArgs& args) {
   const MpiSession mpi(args.mpi);
   const bool root = mpi.rank() == 0;
   const bool quiet = args.quiet || !root;
-  // The study, with --voxel-size applied, and the rig, through the session layer.
-  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
-  const Scene& scene = study->scene();
+  // The study, with --voxel-size applied, and the rig, through the session layer; then the
+  // outputs staged. Both outputs appear together (summary.json last), or neither does. Every
+  // process reads its own copy of the inputs: one collective check after all of this, so an error
+  // on any process (rank 0's staging included) ends every process with its one line, and none is
+  // left waiting.
+  std::shared_ptr<const session::Study> study;
   session::SessionOptions so;
-  so.rig = args.rig;
-  so.rig_option = "--rig";
-  so.disable = args.disable;
-  so.incremental = false;  // one evaluation: no per-pair state
-  so.fields = AnalyzeFieldOptions(args, scene);
-  FieldOptions& options = so.fields;
-  options.partition_count = mpi.size();
-  options.partition_rank = mpi.rank();
-  ProgressBar bar("analyze " + study->FindRig(args.rig, "--rig").name +
-                      (mpi.active() ? " (rank 0 of " + std::to_string(mpi.size()) + ")" : ""),
-                  !quiet);
-  options.progress = [&bar](double f) { bar.Update(f); };
-  session::Session session(study, so);
-  const Rig& rig = session.rig().rig();
-  // Both outputs appear together (summary.json last), or neither does. Under MPI every process
-  // learns whether rank 0 could stage them before any evaluates (a failure on one rank must not
-  // leave the others waiting).
+  std::optional<ProgressBar> bar;
+  std::optional<session::Session> session_holder;
   const std::filesystem::path out(args.out);
   OutputTransaction output;
   std::string vdb_path, summary_path;
   std::exception_ptr failure;
-  if (root) {
-    try {
-      AddSceneInputs(output, scene);
+  try {
+    study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+    so.rig = args.rig;
+    so.rig_option = "--rig";
+    so.disable = args.disable;
+    so.incremental = false;  // one evaluation: no per-pair state
+    so.fields = AnalyzeFieldOptions(args, study->scene());
+    so.fields.partition_count = mpi.size();
+    so.fields.partition_rank = mpi.rank();
+    bar.emplace("analyze " + study->FindRig(args.rig, "--rig").name +
+                    (mpi.active() ? " (rank 0 of " + std::to_string(mpi.size()) + ")" : ""),
+                !quiet);
+    so.fields.progress = [&bar](double f) { bar->Update(f); };
+    session_holder.emplace(study, so);
+    if (root) {
+      AddSceneInputs(output, study->scene());
       vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
       summary_path = output.Stage((out / "summary.json").string(), "--out");
-    } catch (...) {
-      failure = std::current_exception();
+      RemoveStaleOutputs(output, out, /*streamed=*/false, 0);
     }
+  } catch (...) {
+    failure = std::current_exception();
   }
-  if (!mpi.AllOk(!failure)) {
-    if (failure) std::rethrow_exception(failure);
-    return 2;  // rank 0 printed why
-  }
+  mpi.ThrowIfAnyFailed(failure);
+  const Scene& scene = study->scene();
+  FieldOptions& options = so.fields;
+  session::Session& session = *session_holder;
+  const Rig& rig = session.rig().rig();
 
   try {
     session.UpdateFields();
@@ -158,7 +182,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
     return 2;
   }
   Fields fields = session.TakeFields();
-  bar.Finish();
+  bar->Finish();
   // The partitions meet at rank 0: grids merged, statistics added (volume/fields_transfer.h).
   nlohmann::json mpi_summary;
   if (mpi.active()) {
@@ -332,28 +356,35 @@ double PeakRssMiB() {
   return usage.ru_maxrss / 1024.0;  // KiB on Linux
 }
 
-}  // namespace
+// What a streamed run reads and plans before anything is staged.
+struct StreamSetup {
+  std::shared_ptr<const session::Study> study;
+  Rig rig;
+  FieldOptions options;
+  std::vector<BlockColumns> tiles;
+  VoxelLattice lattice;
+};
 
-int RunStreamedAnalyze(const AnalyzeArgs& args) {
-  // Under mpirun every process evaluates its share of the tiles and writes them itself (into rank
-  // 0's staging folder: the processes share a file system); rank 0 adds up the statistics and
-  // writes the summary (docs/scale.md).
-  const MpiSession mpi(args.mpi);
-  const bool root = mpi.rank() == 0;
-  const auto study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+StreamSetup PrepareStream(const AnalyzeArgs& args) {
+  StreamSetup setup;
+  setup.study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+  const auto& study = setup.study;
   const Scene& scene = study->scene();
-  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
-  FieldOptions options = AnalyzeFieldOptions(args, scene);
+  setup.rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
+  const Rig& rig = setup.rig;
+  setup.options = AnalyzeFieldOptions(args, scene);
+  FieldOptions& options = setup.options;
   options.solid_trees = &study->solid_trees();
   CheckStreamable(args, scene, rig, options.fields);
   const double tile_side =
       std::isnan(args.tile_size) ? 0.0 : CheckPositiveOption("--tile-size", args.tile_size, "metres");
-  const VoxelLattice lattice =
+  setup.lattice =
       MakeLattice(scene.study.region.box, scene.study.voxel_size,
                   options.voxel_size_option.empty() ? scene.path : options.voxel_size_option,
                   options.voxel_size_option.empty() ? "$.study.voxel_size" : "");
-  const std::vector<BlockColumns> tiles =
-      PlanTiles(lattice, options.fields, options.memory_budget_bytes, tile_side);
+  const VoxelLattice& lattice = setup.lattice;
+  setup.tiles = PlanTiles(lattice, options.fields, options.memory_budget_bytes, tile_side);
+  const std::vector<BlockColumns>& tiles = setup.tiles;
   constexpr std::size_t kMostTiles = 10000;
   if (tiles.size() > kMostTiles) {
     // Blame what sized the tiles: --tile-size, --memory-budget, or the scene's budget.
@@ -364,35 +395,53 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
                          std::to_string(kMostTiles),
                      "raise the memory budget, or use larger tiles or a coarser voxel size");
   }
+  return setup;
+}
 
+}  // namespace
+
+int RunStreamedAnalyze(const AnalyzeArgs& args) {
+  // Under mpirun every process evaluates its share of the tiles and writes them itself (into rank
+  // 0's staging folder: the processes share a file system); rank 0 adds up the statistics and
+  // writes the summary (docs/scale.md). Every process reads its own copy of the inputs, then rank
+  // 0 stages the outputs: one collective check after both, so an error on any process ends them
+  // all with its one line.
+  const MpiSession mpi(args.mpi);
+  const bool root = mpi.rank() == 0;
+  StreamSetup setup;
   // Every tile and the summary appear together (summary.json last), or none does.
   const std::filesystem::path out(args.out);
   OutputTransaction output;
   std::vector<std::string> tile_files, tile_paths;
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    char name[32];
-    std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
-    tile_files.push_back(name);
-  }
   std::string summary_path, staged;
   std::exception_ptr failure;
-  if (root) {
-    try {
-      AddSceneInputs(output, scene);
+  try {
+    setup = PrepareStream(args);
+    for (std::size_t t = 0; t < setup.tiles.size(); ++t) {
+      char name[32];
+      std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
+      tile_files.push_back(name);
+    }
+    if (root) {
+      AddSceneInputs(output, setup.study->scene());
       for (const std::string& name : tile_files) {
         tile_paths.push_back(output.Stage((out / name).string(), "--out"));
         staged += tile_paths.back() + '\n';
       }
       summary_path = output.Stage((out / "summary.json").string(), "--out");
+      RemoveStaleOutputs(output, out, /*streamed=*/true, setup.tiles.size());
       staged += output.run_id();
-    } catch (...) {
-      failure = std::current_exception();
     }
+  } catch (...) {
+    failure = std::current_exception();
   }
-  if (!mpi.AllOk(!failure)) {
-    if (failure) std::rethrow_exception(failure);
-    return 2;  // rank 0 printed why
-  }
+  mpi.ThrowIfAnyFailed(failure);
+  const auto& study = setup.study;
+  const Scene& scene = study->scene();
+  const Rig& rig = setup.rig;
+  const FieldOptions& options = setup.options;
+  const std::vector<BlockColumns>& tiles = setup.tiles;
+  const VoxelLattice& lattice = setup.lattice;
   // The staged paths and the run id, from rank 0 to every process.
   std::string run_id = output.run_id();
   if (mpi.active()) {

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
+#include <new>
+#include <stdexcept>
 
 #include "analysis/error.h"
 
@@ -43,6 +46,51 @@ bool MpiSession::AllOk(bool ok) const {
   int mine = ok ? 1 : 0, all = 0;
   MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   return all == 1;
+}
+
+void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
+  if (!active_) {
+    if (failure) std::rethrow_exception(failure);
+    return;
+  }
+  int mine = failure ? rank_ : size_, first = size_;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first == size_) return;
+  // The first failing rank's error, as its four parts, to every process.
+  std::string text;
+  if (rank_ == first) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const InputError& e) {
+      text = e.file() + '\0' + e.json_path() + '\0' + e.reason() + '\0' + e.hint();
+    } catch (const std::bad_alloc&) {
+      text = std::string("") + '\0' + "" + '\0' + "out of memory" + '\0' + "close other programs, or lower the work";
+    } catch (const std::exception& e) {
+      text = std::string("") + '\0' + "" + '\0' + e.what() + '\0' + "";
+    }
+  }
+  std::int64_t n = static_cast<std::int64_t>(text.size());
+  MPI_Bcast(&n, 1, MPI_INT64_T, first, MPI_COMM_WORLD);
+  text.resize(static_cast<std::size_t>(n));
+  MPI_Bcast(text.data(), static_cast<int>(n), MPI_BYTE, first, MPI_COMM_WORLD);
+  std::string part[4];
+  std::size_t at = 0;
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t end = k < 3 ? text.find('\0', at) : text.size();
+    part[k] = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    at = end == std::string::npos ? text.size() : end + 1;
+  }
+  const InputError error(part[0], part[1], part[2] + (first == 0 ? "" : " (on MPI rank " + std::to_string(first) + ")"),
+                         part[3]);
+  // Rank 0 prints the one line before any process exits: mpirun kills the others as soon as one
+  // process ends with an error, and rank 0 could be killed before it printed.
+  if (rank_ == 0) {
+    std::fprintf(stderr, "pandora: error: %s\n", error.what());
+    std::fflush(stderr);
+    g_quiet_errors = true;
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  throw error;
 }
 
 std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) const {
@@ -101,6 +149,10 @@ MpiSession::MpiSession(bool use) {
 MpiSession::~MpiSession() = default;
 
 bool MpiSession::AllOk(bool ok) const { return ok; }
+
+void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
+  if (failure) std::rethrow_exception(failure);
+}
 
 std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) const { return {bytes}; }
 

@@ -4,6 +4,7 @@
 /// partition of the blocks, rank 0 gathering and writing. MPI's header stays in mpi_session.cpp;
 /// without MPI at build time (CMake found no MPI) `--mpi` is refused with one line.
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,12 @@ class MpiSession {
   /// True on every process when `ok` is true on every process (a collective: every process calls
   /// it at the same point). True at once without MPI.
   bool AllOk(bool ok) const;
+  /// A collective that every process calls after work that may fail on some processes only (each
+  /// reads its own copy of the scene): returns when `failure` is null on every process; otherwise
+  /// every process throws, the error of the lowest failing rank (InputError, printed by rank 0 as
+  /// the one line, naming that rank), so no process is left waiting in a later collective.
+  /// Without MPI: rethrows `failure` when there is one.
+  void ThrowIfAnyFailed(std::exception_ptr failure) const;
   /// A collective: every process gives its bytes; rank 0 gets them all, index = rank (its own
   /// included), the others get an empty vector. Any size (sent in pieces below 1 GiB).
   std::vector<std::string> GatherToRoot(const std::string& bytes) const;

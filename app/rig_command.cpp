@@ -15,6 +15,7 @@
 #include "app/output.h"
 #include "suggest/scene_text.h"
 #include "suggest/suggestion_file.h"
+#include "suggest/surface_distance.h"
 
 namespace pandora::app {
 namespace {
@@ -30,6 +31,50 @@ double Positive(const std::string& option, double v) {
   return v;
 }
 
+std::string Metres(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+// Moves each generated camera away from the scene's surfaces until its centre is at least
+// `clearance` from every one (a camera near a corner, set in from its own wall, can sit on the next
+// wall's face): along the distance's gradient (away from the nearest point), a few steps for
+// corners. The aim point stays. Returns one note per moved camera; throws InputError naming
+// `option` when a camera cannot be cleared (it is inside a solid thicker than the room allows).
+std::vector<std::string> KeepClearance(const Scene& scene, double clearance, const std::string& option,
+                                       std::vector<GeneratedCamera>* cameras) {
+  std::vector<std::string> notes;
+  const TriangleMesh mesh = scene.AllTriangles();
+  if (mesh.triangles.empty()) return notes;
+  const SurfaceDistance distance(mesh);
+  const double h = 1e-5 * std::max(1.0, clearance);
+  for (GeneratedCamera& c : *cameras) {
+    const Vec3 start = c.position;
+    for (int step = 0; step < 32; ++step) {
+      const double d = distance.Distance(c.position, 2 * clearance);
+      if (d >= clearance * (1 - 1e-9)) break;
+      Vec3 grad;
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e = Vec3::Zero();
+        e[a] = h;
+        grad[a] = (distance.Distance(c.position + e, 4 * clearance) - distance.Distance(c.position - e, 4 * clearance)) / (2 * h);
+      }
+      if (!(grad.norm() > 1e-6)) grad = (c.look_at - c.position).normalized();  // on a surface: go towards the aim
+      c.position += (clearance - d + 1e-6 * clearance) * grad.normalized();
+    }
+    const double d = distance.Distance(c.position, 2 * clearance);
+    if (d < clearance * (1 - 1e-6))
+      throw InputError(option, "", "camera " + c.id + " cannot be kept " + Metres(clearance) +
+                                       " m from every surface (it is " + Metres(d) + " m from one)",
+                       "move the layout away from the walls and objects");
+    if ((c.position - start).norm() > 0)
+      notes.push_back("camera " + c.id + " moved " + Metres((c.position - start).norm()) +
+                      " m away from a surface it was within " + Metres(clearance) + " m of");
+  }
+  return notes;
+}
+
 }  // namespace
 
 int RunRig(const RigArgs& args) {
@@ -39,8 +84,7 @@ int RunRig(const RigArgs& args) {
                                               : "which layout?",
                      "one of --ring N, --grid NX,NY, --wall-grid NU,NZ or --along X0,Y0,X1,Y1[,...]");
   if (args.name.empty()) throw InputError("--name", "", "the new rig needs a name");
-  LoadOptions lo;
-  lo.load_meshes = false;
+  LoadOptions lo;  // meshes too: the cameras keep their clearance from every surface
   const std::string text = scene_text::ReadJsonText(args.scene, "scene file");
   const Scene scene = ParseScene(text, args.scene, lo);
   const Aabb& region = scene.study.region.box;
@@ -93,6 +137,11 @@ int RunRig(const RigArgs& args) {
     if (std::isnan(args.height)) throw InputError("--height", "", "cameras along walls need their height");
     cameras = AlongWallsCameras(args.count, walls, args.height, args.inset, aim, prefix);
   }
+  // Every camera keeps its clearance from every surface: the inset (walls), at least 5 cm.
+  const std::string layout = !args.ring.empty() ? "--ring" : !args.grid.empty() ? "--grid"
+                             : !args.wall_grid.empty() ? "--wall-grid" : "--along";
+  const double clearance = (layout == "--wall-grid" || layout == "--along") ? std::max(args.inset, 0.05) : 0.05;
+  const std::vector<std::string> moved = KeepClearance(scene, clearance, layout, &cameras);
   for (const GeneratedCamera& c : cameras) {
     scene.CheckLength(c.position.norm(), "--ring", "a camera position");
     if (!((c.look_at - c.position).norm() > 1e-9))
@@ -140,6 +189,8 @@ int RunRig(const RigArgs& args) {
       std::printf("%s rig %s (%zu cameras) in %s (previous file kept as %s)\n", replaced ? "replaced" : "wrote",
                   args.name.c_str(), cameras.size(), args.scene.c_str(), backup.c_str());
   }
+  if (!args.quiet)
+    for (const std::string& note : moved) std::printf("%s\n", note.c_str());
   std::fflush(stdout);
   for (const Warning& w : warnings)
     std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(args.scene, w).c_str());

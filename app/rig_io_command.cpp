@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "analysis/error.h"
+#include "analysis/rig_check.h"
 #include "analysis/rig_formats.h"
 #include "analysis/scene.h"
 #include "app/commands.h"
@@ -60,7 +61,21 @@ int RunExportRig(const ExportRigArgs& args) {
     written.push_back(args.out);
   }
   output.Commit();
+  // OpenCV's fisheye model and COLMAP's OPENCV_FISHEYE project through atan(r): rays 90 degrees or
+  // more off the axis have no image there. A wider lens is written, but not all of it.
+  std::vector<std::string> warnings;
+  if (f == "opencv" || f == "colmap")
+    for (const Camera& c : rig.cameras) {
+      if (c.model.intrinsics().model != LensModel::kFisheye) continue;
+      const LensCoverage lens = ComputeLensCoverage(c.model);
+      const double widest = std::max(lens.hfov_deg, lens.vfov_deg);
+      if (widest >= 180.0)
+        warnings.push_back(args.scene + ": camera '" + c.id + "' sees " + std::to_string(int(widest + 0.5)) +
+                           " degrees, but the " + (f == "opencv" ? "OpenCV fisheye" : "COLMAP OPENCV_FISHEYE") +
+                           " model written for it cannot hold rays 90 degrees or more off its axis: that part of its view is lost");
+    }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const std::string& w : warnings) std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   if (!args.quiet) {
     std::printf("rig %s: %zu cameras as %s\n", rig.name.c_str(), rig.cameras.size(), f.c_str());
     for (const std::string& w : written) std::printf("wrote %s\n", w.c_str());

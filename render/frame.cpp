@@ -67,10 +67,14 @@ class ViewRays {
  public:
   // `table`: for a camera's-eye view, unproject every pixel's centre ray once up front (a frame);
   // otherwise each query unprojects (a single pick). Both give the same rays bit for bit.
-  ViewRays(const RenderView& view, const Rig& rig, bool table)
+  // `camera_t_near`: for a camera's-eye view, where its primary rays start, the fields' rule for
+  // the same camera (VisibilityTester::Tolerance(camera, 0)): a surface through the camera centre
+  // (a camera mounted on a wall's face) is behind it for the image as for the fields.
+  ViewRays(const RenderView& view, const Rig& rig, bool table, double camera_t_near = 0.0)
       : width_(view.width), height_(view.height) {
     if (view.camera >= 0) {
       cam_ = &rig.cameras[view.camera];
+      camera_t_near_ = camera_t_near;
       eye_ = cam_->center();
       R_ = cam_->world_from_camera.linear();
       sx_ = double(cam_->model.width()) / width_;
@@ -104,6 +108,7 @@ class ViewRays {
   const Vec3& eye() const { return eye_; }
   // Where the primary ray along unit `d` starts: RenderView::clip_near along the optical axis.
   double NearT(const Vec3& d) const {
+    if (cam_) return camera_t_near_;
     if (!(clip_near_ > 0)) return 0.0;
     const double c = d.dot(R_.col(2));
     return c > 0 ? clip_near_ / c : 0.0;
@@ -178,6 +183,7 @@ class ViewRays {
   Vec3 eye_;
   Mat3 R_;
   double clip_near_ = 0;
+  double camera_t_near_ = 0;
   double f_ = 1, cx_ = 0, cy_ = 0;
   double sx_ = 1, sy_ = 1;
   std::vector<Entry> table_;
@@ -465,7 +471,7 @@ struct FrameRenderer::Impl {
         options(options),
         overlays(overlays),
         tester(rig.cameras, *scene.caster, scene.scene_scale),
-        rays(view, rig, table),
+        rays(view, rig, table, view.camera >= 0 ? tester.Tolerance(view.camera, 0.0) : 0.0),
         culler(rig.cameras) {}
 
   const PreparedSceneData& scene;
@@ -991,13 +997,13 @@ struct PixelPicker::Impl {
         rig(rig),
         width(view.width),
         height(view.height),
-        rays(view, rig, /*table=*/false),
-        tester(rig.cameras, *scene.caster, scene.scene_scale) {}
+        tester(rig.cameras, *scene.caster, scene.scene_scale),
+        rays(view, rig, /*table=*/false, view.camera >= 0 ? tester.Tolerance(view.camera, 0.0) : 0.0) {}
   const internal::PreparedSceneData& scene;
   const Rig& rig;
   int width, height;
+  const VisibilityTester tester;  // before rays: their camera start comes from it
   const internal::ViewRays rays;
-  const VisibilityTester tester;
 };
 
 PixelPicker::PixelPicker(const PreparedScene& scene, const Rig& rig, const RenderView& view) {

@@ -18,6 +18,7 @@
 #include "analysis/uncertainty.h"
 #include "analysis/visibility.h"
 #include "render/colormap.h"
+#include "render/prepared_scene.h"
 #include "render/render.h"
 #include "tests/fixtures.h"
 
@@ -338,6 +339,47 @@ TEST(Render, GridPatternDrawsTheCamerasPixelGridInItsOwnEyeView) {
       const double expected = 0.15 + 0.85 * l;
       EXPECT_NEAR(img.Rgb(x, y).x(), expected, 1e-4) << x << "," << y;
     }
+}
+
+// A camera mounted exactly on a wall's inner face (as `pandora rig --along` once placed two): the
+// camera centre's side of the surface decides, for the fields and the renderer alike. Its own view
+// shows the room, not a flat wall at distance 0, and every pixel it shows is a point the fields'
+// visibility test says it sees, and lit by it in the image.
+TEST(Render, CameraOnAWallFaceSeesTheRoomAsItsFieldsDo) {
+  Scene scene;
+  scene.objects.push_back(Floor());
+  SceneObject wall;
+  wall.name = "wall";
+  wall.source = "box";
+  wall.mesh = MakeBox(Vec3(0.2, 6, 3));
+  for (Vec3& v : wall.mesh.vertices) v += Vec3(-2.1, 0, 1.5);  // inner face at x = -2
+  scene.objects.push_back(wall);
+  Rig rig;
+  rig.name = "wall";
+  rig.cameras.push_back(
+      MakeCamera("w", Vec3(-2.0, 0, 1.5), Vec3(0, 0, 0), Vec3(0, 0, 1), 32, 24, 60, Vec3(1, 1, 1)));
+  const PreparedScene prepared(scene);
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const VisibilityTester tester(rig.cameras, *caster, scene.Bounds().diagonal());
+  RenderView view;
+  view.camera = 0;
+  view.width = 32;
+  view.height = 24;
+  const Image img = Render(scene, rig, *caster, view, BlackOptions());
+  int floor_pixels = 0;
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const auto pick = PickPixel(prepared, rig, view, x, y);
+      if (!pick) continue;
+      // Never the wall the camera sits on (at depth 0): the floor, metres away.
+      EXPECT_NE(scene.objects[pick->object].name, "wall") << x << "," << y << " depth " << pick->depth;
+      EXPECT_GT(pick->depth, 0.5) << x << "," << y;
+      // The fields' rule says the camera sees the point the image shows there, and the image lights it.
+      EXPECT_EQ(tester.Test(0, pick->lit_point, &pick->normal), ViewResult::kSeen) << x << "," << y;
+      EXPECT_GT(img.Rgb(x, y).x(), 0.0) << x << "," << y;
+      ++floor_pixels;
+    }
+  EXPECT_GT(floor_pixels, 32 * 24 / 3);  // looking down at the floor from 1.5 m
 }
 
 TEST(Render, CamerasEyeViewThroughAFisheyeSeesOnlyWhatItLights) {

@@ -466,6 +466,15 @@ TEST(RigImport, NamedDamagesNameLineFieldAndReason) {
       "images.txt: line 5: CAMERA_ID: no camera '9' in the cameras file");
   col(colmap.cameras, replace(colmap.images, "1 0 0 0.8701999067534788", "1 0 0 0.9701999067534788"),
       "images.txt: line 5: QW QX QY QZ: not a unit quaternion");
+  // Names that cannot be camera ids in a JSON scene file (once exit 1, an internal error).
+  col(colmap.cameras, replace(colmap.images, "north%201.png", "north\x01x.png"),
+      "images.txt: line 5: NAME: the image name (a camera id) holds a control character (0x01) at byte 5");
+  col(colmap.cameras, replace(colmap.images, "north%201.png", "north\xff\xfe.png"),
+      "images.txt: line 5: NAME: the image name (a camera id) holds invalid UTF-8 at byte 5");
+  col(colmap.cameras, replace(colmap.images, "north%201.png", "north%01.png"),
+      "images.txt: line 5: NAME: the image name (a camera id) holds a control character (0x01)");
+  col(colmap.cameras, replace(colmap.images, "north%201.png", "north%C3.png"),
+      "images.txt: line 5: NAME: the image name (a camera id) holds invalid UTF-8");
   col(colmap.cameras, replace(colmap.images, "north%201.png\n\n", "north%201.png\n1 2\n"),
       "images.txt: line 6: POINTS2D: expected (X, Y, POINT3D_ID) triples, got 2 numbers");
   col(colmap.cameras, colmap.images.substr(0, colmap.images.size() - 1),

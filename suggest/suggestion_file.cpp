@@ -522,6 +522,21 @@ std::string ReplaceSceneFileWithBackup(const std::string& scene_path, const std:
   if (ec || (perms & fs::perms::owner_write) == fs::perms::none)
     throw InputError(scene_path, "", "the scene file is read-only", "make it writable, then accept again");
   const std::string path = target.string();
+  // Under the folder's lock, the file must still be what the caller read: a second writer that
+  // read the same text before the first one wrote is refused here, never applied over it.
+  FolderLock lock(path);
+  std::string on_disk;
+  try {
+    on_disk = ReadJsonText(path, "scene file");
+  } catch (const InputError&) {
+    throw InputError(scene_path, "", "the scene file vanished or became unreadable while it was being replaced",
+                     "check the file, then try again");
+  }
+  if (Sha256Hex(on_disk) != Sha256Hex(old_text))
+    throw InputError(scene_path, "",
+                     "the scene file was changed by another program while this one worked (SHA-256 differs); "
+                     "nothing was written",
+                     "look at the file, then run the command again");
   std::string backup = path + ".bak";
   for (int n = 1; fs::exists(backup, ec); ++n) backup = path + ".bak." + std::to_string(n);
   OutputTransaction output;

@@ -12,6 +12,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -779,10 +780,38 @@ std::string VisibilityGridName(const std::string& camera_id) {
   return name;
 }
 
+void CheckSameRunAsSummary(const FieldsProvenance& p, const std::string& path) {
+  const auto run = p.metadata.find("run_id");
+  if (run == p.metadata.end() || run->second.empty()) return;  // an older file: nothing to compare
+  // The summary.json written with it: beside a fields.vdb, one folder up from a streamed tile.
+  std::string folder = path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/'));
+  if (folder.empty() && path.find('/') == std::string::npos) folder = ".";
+  const std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+  std::string summary = folder + "/summary.json";
+  if (name.rfind("tile_", 0) == 0) summary = folder + "/../summary.json";
+  struct stat st {};
+  if (::stat(summary.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > (64 << 20)) return;
+  std::FILE* f = std::fopen(summary.c_str(), "rb");
+  if (!f) return;
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  const std::size_t got = std::fread(text.data(), 1, text.size(), f);
+  std::fclose(f);
+  text.resize(got);
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("run_id") || !j["run_id"].is_string()) return;
+  const std::string other = j["run_id"].get<std::string>();
+  if (other != run->second)
+    throw InputError(path, "",
+                     "the fields belong to another run than " + summary + " beside them (run ids " +
+                         run->second + " and " + other + "): one of the two is stale",
+                     "run pandora analyze again into that folder, or give fields with their own summary");
+}
+
 std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
                                                const VoxelLattice& lattice, const Scene& scene,
                                                const Rig& rig, const std::string& path) {
   std::vector<std::string> warnings;
+  CheckSameRunAsSummary(p, path);
   if (p.scene_sha256.empty() && p.rig_name.empty() && p.rig_json.empty()) {
     warnings.push_back(
         path +

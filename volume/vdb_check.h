@@ -83,7 +83,13 @@ struct FieldsProvenance {
   std::map<std::string, std::string> metadata;  ///< Every string metadata entry of the file.
 };
 
+/// Throws InputError (file = `path`) when the fields carry a run id and the summary.json written
+/// beside them (in the same folder; one folder up from a streamed tile) carries another: the two
+/// outputs come from different runs, and one is stale. Nothing happens without either run id.
+void CheckSameRunAsSummary(const FieldsProvenance& provenance, const std::string& path);
+
 /// Compares a fields file read from `path` with the scene and rig it is about to be used with.
+/// Refuses fields of another run than the summary beside them (CheckSameRunAsSummary).
 /// Returns one-line warnings (without a "warning:" prefix): the scene file's SHA-256 differs, the
 /// rig's cameras differ from those the fields were computed for (naming the cameras), or the file
 /// carries no provenance at all. Throws InputError (file = `path`) when the file's rig name differs

@@ -35,4 +35,23 @@ err=$(mpirun -n 2 "$pandora" analyze "$scene" "${rigarg[@]}" --out /proc/pandora
 code=$?
 [ "$code" -ne 0 ] || fail "unwritable --out under mpirun exited 0"
 [ "$(printf '%s\n' "$err" | grep -c '^pandora: error:')" -eq 1 ] || fail "expected one error line, got: $err"
+# An input error on one rank only (rank 1 reads a damaged copy of the scene; rank 0 a good one, as
+# MPMD): every rank ends, mpirun exits non-zero within the timeout, rank 0 prints the one line
+# naming rank 1, and nothing is written. It once left rank 0 waiting for ever.
+head -c 200 "$scene" > "$work/damaged.json"
+modes=(memory)
+# Streamed too where the scene streams (one with moving people is refused by rank 0 itself).
+"$pandora" analyze "$scene" "${rigarg[@]}" --stream --fields coverage --out "$work/stream_check" --quiet 2> /dev/null &&
+  modes+=(stream)
+for mode in "${modes[@]}"; do
+  extra=(); [ $mode = stream ] && extra=(--stream --fields coverage)
+  err=$(timeout 120 mpirun -n 1 "$pandora" analyze "$scene" "${rigarg[@]}" "${extra[@]}" --out "$work/rank1_$mode" --mpi --threads 1 : \
+        -n 1 "$pandora" analyze "$work/damaged.json" "${rigarg[@]}" "${extra[@]}" --out "$work/rank1_$mode" --mpi --threads 1 2>&1 >/dev/null)
+  code=$?
+  [ "$code" -ne 124 ] || fail "$mode: an error on rank 1 alone left the run hanging"
+  [ "$code" -ne 0 ] || fail "$mode: an error on rank 1 alone exited 0"
+  [ "$(printf '%s\n' "$err" | grep -c '^pandora: error:')" -eq 1 ] || fail "$mode: expected one error line, got: $err"
+  printf '%s\n' "$err" | grep -q 'on MPI rank 1' || fail "$mode: the line does not name rank 1: $err"
+  [ ! -e "$work/rank1_$mode/summary.json" ] || fail "$mode: a summary was written"
+done
 echo "mpi: 2 and 4 ranks equal one process"
