@@ -201,9 +201,27 @@ PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from
   // With a density target the head may have to zoom in as far as it goes.
   if (zoom_rate > 0 && min_px_per_m > 0) max_time_ = std::max(max_time_, (head.focal_max - from.focal) / zoom_rate);
   max_time_ = std::max(max_time_, 0.0);
+  // The largest pixel density over the image relative to the axis' at the same distance (a
+  // pinhole's cos^-1.5 at the corners), on a 33 x 33 lattice of pixels, with 2 % to spare for the
+  // lattice and the pivot offset.
+  const Intrinsics& k = base.model.intrinsics();
+  Mat23 J;
+  if (!base.model.Project(Vec3(0, 0, 1), &J)) return;
+  const double axis = PixelDensity(J);
+  double gain = 1.0;
+  for (int i = 0; i <= 32; ++i)
+    for (int j = 0; j <= 32; ++j) {
+      const Vec2 px(-0.5 + k.width * i / 32.0, -0.5 + k.height * j / 32.0);
+      const std::optional<Vec3> ray = base.model.Unproject(px);
+      if (!ray || !(ray->norm() > 0)) continue;
+      if (base.model.Project(ray->normalized(), &J)) gain = std::max(gain, PixelDensity(J) / axis);
+    }
+  boost_ = 1.02 * gain;
 }
 
-std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
+std::optional<PtzState> PtzReach::CentredPose(const Vec3& X, double t, double* needed_focal, bool* clamped) const {
+  if (needed_focal) *needed_focal = 0;
+  if (clamped) *clamped = false;
   const PtzHead& h = head_;
   t = std::max(t, 0.0);
   // The reachable box: pan and tilt intervals, the widest reachable zoom.
@@ -250,6 +268,8 @@ std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
     const double el = Deg(std::atan2(e.dot(h.pan_axis), horizontal * std::cos(dpan)));
     s.pan_deg = h.WrapPan(pan);
     s.tilt_deg = std::clamp(el - el0, tilt_lo, tilt_hi);
+    if (clamped)
+      *clamped = std::abs(Wrap180(pan - az)) > 1e-9 || std::abs(s.tilt_deg - (el - el0)) > 1e-9;
   }
   if (min_px_per_m_ > 0) {
     // The density scales with the focal length: the zoom that meets the target exactly at this
@@ -260,10 +280,150 @@ std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
     const double density = PixelDensity(J);  // at the camera's own focal
     if (!(density > 0)) return std::nullopt;
     const double needed = base_.model.intrinsics().fx * min_px_per_m_ / density;
+    if (needed_focal) *needed_focal = needed;
     const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, from_.focal + zoom_rate * t) : from_.focal;
     s.focal = std::max(s.focal, needed);
     if (s.focal > f_hi) return std::nullopt;
   }
+  return s;
+}
+
+std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
+  // The point centred (closed form): the pose of choice whenever it sees X.
+  double needed = 0;
+  bool clamped = false;
+  const std::optional<PtzState> centred = CentredPose(X, t, &needed, &clamped);
+  if (centred && PtzSees(base_, head_, *centred, X, min_px_per_m_ > 0 ? min_px_per_m_ * (1 - 1e-12) : 0.0))
+    return centred;
+  // Centring was not limited by the reachable angles: off-centre settings can only help the
+  // density, by at most the lens's largest density gain over its image (boost_).
+  if (!clamped) {
+    if (!(min_px_per_m_ > 0) || !(needed > 0)) return centred;
+    const double zoom_rate = head_.zoom_speed * (head_.focal_max - head_.focal_min);
+    const double f_hi = zoom_rate > 0 ? std::min(head_.focal_max, from_.focal + zoom_rate * std::max(t, 0.0)) : from_.focal;
+    if (needed > f_hi * boost_) return centred;
+  }
+  // Otherwise an off-centre setting may: with a density target the point's density grows towards
+  // the image's edges (a pinhole's as cos^-1.5 of the angle off the axis), and a clamped pan or
+  // tilt can leave the point inside the image's corner but not its midline.
+  if (const std::optional<PtzState> off = SearchPose(X, t)) return off;
+  return centred;
+}
+
+std::optional<PtzState> PtzReach::SearchPose(const Vec3& X, double t) const {
+  const PtzHead& h = head_;
+  t = std::max(t, 0.0);
+  const Intrinsics& k = base_.model.intrinsics();
+  // The reachable box at t.
+  double pan_lo = from_.pan_deg - h.pan_speed_deg_s * t, pan_hi = from_.pan_deg + h.pan_speed_deg_s * t;
+  const bool any_pan = h.ContinuousPan() && pan_hi - pan_lo >= 360.0;
+  if (!h.ContinuousPan()) {
+    pan_lo = std::max(pan_lo, h.pan_min_deg);
+    pan_hi = std::min(pan_hi, h.pan_max_deg);
+  }
+  const double tilt_lo = std::max(from_.tilt_deg - h.tilt_speed_deg_s * t, h.tilt_min_deg);
+  const double tilt_hi = std::min(from_.tilt_deg + h.tilt_speed_deg_s * t, h.tilt_max_deg);
+  const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
+  const double f_lo = zoom_rate > 0 ? std::max(h.focal_min, from_.focal - zoom_rate * t) : from_.focal;
+  const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, from_.focal + zoom_rate * t) : from_.focal;
+  // The margin of a pan and tilt: the focal lengths that keep X inside the image are (0, f_in]
+  // (the zoom scales the pixel about the principal point), those meeting the density [needed, inf);
+  // the setting is feasible when [max(needed, f_lo), min(f_in, f_hi)] is not empty. Relative to f_hi.
+  const Vec2 pp(k.cx, k.cy);
+  auto margin = [&](double pan, double tilt, double* focal) {
+    constexpr double kNone = -kInf;
+    PtzState s;
+    s.pan_deg = h.WrapPan(pan);
+    s.tilt_deg = tilt;
+    s.focal = k.fx;
+    const Eigen::Isometry3d pose = h.Pose(s);
+    const Vec3 to_point = X - pose.translation();
+    const double distance = to_point.norm();
+    if (!(distance >= base_.near) || distance > base_.far) return kNone;
+    Mat23 J;
+    const std::optional<Vec2> pixel =
+        base_.model.Project(pose.linear().transpose() * to_point, min_px_per_m_ > 0 ? &J : nullptr);
+    if (!pixel) return kNone;
+    const Vec2 d = *pixel - pp;
+    double scale = kInf;
+    if (d.x() > 0) scale = std::min(scale, (k.width - 0.5 - k.cx) / d.x());
+    if (d.x() < 0) scale = std::min(scale, (-0.5 - k.cx) / d.x());
+    if (d.y() > 0) scale = std::min(scale, (k.height - 0.5 - k.cy) / d.y());
+    if (d.y() < 0) scale = std::min(scale, (-0.5 - k.cy) / d.y());
+    double needed = 0;
+    if (min_px_per_m_ > 0) {
+      const double density = PixelDensity(J);
+      if (!(density > 0)) return kNone;
+      needed = k.fx * min_px_per_m_ / density;
+    }
+    const double lo = std::max(needed, f_lo), hi = std::min(k.fx * scale, f_hi);
+    *focal = lo;
+    return (hi - lo) / f_hi;
+  };
+  // The window: the angles that centre X, widened by the half diagonal of the widest reachable
+  // field of view (a quarter more for distortion); pan widened towards the pan axis, where a pan
+  // moves the image less.
+  const Vec3 C = h.Pose(from_).translation();
+  const Vec3 e = X - C;
+  if (!(e.norm() > 0)) return std::nullopt;
+  const Vec3 x_home = h.home.linear().col(0);
+  const Vec3 forward0 = h.pan_axis.cross(x_home);
+  const double az = Deg(std::atan2(e.dot(-x_home), e.dot(forward0)));
+  const double horizontal = std::hypot(e.dot(-x_home), e.dot(forward0));
+  const double el = Deg(std::atan2(e.dot(h.pan_axis), horizontal));
+  const double corner = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
+  const double half = k.model == LensModel::kFisheye ? 180.0 : std::min(180.0, 1.25 * Deg(std::atan(corner / f_lo)) + 0.5);
+  const double pan_half = std::min(180.0, half / std::max(std::cos(Rad(el)), 0.02));
+  double pan_c = az;
+  if (!any_pan) {  // the turn of the azimuth nearest to the reachable pans
+    double best = kInf;
+    for (int q = -2; q <= 2; ++q) {
+      const double a = az + 360.0 * q;
+      const double gap = std::abs(std::clamp(a, pan_lo, pan_hi) - a);
+      if (gap < best) best = gap, pan_c = a;
+    }
+  }
+  const double p0 = any_pan ? pan_c - pan_half : std::max(pan_lo, pan_c - pan_half);
+  const double p1 = any_pan ? pan_c + pan_half : std::min(pan_hi, pan_c + pan_half);
+  const double tilt_c = el - h.HomeElevationDeg();
+  const double q0 = std::max(tilt_lo, tilt_c - half), q1 = std::min(tilt_hi, tilt_c + half);
+  if (!(p1 >= p0) || !(q1 >= q0)) return std::nullopt;
+  // A 9 x 9 lattice over the window, then a pattern search from its best point (steps halved to
+  // 1e-7 degrees): the margin is smooth and, near the reach time, peaks at one setting.
+  constexpr int kLattice = 9;
+  double best_m = -kInf, best_p = pan_c, best_q = tilt_c, best_f = f_lo;
+  for (int i = 0; i < kLattice && best_m < 0; ++i)  // a feasible setting is enough for reach
+    for (int j = 0; j < kLattice && best_m < 0; ++j) {
+      const double p = p0 + (p1 - p0) * i / (kLattice - 1), q = q0 + (q1 - q0) * j / (kLattice - 1);
+      double f = 0;
+      const double m = margin(p, q, &f);
+      if (m > best_m) best_m = m, best_p = p, best_q = q, best_f = f;
+    }
+  if (best_m == -kInf) return std::nullopt;
+  double dp = 0.5 * (p1 - p0) / (kLattice - 1), dq = 0.5 * (q1 - q0) / (kLattice - 1);
+  // Only a lattice point within kNear of feasible is refined (a farther one is not feasible
+  // anywhere near: the margin changes by less than that between lattice points, measured below).
+  constexpr double kNear = 0.1;
+  for (int evals = 0; best_m < 0 && best_m > -kNear && evals < 400 && (dp > 1e-7 || dq > 1e-7);) {
+    bool moved = false;
+    for (const auto& [sp, sq] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}}) {
+      const double p = std::clamp(best_p + sp * dp, p0, p1), q = std::clamp(best_q + sq * dq, q0, q1);
+      double f = 0;
+      const double m = margin(p, q, &f);
+      ++evals;
+      if (m > best_m) {
+        best_m = m, best_p = p, best_q = q, best_f = f;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) dp *= 0.5, dq *= 0.5;
+  }
+  if (best_m < 0) return std::nullopt;
+  PtzState s;
+  s.pan_deg = h.WrapPan(best_p);
+  s.tilt_deg = best_q;
+  s.focal = best_f;
   return s;
 }
 
@@ -274,15 +434,157 @@ bool PtzReach::Reachable(const Vec3& X, double t, const Vec3* normal, Ray* segme
   return PtzSees(base_, head_, *s, X, 0.0, normal, segment, epsilon);
 }
 
-double PtzReach::ReachTime(const Vec3& X, const Vec3* normal, double tolerance_s) const {
-  if (Reachable(X, 0.0, normal)) return 0.0;
-  if (!Reachable(X, max_time_, normal)) return kInf;
-  double lo = 0.0, hi = max_time_;
-  while (hi - lo > tolerance_s) {
-    const double mid = 0.5 * (lo + hi);
-    (Reachable(X, mid, normal) ? hi : lo) = mid;
+double PtzReach::ReachTime(const Vec3& X, const Vec3* normal, double tolerance_s, PtzState* pose) const {
+  const double target = min_px_per_m_ > 0 ? min_px_per_m_ * (1 - 1e-12) : 0.0;
+  // The centred pose's reach (closed form per time, bisection over time): an upper bound.
+  auto centred = [&](double t, PtzState* s) {
+    const std::optional<PtzState> c = CentredPose(X, t);
+    if (!c || !PtzSees(base_, head_, *c, X, target, normal)) return false;
+    if (s) *s = *c;
+    return true;
+  };
+  PtzState best;
+  double t_c = kInf;
+  if (centred(0.0, &best)) {
+    t_c = 0.0;
+  } else if (centred(max_time_, nullptr)) {
+    double lo = 0.0, hi = max_time_;
+    while (hi - lo > tolerance_s) {
+      const double mid = 0.5 * (lo + hi);
+      (centred(mid, nullptr) ? hi : lo) = mid;
+    }
+    t_c = hi;
+    centred(hi, &best);
   }
-  return hi;
+  // Off-centre settings: the least move time over every setting that sees X. Skipped when the
+  // zoom alone needs nearly t_c: off the axis the density grows by at most boost_.
+  bool search = t_c > 0;
+  if (search && std::isfinite(t_c) && min_px_per_m_ > 0) {
+    double needed = 0;
+    bool clamped = false;
+    CentredPose(X, t_c, &needed, &clamped);
+    const double zoom_rate = head_.zoom_speed * (head_.focal_max - head_.focal_min);
+    if (!clamped && zoom_rate > 0 && (needed / boost_ - from_.focal) / zoom_rate >= t_c - tolerance_s) search = false;
+  }
+  if (search) {
+    PtzState off;
+    const double t_s = FastestSetting(X, normal, t_c, &off);
+    if (t_s < t_c) t_c = t_s, best = off;
+  }
+  if (pose && std::isfinite(t_c)) *pose = best;
+  return t_c;
+}
+
+double PtzReach::FastestSetting(const Vec3& X, const Vec3* normal, double bound, PtzState* pose) const {
+  const PtzHead& h = head_;
+  const Intrinsics& k = base_.model.intrinsics();
+  const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
+  const double target = min_px_per_m_ > 0 ? min_px_per_m_ * (1 - 1e-12) : 0.0;
+  const Vec2 pp(k.cx, k.cy);
+  // The time to a pan and tilt that show X: the move to them, and the zoom into the interval of
+  // focal lengths that keep X inside the image (0, f_in] (the zoom scales the pixel about the
+  // principal point) and meet the density [needed, inf), from the current zoom; inf when none.
+  // A pan and tilt's score: (shortfall, time). Shortfall 0: the setting shows X, and time is the
+  // move to it and the zoom into the interval of focal lengths that keep X inside the image
+  // (0, f_in] (the zoom scales the pixel about the principal point) and meet the density
+  // [needed, inf), nearest the current zoom. Otherwise how far that interval is from existing
+  // (relative focal length), so that the search climbs towards settings that show X.
+  using Score = std::pair<double, double>;
+  const Score kNone{kInf, kInf};
+  auto score = [&](double pan, double tilt, PtzState* out) -> Score {
+    PtzState s;
+    s.pan_deg = h.WrapPan(pan);
+    s.tilt_deg = tilt;
+    s.focal = k.fx;
+    const Eigen::Isometry3d pose = h.Pose(s);
+    const Vec3 to_point = X - pose.translation();
+    const double distance = to_point.norm();
+    if (!(distance >= base_.near) || distance > base_.far) return kNone;
+    if (normal && normal->dot(-to_point) <= 0.0) return kNone;
+    Mat23 J;
+    const std::optional<Vec2> pixel = base_.model.Project(pose.linear().transpose() * to_point, target > 0 ? &J : nullptr);
+    if (!pixel) return kNone;
+    const Vec2 d = *pixel - pp;
+    double scale = kInf;
+    if (d.x() > 0) scale = std::min(scale, (k.width - 0.5 - k.cx) / d.x());
+    if (d.x() < 0) scale = std::min(scale, (-0.5 - k.cx) / d.x());
+    if (d.y() > 0) scale = std::min(scale, (k.height - 0.5 - k.cy) / d.y());
+    if (d.y() < 0) scale = std::min(scale, (-0.5 - k.cy) / d.y());
+    double lo = zoom_rate > 0 ? h.focal_min : from_.focal;
+    double hi = std::min(zoom_rate > 0 ? h.focal_max : from_.focal, k.fx * scale);
+    if (target > 0) {
+      const double density = PixelDensity(J);
+      if (!(density > 0)) return kNone;
+      lo = std::max(lo, k.fx * target / density);
+    }
+    if (lo > hi) return {(lo - hi) / std::max(h.focal_max, from_.focal), kInf};
+    s.focal = std::clamp(from_.focal, lo, hi);
+    if (out) *out = s;
+    return {0.0, h.MoveTime(from_, s)};
+  };
+  // The window: the angles that centre X, widened by the half diagonal of the widest field of view
+  // (a quarter more for distortion), pan widened towards the pan axis, where a pan moves the image less.
+  const Vec3 C = h.Pose(from_).translation();
+  const Vec3 e = X - C;
+  if (!(e.norm() > 0)) return kInf;
+  const Vec3 x_home = h.home.linear().col(0);
+  const Vec3 forward0 = h.pan_axis.cross(x_home);
+  const double az = Deg(std::atan2(e.dot(-x_home), e.dot(forward0)));
+  const double el = Deg(std::atan2(e.dot(h.pan_axis), std::hypot(e.dot(-x_home), e.dot(forward0))));
+  const double widest = std::min(h.focal_min > 0 ? h.focal_min : k.fx, k.fx);
+  const double corner = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
+  const double half = k.model == LensModel::kFisheye ? 180.0 : std::min(180.0, 1.25 * Deg(std::atan(corner / widest)) + 0.5);
+  const double pan_half = std::min(180.0, half / std::max(std::cos(Rad(el)), 0.02));
+  // The turn of the azimuth nearest to the current pan (a bounded pan: nearest to its range).
+  double pan_c = from_.pan_deg + Wrap180(az - from_.pan_deg);
+  if (!h.ContinuousPan()) {
+    double gap_best = kInf;
+    for (int q = -2; q <= 2; ++q) {
+      const double a = az + 360.0 * q;
+      const double gap = std::abs(std::clamp(a, h.pan_min_deg, h.pan_max_deg) - a);
+      if (gap < gap_best) gap_best = gap, pan_c = a;
+    }
+  }
+  double p0 = pan_c - pan_half, p1 = pan_c + pan_half;
+  if (!h.ContinuousPan()) p0 = std::max(p0, h.pan_min_deg), p1 = std::min(p1, h.pan_max_deg);
+  const double tilt_c = el - h.HomeElevationDeg();
+  const double q0 = std::max(h.tilt_min_deg, tilt_c - half), q1 = std::min(h.tilt_max_deg, tilt_c + half);
+  if (!(p1 >= p0) || !(q1 >= q0)) return kInf;
+  // A 9 x 9 lattice over the window, then a pattern search (steps halved down to 1e-7 degrees)
+  // from the best of it: the least time, to the pattern search's resolution.
+  constexpr int kLattice = 9;
+  Score best = kNone;
+  double best_p = pan_c, best_q = tilt_c;
+  for (int i = 0; i < kLattice; ++i)
+    for (int j = 0; j < kLattice; ++j) {
+      const double p = p0 + (p1 - p0) * i / (kLattice - 1), q = q0 + (q1 - q0) * j / (kLattice - 1);
+      const Score sc = score(p, q, nullptr);
+      if (sc < best) best = sc, best_p = p, best_q = q;
+    }
+  if (!std::isfinite(best.first)) return kInf;
+  double dp = 0.5 * (p1 - p0) / (kLattice - 1), dq = 0.5 * (q1 - q0) / (kLattice - 1);
+  for (int evals = 0; evals < 600 && (dp > 1e-7 || dq > 1e-7);) {
+    bool moved = false;
+    for (const auto& [sp, sq] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}}) {
+      const double p = std::clamp(best_p + sp * dp, p0, p1), q = std::clamp(best_q + sq * dq, q0, q1);
+      const Score sc = score(p, q, nullptr);
+      ++evals;
+      if (sc < best) {
+        best = sc, best_p = p, best_q = q;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) dp *= 0.5, dq *= 0.5;
+  }
+  const double best_t = best.first == 0.0 ? best.second : kInf;
+  if (!(best_t < bound)) return kInf;
+  PtzState s;
+  if (score(best_p, best_q, &s).first != 0.0) return kInf;
+  // Checked by the one-setting test (and its density, up to rounding).
+  if (!PtzSees(base_, head_, s, X, target * (1 - 1e-9), normal)) return kInf;
+  if (pose) *pose = s;
+  return best_t;
 }
 
 }  // namespace pandora

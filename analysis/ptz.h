@@ -149,16 +149,41 @@ class PtzReach {
   /// The best pose for seeing `X` among the settings reachable within `t` seconds from `from`
   /// (widest reachable zoom, or with a density target the widest reachable one meeting it); nullopt
   /// when X lies behind every such pose or no reachable zoom meets the density target.
+  /// The point centred when that sees it (pan towards its azimuth, tilt to the image's midline,
+  /// the zoom as above); otherwise an off-centre setting that does, if any (SearchPose), since a
+  /// point's density grows towards the image's edges and a clamped pan or tilt may still leave it
+  /// in a corner.
   std::optional<PtzState> BestPose(const Vec3& X, double t) const;
+  /// The centred pose alone (the closed form above), whether or not it sees X.
+  /// `needed_focal` (when given) receives the focal length the density target needs at that pose
+  /// (0 without a target), `clamped` whether the reachable pan or tilt kept X off the centre.
+  std::optional<PtzState> CentredPose(const Vec3& X, double t, double* needed_focal = nullptr,
+                                      bool* clamped = nullptr) const;
+  /// Some setting reachable within `t` that sees X (inside the image, within range, at the density
+  /// target), found by maximising the feasible zoom interval's width over pan and tilt (a 9 x 9
+  /// lattice over the angles within the widest reachable view's half diagonal of centring X, then a
+  /// pattern search to 1e-7 degrees); nullopt when none is found.
+  std::optional<PtzState> SearchPose(const Vec3& X, double t) const;
   /// True when some setting reachable within `t` sees X geometrically: inside the image (lens and
   /// distortion), within range, and facing `normal` when given. Occlusion is not tested: the
   /// segment from the centre at BestPose to X is returned in `segment` (t_near / t_far with the
   /// visibility tolerance of `epsilon`) for the caller to cast.
   bool Reachable(const Vec3& X, double t, const Vec3* normal = nullptr, Ray* segment = nullptr,
                  double epsilon = 0) const;
-  /// The shortest time after which X is geometrically reachable (bisection to `tolerance_s` on
-  /// Reachable, which is monotone in t); +inf when X is not reachable at all.
-  double ReachTime(const Vec3& X, const Vec3* normal = nullptr, double tolerance_s = 1e-4) const;
+  /// The shortest time after which X is geometrically reachable by any setting, off-centre ones
+  /// included (bisection to `tolerance_s` on Reachable, which is monotone in t: the reachable box
+  /// only grows); +inf when X is not reachable at all.
+  /// `pose` (when given and the time is finite) receives a setting that sees X at that time.
+  /// The centred pose's reach time (bisection) bounds it; FastestSetting then looks for a faster
+  /// off-centre setting (docs/ptz.md; tested against a brute-force lattice).
+  double ReachTime(const Vec3& X, const Vec3* normal = nullptr, double tolerance_s = 1e-4,
+                   PtzState* pose = nullptr) const;
+  /// The least move time from `from` to any setting that sees X (inside the image, within range,
+  /// facing `normal`, at the density target), when below `bound`; +inf otherwise. A 9 x 9 lattice
+  /// over the pans and tilts within the widest view's half diagonal (a quarter more) of centring X,
+  /// then a pattern search to 1e-7 degrees; each pan and tilt takes the zoom nearest the current
+  /// one that keeps X inside the image and meets the density.
+  double FastestSetting(const Vec3& X, const Vec3* normal, double bound, PtzState* pose = nullptr) const;
   /// The longest move from `from` to any setting (the budget beyond which nothing new is reached).
   double MaxTime() const { return max_time_; }
 
@@ -168,6 +193,7 @@ class PtzReach {
   PtzState from_;
   double min_px_per_m_ = 0;
   double max_time_ = 0;
+  double boost_ = 1.02;  // the lens's largest density gain off the axis (constructor), with 2 %
 };
 
 // ---- implementation of WatchTour ----

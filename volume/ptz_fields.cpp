@@ -46,10 +46,11 @@ double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, d
   const Camera& base = tester.cameras()[camera];
   const PtzHead& head = *base.ptz;
   const PtzReach reach(base, head, head.current, min_px_per_m);
-  const double t = reach.ReachTime(X, nullptr, tolerance_s);
+  PtzState pose;
+  const double t = reach.ReachTime(X, nullptr, tolerance_s, &pose);
   if (!std::isfinite(t)) return kInf;
   Ray s;
-  if (!reach.Reachable(X, t, nullptr, &s)) return kInf;
+  if (!PtzSees(base, head, pose, X, 0.0, nullptr, &s)) return kInf;
   if (!PtzSegmentOccluded(tester, camera, s, rays)) return t;
   // The pivot is the centre of every setting: blocked from one, blocked from all.
   if (head.offset.isZero(0.0)) return kInf;

@@ -35,9 +35,11 @@ Scene PtzScene(const std::string& ptz, const std::string& objects = "", const st
   return ParseScene(text, "ptz.json");
 }
 
-// Both axes move at once; the zoom decides: a point 30 deg off the home azimuth is centred after
-// 0.1 s of pan, but the zoom that gives it the target density on the axis (f = density x distance)
-// takes (f - f0) / zoom rate.
+// Both axes move at once; the zoom decides. The reach time is the earliest at which some setting
+// sees the point at the density (issue 27: off-centre settings included): a pinhole's density at
+// an angle theta off the axis is f / (d cos^1.5 theta), so the least zoom puts the point in an image
+// corner, R pixels from the principal point: f = D cos^1.5(atan(R / f)), D = density x distance the
+// zoom the centred point needs. The pan and tilt to that corner take far less than the zoom.
 TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
   const Scene scene = PtzScene(R"("pan_speed_deg_s": 300, "tilt_speed_deg_s": 200, "zoom_hfov_deg": [60, 5],
                                    "zoom_speed_pct_s": 20)");
@@ -48,18 +50,91 @@ TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
   const double f0 = FocalFromHfov(Rad(60), 400, LensModel::kPinhole);
   ASSERT_NEAR(h.current.focal, f0, 1e-9);
   const double rate = 0.2 * (h.focal_max - h.focal_min);
+  const Intrinsics k = rig.cameras[0].model.intrinsics();
+  const double R = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
   for (const auto& [az, d, density] : {std::tuple{30.0, 8.0, 200.0}, {-75.0, 6.0, 300.0}, {140.0, 4.0, 500.0}}) {
     const Vec3 X = Vec3(0, 0, 3) + d * Vec3(-std::sin(Rad(az)), std::cos(Rad(az)), 0);
-    const double expected = (density * d - f0) / rate;
+    const double D = density * d;
+    double lo = 0, hi = D;  // f - D cos^1.5(atan(R / f)) rises from -D to > 0
+    for (int i = 0; i < 200; ++i) {
+      const double f = 0.5 * (lo + hi);
+      (f - D * std::pow(f * f / (f * f + R * R), 0.75) > 0 ? hi : lo) = f;
+    }
+    const double expected = (hi - f0) / rate;
+    const double centred = (D - f0) / rate;
+    ASSERT_LT(expected, centred - 0.02);  // the corner wins by tens of milliseconds
     ASSERT_GT(expected, std::abs(az) / 300 + 0.05);  // the zoom decides
-    EXPECT_NEAR(PtzReachTime(tester, 0, X, density, 1e-6), expected, 2e-6) << az;
+    EXPECT_NEAR(PtzReachTime(tester, 0, X, density, 1e-6), expected, 1e-5) << az;
   }
-  // Beyond the narrowest zoom: never. Without a target: the pan alone (half the FOV at the widest).
+  // Beyond the narrowest zoom even in the corner: never.
   const Vec3 X = Vec3(0, 0, 3) + 8.0 * Vec3(-std::sin(Rad(50)), std::cos(Rad(50)), 0);
   EXPECT_TRUE(std::isinf(PtzReachTime(tester, 0, X, 1.01 * h.focal_max / 8.0)));
-  const Intrinsics k = rig.cameras[0].model.intrinsics();
+  // Without a target: a pan puts the point at the image's side (half the FOV at the widest) no
+  // later than the pan that centres it less half the horizontal view; a corner can only be sooner.
   const double half_h = std::atan((k.width - 1 - k.cx + 0.5) / k.fx) * 180 / kPi;
-  EXPECT_NEAR(PtzReachTime(tester, 0, X, 0.0, 1e-6), (50 - half_h) / 300, 2e-6);
+  const double t = PtzReachTime(tester, 0, X, 0.0, 1e-6);
+  EXPECT_LE(t, (50 - half_h) / 300 + 2e-6);
+  EXPECT_GT(t, (50 - 1.25 * std::atan(R / k.fx) * 180 / kPi) / 300);
+}
+
+// The reach time against a brute-force search: for each point, the earliest time (bisection to
+// 1 ms) at which a lattice of settings reachable by then (pan and tilt every 0.25 degrees within 40
+// degrees of centring the point, 24 zooms) holds one that sees it at the density. The lattice can
+// only be later than the truth, by about its pitch over the speeds (0.25 / 30 s) or its zoom step
+// over the zoom rate; the reach time may not be later than the lattice's.
+TEST(PtzFields, ReachTimeEqualsABruteForceLatticeSearch) {
+  for (const std::string& zoom : {std::string(R"("zoom_hfov_deg": [60, 10], "zoom_speed_pct_s": 30,)"), std::string()}) {
+    const Scene scene = PtzScene(R"("pan_speed_deg_s": 30, "tilt_speed_deg_s": 30, )" + zoom + R"("tilt_range_deg": [-60, 20])");
+    const Rig& rig = scene.rigs[0];
+    const auto empty = MakeBruteForceRayCaster(TriangleMesh());
+    const VisibilityTester tester(rig.cameras, *empty, 10.0);
+    const Camera& base = rig.cameras[0];
+    const PtzHead& h = *base.ptz;
+    const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
+    // Without zoom (f = 346 px) 100 px/m reaches 3.46 m on the axis, farther only off it: the first
+    // and third points (4.1 and 3.9 m) only in a corner of the image.
+    const double density = zoom.empty() ? 100.0 : 300.0;
+    for (const Vec3& X : {Vec3(2.0, 3.0, 1.0), Vec3(-2.5, 2.0, 2.2), Vec3(0.8, 3.5, 1.5)}) {
+      const double t = PtzReachTime(tester, 0, X, density, 1e-5);
+      // The angles that centre X from the pivot.
+      const Vec3 e = X - Vec3(0, 0, 3);
+      const double az = std::atan2(-e.x(), e.y()) * 180 / kPi, el = std::atan2(e.z(), std::hypot(e.x(), e.y())) * 180 / kPi;
+      auto lattice_sees = [&](double time) {
+        const double f_lo = zoom_rate > 0 ? std::max(h.focal_min, h.current.focal - zoom_rate * time) : h.current.focal;
+        const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, h.current.focal + zoom_rate * time) : h.current.focal;
+        for (double pan = az - 40; pan <= az + 40; pan += 0.25) {
+          if (std::abs(pan - h.current.pan_deg) > h.pan_speed_deg_s * time) continue;
+          for (double tilt = el - 40; tilt <= el + 40; tilt += 0.25) {
+            if (std::abs(tilt - h.current.tilt_deg) > h.tilt_speed_deg_s * time) continue;
+            if (tilt < h.tilt_min_deg || tilt > h.tilt_max_deg) continue;
+            for (int z = 0; z <= (f_hi > f_lo ? 23 : 0); ++z) {
+              PtzState s;
+              s.pan_deg = pan;
+              s.tilt_deg = tilt;
+              s.focal = f_lo + (f_hi - f_lo) * z / 23.0;
+              if (PtzSees(base, h, s, X, density)) return true;
+            }
+          }
+        }
+        return false;
+      };
+      double lo = 0, hi = 30;
+      ASSERT_TRUE(lattice_sees(hi)) << X.transpose();
+      while (hi - lo > 1e-3) {
+        const double mid = 0.5 * (lo + hi);
+        (lattice_sees(mid) ? hi : lo) = mid;
+      }
+      SCOPED_TRACE(zoom + " X " + std::to_string(X.x()) + " " + std::to_string(X.y()) + " " + std::to_string(X.z()));
+      EXPECT_LE(t, hi + 1e-3);
+      EXPECT_GE(t, hi - 0.25 / 30 - (zoom_rate > 0 ? (h.focal_max - h.focal_min) / 23.0 / zoom_rate : 0) - 1e-3);
+      // And the setting it reports sees the point then.
+      const PtzReach reach(base, h, h.current, density);
+      PtzState pose;
+      ASSERT_TRUE(std::isfinite(reach.ReachTime(X, nullptr, 1e-5, &pose)));
+      EXPECT_TRUE(PtzSees(base, h, pose, X, density * (1 - 1e-9)));
+      EXPECT_LE(h.MoveTime(h.current, pose), t + 1e-5);
+    }
+  }
 }
 
 // A wall between the pivot and a point: never reached (the pivot is every setting's centre).
