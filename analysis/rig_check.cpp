@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "analysis/inside_mesh.h"
+#include "analysis/motion.h"
 #include "analysis/visibility.h"
 
 namespace pandora {
@@ -160,11 +161,17 @@ void CheckPlausibleValues(const Scene& scene, const Rig& rig, const CameraPath& 
     return std::string(b);
   };
   const Aabb& region = scene.study.region.box;
+  // The whole scene (geometry, region and cameras): a room of 7 cm or 700 km is a unit mistake; a
+  // small study region alone is not (the trauma room studies a 22 cm neck).
+  Aabb extent = scene.ContentBounds();
+  for (const Camera& c : rig.cameras) extent.Extend(c.center());
+  if (!extent.empty()) {
+    const double longest = extent.size().maxCoeff();
+    if (longest < 0.5 || longest > 2e4)
+      add("$.units", "the scene (its geometry, region and cameras) spans " + metres(longest) +
+                         ": are the file's units right (a file in metres read as cm, or the reverse)?");
+  }
   if (!region.empty()) {
-    const double longest = region.size().maxCoeff();
-    if (longest < 0.25 || longest > 1e4)
-      add("$.units", "the study region is " + metres(longest) +
-                         " on its longest side: are the file's units right (a file in metres read as cm, or the reverse)?");
     for (const auto& [name, r] : scene.study.regions) {
       Aabb meet = r.box;
       meet.min = meet.min.cwiseMax(region.min);
@@ -182,6 +189,59 @@ void CheckPlausibleValues(const Scene& scene, const Rig& rig, const CameraPath& 
           "camera '" + rig.cameras[c].id + "' has a field of view of " + std::to_string(hfov).substr(0, 5) +
               " degrees: radians written as degrees (" + std::to_string(hfov * 180 / 3.14159265358979323846).substr(0, 5) +
               " degrees)?");
+  }
+  // Moving groups: one that lies outside the study region at a time sample, or whose centre passes
+  // through a solid object that does not move between two samples (a person keyframed through a
+  // wall). One warning per group, the first such sample.
+  if (!scene.motions.empty()) {
+    TriangleMesh still;
+    for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+      const SceneObject& obj = scene.objects[o];
+      if (!obj.solid || MotionOfObject(scene, int(o)) >= 0 || obj.skin >= 0) continue;
+      const int base = int(still.vertices.size());
+      still.vertices.insert(still.vertices.end(), obj.mesh.vertices.begin(), obj.mesh.vertices.end());
+      for (const auto& tri : obj.mesh.triangles) still.triangles.push_back(tri + Eigen::Vector3i::Constant(base));
+    }
+    const auto walls = still.triangles.empty() ? nullptr : MakeEmbreeRayCaster(still);
+    const std::vector<TimeSample> samples = scene.TimeSamples();
+    for (std::size_t m = 0; m < scene.motions.size(); ++m) {
+      const ObjectMotion& motion = scene.motions[m];
+      Aabb rest;
+      for (int o : motion.objects) rest.Extend(scene.objects[o].mesh.Bounds());
+      if (rest.empty()) continue;
+      std::optional<Vec3> previous;
+      std::string previous_label;
+      for (const TimeSample& sample : samples) {
+        const Eigen::Isometry3d T = MotionTransform(scene, int(m), sample);
+        Aabb moved;
+        for (int c = 0; c < 8; ++c)
+          moved.Extend(T * Vec3(c & 1 ? rest.max.x() : rest.min.x(), c & 2 ? rest.max.y() : rest.min.y(),
+                                c & 4 ? rest.max.z() : rest.min.z()));
+        const std::string path = "$.motions." + motion.name;
+        if (!region.empty() && ((moved.max.array() < region.min.array()).any() ||
+                                (moved.min.array() > region.max.array()).any())) {
+          add(path, "the moving group '" + motion.name + "' lies entirely outside the study region at " +
+                        sample.label + ": is the motion in the file's units and frame?");
+          break;
+        }
+        const Vec3 centre = moved.center();
+        // Between two samples of keyframes the group moves along a line (named poses and random
+        // draws are no path).
+        if (walls && previous && motion.kind == ObjectMotion::Kind::kKeyframes) {
+          const Vec3 step = centre - *previous;
+          const double length = step.norm();
+          if (length > 1e-9) {
+            if (const auto hit = walls->Intersect(Ray{*previous, step / length, 0.0, length})) {
+              add(path, "the moving group '" + motion.name + "' passes through a solid object between " + previous_label +
+                            " and " + sample.label + " (" + metres(hit->t) + " along its path)");
+              break;
+            }
+          }
+        }
+        previous = centre;
+        previous_label = sample.label;
+      }
+    }
   }
   for (std::size_t i = 0; i < scene.study.pixel_targets.size(); ++i) {
     const PixelTarget& t = scene.study.pixel_targets[i];

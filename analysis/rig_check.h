@@ -90,10 +90,10 @@ struct RigCheckOptions {
 ///  - the lens's valid domain ends inside the image (ComputeLensCoverage), with the unreachable
 ///    share of the pixels.
 /// Before the cameras, values of the file that are valid but almost surely mistakes (kImplausible):
-/// a study region under 0.25 m or over 10 km on its longest side (units: a file in metres read as
-/// cm), a field of view under 3.2 degrees (radians written as degrees), a named region that does not
+/// a scene (geometry, region and cameras) under 0.5 m or over 20 km on its longest side (units: a
+/// file in metres read as cm), a field of view under 3.2 degrees (radians written as degrees), a named region that does not
 /// meet the study region, a pixel target over 2 m (a marker), a moving group that leaves the study
-/// region at every time sample.
+/// region at a time sample or whose centre passes through a still solid between two keyframed samples.
 /// The placement warnings are the most specific: a camera inside a solid or outside the room gets
 /// no "sees none" warning on top. Never throws for a valid scene; cheap (a few thousand segments
 /// per camera).

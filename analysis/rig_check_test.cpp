@@ -227,10 +227,32 @@ TEST(CheckRig, ImplausibleValuesAreWarnedAboutByPath) {
   for (const Warning& w : CheckRig(scene, scene.rigs[0], *caster))
     if (w.kind == Warning::Kind::kImplausible) by_path[w.json_path] = w.reason;
   ASSERT_EQ(by_path.size(), 4u);
-  EXPECT_NE(by_path["$.units"].find("0.01 m on its longest side"), std::string::npos) << by_path["$.units"];
+  EXPECT_NE(by_path["$.units"].find("spans 0.065 m"), std::string::npos) << by_path["$.units"];
   EXPECT_NE(by_path["$.rigs[0].cameras[1].hfov_deg"].find("80.21 degrees"), std::string::npos);
   EXPECT_NE(by_path["$.study.regions.elsewhere"].find("outside the study region"), std::string::npos);
   EXPECT_NE(by_path["$.study.pixel_targets[0]"].find("14 m across"), std::string::npos);
+  // A person keyframed through a wall, and a cart moved out of the room (metres this time).
+  const Scene moving = ParseScene(R"({
+  "objects": [{"name": "floor", "box": {"size": [6, 6, 0.1]}, "position": [0, 0, -0.05], "solid": true},
+              {"name": "wall", "box": {"size": [0.1, 6, 3]}, "position": [1, 0, 1.5], "solid": true},
+              {"name": "body", "group": "walker", "capsule": {"radius": 0.2, "length": 1.4}, "position": [0, 0, 0.9], "solid": true},
+              {"name": "cart", "box": {"size": [0.5, 0.5, 0.5]}, "position": [-1, -1, 0.25], "solid": true}],
+  "motions": {"walker": {"keyframes": [{"t": 0}, {"t": 2, "move": [2, 0, 0]}]},
+              "cart": {"keyframes": [{"t": 0}, {"t": 2, "move": [0, -30, 0]}]}},
+  "rigs": [{"name": "r", "cameras": [
+    {"id": "a", "position": [-2.5, -2.5, 2.5], "look_at": [0, 0, 1], "resolution": [640, 480], "hfov_deg": 70}]}],
+  "study": {"region": {"box": {"min": [-2.5, -2.5, 0], "max": [2.5, 2.5, 2.5]}}, "voxel_size": 0.25,
+            "time": {"times": [0, 1, 2]}}
+})", "moving.json");
+  const auto moving_caster = MakeEmbreeRayCaster(moving.AllTriangles());
+  std::map<std::string, std::string> moves;
+  for (const Warning& w : CheckRig(moving, moving.rigs[0], *moving_caster))
+    if (w.kind == Warning::Kind::kImplausible) moves[w.json_path] = w.reason;
+  ASSERT_EQ(moves.size(), 2u);
+  EXPECT_NE(moves["$.motions.walker"].find("passes through a solid object between t=0 s and t=1 s"), std::string::npos)
+      << moves["$.motions.walker"];
+  EXPECT_NE(moves["$.motions.cart"].find("entirely outside the study region at t=1 s"), std::string::npos)
+      << moves["$.motions.cart"];
   // The same file in metres, with sensible values: no such warning.
   std::string fixed = text;
   fixed.replace(fixed.find("\"units\": \"cm\""), 13, "\"units\": \"m\"");
