@@ -78,6 +78,13 @@ FieldOptions AnalyzeFieldOptions(const AnalyzeArgs& args, const Scene& scene) {
   return options;
 }
 
+// The process's peak resident memory so far, MiB.
+double PeakRssMiB() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // KiB on Linux
+}
+
 // An earlier run's outputs that this run does not replace would sit beside its summary.json as if
 // they were this run's: an in-memory run removes every streamed tile, a streamed run of n tiles
 // removes fields.vdb and tiles n and up (in the same transaction as the new outputs).
@@ -260,6 +267,9 @@ int RunAnalyze(const AnalyzeArgs& args) {
   summary["run_id"] = output.run_id();
   if (mpi.active()) summary["mpi"] = mpi_summary;
   WriteFieldsVdb(std::move(fields), vdb_path, FieldsMetadata(scene, rig, output.run_id()));  // the last use: consumed to keep the peak down
+  // The process's peak resident memory, the fields written (what the memory budget bounds).
+  summary["timing"]["peak_rss_mib"] = PeakRssMiB();
+  summary["timing"]["memory_budget_mib"] = options.memory_budget_bytes / 1048576.0;
   WriteFileAtomically(summary_path, summary.dump(2) + "\n");
   output.Commit();
   if (!args.quiet) {
@@ -350,11 +360,6 @@ std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi, const std::vect
   return sum;
 }
 
-double PeakRssMiB() {
-  struct rusage usage {};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;  // KiB on Linux
-}
 
 // What a streamed run reads and plans before anything is staged.
 struct StreamSetup {

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The memory budget bounds the process's peak (docs/robustness.md): 1,000 cameras over 4,096 voxels
+# with the per-camera 'cameras' field (one OpenVDB grid per camera, ~300 kB each) once peaked at
+# 2.6 times the budget. Under a budget below the estimate: refused, one line, nothing written; under
+# the estimate plus 8 MiB: it runs, and summary.json's peak resident memory is within the budget.
+# usage: check_memory_budget.sh PANDORA PYTHON OUT_DIR
+set -uo pipefail
+pandora=$1 python=$2 out=$3
+fail() { echo "FAIL: $*"; exit 1; }
+rm -rf "$out"
+mkdir -p "$out"
+"$python" - "$out/many.json" <<'PY'
+import json, math, sys
+cams = []
+for i in range(1000):
+    a = 2 * math.pi * i / 1000
+    cams.append({"id": f"c{i}", "position": [3 * math.cos(a), 3 * math.sin(a), 1.0 + 0.5 * math.sin(7 * a)],
+                 "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 40})
+json.dump({"pandora": 1, "objects": [{"name": "floor", "box": {"size": [8, 8, 0.1]}, "position": [0, 0, -0.05]}],
+           "rigs": [{"name": "many", "cameras": cams}],
+           "study": {"region": {"box": {"min": [-0.4, -0.4, 0.1], "max": [0.4, 0.4, 0.9]}}, "voxel_size": 0.05}},
+          open(sys.argv[1], "w"))
+PY
+"$pandora" analyze "$out/many.json" --memory-budget 64 --out "$out/small" 2> "$out/err"
+rc=$?
+[ $rc -eq 2 ] || fail "64 MiB budget: exit $rc"
+[ "$(wc -l < "$out/err")" -eq 1 ] && grep -q "with the rig's 1000 cameras, over the budget of 64 MiB" "$out/err" || fail "message: $(cat "$out/err")"
+[ ! -e "$out/small" ] || fail "a refused run left $out/small"
+need=$(sed -n 's/.*needs about \([0-9]*\) MiB.*/\1/p' "$out/err")
+budget=$((need + 8))
+"$pandora" analyze "$out/many.json" --memory-budget $budget --out "$out/fits" --quiet || fail "budget $budget MiB: exit $?"
+peak=$(jq '.timing.peak_rss_mib' "$out/fits/summary.json")
+"$python" -c "import sys; p, b = float('$peak'), $budget; sys.exit(0 if p <= b else 1)" ||
+  fail "peak $peak MiB over the budget of $budget MiB"
+echo "ok: estimate $need MiB, peak $peak MiB within a budget of $budget MiB"
