@@ -189,6 +189,67 @@ bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment,
   return tester.caster().Occluded(segment);
 }
 
+namespace {
+
+// The largest zoom scale (focal over the lens's own) at which `pixel` (at the lens's own focal)
+// stays inside the image: the zoom scales pixels about the principal point. +inf at that point.
+double MaxZoomScale(const Intrinsics& k, const Vec2& pixel) {
+  const double dx = pixel.x() - k.cx, dy = pixel.y() - k.cy;
+  double scale = kInf;
+  if (dx > 0) scale = std::min(scale, (k.width - 0.5 - k.cx) / dx);
+  if (dx < 0) scale = std::min(scale, (-0.5 - k.cx) / dx);
+  if (dy > 0) scale = std::min(scale, (k.height - 0.5 - k.cy) / dy);
+  if (dy < 0) scale = std::min(scale, (-0.5 - k.cy) / dy);
+  return scale;
+}
+
+}  // namespace
+
+bool PtzReach::ZoomInterval(const Vec3& X, double pan, double tilt, const Vec3* normal, double target,
+                            double f_lo, double f_hi, double* lo, double* hi) const {
+  const PtzHead& h = head_;
+  const Intrinsics& k = base_.model.intrinsics();
+  PtzState s;
+  s.pan_deg = h.WrapPan(pan);
+  s.tilt_deg = tilt;
+  s.focal = k.fx;
+  const Eigen::Isometry3d pose = h.Pose(s);
+  const Vec3 to_point = X - pose.translation();
+  const double distance = to_point.norm();
+  if (!(distance >= base_.near) || distance > base_.far) return false;
+  if (normal && normal->dot(-to_point) <= 0.0) return false;
+  Mat23 J;
+  const std::optional<Vec2> pixel = base_.model.Project(pose.linear().transpose() * to_point, target > 0 ? &J : nullptr);
+  if (!pixel) return false;
+  *lo = f_lo;
+  *hi = std::min(f_hi, k.fx * MaxZoomScale(k, *pixel));
+  if (target > 0) {
+    const double density = PixelDensity(J);
+    if (!(density > 0)) return false;
+    *lo = std::max(*lo, k.fx * target / density);
+  }
+  return true;
+}
+
+PtzReach::Box PtzReach::ReachableBox(double t) const {
+  const PtzHead& h = head_;
+  t = std::max(t, 0.0);
+  Box b;
+  b.pan_lo = from_.pan_deg - h.pan_speed_deg_s * t;
+  b.pan_hi = from_.pan_deg + h.pan_speed_deg_s * t;
+  b.any_pan = h.ContinuousPan() && b.pan_hi - b.pan_lo >= 360.0;
+  if (!h.ContinuousPan()) {
+    b.pan_lo = std::max(b.pan_lo, h.pan_min_deg);
+    b.pan_hi = std::min(b.pan_hi, h.pan_max_deg);
+  }
+  b.tilt_lo = std::max(from_.tilt_deg - h.tilt_speed_deg_s * t, h.tilt_min_deg);
+  b.tilt_hi = std::min(from_.tilt_deg + h.tilt_speed_deg_s * t, h.tilt_max_deg);
+  b.zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
+  b.f_lo = b.zoom_rate > 0 ? std::max(h.focal_min, from_.focal - b.zoom_rate * t) : from_.focal;
+  b.f_hi = b.zoom_rate > 0 ? std::min(h.focal_max, from_.focal + b.zoom_rate * t) : from_.focal;
+  return b;
+}
+
 PtzReach::PtzReach(const Camera& base, const PtzHead& head, const PtzState& from, double min_px_per_m)
     : base_(base), head_(head), from_(from), min_px_per_m_(min_px_per_m) {
   const double pan_span = head.ContinuousPan()
@@ -225,15 +286,10 @@ std::optional<PtzState> PtzReach::CentredPose(const Vec3& X, double t, double* n
   const PtzHead& h = head_;
   t = std::max(t, 0.0);
   // The reachable box: pan and tilt intervals, the widest reachable zoom.
-  double pan_lo = from_.pan_deg - h.pan_speed_deg_s * t, pan_hi = from_.pan_deg + h.pan_speed_deg_s * t;
-  const bool any_pan = h.ContinuousPan() && pan_hi - pan_lo >= 360.0;
-  if (!h.ContinuousPan()) {
-    pan_lo = std::max(pan_lo, h.pan_min_deg);
-    pan_hi = std::min(pan_hi, h.pan_max_deg);
-  }
-  const double tilt_lo = std::max(from_.tilt_deg - h.tilt_speed_deg_s * t, h.tilt_min_deg);
-  const double tilt_hi = std::min(from_.tilt_deg + h.tilt_speed_deg_s * t, h.tilt_max_deg);
-  const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
+  const Box b = ReachableBox(t);
+  const double pan_lo = b.pan_lo, pan_hi = b.pan_hi, tilt_lo = b.tilt_lo, tilt_hi = b.tilt_hi;
+  const bool any_pan = b.any_pan;
+  const double zoom_rate = b.zoom_rate;
   PtzState s;
   s.focal = std::max(h.focal_min, from_.focal - zoom_rate * t);
   if (!(zoom_rate > 0)) s.focal = from_.focal;
@@ -315,51 +371,20 @@ std::optional<PtzState> PtzReach::SearchPose(const Vec3& X, double t) const {
   t = std::max(t, 0.0);
   const Intrinsics& k = base_.model.intrinsics();
   // The reachable box at t.
-  double pan_lo = from_.pan_deg - h.pan_speed_deg_s * t, pan_hi = from_.pan_deg + h.pan_speed_deg_s * t;
-  const bool any_pan = h.ContinuousPan() && pan_hi - pan_lo >= 360.0;
-  if (!h.ContinuousPan()) {
-    pan_lo = std::max(pan_lo, h.pan_min_deg);
-    pan_hi = std::min(pan_hi, h.pan_max_deg);
-  }
-  const double tilt_lo = std::max(from_.tilt_deg - h.tilt_speed_deg_s * t, h.tilt_min_deg);
-  const double tilt_hi = std::min(from_.tilt_deg + h.tilt_speed_deg_s * t, h.tilt_max_deg);
-  const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
-  const double f_lo = zoom_rate > 0 ? std::max(h.focal_min, from_.focal - zoom_rate * t) : from_.focal;
-  const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, from_.focal + zoom_rate * t) : from_.focal;
+  const Box b = ReachableBox(t);
+  const double pan_lo = b.pan_lo, pan_hi = b.pan_hi, tilt_lo = b.tilt_lo, tilt_hi = b.tilt_hi;
+  const bool any_pan = b.any_pan;
+  const double f_lo = b.f_lo, f_hi = b.f_hi;
   // The margin of a pan and tilt: the focal lengths that keep X inside the image are (0, f_in]
   // (the zoom scales the pixel about the principal point), those meeting the density [needed, inf);
   // the setting is feasible when [max(needed, f_lo), min(f_in, f_hi)] is not empty. Relative to f_hi.
-  const Vec2 pp(k.cx, k.cy);
   auto margin = [&](double pan, double tilt, double* focal) {
-    constexpr double kNone = -kInf;
-    PtzState s;
-    s.pan_deg = h.WrapPan(pan);
-    s.tilt_deg = tilt;
-    s.focal = k.fx;
-    const Eigen::Isometry3d pose = h.Pose(s);
-    const Vec3 to_point = X - pose.translation();
-    const double distance = to_point.norm();
-    if (!(distance >= base_.near) || distance > base_.far) return kNone;
-    Mat23 J;
-    const std::optional<Vec2> pixel =
-        base_.model.Project(pose.linear().transpose() * to_point, min_px_per_m_ > 0 ? &J : nullptr);
-    if (!pixel) return kNone;
-    const Vec2 d = *pixel - pp;
-    double scale = kInf;
-    if (d.x() > 0) scale = std::min(scale, (k.width - 0.5 - k.cx) / d.x());
-    if (d.x() < 0) scale = std::min(scale, (-0.5 - k.cx) / d.x());
-    if (d.y() > 0) scale = std::min(scale, (k.height - 0.5 - k.cy) / d.y());
-    if (d.y() < 0) scale = std::min(scale, (-0.5 - k.cy) / d.y());
-    double needed = 0;
-    if (min_px_per_m_ > 0) {
-      const double density = PixelDensity(J);
-      if (!(density > 0)) return kNone;
-      needed = k.fx * min_px_per_m_ / density;
-    }
-    const double lo = std::max(needed, f_lo), hi = std::min(k.fx * scale, f_hi);
+    double lo = 0, hi = 0;
+    if (!ZoomInterval(X, pan, tilt, nullptr, min_px_per_m_, f_lo, f_hi, &lo, &hi)) return -kInf;
     *focal = lo;
     return (hi - lo) / f_hi;
   };
+
   // The window: the angles that centre X, widened by the half diagonal of the widest reachable
   // field of view (a quarter more for distortion); pan widened towards the pan axis, where a pan
   // moves the image less.
@@ -480,7 +505,6 @@ double PtzReach::FastestSetting(const Vec3& X, const Vec3* normal, double bound,
   const Intrinsics& k = base_.model.intrinsics();
   const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
   const double target = min_px_per_m_ > 0 ? min_px_per_m_ * (1 - 1e-12) : 0.0;
-  const Vec2 pp(k.cx, k.cy);
   // The time to a pan and tilt that show X: the move to them, and the zoom into the interval of
   // focal lengths that keep X inside the image (0, f_in] (the zoom scales the pixel about the
   // principal point) and meet the density [needed, inf), from the current zoom; inf when none.
@@ -491,37 +515,19 @@ double PtzReach::FastestSetting(const Vec3& X, const Vec3* normal, double bound,
   // (relative focal length), so that the search climbs towards settings that show X.
   using Score = std::pair<double, double>;
   const Score kNone{kInf, kInf};
+  const double f_lo = zoom_rate > 0 ? h.focal_min : from_.focal, f_hi = zoom_rate > 0 ? h.focal_max : from_.focal;
   auto score = [&](double pan, double tilt, PtzState* out) -> Score {
+    double lo = 0, hi = 0;
+    if (!ZoomInterval(X, pan, tilt, normal, target, f_lo, f_hi, &lo, &hi)) return kNone;
+    if (lo > hi) return {(lo - hi) / std::max(h.focal_max, from_.focal), kInf};
     PtzState s;
     s.pan_deg = h.WrapPan(pan);
     s.tilt_deg = tilt;
-    s.focal = k.fx;
-    const Eigen::Isometry3d pose = h.Pose(s);
-    const Vec3 to_point = X - pose.translation();
-    const double distance = to_point.norm();
-    if (!(distance >= base_.near) || distance > base_.far) return kNone;
-    if (normal && normal->dot(-to_point) <= 0.0) return kNone;
-    Mat23 J;
-    const std::optional<Vec2> pixel = base_.model.Project(pose.linear().transpose() * to_point, target > 0 ? &J : nullptr);
-    if (!pixel) return kNone;
-    const Vec2 d = *pixel - pp;
-    double scale = kInf;
-    if (d.x() > 0) scale = std::min(scale, (k.width - 0.5 - k.cx) / d.x());
-    if (d.x() < 0) scale = std::min(scale, (-0.5 - k.cx) / d.x());
-    if (d.y() > 0) scale = std::min(scale, (k.height - 0.5 - k.cy) / d.y());
-    if (d.y() < 0) scale = std::min(scale, (-0.5 - k.cy) / d.y());
-    double lo = zoom_rate > 0 ? h.focal_min : from_.focal;
-    double hi = std::min(zoom_rate > 0 ? h.focal_max : from_.focal, k.fx * scale);
-    if (target > 0) {
-      const double density = PixelDensity(J);
-      if (!(density > 0)) return kNone;
-      lo = std::max(lo, k.fx * target / density);
-    }
-    if (lo > hi) return {(lo - hi) / std::max(h.focal_max, from_.focal), kInf};
     s.focal = std::clamp(from_.focal, lo, hi);
     if (out) *out = s;
     return {0.0, h.MoveTime(from_, s)};
   };
+
   // The window: the angles that centre X, widened by the half diagonal of the widest field of view
   // (a quarter more for distortion), pan widened towards the pan axis, where a pan moves the image less.
   const Vec3 C = h.Pose(from_).translation();

@@ -193,6 +193,19 @@ class PtzReach {
   PtzState from_;
   double min_px_per_m_ = 0;
   double max_time_ = 0;
+  // The settings reachable within t: pan (any, when a continuous pan can turn a full turn), tilt
+  // and focal intervals, and the zoom rate (pixels per second; 0 without zoom).
+  struct Box {
+    double pan_lo = 0, pan_hi = 0, tilt_lo = 0, tilt_hi = 0, f_lo = 0, f_hi = 0, zoom_rate = 0;
+    bool any_pan = false;
+  };
+  Box ReachableBox(double t) const;
+  // The focal lengths [lo, hi] within [f_lo, f_hi] at which the setting (pan, tilt) shows X: inside
+  // the image (hi: the zoom scales the pixel about the principal point), at `target` px/m (lo);
+  // lo > hi when none does. False when X is out of range, faces away from `normal` or does not
+  // project at all.
+  bool ZoomInterval(const Vec3& X, double pan, double tilt, const Vec3* normal, double target, double f_lo,
+                    double f_hi, double* lo, double* hi) const;
   double boost_ = 1.02;  // the lens's largest density gain off the axis (constructor), with 2 %
 };
 

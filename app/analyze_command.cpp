@@ -423,7 +423,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   try {
     setup = PrepareStream(args);
     for (std::size_t t = 0; t < setup.tiles.size(); ++t) {
-      char name[32];
+      char name[48];
       std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
       tile_files.push_back(name);
     }
