@@ -191,6 +191,86 @@ bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment,
 
 namespace {
 
+// The pans and tilts a search looks over: those within the view's half diagonal (a quarter more for
+// distortion) of centring the point, pan widened towards the pan axis, where a pan moves the image
+// less; `pan_c` and `tilt_c` centre it. Empty when it misses the allowed pans or tilts.
+struct Window {
+  double p0 = 0, p1 = 0, q0 = 0, q1 = 0, pan_c = 0, tilt_c = 0;
+  bool empty() const { return !(p1 >= p0) || !(q1 >= q0); }
+};
+
+// The window for X seen from `head` at `from` with focal `focal` (the widest the search allows).
+// Pans: with `clamp_pan`, the turn of X's azimuth nearest to [pan_lo, pan_hi] and the window cut to
+// it; otherwise centred on the turn `free_turn` gives (the azimuth -> its turn), uncut. Tilts cut to
+// [tilt_lo, tilt_hi]. Nothing when X is at the centre.
+template <typename FreeTurn>
+std::optional<Window> SearchWindow(const PtzHead& h, const Intrinsics& k, const PtzState& from, const Vec3& X,
+                                   double focal, bool clamp_pan, double pan_lo, double pan_hi, double tilt_lo,
+                                   double tilt_hi, FreeTurn&& free_turn) {
+  const Vec3 e = X - h.Pose(from).translation();
+  if (!(e.norm() > 0)) return std::nullopt;
+  const Vec3 x_home = h.home.linear().col(0);
+  const Vec3 forward0 = h.pan_axis.cross(x_home);
+  const double az = Deg(std::atan2(e.dot(-x_home), e.dot(forward0)));
+  const double el = Deg(std::atan2(e.dot(h.pan_axis), std::hypot(e.dot(-x_home), e.dot(forward0))));
+  const double corner = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
+  const double half = k.model == LensModel::kFisheye ? 180.0 : std::min(180.0, 1.25 * Deg(std::atan(corner / focal)) + 0.5);
+  const double pan_half = std::min(180.0, half / std::max(std::cos(Rad(el)), 0.02));
+  Window w;
+  w.pan_c = free_turn(az);
+  if (clamp_pan) {
+    double best = kInf;
+    for (int q = -2; q <= 2; ++q) {
+      const double a = az + 360.0 * q;
+      const double gap = std::abs(std::clamp(a, pan_lo, pan_hi) - a);
+      if (gap < best) best = gap, w.pan_c = a;
+    }
+  }
+  w.p0 = w.pan_c - pan_half;
+  w.p1 = w.pan_c + pan_half;
+  if (clamp_pan) w.p0 = std::max(w.p0, pan_lo), w.p1 = std::min(w.p1, pan_hi);
+  w.tilt_c = el - h.HomeElevationDeg();
+  w.q0 = std::max(tilt_lo, w.tilt_c - half);
+  w.q1 = std::min(tilt_hi, w.tilt_c + half);
+  return w;
+}
+
+// Minimises `score(pan, tilt)` (any ordered type) over the window: a 9 x 9 lattice (stopped as soon
+// as `enough(best)`), then from its best point a pattern search of the 8 neighbours, steps halved
+// down to 1e-7 degrees, at most `max_evals` evaluations, while `refine(best)`. Returns the best
+// score and its pan and tilt.
+template <typename Score, typename Eval, typename Enough, typename Refine>
+Score MinimiseOverWindow(const Window& w, Score worst, Eval&& score, Enough&& enough, Refine&& refine,
+                         int max_evals, double* best_p, double* best_q) {
+  constexpr int kLattice = 9;
+  Score best = worst;
+  *best_p = w.pan_c;
+  *best_q = w.tilt_c;
+  for (int i = 0; i < kLattice && !enough(best); ++i)
+    for (int j = 0; j < kLattice && !enough(best); ++j) {
+      const double p = w.p0 + (w.p1 - w.p0) * i / (kLattice - 1), q = w.q0 + (w.q1 - w.q0) * j / (kLattice - 1);
+      const Score sc = score(p, q);
+      if (sc < best) best = sc, *best_p = p, *best_q = q;
+    }
+  if (!(best < worst)) return best;
+  double dp = 0.5 * (w.p1 - w.p0) / (kLattice - 1), dq = 0.5 * (w.q1 - w.q0) / (kLattice - 1);
+  for (int evals = 0; refine(best) && evals < max_evals && (dp > 1e-7 || dq > 1e-7);) {
+    bool moved = false;
+    for (const auto& [sp, sq] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}}) {
+      const double p = std::clamp(*best_p + sp * dp, w.p0, w.p1), q = std::clamp(*best_q + sq * dq, w.q0, w.q1);
+      const Score sc = score(p, q);
+      ++evals;
+      if (sc < best) {
+        best = sc, *best_p = p, *best_q = q;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) dp *= 0.5, dq *= 0.5;
+  }
+  return best;
+}
+
 // The largest zoom scale (focal over the lens's own) at which `pixel` (at the lens's own focal)
 // stays inside the image: the zoom scales pixels about the principal point. +inf at that point.
 double MaxZoomScale(const Intrinsics& k, const Vec2& pixel) {
@@ -355,9 +435,7 @@ std::optional<PtzState> PtzReach::BestPose(const Vec3& X, double t) const {
   // density, by at most the lens's largest density gain over its image (boost_).
   if (!clamped) {
     if (!(min_px_per_m_ > 0) || !(needed > 0)) return centred;
-    const double zoom_rate = head_.zoom_speed * (head_.focal_max - head_.focal_min);
-    const double f_hi = zoom_rate > 0 ? std::min(head_.focal_max, from_.focal + zoom_rate * std::max(t, 0.0)) : from_.focal;
-    if (needed > f_hi * boost_) return centred;
+    if (needed > ReachableBox(t).f_hi * boost_) return centred;
   }
   // Otherwise an off-centre setting may: with a density target the point's density grows towards
   // the image's edges (a pinhole's as cos^-1.5 of the angle off the axis), and a clamped pan or
@@ -377,74 +455,26 @@ std::optional<PtzState> PtzReach::SearchPose(const Vec3& X, double t) const {
   const double f_lo = b.f_lo, f_hi = b.f_hi;
   // The margin of a pan and tilt: the focal lengths that keep X inside the image are (0, f_in]
   // (the zoom scales the pixel about the principal point), those meeting the density [needed, inf);
-  // the setting is feasible when [max(needed, f_lo), min(f_in, f_hi)] is not empty. Relative to f_hi.
-  auto margin = [&](double pan, double tilt, double* focal) {
+  // the setting is feasible when [max(needed, f_lo), min(f_in, f_hi)] is not empty. Relative to
+  // f_hi, negated for the minimiser; the focal is the widest that meets the density.
+  auto focal_at = [&](double pan, double tilt, double* focal) {
     double lo = 0, hi = 0;
     if (!ZoomInterval(X, pan, tilt, nullptr, min_px_per_m_, f_lo, f_hi, &lo, &hi)) return -kInf;
     *focal = lo;
     return (hi - lo) / f_hi;
   };
-
-  // The window: the angles that centre X, widened by the half diagonal of the widest reachable
-  // field of view (a quarter more for distortion); pan widened towards the pan axis, where a pan
-  // moves the image less.
-  const Vec3 C = h.Pose(from_).translation();
-  const Vec3 e = X - C;
-  if (!(e.norm() > 0)) return std::nullopt;
-  const Vec3 x_home = h.home.linear().col(0);
-  const Vec3 forward0 = h.pan_axis.cross(x_home);
-  const double az = Deg(std::atan2(e.dot(-x_home), e.dot(forward0)));
-  const double horizontal = std::hypot(e.dot(-x_home), e.dot(forward0));
-  const double el = Deg(std::atan2(e.dot(h.pan_axis), horizontal));
-  const double corner = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
-  const double half = k.model == LensModel::kFisheye ? 180.0 : std::min(180.0, 1.25 * Deg(std::atan(corner / f_lo)) + 0.5);
-  const double pan_half = std::min(180.0, half / std::max(std::cos(Rad(el)), 0.02));
-  double pan_c = az;
-  if (!any_pan) {  // the turn of the azimuth nearest to the reachable pans
-    double best = kInf;
-    for (int q = -2; q <= 2; ++q) {
-      const double a = az + 360.0 * q;
-      const double gap = std::abs(std::clamp(a, pan_lo, pan_hi) - a);
-      if (gap < best) best = gap, pan_c = a;
-    }
-  }
-  const double p0 = any_pan ? pan_c - pan_half : std::max(pan_lo, pan_c - pan_half);
-  const double p1 = any_pan ? pan_c + pan_half : std::min(pan_hi, pan_c + pan_half);
-  const double tilt_c = el - h.HomeElevationDeg();
-  const double q0 = std::max(tilt_lo, tilt_c - half), q1 = std::min(tilt_hi, tilt_c + half);
-  if (!(p1 >= p0) || !(q1 >= q0)) return std::nullopt;
-  // A 9 x 9 lattice over the window, then a pattern search from its best point (steps halved to
-  // 1e-7 degrees): the margin is smooth and, near the reach time, peaks at one setting.
-  constexpr int kLattice = 9;
-  double best_m = -kInf, best_p = pan_c, best_q = tilt_c, best_f = f_lo;
-  for (int i = 0; i < kLattice && best_m < 0; ++i)  // a feasible setting is enough for reach
-    for (int j = 0; j < kLattice && best_m < 0; ++j) {
-      const double p = p0 + (p1 - p0) * i / (kLattice - 1), q = q0 + (q1 - q0) * j / (kLattice - 1);
-      double f = 0;
-      const double m = margin(p, q, &f);
-      if (m > best_m) best_m = m, best_p = p, best_q = q, best_f = f;
-    }
-  if (best_m == -kInf) return std::nullopt;
-  double dp = 0.5 * (p1 - p0) / (kLattice - 1), dq = 0.5 * (q1 - q0) / (kLattice - 1);
-  // Only a lattice point within kNear of feasible is refined (a farther one is not feasible
-  // anywhere near: the margin changes by less than that between lattice points, measured below).
+  const std::optional<Window> w = SearchWindow(h, k, from_, X, f_lo, !any_pan, pan_lo, pan_hi, tilt_lo, tilt_hi,
+                                               [](double az) { return az; });
+  if (!w || w->empty()) return std::nullopt;
+  // A feasible setting is enough for reach; only a lattice point within kNear of feasible is
+  // refined (the margin changes by less than that between lattice points).
   constexpr double kNear = 0.1;
-  for (int evals = 0; best_m < 0 && best_m > -kNear && evals < 400 && (dp > 1e-7 || dq > 1e-7);) {
-    bool moved = false;
-    for (const auto& [sp, sq] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}}) {
-      const double p = std::clamp(best_p + sp * dp, p0, p1), q = std::clamp(best_q + sq * dq, q0, q1);
-      double f = 0;
-      const double m = margin(p, q, &f);
-      ++evals;
-      if (m > best_m) {
-        best_m = m, best_p = p, best_q = q, best_f = f;
-        moved = true;
-        break;
-      }
-    }
-    if (!moved) dp *= 0.5, dq *= 0.5;
-  }
-  if (best_m < 0) return std::nullopt;
+  double best_p = 0, best_q = 0, best_f = f_lo;
+  const double shortfall = MinimiseOverWindow(
+      *w, kInf, [&](double p, double q) { double f; return -focal_at(p, q, &f); },
+      [](double v) { return v <= 0; }, [&](double v) { return v > 0 && v < kNear; }, 400, &best_p, &best_q);
+  if (!(shortfall <= 0)) return std::nullopt;
+  focal_at(best_p, best_q, &best_f);
   PtzState s;
   s.pan_deg = h.WrapPan(best_p);
   s.tilt_deg = best_q;
@@ -505,9 +535,6 @@ double PtzReach::FastestSetting(const Vec3& X, const Vec3* normal, double bound,
   const Intrinsics& k = base_.model.intrinsics();
   const double zoom_rate = h.zoom_speed * (h.focal_max - h.focal_min);
   const double target = min_px_per_m_ > 0 ? min_px_per_m_ * (1 - 1e-12) : 0.0;
-  // The time to a pan and tilt that show X: the move to them, and the zoom into the interval of
-  // focal lengths that keep X inside the image (0, f_in] (the zoom scales the pixel about the
-  // principal point) and meet the density [needed, inf), from the current zoom; inf when none.
   // A pan and tilt's score: (shortfall, time). Shortfall 0: the setting shows X, and time is the
   // move to it and the zoom into the interval of focal lengths that keep X inside the image
   // (0, f_in] (the zoom scales the pixel about the principal point) and meet the density
@@ -528,61 +555,18 @@ double PtzReach::FastestSetting(const Vec3& X, const Vec3* normal, double bound,
     return {0.0, h.MoveTime(from_, s)};
   };
 
-  // The window: the angles that centre X, widened by the half diagonal of the widest field of view
-  // (a quarter more for distortion), pan widened towards the pan axis, where a pan moves the image less.
-  const Vec3 C = h.Pose(from_).translation();
-  const Vec3 e = X - C;
-  if (!(e.norm() > 0)) return kInf;
-  const Vec3 x_home = h.home.linear().col(0);
-  const Vec3 forward0 = h.pan_axis.cross(x_home);
-  const double az = Deg(std::atan2(e.dot(-x_home), e.dot(forward0)));
-  const double el = Deg(std::atan2(e.dot(h.pan_axis), std::hypot(e.dot(-x_home), e.dot(forward0))));
+  // The window around centring X at the widest zoom; a continuous pan centred on the turn of the
+  // azimuth nearest the current pan.
   const double widest = std::min(h.focal_min > 0 ? h.focal_min : k.fx, k.fx);
-  const double corner = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
-  const double half = k.model == LensModel::kFisheye ? 180.0 : std::min(180.0, 1.25 * Deg(std::atan(corner / widest)) + 0.5);
-  const double pan_half = std::min(180.0, half / std::max(std::cos(Rad(el)), 0.02));
-  // The turn of the azimuth nearest to the current pan (a bounded pan: nearest to its range).
-  double pan_c = from_.pan_deg + Wrap180(az - from_.pan_deg);
-  if (!h.ContinuousPan()) {
-    double gap_best = kInf;
-    for (int q = -2; q <= 2; ++q) {
-      const double a = az + 360.0 * q;
-      const double gap = std::abs(std::clamp(a, h.pan_min_deg, h.pan_max_deg) - a);
-      if (gap < gap_best) gap_best = gap, pan_c = a;
-    }
-  }
-  double p0 = pan_c - pan_half, p1 = pan_c + pan_half;
-  if (!h.ContinuousPan()) p0 = std::max(p0, h.pan_min_deg), p1 = std::min(p1, h.pan_max_deg);
-  const double tilt_c = el - h.HomeElevationDeg();
-  const double q0 = std::max(h.tilt_min_deg, tilt_c - half), q1 = std::min(h.tilt_max_deg, tilt_c + half);
-  if (!(p1 >= p0) || !(q1 >= q0)) return kInf;
-  // A 9 x 9 lattice over the window, then a pattern search (steps halved down to 1e-7 degrees)
-  // from the best of it: the least time, to the pattern search's resolution.
-  constexpr int kLattice = 9;
-  Score best = kNone;
-  double best_p = pan_c, best_q = tilt_c;
-  for (int i = 0; i < kLattice; ++i)
-    for (int j = 0; j < kLattice; ++j) {
-      const double p = p0 + (p1 - p0) * i / (kLattice - 1), q = q0 + (q1 - q0) * j / (kLattice - 1);
-      const Score sc = score(p, q, nullptr);
-      if (sc < best) best = sc, best_p = p, best_q = q;
-    }
-  if (!std::isfinite(best.first)) return kInf;
-  double dp = 0.5 * (p1 - p0) / (kLattice - 1), dq = 0.5 * (q1 - q0) / (kLattice - 1);
-  for (int evals = 0; evals < 600 && (dp > 1e-7 || dq > 1e-7);) {
-    bool moved = false;
-    for (const auto& [sp, sq] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}, {1, -1}, {-1, 1}}) {
-      const double p = std::clamp(best_p + sp * dp, p0, p1), q = std::clamp(best_q + sq * dq, q0, q1);
-      const Score sc = score(p, q, nullptr);
-      ++evals;
-      if (sc < best) {
-        best = sc, best_p = p, best_q = q;
-        moved = true;
-        break;
-      }
-    }
-    if (!moved) dp *= 0.5, dq *= 0.5;
-  }
+  const std::optional<Window> w =
+      SearchWindow(h, k, from_, X, widest, !h.ContinuousPan(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg,
+                   h.tilt_max_deg, [&](double az) { return from_.pan_deg + Wrap180(az - from_.pan_deg); });
+  if (!w || w->empty()) return kInf;
+  // The least time, to the pattern search's resolution.
+  double best_p = 0, best_q = 0;
+  const Score best = MinimiseOverWindow(
+      *w, kNone, [&](double p, double q) { return score(p, q, nullptr); }, [](const Score&) { return false; },
+      [](const Score&) { return true; }, 600, &best_p, &best_q);
   const double best_t = best.first == 0.0 ? best.second : kInf;
   if (!(best_t < bound)) return kInf;
   PtzState s;
