@@ -219,12 +219,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
     const std::vector<TimeSample> samples = scene.TimeSamples();
     for (const TimeSample& s : samples) sample_labels.push_back(s.label);
     if (!samples.empty()) {
-      FieldOptions over_time = options;
-      over_time.partition_count = 1;  // rank 0 evaluates the time samples whole (docs/scale.md)
-      over_time.partition_rank = 0;
-      // The per-camera sets of every sample are not kept: coverage and the uncertainty fields are.
-      over_time.fields.erase(std::remove(over_time.fields.begin(), over_time.fields.end(), "cameras"),
-                             over_time.fields.end());
+      FieldOptions over_time = OverTimeOptions(options);
       ProgressBar time_bar("over " + std::to_string(samples.size()) + " time samples", !args.quiet);
       over_time.progress = [&time_bar](double f) { time_bar.Update(f); };
       TimeFieldsResult result =

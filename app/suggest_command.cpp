@@ -30,7 +30,9 @@ int RunSuggest(const SuggestArgs& args) {
   session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
   const Rig file_rig = session.rig().rig();
-  SuggestOptions options = SuggestOptionsFromArgs(args, scene, file_rig);
+  const std::shared_ptr<SuggestProblem> problem = PrepareSuggest(args, scene, file_rig);
+  const SuggestOptions& options = problem->options;
+  const std::vector<TargetPoint>& targets = problem->targets;
   std::optional<std::vector<double>> perturbation;
   if (!args.perturb.empty()) {
     perturbation = ParseNumbers("--perturb", args.perturb, 2);
@@ -51,24 +53,6 @@ int RunSuggest(const SuggestArgs& args) {
   }
 
   // Run: a benchmark perturbation is an edit of the session's rig; the suggestion starts from it.
-  // Over time: the study's surface targets at every sample, each against its sample's caster.
-  std::unique_ptr<RigidPartsRayCaster> parts;
-  std::vector<std::unique_ptr<RayCaster>> sample_casters;
-  std::vector<TargetPoint> targets;
-  if (args.over_time) {
-    if (!args.target_surfaces.empty())
-      throw InputError("--over-time", "", "takes the study's targets; --target-surface is for a static scene",
-                       "give one of them");
-    const std::vector<TimeSample> samples = scene.TimeSamples();
-    targets = SampleTimeTargets(scene, samples, args.points, args.seed);
-    parts = MakeSceneParts(scene);
-    for (const TimeSample& s : samples) {
-      sample_casters.push_back(CasterAtSample(*parts, scene, s));  // skinned parts posed too
-      options.sample_casters.push_back(sample_casters.back().get());
-    }
-  } else {
-    targets = SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
-  }
   std::optional<double> original;
   if (perturbation) {
     original = EvaluateExact(scene, file_rig, session.study().caster(), targets, options.objective,

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "analysis/error.h"
+#include "analysis/motion.h"
 #include "app/options.h"
 
 namespace pandora::app {
@@ -149,6 +150,29 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   options.clearance = args.clearance;
   scene.CheckLength(options.clearance, "--clearance", "the clearance");
   return options;
+}
+
+std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
+  if (args.cameras.empty())
+    throw InputError("--cameras", "", "which cameras may move?", "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
+  auto problem = std::make_shared<SuggestProblem>();
+  problem->options = SuggestOptionsFromArgs(args, scene, rig);
+  if (args.over_time) {
+    // The study's surface targets at every sample, each against its sample's caster.
+    if (!args.target_surfaces.empty())
+      throw InputError("--over-time", "", "takes the study's targets; --target-surface is for a static scene",
+                       "give one of them");
+    const std::vector<TimeSample> samples = scene.TimeSamples();
+    problem->targets = SampleTimeTargets(scene, samples, args.points, args.seed);
+    problem->parts = MakeSceneParts(scene);
+    for (const TimeSample& s : samples) {
+      problem->sample_casters.push_back(CasterAtSample(*problem->parts, scene, s));  // skinned parts posed too
+      problem->options.sample_casters.push_back(problem->sample_casters.back().get());
+    }
+  } else {
+    problem->targets = SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
+  }
+  return problem;
 }
 
 }  // namespace pandora::app

@@ -4,6 +4,10 @@
 /// id, per-camera limits ("one value, or one per selected camera"), mounts and zoom ranges ("ID:"
 /// prefixes), keep-out boxes, the objective. Every error names the option the user typed.
 
+#include <memory>
+#include <vector>
+
+#include "analysis/ray_caster.h"
 #include "app/commands.h"
 #include "app/session/session.h"
 #include "suggest/suggest.h"
@@ -14,6 +18,22 @@ namespace pandora::app {
 session::SessionOptions SuggestSessionOptions(const SuggestArgs& args);
 
 SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig);
+
+/// Everything a camera suggestion runs on: the options and the target points and, over time
+/// (`--over-time`), the moving parts and one ray caster per time sample (options.sample_casters
+/// points into them, so the problem is kept whole while a suggestion runs).
+struct SuggestProblem {
+  SuggestOptions options;
+  std::vector<TargetPoint> targets;
+  std::unique_ptr<RigidPartsRayCaster> parts;
+  std::vector<std::unique_ptr<RayCaster>> sample_casters;
+};
+
+/// The one door to a camera suggestion's problem: `pandora suggest`, Python's suggest() and the
+/// viewer's Suggest panel all build it here from the same options, so that they optimise the same
+/// objective over the same points (region, named surfaces, or the study's targets at every time
+/// sample). Throws InputError naming the option (--cameras, --over-time, --target-surface, ...).
+std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene, const Rig& rig);
 
 /// The enabled PTZ camera `id` of `rig` (its index), or InputError naming `option` with the rig's
 /// PTZ cameras as the hint.

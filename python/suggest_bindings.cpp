@@ -58,6 +58,7 @@ std::string Keywords(const std::string& text) {
       for (i += 2; i < text.size() && (std::islower(static_cast<unsigned char>(text[i])) || text[i] == '-'); ++i)
         word += text[i] == '-' ? '_' : text[i];
       if (word == "max_rotate" || word == "snap_rotate") word += "_deg";
+      if (word == "target_surface") word += "s";
       out += word;
     } else {
       out += text[i++];
@@ -402,10 +403,7 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
     a.snap_rotate = snap_rotate_deg;
     a.outer_iterations = outer_iterations;
     a.seed = seed;
-    SuggestOptions options;
-    std::vector<TargetPoint> targets;
-    std::unique_ptr<RigidPartsRayCaster> parts;
-    std::vector<std::unique_ptr<RayCaster>> sample_casters;
+    std::shared_ptr<app::SuggestProblem> problem;
     try {
       a.max_move = NumberOrList(max_move, "--max-move");
       a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
@@ -417,20 +415,7 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
       if (!(outer_iterations >= 1 && outer_iterations <= 100)) throw InputError("--outer-iterations", "", "must be in [1, 100]");
       if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
         throw InputError("--clearance", "", "snap_move, snap_rotate_deg and clearance must be >= 0");
-      options = app::SuggestOptionsFromArgs(a, scene, r.rig());
-      if (over_time) {
-        if (!target_surfaces.empty())
-          throw InputError("--over-time", "", "takes the study's targets; target_surfaces is for a static scene");
-        const std::vector<TimeSample> samples = scene.TimeSamples();
-        targets = SampleTimeTargets(scene, samples, points, seed);
-        parts = MakeSceneParts(scene);
-        for (const TimeSample& s : samples) {
-          sample_casters.push_back(CasterAtSample(*parts, scene, s));
-          options.sample_casters.push_back(sample_casters.back().get());
-        }
-      } else {
-        targets = Targets(scene, points, target_surfaces, with_region, "", seed);
-      }
+      problem = app::PrepareSuggest(a, scene, r.rig());
     } catch (const InputError& e) {
       RethrowWithKeyword(e);
     }
@@ -441,11 +426,11 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
     out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
     {
       py::gil_scoped_release release;
-      out.cameras = r.session->Suggest(targets, options);
+      out.cameras = r.session->Suggest(problem->targets, problem->options);
     }
     out.improved = out.cameras->improved;
     out.message = out.cameras->message;
-    out.json = SuggestionToJson(*out.cameras, scene, r.rig(), options);
+    out.json = SuggestionToJson(*out.cameras, scene, r.rig(), problem->options);
     return out;
   }, py::arg("scene"), py::arg("rig"), py::arg("cameras"), py::arg("objective") = "coverage2",
      py::arg("points") = 1500, py::arg("target_surfaces") = std::vector<std::string>{}, py::arg("with_region") = false,

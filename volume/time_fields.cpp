@@ -10,6 +10,13 @@
 
 namespace pandora {
 
+FieldOptions OverTimeOptions(FieldOptions options) {
+  options.partition_count = 1;
+  options.partition_rank = 0;
+  options.fields.erase(std::remove(options.fields.begin(), options.fields.end(), "cameras"), options.fields.end());
+  return options;
+}
+
 TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
                                         const std::vector<TimeSample>& samples, const FieldOptions& options_in,
                                         int min_cameras) {

@@ -62,6 +62,11 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
                                         const std::vector<TimeSample>& samples, const FieldOptions& options,
                                         int min_cameras);
 
+/// The options of EvaluateFieldsOverTime from a run's fields options: the samples evaluated whole
+/// (one partition: under MPI rank 0 evaluates them, docs/scale.md), without the per-camera sets
+/// ("cameras": not kept for every sample). What `pandora analyze` and the viewer's Compare use.
+FieldOptions OverTimeOptions(FieldOptions options);
+
 /// Moves the result's grids into `fields` (written to fields.vdb with them).
 void AddTimeGrids(Fields* fields, TimeFieldsResult* result);
 

@@ -4,6 +4,8 @@
 
 #include "analysis/error.h"
 #include "analysis/input_file.h"
+#include "analysis/motion.h"
+#include "analysis/ray_caster.h"
 #include "app/session/ptz_edit.h"
 #include "render/progressive.h"
 #include "suggest/suggestion_file.h"
@@ -58,6 +60,32 @@ bool Session::TryReadFields(const std::function<void(const Fields&, std::int64_t
   return true;
 }
 
+std::int64_t Session::UpdateTimeInBackground() {
+  const Scene& scene = study_->scene();
+  if (!scene.Animated() && !scene.study.targets) return 0;
+  auto samples = std::make_shared<std::vector<TimeSample>>(scene.TimeSamples());
+  if (samples->empty()) return 0;
+  auto snapshot = std::make_shared<Rig>(rig_.rig());
+  const std::int64_t version = rig_.version();
+  return jobs_.Submit("time", [this, snapshot, samples, version](JobContext& job) {
+    const Scene& scene = study_->scene();
+    std::lock_guard<std::mutex> lock(time_mutex_);
+    if (job.cancelled()) return;
+    if (!parts_) parts_ = MakeSceneParts(scene);
+    FieldOptions options = OverTimeOptions(options_.fields);
+    options.progress = [&job](double f) { job.Progress(f); };
+    options.cancel = &job.cancel_flag();
+    TimeFieldsResult r = EvaluateFieldsOverTime(scene, *snapshot, *parts_, *samples, options, scene.TimeMinCameras());
+    if (job.cancelled()) return;  // a newer rig is on its way
+    time_ = std::make_pair(std::move(r.summary), version);
+  });
+}
+
+std::optional<std::pair<TimeSummary, std::int64_t>> Session::TimeNumbers() const {
+  std::lock_guard<std::mutex> lock(time_mutex_);
+  return time_;
+}
+
 Fields Session::TakeFields() {
   std::lock_guard<std::mutex> lock(fields_mutex_);
   fields_version_ = -1;
@@ -101,7 +129,8 @@ std::int64_t Session::RenderInBackground(
   });
 }
 
-std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options) {
+std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options,
+                                         std::shared_ptr<const void> keep) {
   auto rig = std::make_shared<Rig>(rig_.rig());
   auto data = std::make_shared<std::pair<std::vector<TargetPoint>, SuggestOptions>>(
       std::move(targets), std::move(options));
@@ -109,7 +138,7 @@ std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, Sugg
     std::lock_guard<std::mutex> lock(suggestion_mutex_);
     suggestion_.reset();
   }
-  const std::int64_t job = jobs_.Submit("suggest", [this, rig, data](JobContext& context) {
+  const std::int64_t job = jobs_.Submit("suggest", [this, rig, data, keep = std::move(keep)](JobContext& context) {
     Suggestion s = pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
     if (context.cancelled()) return;  // a newer suggestion was asked for
     std::lock_guard<std::mutex> lock(suggestion_mutex_);

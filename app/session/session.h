@@ -20,6 +20,7 @@
 #include "suggest/suggest.h"
 #include "suggest/suggestion_file.h"
 #include "volume/fields.h"
+#include "volume/time_fields.h"
 
 namespace pandora::session {
 
@@ -70,12 +71,24 @@ class Session {
   /// Moves the fields out (a command that writes them); the next update evaluates in full.
   Fields TakeFields();
 
+  /// A study with time samples (moving objects, people): the fields at every sample combined, as
+  /// `pandora analyze` reports them over time (EvaluateFieldsOverTime with OverTimeOptions of the
+  /// session's fields), for the rig as it is now, as a background job of kind "time" (latest wins).
+  /// The live fields are the static scene's, the volume without the people; these are the numbers
+  /// with them. Returns the job id, or 0 (nothing submitted) for a study without time samples.
+  std::int64_t UpdateTimeInBackground();
+  /// The last summary over time and the rig version it reflects; nothing before the first.
+  std::optional<std::pair<TimeSummary, std::int64_t>> TimeNumbers() const;
+
   /// Runs Suggest on the rig as it is now, on the calling thread (what `pandora suggest` does).
   Suggestion Suggest(const std::vector<TargetPoint>& targets, const SuggestOptions& options) const;
   /// The same as a background job of kind "suggest" (latest wins: a
   /// suggestion asked for later replaces a waiting one; a running one finishes but its result is
   /// dropped). Returns the job id; WaitSuggestion() gives the result.
-  std::int64_t SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options);
+  /// `keep` (may be null) is held until the job ends: what `options.sample_casters` point into
+  /// (app::SuggestProblem).
+  std::int64_t SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options,
+                                   std::shared_ptr<const void> keep = nullptr);
   /// Waits for the suggest job; the suggestion of the newest job, or nothing when it failed (the
   /// status says why) or was replaced.
   std::optional<Suggestion> WaitSuggestion(JobStatus* status = nullptr);
@@ -138,6 +151,9 @@ class Session {
   mutable std::mutex fields_mutex_;
   std::unique_ptr<FieldEvaluator> evaluator_;
   std::int64_t fields_version_ = -1;
+  mutable std::mutex time_mutex_;
+  std::unique_ptr<RigidPartsRayCaster> parts_;  // built by the first "time" job
+  std::optional<std::pair<TimeSummary, std::int64_t>> time_;
   std::mutex suggestion_mutex_;
   std::optional<Suggestion> suggestion_;
   std::int64_t suggestion_job_ = 0;

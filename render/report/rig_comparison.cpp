@@ -82,6 +82,27 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
       specs.push_back({"meets_max_sigma_steady", "Steady state meets &sigma;<sub>max</sub> &le; " + Fmt("%g", *study.max_sigma_mm) + " mm", "", true,
                        [](const Summary& s) { return Uncertainty(s, [](const UncertaintySummary& u) { return u.meets_max_sigma_steady; }); }});
   }
+  // Moving objects (people): the numbers over the time samples, which the static fields above
+  // (the empty volume) cannot show.
+  if (std::any_of(summaries.begin(), summaries.end(), [](const Summary& s) { return s.time.has_value(); })) {
+    auto time = [](const std::function<std::optional<double>(const TimeSummary&)>& get) {
+      return [get](const Summary& s) { return s.time ? get(*s.time) : std::nullopt; };
+    };
+    int k = 3;
+    for (const Summary& s : summaries)
+      if (s.time) k = s.time->min_cameras;
+    const std::string cams = " (&ge; " + std::to_string(k) + " cameras)";
+    specs.push_back({"time_always", "Covered at every time sample" + cams, "", true,
+                     time([](const TimeSummary& t) { return std::optional(t.always); })});
+    specs.push_back({"time_mean", "Covered, mean over the samples" + cams, "", true,
+                     time([](const TimeSummary& t) { return std::optional(t.mean); })});
+    specs.push_back({"time_worst_sample", "Covered in the worst sample" + cams, "", true,
+                     time([](const TimeSummary& t) {
+                       return t.samples.empty() ? std::nullopt : std::optional(t.samples[t.worst_sample].ge_k);
+                     })});
+    specs.push_back({"time_sigma_max_p90_mm", "&sigma;<sub>max</sub> p90 over time (mm)", "%.3f", false,
+                     time([](const TimeSummary& t) { return t.sigma_max_p90; })});
+  }
 
   RigComparison c;
   for (const Summary& s : summaries) {

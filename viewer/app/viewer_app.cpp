@@ -195,7 +195,7 @@ struct ViewerApp::Impl {
   // Suggest panel settings.
   int objective = 0;
   float max_move = 0.3f, max_rotate = 10.0f;
-  int points = 800;
+  int points = 1500;  // pandora suggest's --points
   std::string error;       // the last action's error, shown in the status bar (all of it on hover)
   std::string error_line;  // ... its reason and hint, first in the status bar
 
@@ -1248,6 +1248,19 @@ struct ViewerApp::Impl {
     const std::string numbers =
         fields_numbers + (fields_numbers_version == model.session().rig().version() ? "" : "\n(updating)");
     ImGui::TextUnformatted(fields_numbers_version == -2 ? "evaluating..." : numbers.c_str());
+    // With people (time samples): the live fields above are the empty volume's; these are the
+    // numbers with the people at every sample, as `pandora analyze` reports them.
+    if (const auto time = model.session().TimeNumbers()) {
+      const TimeSummary& t = time->first;
+      const double worst = t.samples.empty() ? 0.0 : t.samples[t.worst_sample].ge_k;
+      ImGui::Text("with people, %zu samples, >=%d:\nalways %.1f%%  worst sample %.1f%%%s", t.samples.size(),
+                  t.min_cameras, 100.0 * t.always, 100.0 * worst,
+                  time->second == model.session().rig().version() ? "" : " (updating)");
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("The fields above are the static scene's (the volume without the moving objects).\n"
+                          "These are over the time samples with them: the share of voxels covered by >= %d\n"
+                          "cameras at every sample where they are free, and in the worst sample.", t.min_cameras);
+    }
     const char* fields[] = {"", "coverage", "resolution", "sigma_max"};
     const OverlayOptions& ov = model.display.overlays;
     int current = 0;
@@ -1361,11 +1374,21 @@ struct ViewerApp::Impl {
     ImGui::SetNextWindowSize(ImVec2(280, 250), ImGuiCond_FirstUseEver);
     ImGui::Begin("Suggest");
     const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution",
-                                "coverage3-n1", "calibration"};
+                                "coverage3-n1", "calibration", "mix"};
     if (model.suggestion)  // the panel shows what the suggestion on screen was asked for
       for (int i = 0; i < IM_ARRAYSIZE(objectives); ++i)
         if (ObjectiveName(model.suggestion->objective) == objectives[i]) objective = i;
     ImGui::Combo("objective", &objective, objectives, IM_ARRAYSIZE(objectives));
+    if (std::string(objectives[objective]) == "mix") ImGui::DragFloat3("weights c s r", weights, 0.05f, 0.0f, 100.0f, "%.2f");
+    // The points the objective is evaluated on, as `pandora suggest`: the study region, named
+    // surfaces (--target-surface, with --with-region), or the study's targets over time (--over-time).
+    const bool has_targets = model.scene().study.targets.has_value();
+    if (!has_targets) over_time = false;
+    if (has_targets) ImGui::Checkbox("over time (the study's targets)", &over_time);
+    if (!over_time) {
+      ImGui::InputText("target surfaces", surfaces, sizeof surfaces);
+      if (surfaces[0]) ImGui::Checkbox("and region points", &with_region);
+    }
     ImGui::DragFloat("max move m", &max_move, 0.01f, 0.0f, 10.0f, "%.2f");
     ImGui::DragFloat("max turn deg", &max_rotate, 0.5f, 0.0f, 179.0f, "%.1f");
     ImGui::DragInt("points", &points, 10, 50, 20000);
@@ -1429,6 +1452,19 @@ struct ViewerApp::Impl {
         a.min_hfov = zoom[0];
         a.max_hfov = zoom[1];
       }
+      if (std::string(objectives[objective]) == "mix") a.weights = Vec3(weights[0], weights[1], weights[2]);
+      a.over_time = over_time;
+      if (!over_time) {
+        std::string list = surfaces, item;
+        for (char ch : list + ",")
+          if (ch == ',') {
+            if (!item.empty()) a.target_surfaces.push_back(item);
+            item.clear();
+          } else if (ch != ' ') {
+            item += ch;
+          }
+        a.with_region = with_region && !a.target_surfaces.empty();
+      }
       Do(a);
       waiting_for_suggestion = true;
     }
@@ -1443,6 +1479,12 @@ struct ViewerApp::Impl {
       ImGui::Separator();
       ImGui::Text("%s: %.4g -> %.4g%s", ObjectiveName(g.objective).c_str(), g.before.objective, g.after.objective,
                   g.improved ? "" : " (no improvement)");
+      ImGui::TextDisabled("over %s", model.suggestion_targets.c_str());
+      if (!g.improved) {  // as `pandora accept`: nothing to accept
+        if (ImGui::Button("Reject")) Do(Make(Action::Kind::kReject));
+        ImGui::End();
+        return;
+      }
       for (const CameraChange& ch : g.cameras) {
         ImGui::PushID(ch.index);
         ImGui::Text("%s: %.3f m, %.1f deg", ch.id.c_str(), ch.move_m, ch.rotate_deg);
@@ -1466,6 +1508,9 @@ struct ViewerApp::Impl {
   std::vector<std::array<float, 6>> keep_outs;
   bool zoom_on = false;
   float clearance = 0.1f, zoom[2] = {30, 60};
+  float weights[3] = {1, 1, 1};
+  bool over_time = false, with_region = false;
+  char surfaces[256] = "";
 
   void DisplayPanel() {
     ImGui::SetNextWindowPos(ImVec2(266, 8), ImGuiCond_FirstUseEver);

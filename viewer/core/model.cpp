@@ -9,13 +9,16 @@
 #include "analysis/error.h"
 #include "analysis/output_transaction.h"
 #include "analysis/pose.h"
+#include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
 #include "app/session/autosave.h"
 #include "app/session/ptz_edit.h"
+#include "app/suggest_options.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
+#include "volume/time_fields.h"
 
 namespace pandora::viewer {
 namespace {
@@ -62,6 +65,70 @@ std::string PtzStatus(const Camera& cam, bool clamped) {
                 s.tilt_deg, HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kDeg,
                 clamped ? " (limited by its ranges)" : "");
   return line;
+}
+
+// A number as `pandora suggest` would be given it on the command line (every bit kept).
+std::string Arg(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+std::string Arg(const Vec3& v) { return Arg(v.x()) + "," + Arg(v.y()) + "," + Arg(v.z()); }
+std::string Arg(const Aabb& b) { return Arg(b.min) + "," + Arg(b.max); }
+
+// A suggest action as `pandora suggest`'s options: the viewer's Suggest panel and scripts go
+// through the same door as the command (app::PrepareSuggest), so they optimise the same objective.
+app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
+  app::SuggestArgs s;
+  s.scene = scene_path;
+  for (const std::string& id : a.cameras) s.cameras += (s.cameras.empty() ? "" : ",") + id;
+  s.objective = a.text;
+  s.max_move = Arg(a.number);
+  s.max_rotate = Arg(a.number2);
+  s.points = int(a.number3);
+  s.seed = a.seed;
+  if (a.mount == "rail") s.rail.push_back(Arg(a.a));
+  if (a.mount == "plane") s.plane.push_back(Arg(a.a));
+  if (a.mount == "box") s.mount_box.push_back(Arg(a.mount_box));
+  if (a.max_hfov > 0) s.hfov_range.push_back(Arg(a.min_hfov) + "," + Arg(a.max_hfov));
+  for (const Aabb& b : a.keep_out) s.keep_out.push_back(Arg(b));
+  if (!std::isnan(a.clearance)) s.clearance = a.clearance;
+  if (!std::isnan(a.weights.x())) s.weights = Arg(a.weights);
+  s.snap_move = a.snap_move;
+  s.snap_rotate = a.snap_rotate;
+  s.outer_iterations = a.outer_iterations;
+  s.target_surfaces = a.target_surfaces;
+  s.with_region = a.with_region;
+  s.over_time = a.over_time;
+  return s;
+}
+
+// An error of `pandora suggest`'s options, renamed to the action's keys ("--max-move" ->
+// "$[8].max_move").
+[[noreturn]] void RethrowAsAction(const InputError& e, const std::string& where) {
+  auto key = [](std::string option) {
+    option = option.substr(2);
+    if (option == "cameras") return std::string("suggest");
+    if (option == "mount-box") return std::string("box");
+    std::replace(option.begin(), option.end(), '-', '_');
+    return option;
+  };
+  auto rename = [&](const std::string& text) {
+    std::string out;
+    for (std::size_t i = 0; i < text.size();) {
+      if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && std::islower(static_cast<unsigned char>(text[i + 2]))) {
+        std::size_t j = i + 2;
+        while (j < text.size() && (std::islower(static_cast<unsigned char>(text[j])) || text[j] == '-')) ++j;
+        out += "'" + key(text.substr(i, j - i)) + "'";
+        i = j;
+      } else {
+        out += text[i++];
+      }
+    }
+    return out;
+  };
+  if (e.file().rfind("--", 0) != 0) throw e;  // the scene's own (a surface name, its targets)
+  throw InputError(where + "." + key(e.file()), e.json_path(), rename(e.reason()), rename(e.hint()));
 }
 
 }  // namespace
@@ -144,6 +211,7 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   stations = s.stations;
   saved_stations = s.stations;
   session_->UpdateFieldsInBackground();
+  session_->UpdateTimeInBackground();  // with people: the numbers over time too
 }
 
 ViewerModel::~ViewerModel() = default;
@@ -217,6 +285,7 @@ std::vector<int> ViewerModel::CameraIndices(const std::vector<std::string>& ids,
 
 void ViewerModel::Edited() {
   session_->UpdateFieldsInBackground();
+  session_->UpdateTimeInBackground();  // with people: the numbers over time too
   if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
   if (on_edit) on_edit();
 }
@@ -246,10 +315,23 @@ void ViewerModel::Compare(const Action& a) {
   // The edited rig: its live fields once they have caught up.
   const session::JobStatus s = session_->WaitFields();
   if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+  // Moving objects: the numbers over the time samples too, as `pandora analyze` gives them (the
+  // live fields are the static scene's: the volume without the people).
+  const std::vector<TimeSample> samples =
+      scene().Animated() || scene().study.targets ? scene().TimeSamples() : std::vector<TimeSample>();
+  if (!samples.empty() && !parts_) parts_ = MakeSceneParts(scene());
+  auto over_time = [&](const Rig& r, Summary* summary) {
+    if (samples.empty()) return;
+    FieldOptions fo;
+    fo.fields = names;
+    fo.scene_path = scene().path;
+    summary->time = EvaluateFieldsOverTime(scene(), r, *parts_, samples, OverTimeOptions(fo), scene().TimeMinCameras()).summary;
+  };
   std::vector<Summary> summaries;
   session_->ReadFields([&](const Fields& f, std::int64_t) {
     summaries.push_back(Summarize(scene(), rig(), f, names, 1));
   });
+  over_time(rig(), &summaries.back());
   summaries.back().rig = rig().name + " (edited)";
   for (std::size_t i = 0; i < others.size(); ++i) {
     const Rig& other = *others[i];
@@ -273,6 +355,7 @@ void ViewerModel::Compare(const Action& a) {
         fo.scene_path = scene().path;
         const Fields f = EvaluateFields(scene(), other, session_->study().caster(), fo);
         summary = Summarize(scene(), other, f, names, 1);
+        over_time(other, &summary);
         compare_cache_.push_back({other, summary});
         if (compare_cache_.size() > 8) compare_cache_.erase(compare_cache_.begin());
       }
@@ -541,8 +624,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       break;
     case Kind::kWait:
       if (a.text == "fields") {
-        const session::JobStatus s = session_->WaitFields();
-        if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+        for (const char* kind : {"fields", "time"}) {
+          const session::JobStatus s = session_->jobs().Wait(kind);
+          if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+        }
       } else if (a.text == "suggest") {
         session::JobStatus s;
         suggestion = session_->WaitSuggestion(&s);
@@ -553,37 +638,30 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       }
       break;
     case Kind::kSuggest: {
-      SuggestOptions o;
-      o.scene_path = a.where;
-      o.cameras = CameraIndices(a.cameras, a);
-      CameraLimits limits;
-      limits.max_move = a.number;
-      limits.max_rotate_deg = a.number2;
-      limits.min_hfov_deg = a.min_hfov;
-      limits.max_hfov_deg = a.max_hfov;
-      if (a.mount == "rail" || a.mount == "plane") {
-        limits.mount.kind = a.mount == "rail" ? MountConstraint::Kind::kLine : MountConstraint::Kind::kPlane;
-        limits.mount.axis = a.a;
-      } else if (a.mount == "box") {
-        limits.mount.kind = MountConstraint::Kind::kBox;
-        limits.mount.box = a.mount_box;
+      std::shared_ptr<app::SuggestProblem> problem;
+      try {
+        problem = app::PrepareSuggest(SuggestArgsOf(a, scene().path), scene(), rig());
+      } catch (const InputError& e) {
+        RethrowAsAction(e, a.where);
       }
-      o.limits = {limits};
-      o.keep_out = a.keep_out;
-      if (!std::isnan(a.clearance)) o.clearance = a.clearance;
-      const std::optional<Objective> objective = ParseObjective(a.text);
-      if (!objective)
-        throw InputError(a.where + ".objective", "", "unknown objective '" + a.text + "'",
-                         "use coverage2 (or coverageK), sigma-mean, sigma-p90, resolution or mix");
-      o.objective = *objective;
-      std::vector<TargetPoint> targets = SampleTargets(scene(), int(a.number3), {}, false, a.seed);
+      problem->options.scene_path = a.where;  // the library's checks name the action
       suggestion.reset();
-      session_->SuggestInBackground(std::move(targets), o);
+      suggestion_targets = std::to_string(problem->targets.size()) + " points " +
+                           (a.over_time ? "on the study's targets at " +
+                                              std::to_string(problem->sample_casters.size()) + " time samples"
+                            : a.target_surfaces.empty() ? std::string("of the study region")
+                                                        : std::string("on the target surfaces") +
+                                                              (a.with_region ? " and in the region" : ""));
+      session_->SuggestInBackground(problem->targets, problem->options, problem);
       status = "suggesting";
       break;
     }
     case Kind::kAccept: {
       if (!suggestion) throw InputError(a.where, "", "there is no suggestion to accept", "suggest first, then wait for it");
+      // As `pandora accept`: a suggestion that does not improve its objective is not offered.
+      if (!suggestion->improved)
+        throw InputError(a.where, "", "the suggestion offers no improvement; nothing to accept",
+                         "suggest again with other limits or cameras, or reject it");
       Suggestion take = *suggestion, keep = *suggestion;
       take.cameras.clear();
       keep.cameras.clear();
@@ -790,6 +868,17 @@ nlohmann::json ViewerModel::StateJson() const {
     const std::optional<double> p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
     fields["sigma_max_p50_mm"] = p50 ? json(*p50) : json();
   });
+  // With people: the numbers over the time samples (the live fields are the empty volume's).
+  if (const auto time = session_->TimeNumbers()) {
+    const TimeSummary& t = time->first;
+    fields["time"] = {{"rig_version", time->second},
+                      {"min_cameras", t.min_cameras},
+                      {"samples", t.samples.size()},
+                      {"always", t.always},
+                      {"mean", t.mean},
+                      {"worst_sample", t.samples.empty() ? json() : json(t.samples[t.worst_sample].ge_k)},
+                      {"sigma_max_p90_mm", t.sigma_max_p90 ? json(*t.sigma_max_p90) : json()}};
+  }
   json j = {{"rig", rig().name},
             {"ptz_trace", ptz_trace},
             {"plan", plan},  // "": the orbit view; else the plan or elevation side
@@ -810,13 +899,19 @@ nlohmann::json ViewerModel::StateJson() const {
   }
   if (comparison) j["comparison"] = *comparison;
   if (suggestion) {
-    json ids = json::array();
-    for (const CameraChange& c : suggestion->cameras) ids.push_back(c.id);
+    json ids = json::array(), positions = json::object();
+    for (const CameraChange& c : suggestion->cameras) {
+      ids.push_back(c.id);
+      const Vec3 p = c.after.translation();
+      positions[c.id] = {p.x(), p.y(), p.z()};
+    }
     j["suggestion"] = {{"cameras", ids},
                        {"objective", ObjectiveName(suggestion->objective)},
                        {"before", suggestion->before.objective},
                        {"after", suggestion->after.objective},
-                       {"improved", suggestion->improved}};
+                       {"improved", suggestion->improved},
+                       {"positions", positions},  // the suggested centres, to compare with `pandora suggest`'s
+                       {"targets", suggestion_targets}};
   }
   return j;
 }

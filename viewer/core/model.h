@@ -79,6 +79,9 @@ class ViewerModel {
   RenderOptions display;                ///< Pattern, surface, brightness, grid, slice and isosurface.
   std::vector<int> selection;           ///< Rig indices.
   std::optional<Suggestion> suggestion; ///< Suggested poses waiting for accept or reject (ghosts).
+  /// What the suggestion asked for last is evaluated on, in words ("1500 points of the study
+  /// region", "the study's targets at 6 time samples"), for the Suggest panel.
+  std::string suggestion_targets;
   std::string status;                   ///< The last action's one-line message.
   /// The scene's viewing stations as placed in this session; Save writes the moved ones (eye and
   /// display centre) into the scene file with the cameras. Station moves are not undo steps.
@@ -141,6 +144,7 @@ class ViewerModel {
     Summary summary;
   };
   std::vector<CachedSummary> compare_cache_;
+  std::unique_ptr<RigidPartsRayCaster> parts_;  // the moving parts, built at the first Compare over time
   std::string drag_label_;  // the drag in progress (its steps amend one edit), empty: none
   ViewerOptions options_;
   std::unique_ptr<session::Session> session_;

@@ -80,22 +80,22 @@ class Entry {
   }
   Aabb Box(std::size_t i) const { return BoxOf(j_.at(i), "[" + std::to_string(i) + "]"); }
   // A camera id or a list of them.
-  std::vector<std::string> Ids(const std::string& key, bool allow_empty) const {
+  std::vector<std::string> Ids(const std::string& key, bool allow_empty, const std::string& what = "camera") const {
     const json& v = j_.at(key);
     std::vector<std::string> out;
     if (v.is_string()) {
       out.push_back(String(key));
     } else if (v.is_array()) {
-      if (v.size() > 10000) Fail(key, "more than 10000 cameras");
+      if (v.size() > 10000) Fail(key, "more than 10000 " + what + "s");
       for (std::size_t i = 0; i < v.size(); ++i) {
         if (!v[i].is_string() || v[i].get<std::string>().empty())
-          Fail(key + "[" + std::to_string(i) + "]", "expected a camera id (a non-empty string)");
+          Fail(key + "[" + std::to_string(i) + "]", "expected a " + what + " id (a non-empty string)");
         out.push_back(v[i].get<std::string>());
       }
     } else {
-      Fail(key, "expected a camera id or an array of ids");
+      Fail(key, "expected a " + what + " id or an array of ids");
     }
-    if (out.empty() && !allow_empty) Fail(key, "name at least one camera");
+    if (out.empty() && !allow_empty) Fail(key, "name at least one " + what);
     return out;
   }
 
@@ -319,12 +319,28 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       break;
     case Kind::kSuggest:
       e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane", "box",
-              "keep_out", "clearance", "hfov_range"});
+              "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate", "outer",
+              "target_surface", "with_region", "over_time"});
       a.cameras = e.Ids("suggest", false);
       a.text = e.Has("objective") ? e.String("objective") : "coverage2";
       a.number = e.Number("max_move", 0, 1e4, 0.3);
       a.number2 = e.Number("max_rotate", 0, 179.999, 10);
-      a.number3 = e.Number("points", 1, 1e6, 800);
+      a.number3 = e.Number("points", 1, 1e6, 1500);  // pandora suggest's --points
+      if (e.Has("weights")) {
+        a.weights = e.Vector("weights");
+        if ((a.weights.array() < 0).any() || a.weights.sum() <= 0)
+          e.Fail("weights", "the weights must be >= 0 and not all zero");
+      }
+      a.snap_move = e.Number("snap_move", 0, 1e4, 0);
+      a.snap_rotate = e.Number("snap_rotate", 0, 180, 0);
+      a.outer_iterations = int(e.Number("outer", 1, 100, 4));
+      if (e.Has("target_surface")) a.target_surfaces = e.Ids("target_surface", false, "surface");
+      for (const char* key : {"with_region", "over_time"})
+        if (e.Has(key) && !j.at(key).is_boolean()) e.Fail(key, "expected true or false");
+      a.with_region = e.Has("with_region") && j.at("with_region").get<bool>();
+      a.over_time = e.Has("over_time") && j.at("over_time").get<bool>();
+      if (a.over_time && !a.target_surfaces.empty())
+        e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene", "give one of them");
       a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
       if (int(e.Has("rail")) + int(e.Has("plane")) + int(e.Has("box")) > 1)
         e.Fail("", "give at most one mount: 'rail', 'plane' or 'box'");

@@ -33,7 +33,10 @@
 ///      {"suggest": ["c03"], "objective": "coverage2", "max_move": 0.3, "max_rotate": 10,
 ///       "points": 600, "seed": 1, "rail": [1, 0, 0],   // or "plane": [0, 0, 1], or "box": [x0, y0,
 ///       "keep_out": [[x0, y0, z0, x1, y1, z1]],         // z0, x1, y1, z1]; all optional
-///       "clearance": 0.1, "hfov_range": [40, 60]},
+///       "clearance": 0.1, "hfov_range": [40, 60],
+///       "weights": [1, 1, 0], "snap_move": 0.05, "snap_rotate": 5, "outer": 4,
+///       "target_surface": ["actor"], "with_region": true,  // or "over_time": true (the
+///       },                                              // study's targets at every time sample)
 ///      {"accept": ["c03"]}, {"accept": "all"}, {"reject": 1},
 ///      {"save": 1},                                     // {"save": "force"} over a changed file
 ///      {"screenshot": "out/main.png"}, {"screenshot": "out/c03.png", "camera": "c03"},
@@ -101,6 +104,14 @@ struct Action {
   std::vector<Aabb> keep_out;
   double clearance = NAN;
   double min_hfov = 0, max_hfov = 0;
+  /// suggest, as `pandora suggest`'s options of the same names (the same defaults): the mix
+  /// weights (NaN: none given), target surfaces (with region points too), the study's targets at
+  /// every time sample, snap steps (m, deg; 0: off) and outer iterations.
+  Vec3 weights = Vec3::Constant(NAN);
+  std::vector<std::string> target_surfaces;
+  bool with_region = false, over_time = false;
+  double snap_move = 0, snap_rotate = 0;
+  int outer_iterations = 4;
   /// mouse: the gizmo handle aimed at (0..2 axes x y z, 3..5 rings; -1: none) and "by" along it
   /// (metres, or degrees on a ring; in `number`); with `has_a`, the world point `a` instead of x, y.
   int gizmo = -1;

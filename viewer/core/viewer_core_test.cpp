@@ -276,6 +276,27 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   ExpectScriptError(R"([{"suggest": ["a"], "keep_out": [[0, 0, 0, 1, 1, 1], [0, 0, "x", 1, 1, 1]]}])",
                     "$[0].keep_out[1][2]");
   ExpectScriptError(R"([{"suggest": ["a"], "hfov_range": [50, 30]}])", "$[0].hfov_range");
+  // `pandora suggest`'s other options, with its defaults.
+  const std::vector<Action> o = ParseScript(
+      R"([{"suggest": ["a"], "objective": "mix", "weights": [1, 0.5, 0], "snap_move": 0.05, "snap_rotate": 5,
+           "outer": 2, "target_surface": ["actor", "table"], "with_region": true},
+          {"suggest": "a", "over_time": true}])", "s.json");
+  EXPECT_EQ(o[0].weights, Vec3(1, 0.5, 0));
+  EXPECT_EQ(o[0].snap_move, 0.05);
+  EXPECT_EQ(o[0].snap_rotate, 5);
+  EXPECT_EQ(o[0].outer_iterations, 2);
+  EXPECT_EQ(o[0].target_surfaces, (std::vector<std::string>{"actor", "table"}));
+  EXPECT_TRUE(o[0].with_region);
+  EXPECT_FALSE(o[0].over_time);
+  EXPECT_TRUE(o[1].over_time);
+  EXPECT_EQ(o[1].number3, 1500);  // --points
+  EXPECT_EQ(o[1].outer_iterations, 4);  // --outer
+  EXPECT_TRUE(std::isnan(o[1].weights.x()));
+  ExpectScriptError(R"([{"suggest": ["a"], "weights": [0, 0, 0]}])", "$[0].weights");
+  ExpectScriptError(R"([{"suggest": ["a"], "over_time": 1}])", "$[0].over_time");
+  ExpectScriptError(R"([{"suggest": ["a"], "over_time": true, "target_surface": "x"}])", "$[0].over_time");
+  ExpectScriptError(R"([{"suggest": ["a"], "target_surface": [""]}])", "$[0].target_surface[0]");
+  ExpectScriptError(R"([{"suggest": ["a"], "outer": 0}])", "$[0].outer");
   // The pointer as a world point or a gizmo handle.
   const std::vector<Action> p = ParseScript(
       R"([{"mouse": "press", "at": [1, 2, 3]}, {"mouse": "move", "gizmo": "ry", "by": -15}, {"mouse": "release", "gizmo": "z"}])",
@@ -436,6 +457,20 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
   EXPECT_EQ(Read(scene), Read(scene));  // still readable
   EXPECT_THROW(m.Run(ParseScript(R"([{"select": ["nope"]}])", "s.json"), &cpu), InputError);
   EXPECT_THROW(m.Run(ParseScript(R"([{"accept": "all"}])", "s.json"), &cpu), InputError);
+  // A suggestion that cannot improve (nothing may move) is refused, as `pandora accept` refuses it.
+  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "max_move": 0, "max_rotate": 0, "points": 100},
+                        {"wait": "suggest"}])", "s.json"),
+        &cpu);
+  ASSERT_TRUE(m.suggestion);
+  EXPECT_FALSE(m.suggestion->improved);
+  const std::int64_t version = m.session().rig().version();
+  try {
+    m.Run(ParseScript(R"([{"accept": "all"}])", "s.json"), &cpu);
+    ADD_FAILURE() << "a suggestion without improvement was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("offers no improvement"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(m.session().rig().version(), version);
   EXPECT_THROW(m.Run(ParseScript(R"([{"slice": "resolution"}])", "s.json"), &cpu), InputError);  // not live
   EXPECT_THROW(m.Run(ParseScript(R"([{"mouse": "press", "x": 1, "y": 1}])", "s.json"), &cpu), InputError);
 }
