@@ -135,6 +135,104 @@ double PtzHead::SampleStep(const Camera& base, const PtzState& a, const PtzState
   return angle / std::max(pan_speed_deg_s, tilt_speed_deg_s);
 }
 
+std::optional<std::vector<std::pair<double, double>>> PtzMoveChanges(const PtzHead& head, const Camera& base,
+                                                                     const PtzState& from, const PtzState& to,
+                                                                     double move_s, const PtzTarget& target,
+                                                                     double resolution_s, int max_evaluations) {
+  const Intrinsics& k = base.model.intrinsics();
+  const bool undistorted = k.model == LensModel::kPinhole ||
+                           (k.model == LensModel::kBrownConrady && k.k1 == 0 && k.k2 == 0 && k.k3 == 0 &&
+                            k.p1 == 0 && k.p2 == 0);
+  if (!undistorted || !(k.fx > 0) || !(k.fy > 0)) return std::nullopt;
+  std::vector<std::pair<double, double>> spans;
+  if (!(move_s > 0)) return spans;
+  // When each axis stops (Along: every axis at its speed until it arrives), and the rates before.
+  double dpan = to.pan_deg - from.pan_deg;
+  if (head.ContinuousPan()) dpan = Wrap180(dpan);
+  const double t_pan = std::abs(dpan) / head.pan_speed_deg_s;
+  const double t_tilt = std::abs(to.tilt_deg - from.tilt_deg) / head.tilt_speed_deg_s;
+  const double zoom_rate = head.zoom_speed * (head.focal_max - head.focal_min);
+  const double t_zoom = to.focal != from.focal && zoom_rate > 0 ? std::abs(to.focal - from.focal) / zoom_rate : 0.0;
+  const double offset = head.offset.norm();
+  const double fy_fx = k.fy / k.fx;
+  // The image in the plane z = 1 at focal f (fx): its farthest corner is R_c / f from the axis.
+  double corner = 0;
+  for (double u : {-0.5, k.width - 0.5})
+    for (double v : {-0.5, k.height - 0.5}) corner = std::max(corner, std::hypot(u - k.cx, (v - k.cy) / fy_fx));
+  const Vec3& X = target.X;
+  const double normal_length = target.normal ? target.normal->norm() : 0.0;
+  // +1: the margin keeps g > 0 over the piece, -1: g < 0 throughout, 0: either.
+  auto sign = [](double g, double change) { return g > change ? 1 : g < -change ? -1 : 0; };
+  // Whether the test's answer is constant on [a, b].
+  auto constant = [&](double a, double b) {
+    const double m = 0.5 * (a + b), h = 0.5 * (b - a);
+    const PtzState s = head.Along(from, to, m);
+    const double turn = Rad((a < t_pan ? head.pan_speed_deg_s : 0.0) + (a < t_tilt ? head.tilt_speed_deg_s : 0.0));
+    const double zoom = a < t_zoom ? zoom_rate : 0.0;
+    const Eigen::Isometry3d pose = head.Pose(s);
+    const Vec3 e = X - pose.translation();
+    const double D = e.norm();
+    const double centre_speed = turn * offset;
+    const double moved = centre_speed * h;  // how far the centre can move within the piece
+    bool all = true;
+    auto margin = [&](double g, double change) {  // false: fails throughout (the answer is false)
+      const int r = sign(g, change);
+      all = all && r > 0;
+      return r >= 0;
+    };
+    if (!margin(D - base.near, moved)) return true;
+    if (std::isfinite(base.far) && !margin(base.far - D, moved)) return true;
+    if (target.normal && !margin(target.normal->dot(-e) / normal_length, moved)) return true;
+    const double D_lo = D - moved;
+    if (!(D_lo > 0)) return false;
+    const double w = turn + centre_speed / D_lo;  // the direction's turn rate in the camera frame
+    const Vec3 p = pose.linear().transpose() * e;
+    const double theta = std::atan2(std::hypot(p.x(), p.y()), p.z());
+    const double f_lo = s.focal - zoom * h, f_hi = s.focal + zoom * h;
+    if (!(f_lo > 0)) return false;
+    // Outside the widest view of the piece throughout.
+    if (theta - w * h > std::atan(corner / f_lo)) return true;
+    const double theta_hi = theta + w * h;
+    if (!(theta_hi < 0.5 * kPi - 1e-6)) return false;
+    const double rho = std::tan(theta_hi);  // |(x/z, y/z)| within the piece
+    // A unit direction turning at w moves (x/z, y/z) at most (1 + rho^2) w (the gnomonic map's
+    // largest stretch, sec^2); the pixel moves with it times the focal, and with the zoom.
+    const double du = zoom * rho + f_hi * (1.0 + rho * rho) * w;
+    const double dv = fy_fx * du;
+    const double u = k.cx + s.focal * p.x() / p.z();
+    const double v = k.cy + s.focal * fy_fx * p.y() / p.z();
+    if (!margin(u + 0.5, du * h) || !margin(k.width - 0.5 - u, du * h) || !margin(v + 0.5, dv * h) ||
+        !margin(k.height - 0.5 - v, dv * h))
+      return true;
+    if (target.min_px_per_m > 0) {
+      // PixelDensity of the pinhole, zoomed: f sqrt(fy/fx) / D * sec^1.5(theta); its logarithm
+      // changes at most by the zoom's, the distance's and 1.5 tan(theta) times the turn rate.
+      const double q2 = (p.x() * p.x() + p.y() * p.y()) / (p.z() * p.z());
+      const double density = s.focal * std::sqrt(fy_fx) / p.z() * std::pow(1.0 + q2, 0.25);
+      const double rate = zoom / f_lo + centre_speed / D_lo + 1.5 * rho * w;
+      if (!margin(std::log(density / target.min_px_per_m), rate * h)) return true;
+    }
+    return all;
+  };
+  std::vector<std::pair<double, double>> stack{{0.0, move_s}};
+  int evaluations = 0;
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    if (++evaluations > max_evaluations) return std::nullopt;
+    if (constant(a, b)) continue;
+    if (b - a <= resolution_s) {
+      if (!spans.empty() && spans.back().second >= a) spans.back().second = b;
+      else spans.emplace_back(a, b);
+      continue;
+    }
+    const double m = 0.5 * (a + b);
+    stack.emplace_back(m, b);
+    stack.emplace_back(a, m);
+  }
+  return spans;
+}
+
 double PtzWatch::watched_s() const {
   double sum = 0;
   for (const auto& [a, b] : intervals) sum += b - a;

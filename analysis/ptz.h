@@ -116,11 +116,36 @@ bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const V
 /// camera `camera` at both ends (VisibilityTester::Tolerance); `rays` (when given) counts the cast.
 bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment, std::int64_t* rays = nullptr);
 
+/// What PtzSees's geometric test of a point depends on besides the setting.
+struct PtzTarget {
+  Vec3 X = Vec3::Zero();
+  double min_px_per_m = 0;
+  const Vec3* normal = nullptr;
+};
+
+/// Where along the move from `from` to `to` (PtzHead::Along, t in [0, move_s]) the answer of
+/// PtzSees(base, head, setting, target...) can change, found without sampling: [0, move_s] is
+/// subdivided until each piece is certified, from bounds on how fast every margin of the test can
+/// change (range and facing with the centre's speed, the four image edges and the density with the
+/// view's turn rate, at most pan + tilt speed, and the zoom's rate; docs/ptz.md), to keep its sign,
+/// or to fail one condition throughout. Returns the pieces left uncertain, each at most
+/// `resolution_s` long, adjacent ones merged, in order: between two of them the answer is constant,
+/// and every change lies inside one. nullopt for a lens with distortion (the bounds are the
+/// pinhole's) or when more than `max_evaluations` tests would be needed.
+std::optional<std::vector<std::pair<double, double>>> PtzMoveChanges(const PtzHead& head, const Camera& base,
+                                                                     const PtzState& from, const PtzState& to,
+                                                                     double move_s, const PtzTarget& target,
+                                                                     double resolution_s = 1e-6,
+                                                                     int max_evaluations = 200000);
+
 /// The intervals of a tour's period during which a point is watched: `sees` (a setting -> bool
-/// test, e.g. PtzSees plus occlusion) is evaluated once per dwell and along each move every
-/// PtzHead::SampleStep, each change refined by bisection to `tolerance_s`. Exact up to
-/// `tolerance_s` per change, except that a visibility shorter than the step inside a move may be
-/// missed (docs/ptz.md measures it).
+/// test, e.g. PtzSees plus occlusion) is evaluated once per dwell and, along each move, once per
+/// piece of constant geometry that PtzMoveChanges certifies when `target` is given (the point and
+/// density `sees` tests) and the lens is undistorted: then every window is found, however short,
+/// its ends to PtzMoveChanges's resolution (1 us), and with a zero offset (the centre fixed, so the
+/// occlusion constant along a move) the answer is exact. Otherwise, and for the occlusion of a head
+/// whose centre moves, along each move every PtzHead::SampleStep, each change refined by bisection
+/// to `tolerance_s`: there a visibility shorter than the step may be missed (docs/ptz.md).
 struct PtzWatch {
   double period = 0;
   std::vector<std::pair<double, double>> intervals;  ///< Sorted, disjoint, within [0, period].
@@ -131,7 +156,7 @@ struct PtzWatch {
 };
 template <typename Sees>
 PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<PtzHead::TourLeg>& legs,
-                   Sees&& sees, double tolerance_s = 1e-3);
+                   Sees&& sees, const PtzTarget* target = nullptr, double tolerance_s = 1e-3);
 
 /// The sweep of the traces: what a PTZ camera can see from `from` within a time budget. With a
 /// zero offset the answer for a point depends only on its direction from the pivot, and the pose
@@ -213,7 +238,7 @@ class PtzReach {
 
 template <typename Sees>
 PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<PtzHead::TourLeg>& legs,
-                   Sees&& sees, double tolerance_s) {
+                   Sees&& sees, const PtzTarget* target, double tolerance_s) {
   PtzWatch w;
   if (legs.empty()) return w;
   w.period = legs.back().end();
@@ -224,17 +249,20 @@ PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<Pt
     else
       w.intervals.emplace_back(a, b);
   };
+  const bool fixed_centre = head.offset.isZero(0.0);
   for (const PtzHead::TourLeg& leg : legs) {
-    // The move: samples every step, each change bisected.
-    if (leg.move_s > 0) {
-      const double step = std::min(head.SampleStep(base, leg.from, leg.to), leg.move_s);
-      const int n = static_cast<int>(std::ceil(leg.move_s / step - 1e-9));
-      auto at = [&](double t) { return sees(head.Along(leg.from, leg.to, t)); };
-      double t0 = 0;
-      bool s0 = at(0);
-      double open = s0 ? 0.0 : -1.0;
+    auto at = [&](double t) { return sees(head.Along(leg.from, leg.to, t)); };
+    // [t_begin, t_end] of the move sampled every step, each change bisected.
+    auto scan = [&](double t_begin, double t_end) {
+      const double length = t_end - t_begin;
+      if (!(length > 0)) return;
+      const double step = std::min(head.SampleStep(base, leg.from, leg.to), length);
+      const int n = std::max(1, static_cast<int>(std::ceil(length / step - 1e-9)));
+      double t0 = t_begin;
+      bool s0 = at(t0);
+      double open = s0 ? t0 : -1.0;
       for (int i = 1; i <= n; ++i) {
-        const double t1 = i == n ? leg.move_s : i * step;
+        const double t1 = i == n ? t_end : t_begin + i * step;
         const bool s1 = at(t1);
         if (s1 != s0) {
           double lo = t0, hi = t1;  // sees(lo) == s0, sees(hi) == s1
@@ -253,7 +281,44 @@ PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<Pt
         t0 = t1;
         s0 = s1;
       }
-      if (open >= 0) add(leg.start + open, leg.start + leg.move_s);
+      if (open >= 0) add(leg.start + open, leg.start + t_end);
+    };
+    if (leg.move_s > 0) {
+      std::optional<std::vector<std::pair<double, double>>> changes;
+      if (target) changes = PtzMoveChanges(head, base, leg.from, leg.to, leg.move_s, *target);
+      if (!changes) {
+        scan(0.0, leg.move_s);
+      } else {
+        // Pieces of constant geometry between the uncertain spans; a change inside a span (at most
+        // 1 us) is put at its middle. Spans merged longer than 1 ms (a margin staying at zero) are
+        // scanned.
+        double begin = 0.0;  // where the current piece starts (a span's middle)
+        double certified = 0.0;  // where its certified part starts
+        auto piece = [&](double end, double certified_end) {
+          if (!(end > begin)) return;
+          const PtzState mid = head.Along(leg.from, leg.to, 0.5 * (certified + certified_end));
+          // The geometry fails throughout the piece: nothing to cast.
+          if (!PtzSees(base, head, mid, target->X, target->min_px_per_m, target->normal)) return;
+          if (fixed_centre) {
+            if (at(0.5 * (certified + certified_end))) add(leg.start + begin, leg.start + end);
+          } else {
+            scan(begin, end);  // the occlusion of a moving centre is sampled
+          }
+        };
+        for (const auto& [lo, hi] : *changes) {
+          if (hi - lo > 1e-3) {
+            piece(lo, lo);
+            scan(lo, hi);
+            begin = certified = hi;
+            continue;
+          }
+          const double middle = 0.5 * (lo + hi);
+          piece(middle, lo);
+          begin = middle;
+          certified = hi;
+        }
+        piece(leg.move_s, leg.move_s);
+      }
     }
     if (leg.dwell_s > 0 && sees(leg.to)) add(leg.start + leg.move_s, leg.end());
   }

@@ -214,7 +214,9 @@ std::vector<double> PtzTourGaps(const PtzPointJudge& judge, const std::vector<in
   const std::vector<PtzHead::TourLeg> legs = judge.head().TourLegs(order);
   std::vector<double> gaps;
   for (std::size_t i = 0; i < judge.size(); ++i) {
-    const PtzWatch w = WatchTour(judge.head(), judge.camera(), legs, [&](const PtzState& s) { return judge.Sees(i, s); });
+    const PtzTarget target = judge.target(i);
+    const PtzWatch w =
+        WatchTour(judge.head(), judge.camera(), legs, [&](const PtzState& s) { return judge.Sees(i, s); }, &target);
     gaps.push_back(w.longest_gap_s());
   }
   return gaps;
@@ -235,7 +237,7 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
   for (int i = 0; i < n; ++i) out.before.push_back(i);
   auto state = [&](int stop) { return h.presets[h.tour[stop].preset].state; };
   // Per point: the dwell at each stop, the move between every ordered pair of stops (relative to
-  // the move's start), exactly as WatchTour samples a leg.
+  // the move's start), exactly as WatchTour finds a leg's.
   std::vector<std::vector<char>> dwell(P, std::vector<char>(n, 0));
   std::vector<std::vector<std::vector<std::pair<double, double>>>> moves(
       P, std::vector<std::vector<std::pair<double, double>>>(n * n));
@@ -245,6 +247,7 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
     for (int b = 0; b < n; ++b) move_s[a * n + b] = h.MoveTime(state(a), state(b));
   for (std::size_t i = 0; i < P; ++i) {
     auto sees = [&](const PtzState& s) { return judge.Sees(i, s); };
+    const PtzTarget target = judge.target(i);
     for (int a = 0; a < n; ++a) {
       dwell[i][a] = h.tour[a].dwell_s > 0 && sees(state(a));
       watchable[i] |= dwell[i][a];
@@ -254,7 +257,7 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
         leg.from = state(a);
         leg.to = state(b);
         leg.move_s = move_s[a * n + b];
-        const PtzWatch w = WatchTour(h, cam, {leg}, sees);
+        const PtzWatch w = WatchTour(h, cam, {leg}, sees, &target);
         moves[i][a * n + b] = w.intervals;
       }
     }

@@ -32,6 +32,8 @@ class PtzPointJudge {
   bool Sees(std::size_t i, const PtzState& s) const;
   std::size_t size() const { return points_.size(); }
   const Vec3& point(std::size_t i) const { return points_[i]; }
+  /// Point `i` as PtzSees tests it (WatchTour's exact move events).
+  PtzTarget target(std::size_t i) const { return {points_[i], min_px_per_m_, nullptr}; }
   std::int64_t rays() const { return rays_; }
 
  private:

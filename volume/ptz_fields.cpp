@@ -85,7 +85,8 @@ PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera, const std::vec
     }
     return !PtzSegmentOccluded(tester, camera, r, rays);
   };
-  return WatchTour(head, base, legs, sees);
+  const PtzTarget target{X, min_px_per_m, nullptr};
+  return WatchTour(head, base, legs, sees, &target);
 }
 
 PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const RayCaster& caster,

@@ -24,6 +24,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 double Rad(double d) { return d * kPi / 180.0; }
+double Deg(double r) { return r * 180.0 / kPi; }
 
 // A room with optional objects; PTZ "p" at (0, 0, 3) looking along +y at home; `ptz` is the block's body.
 Scene PtzScene(const std::string& ptz, const std::string& objects = "", const std::string& study_extra = "",
@@ -238,9 +239,12 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
     std::mt19937_64 rng(13);
     std::uniform_real_distribution<double> u(-1, 1);
     const double dt = 2e-4;
-    // WatchTour samples a move every SampleStep (a quarter of the narrower field of view): a
-    // glimpse shorter than that inside a move may be missed (with an offset the moving centre can
-    // uncover a point behind the pillar's edge for a moment).
+    // With a zero offset WatchTour is exact (PtzMoveChanges certifies every piece of a move): it
+    // differs from the loop by the loop's own resolution at each change, and by glimpses shorter
+    // than dt that the loop misses. With an offset the occlusion of the moving centre is sampled
+    // every SampleStep (a quarter of the narrower field of view): a glimpse of a point behind the
+    // pillar's edge shorter than that may be missed.
+    const bool exact = std::string(offset) == "[0, 0, 0]";
     double step = 0;
     for (const PtzHead::TourLeg& leg : legs) step = std::max(step, h.SampleStep(rig.cameras[0], leg.from, leg.to));
     int missed = 0;
@@ -251,7 +255,7 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
       const Brute b = BruteForceTour(tester, legs, X, px, dt, step);
       // Each change is placed to the bisection's 1e-3 s and the loop's dt; glimpses shorter than
       // the step may be missed.
-      const double tol = (b.changes + 1) * (1e-3 + dt) + b.short_s;
+      const double tol = exact ? (b.changes + 1) * dt : (b.changes + 1) * (1e-3 + dt) + b.short_s;
       missed += b.short_s > 0 && std::abs(w.watched_s() - b.watched) > (b.changes + 1) * (1e-3 + dt);
       EXPECT_NEAR(w.watched_s(), b.watched, tol) << offset << " point " << X.transpose();
       EXPECT_NEAR(w.longest_gap_s(), b.gap, tol) << offset << " point " << X.transpose();
@@ -262,6 +266,55 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
   }
   EXPECT_EQ(compared, 80);
   EXPECT_GE(partial, 20);  // the comparison is not between all-or-nothing points
+}
+
+// A glimpse far shorter than a move's sampling step: a point just inside the image's top edge when
+// the pan passes it (elevation tan(el) = 0.9999 x the edge's), outside it a degree to either side
+// (its image rises as 1 / cos of the pan off its azimuth). The tour's two moves pass it; each
+// watches it 2 acos(0.9999) / pan speed = 18 ms (the step is 130 ms). Sampling alone misses both;
+// the certified move events find them to the microsecond. And the density: a 0.9999 x the
+// density's edge at the axis (a pinhole's density grows as sec^1.5 off the axis, so it is met only
+// away from the point's azimuth) -- the closed form again.
+TEST(PtzFields, TourFindsAGlimpseShorterThanTheSampleStep) {
+  const Scene scene = PtzScene(R"("pan_speed_deg_s": 90, "tilt_speed_deg_s": 30,
+      "presets": [{"name": "a", "pan_deg": -60, "tilt_deg": 0}, {"name": "b", "pan_deg": 60, "tilt_deg": 0}],
+      "tour": [{"preset": "a", "dwell_s": 1}, {"preset": "b", "dwell_s": 1}])");
+  const Rig& rig = scene.rigs[0];
+  const Camera& cam = rig.cameras[0];
+  const auto empty = MakeBruteForceRayCaster(TriangleMesh());
+  const VisibilityTester tester(rig.cameras, *empty, 10.0);
+  const PtzHead& h = *cam.ptz;
+  const std::vector<PtzHead::TourLeg> legs = h.TourLegs();
+  const Intrinsics k = cam.model.intrinsics();
+  const double ratio = 0.9999;
+  const double tan_el = ratio * (k.cy + 0.5) / k.fy;
+  const Vec3 X(0, 5, 3 + 5 * tan_el);
+  const double window = 2 * Deg(std::acos(ratio)) / 90.0;
+  ASSERT_LT(window, 0.2 * h.SampleStep(cam, legs[0].from, legs[0].to));
+  const PtzWatch w = PtzTourWatch(tester, 0, legs, X, 0.0);
+  ASSERT_EQ(w.intervals.size(), 2u);
+  EXPECT_NEAR(w.watched_s(), 2 * window, 4e-6);
+  // The windows are centred where the pan passes 0: 60 / 90 s into each move.
+  for (int i = 0; i < 2; ++i)
+    EXPECT_NEAR(0.5 * (w.intervals[i].first + w.intervals[i].second), legs[i].start + 60.0 / 90.0, 2e-6);
+  const PtzWatch sampled = WatchTour(h, cam, legs, [&](const PtzState& s) { return PtzSees(cam, h, s, X); });
+  EXPECT_EQ(sampled.watched_s(), 0.0);  // what sampling alone gave
+
+  // The density: at the point's azimuth (centred horizontally, on the midline) it needs
+  // f sqrt(fy/fx) / D, D = 5 m; off by the pan phi it has sec^1.5(phi) more. A target of that
+  // over 0.9999 is met while cos^1.5(phi) <= 0.9999, i.e. |phi| >= acos(0.9999^(2/3)), until the
+  // point leaves the image's side (phi = 30 deg, the half field of view).
+  const Vec3 Y(0, 5, 3);
+  const double base_density = k.fx * std::sqrt(k.fy / k.fx) / 5.0;
+  const double target = base_density / ratio;
+  const PtzWatch d = PtzTourWatch(tester, 0, legs, Y, target);
+  const double gap = 2 * Deg(std::acos(std::pow(ratio, 2.0 / 3.0))) / 90.0;
+  const double side = Deg(std::atan((k.cx + 0.5) / k.fx));  // where Y leaves the image, off the axis
+  // Each move: watched from entering (phi = side) to -gap/2 of the azimuth, and from +gap/2 to the
+  // other side, the dwells not (at +-60 deg Y is outside the 30 deg half view).
+  const double per_move = 2 * (side / 90.0 - 0.5 * gap);
+  EXPECT_NEAR(d.watched_s(), 2 * per_move, 1e-5);
+  EXPECT_EQ(d.intervals.size(), 4u);
 }
 
 // The grids hold the per-voxel values, the shares count them; the rig's minimum is the minimum.
