@@ -383,7 +383,8 @@ StreamSetup PrepareStream(const AnalyzeArgs& args) {
                   options.voxel_size_option.empty() ? scene.path : options.voxel_size_option,
                   options.voxel_size_option.empty() ? "$.study.voxel_size" : "");
   const VoxelLattice& lattice = setup.lattice;
-  setup.tiles = PlanTiles(lattice, options.fields, options.memory_budget_bytes, tile_side);
+  // The tiles share the budget with the scene's structures (held for the whole run).
+  setup.tiles = PlanTiles(lattice, options.fields, std::max(0.0, options.memory_budget_bytes - SceneStructureBytes(scene)), tile_side);
   const std::vector<BlockColumns>& tiles = setup.tiles;
   constexpr std::size_t kMostTiles = 10000;
   if (tiles.size() > kMostTiles) {

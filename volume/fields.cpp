@@ -27,6 +27,22 @@
 
 namespace pandora {
 
+double SceneStructureBytes(const Scene& scene) {
+  // Measured on a 1,002,252-triangle mesh (a subdivided cube, 0.5 M vertices), resident after its
+  // import with the freed memory returned (Study::Load): the scene's meshes 26 MiB, the Embree BVH
+  // 99 MiB (125 MiB: 131 bytes a triangle). 192 bytes a triangle leaves 61 for a solid's search
+  // trees (an AABB tree of its triangles, built for the fields; not measured apart).
+  double triangles = 0;
+  for (const SceneObject& o : scene.objects) triangles += double(o.mesh.triangles.size());
+  return 192.0 * triangles + 4096.0;
+}
+
+// The 8^3 blocks that cover `lattice`.
+static double LatticeBlocks(const VoxelLattice& lattice) {
+  double n = 1;
+  for (int a = 0; a < 3; ++a) n *= std::ceil(double(std::max(lattice.dims[a], 0)) / 8.0);
+  return n;
+}
 // EstimateFieldBytes for a number of voxels (the blocks that hold free voxels, or a box's).
 static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count);
 // What each camera adds to that (FieldEvaluator::Update checks both against the budget).
@@ -1008,9 +1024,12 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
       throw InputError(opt.memory_budget_option, "", reason.str(), hint.str());
     throw InputError(size_file, size_path, reason.str(), hint.str());
   };
-  const double box_voxels = static_cast<double>(estimated.voxel_count());
-  check_budget(sparse ? (box_voxels / 512.0 + 1.0) * (sizeof(Block) + 513.0)
-                      : EstimateBytesForVoxels(box_voxels, opt.fields, 0));
+  // Memory goes by 8^3 blocks (an OpenVDB leaf holds 512 values however few are active): a region
+  // one voxel thick needs as many blocks as one eight voxels thick (issue 27: a 2 cm slab over a
+  // floor peaked at 1.4 GB under a 700 MiB budget when voxels were counted).
+  const double box_blocks = LatticeBlocks(estimated);
+  check_budget(sparse ? box_blocks * (sizeof(Block) + 513.0)
+                      : EstimateBytesForVoxels(512.0 * box_blocks, opt.fields, 0));
 
   S.want_coverage = Wants(opt.fields, "coverage");
   S.want_cameras = Wants(opt.fields, "cameras");
@@ -1153,16 +1172,20 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   // voxels peaked at 675 MB under a 256 MiB budget before (issue 27).
   if (!S.evaluated || new_count > old_count) {
     const double blocks = double(S.blocks.size());
-    // The budget bounds what the evaluation adds to the process (the libraries, the scene and its
-    // BVH are there before: about 50 MB for the examples; summary.json's timing.peak_rss_mib shows
-    // the whole), so that a streamed tile can be held to a budget of a few MiB.
-    const double need = S.fields.stats.estimated_bytes +
+    // The budget bounds the process's data: the evaluation, every camera's share, and the scene's
+    // structures held for the run (its meshes, the Embree BVH and the solids' search trees:
+    // SceneStructureBytes). The program itself (code and libraries, about 45 MiB resident before
+    // any input) comes on top; summary.json's timing.peak_rss_mib shows the whole.
+    const double scene_bytes = SceneStructureBytes(S.scene);
+    const double need = S.fields.stats.estimated_bytes + scene_bytes +
                         double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
     if (need > opt.memory_budget_bytes) {
       std::ostringstream reason;
-      reason << "the region needs about " << std::llround(need / 1048576.0) << " MiB with the rig's "
-             << new_count << " cameras, over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
-             << " MiB";
+      reason << "the run needs about " << std::llround(need / 1048576.0) << " MiB (the region's fields with the rig's "
+             << new_count << " cameras";
+      if (scene_bytes >= 1048576.0)
+        reason << ", the scene's meshes and BVH " << std::llround(scene_bytes / 1048576.0) << " MiB of it";
+      reason << "), over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
       const std::string hint = Wants(opt.fields, "cameras")
                                    ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
                                    : "raise the budget (--memory-budget or study.memory_budget_mb), or use fewer cameras";
@@ -1480,7 +1503,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
 
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count) {
-  return EstimateBytesForVoxels(static_cast<double>(lattice.voxel_count()), fields, camera_count);
+  return EstimateBytesForVoxels(512.0 * LatticeBlocks(lattice), fields, camera_count);
 }
 
 static double PerCameraBytes(const VoxelLattice& lattice, double blocks, const std::vector<std::string>& fields,

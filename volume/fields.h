@@ -120,6 +120,10 @@ class Fields {
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count);
 
+/// The memory the scene's structures hold while fields are evaluated (its meshes, the ray caster's
+/// BVH, the solids' search trees), in bytes: counted in the memory budget with the fields'.
+double SceneStructureBytes(const Scene& scene);
+
 /// The tiles of a streamed evaluation (`pandora analyze --stream`, docs/scale.md): rectangles of
 /// whole block columns that cover the lattice's columns once, row by row along y, then x. With
 /// `tile_side` > 0 (metres) each tile is that wide (rounded to whole 8-voxel blocks, at least one);
