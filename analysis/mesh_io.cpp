@@ -958,7 +958,17 @@ std::uint64_t AssimpBudgetBytes(std::uint64_t file_size) {
   return budget;
 }
 
+// The open ScopedMeshImportBudget (0 bytes: none).
+double g_import_budget = 0;
+std::string g_import_budget_where;
+
 [[noreturn]] void ThrowOverBudget(const std::string& path, std::uint64_t file_size) {
+  if (g_import_budget > 0 && g_import_budget < double(AssimpBudgetBytes(file_size)))
+    throw InputError(path, "",
+                     "reading the mesh file needs more than the memory budget of " +
+                         std::to_string(std::llround(g_import_budget / 1048576.0)) + " MiB (" +
+                         g_import_budget_where + ")",
+                     "raise the budget, or simplify or split the mesh");
   throw InputError(path, "",
                    "cannot read mesh file: reading it needs more than " +
                        ByteSize(AssimpBudgetBytes(file_size)) + " of memory for a file of " +
@@ -1012,14 +1022,18 @@ auto ReadCheckedFile(const std::string& path, unsigned steps, Use&& use) {
   // What assimp may hold at once while it reads and post-processes: far above what a valid file
   // of this size needs (measured in docs/robustness.md), far below what a damaged file's sizes
   // could make it ask for.
-  AllocationBudget budget(AssimpBudgetBytes(file_size));
+  AllocationBudget budget(g_import_budget > 0
+                              ? std::min<std::uint64_t>(AssimpBudgetBytes(file_size), std::uint64_t(g_import_budget))
+                              : AssimpBudgetBytes(file_size));
   const aiScene* scene = nullptr;
   try {
     // Read first, check what the post-processing steps trust, then run them.
     const aiScene* raw = importer.ReadFile(path, 0);
+    if (raw == nullptr && budget.exceeded()) ThrowOverBudget(path, file_size);  // assimp caught the bad_alloc
     if (raw == nullptr) fail();
     CheckImportedScene(*raw, path);
     scene = importer.ApplyPostProcessing(steps);
+    if (scene == nullptr && budget.exceeded()) ThrowOverBudget(path, file_size);
   } catch (const std::bad_alloc&) {
     ThrowOverBudget(path, file_size);
   }
@@ -1336,5 +1350,18 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
     return result;
   });
 }
+
+ScopedMeshImportBudget::ScopedMeshImportBudget(double bytes, std::string where)
+    : previous_bytes_(g_import_budget), previous_where_(g_import_budget_where) {
+  g_import_budget = bytes > 0 && std::isfinite(bytes) ? bytes : 0;
+  g_import_budget_where = std::move(where);
+}
+
+ScopedMeshImportBudget::~ScopedMeshImportBudget() {
+  g_import_budget = previous_bytes_;
+  g_import_budget_where = previous_where_;
+}
+
+bool ScopedMeshImportBudget::active() { return g_import_budget > 0; }
 
 }  // namespace pandora

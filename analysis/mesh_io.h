@@ -36,6 +36,27 @@ struct MeshPart {
 /// reported as "corrupt ...".
 std::vector<MeshPart> LoadMeshFile(const std::string& path);
 
+/// The user's memory budget for reading mesh files, while it lives (the innermost one counts): each
+/// import may then hold at most `bytes` at once (besides its own cap from the file's size, which
+/// guards against damaged files); past it the import ends in InputError naming the mesh file, the
+/// budget and `where` ("--memory-budget", or "$.study.memory_budget_mb of scene.json"). The mesh
+/// import's transient peak (assimp reading a 1M-triangle OBJ holds ~560 MiB) comes before any
+/// triangle count is known, so this is the only check that can bound it. Not thread-safe: set by
+/// a command around its scene loading.
+class ScopedMeshImportBudget {
+ public:
+  ScopedMeshImportBudget(double bytes, std::string where);
+  ~ScopedMeshImportBudget();
+  ScopedMeshImportBudget(const ScopedMeshImportBudget&) = delete;
+  ScopedMeshImportBudget& operator=(const ScopedMeshImportBudget&) = delete;
+  /// Whether one is open.
+  static bool active();
+
+ private:
+  double previous_bytes_;
+  std::string previous_where_;
+};
+
 /// A mesh file read for skinned animation (analysis/skinning.h).
 struct SkinnedMeshFile {
   /// One part per material as LoadMeshFile groups them; each mesh in the rest pose (the node tree

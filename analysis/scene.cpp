@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -1772,6 +1773,15 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto objects = root.Find("objects")) {
     const size_t n = objects->ArraySize("an array of objects");
     std::set<std::string> names;
+    // The study's memory budget bounds each mesh import too, unless a command's option set one
+    // (read before the study itself, which comes after the objects; checked there).
+    std::optional<ScopedMeshImportBudget> import_budget;
+    if (!ScopedMeshImportBudget::active() && root_value.is_object() && root_value.contains("study") &&
+        root_value["study"].is_object() && root_value["study"].contains("memory_budget_mb")) {
+      const json& mb = root_value["study"]["memory_budget_mb"];
+      if (mb.is_number() && mb.get<double>() > 0 && std::isfinite(mb.get<double>()))
+        import_budget.emplace(mb.get<double>() * 1048576.0, "$.study.memory_budget_mb of " + path);
+    }
     for (size_t i = 0; i < n; ++i) ReadObject(objects->At(i), material_index, &names, &scene);
   }
 

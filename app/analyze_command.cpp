@@ -12,6 +12,7 @@
 
 #include "analysis/calibration.h"
 #include "analysis/error.h"
+#include "analysis/mesh_io.h"
 #include "analysis/ray_caster.h"
 #include "analysis/motion.h"
 #include "analysis/rig_check.h"
@@ -59,6 +60,12 @@ std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& field
   if (auto problem = CheckFieldList(fields, study.motion.has_value()))
     throw InputError("--fields", "", problem->reason, problem->hint);
   return fields;
+}
+
+// --memory-budget bounds the mesh imports as well (analysis/mesh_io.h).
+std::unique_ptr<ScopedMeshImportBudget> ImportBudget(const AnalyzeArgs& args) {
+  if (std::isnan(args.memory_budget_mb) || !(args.memory_budget_mb > 0)) return nullptr;
+  return std::make_unique<ScopedMeshImportBudget>(args.memory_budget_mb * 1048576.0, "--memory-budget");
 }
 
 // The field options of `pandora analyze`: the study's, with --fields and --memory-budget applied.
@@ -151,7 +158,10 @@ int RunAnalyze(const AnalyzeArgs& args) {
   std::string vdb_path, summary_path;
   std::exception_ptr failure;
   try {
-    study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+    {
+      const auto import_budget = ImportBudget(args);
+      study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+    }
     so.rig = args.rig;
     so.rig_option = "--rig";
     so.disable = args.disable;
@@ -367,7 +377,10 @@ struct StreamSetup {
 
 StreamSetup PrepareStream(const AnalyzeArgs& args) {
   StreamSetup setup;
-  setup.study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+  {
+    const auto import_budget = ImportBudget(args);
+    setup.study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
+  }
   const auto& study = setup.study;
   const Scene& scene = study->scene();
   setup.rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");

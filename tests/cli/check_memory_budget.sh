@@ -63,4 +63,48 @@ peak=$(jq '.timing.peak_rss_mib' "$out/thin_fits/summary.json")
 "$python" -c "import sys; p, b, o = float('$peak'), $budget, float('$base'); sys.exit(0 if p - o <= b else 1)" ||
   fail "thin region: peak $peak MiB less the baseline $base MiB is over the budget of $budget MiB"
 echo "thin region: estimate $need MiB, peak $peak MiB within a budget of $budget MiB"
-echo "ok: the memory budget bounds the peak (many cameras, a thin region)"
+# A mesh import: the importer's transient peak comes before any triangle count is known, so the
+# budget bounds each import itself. A 99,372-triangle OBJ (a subdivided cube) needs tens of MiB.
+"$python" - "$out/cube.obj" <<'PY'
+import sys
+n = 91
+index, verts, faces = {}, [], []
+def v(p):
+    if p not in index:
+        index[p] = len(verts) + 1
+        verts.append(p)
+    return index[p]
+for axis in range(3):
+    for side in (-1, 1):
+        u, w = (axis + 1) % 3, (axis + 2) % 3
+        def P(a, b):
+            p = [0, 0, 0]; p[axis] = side * n; p[u] = -n + 2 * a; p[w] = -n + 2 * b
+            return tuple(p)
+        for i in range(n):
+            for j in range(n):
+                a, b, c, d = v(P(i, j)), v(P(i + 1, j)), v(P(i + 1, j + 1)), v(P(i, j + 1))
+                faces += [(a, b, c), (a, c, d)] if side > 0 else [(a, c, b), (a, d, c)]
+with open(sys.argv[1], "w") as f:
+    f.writelines("v %.6f %.6f %.6f\n" % (x / n, y / n, z / n) for x, y, z in verts)
+    f.writelines("f %d %d %d\n" % t for t in faces)
+PY
+jq '.objects += [{"name": "cube", "mesh": {"file": "cube.obj", "up_axis": "z"}, "position": [3, 3, 1]}] | .rigs[0].cameras |= .[0:2]' \
+  "$out/thin.json" > "$out/mesh.json"
+"$pandora" analyze "$out/mesh.json" --memory-budget 8 --out "$out/mesh_small" 2> "$out/mesh_err"
+rc=$?
+[ $rc -eq 2 ] && [ "$(wc -l < "$out/mesh_err")" -eq 1 ] &&
+  grep -qF "mesh.file: reading the mesh file needs more than the memory budget of 8 MiB (--memory-budget) (" "$out/mesh_err" ||
+  fail "mesh import over --memory-budget 8: exit $rc, $(cat "$out/mesh_err")"
+jq '.study.memory_budget_mb = 8' "$out/mesh.json" > "$out/mesh_in_file.json"
+"$pandora" analyze "$out/mesh_in_file.json" --out "$out/mesh_small" 2> "$out/mesh_err"
+rc=$?
+[ $rc -eq 2 ] && grep -q 'memory budget of 8 MiB (\$.study.memory_budget_mb of ' "$out/mesh_err" ||
+  fail "mesh import over the study's budget: exit $rc, $(cat "$out/mesh_err")"
+[ ! -e "$out/mesh_small" ] || fail "a refused run left $out/mesh_small"
+budget=200
+"$pandora" analyze "$out/mesh.json" --memory-budget $budget --out "$out/mesh_fits" --quiet || fail "mesh, budget $budget MiB: exit $?"
+peak=$(jq '.timing.peak_rss_mib' "$out/mesh_fits/summary.json")
+"$python" -c "import sys; p, b, o = float('$peak'), $budget, float('$base'); sys.exit(0 if p - o <= b else 1)" ||
+  fail "mesh: peak $peak MiB less the baseline $base MiB is over the budget of $budget MiB"
+echo "mesh import: refused under 8 MiB (option and study), peak $peak MiB within a budget of $budget MiB"
+echo "ok: the memory budget bounds the peak (many cameras, a thin region, a mesh import)"
