@@ -1375,9 +1375,11 @@ struct ViewerApp::Impl {
     ImGui::Begin("Suggest");
     const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution",
                                 "coverage3-n1", "calibration", "mix"};
-    if (model.suggestion)  // the panel shows what the suggestion on screen was asked for
+    if (model.suggestion) {  // the panel shows what the suggestion on screen was asked for
       for (int i = 0; i < IM_ARRAYSIZE(objectives); ++i)
         if (ObjectiveName(model.suggestion->objective) == objectives[i]) objective = i;
+      over_time = model.suggestion_over_time;
+    }
     ImGui::Combo("objective", &objective, objectives, IM_ARRAYSIZE(objectives));
     if (std::string(objectives[objective]) == "mix") ImGui::DragFloat3("weights c s r", weights, 0.05f, 0.0f, 100.0f, "%.2f");
     // The points the objective is evaluated on, as `pandora suggest`: the study region, named

@@ -646,6 +646,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       }
       problem->options.scene_path = a.where;  // the library's checks name the action
       suggestion.reset();
+      suggestion_over_time = a.over_time;
       suggestion_targets = std::to_string(problem->targets.size()) + " points " +
                            (a.over_time ? "on the study's targets at " +
                                               std::to_string(problem->sample_casters.size()) + " time samples"

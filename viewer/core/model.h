@@ -82,6 +82,7 @@ class ViewerModel {
   /// What the suggestion asked for last is evaluated on, in words ("1500 points of the study
   /// region", "the study's targets at 6 time samples"), for the Suggest panel.
   std::string suggestion_targets;
+  bool suggestion_over_time = false;  ///< It was asked for over time (the panel shows what was asked).
   std::string status;                   ///< The last action's one-line message.
   /// The scene's viewing stations as placed in this session; Save writes the moved ones (eye and
   /// display centre) into the scene file with the cameras. Station moves are not undo steps.
