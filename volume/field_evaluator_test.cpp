@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <random>
 
+#include "analysis/error.h"
 #include "analysis/primitives.h"
 #include "tests/fixtures.h"
 #include "volume/fields.h"
@@ -373,6 +374,38 @@ TEST(FieldEvaluator, IncrementalEqualsFullRecomputeOnTheTraumaRoom) {
   Scene scene = LoadScene("examples/trauma_room/scene.json");
   scene.study.voxel_size = 0.008;  // 8 mm keeps 200 full recomputes under a few seconds
   RunRandomEdits(scene, scene.FindRig("grid4x2"), 200, 2);
+}
+
+// A session keeps every camera's per-block entries for incremental updates: that state is bounded
+// by the budget too. The smallest budget (doubling from 64 kB) at which one evaluation fits refuses
+// the same rig with kept state, naming it (its upper bound: every candidate camera seeing every
+// free voxel, 12 times the one evaluation here); 32 times more holds both.
+TEST(FieldEvaluator, KeptStateIsHeldToTheBudget) {
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions options;
+  options.fields = {"coverage", "resolution", "sigma_max"};
+  double budget = 65536;
+  for (;; budget *= 2) {
+    ASSERT_LT(budget, 1e10);
+    options.memory_budget_bytes = budget;
+    try {
+      FieldEvaluator once(scene, *caster, options, /*keep_state=*/false);
+      once.Update(scene.rigs[0]);
+      break;
+    } catch (const InputError&) {
+    }
+  }
+  FieldEvaluator kept(scene, *caster, options, /*keep_state=*/true);
+  try {
+    kept.Update(scene.rigs[0]);
+    ADD_FAILURE() << "kept state over the budget of " << budget << " bytes was allowed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("incremental updates of rig"), std::string::npos) << e.what();
+  }
+  options.memory_budget_bytes = 32 * budget;
+  FieldEvaluator roomy(scene, *caster, options, /*keep_state=*/true);
+  EXPECT_NO_THROW(roomy.Update(scene.rigs[0]));
 }
 
 TEST(FieldEvaluator, NothingChangedCostsNothing) {

@@ -1252,7 +1252,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     for (std::size_t b = 0; b < S.blocks.size(); ++b)
       bytes += 512.0 * per_voxel + double(candidates[b].size()) *
                                 (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
-    const double total = bytes + S.fields.stats.estimated_bytes;
+    const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(S.scene);
     if (total > opt.memory_budget_bytes) {
       std::ostringstream reason;
       reason << "incremental updates of rig '" << rig.name << "' need up to "
@@ -1521,8 +1521,8 @@ static double PerCameraBytes(const VoxelLattice& lattice, double blocks, const s
     };
     bytes += 20480.0 + nodes(4096) * (32768.0 * 8 + 2 * 4096) + nodes(128) * (4096.0 * 8 + 2 * 512) + blocks * 192.0;
   }
-  // Kept state (sessions) is not counted: each camera's entries cover only the blocks it sees, and
-  // counting every block would refuse sessions that fit (left open in docs/robustness.md).
+  // Kept state (sessions) is bounded apart, at each update (its entries cover only the blocks a
+  // camera's frustum meets): "incremental updates of rig ... need up to".
   (void)kept;
   return bytes;
 }
