@@ -850,14 +850,24 @@ std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
         after[cam["id"].get<std::string>()] = &cam;
         order_after.push_back(cam["id"].get<std::string>());
       }
-      std::string changed, added, removed;
+      std::string changed, added, removed, disabled, enabled;
       auto add = [](std::string& list, const std::string& id) {
         list += (list.empty() ? "" : ", ") + Quote(id);
+      };
+      // On or off (--disable) and nothing else: said so.
+      auto enabled_of = [](const nlohmann::json& cam) {
+        return !(cam.is_object() && cam.contains("enabled") && cam["enabled"] == false);
+      };
+      auto without_enabled = [](nlohmann::json cam) {
+        if (cam.is_object()) cam.erase("enabled");
+        return cam;
       };
       for (const auto& [id, cam] : after) {
         auto it = before.find(id);
         if (it == before.end())
           add(added, id);
+        else if (*it->second != *cam && without_enabled(*it->second) == without_enabled(*cam))
+          add(enabled_of(*cam) ? enabled : disabled, id);
         else if (*it->second != *cam)
           add(changed, id);
       }
@@ -867,6 +877,8 @@ std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
       if (!changed.empty()) what += "changed " + changed;
       if (!added.empty()) what += std::string(what.empty() ? "" : "; ") + "added " + added;
       if (!removed.empty()) what += std::string(what.empty() ? "" : "; ") + "removed " + removed;
+      if (!disabled.empty()) what += std::string(what.empty() ? "" : "; ") + "off here, on for the fields: " + disabled;
+      if (!enabled.empty()) what += std::string(what.empty() ? "" : "; ") + "on here, off for the fields: " + enabled;
       if (what.empty() && order_before != order_after) what = "the same cameras in another order";
       if (!what.empty())
         warnings.push_back("the cameras of rig '" + rig.name + "' differ from those " + path +

@@ -765,6 +765,16 @@ TEST_F(Provenance, ChangedCamerasWarnNamingThem) {
   w = CheckFieldsProvenance(p, lattice, scene, swapped, "f.vdb");
   ASSERT_EQ(w.size(), 1u);
   EXPECT_NE(w[0].find("another order"), std::string::npos) << w[0];
+  // On or off alone (--disable) is said so, both ways; with a move too it is a change.
+  Rig off = rig;
+  off.cameras[0].enabled = false;
+  w = CheckFieldsProvenance(p, lattice, scene, off, "f.vdb");
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("off here, on for the fields: 'a'"), std::string::npos) << w[0];
+  off.cameras[0].world_from_camera.translation() += Vec3(0.01, 0, 0);
+  w = CheckFieldsProvenance(p, lattice, scene, off, "f.vdb");
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("changed 'a'"), std::string::npos) << w[0];
 }
 
 TEST_F(Provenance, ALatticeOutsideTheRegionIsRefused) {
