@@ -297,12 +297,10 @@ PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<Pt
         auto piece = [&](double end, double certified_end) {
           if (!(end > begin)) return;
           const PtzState mid = head.Along(leg.from, leg.to, 0.5 * (certified + certified_end));
-          // The geometry fails throughout the piece: nothing to cast.
-          if (!PtzSees(base, head, mid, target->X, target->min_px_per_m, target->normal)) return;
           if (fixed_centre) {
-            if (at(0.5 * (certified + certified_end))) add(leg.start + begin, leg.start + end);
-          } else {
-            scan(begin, end);  // the occlusion of a moving centre is sampled
+            if (sees(mid)) add(leg.start + begin, leg.start + end);
+          } else if (PtzSees(base, head, mid, target->X, target->min_px_per_m, target->normal)) {
+            scan(begin, end);  // the geometry sees X throughout; the moving centre's occlusion is sampled
           }
         };
         for (const auto& [lo, hi] : *changes) {

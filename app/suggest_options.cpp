@@ -1,5 +1,6 @@
 #include "app/suggest_options.h"
 
+#include <cctype>
 #include <cmath>
 
 #include "analysis/error.h"
@@ -150,6 +151,22 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   options.clearance = args.clearance;
   scene.CheckLength(options.clearance, "--clearance", "the clearance");
   return options;
+}
+
+std::string ReplaceOptionNames(const std::string& text, const std::function<std::string(const std::string&)>& name) {
+  auto lower = [&](std::size_t i) { return std::islower(static_cast<unsigned char>(text[i])) != 0; };
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && lower(i + 2)) {
+      std::size_t j = i + 2;
+      while (j < text.size() && (lower(j) || text[j] == '-')) ++j;
+      out += name(text.substr(i, j - i));
+      i = j;
+    } else {
+      out += text[i++];
+    }
+  }
+  return out;
 }
 
 std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene, const Rig& rig) {

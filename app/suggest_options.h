@@ -4,7 +4,9 @@
 /// id, per-camera limits ("one value, or one per selected camera"), mounts and zoom ranges ("ID:"
 /// prefixes), keep-out boxes, the objective. Every error names the option the user typed.
 
+#include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "analysis/ray_caster.h"
@@ -18,6 +20,11 @@ namespace pandora::app {
 session::SessionOptions SuggestSessionOptions(const SuggestArgs& args);
 
 SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig);
+
+/// `text` (an error's file, reason or hint) with every command-line option in it ("--max-move")
+/// replaced by `name(option)`: how Python and the viewer's scripts name `pandora suggest`'s options
+/// in the errors of PrepareSuggest.
+std::string ReplaceOptionNames(const std::string& text, const std::function<std::string(const std::string&)>& name);
 
 /// Everything a camera suggestion runs on: the options and the target points and, over time
 /// (`--over-time`), the moving parts and one ray caster per time sample (options.sample_casters

@@ -4,6 +4,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
@@ -51,20 +52,13 @@ struct PySuggestion {
 
 // `pandora suggest`'s option names in errors become the keyword arguments' ("--max-move" -> "max_move").
 std::string Keywords(const std::string& text) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size();) {
-    if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && std::islower(static_cast<unsigned char>(text[i + 2]))) {
-      std::string word;
-      for (i += 2; i < text.size() && (std::islower(static_cast<unsigned char>(text[i])) || text[i] == '-'); ++i)
-        word += text[i] == '-' ? '_' : text[i];
-      if (word == "max_rotate" || word == "snap_rotate") word += "_deg";
-      if (word == "target_surface") word += "s";
-      out += word;
-    } else {
-      out += text[i++];
-    }
-  }
-  return out;
+  return app::ReplaceOptionNames(text, [](const std::string& option) {
+    std::string word = option.substr(2);
+    std::replace(word.begin(), word.end(), '-', '_');
+    if (word == "max_rotate" || word == "snap_rotate") word += "_deg";
+    if (word == "target_surface") word += "s";
+    return word;
+  });
 }
 
 [[noreturn]] void RethrowWithKeyword(const InputError& e) {

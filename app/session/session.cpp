@@ -60,24 +60,34 @@ bool Session::TryReadFields(const std::function<void(const Fields&, std::int64_t
   return true;
 }
 
+std::optional<TimeSummary> Session::EvaluateOverTime(const Rig& rig, const std::atomic<bool>* cancel,
+                                                    const std::function<void(double)>& progress) const {
+  const Scene& scene = study_->scene();
+  if (!scene.Animated() && !scene.study.targets) return std::nullopt;
+  const std::vector<TimeSample> samples = scene.TimeSamples();
+  if (samples.empty()) return std::nullopt;
+  std::lock_guard<std::mutex> lock(parts_mutex_);
+  if (!parts_) parts_ = MakeSceneParts(scene);
+  FieldOptions options = OverTimeOptions(options_.fields);
+  options.progress = progress;
+  options.cancel = cancel;
+  TimeFieldsResult r = EvaluateFieldsOverTime(scene, rig, *parts_, samples, options, scene.TimeMinCameras());
+  if (cancel && cancel->load()) return std::nullopt;
+  return std::move(r.summary);
+}
+
 std::int64_t Session::UpdateTimeInBackground() {
   const Scene& scene = study_->scene();
-  if (!scene.Animated() && !scene.study.targets) return 0;
-  auto samples = std::make_shared<std::vector<TimeSample>>(scene.TimeSamples());
-  if (samples->empty()) return 0;
+  if ((!scene.Animated() && !scene.study.targets) || scene.TimeSamples().empty()) return 0;
   auto snapshot = std::make_shared<Rig>(rig_.rig());
   const std::int64_t version = rig_.version();
-  return jobs_.Submit("time", [this, snapshot, samples, version](JobContext& job) {
-    const Scene& scene = study_->scene();
-    std::lock_guard<std::mutex> lock(time_mutex_);
+  return jobs_.Submit("time", [this, snapshot, version](JobContext& job) {
     if (job.cancelled()) return;
-    if (!parts_) parts_ = MakeSceneParts(scene);
-    FieldOptions options = OverTimeOptions(options_.fields);
-    options.progress = [&job](double f) { job.Progress(f); };
-    options.cancel = &job.cancel_flag();
-    TimeFieldsResult r = EvaluateFieldsOverTime(scene, *snapshot, *parts_, *samples, options, scene.TimeMinCameras());
-    if (job.cancelled()) return;  // a newer rig is on its way
-    time_ = std::make_pair(std::move(r.summary), version);
+    std::optional<TimeSummary> t =
+        EvaluateOverTime(*snapshot, &job.cancel_flag(), [&job](double f) { job.Progress(f); });
+    if (!t) return;  // a newer rig is on its way
+    std::lock_guard<std::mutex> lock(time_mutex_);
+    time_ = std::make_pair(std::move(*t), version);
   });
 }
 

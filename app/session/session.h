@@ -79,6 +79,11 @@ class Session {
   std::int64_t UpdateTimeInBackground();
   /// The last summary over time and the rig version it reflects; nothing before the first.
   std::optional<std::pair<TimeSummary, std::int64_t>> TimeNumbers() const;
+  /// The same summary for any `rig`, on the calling thread (the viewer's Compare), over the
+  /// session's moving parts (built once); nothing for a study without time samples, or when
+  /// `cancel` was set.
+  std::optional<TimeSummary> EvaluateOverTime(const Rig& rig, const std::atomic<bool>* cancel = nullptr,
+                                              const std::function<void(double)>& progress = {}) const;
 
   /// Runs Suggest on the rig as it is now, on the calling thread (what `pandora suggest` does).
   Suggestion Suggest(const std::vector<TargetPoint>& targets, const SuggestOptions& options) const;
@@ -151,8 +156,9 @@ class Session {
   mutable std::mutex fields_mutex_;
   std::unique_ptr<FieldEvaluator> evaluator_;
   std::int64_t fields_version_ = -1;
+  mutable std::mutex parts_mutex_;
+  mutable std::unique_ptr<RigidPartsRayCaster> parts_;  // built at the first evaluation over time
   mutable std::mutex time_mutex_;
-  std::unique_ptr<RigidPartsRayCaster> parts_;  // built by the first "time" job
   std::optional<std::pair<TimeSummary, std::int64_t>> time_;
   std::mutex suggestion_mutex_;
   std::optional<Suggestion> suggestion_;

@@ -9,7 +9,6 @@
 #include "analysis/error.h"
 #include "analysis/output_transaction.h"
 #include "analysis/pose.h"
-#include "analysis/ray_caster.h"
 #include "analysis/rig_check.h"
 #include "app/session/autosave.h"
 #include "app/session/ptz_edit.h"
@@ -18,7 +17,6 @@
 #include "viewer/core/manipulate.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
-#include "volume/time_fields.h"
 
 namespace pandora::viewer {
 namespace {
@@ -114,18 +112,7 @@ app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
     return option;
   };
   auto rename = [&](const std::string& text) {
-    std::string out;
-    for (std::size_t i = 0; i < text.size();) {
-      if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && std::islower(static_cast<unsigned char>(text[i + 2]))) {
-        std::size_t j = i + 2;
-        while (j < text.size() && (std::islower(static_cast<unsigned char>(text[j])) || text[j] == '-')) ++j;
-        out += "'" + key(text.substr(i, j - i)) + "'";
-        i = j;
-      } else {
-        out += text[i++];
-      }
-    }
-    return out;
+    return app::ReplaceOptionNames(text, [&](const std::string& option) { return "'" + key(option) + "'"; });
   };
   if (e.file().rfind("--", 0) != 0) throw e;  // the scene's own (a surface name, its targets)
   throw InputError(where + "." + key(e.file()), e.json_path(), rename(e.reason()), rename(e.hint()));
@@ -317,16 +304,7 @@ void ViewerModel::Compare(const Action& a) {
   if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
   // Moving objects: the numbers over the time samples too, as `pandora analyze` gives them (the
   // live fields are the static scene's: the volume without the people).
-  const std::vector<TimeSample> samples =
-      scene().Animated() || scene().study.targets ? scene().TimeSamples() : std::vector<TimeSample>();
-  if (!samples.empty() && !parts_) parts_ = MakeSceneParts(scene());
-  auto over_time = [&](const Rig& r, Summary* summary) {
-    if (samples.empty()) return;
-    FieldOptions fo;
-    fo.fields = names;
-    fo.scene_path = scene().path;
-    summary->time = EvaluateFieldsOverTime(scene(), r, *parts_, samples, OverTimeOptions(fo), scene().TimeMinCameras()).summary;
-  };
+  auto over_time = [&](const Rig& r, Summary* summary) { summary->time = session_->EvaluateOverTime(r); };
   std::vector<Summary> summaries;
   session_->ReadFields([&](const Fields& f, std::int64_t) {
     summaries.push_back(Summarize(scene(), rig(), f, names, 1));

@@ -145,7 +145,6 @@ class ViewerModel {
     Summary summary;
   };
   std::vector<CachedSummary> compare_cache_;
-  std::unique_ptr<RigidPartsRayCaster> parts_;  // the moving parts, built at the first Compare over time
   std::string drag_label_;  // the drag in progress (its steps amend one edit), empty: none
   ViewerOptions options_;
   std::unique_ptr<session::Session> session_;
