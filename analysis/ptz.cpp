@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "analysis/camera.h"
+#include "analysis/surface_distance.h"
 #include "analysis/visibility.h"  // PixelDensity
 
 namespace pandora {
@@ -275,6 +276,98 @@ bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const V
     segment->t_far = std::max(epsilon, distance - epsilon);
   }
   return true;
+}
+
+double PtzHead::CentreSpeedBound() const { return offset.norm() * Rad(pan_speed_deg_s + tilt_speed_deg_s); }
+
+int PtzSweptOcclusion(const VisibilityTester& tester, int camera, const Vec3& centre, double r, const Vec3& X) {
+  const SurfaceDistance* surfaces = tester.surfaces();
+  if (!surfaces || !(r >= 0)) return 0;
+  const Vec3 e = X - centre;
+  const double D = e.norm();
+  if (!(D > 0)) return 0;
+  // Only the answer the middle segment has can hold for all: its ray decides which to try (a
+  // clearance march towards a surface it would cross ends only near it, many steps in).
+  Ray middle;
+  middle.origin = centre;
+  middle.direction = e / D;
+  middle.t_far = D;
+  // PtzSegmentOccluded trims each segment by its own tolerance, which grows with its length in
+  // [D - r, D + r]: the clearance covers the most a segment keeps, the crossing must lie inside the
+  // least.
+  if (!PtzSegmentOccluded(tester, camera, middle, nullptr))
+    return surfaces->ConeClear(centre, r, X, tester.Tolerance(camera, std::max(0.0, D - r))) ? 1 : 0;
+  return surfaces->ConeBlocked(centre, r, X, tester.Tolerance(camera, D + r)) ? -1 : 0;
+}
+
+bool PtzCanCertifyOcclusion(const PtzTarget& target) {
+  return target.tester && target.tester->surfaces() && target.camera >= 0;
+}
+
+std::optional<std::vector<std::pair<double, double>>> PtzMoveClearWindows(const PtzHead& head, const PtzState& from,
+                                                                          const PtzState& to, double t_begin,
+                                                                          double t_end, const PtzTarget& target,
+                                                                          int max_certificates) {
+  if (!PtzCanCertifyOcclusion(target)) return std::nullopt;
+  const VisibilityTester& tester = *target.tester;
+  const int camera = target.camera;
+  const Vec3& X = target.X;
+  const double speed = head.CentreSpeedBound();
+  auto centre = [&](double t) -> Vec3 {
+    const Eigen::Isometry3d pose = head.Pose(head.Along(from, to, t));
+    return pose.translation();
+  };
+  auto clear_at = [&](double t) {
+    const Vec3 c = centre(t);
+    const Vec3 e = X - c;
+    Ray segment;
+    segment.origin = c;
+    segment.t_far = e.norm();
+    if (!(segment.t_far > 0)) return false;
+    segment.direction = e / segment.t_far;
+    return !PtzSegmentOccluded(tester, camera, segment, nullptr);
+  };
+  std::vector<std::pair<double, double>> found;
+  auto add = [&found](double a, double b) {
+    if (!(b > a)) return;
+    if (!found.empty() && found.back().second >= a) found.back().second = std::max(found.back().second, b);
+    else found.emplace_back(a, b);
+  };
+  std::vector<std::pair<double, double>> stack{{t_begin, t_end}};  // in order: the last is the earliest
+  int certificates = 0;
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    if (!(b > a)) continue;
+    if (++certificates > max_certificates) return std::nullopt;
+    const double m = 0.5 * (a + b);
+    const double r = speed * 0.5 * (b - a);
+    const Vec3 c = centre(m);
+    const int answer = PtzSweptOcclusion(tester, camera, c, r, X);
+    if (answer > 0) add(a, b);
+    if (answer != 0) continue;
+    if (b - a <= 1e-6 || r <= tester.Tolerance(camera, (X - c).norm())) {
+      // Below the tolerance: the ends decide, a change between them bisected.
+      bool ca = clear_at(a);
+      const bool cb = clear_at(b);
+      if (ca == cb) {
+        if (ca) add(a, b);
+        continue;
+      }
+      double lo = a, hi = b;  // clear_at(lo) == ca, clear_at(hi) == cb
+      while (hi - lo > 1e-6) {
+        const double mid = 0.5 * (lo + hi);
+        (clear_at(mid) == ca ? lo : hi) = mid;
+      }
+      const double change = 0.5 * (lo + hi);
+      if (ca) add(a, change);
+      else add(change, b);
+      continue;
+    }
+    stack.emplace_back(m, b);
+    stack.emplace_back(a, m);
+  }
+  return found;
 }
 
 bool PtzSegmentOccluded(const VisibilityTester& tester, int camera, Ray segment, std::int64_t* rays) {

@@ -103,6 +103,9 @@ struct PtzHead {
   /// A step (seconds) for sampling a move from `a` to `b` so that the view turns by at most a
   /// quarter of the narrower field of view along it (the narrowest zoom the move passes through).
   double SampleStep(const Camera& base, const PtzState& a, const PtzState& b) const;
+  /// The fastest the centre of projection moves (m/s): it turns about the pivot at |offset| with an
+  /// angular velocity of at most pan + tilt speed (the zoom does not move it).
+  double CentreSpeedBound() const;
 };
 
 /// Whether `base` at setting `s` of `head` sees X geometrically: inside the image (lens and
@@ -121,7 +124,36 @@ struct PtzTarget {
   Vec3 X = Vec3::Zero();
   double min_px_per_m = 0;
   const Vec3* normal = nullptr;
+  /// For a head whose centre moves: the tester (and its camera) whose occlusion `sees` tests; when
+  /// it holds the scene's triangles (VisibilityTester::surfaces()), WatchTour certifies the
+  /// occlusion along each move with PtzSweptOcclusion instead of sampling it.
+  const VisibilityTester* tester = nullptr;
+  int camera = -1;
 };
+
+/// For a head whose centre moves (an offset): whether the occlusion segments (PtzSegmentOccluded)
+/// of camera `camera` from every centre within `r` of `centre` to X all miss the scene (+1) or all
+/// cross it (-1), certified in double precision on tester.surfaces() (SurfaceDistance::ConeClear,
+/// with the tolerance of the shortest segment; ConeBlocked, with the longest's); 0 when neither
+/// holds or the tester has no triangles.
+int PtzSweptOcclusion(const VisibilityTester& tester, int camera, const Vec3& centre, double r, const Vec3& X);
+/// Whether `target` names a tester holding the scene's triangles (PtzSweptOcclusion can answer).
+bool PtzCanCertifyOcclusion(const PtzTarget& target);
+
+/// Where, in [t_begin, t_end] of the move from `from` to `to` (PtzHead::Along times), the
+/// occlusion segment (PtzSegmentOccluded) from the moving centre to target.X is clear: the span is
+/// cut in halves until PtzSweptOcclusion certifies each piece (the centre within
+/// CentreSpeedBound() x half its length of the piece's middle). A piece left uncertain once the
+/// centre moves less than the occlusion tolerance within it (the segment within the tolerance of
+/// an edge throughout) or once it is 1 us long takes the occlusion test at its ends, a change
+/// between them bisected to 1 us: a visibility shorter than that much motion of the centre is below
+/// the tolerance. Clear intervals in order, merged; nullopt when more than `max_certificates`
+/// certificates would be needed or target.tester holds no triangles. The geometry (PtzSees) is not
+/// tested: the caller knows it sees X throughout.
+std::optional<std::vector<std::pair<double, double>>> PtzMoveClearWindows(const PtzHead& head, const PtzState& from,
+                                                                          const PtzState& to, double t_begin,
+                                                                          double t_end, const PtzTarget& target,
+                                                                          int max_certificates = 4096);
 
 /// Where along the move from `from` to `to` (PtzHead::Along, t in [0, move_s]) the answer of
 /// PtzSees(base, head, setting, target...) can change, found without sampling: [0, move_s] is
@@ -142,10 +174,13 @@ std::optional<std::vector<std::pair<double, double>>> PtzMoveChanges(const PtzHe
 /// test, e.g. PtzSees plus occlusion) is evaluated once per dwell and, along each move, once per
 /// piece of constant geometry that PtzMoveChanges certifies when `target` is given (the point and
 /// density `sees` tests) and the lens is undistorted: then every window is found, however short,
-/// its ends to PtzMoveChanges's resolution (1 us), and with a zero offset (the centre fixed, so the
-/// occlusion constant along a move) the answer is exact. Otherwise, and for the occlusion of a head
-/// whose centre moves, along each move every PtzHead::SampleStep, each change refined by bisection
-/// to `tolerance_s`: there a visibility shorter than the step may be missed (docs/ptz.md).
+/// its ends to PtzMoveChanges's resolution (1 us). With a zero offset (the centre fixed, so the
+/// occlusion constant along a move) the answer is exact. With an offset and target->tester holding
+/// the scene's triangles, each piece where the geometry sees X is cut further until the occlusion
+/// of every centre in a piece is certified (PtzMoveClearWindows): exact too, each change to 1 us,
+/// but for visibilities shorter than the centre's move across the occlusion tolerance. Otherwise (a lens with distortion, no target, no triangles, or more than 4096
+/// certificates in one piece), along each move every PtzHead::SampleStep, each change refined by
+/// bisection to `tolerance_s`: there a visibility shorter than the step may be missed (docs/ptz.md).
 struct PtzWatch {
   double period = 0;
   std::vector<std::pair<double, double>> intervals;  ///< Sorted, disjoint, within [0, period].
@@ -300,7 +335,13 @@ PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<Pt
           if (fixed_centre) {
             if (sees(mid)) add(leg.start + begin, leg.start + end);
           } else if (PtzSees(base, head, mid, target->X, target->min_px_per_m, target->normal)) {
-            scan(begin, end);  // the geometry sees X throughout; the moving centre's occlusion is sampled
+            // The geometry sees X throughout; the moving centre's occlusion certified, else sampled.
+            const std::optional<std::vector<std::pair<double, double>>> clear =
+                PtzCanCertifyOcclusion(*target) ? PtzMoveClearWindows(head, leg.from, leg.to, begin, end, *target)
+                                                : std::nullopt;
+            if (!clear) scan(begin, end);
+            else
+              for (const auto& [a, b] : *clear) add(leg.start + a, leg.start + b);
           }
         };
         for (const auto& [lo, hi] : *changes) {

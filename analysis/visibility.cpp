@@ -33,8 +33,8 @@ double PixelDensity(const Mat23& J) {
 }
 
 VisibilityTester::VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster,
-                                   double scene_scale)
-    : cameras_(cameras), caster_(caster), epsilon_(kRelativeEpsilon * scene_scale) {
+                                   double scene_scale, const SurfaceDistance* surfaces)
+    : cameras_(cameras), caster_(caster), surfaces_(surfaces), epsilon_(kRelativeEpsilon * scene_scale) {
   camera_from_world_.reserve(cameras_.size());
   const Aabb& bounds = caster.bounds();
   const Vec3 frame_origin = bounds.empty() ? Vec3::Zero() : bounds.center();

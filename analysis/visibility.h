@@ -12,6 +12,8 @@
 
 namespace pandora {
 
+class SurfaceDistance;
+
 /// Why a point is or is not seen, in the order the tests run (cheapest first).
 enum class ViewResult : uint8_t {
   kSeen = 0,
@@ -45,7 +47,11 @@ class VisibilityTester {
   /// segment from a camera to X stops Tolerance() short of both ends, so a point lying on a surface
   /// is not occluded by that surface and single-precision round-off in the ray caster cannot flip
   /// the answer for occluders farther than that from the segment's ends (docs/accuracy.md).
-  VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster, double scene_scale);
+  /// `surfaces` (optional, not owned) holds the caster's triangles in double precision: the tests
+  /// that certify a whole family of segments at once (a PTZ head whose centre moves along a move,
+  /// PtzSweptOcclusion) need it; nothing else reads it.
+  VisibilityTester(const std::vector<Camera>& cameras, const RayCaster& caster, double scene_scale,
+                   const SurfaceDistance* surfaces = nullptr);
 
   const std::vector<Camera>& cameras() const { return cameras_; }
   /// The floor of the tolerance: kRelativeEpsilon * scene_scale, metres.
@@ -115,12 +121,15 @@ class VisibilityTester {
   void TestBatch(int camera, const std::vector<Vec3>& points, std::vector<ViewResult>* results) const;
 
   const RayCaster& caster() const { return caster_; }
+  /// The caster's triangles in double precision, or null (constructor).
+  const SurfaceDistance* surfaces() const { return surfaces_; }
 
  private:
   std::vector<Camera> cameras_;
   std::vector<Eigen::Isometry3d> camera_from_world_;
   std::vector<Mat3> rotation_;  // camera_from_world_[c].linear()
   const RayCaster& caster_;
+  const SurfaceDistance* surfaces_ = nullptr;
   double epsilon_;
   std::vector<double> float_error_base_;  // kFloatErrorFactor 2^-24 (R + |C - O|) per camera
 };

@@ -15,7 +15,7 @@
 #include "app/output.h"
 #include "suggest/scene_text.h"
 #include "suggest/suggestion_file.h"
-#include "suggest/surface_distance.h"
+#include "analysis/surface_distance.h"
 
 namespace pandora::app {
 namespace {

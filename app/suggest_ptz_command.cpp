@@ -1,6 +1,7 @@
 // `pandora suggest --ptz-preset ID:PRESET | --ptz-tour ID`: a PTZ controller's preset setting or
 // tour order for the target points, written as a suggestion file for `pandora accept` (docs/ptz.md).
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "app/suggest_options.h"
 #include "suggest/ptz_suggest.h"
 #include "suggest/suggest.h"
+#include "volume/ptz_fields.h"
 
 namespace pandora::app {
 namespace {
@@ -79,7 +81,8 @@ int RunSuggestPtz(const SuggestArgs& args) {
       scene, "--target-region", args.target_region, args.points, args.target_surfaces, args.with_region, args.seed);
   std::vector<Vec3> points;
   for (const TargetPoint& t : targets) points.push_back(t.p);
-  const VisibilityTester tester(rig.cameras, session.study().caster(), scene.ContentBounds().diagonal());
+  const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
+  const VisibilityTester tester(rig.cameras, session.study().caster(), scene.ContentBounds().diagonal(), surfaces.get());
   const double px = scene.study.ptz.min_px_per_m;
 
   OutputTransaction output;

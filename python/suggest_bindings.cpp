@@ -29,6 +29,7 @@
 #include "suggest/suggest.h"
 #include "suggest/suggestion_file.h"
 #include "suggest/suggestion_text.h"
+#include "volume/ptz_fields.h"
 
 namespace pandora::python {
 namespace {
@@ -499,7 +500,9 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
     out.ptz_camera = c;
     {
       py::gil_scoped_release release;
-      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal());
+      const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(sc.scene(), r.rig());
+      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal(),
+                                    surfaces.get());
       out.tour = SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m,
                                 objective == "max" ? TourObjective::kMax : TourObjective::kMean);
     }

@@ -33,7 +33,7 @@ class PtzPointJudge {
   std::size_t size() const { return points_.size(); }
   const Vec3& point(std::size_t i) const { return points_[i]; }
   /// Point `i` as PtzSees tests it (WatchTour's exact move events).
-  PtzTarget target(std::size_t i) const { return {points_[i], min_px_per_m_, nullptr}; }
+  PtzTarget target(std::size_t i) const { return {points_[i], min_px_per_m_, nullptr, &tester_, camera_}; }
   std::int64_t rays() const { return rays_; }
 
  private:

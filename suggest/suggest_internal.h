@@ -11,7 +11,7 @@
 #include "analysis/calibration.h"
 #include "analysis/visibility.h"
 #include "suggest/suggest.h"
-#include "suggest/surface_distance.h"
+#include "analysis/surface_distance.h"
 
 namespace pandora::suggest_detail {
 

@@ -21,7 +21,6 @@
 #include "analysis/visibility.h"
 #include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
-#include "suggest/surface_distance.h"
 
 namespace pandora {
 namespace {
@@ -517,39 +516,6 @@ TEST(Suggest, ClearanceKeepsTheCentreOffTheWall) {
   SuggestOptions bad = Options({1}, 0.3, 5);
   bad.clearance = -0.1;
   EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, bad), InputError);
-}
-
-TEST(SurfaceDistance, MatchesBruteForceAndClosedForms) {
-  // A unit cube at the origin: outside a face the distance is the offset, beyond an edge or a corner
-  // the Euclidean distance to it; inside, the distance to the nearest face.
-  Scene scene = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}}],
-    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 0], "look_at": [0, 0, 0],
-    "resolution": [64, 48], "hfov_deg": 40}]}],
-    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "cube.json");
-  const TriangleMesh mesh = scene.AllTriangles();
-  const SurfaceDistance d(mesh);
-  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.1, -0.2)), 0.3, 1e-12);                 // face
-  EXPECT_NEAR(d.Distance(Vec3(0.8, 0.9, 0.0)), std::hypot(0.3, 0.4), 1e-12);  // edge
-  EXPECT_NEAR(d.Distance(Vec3(1.5, 1.5, 1.5)), std::sqrt(3.0), 1e-12);        // corner
-  EXPECT_NEAR(d.Distance(Vec3(0.1, 0.0, 0.0)), 0.4, 1e-12);                 // inside
-  EXPECT_EQ(d.Distance(Vec3(5, 0, 0), 1.0), 1.0);                            // capped
-  // Against a brute-force loop on a finer mesh (a 64-segment sphere and the cube), random points.
-  Scene two = ParseScene(R"({"objects": [{"name": "c", "box": {"size": [1, 1, 1]}},
-    {"name": "s", "sphere": {"radius": 0.7, "segments": 64}, "position": [2, 0.5, 0]}],
-    "rigs": [{"name": "r", "cameras": [{"id": "a", "position": [3, 0, 3], "look_at": [0, 0, 0],
-    "resolution": [64, 48], "hfov_deg": 40}]}],
-    "study": {"region": {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}}}})", "two.json");
-  const TriangleMesh all = two.AllTriangles();
-  const SurfaceDistance fast(all);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-2, 4);
-  for (int i = 0; i < 200; ++i) {
-    const Vec3 p(u(rng), u(rng) * 0.5, u(rng) * 0.5);
-    double brute = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3i& t : all.triangles)
-      brute = std::min(brute, PointTriangleDistance(p, all.vertices[t[0]], all.vertices[t[1]], all.vertices[t[2]]));
-    ASSERT_EQ(fast.Distance(p), brute) << p.transpose();
-  }
 }
 
 TEST(Suggest, CameraThatSeesNothingEndsCleanly) {

@@ -121,7 +121,8 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
                           int camera_count);
 
 /// The memory the scene's structures hold while fields are evaluated (its meshes, the ray caster's
-/// BVH, the solids' search trees), in bytes: counted in the memory budget with the fields'.
+/// BVH, the solids' search trees, the triangles in double precision when a PTZ tour has a moving
+/// centre), in bytes: counted in the memory budget with the fields'.
 double SceneStructureBytes(const Scene& scene);
 
 /// The tiles of a streamed evaluation (`pandora analyze --stream`, docs/scale.md): rectangles of

@@ -41,6 +41,13 @@ bool RigHasPtz(const Rig& rig) {
   return false;
 }
 
+std::unique_ptr<SurfaceDistance> PtzSweptOccluders(const Scene& scene, const Rig& rig) {
+  for (const Camera& c : rig.cameras)
+    if (c.enabled && c.ptz && !c.ptz->offset.isZero(0.0) && c.ptz->tour.size() >= 2)
+      return std::make_unique<SurfaceDistance>(scene.AllTriangles());
+  return nullptr;
+}
+
 double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, double min_px_per_m,
                     double tolerance_s, std::int64_t* rays) {
   const Camera& base = tester.cameras()[camera];
@@ -85,7 +92,7 @@ PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera, const std::vec
     }
     return !PtzSegmentOccluded(tester, camera, r, rays);
   };
-  const PtzTarget target{X, min_px_per_m, nullptr};
+  const PtzTarget target{X, min_px_per_m, nullptr, &tester, camera};
   return WatchTour(head, base, legs, sees, &target);
 }
 
@@ -102,7 +109,8 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
   ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) { voxels.push_back(c); });
   const std::size_t n = voxels.size();
   out.region_voxels = static_cast<std::int64_t>(n);
-  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal());
+  const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
+  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal(), surfaces.get());
   std::vector<int> ptz;
   for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c)
     if (rig.cameras[c].enabled && rig.cameras[c].ptz) ptz.push_back(c);

@@ -8,6 +8,7 @@
 /// Computed after the fields (the coverage grid gives the free region voxels).
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "analysis/ptz.h"
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
+#include "analysis/surface_distance.h"
 #include "analysis/visibility.h"
 #include "volume/fields.h"
 
@@ -57,6 +59,12 @@ struct PtzFieldsSummary {
 
 /// True when `rig` has an enabled camera with a PTZ head.
 bool RigHasPtz(const Rig& rig);
+
+/// The scene's triangles in double precision, for the VisibilityTester of PTZ work, when some
+/// enabled PTZ camera of `rig` has a tour and a centre offset from its pivot: WatchTour then
+/// certifies the occlusion along each move on them (PtzSweptOcclusion) instead of sampling it.
+/// Null otherwise (nothing needs them).
+std::unique_ptr<SurfaceDistance> PtzSweptOccluders(const Scene& scene, const Rig& rig);
 
 /// Reach time of X for `base` (a rig camera with a head) from its current setting: PtzReach's
 /// geometric reach time (bisection to `tolerance_s`) with the occlusion of the segment from the
