@@ -22,11 +22,11 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "analysis/visibility.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kDegree = M_PI / 180.0;
 constexpr int kTriesPerPose = 1000;
 
 // A double uniform in [0, 1) from 53 random bits (the same on every standard library, unlike
@@ -58,8 +58,8 @@ struct OrientationDraw {
 Mat3 UniformOrientation(const OrientationDraw& d) {
   const double z = 2.0 * d.z - 1.0;
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  const double a = 2.0 * M_PI * d.sphere_azimuth;
-  return FrameFromNormal(Vec3(r * std::cos(a), r * std::sin(a), z), 2.0 * M_PI * d.roll);
+  const double a = 2.0 * kPi * d.sphere_azimuth;
+  return FrameFromNormal(Vec3(r * std::cos(a), r * std::sin(a), z), 2.0 * kPi * d.roll);
 }
 
 // The board turned toward a camera that sees `position` (uniform among them), tilted from facing it
@@ -74,13 +74,13 @@ Mat3 TowardCameraOrientation(const VisibilityTester& tester, const CalibrationBo
   const Vec3 to_camera = tester.cameras()[pick].center() - position;
   if (!(to_camera.norm() > 0)) return UniformOrientation(d);
   const Vec3 n0 = to_camera.normalized();
-  const double cos_max = std::cos(board.tilt_max_deg * kDegree);
+  const double cos_max = std::cos(board.tilt_max_deg * kRadPerDeg);
   const double cos_t = 1.0 - d.cos_fraction * (1.0 - cos_max);
   const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
   const Vec3 e1 = Perpendicular(n0), e2 = n0.cross(e1);
-  const double a = 2.0 * M_PI * d.azimuth;
+  const double a = 2.0 * kPi * d.azimuth;
   const Vec3 n = (cos_t * n0 + sin_t * (std::cos(a) * e1 + std::sin(a) * e2)).normalized();
-  return FrameFromNormal(n, 2.0 * M_PI * d.roll);
+  return FrameFromNormal(n, 2.0 * kPi * d.roll);
 }
 
 // Disjoint sets over camera indices.
@@ -144,7 +144,7 @@ BoardView TestBoard(const VisibilityTester& tester, int camera, const Calibratio
   const double distance = to_camera.norm();
   if (!(distance > 0)) return BoardView::kNotInImage;
   const double cos_tilt = std::clamp(normal.dot(to_camera) / distance, -1.0, 1.0);
-  if (!(std::acos(cos_tilt) <= board.tilt_max_deg * kDegree)) return BoardView::kTilted;
+  if (!(std::acos(cos_tilt) <= board.tilt_max_deg * kRadPerDeg)) return BoardView::kTilted;
   // Every corner projects into the image, within range, on the front face.
   const std::vector<Vec3> corners = BoardCorners(board, pose);
   std::vector<Ray> segments(corners.size());

@@ -16,6 +16,7 @@
 #include "analysis/visibility.h"
 #include "tests/expect_input_error.h"
 #include "tests/fixtures.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -197,7 +198,7 @@ TEST(Calibration, DeterministicForASeed) {
 // +x (60 degree pinhole, 640 x 480), its front normal turned `yaw_deg` from facing the camera
 // about the vertical.
 CalibrationPose BoardInFront(double yaw_deg, const Vec3& centre = Vec3(2, 0, 0)) {
-  const double a = yaw_deg * M_PI / 180;
+  const double a = yaw_deg * kPi / 180;
   CalibrationPose pose;
   pose.position = centre;
   const Vec3 n(-std::cos(a), std::sin(a), 0);

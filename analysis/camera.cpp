@@ -3,6 +3,7 @@
 /// Newton iterations, the monotonic domain of the radial maps and the field of view of the image.
 
 #include "analysis/camera.h"
+#include "analysis/units.h"
 
 #include <algorithm>
 #include <array>
@@ -14,7 +15,6 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 

@@ -1,4 +1,5 @@
 #include "analysis/camera.h"
+#include "analysis/units.h"
 
 #include <gtest/gtest.h>
 
@@ -11,10 +12,7 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double Deg(double degrees) { return degrees * kPi / 180; }
 
 // ---------------------------------------------------------------------------------------------
 // Cameras used throughout.
@@ -53,7 +51,7 @@ Intrinsics FisheyeIntrinsics() {
   k.width = 1920;
   k.height = 1080;
   k.model = LensModel::kFisheye;
-  k.fx = FocalFromHfov(Deg(190), k.width, LensModel::kFisheye);
+  k.fx = FocalFromHfov(Rad(190), k.width, LensModel::kFisheye);
   k.fy = k.fx * 1.001;
   k.cx = 959.5 - 4.0;
   k.cy = 539.5 + 1.5;
@@ -69,7 +67,7 @@ Intrinsics PinholeIntrinsics(double hfov_deg, int width, int height) {
   k.width = width;
   k.height = height;
   k.model = LensModel::kPinhole;
-  k.fx = k.fy = FocalFromHfov(Deg(hfov_deg), width, LensModel::kPinhole);
+  k.fx = k.fy = FocalFromHfov(Rad(hfov_deg), width, LensModel::kPinhole);
   k.cx = 0.5 * (width - 1);
   k.cy = 0.5 * (height - 1);
   return k;
@@ -201,10 +199,10 @@ TEST(FocalTest, EighteenMillimetreLensOnApsC) {
 
 TEST(FocalTest, ClosedForms) {
   // 90 degrees across 1000 px: tan(45) = 1.
-  EXPECT_NEAR(FocalFromHfov(Deg(90), 1000, LensModel::kPinhole), 500.0, 1e-12);
-  EXPECT_NEAR(FocalFromHfov(Deg(90), 1000, LensModel::kBrownConrady), 500.0, 1e-12);
+  EXPECT_NEAR(FocalFromHfov(Rad(90), 1000, LensModel::kPinhole), 500.0, 1e-12);
+  EXPECT_NEAR(FocalFromHfov(Rad(90), 1000, LensModel::kBrownConrady), 500.0, 1e-12);
   // Equidistant fisheye: 180 degrees across 1000 px is 500 px per pi/2.
-  EXPECT_NEAR(FocalFromHfov(Deg(180), 1000, LensModel::kFisheye), 1000.0 / kPi, 1e-12);
+  EXPECT_NEAR(FocalFromHfov(Rad(180), 1000, LensModel::kFisheye), 1000.0 / kPi, 1e-12);
   EXPECT_NEAR(HfovFromFocal(1000.0 / kPi, 1000, LensModel::kFisheye), kPi, 1e-15);
   EXPECT_NEAR(HfovFromFocal(500, 1000, LensModel::kPinhole), kPi / 2, 1e-15);
 }
@@ -212,13 +210,13 @@ TEST(FocalTest, ClosedForms) {
 TEST(FocalTest, RoundTrips) {
   for (double deg = 1; deg < 180; deg += 0.5) {
     for (LensModel model : {LensModel::kPinhole, LensModel::kBrownConrady}) {
-      const double fx = FocalFromHfov(Deg(deg), 1920, model);
-      EXPECT_NEAR(HfovFromFocal(fx, 1920, model), Deg(deg), 1e-13) << deg;
+      const double fx = FocalFromHfov(Rad(deg), 1920, model);
+      EXPECT_NEAR(HfovFromFocal(fx, 1920, model), Rad(deg), 1e-13) << deg;
     }
   }
   for (double deg = 1; deg < 360; deg += 0.5) {
-    const double fx = FocalFromHfov(Deg(deg), 1920, LensModel::kFisheye);
-    EXPECT_NEAR(HfovFromFocal(fx, 1920, LensModel::kFisheye), Deg(deg), 1e-13) << deg;
+    const double fx = FocalFromHfov(Rad(deg), 1920, LensModel::kFisheye);
+    EXPECT_NEAR(HfovFromFocal(fx, 1920, LensModel::kFisheye), Rad(deg), 1e-13) << deg;
   }
 }
 
@@ -260,7 +258,7 @@ TEST(PinholeTest, RoundTripsAndJacobian) {
   int failures = 0;
   EXPECT_LT(MaxPixelRoundTripError(model, 2000, &failures), 1e-9);
   EXPECT_EQ(failures, 0);
-  EXPECT_LT(MaxRayRoundTripError(model, Deg(60), 2000, &failures), 1e-14);
+  EXPECT_LT(MaxRayRoundTripError(model, Rad(60), 2000, &failures), 1e-14);
   EXPECT_EQ(failures, 0);
   std::mt19937 rng(3);
   for (int i = 0; i < 200; ++i) {
@@ -275,7 +273,7 @@ TEST(PinholeTest, WideAngleEdge) {
   for (const Vec2& pixel : {Vec2(-0.5, 539.5), Vec2(1919.5, 539.5)}) {
     const std::optional<Vec3> ray = model.Unproject(pixel);
     ASSERT_TRUE(ray);
-    EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Deg(85), 1e-13);
+    EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Rad(85), 1e-13);
     EXPECT_NEAR(ray->y(), 0, 1e-15);
     const std::optional<Vec2> back = model.Project(*ray * 10);
     ASSERT_TRUE(back);
@@ -483,7 +481,7 @@ TEST(FisheyeTest, ProjectClosedForm) {
   k.cx = 499.5;
   k.cy = 489.5;
   k.model = LensModel::kFisheye;
-  const double theta = Deg(60), phi = Deg(30);
+  const double theta = Rad(60), phi = Rad(30);
   const Vec3 p =
       2.5 * Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
   {
@@ -495,9 +493,9 @@ TEST(FisheyeTest, ProjectClosedForm) {
     EXPECT_NEAR(pixel->y(), 489.5 + 510 * theta * std::sin(phi), 1e-10);
     // Behind the camera plane: theta = 120 degrees.
     const std::optional<Vec2> behind =
-        model.Project(Vec3(std::sin(Deg(120)), 0, std::cos(Deg(120))));
+        model.Project(Vec3(std::sin(Rad(120)), 0, std::cos(Rad(120))));
     ASSERT_TRUE(behind);
-    EXPECT_NEAR(behind->x(), 499.5 + 500 * Deg(120), 1e-10);
+    EXPECT_NEAR(behind->x(), 499.5 + 500 * Rad(120), 1e-10);
     EXPECT_NEAR(behind->y(), 489.5, 1e-12);
   }
   k.k1 = 0.05;
@@ -567,7 +565,7 @@ TEST(FisheyeTest, DomainClosedForms) {
   const double r = CameraModel(k).max_radius();
   EXPECT_NEAR(r, brute, 1e-6);
   EXPECT_NEAR(slope(r), 0, 1e-12);
-  EXPECT_GT(r, Deg(95));
+  EXPECT_GT(r, Rad(95));
 }
 
 TEST(FisheyeTest, DomainEdge) {
@@ -616,7 +614,7 @@ TEST(FisheyeTest, EdgeOf190DegreeLens) {
   for (const Vec2& pixel : {Vec2(-0.5, k.cy), Vec2(1919.5, k.cy)}) {
     const std::optional<Vec3> ray = model.Unproject(pixel);
     ASSERT_TRUE(ray);
-    EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Deg(95), 1e-14);
+    EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Rad(95), 1e-14);
     EXPECT_LT(ray->z(), 0);
     const std::optional<Vec2> back = model.Project(*ray * 2);
     ASSERT_TRUE(back);
@@ -886,17 +884,17 @@ TEST(CameraTest, BehindCameraFisheyeProjects) {
   Camera fisheye = pinhole;
   fisheye.model = CameraModel(k);
   // 3 degrees behind the camera plane, to the left (world +Y): theta = 93 degrees.
-  const Vec3 behind(-5 * std::sin(Deg(3)), 5 * std::cos(Deg(3)), 2);
+  const Vec3 behind(-5 * std::sin(Rad(3)), 5 * std::cos(Rad(3)), 2);
   EXPECT_FALSE(pinhole.Project(behind));
   Mat23 jacobian;
   const std::optional<Vec2> pixel = fisheye.Project(behind, &jacobian);
   ASSERT_TRUE(pixel);
   EXPECT_TRUE(fisheye.model.InImage(*pixel));
-  EXPECT_NEAR(pixel->x(), 959.5 - k.fx * Deg(93), 1e-9);
+  EXPECT_NEAR(pixel->x(), 959.5 - k.fx * Rad(93), 1e-9);
   EXPECT_NEAR(pixel->y(), 539.5, 1e-9);
   const std::optional<Vec3> ray = fisheye.model.Unproject(*pixel);
   ASSERT_TRUE(ray);
-  EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Deg(93), 1e-12);
+  EXPECT_NEAR(std::atan2(ray->head<2>().norm(), ray->z()), Rad(93), 1e-12);
   Mat23 numeric;
   ASSERT_TRUE(
       NumericJacobian([&](const Vec3& q) { return fisheye.Project(q); }, behind, 1e-5, &numeric));

@@ -7,6 +7,7 @@
 
 #include "analysis/inside_mesh.h"
 #include "analysis/primitives.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -68,7 +69,7 @@ TEST(InsideMesh, ColumnsAgreeWithPointsOnLatticeAlignedBoxes) {
   EXPECT_EQ(inside_a, 9 * 5 * 7);  // 0..1, 0..0.5, 0..0.75 in steps of 1/8, boundary included
   EXPECT_GT(degenerate, 0);
   // A box turned 45 degrees about z, its vertical edges on lattice lines.
-  const Mat3 turn = Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
+  const Mat3 turn = Eigen::AngleAxisd(kPi / 4, Vec3::UnitZ()).toRotationMatrix();
   const InsideMesh b(Moved(MakeBox(Vec3(0.5, 0.5, 0.5)), turn, Vec3(0, 0, 0)));
   CompareOnLattice(b, h, Vec3(-0.5, -0.5, -0.5), &degenerate);
 }

@@ -7,11 +7,11 @@
 #include "analysis/ray_caster.h"
 #include "analysis/seeded.h"
 #include "analysis/scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 
 std::string Short(double v) {

@@ -10,11 +10,11 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "analysis/visibility.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A floor, a static post and a box "cart" (0.4 x 0.4 x 0.5, 0.1 m above the floor: its anchor is
 // (0, 0, 0.1)) with

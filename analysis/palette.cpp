@@ -1,5 +1,6 @@
 // The cameras' colour palette and the CIELAB / CIEDE2000 arithmetic behind it (analysis/palette.h).
 #include "analysis/palette.h"
+#include "analysis/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Greedy farthest-point selection under CIEDE2000 from the sRGB colours on a 1/20 grid with
 // L* >= 45, chroma >= 45 and a channel >= 0.8, seeded with red: every prefix is spread out too
@@ -23,8 +23,6 @@ int Index(int index) {
   return i < 0 ? i + kCameraPaletteSize : i;
 }
 
-double Deg(double rad) { return rad * 180.0 / kPi; }
-double Rad(double deg) { return deg * kPi / 180.0; }
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 // The Euler-angle convention of camera orientations (analysis/pose.h).
 #include "analysis/pose.h"
+#include "analysis/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +8,7 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
-double Deg(double rad) { return rad * 180.0 / kPi; }
-double Rad(double deg) { return deg * kPi / 180.0; }
 
 }  // namespace
 

@@ -10,11 +10,11 @@
 
 #include "analysis/camera.h"
 #include "analysis/scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(Euler, BaseLooksAlongPlusXWithImageRightMinusYAndDownMinusZ) {
   const Mat3 base = RotationFromYawPitchRollDeg(Vec3::Zero());

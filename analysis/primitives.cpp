@@ -1,4 +1,5 @@
 #include "analysis/primitives.h"
+#include "analysis/units.h"
 
 #include <array>
 #include <cmath>
@@ -11,7 +12,6 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A point of a surface of revolution's profile: distance from the z axis and height.
 struct ProfilePoint {

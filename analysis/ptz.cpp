@@ -7,15 +7,13 @@
 
 #include "analysis/camera.h"
 #include "analysis/surface_distance.h"
+#include "analysis/units.h"
 #include "analysis/visibility.h"  // PixelDensity
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-double Rad(double deg) { return deg * kPi / 180.0; }
-double Deg(double rad) { return rad * 180.0 / kPi; }
 
 double Wrap180(double deg) {
   double a = std::fmod(deg + 180.0, 360.0);

@@ -17,12 +17,11 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "analysis/visibility.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-double Rad(double d) { return d * kPi / 180.0; }
 
 // An empty room: one PTZ at (0, 0, 3) looking along +y at home; `ptz` is the block's body.
 Scene PtzScene(const std::string& ptz, const std::string& camera_extra = "") {

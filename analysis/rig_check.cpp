@@ -14,11 +14,11 @@
 #include "analysis/inside_mesh.h"
 #include "analysis/motion.h"
 #include "analysis/visibility.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 std::string Format(const char* format, double v) {
   char b[64];
@@ -144,8 +144,8 @@ double EffectiveFov(const CameraModel& model, int axis) {
   const Vec2 a = LastReachable(model, centre, pixel(-0.5), 1e-9);
   const Vec2 b = LastReachable(model, centre, pixel(extent), 1e-9);
   const Vec3 ra = *model.Unproject(a), rb = *model.Unproject(b);
-  if (pp >= -0.5 && pp <= extent) return (AxisAngle(ra) + AxisAngle(rb)) * kDeg;
-  return std::atan2(ra.cross(rb).norm(), ra.dot(rb)) * kDeg;
+  if (pp >= -0.5 && pp <= extent) return (AxisAngle(ra) + AxisAngle(rb)) * kDegPerRad;
+  return std::atan2(ra.cross(rb).norm(), ra.dot(rb)) * kDegPerRad;
 }
 
 // Valid values that are almost surely mistakes (Warning::Kind::kImplausible; rig_check.h).
@@ -183,11 +183,11 @@ void CheckPlausibleValues(const Scene& scene, const Rig& rig, const CameraPath& 
   }
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const Intrinsics& k = rig.cameras[c].model.intrinsics();
-    const double hfov = HfovFromFocal(k.fx, k.width, k.model) * kDeg;
+    const double hfov = HfovFromFocal(k.fx, k.width, k.model) * kDegPerRad;
     if (hfov < 3.2)
       add(camera_path(c) + ".hfov_deg",
           "camera '" + rig.cameras[c].id + "' has a field of view of " + std::to_string(hfov).substr(0, 5) +
-              " degrees: radians written as degrees (" + std::to_string(hfov * 180 / 3.14159265358979323846).substr(0, 5) +
+              " degrees: radians written as degrees (" + std::to_string(hfov * 180 / kPi).substr(0, 5) +
               " degrees)?");
   }
   // Moving groups: one that lies outside the study region at a time sample, or whose centre passes
@@ -296,8 +296,8 @@ std::string FormatWarning(const std::string& file, const Warning& w) {
 LensCoverage ComputeLensCoverage(const CameraModel& model) {
   LensCoverage c;
   const Intrinsics& k = model.intrinsics();
-  c.nominal_hfov_deg = HfovFromFocal(k.fx, k.width, k.model) * kDeg;
-  c.nominal_vfov_deg = HfovFromFocal(k.fy, k.height, k.model) * kDeg;
+  c.nominal_hfov_deg = HfovFromFocal(k.fx, k.width, k.model) * kDegPerRad;
+  c.nominal_vfov_deg = HfovFromFocal(k.fy, k.height, k.model) * kDegPerRad;
   c.hfov_deg = EffectiveFov(model, 0);
   c.vfov_deg = EffectiveFov(model, 1);
   const double x0 = -0.5, x1 = k.width - 0.5, y0 = -0.5, y1 = k.height - 0.5;
@@ -349,7 +349,7 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
         });
     enclosed = true;
     for (int k = 0; k < 16 && enclosed; ++k) {
-      const double a = 2 * 3.14159265358979323846 * k / 16;
+      const double a = 2 * kPi * k / 16;
       enclosed =
           caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
     }

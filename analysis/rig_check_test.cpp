@@ -11,12 +11,11 @@
 
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = 180.0 / kPi;
 
 Intrinsics Lens(int w, int h, double f, LensModel model = LensModel::kPinhole) {
   Intrinsics k;
@@ -32,7 +31,7 @@ Intrinsics Lens(int w, int h, double f, LensModel model = LensModel::kPinhole) {
 TEST(LensCoverage, PinholeEffectiveEqualsNominal) {
   const CameraModel m(Lens(1280, 720, 900));
   const LensCoverage c = ComputeLensCoverage(m);
-  const double h = 2 * std::atan(640.0 / 900) * kDeg, v = 2 * std::atan(360.0 / 900) * kDeg;
+  const double h = 2 * std::atan(640.0 / 900) * kDegPerRad, v = 2 * std::atan(360.0 / 900) * kDegPerRad;
   EXPECT_NEAR(c.nominal_hfov_deg, h, 1e-9);
   EXPECT_NEAR(c.nominal_vfov_deg, v, 1e-9);
   EXPECT_NEAR(c.hfov_deg, h, 1e-9);
@@ -60,21 +59,21 @@ TEST(LensCoverage, BarrelDomainEndsInsideTheImageClosedForm) {
   EXPECT_TRUE(c.domain_ends_inside_image);
   EXPECT_NEAR(c.unreachable_fraction, expected, 5e-4) << "expected " << expected;
   // Horizontally the domain ends first: the last ray is at r*, so the FOV is 2 atan(r*).
-  EXPECT_NEAR(c.hfov_deg, 2 * std::atan(r_star) * kDeg, 1e-3);
+  EXPECT_NEAR(c.hfov_deg, 2 * std::atan(r_star) * kDegPerRad, 1e-3);
   // Vertically the edge (r_d = 0.8) is reachable: r (1 + k1 r^2) = 0.8 on [0, r*].
   double lo = 0, hi = r_star;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
     (mid * (1 + k1 * mid * mid) < 0.8 ? lo : hi) = mid;
   }
-  EXPECT_NEAR(c.vfov_deg, 2 * std::atan(lo) * kDeg, 1e-6);
+  EXPECT_NEAR(c.vfov_deg, 2 * std::atan(lo) * kDegPerRad, 1e-6);
   EXPECT_NEAR(c.nominal_hfov_deg, 90.0, 1e-9);
 }
 
 TEST(LensCoverage, FisheyeOver180DegreesIsReportedAsSuch) {
   // An equidistant fisheye (no distortion coefficients): theta = r_d, 200 degrees across.
   const int w = 1000;
-  const double f = FocalFromHfov(200.0 / kDeg, w, LensModel::kFisheye);
+  const double f = FocalFromHfov(200.0 / kDegPerRad, w, LensModel::kFisheye);
   const LensCoverage c = ComputeLensCoverage(CameraModel(Lens(w, w, f, LensModel::kFisheye)));
   EXPECT_NEAR(c.nominal_hfov_deg, 200.0, 1e-9);
   EXPECT_NEAR(c.hfov_deg, 200.0, 1e-6);

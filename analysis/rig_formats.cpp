@@ -19,6 +19,7 @@
 #include "analysis/error.h"
 #include "analysis/text.h"
 #include "analysis/pose.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -1076,8 +1077,8 @@ std::string RigToSheetCsv(const Rig& rig) {
     out += Csv(camera.id) + "," + Csv(camera.name) + "," + colour + "," + Fixed(p.x(), 1) + "," +
            Fixed(p.y(), 1) + "," + Fixed(p.z(), 1) + "," + Fixed(ypr.x(), 2) + "," +
            Fixed(ypr.y(), 2) + "," + Fixed(ypr.z(), 2) + "," +
-           Fixed(HfovFromFocal(k.fx, k.width, k.model) * 180.0 / M_PI, 2) + "," +
-           Fixed(HfovFromFocal(k.fy, k.height, k.model) * 180.0 / M_PI, 2) + "," +
+           Fixed(HfovFromFocal(k.fx, k.width, k.model) * 180.0 / kPi, 2) + "," +
+           Fixed(HfovFromFocal(k.fy, k.height, k.model) * 180.0 / kPi, 2) + "," +
            Fixed(k.fx, 1) + "," + Fixed(k.fy, 1) + "," + Fixed(k.cx, 1) + "," + Fixed(k.cy, 1) +
            "," + LensModelName(k.model) + "," + std::to_string(k.width) + "," +
            std::to_string(k.height) + "," + (camera.enabled ? "yes" : "no") + "\n";

@@ -1,5 +1,6 @@
 // Rig generators: rings, ceiling and wall grids, cameras along walls (docs/rig-generators.md).
 #include "analysis/rig_generators.h"
+#include "analysis/units.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -7,7 +8,6 @@
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 GeneratedCamera Aimed(const std::string& id, const Vec3& p, const Vec3& aim) {
   GeneratedCamera c;

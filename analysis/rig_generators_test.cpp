@@ -10,11 +10,11 @@
 
 #include "analysis/camera.h"
 #include "analysis/scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // The cameras as a rig of the scene format, read back.
 Rig ReadBack(const std::vector<GeneratedCamera>& cameras) {

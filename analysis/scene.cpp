@@ -23,6 +23,7 @@
 #include "analysis/primitives.h"
 #include "analysis/ptz.h"
 #include "analysis/sha256.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -30,8 +31,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegree = kPi / 180.0;
 constexpr int kMaxResolution = 65536;
 constexpr int kMinSegments = 3;
 constexpr int kMaxSegments = 4096;
@@ -434,9 +433,9 @@ json ParseJson(const std::string& text, const std::string& file) {
 // Scene parts.
 
 Mat3 RotationXyzDegrees(const Vec3& degrees) {
-  return (Eigen::AngleAxisd(degrees.z() * kDegree, Vec3::UnitZ()) *
-          Eigen::AngleAxisd(degrees.y() * kDegree, Vec3::UnitY()) *
-          Eigen::AngleAxisd(degrees.x() * kDegree, Vec3::UnitX()))
+  return (Eigen::AngleAxisd(degrees.z() * kRadPerDeg, Vec3::UnitZ()) *
+          Eigen::AngleAxisd(degrees.y() * kRadPerDeg, Vec3::UnitY()) *
+          Eigen::AngleAxisd(degrees.x() * kRadPerDeg, Vec3::UnitX()))
       .toRotationMatrix();
 }
 
@@ -837,9 +836,9 @@ Eigen::Isometry3d ReadPose(const Node& node) {
   const Node euler = node.Get("euler_deg");
   euler.CheckKeys({"yaw", "pitch", "roll"});
   double yaw = 0, pitch = 0, roll = 0;
-  if (auto n = euler.Find("yaw")) yaw = n->Number() * kDegree;
-  if (auto n = euler.Find("pitch")) pitch = n->Number() * kDegree;
-  if (auto n = euler.Find("roll")) roll = n->Number() * kDegree;
+  if (auto n = euler.Find("yaw")) yaw = n->Number() * kRadPerDeg;
+  if (auto n = euler.Find("pitch")) pitch = n->Number() * kRadPerDeg;
+  if (auto n = euler.Find("roll")) roll = n->Number() * kRadPerDeg;
   pose.linear() = RotationFromYawPitchRoll(yaw, pitch, roll);  // analysis/pose.h
   return pose;
 }
@@ -893,7 +892,7 @@ Intrinsics ReadIntrinsics(const Node& node) {
                  ? ""
                  : "for wider lenses use \"distortion\": {\"model\": \"fisheye\"}");
     }
-    k.fx = k.fy = FocalFromHfov(hfov * kDegree, k.width, k.model);
+    k.fx = k.fy = FocalFromHfov(hfov * kRadPerDeg, k.width, k.model);
   } else if (form == "focal_px") {
     const Node n = node.Get("focal_px");
     if (n.value().is_number()) {
@@ -999,7 +998,7 @@ void ReadPtz(const Node& node, Camera* camera) {
     const double hfov = n.Positive();
     const double max = k.model == LensModel::kFisheye ? 360.0 : 180.0;
     if (!(hfov < max)) n.Fail("a field of view must be below " + FormatNumber(max) + " degrees");
-    return FocalFromHfov(hfov * kDegree, k.width, k.model);
+    return FocalFromHfov(hfov * kRadPerDeg, k.width, k.model);
   };
   h.focal_min = h.focal_max = k.fx;
   if (auto n = node.Find("zoom_hfov_deg")) {
@@ -1932,7 +1931,7 @@ json RigToJson(const Rig& rig) {
       const Vec3 pivot = h.home.translation();
       c["position"] = {pivot.x(), pivot.y(), pivot.z()};
       c["quaternion"] = {qh.w(), qh.x(), qh.y(), qh.z()};
-      const auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) / kDegree; };
+      const auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) / kRadPerDeg; };
       json ptz = {{"pan_deg", h.current.pan_deg},
                   {"tilt_deg", h.current.tilt_deg},
                   {"pan_axis", {h.pan_axis.x(), h.pan_axis.y(), h.pan_axis.z()}},

@@ -27,6 +27,7 @@
 #include "analysis/primitives.h"
 #include "analysis/sha256.h"
 #include "tests/temp_dir.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -34,7 +35,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // -------------------------------------------------------------------------------------------------
 // Helpers.

@@ -19,6 +19,7 @@
 #include "tests/expect_input_error.h"
 #include "tests/skinned_gltf.h"
 #include "tests/temp_dir.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -227,7 +228,7 @@ TEST(Skinning, TheShadowOfTheTurningBoneMovesAsPredicted) {
   const Scene scene = Load(dir, BarScene(dir, &tube, R"({"clip": "bend", "loop": false})", R"({"samples": 7})"));
   const auto parts = MakeSceneParts(scene);
   int checked = 0;
-  const double kPi = 3.14159265358979323846;
+  const double kPi = kPi;
   for (const TimeSample& sample : scene.TimeSamples()) {
     const auto caster = CasterAtSample(*parts, scene, sample);
     const double theta = 0.5 * kPi * sample.time;

@@ -11,6 +11,7 @@
 #include "analysis/camera.h"
 #include "analysis/uncertainty.h"
 #include "tests/fixtures.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -59,7 +60,7 @@ TEST(StaticUncertainty, RectifiedStereoDepth) {
 TEST(StaticUncertainty, ConvergingCameras) {
   const double f = 1000, D = 3.0, sigma = 0.3;
   for (double deg : {90.0, 10.0, 1.0, 0.1}) {
-    const double t = deg * M_PI / 180.0;
+    const double t = deg * kPi / 180.0;
     const Vec3 X(0.2, -0.1, 1.5);
     std::vector<Camera> cams{
         Pinhole(X + D * Vec3(std::sin(t / 2), -std::cos(t / 2), 0), X, f),
@@ -144,7 +145,7 @@ TEST(StaticUncertainty, ExtremeLenses) {
     k.width = 1000;
     k.height = 1000;
     k.model = model;
-    k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180, k.width, model);
+    k.fx = k.fy = FocalFromHfov(hfov_deg * kPi / 180, k.width, model);
     k.cx = k.cy = 499.5;
     k.k1 = k1;
     k.k2 = k2;
@@ -160,17 +161,17 @@ TEST(StaticUncertainty, ExtremeLenses) {
       {"pinhole 170 deg near edge", lens(LensModel::kPinhole, 170, 0, 0), 84.0},
       {"fisheye 190 deg at 94 deg", lens(LensModel::kFisheye, 190, 0, 0), 94.0},
       {"brown-conrady at 0.999 of its domain",
-       lens(LensModel::kBrownConrady, 120, -0.3, 0), std::atan(0.999 * rmax_k1) * 180 / M_PI},
+       lens(LensModel::kBrownConrady, 120, -0.3, 0), std::atan(0.999 * rmax_k1) * 180 / kPi},
   };
   for (const Case& c : cases) {
     // Two cameras 1 m from X, 60 degrees apart, each rotated so X appears off_axis_deg off-axis.
     const Vec3 X(0, 0, 0);
     InformationBuilder b;
     for (double side : {-1.0, 1.0}) {
-      const double a = side * 30 * M_PI / 180;
+      const double a = side * 30 * kPi / 180;
       const Vec3 C = Vec3(std::sin(a), -std::cos(a), 0);
       // Aim the optical axis off_axis_deg away from X, rotating about the vertical.
-      const double off = c.off_axis_deg * M_PI / 180;
+      const double off = c.off_axis_deg * kPi / 180;
       const Vec3 to_x = (X - C).normalized();
       const Vec3 axis = Eigen::AngleAxisd(off, Vec3::UnitZ()) * to_x;
       Camera cam;
@@ -276,7 +277,7 @@ TEST(SymmetricEigenvalues3, MatchLongDoubleReferenceAtEveryConditioning) {
 }
 
 TEST(MaxTriangulationAngle, IsAccurateAtTinyAndLargeAngles) {
-  for (double t : {1e-9, 1e-3, 0.5, 3.0, M_PI - 1e-9}) {
+  for (double t : {1e-9, 1e-3, 0.5, 3.0, kPi - 1e-9}) {
     std::vector<Vec3> d{Vec3(1, 0, 0), Vec3(std::cos(t), std::sin(t), 0), Vec3(1, 1e-12, 0).normalized()};
     EXPECT_NEAR(MaxTriangulationAngle(d), t, 1e-15 + 1e-12 * t);
   }

@@ -8,6 +8,7 @@
 #include "analysis/visibility.h"
 #include "tests/fixtures.h"
 #include "tests/random_scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -45,7 +46,7 @@ TEST(Visibility, EachRuleInIsolation) {
   EXPECT_EQ(disabled.Test(0, Vec3(3, 0, 0)), ViewResult::kDisabled);
 
   // The horizontal half-FOV boundary at depth 3: y = 3 tan(30 deg) maps to the image edge.
-  const double edge = 3.0 * std::tan(M_PI / 6);
+  const double edge = 3.0 * std::tan(kPi / 6);
   EXPECT_EQ(vis.Test(0, Vec3(3, -0.999 * edge, 0)), ViewResult::kSeen);
   EXPECT_EQ(vis.Test(0, Vec3(3, -1.001 * edge, 0)), ViewResult::kOutsideImage);
 }
@@ -235,7 +236,7 @@ TEST(Visibility, FarCamerasSmallObjectToleranceFromFloatError) {
   const auto brute = MakeBruteForceRayCaster(mesh);
   std::vector<Camera> cams;
   for (int c = 0; c < 8; ++c) {
-    const double az = 2 * M_PI * c / 8, el = 0.3 + 0.1 * c;
+    const double az = 2 * kPi * c / 8, el = 0.3 + 0.1 * c;
     const Vec3 pos = 300.0 * Vec3(std::cos(az) * std::cos(el), std::sin(az) * std::cos(el), std::sin(el));
     cams.push_back(MakePinhole(pos, Vec3::Zero(), 0.01, 1000, 1000));  // 5 cm across at 300 m
   }

@@ -17,11 +17,11 @@
 #include "suggest/ptz_suggest.h"
 #include "suggest/suggest.h"
 #include "volume/ptz_fields.h"
+#include "analysis/units.h"
 
 namespace pandora::app {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::string Names(const std::vector<std::string>& names) {
   std::string out;

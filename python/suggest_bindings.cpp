@@ -30,11 +30,11 @@
 #include "suggest/suggestion_file.h"
 #include "suggest/suggestion_text.h"
 #include "volume/ptz_fields.h"
+#include "analysis/units.h"
 
 namespace pandora::python {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A suggestion for the rig it was made on (camera nudges or a PTZ controller change).
 struct PySuggestion {

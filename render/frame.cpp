@@ -24,6 +24,7 @@
 #include "render/colormap.h"
 #include "render/image_overlays.h"
 #include "volume/active_set.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace internal {
@@ -91,7 +92,7 @@ class ViewRays {
       eye_ = view.from;
       clip_near_ = view.clip_near;
       R_ = pose->linear();
-      f_ = 0.5 * width_ / std::tan(0.5 * view.fov_deg * M_PI / 180.0);
+      f_ = 0.5 * width_ / std::tan(0.5 * view.fov_deg * kPi / 180.0);
       cx_ = 0.5 * width_ - 0.5;
       cy_ = 0.5 * height_ - 0.5;
       Intrinsics k;
@@ -201,7 +202,7 @@ struct Cull {
         near2(cam.near * cam.near),
         far2(cam.far * cam.far),
         bounds(cam.model.normalized_bounds()),
-        use_bounds(cam.model.max_field_angle() < 0.5 * M_PI) {}
+        use_bounds(cam.model.max_field_angle() < 0.5 * kPi) {}
   inline bool MaySee(const Vec3& X, const Vec3& n) const {
     const Vec3 v = center - X;
     if (n.dot(v) <= 0.0) return false;
@@ -925,7 +926,7 @@ void FrameRenderer::Finish(FrameBuffers* frame) const {
   if (options.surface == Surface::kContours) {
     const std::vector<Vec3>& normal = frame->normal;
     std::vector<float> a(pixels, 0.0f);
-    const double cos_crease = std::cos(30.0 * M_PI / 180.0);
+    const double cos_crease = std::cos(30.0 * kPi / 180.0);
     auto edge = [&](std::size_t p, std::size_t q, const Vec3& dq) {
       const bool hp = std::isfinite(image.depth[p]), hq = std::isfinite(image.depth[q]);
       if (!hp && !hq) return;
@@ -1084,7 +1085,7 @@ std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
         std::swap(a, b);
       edges[Key{{a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}}].push_back({uint32_t(t), uint8_t(i)});
     }
-  const double cos_crease = std::cos(1.0 * M_PI / 180.0);
+  const double cos_crease = std::cos(1.0 * kPi / 180.0);
   std::vector<uint8_t> drawn(n, 0);
   for (const auto& [key, list] : edges) {
     bool draw = list.size() == 1;

@@ -15,6 +15,7 @@
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "render/test_options.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -49,14 +50,14 @@ Scene ManyCameraScene(int n) {
     Intrinsics k;
     k.width = 64;
     k.height = 48;
-    k.fx = k.fy = FocalFromHfov((20 + 25 * i / 7.0) * M_PI / 180.0, 64, LensModel::kPinhole);
+    k.fx = k.fy = FocalFromHfov((20 + 25 * i / 7.0) * kPi / 180.0, 64, LensModel::kPinhole);
     k.cx = 31.5;
     k.cy = 23.5;
     lenses.emplace_back(k);
   }
   std::mt19937 g(20240611);
   for (int c = 0; c < n; ++c) {
-    const double azimuth = Uniform(g, 0, 2 * M_PI), radius = Uniform(g, 2.5, 5.0);
+    const double azimuth = Uniform(g, 0, 2 * kPi), radius = Uniform(g, 2.5, 5.0);
     const Vec3 position(radius * std::cos(azimuth), radius * std::sin(azimuth),
                         Uniform(g, 0.8, 4.0));
     const Vec3 target(Uniform(g, -2.5, 2.5), Uniform(g, -2.5, 2.5), Uniform(g, 0.0, 0.5));

@@ -13,6 +13,7 @@
 #include "volume/surface.h"
 #include "volume/vdb_io.h"
 #include "tests/fixtures.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -78,7 +79,7 @@ TEST(Overlay, SliceShowsTheVoxelValueWhereTheEyeRayCrossesThePlane) {
   const openvdb::Int32Grid& grid = *s.fields.impl().coverage;
   auto acc = grid.getConstAccessor();
   const Eigen::Isometry3d pose = *LookAt(view.from, view.at, view.up);
-  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * M_PI / 180.0);
+  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   int checked = 0, per_value[3] = {0, 0, 0};
   for (int y = 0; y < view.height; ++y)
     for (int x = 0; x < view.width; ++x) {
@@ -188,7 +189,7 @@ TEST(Render, ExrLayersMatchTheFieldValuesAtSampledPixels) {
 
   const PointEvaluator evaluator(scene, rig, *caster);
   const Mat3 R = LookAt(view.from, view.at, view.up)->linear();
-  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * M_PI / 180.0);
+  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   const double cx = 0.5 * view.width - 0.5, cy = 0.5 * view.height - 0.5;
   int sampled = 0, agree = 0, triangulable = 0, seen = 0;
   for (int y = 1; y < image.height; y += 4)

@@ -11,6 +11,7 @@
 #include "analysis/error.h"
 #include "render/frame.h"
 #include "render/prepared_scene.h"
+#include "analysis/units.h"
 
 namespace pandora {
 
@@ -60,7 +61,7 @@ std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, 
   v.at = bounds.center();
   v.from = v.at + distance * out;
   v.up = up;
-  v.fov_deg = 2.0 * std::atan(half / distance) * 180.0 / 3.14159265358979323846;
+  v.fov_deg = 2.0 * std::atan(half / distance) * 180.0 / kPi;
   v.width = width;
   v.height = height;
   if (metres_per_pixel) *metres_per_pixel = 2.0 * half / width;

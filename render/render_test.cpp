@@ -21,6 +21,7 @@
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "tests/fixtures.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -55,7 +56,7 @@ SceneObject Sphere(const Vec3& center, double radius, int segments) {
 // The eye ray of output pixel (x, y) of a pinhole RenderView, computed independently of render.cpp.
 Vec3 EyeRay(const RenderView& v, double x, double y) {
   const Eigen::Isometry3d pose = *LookAt(v.from, v.at, v.up);
-  const double f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * M_PI / 180.0);
+  const double f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * kPi / 180.0);
   const Vec3 d((x - (0.5 * v.width - 0.5)) / f, (y - (0.5 * v.height - 0.5)) / f, 1.0);
   return (pose.linear() * d).normalized();
 }
@@ -215,7 +216,7 @@ TEST(Render, SphereCastsThePredictedShadow) {
   const Camera& cam = rig.cameras[0];
   // The tessellated sphere lies between the sphere of radius r (its vertices) and the sphere of
   // radius r cos^2(pi / segments) (its faces' nearest points, generously): decided outside that band.
-  const double r_in = r * std::pow(std::cos(M_PI / segments), 2);
+  const double r_in = r * std::pow(std::cos(kPi / segments), 2);
   auto distance_to_segment = [&](const Vec3& a, const Vec3& b) {
     const Vec3 ab = b - a;
     const double s = std::clamp((center - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
@@ -442,7 +443,7 @@ TEST(Render, HiddenLineDrawsBoxEdgesButNotCoplanarDiagonals) {
   const Image img = Render(scene, rig, *caster, view, options);
   // Project the top face's corners with the view's pinhole to find its edges on screen.
   const Eigen::Isometry3d cfw = LookAt(view.from, view.at, view.up)->inverse();
-  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * M_PI / 180.0);
+  const double f = 0.5 * view.width / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   auto project = [&](const Vec3& X) {
     const Vec3 p = cfw * X;
     return Vec2(f * p.x() / p.z() + 50.0, f * p.y() / p.z() + 50.0);

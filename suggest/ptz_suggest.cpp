@@ -15,14 +15,13 @@
 #include "analysis/sha256.h"
 #include "suggest/scene_text.h"
 #include "suggest/suggestion_file.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
-constexpr double kPi = 3.14159265358979323846;
-double Deg(double rad) { return rad * 180.0 / kPi; }
 
 double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -24,11 +24,11 @@
 #include "analysis/ray_caster.h"
 #include "analysis/scene.h"
 #include "suggest/suggestion_file.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A 10 x 8 m room with a pillar and a cabinet; a ceiling dome "d" at (0, 0, 2.8) looking along +y.
 std::string SceneText(const std::string& ptz) {

@@ -12,6 +12,7 @@
 #include "analysis/rig_formats.h"
 #include "suggest/scene_text.h"
 #include "suggest/suggestion_file.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -73,7 +74,7 @@ bool SameIntrinsics(const Intrinsics& a, const Intrinsics& b) {
 }
 
 double AngleDeg(const Mat3& a, const Mat3& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
+  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / kPi;
 }
 
 }  // namespace
@@ -224,7 +225,7 @@ RigImportResult ImportRig(const RigImportOptions& options) {
     const int i = written.FindCamera(c.id);
     const bool ok = i >= 0 &&
                     (written.cameras[i].center() - c.center()).norm() <= 1e-9 * std::max(1.0, c.center().norm()) &&
-                    AngleDeg(written.cameras[i].world_from_camera.linear(), c.world_from_camera.linear()) <= 1e-9 * 180 / M_PI &&
+                    AngleDeg(written.cameras[i].world_from_camera.linear(), c.world_from_camera.linear()) <= 1e-9 * 180 / kPi &&
                     SameIntrinsics(written.cameras[i].model.intrinsics(), c.model.intrinsics());
     if (!ok)
       throw InputError(options.scene, "", "the rewritten scene does not hold camera '" + c.id + "' as imported",

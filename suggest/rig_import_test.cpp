@@ -18,6 +18,7 @@
 #include "analysis/scene.h"
 #include "suggest/rig_import.h"
 #include "tests/temp_dir.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -300,7 +301,7 @@ TEST(RigImport, MovedCameraIsReportedAndWrittenWithBackup) {
   // The installer put camera 7 5 cm lower and turned it 1 degree about its optical axis.
   Camera& c = calibrated.cameras[1];
   c.world_from_camera.translation() += Vec3(0, 0, -0.05);
-  c.world_from_camera.linear() = c.world_from_camera.linear() * Eigen::AngleAxisd(M_PI / 180, Vec3::UnitZ()).toRotationMatrix();
+  c.world_from_camera.linear() = c.world_from_camera.linear() * Eigen::AngleAxisd(kPi / 180, Vec3::UnitZ()).toRotationMatrix();
   dir.Write("calib.yml", RigToOpenCvYaml(calibrated));
   const std::string before = ReadText(scene);
   RigImportOptions options{scene, "opencv", dir.File("calib.yml"), "design", ""};

@@ -21,16 +21,14 @@
 
 #include "analysis/surface_targets.h"
 #include "suggest/suggest_internal.h"
+#include "analysis/units.h"
 
 namespace pandora {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double Deg(double rad) { return rad * 180.0 / kPi; }
-double Rad(double deg) { return deg * kPi / 180.0; }
 
 std::string Format(const char* fmt, double v) {
   char buf[64];

@@ -21,6 +21,7 @@
 #include "analysis/visibility.h"
 #include "suggest/suggest.h"
 #include "suggest/suggest_internal.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -694,11 +695,11 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
       if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
       const Vec3 ypr = YawPitchRollDeg(R);
       if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
-      const double limit = charts[c].max_rotate * 180.0 / M_PI * (1 + 1e-9);
+      const double limit = charts[c].max_rotate * 180.0 / kPi * (1 + 1e-9);
       // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
       const Vec3 axis = R.col(2);
-      const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / M_PI;
-      const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / M_PI;
+      const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / kPi;
+      const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / kPi;
       std::vector<Eigen::Isometry3d> best_trial;
       Metrics best_level;
       double best_level_score = -kInf;

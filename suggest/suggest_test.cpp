@@ -21,6 +21,7 @@
 #include "analysis/visibility.h"
 #include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -889,7 +890,7 @@ TEST(SuggestReplacePoses, LookAtKeepsUpOrSaysWhyNot) {
   EXPECT_TRUE(SamePose(ParseScene(out, "x.json").rigs[0].cameras[0].world_from_camera, pose));
   // Rolled 5 degrees about its optical axis: up cannot stay [0, 0, 1]; it becomes the camera's up.
   Eigen::Isometry3d rolled = pose;
-  rolled.linear() = pose.linear() * Eigen::AngleAxisd(5 * M_PI / 180, Vec3::UnitZ()).toRotationMatrix();
+  rolled.linear() = pose.linear() * Eigen::AngleAxisd(5 * kPi / 180, Vec3::UnitZ()).toRotationMatrix();
   out = ReplacePoses(text, "x.json", "ring", {{"c1", rolled, std::nullopt, 0}}, &notes);
   cam = nlohmann::ordered_json::parse(out)["rigs"][0]["cameras"][0];
   EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "up", "resolution", "hfov_deg", "range"}));

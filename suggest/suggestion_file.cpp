@@ -24,6 +24,7 @@
 #include "suggest/ptz_suggest.h"
 #include "suggest/scene_text.h"
 #include "suggest/suggest.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -233,7 +234,7 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
             std::snprintf(line, sizeof line,
                           "%s: the suggestion also turns the camera %.3g deg about its optical axis "
                           "(a roll the old 'up' cannot express): 'up' is now [%.6g, %.6g, %.6g]",
-                          update.id.c_str(), kept ? AngleRad(kept->linear(), R) * 57.29577951308232 : 0.0,
+                          update.id.c_str(), kept ? AngleRad(kept->linear(), R) * kDegPerRad : 0.0,
                           own.x(), own.y(), own.z());
             notes->push_back(line);
           }
@@ -280,7 +281,6 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
     throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras", "no cameras",
                      "the scene file no longer matches the session");
   ordered_json& cameras = (*rig)["cameras"];
-  constexpr double kDegree = 3.14159265358979323846 / 180.0;
   for (const PtzHeadUpdate& u : heads) {
     std::size_t c = 0;
     while (c < cameras.size() && !(cameras[c].is_object() && cameras[c].contains("id") && IdOf(cameras[c]["id"]) == u.id)) ++c;
@@ -294,7 +294,7 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
                        "the scene file no longer matches the session");
     const PtzHead& a = u.before;
     const PtzHead& b = u.after;
-    auto hfov = [&](double f) { return Number(Clean(HfovFromFocal(f, u.lens.width, u.lens.model) / kDegree)); };
+    auto hfov = [&](double f) { return Number(Clean(HfovFromFocal(f, u.lens.width, u.lens.model) / kRadPerDeg)); };
     // A value that changed: written (a default that stays left out stays out).
     auto set = [](ordered_json& obj, const char* key, double now, double before, double default_value) {
       if (now == before) return;

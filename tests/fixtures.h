@@ -12,6 +12,7 @@
 #include "analysis/geometry.h"
 #include "analysis/primitives.h"
 #include "analysis/scene.h"
+#include "analysis/units.h"
 
 namespace pandora::testing {
 
@@ -33,7 +34,7 @@ inline Camera TestCamera(const std::string& id, const Vec3& position, const Vec3
   k.width = width;
   k.height = height;
   k.model = lens;
-  k.fx = k.fy = FocalFromHfov(hfov_deg * M_PI / 180.0, width, lens);
+  k.fx = k.fy = FocalFromHfov(hfov_deg * kPi / 180.0, width, lens);
   k.cx = (width - 1) / 2.0;
   k.cy = (height - 1) / 2.0;
   Camera camera;
@@ -64,7 +65,7 @@ inline Rig RingRig(int n, double radius, double height, const Vec3& centre = Vec
   Rig rig;
   rig.name = name;
   for (int i = 0; i < n; ++i) {
-    const double a = 2 * M_PI * i / n;
+    const double a = 2 * kPi * i / n;
     const Vec3 position = centre + Vec3(radius * std::cos(a), radius * std::sin(a), height);
     rig.cameras.push_back(
         TestCamera("c" + std::to_string(i), position, centre, hfov_deg, width, height_px));

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "analysis/ray_caster.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -16,7 +17,7 @@ TEST(Fixtures, TestCameraLooksAtItsTargetThroughThePrincipalPoint) {
   ASSERT_TRUE(px);
   EXPECT_NEAR(px->x(), 399.5, 1e-9);
   EXPECT_NEAR(px->y(), 299.5, 1e-9);
-  EXPECT_NEAR(c.model.intrinsics().fx, 400.0 / std::tan(35 * M_PI / 180), 1e-9);
+  EXPECT_NEAR(c.model.intrinsics().fx, 400.0 / std::tan(35 * kPi / 180), 1e-9);
   // Straight down: DefaultUp switches to +Y, LookAt succeeds.
   const Camera down = testing::TestCamera("d", Vec3(0, 0, 3), Vec3(0, 0, 0));
   EXPECT_TRUE(down.world_from_camera.linear().col(2).isApprox(Vec3(0, 0, -1)));

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/geometry.h"
+#include "analysis/units.h"
 
 namespace pandora::testing {
 
@@ -40,7 +41,7 @@ struct SkinnedTube {
   /// The closed-form position of vertex `v` in the "bend" clip at clip time tau in [0, 1]: the
   /// normalised blend of the rest position (bone0) and its turn by 90 tau degrees about the joint.
   Vec3 BendPose(std::size_t v, double tau) const {
-    const double a = 0.5 * 3.14159265358979323846 * tau;
+    const double a = 0.5 * kPi * tau;
     const Vec3 p = vertices[v], j(joint, 0, 0);
     const Vec3 d = p - j;
     const Vec3 turned = j + Vec3(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y(), d.z());
@@ -93,7 +94,7 @@ inline std::string SkinnedTube::Gltf() {
   vertices.clear();
   weights.clear();
   std::vector<std::uint32_t> index;
-  const double kPi = 3.14159265358979323846;
+  const double kPi = kPi;
   for (const TubeRing& r : rings)
     for (int s = 0; s < segments; ++s) {
       const double a = 2 * kPi * s / segments;

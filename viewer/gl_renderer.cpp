@@ -28,11 +28,11 @@
 #include "analysis/color.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // A camera whose field reaches this far off its axis gets a cube of maps: one perspective map
 // would spend most of its texels at the edges (tan 75 deg = 3.7 times the centre's spacing).
 constexpr double kMaxPerspectiveFieldAngle = 75.0 * kPi / 180.0;

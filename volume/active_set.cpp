@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "analysis/error.h"
+#include "analysis/units.h"
 
 namespace pandora {
 
@@ -68,7 +69,7 @@ FrustumCuller::FrustumCuller(const std::vector<Camera>& cameras) {
     p.near = cam.near;
     p.far = cam.far;
     p.max_angle = cam.model.max_field_angle();
-    p.use_planes = p.max_angle < 0.5 * M_PI - 1e-9;
+    p.use_planes = p.max_angle < 0.5 * kPi - 1e-9;
     if (p.use_planes) {
       const Eigen::Vector4d& b = cam.model.normalized_bounds();  // x_min, x_max, y_min, y_max
       p.normals[0] = Vec3(1, 0, -b[0]);

@@ -25,6 +25,7 @@
 #include "analysis/visibility.h"
 #include "volume/fields_vdb.h"
 #include "volume/information_sum.h"
+#include "analysis/units.h"
 
 namespace pandora {
 
@@ -158,7 +159,7 @@ inline double AtanNonNegative(double t) {
   const bool big = t > 2.414213562373095;
   const bool mid = t > 0.4142135623730950;
   const double x = big ? -1.0 / t : (mid ? (t - 1.0) / (t + 1.0) : t);
-  const double base = big ? M_PI_2 : (mid ? M_PI_4 : 0.0);
+  const double base = big ? (0.5 * kPi) : (mid ? (0.25 * kPi) : 0.0);
   const double z = x * x;
   return base +
          (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z -
@@ -260,7 +261,7 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
       const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
       const double dot = best_dot[m];
       const double angle = AtanNonNegative(std::sqrt(cx * cx + cy * cy + cz * cz) / std::abs(dot));
-      degrees[start + m] = static_cast<float>((dot < 0 ? M_PI - angle : angle) * (180.0 / M_PI));
+      degrees[start + m] = static_cast<float>((dot < 0 ? kPi - angle : angle) * (180.0 / kPi));
     }
     for (int m = 0; m < n; ++m) {
       best_dot_io[start + m] = best_dot[m];

@@ -16,6 +16,7 @@
 #include "volume/summary.h"
 #include "volume/vdb_io.h"
 #include "tests/fixtures.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -205,7 +206,7 @@ TEST(Fields, UncertaintyMatchesPerPointComputation) {
     EXPECT_NEAR(smean.getValue(xyz), 1e3 * s.sigma_mean, 1e-6 * 1e3 * s.sigma_mean);
     EXPECT_NEAR(cond.getValue(xyz), s.condition, 1e-6 * s.condition);
     // Float grid (6e-8) and an atan polynomial good to 2.1e-8: 3e-7 relative.
-    const double reference = MaxTriangulationAngle(directions) * 180 / M_PI;
+    const double reference = MaxTriangulationAngle(directions) * 180 / kPi;
     EXPECT_NEAR(angle.getValue(xyz), reference, 3e-7 * reference);
     const SteadyUncertainty st = SteadyFromInformation(info, builder.cameras(), *scene.study.motion);
     EXPECT_NEAR(steady_max.getValue(xyz), 1e3 * st.sigma_max, 1e-6 * 1e3 * st.sigma_max);

@@ -21,13 +21,11 @@
 #include "analysis/visibility.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
+#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-double Rad(double d) { return d * kPi / 180.0; }
-double Deg(double r) { return r * 180.0 / kPi; }
 
 // A room with optional objects; PTZ "p" at (0, 0, 3) looking along +y at home; `ptz` is the block's body.
 Scene PtzScene(const std::string& ptz, const std::string& objects = "", const std::string& study_extra = "",

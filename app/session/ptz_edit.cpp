@@ -5,13 +5,11 @@
 #include <stdexcept>
 
 #include "analysis/error.h"
+#include "analysis/units.h"
 
 namespace pandora::session {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-double Rad(double deg) { return deg * kPi / 180.0; }
-double Deg(double rad) { return rad * 180.0 / kPi; }
 
 bool SameState(const PtzState& a, const PtzState& b) {
   return a.pan_deg == b.pan_deg && a.tilt_deg == b.tilt_deg && a.focal == b.focal;

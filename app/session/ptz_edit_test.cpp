@@ -14,12 +14,12 @@
 #include "app/session/autosave.h"
 #include "app/session/ptz_edit.h"
 #include "app/session/session.h"
+#include "analysis/units.h"
 
 namespace pandora::session {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 std::string Read(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -49,7 +49,7 @@ fs::path CopyPtzScene(const std::string& name, const std::string& from = "", con
 }
 
 double Focal(const Camera& c, double hfov_deg) {
-  return FocalFromHfov(hfov_deg * kDeg, c.model.width(), c.model.intrinsics().model);
+  return FocalFromHfov(hfov_deg * kRadPerDeg, c.model.width(), c.model.intrinsics().model);
 }
 
 double PoseDistance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -95,8 +95,8 @@ TEST(PtzSession, SetStateIsClampedAndOneUndoStep) {
   EXPECT_EQ(now.world_from_camera.matrix(), expected.world_from_camera.matrix());
   EXPECT_EQ(now.model.intrinsics().fx, Focal(before, 45));
   // The pose closed form: pan 40 about +z, tilt -20 about the camera's x after it.
-  const Mat3 R = Eigen::AngleAxisd(40 * kDeg, Vec3::UnitZ()) * h0.home.linear() *
-                 Eigen::AngleAxisd(-20 * kDeg, Vec3::UnitX());
+  const Mat3 R = Eigen::AngleAxisd(40 * kRadPerDeg, Vec3::UnitZ()) * h0.home.linear() *
+                 Eigen::AngleAxisd(-20 * kRadPerDeg, Vec3::UnitX());
   EXPECT_LT((now.world_from_camera.linear() - R).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_EQ(session.rig().undo_label(), "pan/tilt/zoom dome");
   EXPECT_EQ(session.rig().Unsaved(), std::vector<int>{0});
@@ -107,7 +107,7 @@ TEST(PtzSession, SetStateIsClampedAndOneUndoStep) {
   EXPECT_DOUBLE_EQ(h.current.pan_deg, -160);
   EXPECT_EQ(h.current.tilt_deg, -75);
   EXPECT_DOUBLE_EQ(h.current.focal, Focal(before, 60));
-  EXPECT_DOUBLE_EQ(HfovFromFocal(session.rig().rig().cameras[0].model.intrinsics().fx, 1280, LensModel::kPinhole) / kDeg, 60);
+  EXPECT_DOUBLE_EQ(HfovFromFocal(session.rig().rig().cameras[0].model.intrinsics().fx, 1280, LensModel::kPinhole) / kRadPerDeg, 60);
 
   ASSERT_TRUE(session.rig().Undo());
   ASSERT_TRUE(session.rig().Undo());
@@ -217,8 +217,8 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
   EXPECT_EQ(m.ptz->home.linear(), h.home.linear());
   // A turn of 25 degrees about the pan axis and a roll: pan 25, tilt 0, the roll dropped.
   Camera turned = cam;
-  turned.world_from_camera.linear() = Eigen::AngleAxisd(25 * kDeg, Vec3::UnitZ()) * cam.world_from_camera.linear() *
-                                      Eigen::AngleAxisd(7 * kDeg, Vec3::UnitZ());
+  turned.world_from_camera.linear() = Eigen::AngleAxisd(25 * kRadPerDeg, Vec3::UnitZ()) * cam.world_from_camera.linear() *
+                                      Eigen::AngleAxisd(7 * kRadPerDeg, Vec3::UnitZ());
   bool clamped = true;
   const Camera t = PtzFollow(cam, turned, &clamped);
   EXPECT_FALSE(clamped);
@@ -227,13 +227,13 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
   EXPECT_LT(PoseDistance(t.world_from_camera, h.Pose({25, 0, h.current.focal})), 1e-12);
   // Aimed 50 degrees below home's axis: tilt -50; 20 above: clamped at the range's 10.
   Camera down = cam;
-  down.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(-50 * kDeg, Vec3::UnitX());
+  down.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(-50 * kRadPerDeg, Vec3::UnitX());
   const Camera d = PtzFollow(cam, down, &clamped);
   EXPECT_FALSE(clamped);
   EXPECT_NEAR(d.ptz->current.tilt_deg, -50, 1e-12);
   EXPECT_NEAR(d.ptz->current.pan_deg, 0, 1e-12);
   Camera up = cam;
-  up.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(20 * kDeg, Vec3::UnitX());
+  up.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(20 * kRadPerDeg, Vec3::UnitX());
   const Camera u = PtzFollow(cam, up, &clamped);
   EXPECT_TRUE(clamped);
   EXPECT_EQ(u.ptz->current.tilt_deg, 10);

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "render/report/plot.h"
+#include "analysis/units.h"
 
 namespace pandora::report {
 namespace {
@@ -193,7 +194,7 @@ AccuracySection MonteCarloSection(const MonteCarloStudy& mc, int threads) {
     frob.x.push_back(r.seconds_per_point);
     frob.y.push_back(100 * r.frob_mean);
     guide.x.push_back(r.seconds_per_point);
-    guide.y.push_back(100 / std::sqrt(M_PI * r.trials));
+    guide.y.push_back(100 / std::sqrt(kPi * r.trials));
   }
   section.table.AddRow({"prediction", std::to_string(mc.points.size()), Cell("%.3g", mc.prediction_seconds),
                         "(reference)", "", "", "", "", "1"});

@@ -33,11 +33,11 @@
 #include "volume/fields.h"
 #include "volume/slice.h"
 #include "volume/summary.h"
+#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 std::string g_glfw_error;
 void OnGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (" + std::to_string(code) + ")"; }
@@ -77,7 +77,7 @@ struct Projector {
   double f = 1, cx = 0, cy = 0;
   explicit Projector(const RenderView& v) {
     camera_from_world = LookAt(v.from, v.at, v.up)->inverse();
-    f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * kDeg);
+    f = 0.5 * v.width / std::tan(0.5 * v.fov_deg * kRadPerDeg);
     cx = 0.5 * v.width - 0.5;
     cy = 0.5 * v.height - 0.5;
   }
@@ -714,7 +714,7 @@ struct ViewerApp::Impl {
       const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
       const bool ring_hot = (drag == Drag::kRing && drag_handle == k) || (drag == Drag::kNone && hover_handle == k + 3);
       for (int i = 0; i < 48; ++i) {
-        const double t0 = 2 * M_PI * i / 48, t1 = 2 * M_PI * (i + 1) / 48;
+        const double t0 = 2 * kPi * i / 48, t1 = 2 * kPi * (i + 1) / 48;
         const Vec3 p0 = o + 0.8 * len * (std::cos(t0) * u + std::sin(t0) * v);
         const Vec3 p1 = o + 0.8 * len * (std::cos(t1) * u + std::sin(t1) * v);
         if (P.Segment(p0, p1, &a, &b)) dl->AddLine(a, b, axis_col[k] & 0xB0FFFFFF, ring_hot ? 3.5f : 1.5f);
@@ -742,7 +742,7 @@ struct ViewerApp::Impl {
       if (!rings) continue;
       const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
       for (int i = 0; i < 48; ++i) {
-        const double t0 = 2 * M_PI * i / 48, t1 = 2 * M_PI * (i + 1) / 48;
+        const double t0 = 2 * kPi * i / 48, t1 = 2 * kPi * (i + 1) / 48;
         if (P.Segment(o + 0.8 * len * (std::cos(t0) * u + std::sin(t0) * v),
                       o + 0.8 * len * (std::cos(t1) * u + std::sin(t1) * v), &a, &b)) {
           const double d = SegmentDistance(m, a, b);
@@ -829,7 +829,7 @@ struct ViewerApp::Impl {
     } else {
       const auto angle = SweptAngle(drag_ray, *ray, o, axis);
       if (!angle) return;
-      const double total = Snap(*angle / kDeg, rotate_step);
+      const double total = Snap(*angle / kRadPerDeg, rotate_step);
       if (total == applied) return;
       Action a = Make(Action::Kind::kRotate, SelectedIds());
       a.a = axis;
@@ -1060,7 +1060,7 @@ struct ViewerApp::Impl {
       Do(a);
     }
     const Intrinsics& k = cam.model.intrinsics();
-    float hfov = float(HfovFromFocal(k.fx, k.width, k.model) / kDeg);
+    float hfov = float(HfovFromFocal(k.fx, k.width, k.model) / kRadPerDeg);
     if (ImGui::DragFloat("hfov deg", &hfov, 0.1f, 1.0f, k.model == LensModel::kFisheye ? 359.0f : 179.0f, "%.1f")) {
       Action a = Make(Action::Kind::kHfov, {cam.id});
       a.number = hfov;
@@ -1081,7 +1081,7 @@ struct ViewerApp::Impl {
     const PtzHead& h = *cam.ptz;
     if (!ImGui::CollapsingHeader("Pan / tilt / zoom", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const Intrinsics& k = cam.model.intrinsics();
-    auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kDeg); };
+    auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kRadPerDeg); };
     const Vec3 pivot = h.home.translation();
     ImGui::TextDisabled("pivot %.3f %.3f %.3f, home elevation %.1f deg", pivot.x(), pivot.y(), pivot.z(),
                         h.HomeElevationDeg());
@@ -1785,7 +1785,7 @@ void ViewerApp::Input(ViewerModel&, const Action& a) {
           pixel(o + (0.6 * len + a.number) * axis);
         } else {
           const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
-          const double t = 0.6 + a.number * kDeg;  // the grip at 0.6 rad round the ring
+          const double t = 0.6 + a.number * kRadPerDeg;  // the grip at 0.6 rad round the ring
           pixel(o + 0.8 * len * (std::cos(t) * u + std::sin(t) * v));
         }
         if (a.text == "release") m.script_gizmo.reset();

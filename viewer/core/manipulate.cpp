@@ -1,4 +1,5 @@
 #include "viewer/core/manipulate.h"
+#include "analysis/units.h"
 
 #include <algorithm>
 #include <cmath>
@@ -85,7 +86,7 @@ Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const 
                              StickCurve(axes.left_trigger * 0.5 + 0.5, 0.05));
   const Vec3 move = step * (StickCurve(axes.left_x) * right - StickCurve(axes.left_y) * forward +
                             lift * Vec3::UnitZ());
-  const double turn = degrees_per_second * dt * M_PI / 180.0;
+  const double turn = degrees_per_second * dt * kPi / 180.0;
   const Mat3 yaw = Eigen::AngleAxisd(-turn * StickCurve(axes.right_x), Vec3::UnitZ()).toRotationMatrix();
   const Mat3 pitch = Eigen::AngleAxisd(-turn * StickCurve(axes.right_y), R.col(0)).toRotationMatrix();
   Eigen::Isometry3d out = world_from_camera;

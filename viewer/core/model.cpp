@@ -17,11 +17,11 @@
 #include "viewer/core/manipulate.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
+#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 std::vector<std::string> DefaultFields() { return {"coverage", "cameras", "resolution", "sigma_max"}; }
 
@@ -60,7 +60,7 @@ std::string PtzStatus(const Camera& cam, bool clamped) {
   const PtzState& s = cam.ptz->current;
   char line[200];
   std::snprintf(line, sizeof line, "%s (PTZ): pan %.1f, tilt %.1f, hfov %.1f deg%s", cam.id.c_str(), s.pan_deg,
-                s.tilt_deg, HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kDeg,
+                s.tilt_deg, HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kRadPerDeg,
                 clamped ? " (limited by its ranges)" : "");
   return line;
 }
@@ -210,7 +210,7 @@ RenderView ViewerModel::MainView() const {
   // Panning moves eye and target in the picture's plane: the distance to the cut stays.
   v.from += plan_offset;
   v.at += plan_offset;
-  v.fov_deg = 2.0 * std::atan(std::tan(0.5 * v.fov_deg * M_PI / 180.0) / plan_zoom) * 180.0 / M_PI;
+  v.fov_deg = 2.0 * std::atan(std::tan(0.5 * v.fov_deg * kPi / 180.0) / plan_zoom) * 180.0 / kPi;
   return v;
 }
 
@@ -247,7 +247,7 @@ void ViewerModel::Pan(double dx_px, double dy_px) {
   const Vec3 up = right.cross(forward);
   // The scale at the framed centre: the picture is orthographic to 1 / kPlanDistance.
   const double metres_per_px =
-      2.0 * (v.at - v.from).norm() * std::tan(0.5 * v.fov_deg * M_PI / 180.0) / std::max(width, 1);
+      2.0 * (v.at - v.from).norm() * std::tan(0.5 * v.fov_deg * kPi / 180.0) / std::max(width, 1);
   plan_offset += metres_per_px * (-dx_px * right + dy_px * up);
 }
 
@@ -408,7 +408,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         pivot += rig().cameras[c].center() / double(cams.size());
         poses.push_back(rig().cameras[c].world_from_camera);
       }
-      const Mat3 R = Eigen::AngleAxisd(a.number * kDeg, a.a.normalized()).toRotationMatrix();
+      const Mat3 R = Eigen::AngleAxisd(a.number * kRadPerDeg, a.a.normalized()).toRotationMatrix();
       const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, pivot, Vec3::Zero(), R);
       std::size_t i = 0;
       apply(cams, label("rotate", cams), [&](Camera& cam) { cam.world_from_camera = moved[i++]; });
@@ -439,7 +439,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       const std::vector<int> cams = CameraIndices(a.cameras, a);
       apply(cams, label("zoom", cams), [&](Camera& cam) {
         Intrinsics k = cam.model.intrinsics();
-        const double fx = FocalFromHfov(a.number * kDeg, k.width, k.model);
+        const double fx = FocalFromHfov(a.number * kRadPerDeg, k.width, k.model);
         if (k.model != LensModel::kFisheye && a.number >= 180)
           throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
         k.fy *= fx / k.fx;
@@ -473,8 +473,8 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
           if ((to == LensModel::kFisheye) != (k.model == LensModel::kFisheye)) {
             // Keep the nominal field of view across the projection's change.
             const double hfov = HfovFromFocal(k.fx, k.width, k.model);
-            if (to != LensModel::kFisheye && !(hfov < M_PI))
-              throw InputError(a.where, "", "camera '" + cam.id + "' sees " + std::to_string(int(std::lround(hfov / kDeg))) +
+            if (to != LensModel::kFisheye && !(hfov < kPi))
+              throw InputError(a.where, "", "camera '" + cam.id + "' sees " + std::to_string(int(std::lround(hfov / kRadPerDeg))) +
                                                 " degrees; a " + a.lens + " lens sees less than 180",
                                "narrow its field of view (hfov) first");
             const double fx = FocalFromHfov(hfov, k.width, to);
@@ -759,7 +759,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
           const Intrinsics& k = cam.model.intrinsics();
           if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
             throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
-          s.focal = FocalFromHfov(a.hfov_deg * kDeg, k.width, k.model);
+          s.focal = FocalFromHfov(a.hfov_deg * kRadPerDeg, k.width, k.model);
         }
       }
       const PtzState want = s;
@@ -817,7 +817,7 @@ nlohmann::json ViewerModel::StateJson() const {
     cameras.push_back({{"id", c.id},
                        {"enabled", c.enabled},
                        {"position", {p.x(), p.y(), p.z()}},
-                       {"hfov_deg", HfovFromFocal(k.fx, c.model.width(), k.model) / kDeg},
+                       {"hfov_deg", HfovFromFocal(k.fx, c.model.width(), k.model) / kRadPerDeg},
                        {"resolution", {k.width, k.height}},
                        {"lens", lens},
                        {"range", {c.near, std::isfinite(c.far) ? json(c.far) : json()}},

@@ -1,4 +1,5 @@
 #include "viewer/core/station.h"
+#include "analysis/units.h"
 
 #include <cmath>
 
@@ -40,8 +41,8 @@ Camera DisplayCamera(const ViewingStation& s) {
 
 std::array<Vec3, 8> TrackerCorners(const ViewingStation& s) {
   std::array<Vec3, 8> out;
-  const double tx = std::tan(0.5 * s.tracker_hfov_deg * M_PI / 180.0);
-  const double ty = std::tan(0.5 * s.tracker_vfov_deg * M_PI / 180.0);
+  const double tx = std::tan(0.5 * s.tracker_hfov_deg * kPi / 180.0);
+  const double ty = std::tan(0.5 * s.tracker_vfov_deg * kPi / 180.0);
   const double signs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};  // image y down: top first
   for (int plane = 0; plane < 2; ++plane) {
     const double z = plane == 0 ? s.tracker_near : s.tracker_far;

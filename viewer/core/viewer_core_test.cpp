@@ -21,12 +21,12 @@
 #include "viewer/core/station.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
+#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = M_PI / 180.0;
 
 std::string Read(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -62,7 +62,7 @@ TEST(Navigation, PanMovesThePointUnderTheCursorWithIt) {
   const auto pose = LookAt(after.from, after.at, after.up);
   ASSERT_TRUE(pose);
   const Vec3 local = pose->inverse() * target;
-  const double f = 0.5 * 800 / std::tan(0.5 * 60 * kDeg);
+  const double f = 0.5 * 800 / std::tan(0.5 * 60 * kRadPerDeg);
   EXPECT_NEAR(local.x() / local.z() * f, 100.0, 1e-9);
   EXPECT_NEAR(local.y() / local.z() * f, 0.0, 1e-9);
   (void)before;
@@ -102,9 +102,9 @@ TEST(Manipulate, RingDragSweepsTheAngleAboutTheAxis) {
   const Vec3 eye(0, 0, 10);
   const Ray a{eye, (Vec3(1, 0, 0) - eye).normalized(), 0, 1e30};
   const Ray b{eye, (Vec3(0, 1, 0) - eye).normalized(), 0, 1e30};
-  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), Vec3::UnitZ()), M_PI / 2, 1e-12);
-  EXPECT_NEAR(*SweptAngle(b, a, Vec3::Zero(), Vec3::UnitZ()), -M_PI / 2, 1e-12);
-  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), -Vec3::UnitZ()), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), Vec3::UnitZ()), kPi / 2, 1e-12);
+  EXPECT_NEAR(*SweptAngle(b, a, Vec3::Zero(), Vec3::UnitZ()), -kPi / 2, 1e-12);
+  EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), -Vec3::UnitZ()), -kPi / 2, 1e-12);
   EXPECT_FALSE(SweptAngle(Ray{eye, Vec3(1, 0, 0), 0, 1}, b, Vec3::Zero(), Vec3::UnitZ()));  // parallel
   EXPECT_EQ(Snap(0.26, 0.1), 0.30000000000000004);
   EXPECT_EQ(Snap(-0.24, 0.1), -0.2);
@@ -115,7 +115,7 @@ TEST(Manipulate, GroupsMoveRigidlyAndPickingFindsTheNearestBody) {
   Rig rig = testing::RingRig(4, 2.0, 1.0);
   std::vector<Eigen::Isometry3d> poses;
   for (const Camera& c : rig.cameras) poses.push_back(c.world_from_camera);
-  const Mat3 R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix();
+  const Mat3 R = Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()).toRotationMatrix();
   const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, Vec3::Zero(), Vec3(0, 0, 0.5), R);
   // A quarter turn about the ring's axis takes camera i to camera i + 1's place, lifted 0.5 m.
   for (int i = 0; i < 4; ++i) {
@@ -151,7 +151,7 @@ TEST(Manipulate, FourthPowerStickMapping) {
   turn.right_x = 1;
   for (int i = 0; i < 60; ++i) p = GamepadMove(p, turn, 1.0 / 60, 0.5, 45);
   const Vec3 view = p.linear().col(2);
-  EXPECT_NEAR(std::atan2(view.y(), view.x()), -45 * kDeg, 1e-12);
+  EXPECT_NEAR(std::atan2(view.y(), view.x()), -45 * kRadPerDeg, 1e-12);
   EXPECT_NEAR(view.z(), 0, 1e-12);
 }
 
@@ -199,8 +199,8 @@ TEST(Station, TrackerRangeCorners) {
   s.tracker_far = 2.0;
   const std::array<Vec3, 8> c = TrackerCorners(s);
   // Far top left: 2 m along +X, left (+Y) by 2 tan 45 = 2, up by 2 tan 30.
-  EXPECT_LT((c[4] - Vec3(2, 2, 2 + 2 * std::tan(30 * kDeg))).norm(), 1e-12);
-  EXPECT_LT((c[2] - Vec3(0.5, -0.5, 2 - 0.5 * std::tan(30 * kDeg))).norm(), 1e-12);
+  EXPECT_LT((c[4] - Vec3(2, 2, 2 + 2 * std::tan(30 * kRadPerDeg))).norm(), 1e-12);
+  EXPECT_LT((c[2] - Vec3(0.5, -0.5, 2 - 0.5 * std::tan(30 * kRadPerDeg))).norm(), 1e-12);
 }
 
 void ExpectScriptError(const std::string& text, const std::string& json_path) {
@@ -587,7 +587,7 @@ TEST(ViewerModel, GroupEditsAreOneUndoStep) {
         nullptr);
   EXPECT_NEAR(m.rig().cameras[2].center().z() - original.cameras[2].center().z(), 0.25, 1e-12);
   EXPECT_NEAR(HfovFromFocal(m.rig().cameras[0].model.intrinsics().fx, m.rig().cameras[0].model.width(),
-                            LensModel::kPinhole) / kDeg, 30, 1e-9);
+                            LensModel::kPinhole) / kRadPerDeg, 30, 1e-9);
   EXPECT_FALSE(m.rig().cameras[2].enabled);
   // A drag of three steps on one camera is one undo step; a new drag starts a new one.
   m.Run(ParseScript(R"([{"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true},
@@ -673,7 +673,7 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
   const Intrinsics& f = m.rig().cameras[1].model.intrinsics();
   EXPECT_EQ(f.model, LensModel::kFisheye);
   EXPECT_EQ(f.k4, 0.001);
-  EXPECT_NEAR(HfovFromFocal(f.fx, f.width, LensModel::kFisheye), 50 * kDeg, 1e-12);
+  EXPECT_NEAR(HfovFromFocal(f.fx, f.width, LensModel::kFisheye), 50 * kRadPerDeg, 1e-12);
   run(R"([{"hfov": ")" + b + R"(", "deg": 200}])");
   EXPECT_THROW(run(R"([{"intrinsics": ")" + b + R"(", "model": "pinhole"}])"), InputError);
   run(R"([{"undo": 1}, {"undo": 1}])");
@@ -988,7 +988,7 @@ TEST(ViewerModel, PlanAndElevationViewsAreRenderPlansAndPanWithinThem) {
   // Dolly magnifies: the half field's tangent x 0.85^2, the eye and the cut stay.
   const RenderView panned = m.MainView();
   run(R"([{"dolly": 2}])");
-  EXPECT_NEAR(std::tan(0.5 * m.MainView().fov_deg * kDeg), 0.85 * 0.85 * std::tan(0.5 * panned.fov_deg * kDeg), 1e-12);
+  EXPECT_NEAR(std::tan(0.5 * m.MainView().fov_deg * kRadPerDeg), 0.85 * 0.85 * std::tan(0.5 * panned.fov_deg * kRadPerDeg), 1e-12);
   EXPECT_LT((m.MainView().from - panned.from).norm(), 1e-9);
   // Orbit leaves the plan for a perspective view from above the panned centre, then turns.
   run(R"([{"orbit": [0, 0]}])");
