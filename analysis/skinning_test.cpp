@@ -228,7 +228,6 @@ TEST(Skinning, TheShadowOfTheTurningBoneMovesAsPredicted) {
   const Scene scene = Load(dir, BarScene(dir, &tube, R"({"clip": "bend", "loop": false})", R"({"samples": 7})"));
   const auto parts = MakeSceneParts(scene);
   int checked = 0;
-  const double kPi = kPi;
   for (const TimeSample& sample : scene.TimeSamples()) {
     const auto caster = CasterAtSample(*parts, scene, sample);
     const double theta = 0.5 * kPi * sample.time;

@@ -94,7 +94,6 @@ inline std::string SkinnedTube::Gltf() {
   vertices.clear();
   weights.clear();
   std::vector<std::uint32_t> index;
-  const double kPi = kPi;
   for (const TubeRing& r : rings)
     for (int s = 0; s < segments; ++s) {
       const double a = 2 * kPi * s / segments;
