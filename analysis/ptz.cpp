@@ -278,35 +278,42 @@ bool PtzSees(const Camera& base, const PtzHead& head, const PtzState& s, const V
 
 double PtzHead::CentreSpeedBound() const { return offset.norm() * Rad(pan_speed_deg_s + tilt_speed_deg_s); }
 
+namespace {
+
+// Whether the occlusion segment from `centre` to X is clear (PtzSegmentOccluded); false when they
+// coincide.
+bool SegmentClear(const VisibilityTester& tester, int camera, const Vec3& centre, const Vec3& X) {
+  const Vec3 e = X - centre;
+  Ray segment;
+  segment.origin = centre;
+  segment.t_far = e.norm();
+  if (!(segment.t_far > 0)) return false;
+  segment.direction = e / segment.t_far;
+  return !PtzSegmentOccluded(tester, camera, segment, nullptr);
+}
+
+}  // namespace
+
 int PtzSweptOcclusion(const VisibilityTester& tester, int camera, const Vec3& centre, double r, const Vec3& X) {
   const SurfaceDistance* surfaces = tester.surfaces();
   if (!surfaces || !(r >= 0)) return 0;
-  const Vec3 e = X - centre;
-  const double D = e.norm();
+  const double D = (X - centre).norm();
   if (!(D > 0)) return 0;
   // Only the answer the middle segment has can hold for all: its ray decides which to try (a
   // clearance march towards a surface it would cross ends only near it, many steps in).
-  Ray middle;
-  middle.origin = centre;
-  middle.direction = e / D;
-  middle.t_far = D;
   // PtzSegmentOccluded trims each segment by its own tolerance, which grows with its length in
   // [D - r, D + r]: the clearance covers the most a segment keeps, the crossing must lie inside the
   // least.
-  if (!PtzSegmentOccluded(tester, camera, middle, nullptr))
+  if (SegmentClear(tester, camera, centre, X))
     return surfaces->ConeClear(centre, r, X, tester.Tolerance(camera, std::max(0.0, D - r))) ? 1 : 0;
   return surfaces->ConeBlocked(centre, r, X, tester.Tolerance(camera, D + r)) ? -1 : 0;
-}
-
-bool PtzCanCertifyOcclusion(const PtzTarget& target) {
-  return target.tester && target.tester->surfaces() && target.camera >= 0;
 }
 
 std::optional<std::vector<std::pair<double, double>>> PtzMoveClearWindows(const PtzHead& head, const PtzState& from,
                                                                           const PtzState& to, double t_begin,
                                                                           double t_end, const PtzTarget& target,
                                                                           int max_certificates) {
-  if (!PtzCanCertifyOcclusion(target)) return std::nullopt;
+  if (!target.tester || !target.tester->surfaces() || target.camera < 0) return std::nullopt;
   const VisibilityTester& tester = *target.tester;
   const int camera = target.camera;
   const Vec3& X = target.X;
@@ -315,16 +322,7 @@ std::optional<std::vector<std::pair<double, double>>> PtzMoveClearWindows(const 
     const Eigen::Isometry3d pose = head.Pose(head.Along(from, to, t));
     return pose.translation();
   };
-  auto clear_at = [&](double t) {
-    const Vec3 c = centre(t);
-    const Vec3 e = X - c;
-    Ray segment;
-    segment.origin = c;
-    segment.t_far = e.norm();
-    if (!(segment.t_far > 0)) return false;
-    segment.direction = e / segment.t_far;
-    return !PtzSegmentOccluded(tester, camera, segment, nullptr);
-  };
+  auto clear_at = [&](double t) { return SegmentClear(tester, camera, centre(t), X); };
   std::vector<std::pair<double, double>> found;
   auto add = [&found](double a, double b) {
     if (!(b > a)) return;
@@ -346,7 +344,7 @@ std::optional<std::vector<std::pair<double, double>>> PtzMoveClearWindows(const 
     if (answer != 0) continue;
     if (b - a <= 1e-6 || r <= tester.Tolerance(camera, (X - c).norm())) {
       // Below the tolerance: the ends decide, a change between them bisected.
-      bool ca = clear_at(a);
+      const bool ca = clear_at(a);
       const bool cb = clear_at(b);
       if (ca == cb) {
         if (ca) add(a, b);

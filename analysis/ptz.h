@@ -106,6 +106,8 @@ struct PtzHead {
   /// The fastest the centre of projection moves (m/s): it turns about the pivot at |offset| with an
   /// angular velocity of at most pan + tilt speed (the zoom does not move it).
   double CentreSpeedBound() const;
+  /// Whether a tour moves the centre of projection: an offset and at least two stops (a move).
+  bool TourMovesCentre() const { return !offset.isZero(0.0) && tour.size() >= 2; }
 };
 
 /// Whether `base` at setting `s` of `head` sees X geometrically: inside the image (lens and
@@ -137,8 +139,6 @@ struct PtzTarget {
 /// with the tolerance of the shortest segment; ConeBlocked, with the longest's); 0 when neither
 /// holds or the tester has no triangles.
 int PtzSweptOcclusion(const VisibilityTester& tester, int camera, const Vec3& centre, double r, const Vec3& X);
-/// Whether `target` names a tester holding the scene's triangles (PtzSweptOcclusion can answer).
-bool PtzCanCertifyOcclusion(const PtzTarget& target);
 
 /// Where, in [t_begin, t_end] of the move from `from` to `to` (PtzHead::Along times), the
 /// occlusion segment (PtzSegmentOccluded) from the moving centre to target.X is clear: the span is
@@ -337,8 +337,7 @@ PtzWatch WatchTour(const PtzHead& head, const Camera& base, const std::vector<Pt
           } else if (PtzSees(base, head, mid, target->X, target->min_px_per_m, target->normal)) {
             // The geometry sees X throughout; the moving centre's occlusion certified, else sampled.
             const std::optional<std::vector<std::pair<double, double>>> clear =
-                PtzCanCertifyOcclusion(*target) ? PtzMoveClearWindows(head, leg.from, leg.to, begin, end, *target)
-                                                : std::nullopt;
+                PtzMoveClearWindows(head, leg.from, leg.to, begin, end, *target);
             if (!clear) scan(begin, end);
             else
               for (const auto& [a, b] : *clear) add(leg.start + a, leg.start + b);

@@ -41,7 +41,7 @@ double SceneStructureBytes(const Scene& scene) {
   bool swept = false;
   for (const Rig& rig : scene.rigs)
     for (const Camera& c : rig.cameras)
-      swept = swept || (c.enabled && c.ptz && !c.ptz->offset.isZero(0.0) && c.ptz->tour.size() >= 2);
+      swept = swept || (c.enabled && c.ptz && c.ptz->TourMovesCentre());
   return (swept ? 192.0 + 114.0 : 192.0) * triangles + 4096.0;
 }
 

@@ -43,7 +43,7 @@ bool RigHasPtz(const Rig& rig) {
 
 std::unique_ptr<SurfaceDistance> PtzSweptOccluders(const Scene& scene, const Rig& rig) {
   for (const Camera& c : rig.cameras)
-    if (c.enabled && c.ptz && !c.ptz->offset.isZero(0.0) && c.ptz->tour.size() >= 2)
+    if (c.enabled && c.ptz && c.ptz->TourMovesCentre())
       return std::make_unique<SurfaceDistance>(scene.AllTriangles());
   return nullptr;
 }
