@@ -1,28 +1,27 @@
 // `pandora accuracy`: error against run time for the approximations Pandora makes or could make
-// (issue 3, point 6). The studies are suggest/accuracy.h, their tables, CSV files and plots
-// render/report/accuracy_tables.h; this runs them in turn, prints each table as it is done and
+// (issue 3, point 6). The studies are app/session/accuracy.h, their tables, CSV files and plots
+// app/report/accuracy_tables.h; this runs them in turn, prints each table as it is done and
 // writes every file in one output transaction.
-#include <tbb/global_control.h>
-
 #include <sys/wait.h>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "analysis/error.h"
-#include "analysis/input_file.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/output.h"
-#include "render/report/accuracy_tables.h"
-#include "suggest/accuracy.h"
+#include "app/report/accuracy_tables.h"
+#include "app/session/accuracy.h"
+#include "app/session/study.h"
 
 namespace pandora::app {
 namespace {
@@ -35,10 +34,13 @@ std::string GpuBench(const Scene& scene) {
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
   const std::string bench = (self.parent_path() / "pandora_gl_bench").string();
   if (!std::filesystem::exists(bench))
-    throw InputError("--gpu", "", "the GPU bench " + bench + " is not built", "build the pandora_gl_bench target");
+    throw InputError("--gpu", "", "the GPU bench " + bench + " is not built",
+                     "build the pandora_gl_bench target");
   if (!std::getenv("DISPLAY"))
-    throw InputError("--gpu", "", "needs a display for OpenGL", "run under `xvfb-run -a` on a machine without one");
-  if (scene.views.empty()) throw InputError("--gpu", "", "the scene has no views to render", "add one to \"views\"");
+    throw InputError("--gpu", "", "needs a display for OpenGL",
+                     "run under `xvfb-run -a` on a machine without one");
+  if (scene.views.empty())
+    throw InputError("--gpu", "", "the scene has no views to render", "add one to \"views\"");
   return bench;
 }
 
@@ -50,8 +52,9 @@ report::AccuracySection GpuStudy(const Scene& scene, const Rig& rig, bool quick)
   close(fd);
   const std::string size = quick ? "320x180" : "1280x720";
   const std::string frames = quick ? "1" : "5";
-  std::vector<std::string> args{bench, scene.path, "--rig", rig.name, "--size", size, "--frames", frames,
-                                "--cpu-frames", quick ? "1" : "3", "--csv", name};
+  std::vector<std::string> args{bench,   scene.path, "--rig", rig.name,       "--size",
+                                size,    "--frames", frames,  "--cpu-frames", quick ? "1" : "3",
+                                "--csv", name};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -64,11 +67,15 @@ report::AccuracySection GpuStudy(const Scene& scene, const Rig& rig, bool quick)
   int status = 0;
   waitpid(pid, &status, 0);
   const std::string csv = WIFEXITED(status) && WEXITSTATUS(status) == 0
-                              ? ReadInputFile(name, 1 << 20, "GPU bench output") : std::string();
+                              ? ReadInputFile(name, 1 << 20, "GPU bench output")
+                              : std::string();
   std::remove(name);
-  if (csv.empty()) throw InputError("--gpu", "", "the GPU bench failed (exit " + std::to_string(WEXITSTATUS(status)) + ")");
-  const std::string note = "view '" + scene.views.begin()->first + "' at " + size + ", rig " + rig.name + " (" +
-                           std::to_string(rig.enabled_count()) + " cameras); times are of this machine's GL";
+  if (csv.empty())
+    throw InputError("--gpu", "",
+                     "the GPU bench failed (exit " + std::to_string(WEXITSTATUS(status)) + ")");
+  const std::string note = "view '" + scene.views.begin()->first + "' at " + size + ", rig " +
+                           rig.name + " (" + std::to_string(rig.enabled_count()) +
+                           " cameras); times are of this machine's GL";
   return report::GpuSection(report::ParseGpuAccuracyCsv(csv, bench), note);
 }
 
@@ -79,9 +86,11 @@ int RunAccuracy(const AccuracyArgs& args) {
   const Clock::time_point start = Clock::now();
   const auto study = session::Study::Load(args.scene);  // the scene and its ray caster, once
   const Scene& scene = study->scene();
-  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
+  const Rig rig =
+      session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
   if (args.gpu && !args.disable.empty())  // the GL bench runs the rig as the file has it
-    throw InputError("--disable", "", "cannot be combined with --gpu", "run the GPU study without --disable");
+    throw InputError("--disable", "", "cannot be combined with --gpu",
+                     "run the GPU study without --disable");
   const AccuracyOptions options = args.quick ? AccuracyOptions::Quick() : AccuracyOptions();
   options.Check();
   if (args.gpu) GpuBench(scene);  // a missing display fails now, not after the other studies
@@ -92,9 +101,10 @@ int RunAccuracy(const AccuracyArgs& args) {
   const std::string tables_path = output.Stage((dir / "accuracy_tables.md").string(), "--out");
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  std::printf("accuracy: %s, rig %s (%d cameras), study voxel %g mm, pixel sigma %.3g px, %d threads%s\n",
-              scene.path.c_str(), rig.name.c_str(), rig.enabled_count(), 1e3 * scene.study.voxel_size,
-              scene.study.pixel_sigma, threads, args.quick ? ", quick" : "");
+  std::printf(
+      "accuracy: %s, rig %s (%d cameras), study voxel %g mm, pixel sigma %.3g px, %d threads%s\n",
+      scene.path.c_str(), rig.name.c_str(), rig.enabled_count(), 1e3 * scene.study.voxel_size,
+      scene.study.pixel_sigma, threads, args.quick ? ", quick" : "");
   std::fflush(stdout);
   const RayCaster* caster = &study->caster();
 
@@ -104,7 +114,8 @@ int RunAccuracy(const AccuracyArgs& args) {
     std::printf("%s", section.Text().c_str());
     std::fflush(stdout);
     markdown += section.Markdown();
-    for (const auto& [name, text] : {std::pair{section.csv_name, section.csv}, std::pair{section.svg_name, section.svg}}) {
+    for (const auto& [name, text] :
+         {std::pair{section.csv_name, section.csv}, std::pair{section.svg_name, section.svg}}) {
       const std::string path = (dir / name).string();
       output.Write(path, "--out", text);
       written.push_back(path);
@@ -121,7 +132,8 @@ int RunAccuracy(const AccuracyArgs& args) {
   written.push_back(tables_path);
   output.Commit();
   std::printf("\n%.1f s; wrote", std::chrono::duration<double>(Clock::now() - start).count());
-  for (const std::string& path : written) std::printf(" %s", std::filesystem::path(path).filename().c_str());
+  for (const std::string& path : written)
+    std::printf(" %s", std::filesystem::path(path).filename().c_str());
   std::printf(" in %s\n", args.out.c_str());
   return 0;
 }

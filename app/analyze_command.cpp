@@ -10,23 +10,23 @@
 #include <optional>
 #include <sstream>
 
-#include "analysis/calibration.h"
-#include "analysis/error.h"
-#include "analysis/mesh_io.h"
-#include "analysis/ray_caster.h"
-#include "analysis/motion.h"
-#include "analysis/rig_check.h"
-#include "analysis/surface_targets.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/rig/calibration.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/mesh_io.h"
+#include "analysis/scene/motion.h"
+#include "analysis/scene/scene.h"
+#include "analysis/scene/surface_targets.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
 #include "app/mpi_session.h"
-#include "app/session/session.h"
 #include "app/output.h"
+#include "app/session/session.h"
 #include "volume/fields.h"
 #include "volume/fields_transfer.h"
+#include "volume/pixel_targets.h"
 #include "volume/robustness.h"
 #include "volume/summary.h"
-#include "volume/pixel_targets.h"
 #include "volume/time_fields.h"
 #include "volume/value_spill.h"
 #include "volume/vdb_io.h"
@@ -56,16 +56,18 @@ std::string FormatNumber(double v) {
 // The --fields option: known names, each once, steady-state ones only with a motion model.
 std::vector<std::string> CheckFieldsOption(const std::vector<std::string>& fields,
                                            const Study& study) {
-  if (fields.empty()) throw InputError("--fields", "", "no field given", "e.g. --fields coverage,sigma_max");
+  if (fields.empty())
+    throw InputError("--fields", "", "no field given", "e.g. --fields coverage,sigma_max");
   if (auto problem = CheckFieldList(fields, study.motion.has_value()))
     throw InputError("--fields", "", problem->reason, problem->hint);
   return fields;
 }
 
-// --memory-budget bounds the mesh imports as well (analysis/mesh_io.h).
+// --memory-budget bounds the mesh imports as well (analysis/scene/mesh_io.h).
 std::unique_ptr<ScopedMeshImportBudget> ImportBudget(const AnalyzeArgs& args) {
   if (std::isnan(args.memory_budget_mb) || !(args.memory_budget_mb > 0)) return nullptr;
-  return std::make_unique<ScopedMeshImportBudget>(args.memory_budget_mb * 1048576.0, "--memory-budget");
+  return std::make_unique<ScopedMeshImportBudget>(args.memory_budget_mb * 1048576.0,
+                                                  "--memory-budget");
 }
 
 // The field options of `pandora analyze`: the study's, with --fields and --memory-budget applied.
@@ -74,7 +76,8 @@ FieldOptions AnalyzeFieldOptions(const AnalyzeArgs& args, const Scene& scene) {
   options.scene_path = scene.path;
   if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
   options.fields = scene.study.fields;
-  if (!args.fields.empty()) options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
+  if (!args.fields.empty())
+    options.fields = CheckFieldsOption(SplitFields(args.fields), scene.study);
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
   if (!std::isnan(args.memory_budget_mb)) {
     options.memory_budget_bytes =
@@ -132,7 +135,8 @@ std::map<std::string, std::string> FieldsMetadata(const Scene& scene, const Rig&
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
   if (!(value > 0) || !std::isfinite(value))
-    throw InputError(option, "", std::string("must be a positive number") + (*unit ? " of " : "") + unit);
+    throw InputError(option, "",
+                     std::string("must be a positive number") + (*unit ? " of " : "") + unit);
   return value;
 }
 
@@ -207,7 +211,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
     const nlohmann::json mine{{"seconds", fields.stats.seconds},
                               {"rays", fields.stats.rays},
                               {"point_camera_tests", fields.stats.point_camera_tests}};
-    const std::vector<std::string> parts = mpi.GatherToRoot(mine.dump() + '\n' + SerializePartialFields(fields));
+    const std::vector<std::string> parts =
+        mpi.GatherToRoot(mine.dump() + '\n' + SerializePartialFields(fields));
     if (!root) return 0;
     mpi_summary = {{"ranks", mpi.size()}, {"per_rank", nlohmann::json::array()}};
     mpi_summary["per_rank"].push_back(mine);
@@ -216,7 +221,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
       mpi_summary["per_rank"].push_back(nlohmann::json::parse(parts[r].substr(0, newline)));
       MergePartialFields(parts[r].substr(newline + 1), &fields);
     }
-    mpi_summary["merge_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    mpi_summary["merge_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   // Moving objects: the fields at every time sample; surface targets at each (docs/time.md).
   std::optional<TimeSummary> time;
@@ -225,7 +231,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   if (scene.Animated() || scene.study.targets) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto parts = MakeSceneParts(scene);
-    const double parts_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double parts_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::vector<TimeSample> samples = scene.TimeSamples();
     for (const TimeSample& s : samples) sample_labels.push_back(s.label);
     if (!samples.empty()) {
@@ -242,7 +249,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
     targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
   }
   // Pixel-size targets and DORI classes, from the fields without casting again.
-  std::vector<PixelTargetSummary> pixel_targets = EvaluatePixelTargets(scene, rig, fields, scene.TimeMinCameras(), &fields);
+  std::vector<PixelTargetSummary> pixel_targets =
+      EvaluatePixelTargets(scene, rig, fields, scene.TimeMinCameras(), &fields);
   std::optional<DoriSummary> dori;
   if (scene.study.dori) dori = EvaluateDori(scene, fields, &fields);
   const RayCaster& caster = study->caster();
@@ -261,7 +269,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   typed.dori = dori;
   if (scene.study.calibration)
     typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
-  // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets (docs/failures.md).
+  // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets
+  // (docs/failures.md).
   if (HasCameraSets(fields)) {
     typed.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
     AddCoverageN1Grid(&fields);
@@ -271,7 +280,9 @@ int RunAnalyze(const AnalyzeArgs& args) {
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   if (mpi.active()) summary["mpi"] = mpi_summary;
-  WriteFieldsVdb(std::move(fields), vdb_path, FieldsMetadata(scene, rig, output.run_id()));  // the last use: consumed to keep the peak down
+  WriteFieldsVdb(
+      std::move(fields), vdb_path,
+      FieldsMetadata(scene, rig, output.run_id()));  // the last use: consumed to keep the peak down
   // The process's peak resident memory, the fields written (what the memory budget bounds).
   summary["timing"]["peak_rss_mib"] = PeakRssMiB();
   summary["timing"]["memory_budget_mib"] = options.memory_budget_bytes / 1048576.0;
@@ -296,17 +307,27 @@ namespace {
 // with one line naming where the study (or --fields) asks for it.
 void CheckStreamable(const AnalyzeArgs& args, const Scene& scene, const Rig& rig,
                      const std::vector<std::string>& fields) {
-  const std::string hint = "run without --stream (at a voxel size the memory budget allows), or leave it out";
-  const auto refuse = [&](const std::string& file, const std::string& path, const std::string& what) {
-    throw InputError(file, path, what + " needs the whole fields in memory and is not computed by a streamed run (--stream)", hint);
+  const std::string hint =
+      "run without --stream (at a voxel size the memory budget allows), or leave it out";
+  const auto refuse = [&](const std::string& file, const std::string& path,
+                          const std::string& what) {
+    throw InputError(
+        file, path,
+        what + " needs the whole fields in memory and is not computed by a streamed run (--stream)",
+        hint);
   };
   if (std::find(fields.begin(), fields.end(), "cameras") != fields.end())
-    throw InputError(args.fields.empty() ? scene.path : "--fields", args.fields.empty() ? "$.study.fields" : "",
-                     "the field 'cameras' (per-camera grids, N-1 criticality) is not computed by a streamed run (--stream)",
+    throw InputError(args.fields.empty() ? scene.path : "--fields",
+                     args.fields.empty() ? "$.study.fields" : "",
+                     "the field 'cameras' (per-camera grids, N-1 criticality) is not computed by a "
+                     "streamed run (--stream)",
                      "ask for the others, e.g. --fields coverage,resolution,sigma_max");
   if (RigHasPtz(rig)) refuse(scene.path, "$.rigs", "the PTZ fields of rig '" + rig.name + "'");
-  if (scene.Animated()) refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions", "moving objects' fields over time");
-  if (!scene.study.pixel_targets.empty()) refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
+  if (scene.Animated())
+    refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions",
+           "moving objects' fields over time");
+  if (!scene.study.pixel_targets.empty())
+    refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
 }
 
 std::string Triple(const Eigen::Vector3i& v) {
@@ -315,12 +336,21 @@ std::string Triple(const Eigen::Vector3i& v) {
 
 // The additive part of FieldStats, to send to rank 0 and add up there.
 nlohmann::json StatsToJson(const FieldStats& s) {
-  return {{"region_voxels", s.active_set.region_voxels}, {"solid_voxels", s.active_set.solid_voxels},
-          {"blocks", s.active_set.blocks}, {"culled_blocks", s.active_set.culled_blocks},
-          {"seen", s.seen_voxels}, {"triangulable", s.triangulable_voxels},
-          {"unobservable", s.unobservable_voxels}, {"tests", s.point_camera_tests}, {"rays", s.rays},
-          {"seconds", s.seconds}, {"cpu_seconds", s.cpu_seconds}, {"active_set_seconds", s.active_set_seconds},
-          {"estimated", s.estimated_bytes}, {"histogram", s.coverage_histogram}, {"per_camera", s.per_camera_seen}};
+  return {{"region_voxels", s.active_set.region_voxels},
+          {"solid_voxels", s.active_set.solid_voxels},
+          {"blocks", s.active_set.blocks},
+          {"culled_blocks", s.active_set.culled_blocks},
+          {"seen", s.seen_voxels},
+          {"triangulable", s.triangulable_voxels},
+          {"unobservable", s.unobservable_voxels},
+          {"tests", s.point_camera_tests},
+          {"rays", s.rays},
+          {"seconds", s.seconds},
+          {"cpu_seconds", s.cpu_seconds},
+          {"active_set_seconds", s.active_set_seconds},
+          {"estimated", s.estimated_bytes},
+          {"histogram", s.coverage_histogram},
+          {"per_camera", s.per_camera_seen}};
 }
 
 void AddStats(FieldStats* s, const nlohmann::json& j) {
@@ -351,10 +381,11 @@ nlohmann::json RegionCountsToJson(const std::vector<RegionCounts>& regions) {
 }
 
 // Every process's `counts` (`size` of them), summed at rank 0 (empty on the others).
-std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi, const std::vector<std::int64_t>& counts,
+std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi,
+                                          const std::vector<std::int64_t>& counts,
                                           std::size_t size) {
-  const std::vector<std::string> parts =
-      mpi.GatherToRoot(std::string(reinterpret_cast<const char*>(counts.data()), counts.size() * 8));
+  const std::vector<std::string> parts = mpi.GatherToRoot(
+      std::string(reinterpret_cast<const char*>(counts.data()), counts.size() * 8));
   std::vector<std::int64_t> sum(parts.empty() ? 0 : size, 0);
   for (const std::string& p : parts)
     for (std::size_t i = 0; i < size && i < p.size() / 8; ++i) {
@@ -364,7 +395,6 @@ std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi, const std::vect
     }
   return sum;
 }
-
 
 // What a streamed run reads and plans before anything is staged.
 struct StreamSetup {
@@ -389,24 +419,30 @@ StreamSetup PrepareStream(const AnalyzeArgs& args) {
   FieldOptions& options = setup.options;
   options.solid_trees = &study->solid_trees();
   CheckStreamable(args, scene, rig, options.fields);
-  const double tile_side =
-      std::isnan(args.tile_size) ? 0.0 : CheckPositiveOption("--tile-size", args.tile_size, "metres");
+  const double tile_side = std::isnan(args.tile_size)
+                               ? 0.0
+                               : CheckPositiveOption("--tile-size", args.tile_size, "metres");
   setup.lattice =
       MakeLattice(scene.study.region.box, scene.study.voxel_size,
                   options.voxel_size_option.empty() ? scene.path : options.voxel_size_option,
                   options.voxel_size_option.empty() ? "$.study.voxel_size" : "");
   const VoxelLattice& lattice = setup.lattice;
   // The tiles share the budget with the scene's structures (held for the whole run).
-  setup.tiles = PlanTiles(lattice, options.fields, std::max(0.0, options.memory_budget_bytes - SceneStructureBytes(scene)), tile_side);
+  setup.tiles =
+      PlanTiles(lattice, options.fields,
+                std::max(0.0, options.memory_budget_bytes - SceneStructureBytes(scene)), tile_side);
   const std::vector<BlockColumns>& tiles = setup.tiles;
   constexpr std::size_t kMostTiles = 10000;
   if (tiles.size() > kMostTiles) {
     // Blame what sized the tiles: --tile-size, --memory-budget, or the scene's budget.
-    const bool by_side = !std::isnan(args.tile_size), by_option = !options.memory_budget_option.empty();
-    throw InputError(by_side ? "--tile-size" : by_option ? options.memory_budget_option : scene.path,
+    const bool by_side = !std::isnan(args.tile_size),
+               by_option = !options.memory_budget_option.empty();
+    throw InputError(by_side     ? "--tile-size"
+                     : by_option ? options.memory_budget_option
+                                 : scene.path,
                      by_side || by_option ? "" : "$.study.memory_budget_mb",
-                     "the region would stream in " + std::to_string(tiles.size()) + " tiles, over " +
-                         std::to_string(kMostTiles),
+                     "the region would stream in " + std::to_string(tiles.size()) +
+                         " tiles, over " + std::to_string(kMostTiles),
                      "raise the memory budget, or use larger tiles or a coarser voxel size");
   }
   return setup;
@@ -480,7 +516,8 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   std::vector<std::unique_ptr<ValueSpill>> region_spills(2 * region_count);
   nlohmann::json tile_list = nlohmann::json::array();
   std::vector<std::size_t> mine;
-  for (std::size_t t = std::size_t(mpi.rank()); t < tiles.size(); t += std::size_t(mpi.size())) mine.push_back(t);
+  for (std::size_t t = std::size_t(mpi.rank()); t < tiles.size(); t += std::size_t(mpi.size()))
+    mine.push_back(t);
   ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
                       (mpi.active() ? ", rank 0 of " + std::to_string(mpi.size()) : "") + ")",
                   !(args.quiet || !root));
@@ -491,7 +528,9 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       const std::size_t t = mine[i];
       FieldOptions o = options;
       o.tile = tiles[t];
-      o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
+      o.progress = [&bar, i, n = mine.size()](double f) {
+        bar.Update((double(i) + f) / double(n));
+      };
       Fields f = EvaluateFields(scene, rig, study->caster(), o);
       FieldStats& st = f.stats;
       // DORI classes: the tile's grid, and its counts added up (the shares at the end).
@@ -539,9 +578,12 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
 
   // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
   // spilled values by two rounds of summed counts (only the counts travel).
-  const nlohmann::json part{{"stats", StatsToJson(total)}, {"tiles", tile_list},
-                            {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
-                            {"regions", RegionCountsToJson(regions)}, {"peak_rss_mib", PeakRssMiB()}};
+  const nlohmann::json part{
+      {"stats", StatsToJson(total)},
+      {"tiles", tile_list},
+      {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
+      {"regions", RegionCountsToJson(regions)},
+      {"peak_rss_mib", PeakRssMiB()}};
   const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
   nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
   if (root) {
@@ -569,11 +611,12 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
     // Rank 0 selects the bins from the summed upper counts; every process counts inside them.
     const PercentileBins selection =
         SelectPercentileBins(SumCountsAtRoot(mpi, spill.HighCounts(), 1 << 16), p);
-    const std::string sent = mpi.Broadcast(
-        std::string(reinterpret_cast<const char*>(selection.bins.data()), selection.bins.size() * 4));
+    const std::string sent = mpi.Broadcast(std::string(
+        reinterpret_cast<const char*>(selection.bins.data()), selection.bins.size() * 4));
     std::vector<std::uint32_t> bins(sent.size() / 4);
     std::memcpy(bins.data(), sent.data(), sent.size());
-    return ResolvePercentiles(selection, SumCountsAtRoot(mpi, spill.LowCounts(bins), bins.size() << 16), p.size());
+    return ResolvePercentiles(
+        selection, SumCountsAtRoot(mpi, spill.LowCounts(bins), bins.size() << 16), p.size());
   };
   const auto sum_at_root = [&](std::int64_t count) {
     const std::vector<std::int64_t> sum = SumCountsAtRoot(mpi, {count}, 1);
@@ -588,13 +631,15 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   const std::int64_t steady_meets = target ? sum_at_root(spills[2]->CountAtMost(*target)) : 0;
   // Each region's percentiles, and how many of its voxels have a sigma_max (every process's spill).
   std::vector<RegionSummary> region_summaries;
-  const bool has_sigma = std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
+  const bool has_sigma =
+      std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
   for (std::size_t r = 0; r < region_count; ++r) {
     const auto p10 = percentiles(*region_spills[2 * r], {10});
     const auto sigma_p = percentiles(*region_spills[2 * r + 1], {50, 90});
     const std::int64_t sigma_count = sum_at_root(region_spills[2 * r + 1]->size());
-    region_summaries.push_back(FinishRegion(scene.study.regions[r].first, regions[r], want_resolution,
-                                            has_sigma, sigma_count, p10[0], sigma_p[0], sigma_p[1]));
+    region_summaries.push_back(FinishRegion(scene.study.regions[r].first, regions[r],
+                                            want_resolution, has_sigma, sigma_count, p10[0],
+                                            sigma_p[0], sigma_p[1]));
   }
   if (!root) return 0;
 
@@ -609,11 +654,15 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   Summary typed = Summarize(scene, rig, merged, options.fields, threads, warnings);
   // The percentiles and shares from the spilled values: the same nearest ranks over the same
   // multisets as an in-memory run.
-  if (want_resolution) typed.resolution_px_per_m = ResolutionPercentiles{resolution_p[0], resolution_p[1], resolution_p[2]};
+  if (want_resolution)
+    typed.resolution_px_per_m =
+        ResolutionPercentiles{resolution_p[0], resolution_p[1], resolution_p[2]};
   if (typed.uncertainty) {
     UncertaintySummary& u = *typed.uncertainty;
     const std::int64_t region = merged.stats.active_set.region_voxels;
-    const auto share = [region](std::int64_t n) { return region > 0 ? double(n) / double(region) : 0.0; };
+    const auto share = [region](std::int64_t n) {
+      return region > 0 ? double(n) / double(region) : 0.0;
+    };
     u.sigma_max_mm = SigmaPercentiles{sigma_p[0], sigma_p[1], sigma_p[2]};
     if (u.max_sigma_mm) u.meets_max_sigma = share(sigma_meets);
     if (u.motion) {
@@ -627,7 +676,8 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   }
   typed.regions = std::move(region_summaries);
   if (scene.study.targets)
-    typed.targets = EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());
+    typed.targets =
+        EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());
   if (scene.study.calibration)
     typed.calibration = SimulateCalibration(scene, rig, study->caster(), *scene.study.calibration);
   nlohmann::json summary = typed;

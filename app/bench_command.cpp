@@ -4,18 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
-
 #include <nlohmann/json.hpp>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/output.h"
+#include "app/session/study.h"
 #include "volume/fields.h"
 
 namespace pandora::app {
@@ -48,7 +47,8 @@ int RunBench(const BenchArgs& args) {
   options.record_rays = false;
   const std::vector<Ray> rays = std::move(recorded.recorded_rays);
 
-  // Interleave the two measurements so drifts in machine load hit both alike; keep the best of each.
+  // Interleave the two measurements so drifts in machine load hit both alike; keep the best of
+  // each.
   double best_fields = std::numeric_limits<double>::infinity();
   double best_raw = std::numeric_limits<double>::infinity();
   double best_packet = std::numeric_limits<double>::infinity();
@@ -61,14 +61,16 @@ int RunBench(const BenchArgs& args) {
     const RawOcclusionResult raw = RawEmbreeOcclusion(*caster, rays);
     best_raw = std::min(best_raw, raw.seconds);
     occluded = raw.occluded;
-    best_packet = std::min(best_packet, RawEmbreeOcclusion(*caster, rays, RawMode::kPacket).seconds);
+    best_packet =
+        std::min(best_packet, RawEmbreeOcclusion(*caster, rays, RawMode::kPacket).seconds);
   }
 
   // What the uncertainty fields add over coverage alone (same run, interleaved, best of each).
   FieldOptions coverage_only = options;
   coverage_only.fields = {"coverage"};
   FieldOptions with_uncertainty = options;
-  with_uncertainty.fields = {"coverage", "sigma_max", "sigma_mean", "triangulation_angle", "condition"};
+  with_uncertainty.fields = {"coverage", "sigma_max", "sigma_mean", "triangulation_angle",
+                             "condition"};
   if (scene.study.motion) {
     with_uncertainty.fields.push_back("sigma_max_steady");
     with_uncertainty.fields.push_back("sigma_mean_steady");
@@ -94,28 +96,35 @@ int RunBench(const BenchArgs& args) {
   std::printf("pandora bench: %s, rig %s, %zu triangles, voxel %.4g m, %d threads\n",
               scene.path.c_str(), rig.name.c_str(), caster->triangle_count(),
               scene.study.voxel_size, threads);
-  std::printf("  region voxels %lld, blocks %lld (culled %lld), point-camera tests %lld, rays %lld "
-              "(%zu occluded)\n",
-              (long long)stats.active_set.region_voxels, (long long)stats.active_set.blocks,
-              (long long)stats.active_set.culled_blocks, (long long)stats.point_camera_tests,
-              (long long)stats.rays, occluded);
-  std::printf("  %-44s %9.4f s  %8.2f M tests/s  %8.2f M rays/s\n", "field evaluation (best of runs)",
-              best_fields, stats.point_camera_tests / best_fields / 1e6, stats.rays / best_fields / 1e6);
-  std::printf("  %-44s %9.4f s  %8s            %8.2f M rays/s\n", "raw Embree rtcOccluded1 loop, same rays",
-              best_raw, "", rays.size() / best_raw / 1e6);
+  std::printf(
+      "  region voxels %lld, blocks %lld (culled %lld), point-camera tests %lld, rays %lld "
+      "(%zu occluded)\n",
+      (long long)stats.active_set.region_voxels, (long long)stats.active_set.blocks,
+      (long long)stats.active_set.culled_blocks, (long long)stats.point_camera_tests,
+      (long long)stats.rays, occluded);
+  std::printf("  %-44s %9.4f s  %8.2f M tests/s  %8.2f M rays/s\n",
+              "field evaluation (best of runs)", best_fields,
+              stats.point_camera_tests / best_fields / 1e6, stats.rays / best_fields / 1e6);
+  std::printf("  %-44s %9.4f s  %8s            %8.2f M rays/s\n",
+              "raw Embree rtcOccluded1 loop, same rays", best_raw, "",
+              rays.size() / best_raw / 1e6);
   const std::string packet_label =
       "raw Embree rtcOccluded" + std::to_string(width) + " packets, same rays";
   std::printf("  %-44s %9.4f s  %8s            %8.2f M rays/s\n", packet_label.c_str(), best_packet,
               "", rays.size() / best_packet / 1e6);
-  std::printf("  of the field time, active set (region, solids, culling): %.4f s\n", stats.active_set_seconds);
-  std::printf("  not in it: the solids' search trees, built once per study like the BVH: %d in %.4f s\n",
-              study->solid_trees().built(), study->solid_trees().build_seconds());
+  std::printf("  of the field time, active set (region, solids, culling): %.4f s\n",
+              stats.active_set_seconds);
+  std::printf(
+      "  not in it: the solids' search trees, built once per study like the BVH: %d in %.4f s\n",
+      study->solid_trees().built(), study->solid_trees().build_seconds());
   std::printf("  ratio raw single-ray time / field time = %.3f (target >= 0.8)\n", ratio);
-  std::printf("  ratio raw packet time / field time     = %.3f (target >= 0.8; our overhead over Embree)\n",
-              packet_ratio);
-  std::printf("  coverage alone %.4f s; with %zu uncertainty fields %.4f s: +%.1f%% (target <= 25%%)\n",
-              best_coverage, with_uncertainty.fields.size() - 1, best_uncertainty,
-              100.0 * uncertainty_overhead);
+  std::printf(
+      "  ratio raw packet time / field time     = %.3f (target >= 0.8; our overhead over Embree)\n",
+      packet_ratio);
+  std::printf(
+      "  coverage alone %.4f s; with %zu uncertainty fields %.4f s: +%.1f%% (target <= 25%%)\n",
+      best_coverage, with_uncertainty.fields.size() - 1, best_uncertainty,
+      100.0 * uncertainty_overhead);
   std::printf("  the same in CPU time: %.4f s and %.4f s: +%.1f%% (less disturbed by other load)\n",
               cpu_coverage, cpu_uncertainty, 100.0 * cpu_overhead);
 

@@ -9,18 +9,17 @@
 #include <cstdio>
 #include <ctime>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/output.h"
+#include "app/session/study.h"
 #include "volume/fields.h"
 
 namespace pandora::app {
@@ -94,9 +93,11 @@ int RunIncrementalBench(const BenchArgs& args) {
   const double ratio_cpu = mean_cpu / best_full_cpu;
   const double state_mib = evaluator.state_bytes() / 1048576.0;
 
-  std::printf("pandora bench --incremental: %s, rig %s (%d cameras), voxel %.4g m, %zu fields, %d threads\n",
-              scene.path.c_str(), rig.name.c_str(), n, scene.study.voxel_size,
-              options.fields.size(), threads);
+  std::printf(
+      "pandora bench --incremental: %s, rig %s (%d cameras), voxel %.4g m, %zu fields, %d "
+      "threads\n",
+      scene.path.c_str(), rig.name.c_str(), n, scene.study.voxel_size, options.fields.size(),
+      threads);
   std::printf("  region voxels %lld, rays of a full evaluation %lld\n", (long long)region_voxels,
               (long long)full_rays);
   std::printf("  %-52s %9.4f s\n", "full evaluation (EvaluateFields, best of runs)", best_full);
@@ -104,8 +105,10 @@ int RunIncrementalBench(const BenchArgs& args) {
               "first update of the incremental evaluator", first.seconds, state_mib);
   std::printf("  %-52s %9.4f s  median %.4f s, worst %.4f s (%zu updates)\n",
               "update after moving one camera: mean", mean, median, worst, updates.size());
-  std::printf("  an update re-casts %.1f%% of a full evaluation's rays and re-derives %.1f%% of its voxels\n",
-              100.0 * ray_share, 100.0 * dirty_share);
+  std::printf(
+      "  an update re-casts %.1f%% of a full evaluation's rays and re-derives %.1f%% of its "
+      "voxels\n",
+      100.0 * ray_share, 100.0 * dirty_share);
   std::printf("  ratio update / full = %.3f wall, %.3f CPU (ideal about 1/%d = %.3f)\n", ratio,
               ratio_cpu, n, 1.0 / n);
   std::printf("  edit-to-updated-fields latency: median %.1f ms, worst %.1f ms\n", 1e3 * median,

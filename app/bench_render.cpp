@@ -9,16 +9,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-
 #include <nlohmann/json.hpp>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/options.h"
 #include "app/output.h"
+#include "app/session/study.h"
 #include "render/prepared_scene.h"
 #include "render/progressive.h"
 #include "render/render.h"
@@ -53,7 +52,8 @@ int RunRenderBench(const BenchArgs& args) {
     view.width = width;
     view.height = height;
   }
-  const std::string view_name = args.view.empty() && !scene.views.empty() ? scene.views.begin()->first : args.view;
+  const std::string view_name =
+      args.view.empty() && !scene.views.empty() ? scene.views.begin()->first : args.view;
   const RayCaster* caster = &study->caster();
   const int threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -132,79 +132,98 @@ int RunRenderBench(const BenchArgs& args) {
   const double raw_single = best_primary + best_single;
   const double ratio = best_render / raw;
   const double ratio_single = best_render / raw_single;
-  std::printf("pandora bench --render: %s, rig %s (%d enabled cameras), %zu triangles, %dx%d, view %s, "
-              "%d threads\n",
-              scene.path.c_str(), rig.name.c_str(), rig.enabled_count(), caster->triangle_count(),
-              view.width, view.height, view_name.empty() ? "(from the bounds)" : view_name.c_str(),
-              threads);
+  std::printf(
+      "pandora bench --render: %s, rig %s (%d enabled cameras), %zu triangles, %dx%d, view %s, "
+      "%d threads\n",
+      scene.path.c_str(), rig.name.c_str(), rig.enabled_count(), caster->triangle_count(),
+      view.width, view.height, view_name.empty() ? "(from the bounds)" : view_name.c_str(),
+      threads);
   std::printf("  primary rays %zu (%zu hit), shadow segments %zu (%zu occluded)\n", primary.size(),
               hits, shadow.size(), occluded);
   std::printf("  %-58s %9.4f s\n", "render, PNG defaults (best of runs)", best_render);
   std::printf("  %-58s %9.4f s\n", "render with the EXR layers (best of runs)", best_layers);
   const int packet_width = EmbreePacketWidth(*caster);
   const std::string w = std::to_string(packet_width);
-  std::printf("  %-58s %9.4f s\n", "raw Embree rtcIntersect1 loop, same primary rays", best_primary);
-  std::printf("  %-58s %9.4f s\n", ("raw Embree rtcIntersect" + w + " packets, same primary rays").c_str(),
+  std::printf("  %-58s %9.4f s\n", "raw Embree rtcIntersect1 loop, same primary rays",
+              best_primary);
+  std::printf("  %-58s %9.4f s\n",
+              ("raw Embree rtcIntersect" + w + " packets, same primary rays").c_str(),
               best_primary_packet);
-  std::printf("  %-58s %9.4f s\n", "raw Embree rtcOccluded1 loop, same shadow segments", best_single);
-  std::printf("  %-58s %9.4f s\n", ("raw Embree rtcOccluded" + w + " packets, same shadow segments").c_str(),
+  std::printf("  %-58s %9.4f s\n", "raw Embree rtcOccluded1 loop, same shadow segments",
+              best_single);
+  std::printf("  %-58s %9.4f s\n",
+              ("raw Embree rtcOccluded" + w + " packets, same shadow segments").c_str(),
               best_packet);
-  std::printf("  ratio render / raw single-ray loops (rtcIntersect1 + rtcOccluded1) = %.3f "
-              "(target <= 1.5)\n", ratio_single);
-  std::printf("  ratio render / raw packet loops (rtcIntersect%d + rtcOccluded%d) = %.3f "
-              "(our overhead over Embree itself)\n", packet_width, packet_width, ratio);
-  std::printf("  with the EXR layers: ratio to the single-ray loops = %.3f, to the packet loops = %.3f\n",
-              best_layers / raw_single, best_layers / raw);
-  std::printf("  %-58s %9.4f s\n", "one-shot Render, caster given (preparation per call)", best_render);
-  std::printf("  %-58s %9.4f s\n", "one-shot with its BVH build (as `pandora render`)", best_with_bvh);
+  std::printf(
+      "  ratio render / raw single-ray loops (rtcIntersect1 + rtcOccluded1) = %.3f "
+      "(target <= 1.5)\n",
+      ratio_single);
+  std::printf(
+      "  ratio render / raw packet loops (rtcIntersect%d + rtcOccluded%d) = %.3f "
+      "(our overhead over Embree itself)\n",
+      packet_width, packet_width, ratio);
+  std::printf(
+      "  with the EXR layers: ratio to the single-ray loops = %.3f, to the packet loops = %.3f\n",
+      best_layers / raw_single, best_layers / raw);
+  std::printf("  %-58s %9.4f s\n", "one-shot Render, caster given (preparation per call)",
+              best_render);
+  std::printf("  %-58s %9.4f s\n", "one-shot with its BVH build (as `pandora render`)",
+              best_with_bvh);
   std::printf("  %-58s %9.4f s\n", "prepared Render, per frame", best_prepared);
-  std::printf("  %-58s %9.4f s\n", "hidden-line: one-shot (edges found per call)", best_hidden_once);
+  std::printf("  %-58s %9.4f s\n", "hidden-line: one-shot (edges found per call)",
+              best_hidden_once);
   std::printf("  %-58s %9.4f s\n", "hidden-line: prepared, per frame", best_hidden_prepared);
-  std::printf("  ratio prepared frame / one-shot = %.3f (with the BVH build: %.3f; hidden-line: %.3f)\n",
-              best_prepared / best_render, best_prepared / best_with_bvh,
-              best_hidden_prepared / best_hidden_once);
+  std::printf(
+      "  ratio prepared frame / one-shot = %.3f (with the BVH build: %.3f; hidden-line: %.3f)\n",
+      best_prepared / best_render, best_prepared / best_with_bvh,
+      best_hidden_prepared / best_hidden_once);
   std::printf("  progressive passes after Restart (1 pixel per 8x8, 4x4, 2x2 block, then all):");
-  for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass) std::printf(" %.4f", best_pass[pass]);
+  for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass)
+    std::printf(" %.4f", best_pass[pass]);
   std::printf(" s\n");
-  std::printf("  %-58s %9.4f s\n", "first pass of a new ProgressiveRender (fresh buffers)", best_first_fresh);
-  std::printf("  ratio first pass / prepared full frame = %.3f (new ProgressiveRender: %.3f); "
-              "all passes / prepared full frame = %.3f\n",
-              best_pass[0] / best_prepared, best_first_fresh / best_prepared, best_progressive / best_prepared);
+  std::printf("  %-58s %9.4f s\n", "first pass of a new ProgressiveRender (fresh buffers)",
+              best_first_fresh);
+  std::printf(
+      "  ratio first pass / prepared full frame = %.3f (new ProgressiveRender: %.3f); "
+      "all passes / prepared full frame = %.3f\n",
+      best_pass[0] / best_prepared, best_first_fresh / best_prepared,
+      best_progressive / best_prepared);
   if (!args.json_out.empty()) {
-    nlohmann::json j{{"scene", scene.path},
-                     {"rig", rig.name},
-                     {"cameras", rig.enabled_count()},
-                     {"triangles", caster->triangle_count()},
-                     {"width", view.width},
-                     {"height", view.height},
-                     {"threads", threads},
-                     {"repeat", args.repeat},
-                     {"primary_rays", primary.size()},
-                     {"shadow_rays", shadow.size()},
-                     {"render_seconds", best_render},
-                     {"raw_primary_seconds", best_primary},
-                     {"raw_primary_packet_seconds", best_primary_packet},
-                     {"raw_shadow_packet_seconds", best_packet},
-                     {"packet_width", EmbreePacketWidth(*caster)},
-                     {"raw_shadow_single_seconds", best_single},
-                     {"ratio", ratio},
-                     {"ratio_single", ratio_single},
-                     {"render_with_layers_seconds", best_layers},
-                     {"ratio_with_layers", best_layers / raw},
-                     {"ratio_single_with_layers", best_layers / raw_single},
-                     {"one_shot_seconds", best_render},
-                     {"one_shot_with_bvh_seconds", best_with_bvh},
-                     {"prepared_seconds", best_prepared},
-                     {"hidden_line_one_shot_seconds", best_hidden_once},
-                     {"hidden_line_prepared_seconds", best_hidden_prepared},
-                     {"ratio_prepared_to_one_shot", best_prepared / best_render},
-                     {"ratio_prepared_to_one_shot_with_bvh", best_prepared / best_with_bvh},
-                     {"ratio_hidden_line_prepared_to_one_shot", best_hidden_prepared / best_hidden_once},
-                     {"progressive_pass_seconds", best_pass},
-                     {"progressive_first_pass_fresh_seconds", best_first_fresh},
-                     {"ratio_first_pass_fresh_to_frame", best_first_fresh / best_prepared},
-                     {"ratio_first_pass_to_frame", best_pass[0] / best_prepared},
-                     {"ratio_all_passes_to_frame", best_progressive / best_prepared}};
+    nlohmann::json j{
+        {"scene", scene.path},
+        {"rig", rig.name},
+        {"cameras", rig.enabled_count()},
+        {"triangles", caster->triangle_count()},
+        {"width", view.width},
+        {"height", view.height},
+        {"threads", threads},
+        {"repeat", args.repeat},
+        {"primary_rays", primary.size()},
+        {"shadow_rays", shadow.size()},
+        {"render_seconds", best_render},
+        {"raw_primary_seconds", best_primary},
+        {"raw_primary_packet_seconds", best_primary_packet},
+        {"raw_shadow_packet_seconds", best_packet},
+        {"packet_width", EmbreePacketWidth(*caster)},
+        {"raw_shadow_single_seconds", best_single},
+        {"ratio", ratio},
+        {"ratio_single", ratio_single},
+        {"render_with_layers_seconds", best_layers},
+        {"ratio_with_layers", best_layers / raw},
+        {"ratio_single_with_layers", best_layers / raw_single},
+        {"one_shot_seconds", best_render},
+        {"one_shot_with_bvh_seconds", best_with_bvh},
+        {"prepared_seconds", best_prepared},
+        {"hidden_line_one_shot_seconds", best_hidden_once},
+        {"hidden_line_prepared_seconds", best_hidden_prepared},
+        {"ratio_prepared_to_one_shot", best_prepared / best_render},
+        {"ratio_prepared_to_one_shot_with_bvh", best_prepared / best_with_bvh},
+        {"ratio_hidden_line_prepared_to_one_shot", best_hidden_prepared / best_hidden_once},
+        {"progressive_pass_seconds", best_pass},
+        {"progressive_first_pass_fresh_seconds", best_first_fresh},
+        {"ratio_first_pass_fresh_to_frame", best_first_fresh / best_prepared},
+        {"ratio_first_pass_to_frame", best_pass[0] / best_prepared},
+        {"ratio_all_passes_to_frame", best_progressive / best_prepared}};
     WriteFileAtomically(json_path, j.dump(2) + "\n");
     output.Commit();
   }

@@ -1,7 +1,7 @@
 #pragma once
 /// \file commands.h
-/// The `pandora` subcommands. Each returns the process exit code; bad input throws InputError, which
-/// main() prints as one line and turns into exit code 2.
+/// The `pandora` subcommands. Each returns the process exit code; bad input throws InputError,
+/// which main() prints as one line and turns into exit code 2.
 
 #include <limits>
 #include <string>
@@ -21,8 +21,8 @@ struct AnalyzeArgs {
   std::string rig;
   std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
   std::string out = "out";
-  double voxel_size = kUnset;  ///< kUnset: the scene's study.voxel_size.
-  std::string fields;     ///< Comma-separated; empty: the scene's study.fields.
+  double voxel_size = kUnset;        ///< kUnset: the scene's study.voxel_size.
+  std::string fields;                ///< Comma-separated; empty: the scene's study.fields.
   double memory_budget_mb = kUnset;  ///< MiB; kUnset: the scene's study.memory_budget_mb.
   bool quiet = false;
   /// `--mpi`: one of the processes of `mpirun -n N pandora analyze ...` (docs/scale.md): each
@@ -84,17 +84,17 @@ struct RenderArgs {
   std::string scene;
   std::string rig;
   std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
-  std::string view;            ///< Name in the scene's "views".
+  std::string view;                  ///< Name in the scene's "views".
   /// `--plan` ("plan") or `--elevation SIDE` ("north", "south", "east", "west"): an orthographic
   /// proposal view of the scene's content, camera ids labelled (render/render.h PlanView).
   std::string plan;
   /// The plan's cut height or the elevation's section coordinate (metres); unset: the study
   /// region's face on the eye's side.
   double cut = kUnset;
-  std::string from, at, up;    ///< "X,Y,Z" each.
-  std::string camera;          ///< Camera id: render what that camera images.
-  double fov = kUnset;         ///< Horizontal field of view, degrees.
-  std::string size;            ///< "WxH"; empty: 1280x720, or the camera's resolution with --camera.
+  std::string from, at, up;  ///< "X,Y,Z" each.
+  std::string camera;        ///< Camera id: render what that camera images.
+  double fov = kUnset;       ///< Horizontal field of view, degrees.
+  std::string size;          ///< "WxH"; empty: 1280x720, or the camera's resolution with --camera.
   std::string out = "render.png";
   std::string pattern = "uniform";   ///< uniform | grid
   std::string surface = "material";  ///< material | black | hidden-line | contours
@@ -102,12 +102,12 @@ struct RenderArgs {
   int grid = 32;
   int samples = 1;
   bool no_cameras = false;
-  bool no_key = false;         ///< `--no-key`: no colour key (camera id -> colour) in the image.
-  std::string fields;          ///< fields.vdb for the overlays.
-  std::string slice;           ///< Field shown on a slice plane.
+  bool no_key = false;  ///< `--no-key`: no colour key (camera id -> colour) in the image.
+  std::string fields;   ///< fields.vdb for the overlays.
+  std::string slice;    ///< Field shown on a slice plane.
   std::string slice_axis = "z";
   double slice_at = kUnset;
-  std::string iso;             ///< Field whose isosurface is drawn.
+  std::string iso;  ///< Field whose isosurface is drawn.
   double iso_value = kUnset;
   /// `--time-sample`: the scene at one of the study's time samples (docs/time.md): its number
   /// (1-based), its pose name or its label; empty: the scene as placed.
@@ -122,8 +122,8 @@ struct RenderArgs {
 int RunRender(const RenderArgs& args);
 
 /// `pandora export-surface`: the scene's surfaces sampled every `spacing` metres (area-weighted,
-/// deterministic), each sample with coverage, resolution and sigma_max for `rig`, written as a binary
-/// PLY point cloud (volume/surface.h, docs/report.md).
+/// deterministic), each sample with coverage, resolution and sigma_max for `rig`, written as a
+/// binary PLY point cloud (volume/surface.h, docs/report.md).
 struct ExportSurfaceArgs {
   std::string scene;
   std::string rig;
@@ -142,44 +142,45 @@ int RunExportSurface(const ExportSurfaceArgs& args);
 /// histograms, the camera table and the summary numbers, the rigs side by side (docs/report.md).
 struct ReportArgs {
   std::string scene;
-  std::vector<std::string> rigs;  ///< Names (each may be comma-separated); empty: every rig.
+  std::vector<std::string> rigs;     ///< Names (each may be comma-separated); empty: every rig.
   std::vector<std::string> disable;  ///< --disable: camera ids disabled in every rig that has them.
   std::string out = "report";
-  double voxel_size = kUnset;     ///< kUnset: the scene's study.voxel_size.
-  int width = 640;                ///< Pixels across the renders from the named views.
-  int camera_width = 320;         ///< Pixels across each camera's own view.
-  double brightness = kUnset;     ///< Scale of every camera's light; kUnset: DefaultBrightness.
+  double voxel_size = kUnset;  ///< kUnset: the scene's study.voxel_size.
+  int width = 640;             ///< Pixels across the renders from the named views.
+  int camera_width = 320;      ///< Pixels across each camera's own view.
+  double brightness = kUnset;  ///< Scale of every camera's light; kUnset: DefaultBrightness.
   bool quiet = false;
 };
 int RunReport(const ReportArgs& args);
-/// `pandora suggest` (issue 5): nudge the selected cameras within limits (docs/suggest.md); prints the
-/// before/after table and writes the suggestion file. With `compare_baseline` also runs the random
-/// local search with the same evaluation budget and writes CSV + SVG of objective against time.
+/// `pandora suggest` (issue 5): nudge the selected cameras within limits (docs/suggest.md); prints
+/// the before/after table and writes the suggestion file. With `compare_baseline` also runs the
+/// random local search with the same evaluation budget and writes CSV + SVG of objective against
+/// time.
 struct SuggestArgs {
   std::string scene;
   std::string rig;
   std::vector<std::string> disable;  ///< --disable: camera ids disabled for this run.
-  std::string cameras;            ///< Comma-separated camera ids.
-  std::string max_move = "0.3";   ///< Metres: one value, or one per selected camera (commas).
-  std::string max_rotate = "10";  ///< Degrees: likewise.
+  std::string cameras;               ///< Comma-separated camera ids.
+  std::string max_move = "0.3";      ///< Metres: one value, or one per selected camera (commas).
+  std::string max_rotate = "10";     ///< Degrees: likewise.
   std::string objective = "coverage2";
-  std::string weights;            ///< "wc,ws,wr" for the mix.
+  std::string weights;  ///< "wc,ws,wr" for the mix.
   /// Mounts (at most one per camera) and zoom ranges ("MIN,MAX" degrees): each entry applies to all
   /// selected cameras, or to one with an "ID:" prefix.
   std::vector<std::string> rail, plane, mount_box, hfov_range;
-  std::vector<std::string> keep_out;   ///< Boxes "x0,y0,z0,x1,y1,z1".
+  std::vector<std::string> keep_out;  ///< Boxes "x0,y0,z0,x1,y1,z1".
   std::vector<std::string> target_surfaces;
-  bool with_region = false;       ///< Region points as well as surface points.
+  bool with_region = false;  ///< Region points as well as surface points.
   /// `--over-time`: the targets are the study's surface targets at every time sample (each point
   /// tested against its sample's scene); docs/time.md.
   bool over_time = false;
   int points = 1500;
   double snap_move = 0, snap_rotate = 0;
-  double clearance = 0.1;         ///< Metres from every scene surface (`--clearance`).
+  double clearance = 0.1;  ///< Metres from every scene surface (`--clearance`).
   int outer_iterations = 4;
   std::string out = "suggestion.json";
-  std::string perturb;            ///< "MOVE,DEG": benchmark from perturbed poses.
-  std::string compare_baseline;   ///< Output folder for the baseline comparison.
+  std::string perturb;           ///< "MOVE,DEG": benchmark from perturbed poses.
+  std::string compare_baseline;  ///< Output folder for the baseline comparison.
   unsigned long long seed = 1;
   bool quiet = false;
   /// PTZ controller suggestions (docs/ptz.md): "ID:PRESET" (the preset's best setting for the
@@ -223,7 +224,7 @@ int RunAccept(const AcceptArgs& args);
 namespace pandora::app {
 
 /// `pandora export-rig`: the rig as OpenCV YAML, a COLMAP text model (a folder), glTF (meshes and
-/// cameras) or an installation sheet (CSV); analysis/rig_formats.h, docs/tool-chain.md.
+/// cameras) or an installation sheet (CSV); analysis/rig/rig_formats.h, docs/tool-chain.md.
 struct ExportRigArgs {
   std::string scene;
   std::string rig;
@@ -234,7 +235,7 @@ struct ExportRigArgs {
 int RunExportRig(const ExportRigArgs& args);
 
 /// `pandora import-rig`: a calibrated rig (OpenCV YAML or a COLMAP text model) into the scene file
-/// with a backup, compared with the design (suggest/rig_import.h).
+/// with a backup, compared with the design (analysis/rig/rig_import.h).
 struct ImportRigArgs {
   std::string scene;
   std::string format;  ///< opencv | colmap

@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/rig_check.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/output.h"
+#include "app/session/study.h"
 #include "volume/surface.h"
 
 #ifndef PANDORA_VERSION
@@ -23,19 +23,22 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   // Options first: a bad --spacing or --out is reported before the scene's meshes are read.
   CheckPositiveOption("--spacing", args.spacing, "metres");
-  if (args.out.empty()) throw InputError("--out", "", "no output file given", "e.g. --out surface.ply");
+  if (args.out.empty())
+    throw InputError("--out", "", "no output file given", "e.g. --out surface.ply");
   const auto study = session::Study::Load(args.scene);
   const Scene& scene = study->scene();
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::string staged = output.Stage(args.out, "--out");
-  const Rig rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
+  const Rig rig =
+      session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
   const SurfaceSelection selection =
       args.all_surfaces ? SurfaceSelection::kAll : SurfaceSelection::kFacing;
   const std::vector<SurfaceSample> samples =
       SampleSurfaces(scene, args.spacing, args.seed, "--spacing", selection, &rig);
   const RayCaster* caster = &study->caster();
-  const std::vector<PointValues> values = PointEvaluator(scene, rig, *caster).EvaluateSamples(samples);
+  const std::vector<PointValues> values =
+      PointEvaluator(scene, rig, *caster).EvaluateSamples(samples);
 
   std::int64_t seen = 0, triangulable = 0;
   for (const PointValues& v : values) {
@@ -67,8 +70,9 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
                 rig.name.c_str(), samples.size(), spacing, 100.0 * seen / n,
                 100.0 * triangulable / n);
     if (!args.all_surfaces)
-      std::printf("surfaces facing the region or a camera: %.3g of %.3g m^2 (--all-surfaces for all)\n",
-                  SurfaceArea(scene, selection, &rig), SurfaceArea(scene));
+      std::printf(
+          "surfaces facing the region or a camera: %.3g of %.3g m^2 (--all-surfaces for all)\n",
+          SurfaceArea(scene, selection, &rig), SurfaceArea(scene));
     std::printf("wrote %s (%.2f s)\n", args.out.c_str(), seconds);
     std::fflush(stdout);
     for (const Warning& w : CheckRig(scene, rig, *caster))

@@ -6,7 +6,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 
 #ifdef PANDORA_HAVE_MPI
 #include <mpi.h>
@@ -64,7 +64,8 @@ void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
     } catch (const InputError& e) {
       text = e.file() + '\0' + e.json_path() + '\0' + e.reason() + '\0' + e.hint();
     } catch (const std::bad_alloc&) {
-      text = std::string("") + '\0' + "" + '\0' + "out of memory" + '\0' + "close other programs, or lower the work";
+      text = std::string("") + '\0' + "" + '\0' + "out of memory" + '\0' +
+             "close other programs, or lower the work";
     } catch (const std::exception& e) {
       text = std::string("") + '\0' + "" + '\0' + e.what() + '\0' + "";
     }
@@ -80,8 +81,9 @@ void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
     part[k] = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
     at = end == std::string::npos ? text.size() : end + 1;
   }
-  const InputError error(part[0], part[1], part[2] + (first == 0 ? "" : " (on MPI rank " + std::to_string(first) + ")"),
-                         part[3]);
+  const InputError error(
+      part[0], part[1],
+      part[2] + (first == 0 ? "" : " (on MPI rank " + std::to_string(first) + ")"), part[3]);
   // Rank 0 prints the one line before any process exits: mpirun kills the others as soon as one
   // process ends with an error, and rank 0 could be killed before it printed.
   if (rank_ == 0) {
@@ -142,8 +144,9 @@ bool MpiAvailable() { return false; }
 
 MpiSession::MpiSession(bool use) {
   if (use)
-    throw InputError("--mpi", "", "this pandora was built without MPI",
-                     "install libopenmpi-dev and openmpi-bin (scripts/setup.sh does) and build again");
+    throw InputError(
+        "--mpi", "", "this pandora was built without MPI",
+        "install libopenmpi-dev and openmpi-bin (scripts/setup.sh does) and build again");
 }
 
 MpiSession::~MpiSession() = default;
@@ -154,7 +157,9 @@ void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
   if (failure) std::rethrow_exception(failure);
 }
 
-std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) const { return {bytes}; }
+std::vector<std::string> MpiSession::GatherToRoot(const std::string& bytes) const {
+  return {bytes};
+}
 
 std::string MpiSession::Broadcast(const std::string& bytes) const { return bytes; }
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 
 namespace pandora::app {
 
@@ -22,19 +22,22 @@ std::vector<std::string> SplitList(const std::string& text) {
   return out;
 }
 
-std::vector<double> ParseNumbers(const std::string& option, const std::string& text, std::size_t count) {
+std::vector<double> ParseNumbers(const std::string& option, const std::string& text,
+                                 std::size_t count) {
   std::vector<double> out;
   for (const std::string& s : SplitList(text)) {
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
     if (s.empty() || !end || *end != '\0' || !std::isfinite(v))
-      throw InputError(option, "", "'" + text + "' is not a list of " + std::to_string(count) + " numbers",
+      throw InputError(option, "",
+                       "'" + text + "' is not a list of " + std::to_string(count) + " numbers",
                        "separate the numbers with commas");
     out.push_back(v);
   }
   if (out.size() != count)
-    throw InputError(option, "", "expected " + std::to_string(count) + " comma-separated numbers, got " +
-                                     std::to_string(out.size()));
+    throw InputError(option, "",
+                     "expected " + std::to_string(count) + " comma-separated numbers, got " +
+                         std::to_string(out.size()));
   return out;
 }
 
@@ -56,31 +59,36 @@ Aabb ParseBox(const Scene& scene, const std::string& option, const std::string& 
   scene.CheckReach(b.min, option, "the box's min corner");
   scene.CheckReach(b.max, option, "the box's max corner");
   if ((b.min.array() > b.max.array()).any())
-    throw InputError(option, "", "the box's min exceeds its max", "give XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
+    throw InputError(option, "", "the box's min exceeds its max",
+                     "give XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
   return b;
 }
 
 int CameraOption(const Rig& rig, const std::string& option, const std::string& id) {
   const int index = rig.FindCamera(id);
   if (index < 0)
-    throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "cameras: " + rig.CameraIds());
+    throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'",
+                     "cameras: " + rig.CameraIds());
   return index;
 }
 
-RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name, int width,
-                     int height) {
+RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name,
+                     int width, int height) {
   const auto it = scene.views.find(name);
   if (it == scene.views.end()) {
     std::string names;
-    for (const auto& [view_name, view] : scene.views) names += (names.empty() ? "" : ", ") + view_name;
+    for (const auto& [view_name, view] : scene.views)
+      names += (names.empty() ? "" : ", ") + view_name;
     throw InputError(option, "", "no view '" + name + "' in " + scene.path,
-                     names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z" : "views: " + names);
+                     names.empty() ? "the scene defines no views; use --from X,Y,Z --at X,Y,Z"
+                                   : "views: " + names);
   }
   return ViewFromScene(it->second, width, height);
 }
 
 std::string Lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return text;
 }
 

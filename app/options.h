@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 #include "render/render.h"
 
 namespace pandora::app {
@@ -17,7 +17,8 @@ namespace pandora::app {
 std::vector<std::string> SplitList(const std::string& text);
 
 /// Exactly `count` finite numbers separated by commas.
-std::vector<double> ParseNumbers(const std::string& option, const std::string& text, std::size_t count);
+std::vector<double> ParseNumbers(const std::string& option, const std::string& text,
+                                 std::size_t count);
 
 /// Three numbers "X,Y,Z" (a point or a direction); the hint shows an example.
 Vec3 ParseVec3(const std::string& option, const std::string& text);
@@ -30,8 +31,8 @@ int CameraOption(const Rig& rig, const std::string& option, const std::string& i
 
 /// The scene's view `name` at `width` x `height`; an unknown name names the option and lists the
 /// scene's views.
-RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name, int width,
-                     int height);
+RenderView NamedView(const Scene& scene, const std::string& option, const std::string& name,
+                     int width, int height);
 
 /// `text` in lower case (ASCII), for keyword options.
 std::string Lower(std::string text);

@@ -1,14 +1,13 @@
 #include "app/output.h"
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
-
 #include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
 
 namespace pandora::app {
@@ -49,8 +48,8 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
     errno = 0;
     const long v = part.empty() ? 0 : std::strtol(part.c_str(), &end, 10);
     if (part.empty() || *end != '\0' || errno != 0 || v < 1 || v > 16384)
-      throw InputError(option, "", "expected WIDTHxHEIGHT in pixels, 1 to 16384 each, got '" + text + "'",
-                       hint);
+      throw InputError(
+          option, "", "expected WIDTHxHEIGHT in pixels, 1 to 16384 each, got '" + text + "'", hint);
     return static_cast<int>(v);
   };
   if (x == std::string::npos)
@@ -58,7 +57,8 @@ std::pair<int, int> ParseImageSize(const std::string& option, const std::string&
   const int w = side(text.substr(0, x)), h = side(text.substr(x + 1));
   if (static_cast<long long>(w) * h > 64LL * 1024 * 1024)
     throw InputError(option, "",
-                     "'" + text + "' is " + std::to_string(static_cast<long long>(w) * h / 1000000) +
+                     "'" + text + "' is " +
+                         std::to_string(static_cast<long long>(w) * h / 1000000) +
                          " Mpx; at most 64 Mpx (about 40 bytes per pixel with the float layers)",
                      hint);
   return {w, h};

@@ -1,20 +1,19 @@
 #pragma once
 /// \file output.h
 /// Output helpers for the command-line tool: image sizes, the progress bar, and the inputs every
-/// command's OutputTransaction (analysis/output_transaction.h) must not overwrite.
+/// command's OutputTransaction (analysis/util/output_transaction.h) must not overwrite.
 
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/output_transaction.h"
-#include <memory>
-
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/output_transaction.h"
 #include "app/session/study.h"
 
 namespace pandora::app {

@@ -1,10 +1,10 @@
 #pragma once
 /// \file plot.h
-/// Moved: the SVG plots are render/report/plot.h (namespace pandora::report). This forwarding
+/// Moved: the SVG plots are app/report/plot.h (namespace pandora::report). This forwarding
 /// header keeps the commands that still include app/plot.h (suggest_command.cpp) compiling until
-/// they include render/report/plot.h themselves; then delete it.
+/// they include app/report/plot.h themselves; then delete it.
 
-#include "render/report/plot.h"
+#include "app/report/plot.h"
 
 namespace pandora::app {
 using report::BarChart;

@@ -1,16 +1,16 @@
-// `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its own
-// colour (render/render.h), written as PNG or multi-layer OpenEXR.
+// `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its
+// own colour (render/render.h), written as PNG or multi-layer OpenEXR.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
-#include "analysis/error.h"
-#include "analysis/ptz.h"
-#include "app/session/ptz_edit.h"
-#include "analysis/rig_check.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
+#include "app/session/ptz_edit.h"
 #include "app/session/session.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
@@ -26,14 +26,16 @@ int RunRender(const RenderArgs& args) {
     throw InputError("--out", "", "unsupported image type '" + ext + "'",
                      "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
   const bool have_from = !args.from.empty() || !args.at.empty();
-  const int viewpoints =
-      int(!args.view.empty()) + int(have_from) + int(!args.camera.empty()) + int(!args.plan.empty());
+  const int viewpoints = int(!args.view.empty()) + int(have_from) + int(!args.camera.empty()) +
+                         int(!args.plan.empty());
   if (viewpoints > 1)
     throw InputError(!args.view.empty() ? "--view" : (have_from ? "--from" : "--plan"), "",
-                     "give one viewpoint: --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, --plan or --elevation SIDE");
+                     "give one viewpoint: --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, "
+                     "--plan or --elevation SIDE");
   if (viewpoints == 0)
-    throw InputError("--view", "", "no viewpoint given",
-                     "give --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, --plan or --elevation SIDE");
+    throw InputError(
+        "--view", "", "no viewpoint given",
+        "give --view NAME, --from X,Y,Z --at X,Y,Z, --camera ID, --plan or --elevation SIDE");
   if (args.plan.empty() && !std::isnan(args.cut))
     throw InputError("--cut", "", "is for --plan and --elevation");
   if (!args.plan.empty() && !std::isnan(args.fov))
@@ -43,22 +45,34 @@ int RunRender(const RenderArgs& args) {
   if (!std::isnan(args.fov) && !(args.fov > 0 && args.fov < 180))
     throw InputError("--fov", "", "must be in (0, 180) degrees");
   RenderOptions options;
-  if (!std::isnan(args.brightness)) options.brightness = CheckPositiveOption("--brightness", args.brightness, "times one camera's light");
+  if (!std::isnan(args.brightness))
+    options.brightness =
+        CheckPositiveOption("--brightness", args.brightness, "times one camera's light");
   const std::string pattern = Lower(args.pattern);
-  if (pattern == "uniform") options.pattern = Pattern::kUniform;
-  else if (pattern == "grid") options.pattern = Pattern::kGrid;
-  else throw InputError("--pattern", "", "unknown pattern '" + args.pattern + "'", "use uniform or grid");
+  if (pattern == "uniform")
+    options.pattern = Pattern::kUniform;
+  else if (pattern == "grid")
+    options.pattern = Pattern::kGrid;
+  else
+    throw InputError("--pattern", "", "unknown pattern '" + args.pattern + "'",
+                     "use uniform or grid");
   const std::string surface = Lower(args.surface);
-  if (surface == "material") options.surface = Surface::kMaterial;
-  else if (surface == "black") options.surface = Surface::kBlack;
-  else if (surface == "hidden-line") options.surface = Surface::kHiddenLine;
-  else if (surface == "contours") options.surface = Surface::kContours;
+  if (surface == "material")
+    options.surface = Surface::kMaterial;
+  else if (surface == "black")
+    options.surface = Surface::kBlack;
+  else if (surface == "hidden-line")
+    options.surface = Surface::kHiddenLine;
+  else if (surface == "contours")
+    options.surface = Surface::kContours;
   else
     throw InputError("--surface", "", "unknown surface mode '" + args.surface + "'",
                      "use material, black, hidden-line or contours");
-  if (args.grid < 1 || args.grid > 100000) throw InputError("--grid", "", "must be a whole number of camera pixels >= 1");
+  if (args.grid < 1 || args.grid > 100000)
+    throw InputError("--grid", "", "must be a whole number of camera pixels >= 1");
   options.grid_pixels = args.grid;
-  if (args.samples < 1 || args.samples > 16) throw InputError("--samples", "", "must be 1 to 16 (per axis)");
+  if (args.samples < 1 || args.samples > 16)
+    throw InputError("--samples", "", "must be 1 to 16 (per axis)");
   options.samples = args.samples;
   options.overlays.cameras = !args.no_cameras;
   options.overlays.key = !args.no_key;
@@ -69,10 +83,14 @@ int RunRender(const RenderArgs& args) {
   }
   options.overlays.slice_field = args.slice;
   const std::string axis = Lower(args.slice_axis);
-  if (axis == "x") options.overlays.slice_axis = 0;
-  else if (axis == "y") options.overlays.slice_axis = 1;
-  else if (axis == "z") options.overlays.slice_axis = 2;
-  else throw InputError("--slice-axis", "", "must be x, y or z");
+  if (axis == "x")
+    options.overlays.slice_axis = 0;
+  else if (axis == "y")
+    options.overlays.slice_axis = 1;
+  else if (axis == "z")
+    options.overlays.slice_axis = 2;
+  else
+    throw InputError("--slice-axis", "", "must be x, y or z");
   options.overlays.slice_position = args.slice_at;
   if (!std::isnan(args.slice_at) && !(std::abs(args.slice_at) <= SceneLimits::kMaxCoordinate))
     throw InputError("--slice-at", "", "is beyond the limit of 1e7 m on coordinates");
@@ -93,17 +111,20 @@ int RunRender(const RenderArgs& args) {
     const Scene& placed = study->scene();
     const std::vector<TimeSample> samples = placed.TimeSamples();
     if (samples.empty())
-      throw InputError("--time-sample", "", "the scene has no moving objects", "add \"motions\" or an \"animation\" (docs/time.md)");
+      throw InputError("--time-sample", "", "the scene has no moving objects",
+                       "add \"motions\" or an \"animation\" (docs/time.md)");
     int pick = -1;
     for (std::size_t i = 0; i < samples.size(); ++i)
-      if (samples[i].label == args.time_sample || samples[i].label == "pose '" + args.time_sample + "'" ||
+      if (samples[i].label == args.time_sample ||
+          samples[i].label == "pose '" + args.time_sample + "'" ||
           std::to_string(i + 1) == args.time_sample)
         pick = int(i);
     if (pick < 0) {
       std::string labels;
       for (std::size_t i = 0; i < samples.size(); ++i)
         labels += (labels.empty() ? "" : ", ") + std::to_string(i + 1) + " " + samples[i].label;
-      throw InputError("--time-sample", "", "no time sample '" + args.time_sample + "'", "the samples: " + labels);
+      throw InputError("--time-sample", "", "no time sample '" + args.time_sample + "'",
+                       "the samples: " + labels);
     }
     study = session::Study::FromScene(SceneAtSample(placed, samples[pick]), study->text());
   }
@@ -131,9 +152,11 @@ int RunRender(const RenderArgs& args) {
     const Aabb& region = scene.study.region.box;
     double cut = args.cut;
     if (std::isnan(cut)) cut = PlanDefaultCut(region, side);
-    const std::optional<RenderView> plan = PlanView(scene.ContentBounds(), side, w, h, cut, &plan_scale);
+    const std::optional<RenderView> plan =
+        PlanView(scene.ContentBounds(), side, w, h, cut, &plan_scale);
     if (!plan)
-      throw InputError("--elevation", "", "unknown side '" + args.plan + "'", "use north, south, east or west (or --plan)");
+      throw InputError("--elevation", "", "unknown side '" + args.plan + "'",
+                       "use north, south, east or west (or --plan)");
     view = *plan;
     options.overlays.labels = true;
     // Frusta long enough to read on the plan: 4 % of the framed width.
@@ -145,7 +168,8 @@ int RunRender(const RenderArgs& args) {
     scene.CheckReach(view.from, "--from", "the eye");
     scene.CheckReach(view.at, "--at", "the point looked at");
     if (!LookAt(view.from, view.at, view.up))
-      throw InputError("--at", "", "--at equals --from, or --up is parallel to the viewing direction");
+      throw InputError("--at", "",
+                       "--at equals --from, or --up is parallel to the viewing direction");
   }
   if (!std::isnan(args.fov)) view.fov_deg = args.fov;
   if (!args.size.empty()) std::tie(view.width, view.height) = ParseImageSize("--size", args.size);
@@ -175,24 +199,32 @@ int RunRender(const RenderArgs& args) {
   bool any = false;
   const Rig traced = session::PtzTracedRig(rig, ptz_mode, args.ptz_time, &options.ptz_all, &any);
   if (ptz_mode != "single" && !any)
-    throw InputError("--ptz", "", "rig '" + rig.name + "' has no enabled PTZ camera", "add a \"ptz\" block to a camera (docs/ptz.md)");
-  const Image image = ptz_mode == "single"
-                          ? session.Render(view, options, overlays.get(), &stats)
-                          : RenderWithStats(session.study().prepared(), traced, view, options, overlays.get(), &stats);
-  if (ext == ".png") WritePng(image, staged);
-  else WriteExr(image, staged, int(rig.cameras.size()));
+    throw InputError("--ptz", "", "rig '" + rig.name + "' has no enabled PTZ camera",
+                     "add a \"ptz\" block to a camera (docs/ptz.md)");
+  const Image image = ptz_mode == "single" ? session.Render(view, options, overlays.get(), &stats)
+                                           : RenderWithStats(session.study().prepared(), traced,
+                                                             view, options, overlays.get(), &stats);
+  if (ext == ".png")
+    WritePng(image, staged);
+  else
+    WriteExr(image, staged, int(rig.cameras.size()));
   output.Commit();
-  const std::vector<Warning> warnings = args.quiet ? std::vector<Warning>() : CheckRig(scene, rig, session.study().caster());
+  const std::vector<Warning> warnings =
+      args.quiet ? std::vector<Warning>() : CheckRig(scene, rig, session.study().caster());
   if (!args.quiet) {
-    const double brightness =
-        std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
-    std::printf("wrote %s: %dx%d, rig %s (%d enabled cameras, brightness %.3g%s), %zu triangles, %.3f s\n",
-                args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
-                brightness, std::isnan(options.brightness) ? " by default" : "",
-                session.study().caster().triangle_count(), stats.seconds);
+    const double brightness = std::isnan(options.brightness)
+                                  ? DefaultBrightness(rig.enabled_count())
+                                  : options.brightness;
+    std::printf(
+        "wrote %s: %dx%d, rig %s (%d enabled cameras, brightness %.3g%s), %zu triangles, %.3f s\n",
+        args.out.c_str(), image.width, image.height, rig.name.c_str(), rig.enabled_count(),
+        brightness, std::isnan(options.brightness) ? " by default" : "",
+        session.study().caster().triangle_count(), stats.seconds);
     if (plan_scale > 0)
-      std::printf("%s: 1 px = %.3g cm, orthographic to %.2g %% (the eye %.0f times the scene's size away)\n",
-                  args.plan.c_str(), 100 * plan_scale, 100.0 / kPlanDistance, kPlanDistance);
+      std::printf(
+          "%s: 1 px = %.3g cm, orthographic to %.2g %% (the eye %.0f times the scene's size "
+          "away)\n",
+          args.plan.c_str(), 100 * plan_scale, 100.0 / kPlanDistance, kPlanDistance);
     std::fflush(stdout);
     for (const Warning& w : warnings)
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());

@@ -1,18 +1,18 @@
 // `pandora report`: one self-contained HTML page per scene (docs/report.md). The page and its
-// numbers are render/report/report.h; this parses the options, checks them, runs and prints.
+// numbers are app/report/report.h; this parses the options, checks them, runs and prints.
 #include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <sstream>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/rig_check.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
-#include "app/session/study.h"
 #include "app/output.h"
-#include "render/report/report.h"
+#include "app/report/report.h"
+#include "app/session/study.h"
 
 namespace pandora::app {
 namespace {
@@ -31,10 +31,12 @@ std::vector<std::string> SplitList(const std::vector<std::string>& items) {
 
 // --disable: each id disabled in every rig of the report that has it; an id that none of them has
 // (or an empty one) is an error naming the option.
-void DisableInReportRigs(Scene* scene, const std::vector<std::string>& rigs, const std::vector<std::string>& ids) {
+void DisableInReportRigs(Scene* scene, const std::vector<std::string>& rigs,
+                         const std::vector<std::string>& ids) {
   std::vector<Rig*> selected;
   for (Rig& rig : scene->rigs)
-    if (rigs.empty() || std::find(rigs.begin(), rigs.end(), rig.name) != rigs.end()) selected.push_back(&rig);
+    if (rigs.empty() || std::find(rigs.begin(), rigs.end(), rig.name) != rigs.end())
+      selected.push_back(&rig);
   for (const std::string& id : ids) {
     if (id.empty()) throw InputError("--disable", "", "an empty camera id", "e.g. --disable c1,c2");
     bool found = false;
@@ -50,7 +52,8 @@ void DisableInReportRigs(Scene* scene, const std::vector<std::string>& rigs, con
       names += (names.empty() ? "'" : ", '") + rig->name + "'";
       cameras += (cameras.empty() ? "" : "; ") + rig->name + ": " + rig->CameraIds();
     }
-    throw InputError("--disable", "", "no camera '" + id + "' in rig " + names, "cameras: " + cameras);
+    throw InputError("--disable", "", "no camera '" + id + "' in rig " + names,
+                     "cameras: " + cameras);
   }
 }
 
@@ -92,7 +95,8 @@ int RunReport(const ReportArgs& args) {
   const report::ReportFile file = report::WriteReport(report_scene, *caster, data, options, target);
   output.Commit();
   if (!args.quiet) {
-    std::printf("wrote %s (%d images, %.1f MiB)\n", file.path.c_str(), file.images, file.bytes / 1048576.0);
+    std::printf("wrote %s (%d images, %.1f MiB)\n", file.path.c_str(), file.images,
+                file.bytes / 1048576.0);
     std::fflush(stdout);
     for (const report::RigReport& r : data.rigs)
       for (const Warning& w : r.warnings)

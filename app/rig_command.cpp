@@ -5,17 +5,17 @@
 #include <string>
 #include <vector>
 
-#include "analysis/error.h"
-#include "analysis/input_file.h"
-#include "analysis/ray_caster.h"
-#include "analysis/rig_check.h"
-#include "analysis/rig_generators.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/rig/rig_generators.h"
+#include "analysis/scene/scene_text.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
-#include "suggest/scene_text.h"
 #include "suggest/suggestion_file.h"
-#include "analysis/surface_distance.h"
 
 namespace pandora::app {
 namespace {
@@ -27,7 +27,8 @@ int Count(const std::string& option, double v, int max) {
 }
 
 double Positive(const std::string& option, double v) {
-  if (!(v > 0) || !std::isfinite(v)) throw InputError(option, "", "must be a positive number of metres");
+  if (!(v > 0) || !std::isfinite(v))
+    throw InputError(option, "", "must be a positive number of metres");
   return v;
 }
 
@@ -42,7 +43,8 @@ std::string Metres(double v) {
 // wall's face): along the distance's gradient (away from the nearest point), a few steps for
 // corners. The aim point stays. Returns one note per moved camera; throws InputError naming
 // `option` when a camera cannot be cleared (it is inside a solid thicker than the room allows).
-std::vector<std::string> KeepClearance(const Scene& scene, double clearance, const std::string& option,
+std::vector<std::string> KeepClearance(const Scene& scene, double clearance,
+                                       const std::string& option,
                                        std::vector<GeneratedCamera>* cameras) {
   std::vector<std::string> notes;
   const TriangleMesh mesh = scene.AllTriangles();
@@ -58,15 +60,19 @@ std::vector<std::string> KeepClearance(const Scene& scene, double clearance, con
       for (int a = 0; a < 3; ++a) {
         Vec3 e = Vec3::Zero();
         e[a] = h;
-        grad[a] = (distance.Distance(c.position + e, 4 * clearance) - distance.Distance(c.position - e, 4 * clearance)) / (2 * h);
+        grad[a] = (distance.Distance(c.position + e, 4 * clearance) -
+                   distance.Distance(c.position - e, 4 * clearance)) /
+                  (2 * h);
       }
-      if (!(grad.norm() > 1e-6)) grad = (c.look_at - c.position).normalized();  // on a surface: go towards the aim
+      if (!(grad.norm() > 1e-6))
+        grad = (c.look_at - c.position).normalized();  // on a surface: go towards the aim
       c.position += (clearance - d + 1e-6 * clearance) * grad.normalized();
     }
     const double d = distance.Distance(c.position, 2 * clearance);
     if (d < clearance * (1 - 1e-6))
-      throw InputError(option, "", "camera " + c.id + " cannot be kept " + Metres(clearance) +
-                                       " m from every surface (it is " + Metres(d) + " m from one)",
+      throw InputError(option, "",
+                       "camera " + c.id + " cannot be kept " + Metres(clearance) +
+                           " m from every surface (it is " + Metres(d) + " m from one)",
                        "move the layout away from the walls and objects");
     if ((c.position - start).norm() > 0)
       notes.push_back("camera " + c.id + " moved " + Metres((c.position - start).norm()) +
@@ -78,11 +84,13 @@ std::vector<std::string> KeepClearance(const Scene& scene, double clearance, con
 }  // namespace
 
 int RunRig(const RigArgs& args) {
-  const int generators = !args.ring.empty() + !args.grid.empty() + !args.wall_grid.empty() + !args.along.empty();
+  const int generators =
+      !args.ring.empty() + !args.grid.empty() + !args.wall_grid.empty() + !args.along.empty();
   if (generators != 1)
-    throw InputError("--ring", "", generators ? "give one layout, not " + std::to_string(generators)
-                                              : "which layout?",
-                     "one of --ring N, --grid NX,NY, --wall-grid NU,NZ or --along X0,Y0,X1,Y1[,...]");
+    throw InputError(
+        "--ring", "",
+        generators ? "give one layout, not " + std::to_string(generators) : "which layout?",
+        "one of --ring N, --grid NX,NY, --wall-grid NU,NZ or --along X0,Y0,X1,Y1[,...]");
   if (args.name.empty()) throw InputError("--name", "", "the new rig needs a name");
   LoadOptions lo;  // meshes too: the cameras keep their clearance from every surface
   const std::string text = scene_text::ReadJsonText(args.scene, "scene file");
@@ -90,38 +98,49 @@ int RunRig(const RigArgs& args) {
   const Aabb& region = scene.study.region.box;
   const Vec3 aim = args.aim.empty() ? Vec3(region.center()) : ParseVec3("--aim", args.aim);
   const auto [width, height] = ParseImageSize("--resolution", args.resolution);
-  if (!(args.hfov_deg > 0 && args.hfov_deg < 180)) throw InputError("--hfov", "", "must be in (0, 180) degrees");
+  if (!(args.hfov_deg > 0 && args.hfov_deg < 180))
+    throw InputError("--hfov", "", "must be in (0, 180) degrees");
   const std::string prefix = args.prefix.empty() ? args.name + "_" : args.prefix;
   std::vector<GeneratedCamera> cameras;
   if (!args.ring.empty()) {
     const int n = Count("--ring", ParseNumbers("--ring", args.ring, 1)[0], 1000);
-    if (std::isnan(args.radius)) throw InputError("--radius", "", "a ring needs its radius", "e.g. --radius 4");
-    if (std::isnan(args.height)) throw InputError("--height", "", "a ring needs its height", "e.g. --height 2.5");
+    if (std::isnan(args.radius))
+      throw InputError("--radius", "", "a ring needs its radius", "e.g. --radius 4");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "a ring needs its height", "e.g. --height 2.5");
     Vec2 c = region.center().head<2>();
     if (!args.center.empty()) {
       const std::vector<double> xy = ParseNumbers("--center", args.center, 2);
       c = Vec2(xy[0], xy[1]);
     }
-    cameras = RingCameras(n, Vec3(c.x(), c.y(), args.height), Positive("--radius", args.radius), args.start_deg, aim, prefix);
+    cameras = RingCameras(n, Vec3(c.x(), c.y(), args.height), Positive("--radius", args.radius),
+                          args.start_deg, aim, prefix);
   } else if (!args.grid.empty()) {
     const std::vector<double> g = ParseNumbers("--grid", args.grid, 2);
     const int nx = Count("--grid", g[0], 100), ny = Count("--grid", g[1], 100);
-    if (args.rect.empty()) throw InputError("--rect", "", "a ceiling grid needs its rectangle X0,Y0,X1,Y1");
+    if (args.rect.empty())
+      throw InputError("--rect", "", "a ceiling grid needs its rectangle X0,Y0,X1,Y1");
     const std::vector<double> r = ParseNumbers("--rect", args.rect, 4);
-    if (!(r[2] > r[0] && r[3] > r[1])) throw InputError("--rect", "", "expected X0 < X1 and Y0 < Y1");
-    if (std::isnan(args.height)) throw InputError("--height", "", "a ceiling grid needs its height");
+    if (!(r[2] > r[0] && r[3] > r[1]))
+      throw InputError("--rect", "", "expected X0 < X1 and Y0 < Y1");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "a ceiling grid needs its height");
     const Vec3* aimed = args.aim.empty() ? nullptr : &aim;
-    cameras = CeilingGridCameras(nx, ny, Vec2(r[0], r[1]), Vec2(r[2], r[3]), args.height, aimed, prefix);
+    cameras =
+        CeilingGridCameras(nx, ny, Vec2(r[0], r[1]), Vec2(r[2], r[3]), args.height, aimed, prefix);
   } else if (!args.wall_grid.empty()) {
     const std::vector<double> g = ParseNumbers("--wall-grid", args.wall_grid, 2);
     const int nu = Count("--wall-grid", g[0], 100), nz = Count("--wall-grid", g[1], 100);
     if (args.wall.empty()) throw InputError("--wall", "", "a wall grid needs its wall X0,Y0,X1,Y1");
     const std::vector<double> w = ParseNumbers("--wall", args.wall, 4);
-    if (!(std::hypot(w[2] - w[0], w[3] - w[1]) > 0)) throw InputError("--wall", "", "the wall has no length");
-    if (args.z_range.empty()) throw InputError("--z-range", "", "a wall grid needs its heights Z0,Z1");
+    if (!(std::hypot(w[2] - w[0], w[3] - w[1]) > 0))
+      throw InputError("--wall", "", "the wall has no length");
+    if (args.z_range.empty())
+      throw InputError("--z-range", "", "a wall grid needs its heights Z0,Z1");
     const std::vector<double> z = ParseNumbers("--z-range", args.z_range, 2);
     if (!(z[1] >= z[0])) throw InputError("--z-range", "", "expected Z0 <= Z1");
-    cameras = WallGridCameras(nu, nz, Vec2(w[0], w[1]), Vec2(w[2], w[3]), z[0], z[1], args.inset, aim, prefix);
+    cameras = WallGridCameras(nu, nz, Vec2(w[0], w[1]), Vec2(w[2], w[3]), z[0], z[1], args.inset,
+                              aim, prefix);
   } else {
     const std::vector<std::string> items = SplitList(args.along);
     if (items.size() < 4 || items.size() % 2)
@@ -131,21 +150,28 @@ int RunRig(const RigArgs& args) {
     for (std::size_t i = 0; i < xy.size(); i += 2) {
       walls.emplace_back(xy[i], xy[i + 1]);
       if (walls.size() > 1 && !((walls.back() - walls[walls.size() - 2]).norm() > 0))
-        throw InputError("--along", "", "wall " + std::to_string(walls.size() - 1) + " has no length");
+        throw InputError("--along", "",
+                         "wall " + std::to_string(walls.size() - 1) + " has no length");
     }
-    if (args.count < 1 || args.count > 1000) throw InputError("--count", "", "expected 1 to 1000 cameras");
-    if (std::isnan(args.height)) throw InputError("--height", "", "cameras along walls need their height");
+    if (args.count < 1 || args.count > 1000)
+      throw InputError("--count", "", "expected 1 to 1000 cameras");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "cameras along walls need their height");
     cameras = AlongWallsCameras(args.count, walls, args.height, args.inset, aim, prefix);
   }
   // Every camera keeps its clearance from every surface: the inset (walls), at least 5 cm.
-  const std::string layout = !args.ring.empty() ? "--ring" : !args.grid.empty() ? "--grid"
-                             : !args.wall_grid.empty() ? "--wall-grid" : "--along";
-  const double clearance = (layout == "--wall-grid" || layout == "--along") ? std::max(args.inset, 0.05) : 0.05;
+  const std::string layout = !args.ring.empty()        ? "--ring"
+                             : !args.grid.empty()      ? "--grid"
+                             : !args.wall_grid.empty() ? "--wall-grid"
+                                                       : "--along";
+  const double clearance =
+      (layout == "--wall-grid" || layout == "--along") ? std::max(args.inset, 0.05) : 0.05;
   const std::vector<std::string> moved = KeepClearance(scene, clearance, layout, &cameras);
   for (const GeneratedCamera& c : cameras) {
     scene.CheckLength(c.position.norm(), "--ring", "a camera position");
     if (!((c.look_at - c.position).norm() > 1e-9))
-      throw InputError("--aim", "", "camera " + c.id + " sits on the point it should look at", "move --aim");
+      throw InputError("--aim", "", "camera " + c.id + " sits on the point it should look at",
+                       "move --aim");
   }
 
   // The rig in the file's form and units, appended (or replacing the rig of that name).
@@ -186,8 +212,9 @@ int RunRig(const RigArgs& args) {
   } else {
     const std::string backup = ReplaceSceneFileWithBackup(args.scene, text, new_text);
     if (!args.quiet)
-      std::printf("%s rig %s (%zu cameras) in %s (previous file kept as %s)\n", replaced ? "replaced" : "wrote",
-                  args.name.c_str(), cameras.size(), args.scene.c_str(), backup.c_str());
+      std::printf("%s rig %s (%zu cameras) in %s (previous file kept as %s)\n",
+                  replaced ? "replaced" : "wrote", args.name.c_str(), cameras.size(),
+                  args.scene.c_str(), backup.c_str());
   }
   if (!args.quiet)
     for (const std::string& note : moved) std::printf("%s\n", note.c_str());

@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "analysis/error.h"
-#include "analysis/rig_check.h"
-#include "analysis/rig_formats.h"
-#include "analysis/scene.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/rig/rig_formats.h"
+#include "analysis/rig/rig_import.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
 #include "app/output.h"
-#include "suggest/rig_import.h"
 
 namespace pandora::app {
 
@@ -36,9 +36,10 @@ int RunExportRig(const ExportRigArgs& args) {
   if (f == "colmap") {
     const ColmapText model = RigToColmap(rig);
     const std::filesystem::path dir(args.out);
-    for (const auto& [name, text] : {std::pair<std::string, const std::string*>{"cameras.txt", &model.cameras},
-                                     {"images.txt", &model.images},
-                                     {"points3D.txt", &model.points3d}}) {
+    for (const auto& [name, text] :
+         {std::pair<std::string, const std::string*>{"cameras.txt", &model.cameras},
+          {"images.txt", &model.images},
+          {"points3D.txt", &model.points3d}}) {
       output.Write((dir / name).string(), "--out", *text);
       written.push_back((dir / name).string());
     }
@@ -70,11 +71,14 @@ int RunExportRig(const ExportRigArgs& args) {
       const LensCoverage lens = ComputeLensCoverage(c.model);
       const double widest = std::max(lens.hfov_deg, lens.vfov_deg);
       if (widest >= 180.0)
-        warnings.push_back(args.scene + ": camera '" + c.id + "' sees " + std::to_string(int(widest + 0.5)) +
-                           " degrees, but the " + (f == "opencv" ? "OpenCV fisheye" : "COLMAP OPENCV_FISHEYE") +
-                           " model written for it cannot hold rays 90 degrees or more off its axis: that part of its view is lost");
+        warnings.push_back(args.scene + ": camera '" + c.id + "' sees " +
+                           std::to_string(int(widest + 0.5)) + " degrees, but the " +
+                           (f == "opencv" ? "OpenCV fisheye" : "COLMAP OPENCV_FISHEYE") +
+                           " model written for it cannot hold rays 90 degrees or more off its "
+                           "axis: that part of its view is lost");
     }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const std::string& w : warnings) std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   if (!args.quiet) {
     std::printf("rig %s: %zu cameras as %s\n", rig.name.c_str(), rig.cameras.size(), f.c_str());
@@ -86,7 +90,8 @@ int RunExportRig(const ExportRigArgs& args) {
 
 int RunImportRig(const ImportRigArgs& args) {
   if (args.format != "opencv" && args.format != "colmap")
-    throw InputError("--from", "", "unknown format '" + args.format + "'", "opencv or colmap, e.g. --from opencv rig.yml");
+    throw InputError("--from", "", "unknown format '" + args.format + "'",
+                     "opencv or colmap, e.g. --from opencv rig.yml");
   RigImportOptions options;
   options.scene = args.scene;
   options.format = args.format;
@@ -96,12 +101,13 @@ int RunImportRig(const ImportRigArgs& args) {
   const RigImportResult r = ImportRig(options);
   if (!args.quiet) {
     std::printf("%s rig '%s' in %s (%zu cameras); backup %s\n", r.new_rig ? "added" : "updated",
-                r.rig_written.c_str(), r.scene_path.c_str(), r.differences.size(), r.backup_path.c_str());
+                r.rig_written.c_str(), r.scene_path.c_str(), r.differences.size(),
+                r.backup_path.c_str());
     bool any = false;
     for (const RigImportDifference& d : r.differences) any = any || d.in_design;
     if (any) {
-      std::printf("against the design rig '%s':\n%-16s %12s %11s %12s %12s\n", args.rig.c_str(), "camera",
-                  "moved_mm", "turned_deg", "fx_design", "fx_calib");
+      std::printf("against the design rig '%s':\n%-16s %12s %11s %12s %12s\n", args.rig.c_str(),
+                  "camera", "moved_mm", "turned_deg", "fx_design", "fx_calib");
       for (const RigImportDifference& d : r.differences) {
         if (d.in_design)
           std::printf("%-16s %12.3f %11.4f %12.2f %12.2f\n", d.id.c_str(), d.moved_m * 1000.0,

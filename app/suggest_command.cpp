@@ -5,16 +5,16 @@
 #include <filesystem>
 #include <optional>
 
-#include "analysis/error.h"
-#include "analysis/motion.h"
-#include "analysis/ray_caster.h"
-#include "analysis/rig_check.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/motion.h"
+#include "analysis/util/error.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
+#include "app/report/suggest_comparison.h"
 #include "app/session/session.h"
 #include "app/suggest_options.h"
-#include "render/report/suggest_comparison.h"
 #include "suggest/suggestion_file.h"
 #include "suggest/suggestion_text.h"
 
@@ -23,9 +23,11 @@ namespace pandora::app {
 int RunSuggest(const SuggestArgs& args) {
   if (!args.ptz_preset.empty() || !args.ptz_tour.empty()) return RunSuggestPtz(args);
   if (args.cameras.empty())
-    throw InputError("--cameras", "", "which cameras may move?", "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
+    throw InputError("--cameras", "", "which cameras may move?",
+                     "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
   if (!args.target_region.empty())
-    throw InputError("--target-region", "", "is for --ptz-preset and --ptz-tour", "use --target-surface for camera nudges");
+    throw InputError("--target-region", "", "is for --ptz-preset and --ptz-tour",
+                     "use --target-surface for camera nudges");
   // Parse and check: the study through the session layer, then every option against it.
   session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
@@ -56,10 +58,13 @@ int RunSuggest(const SuggestArgs& args) {
   std::optional<double> original;
   if (perturbation) {
     original = EvaluateExact(scene, file_rig, session.study().caster(), targets, options.objective,
-                             options.sample_casters).objective;
-    const Rig perturbed = PerturbCameras(file_rig, options.cameras, (*perturbation)[0], (*perturbation)[1], args.seed);
+                             options.sample_casters)
+                   .objective;
+    const Rig perturbed = PerturbCameras(file_rig, options.cameras, (*perturbation)[0],
+                                         (*perturbation)[1], args.seed);
     std::vector<session::EditableRig::Pose> poses;
-    for (int c : options.cameras) poses.push_back({perturbed.cameras[c].id, perturbed.cameras[c].world_from_camera, 1.0});
+    for (int c : options.cameras)
+      poses.push_back({perturbed.cameras[c].id, perturbed.cameras[c].world_from_camera, 1.0});
     session.rig().SetPoses(poses, "perturb for a benchmark", scene.path);
   }
   const Rig& rig = session.rig().rig();
@@ -75,8 +80,8 @@ int RunSuggest(const SuggestArgs& args) {
   WriteFileAtomically(suggestion_path, text);
   std::optional<report::SuggestComparison> comparison;
   if (!args.compare_baseline.empty()) {
-    comparison = report::CompareWithBaselines(scene, rig, session.study().caster(), targets, options, s,
-                                              args.seed + 1, original);
+    comparison = report::CompareWithBaselines(scene, rig, session.study().caster(), targets,
+                                              options, s, args.seed + 1, original);
     WriteFileAtomically(csv_path, comparison->csv);
     WriteFileAtomically(svg_path, comparison->svg);
   }
@@ -87,7 +92,8 @@ int RunSuggest(const SuggestArgs& args) {
 
   if (!args.quiet) {
     if (comparison) std::printf("\n%s", comparison->table.c_str());
-    std::printf("wrote %s%s\n", args.out.c_str(), s.improved ? "" : " (no improvement: nothing to accept)");
+    std::printf("wrote %s%s\n", args.out.c_str(),
+                s.improved ? "" : " (no improvement: nothing to accept)");
     if (comparison) std::printf("wrote %s.csv and %s.svg\n", stem.c_str(), stem.c_str());
   }
   std::fflush(stdout);
@@ -106,8 +112,8 @@ int RunAccept(const AcceptArgs& args) {
   std::string ids;
   for (const std::string& id : r.accepted) ids += (ids.empty() ? "" : ", ") + id;
   if (!args.quiet) {
-    std::printf("accepted %s into %s (previous file kept as %s)\n", ids.c_str(), r.scene_path.c_str(),
-                r.backup_path.c_str());
+    std::printf("accepted %s into %s (previous file kept as %s)\n", ids.c_str(),
+                r.scene_path.c_str(), r.backup_path.c_str());
     for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
   }
   return 0;

@@ -3,8 +3,8 @@
 #include <cctype>
 #include <cmath>
 
-#include "analysis/error.h"
-#include "analysis/motion.h"
+#include "analysis/scene/motion.h"
+#include "analysis/util/error.h"
 #include "app/options.h"
 
 namespace pandora::app {
@@ -14,7 +14,9 @@ namespace {
 std::vector<double> PerCamera(const char* option, const std::string& value, std::size_t selected) {
   const std::vector<std::string> items = SplitList(value);
   if (items.size() != 1 && items.size() != selected)
-    throw InputError(option, "", "give one value, or one per selected camera (" + std::to_string(selected) + ")");
+    throw InputError(
+        option, "",
+        "give one value, or one per selected camera (" + std::to_string(selected) + ")");
   std::vector<double> out;
   for (const std::string& item : items) out.push_back(ParseNumbers(option, item, 1)[0]);
   out.resize(selected, out.back());
@@ -28,9 +30,12 @@ std::vector<std::size_t> Targets(const char* option, const std::string& entry, c
   const std::size_t colon = entry.find(':');
   *value = colon == std::string::npos ? entry : entry.substr(colon + 1);
   for (std::size_t c = 0; c < selection.size(); ++c)
-    if (colon == std::string::npos || rig.cameras[selection[c]].id == entry.substr(0, colon)) which.push_back(c);
+    if (colon == std::string::npos || rig.cameras[selection[c]].id == entry.substr(0, colon))
+      which.push_back(c);
   if (which.empty() && colon != std::string::npos)
-    throw InputError(option, "", "camera '" + entry.substr(0, colon) + "' is not among the selected cameras (--cameras)");
+    throw InputError(
+        option, "",
+        "camera '" + entry.substr(0, colon) + "' is not among the selected cameras (--cameras)");
   return which;
 }
 
@@ -47,16 +52,20 @@ int PtzCameraOption(const Rig& rig, const std::string& option, const std::string
   std::vector<std::string> ptz;
   for (const Camera& cam : rig.cameras)
     if (cam.ptz && cam.enabled) ptz.push_back(cam.id);
-  if (c < 0) throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "PTZ cameras: " + Names(ptz));
+  if (c < 0)
+    throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'",
+                     "PTZ cameras: " + Names(ptz));
   if (!rig.cameras[c].ptz)
-    throw InputError(option, "", "camera '" + id + "' has no PTZ head", "PTZ cameras: " + Names(ptz));
+    throw InputError(option, "", "camera '" + id + "' has no PTZ head",
+                     "PTZ cameras: " + Names(ptz));
   if (!rig.cameras[c].enabled) throw InputError(option, "", "camera '" + id + "' is disabled");
   return c;
 }
 
-std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::string& option, const std::string& region,
-                                               int points, const std::vector<std::string>& surfaces, bool with_region,
-                                               std::uint64_t seed) {
+std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::string& option,
+                                               const std::string& region, int points,
+                                               const std::vector<std::string>& surfaces,
+                                               bool with_region, std::uint64_t seed) {
   if (region.empty()) return SampleTargets(scene, points, surfaces, with_region, seed);
   std::vector<std::string> names;
   for (const auto& [name, r] : scene.study.regions) {
@@ -67,7 +76,8 @@ std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::st
       return SampleTargets(sub, points, surfaces, with_region, seed);
     }
   }
-  throw InputError(option, "", "no region '" + region + "' in the study", "study.regions: " + Names(names));
+  throw InputError(option, "", "no region '" + region + "' in the study",
+                   "study.regions: " + Names(names));
 }
 
 session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
@@ -81,14 +91,16 @@ session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
 SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
   SuggestOptions options;
   options.scene_path = scene.path;
-  for (const std::string& id : SplitList(args.cameras)) options.cameras.push_back(CameraOption(rig, "--cameras", id));
+  for (const std::string& id : SplitList(args.cameras))
+    options.cameras.push_back(CameraOption(rig, "--cameras", id));
   const std::size_t n = options.cameras.size();
 
   const std::vector<double> moves = PerCamera("--max-move", args.max_move, n);
   const std::vector<double> rotations = PerCamera("--max-rotate", args.max_rotate, n);
   options.limits.assign(n, CameraLimits());
   for (std::size_t c = 0; c < n; ++c) {
-    if (!(moves[c] >= 0)) throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
+    if (!(moves[c] >= 0))
+      throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
     scene.CheckLength(moves[c], "--max-move", "the move");
     if (!(rotations[c] >= 0) || !(rotations[c] < 180))
       throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
@@ -107,7 +119,8 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
       } else {
         const std::vector<double> v = ParseNumbers(option, value, 3);
         m.axis = Vec3(v[0], v[1], v[2]);
-        if (!(m.axis.norm() > 0)) throw InputError(option, "", "the direction must be a non-zero vector");
+        if (!(m.axis.norm() > 0))
+          throw InputError(option, "", "the direction must be a non-zero vector");
       }
       if (++mounts[c] > 1)
         throw InputError(option, "", "give at most one of --rail, --plane, --mount-box per camera");
@@ -115,7 +128,8 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   };
   for (const std::string& e : args.rail) add_mount("--rail", e, MountConstraint::Kind::kLine);
   for (const std::string& e : args.plane) add_mount("--plane", e, MountConstraint::Kind::kPlane);
-  for (const std::string& e : args.mount_box) add_mount("--mount-box", e, MountConstraint::Kind::kBox);
+  for (const std::string& e : args.mount_box)
+    add_mount("--mount-box", e, MountConstraint::Kind::kBox);
   for (const std::string& e : args.hfov_range) {
     std::string value;
     for (std::size_t c : Targets("--hfov-range", e, rig, options.cameras, &value)) {
@@ -126,13 +140,15 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
       options.limits[c].max_hfov_deg = v[1];
     }
   }
-  for (const std::string& box : args.keep_out) options.keep_out.push_back(ParseBox(scene, "--keep-out", box));
+  for (const std::string& box : args.keep_out)
+    options.keep_out.push_back(ParseBox(scene, "--keep-out", box));
 
   const std::optional<Objective> objective = ParseObjective(args.objective);
   if (!objective)
-    throw InputError("--objective", "", "unknown objective '" + args.objective + "'",
-                     "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution, mix, "
-                     "coverage3-n1 (coverageK-n1: after the worst camera failure) or calibration");
+    throw InputError(
+        "--objective", "", "unknown objective '" + args.objective + "'",
+        "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution, mix, "
+        "coverage3-n1 (coverageK-n1: after the worst camera failure) or calibration");
   options.objective = *objective;
   if (!args.weights.empty()) {
     const std::vector<double> w = ParseNumbers("--weights", args.weights, 3);
@@ -153,8 +169,11 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   return options;
 }
 
-std::string ReplaceOptionNames(const std::string& text, const std::function<std::string(const std::string&)>& name) {
-  auto lower = [&](std::size_t i) { return std::islower(static_cast<unsigned char>(text[i])) != 0; };
+std::string ReplaceOptionNames(const std::string& text,
+                               const std::function<std::string(const std::string&)>& name) {
+  auto lower = [&](std::size_t i) {
+    return std::islower(static_cast<unsigned char>(text[i])) != 0;
+  };
   std::string out;
   for (std::size_t i = 0; i < text.size();) {
     if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && lower(i + 2)) {
@@ -169,25 +188,30 @@ std::string ReplaceOptionNames(const std::string& text, const std::function<std:
   return out;
 }
 
-std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
+std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene,
+                                               const Rig& rig) {
   if (args.cameras.empty())
-    throw InputError("--cameras", "", "which cameras may move?", "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
+    throw InputError("--cameras", "", "which cameras may move?",
+                     "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
   auto problem = std::make_shared<SuggestProblem>();
   problem->options = SuggestOptionsFromArgs(args, scene, rig);
   if (args.over_time) {
     // The study's surface targets at every sample, each against its sample's caster.
     if (!args.target_surfaces.empty())
-      throw InputError("--over-time", "", "takes the study's targets; --target-surface is for a static scene",
+      throw InputError("--over-time", "",
+                       "takes the study's targets; --target-surface is for a static scene",
                        "give one of them");
     const std::vector<TimeSample> samples = scene.TimeSamples();
     problem->targets = SampleTimeTargets(scene, samples, args.points, args.seed);
     problem->parts = MakeSceneParts(scene);
     for (const TimeSample& s : samples) {
-      problem->sample_casters.push_back(CasterAtSample(*problem->parts, scene, s));  // skinned parts posed too
+      problem->sample_casters.push_back(
+          CasterAtSample(*problem->parts, scene, s));  // skinned parts posed too
       problem->options.sample_casters.push_back(problem->sample_casters.back().get());
     }
   } else {
-    problem->targets = SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
+    problem->targets =
+        SampleTargets(scene, args.points, args.target_surfaces, args.with_region, args.seed);
   }
   return problem;
 }

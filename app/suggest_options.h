@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ray_caster.h"
+#include "analysis/geometry/ray_caster.h"
 #include "app/commands.h"
 #include "app/session/session.h"
 #include "suggest/suggest.h"
@@ -24,7 +24,8 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
 /// `text` (an error's file, reason or hint) with every command-line option in it ("--max-move")
 /// replaced by `name(option)`: how Python and the viewer's scripts name `pandora suggest`'s options
 /// in the errors of PrepareSuggest.
-std::string ReplaceOptionNames(const std::string& text, const std::function<std::string(const std::string&)>& name);
+std::string ReplaceOptionNames(const std::string& text,
+                               const std::function<std::string(const std::string&)>& name);
 
 /// Everything a camera suggestion runs on: the options and the target points and, over time
 /// (`--over-time`), the moving parts and one ray caster per time sample (options.sample_casters
@@ -40,7 +41,8 @@ struct SuggestProblem {
 /// viewer's Suggest panel all build it here from the same options, so that they optimise the same
 /// objective over the same points (region, named surfaces, or the study's targets at every time
 /// sample). Throws InputError naming the option (--cameras, --over-time, --target-surface, ...).
-std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene, const Rig& rig);
+std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene,
+                                               const Rig& rig);
 
 /// The enabled PTZ camera `id` of `rig` (its index), or InputError naming `option` with the rig's
 /// PTZ cameras as the hint.
@@ -48,8 +50,9 @@ int PtzCameraOption(const Rig& rig, const std::string& option, const std::string
 
 /// SampleTargets over the study region, or over the study's region `region` when it is not empty
 /// (InputError naming `option` and the study's regions when there is none of that name).
-std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::string& option, const std::string& region,
-                                               int points, const std::vector<std::string>& surfaces, bool with_region,
-                                               std::uint64_t seed);
+std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::string& option,
+                                               const std::string& region, int points,
+                                               const std::vector<std::string>& surfaces,
+                                               bool with_region, std::uint64_t seed);
 
 }  // namespace pandora::app

@@ -4,8 +4,8 @@
 
 #include <random>
 
-#include "analysis/camera.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/visibility.h"
 
 namespace pandora {
 namespace {

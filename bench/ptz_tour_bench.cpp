@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ptz.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
-#include "analysis/surface_distance.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 #include "volume/ptz_fields.h"
 
 using namespace pandora;
@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const auto t_build = std::chrono::steady_clock::now();
   const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
-  const double build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
+  const double build_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_build).count();
   if (!surfaces) {
     std::printf("no PTZ camera with a tour and an offset in rig %s\n", argv[2]);
     return 0;
@@ -48,20 +49,24 @@ int main(int argc, char** argv) {
   std::vector<Vec3> points;
   for (int i = 0; i < n; ++i) {
     Vec3 p;
-    for (int a = 0; a < 3; ++a) p[a] = std::uniform_real_distribution<double>(box.min[a], box.max[a])(rng);
+    for (int a = 0; a < 3; ++a)
+      p[a] = std::uniform_real_distribution<double>(box.min[a], box.max[a])(rng);
     points.push_back(p);
   }
   const double px = scene.study.ptz.min_px_per_m;
-  std::printf("%s rig %s: %d points, %zu triangles (hierarchy built in %.3f s, %.1f MiB)\n", argv[1], argv[2], n,
-              surfaces->triangle_count(), build_s, surfaces->bytes() / 1048576.0);
+  std::printf("%s rig %s: %d points, %zu triangles (hierarchy built in %.3f s, %.1f MiB)\n",
+              argv[1], argv[2], n, surfaces->triangle_count(), build_s,
+              surfaces->bytes() / 1048576.0);
   for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c) {
     const Camera& cam = rig.cameras[c];
-    if (!cam.enabled || !cam.ptz || cam.ptz->offset.isZero(0.0) || cam.ptz->tour.size() < 2) continue;
+    if (!cam.enabled || !cam.ptz || cam.ptz->offset.isZero(0.0) || cam.ptz->tour.size() < 2)
+      continue;
     const std::vector<PtzHead::TourLeg> legs = cam.ptz->TourLegs();
     const double period = legs.back().end();
     auto run = [&](const VisibilityTester& tester, std::vector<double>* watched) {
       const auto t0 = std::chrono::steady_clock::now();
-      for (const Vec3& X : points) watched->push_back(PtzTourWatch(tester, c, legs, X, px).watched_s() / period);
+      for (const Vec3& X : points)
+        watched->push_back(PtzTourWatch(tester, c, legs, X, px).watched_s() / period);
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
     std::vector<double> we, ws;
@@ -92,19 +97,24 @@ int main(int argc, char** argv) {
       double brute = 0;
       for (double t = 0.5 * dt; t < period; t += dt) {
         Ray r;
-        if (!PtzSees(cam, *cam.ptz, cam.ptz->TourState(legs, t), points[i], px, nullptr, &r)) continue;
+        if (!PtzSees(cam, *cam.ptz, cam.ptz->TourState(legs, t), points[i], px, nullptr, &r))
+          continue;
         if (!PtzSegmentOccluded(exact, c, r, nullptr)) brute += dt;
       }
       worst_e = std::max(worst_e, std::abs(we[i] * period - brute));
       worst_s = std::max(worst_s, std::abs(ws[i] * period - brute));
     }
-    std::printf("%s (offset %.3f m, period %.1f s): sampled %.3f s, certified %.3f s, ratio %.2f\n", cam.id.c_str(),
-                cam.ptz->offset.norm(), period, ts, te, te / ts);
-    std::printf("  watched mean %.4f %% -> %.4f %%, at some time %.2f %% -> %.2f %%; %d points differ by more than 2 ms "
-                "(largest %.3f s)\n",
-                100 * mean_s, 100 * mean_e, 100.0 * some_s / n, 100.0 * some_e / n, differ, max_diff);
-    std::printf("  there, against a loop every %.1f ms: sampled off by up to %.4f s, certified by up to %.4f s\n", 1e3 * dt,
-                worst_s, worst_e);
+    std::printf("%s (offset %.3f m, period %.1f s): sampled %.3f s, certified %.3f s, ratio %.2f\n",
+                cam.id.c_str(), cam.ptz->offset.norm(), period, ts, te, te / ts);
+    std::printf(
+        "  watched mean %.4f %% -> %.4f %%, at some time %.2f %% -> %.2f %%; %d points differ by "
+        "more than 2 ms "
+        "(largest %.3f s)\n",
+        100 * mean_s, 100 * mean_e, 100.0 * some_s / n, 100.0 * some_e / n, differ, max_diff);
+    std::printf(
+        "  there, against a loop every %.1f ms: sampled off by up to %.4f s, certified by up to "
+        "%.4f s\n",
+        1e3 * dt, worst_s, worst_e);
   }
   return 0;
 }

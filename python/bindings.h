@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/error.h"
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/util/error.h"
 #include "app/session/session.h"
 #include "app/session/study.h"
 
@@ -32,7 +32,9 @@ struct PyRig {
   const Rig& rig() const { return session->rig().rig(); }
   int Index(const std::string& id) const {
     const int c = rig().FindCamera(id);
-    if (c < 0) throw InputError(study->scene().path, "", "no camera '" + id + "' in rig '" + rig().name + "'");
+    if (c < 0)
+      throw InputError(study->scene().path, "",
+                       "no camera '" + id + "' in rig '" + rig().name + "'");
     return c;
   }
 };
@@ -40,7 +42,8 @@ struct PyRig {
 py::array_t<double> Vec3Array(const Vec3& v);
 
 // (N, 3) metres -> points; InputError("points", "[i]") for a non-finite one.
-std::vector<Vec3> Points(const py::array_t<double, py::array::c_style | py::array::forcecast>& points);
+std::vector<Vec3> Points(
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& points);
 
 // Refuses (InputError) an output `path` that is one of the scene's input files (the scene, a mesh).
 void RefuseInputPath(const Scene& scene, const std::string& path, const std::string& what);

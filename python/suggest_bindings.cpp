@@ -16,12 +16,13 @@
 #include <string>
 #include <vector>
 
-#include "analysis/atomic_file.h"
-#include "analysis/camera.h"
-#include "analysis/input_file.h"
-#include "analysis/motion.h"
-#include "analysis/ptz.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/motion.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/input_file.h"
+#include "analysis/util/units.h"
 #include "app/commands.h"
 #include "app/suggest_options.h"
 #include "python/bindings.h"
@@ -30,11 +31,9 @@
 #include "suggest/suggestion_file.h"
 #include "suggest/suggestion_text.h"
 #include "volume/ptz_fields.h"
-#include "analysis/units.h"
 
 namespace pandora::python {
 namespace {
-
 
 // A suggestion for the rig it was made on (camera nudges or a PTZ controller change).
 struct PySuggestion {
@@ -51,7 +50,8 @@ struct PySuggestion {
   int ptz_camera = -1, ptz_preset = -1;
 };
 
-// `pandora suggest`'s option names in errors become the keyword arguments' ("--max-move" -> "max_move").
+// `pandora suggest`'s option names in errors become the keyword arguments' ("--max-move" ->
+// "max_move").
 std::string Keywords(const std::string& text) {
   return app::ReplaceOptionNames(text, [](const std::string& option) {
     std::string word = option.substr(2);
@@ -80,7 +80,8 @@ std::string Join(const std::vector<double>& v) {
 
 // A number, or a list of numbers (one per selected camera) -> "a" or "a,b,c".
 std::string NumberOrList(const py::handle& value, const char* name) {
-  if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) return Num(value.cast<double>());
+  if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value))
+    return Num(value.cast<double>());
   try {
     return Join(value.cast<std::vector<double>>());
   } catch (const py::cast_error&) {
@@ -95,7 +96,8 @@ std::vector<std::string> PerCameraEntries(const py::object& value, F format) {
   std::vector<std::string> out;
   if (value.is_none()) return out;
   if (py::isinstance<py::dict>(value)) {
-    for (const auto& [id, v] : value.cast<py::dict>()) out.push_back(py::str(id).cast<std::string>() + ":" + format(v));
+    for (const auto& [id, v] : value.cast<py::dict>())
+      out.push_back(py::str(id).cast<std::string>() + ":" + format(v));
   } else {
     out.push_back(format(value));
   }
@@ -103,7 +105,8 @@ std::vector<std::string> PerCameraEntries(const py::object& value, F format) {
 }
 
 // `n` numbers from a Python sequence, or InputError(name, reason).
-std::vector<double> Numbers(const py::handle& v, std::size_t n, const char* name, const char* reason) {
+std::vector<double> Numbers(const py::handle& v, std::size_t n, const char* name,
+                            const char* reason) {
   std::vector<double> x;
   try {
     x = v.cast<std::vector<double>>();
@@ -153,10 +156,12 @@ py::dict MetricsDict(const Metrics& m) {
 Eigen::Matrix4d Matrix(const Eigen::Isometry3d& pose) { return pose.matrix(); }
 
 // The target points of a suggestion: the study region's or a named region's, and/or surfaces.
-std::vector<TargetPoint> Targets(const Scene& scene, int points, const std::vector<std::string>& surfaces,
-                                 bool with_region, const std::string& region_name, std::uint64_t seed) {
+std::vector<TargetPoint> Targets(const Scene& scene, int points,
+                                 const std::vector<std::string>& surfaces, bool with_region,
+                                 const std::string& region_name, std::uint64_t seed) {
   if (points < 1 || points > 1000000) throw InputError("points", "", "must be in [1, 1000000]");
-  return app::SampleTargetsInRegion(scene, "target_region", region_name, points, surfaces, with_region, seed);
+  return app::SampleTargetsInRegion(scene, "target_region", region_name, points, surfaces,
+                                    with_region, seed);
 }
 
 // Applies a suggestion to its rig in memory as one undo step: `subset` (the accepted cameras of a
@@ -173,13 +178,15 @@ void ApplyInMemory(PySuggestion& s, const Suggestion* subset) {
     if (c.ptz->presets.at(s.ptz_preset).state.pan_deg != s.preset->before.pan_deg ||
         c.ptz->presets.at(s.ptz_preset).state.tilt_deg != s.preset->before.tilt_deg ||
         c.ptz->presets.at(s.ptz_preset).state.focal != s.preset->before.focal)
-      throw InputError(s.study->scene().path, "", "preset '" + s.preset->preset + "' changed since the suggestion",
+      throw InputError(s.study->scene().path, "",
+                       "preset '" + s.preset->preset + "' changed since the suggestion",
                        "ask for a new suggestion");
     head->presets.at(s.ptz_preset).state = s.preset->after;
     label = "suggested preset " + s.preset->preset;
   } else {
     if (c.ptz->tour.size() != s.tour->after.size())
-      throw InputError(s.study->scene().path, "", "the tour changed since the suggestion", "ask for a new suggestion");
+      throw InputError(s.study->scene().path, "", "the tour changed since the suggestion",
+                       "ask for a new suggestion");
     head->tour.clear();
     for (int stop : s.tour->after) head->tour.push_back(c.ptz->tour.at(stop));
     label = "suggested tour order";
@@ -227,305 +234,397 @@ AcceptResult AcceptText(const std::string& text, const AcceptOptions& options) {
 
 void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
   // ---- PTZ settings of a rig camera, and save ---------------------------------------------------
-  rig.def("ptz", [](const PyRig& r, const std::string& id) {
-       const Camera& c = r.rig().cameras[r.Index(id)];
-       if (!c.ptz) throw InputError("ptz", "", "camera '" + id + "' has no PTZ head");
-       const PtzHead& h = *c.ptz;
-       const Intrinsics& k = c.model.intrinsics();
-       auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) * 180 / kPi; };
-       py::dict d;
-       d["pan_deg"] = h.current.pan_deg;
-       d["tilt_deg"] = h.current.tilt_deg;
-       d["hfov_deg"] = hfov(h.current.focal);
-       d["pan_range_deg"] = py::make_tuple(h.pan_min_deg, h.pan_max_deg);
-       d["tilt_range_deg"] = py::make_tuple(h.tilt_min_deg, h.tilt_max_deg);
-       d["hfov_range_deg"] = py::make_tuple(hfov(h.focal_max), hfov(h.focal_min));
-       d["pivot"] = Vec3Array(h.home.translation());
-       py::list presets;
-       for (const PtzPreset& p : h.presets) {
-         py::dict q;
-         q["name"] = p.name;
-         q["pan_deg"] = p.state.pan_deg;
-         q["tilt_deg"] = p.state.tilt_deg;
-         q["hfov_deg"] = hfov(p.state.focal);
-         presets.append(q);
-       }
-       d["presets"] = presets;
-       py::list tour;
-       for (const PtzTourStop& s : h.tour) {
-         py::dict q;
-         q["preset"] = h.presets[s.preset].name;
-         q["dwell_s"] = s.dwell_s;
-         tour.append(q);
-       }
-       d["tour"] = tour;
-       return d;
-     }, py::arg("id"), "A PTZ camera's setting (pan, tilt, hfov), ranges, presets and tour.")
-      .def("set_ptz", [](PyRig& r, const std::string& id, std::optional<double> pan_deg, std::optional<double> tilt_deg,
-                         std::optional<double> hfov_deg, const std::string& preset) {
-        const int index = r.Index(id);
-        const Camera& c = r.rig().cameras[index];
-        if (!c.ptz) throw InputError("set_ptz", "", "camera '" + id + "' has no PTZ head", "move() places a fixed camera");
-        PtzState s = c.ptz->current;
-        if (!preset.empty()) {
-          bool found = false;
-          for (const PtzPreset& p : c.ptz->presets)
-            if (p.name == preset) s = p.state, found = true;
-          if (!found) throw InputError("set_ptz", "preset", "camera '" + id + "' has no preset '" + preset + "'");
-        }
-        for (const auto& [v, name] : {std::pair{pan_deg, "pan_deg"}, {tilt_deg, "tilt_deg"}, {hfov_deg, "hfov_deg"}})
-          if (v && !std::isfinite(*v)) throw InputError("set_ptz", name, "not a finite angle");
-        if (pan_deg) s.pan_deg = *pan_deg;
-        if (tilt_deg) s.tilt_deg = *tilt_deg;
-        if (hfov_deg) {
-          if (!(*hfov_deg > 0 && *hfov_deg < 360)) throw InputError("set_ptz", "hfov_deg", "must be in (0, 360) degrees");
-          const Intrinsics& k = c.model.intrinsics();
-          s.focal = FocalFromHfov(*hfov_deg * kPi / 180, k.width, k.model);
-        }
-        r.session->SetPtzState(index, s);  // clamped to the head's ranges
-      }, py::arg("id"), py::arg("pan_deg") = py::none(), py::arg("tilt_deg") = py::none(),
-         py::arg("hfov_deg") = py::none(), py::arg("preset") = "",
-         "Points PTZ camera `id` (a preset's setting, then the given angles; clamped to its ranges). One undo step.")
-      .def("save", [](PyRig& r, bool force) {
-        const session::SaveResult s = r.session->Save(force);
-        py::dict d;
-        d["scene_path"] = s.scene_path;
-        d["backup_path"] = s.backup_path;
-        d["saved"] = s.saved;
-        d["notes"] = s.notes;
-        return d;
-      }, py::arg("force") = false,
-         "Writes the edited cameras' poses and zooms (PTZ: pan, tilt, zoom) into the scene file, keeping "
-         "the previous file as a backup; refuses when the file changed since it was loaded (unless force).");
+  rig.def(
+         "ptz",
+         [](const PyRig& r, const std::string& id) {
+           const Camera& c = r.rig().cameras[r.Index(id)];
+           if (!c.ptz) throw InputError("ptz", "", "camera '" + id + "' has no PTZ head");
+           const PtzHead& h = *c.ptz;
+           const Intrinsics& k = c.model.intrinsics();
+           auto hfov = [&](double f) { return HfovFromFocal(f, k.width, k.model) * 180 / kPi; };
+           py::dict d;
+           d["pan_deg"] = h.current.pan_deg;
+           d["tilt_deg"] = h.current.tilt_deg;
+           d["hfov_deg"] = hfov(h.current.focal);
+           d["pan_range_deg"] = py::make_tuple(h.pan_min_deg, h.pan_max_deg);
+           d["tilt_range_deg"] = py::make_tuple(h.tilt_min_deg, h.tilt_max_deg);
+           d["hfov_range_deg"] = py::make_tuple(hfov(h.focal_max), hfov(h.focal_min));
+           d["pivot"] = Vec3Array(h.home.translation());
+           py::list presets;
+           for (const PtzPreset& p : h.presets) {
+             py::dict q;
+             q["name"] = p.name;
+             q["pan_deg"] = p.state.pan_deg;
+             q["tilt_deg"] = p.state.tilt_deg;
+             q["hfov_deg"] = hfov(p.state.focal);
+             presets.append(q);
+           }
+           d["presets"] = presets;
+           py::list tour;
+           for (const PtzTourStop& s : h.tour) {
+             py::dict q;
+             q["preset"] = h.presets[s.preset].name;
+             q["dwell_s"] = s.dwell_s;
+             tour.append(q);
+           }
+           d["tour"] = tour;
+           return d;
+         },
+         py::arg("id"), "A PTZ camera's setting (pan, tilt, hfov), ranges, presets and tour.")
+      .def(
+          "set_ptz",
+          [](PyRig& r, const std::string& id, std::optional<double> pan_deg,
+             std::optional<double> tilt_deg, std::optional<double> hfov_deg,
+             const std::string& preset) {
+            const int index = r.Index(id);
+            const Camera& c = r.rig().cameras[index];
+            if (!c.ptz)
+              throw InputError("set_ptz", "", "camera '" + id + "' has no PTZ head",
+                               "move() places a fixed camera");
+            PtzState s = c.ptz->current;
+            if (!preset.empty()) {
+              bool found = false;
+              for (const PtzPreset& p : c.ptz->presets)
+                if (p.name == preset) s = p.state, found = true;
+              if (!found)
+                throw InputError("set_ptz", "preset",
+                                 "camera '" + id + "' has no preset '" + preset + "'");
+            }
+            for (const auto& [v, name] :
+                 {std::pair{pan_deg, "pan_deg"}, {tilt_deg, "tilt_deg"}, {hfov_deg, "hfov_deg"}})
+              if (v && !std::isfinite(*v)) throw InputError("set_ptz", name, "not a finite angle");
+            if (pan_deg) s.pan_deg = *pan_deg;
+            if (tilt_deg) s.tilt_deg = *tilt_deg;
+            if (hfov_deg) {
+              if (!(*hfov_deg > 0 && *hfov_deg < 360))
+                throw InputError("set_ptz", "hfov_deg", "must be in (0, 360) degrees");
+              const Intrinsics& k = c.model.intrinsics();
+              s.focal = FocalFromHfov(*hfov_deg * kPi / 180, k.width, k.model);
+            }
+            r.session->SetPtzState(index, s);  // clamped to the head's ranges
+          },
+          py::arg("id"), py::arg("pan_deg") = py::none(), py::arg("tilt_deg") = py::none(),
+          py::arg("hfov_deg") = py::none(), py::arg("preset") = "",
+          "Points PTZ camera `id` (a preset's setting, then the given angles; clamped to its "
+          "ranges). One undo step.")
+      .def(
+          "save",
+          [](PyRig& r, bool force) {
+            const session::SaveResult s = r.session->Save(force);
+            py::dict d;
+            d["scene_path"] = s.scene_path;
+            d["backup_path"] = s.backup_path;
+            d["saved"] = s.saved;
+            d["notes"] = s.notes;
+            return d;
+          },
+          py::arg("force") = false,
+          "Writes the edited cameras' poses and zooms (PTZ: pan, tilt, zoom) into the scene file, "
+          "keeping "
+          "the previous file as a backup; refuses when the file changed since it was loaded "
+          "(unless force).");
 
   // ---- Suggestions -----------------------------------------------------------------------------
-  py::class_<PySuggestion>(m, "Suggestion", "A suggestion: look at it, apply it to the rig, save it, or accept it.")
+  py::class_<PySuggestion>(m, "Suggestion",
+                           "A suggestion: look at it, apply it to the rig, save it, or accept it.")
       .def_property_readonly("kind", [](const PySuggestion& s) { return s.kind; })
       .def_property_readonly("improved", [](const PySuggestion& s) { return s.improved; })
       .def_property_readonly("message", [](const PySuggestion& s) { return s.message; })
-      .def_property_readonly("before", [](const PySuggestion& s) -> py::object {
-        if (s.cameras) return MetricsDict(s.cameras->before);
-        return JsonToPython(s.json)["ptz"]["before"];
-      }, "The exact measures at the start (camera nudges) or the PTZ measures before.")
-      .def_property_readonly("after", [](const PySuggestion& s) -> py::object {
-        if (s.cameras) return MetricsDict(s.cameras->after);
-        return JsonToPython(s.json)["ptz"]["after"];
-      })
-      .def_property_readonly("cameras", [](const PySuggestion& s) {
-        py::list out;
-        if (!s.cameras) return out;
-        for (const CameraChange& c : s.cameras->cameras) {
-          py::dict d;
-          d["id"] = c.id;
-          d["before"] = Matrix(c.before);
-          d["after"] = Matrix(c.after);
-          d["move_m"] = c.move_m;
-          d["rotate_deg"] = c.rotate_deg;
-          d["hfov_before_deg"] = c.hfov_before_deg;
-          d["hfov_after_deg"] = c.hfov_after_deg;
-          d["note"] = c.note;
-          out.append(d);
-        }
-        return out;
-      }, "Per selected camera: world_from_camera 4x4 before and after, the move, the turn, the zoom.")
-      .def("to_dict", [](const PySuggestion& s) { return JsonToPython(s.json); }, "The suggestion file, as a dict.")
+      .def_property_readonly(
+          "before",
+          [](const PySuggestion& s) -> py::object {
+            if (s.cameras) return MetricsDict(s.cameras->before);
+            return JsonToPython(s.json)["ptz"]["before"];
+          },
+          "The exact measures at the start (camera nudges) or the PTZ measures before.")
+      .def_property_readonly("after",
+                             [](const PySuggestion& s) -> py::object {
+                               if (s.cameras) return MetricsDict(s.cameras->after);
+                               return JsonToPython(s.json)["ptz"]["after"];
+                             })
+      .def_property_readonly(
+          "cameras",
+          [](const PySuggestion& s) {
+            py::list out;
+            if (!s.cameras) return out;
+            for (const CameraChange& c : s.cameras->cameras) {
+              py::dict d;
+              d["id"] = c.id;
+              d["before"] = Matrix(c.before);
+              d["after"] = Matrix(c.after);
+              d["move_m"] = c.move_m;
+              d["rotate_deg"] = c.rotate_deg;
+              d["hfov_before_deg"] = c.hfov_before_deg;
+              d["hfov_after_deg"] = c.hfov_after_deg;
+              d["note"] = c.note;
+              out.append(d);
+            }
+            return out;
+          },
+          "Per selected camera: world_from_camera 4x4 before and after, the move, the turn, the "
+          "zoom.")
+      .def(
+          "to_dict", [](const PySuggestion& s) { return JsonToPython(s.json); },
+          "The suggestion file, as a dict.")
       .def("__str__", [](const PySuggestion& s) { return s.message; })
-      .def("save", [](const PySuggestion& s, const std::string& path) {
-        RefuseInputPath(s.study->scene(), path, "the suggestion file");
-        WriteFileAtomically(path, s.json);
-      }, py::arg("path"), "Writes the suggestion file (`pandora accept PATH` takes it), atomically.")
-      .def("apply", [](PySuggestion& s) {
-        if (!s.improved) throw InputError("apply", "", "the suggestion offers no improvement; nothing to apply");
-        ApplyInMemory(s, s.cameras ? &*s.cameras : nullptr);
-      }, "Applies the suggestion to the rig in memory (one undo step); nothing is written.")
-      .def("accept", [](PySuggestion& s, std::vector<std::string> cameras, bool force) {
-        const Scene& scene = s.study->scene();
-        if (!s.improved) throw InputError(scene.path, "", "the suggestion offers no improvement; nothing to accept");
-        if (s.from_unsaved_rig)
-          throw InputError(scene.path, "", "the suggestion was made on a rig with unsaved edits",
-                           "apply() it and save() the rig, which writes those edits too");
-        if (!s.session->rig().Unsaved().empty())
-          throw InputError(scene.path, "", "the rig has unsaved edits since the suggestion",
-                           "save() or undo() them first");
-        AcceptOptions options;
-        options.cameras = cameras;
-        options.force = force;
-        // In memory first (refused when a camera moved since), then the file; a failure undoes both.
-        Suggestion accepted;
-        if (s.cameras) {
-          accepted = *s.cameras;
-          if (!cameras.empty()) {
-            accepted.cameras.clear();
-            for (const CameraChange& c : s.cameras->cameras)
-              for (const std::string& id : cameras)
-                if (c.id == id) accepted.cameras.push_back(c);
-          }
-        }
-        const std::int64_t version = s.session->rig().version();
-        if (!s.cameras || !accepted.cameras.empty()) ApplyInMemory(s, s.cameras ? &accepted : nullptr);
-        AcceptResult result;
+      .def(
+          "save",
+          [](const PySuggestion& s, const std::string& path) {
+            RefuseInputPath(s.study->scene(), path, "the suggestion file");
+            WriteFileAtomically(path, s.json);
+          },
+          py::arg("path"),
+          "Writes the suggestion file (`pandora accept PATH` takes it), atomically.")
+      .def(
+          "apply",
+          [](PySuggestion& s) {
+            if (!s.improved)
+              throw InputError("apply", "",
+                               "the suggestion offers no improvement; nothing to apply");
+            ApplyInMemory(s, s.cameras ? &*s.cameras : nullptr);
+          },
+          "Applies the suggestion to the rig in memory (one undo step); nothing is written.")
+      .def(
+          "accept",
+          [](PySuggestion& s, std::vector<std::string> cameras, bool force) {
+            const Scene& scene = s.study->scene();
+            if (!s.improved)
+              throw InputError(scene.path, "",
+                               "the suggestion offers no improvement; nothing to accept");
+            if (s.from_unsaved_rig)
+              throw InputError(scene.path, "",
+                               "the suggestion was made on a rig with unsaved edits",
+                               "apply() it and save() the rig, which writes those edits too");
+            if (!s.session->rig().Unsaved().empty())
+              throw InputError(scene.path, "", "the rig has unsaved edits since the suggestion",
+                               "save() or undo() them first");
+            AcceptOptions options;
+            options.cameras = cameras;
+            options.force = force;
+            // In memory first (refused when a camera moved since), then the file; a failure undoes
+            // both.
+            Suggestion accepted;
+            if (s.cameras) {
+              accepted = *s.cameras;
+              if (!cameras.empty()) {
+                accepted.cameras.clear();
+                for (const CameraChange& c : s.cameras->cameras)
+                  for (const std::string& id : cameras)
+                    if (c.id == id) accepted.cameras.push_back(c);
+              }
+            }
+            const std::int64_t version = s.session->rig().version();
+            if (!s.cameras || !accepted.cameras.empty())
+              ApplyInMemory(s, s.cameras ? &accepted : nullptr);
+            AcceptResult result;
+            try {
+              result = AcceptText(s.json, options);
+            } catch (...) {
+              if (s.session->rig().version() != version) s.session->rig().Undo();
+              throw;
+            }
+            s.session->MarkSaved(ReadInputFile(result.scene_path, 64u << 20, "scene file"));
+            return AcceptDict(result);
+          },
+          py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
+          "Writes the suggestion into the scene file as `pandora accept` does (backup, read-back "
+          "check) and "
+          "applies it to the rig; `cameras`: only these ids (camera nudges).");
+
+  m.def(
+      "suggest",
+      [](const PyScene& sc, PyRig& r, std::vector<std::string> cameras,
+         const std::string& objective, int points, std::vector<std::string> target_surfaces,
+         bool with_region, bool over_time, const py::object& max_move,
+         const py::object& max_rotate_deg, const py::object& hfov_range, const py::object& rail,
+         const py::object& plane, const py::object& mount_box,
+         const std::vector<py::object>& keep_out, double clearance, double snap_move,
+         double snap_rotate_deg, int outer_iterations, std::uint64_t seed) {
+        const Scene& scene = sc.scene();
+        if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
+        if (cameras.empty())
+          throw InputError("cameras", "", "which cameras may move?", "give cameras=[ids]");
+        app::SuggestArgs a;
+        a.scene = scene.path;
+        for (const std::string& id : cameras) a.cameras += (a.cameras.empty() ? "" : ",") + id;
+        a.objective = objective;
+        a.points = points;
+        a.target_surfaces = target_surfaces;
+        a.with_region = with_region;
+        a.over_time = over_time;
+        a.clearance = clearance;
+        a.snap_move = snap_move;
+        a.snap_rotate = snap_rotate_deg;
+        a.outer_iterations = outer_iterations;
+        a.seed = seed;
+        std::shared_ptr<app::SuggestProblem> problem;
         try {
-          result = AcceptText(s.json, options);
-        } catch (...) {
-          if (s.session->rig().version() != version) s.session->rig().Undo();
-          throw;
+          a.max_move = NumberOrList(max_move, "--max-move");
+          a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
+          a.hfov_range = PerCameraEntries(
+              hfov_range, [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
+          a.rail =
+              PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "--rail"); });
+          a.plane = PerCameraEntries(plane,
+                                     [](const py::handle& v) { return Vector3Text(v, "--plane"); });
+          a.mount_box = PerCameraEntries(
+              mount_box, [](const py::handle& v) { return BoxText(v, "--mount-box"); });
+          for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "--keep-out"));
+          if (!(outer_iterations >= 1 && outer_iterations <= 100))
+            throw InputError("--outer-iterations", "", "must be in [1, 100]");
+          if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
+            throw InputError("--clearance", "",
+                             "snap_move, snap_rotate_deg and clearance must be >= 0");
+          problem = app::PrepareSuggest(a, scene, r.rig());
+        } catch (const InputError& e) {
+          RethrowWithKeyword(e);
         }
-        s.session->MarkSaved(ReadInputFile(result.scene_path, 64u << 20, "scene file"));
-        return AcceptDict(result);
-      }, py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
-         "Writes the suggestion into the scene file as `pandora accept` does (backup, read-back check) and "
-         "applies it to the rig; `cameras`: only these ids (camera nudges).");
+        PySuggestion out;
+        out.study = sc.study;
+        out.session = r.session;
+        out.kind = "cameras";
+        out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+        {
+          py::gil_scoped_release release;
+          out.cameras = r.session->Suggest(problem->targets, problem->options);
+        }
+        out.improved = out.cameras->improved;
+        out.message = out.cameras->message;
+        out.json = SuggestionToJson(*out.cameras, scene, r.rig(), problem->options);
+        return out;
+      },
+      py::arg("scene"), py::arg("rig"), py::arg("cameras"), py::arg("objective") = "coverage2",
+      py::arg("points") = 1500, py::arg("target_surfaces") = std::vector<std::string>{},
+      py::arg("with_region") = false, py::arg("over_time") = false,
+      py::arg("max_move") = py::float_(0.3), py::arg("max_rotate_deg") = py::float_(10.0),
+      py::arg("hfov_range") = py::none(), py::arg("rail") = py::none(),
+      py::arg("plane") = py::none(), py::arg("mount_box") = py::none(),
+      py::arg("keep_out") = std::vector<py::object>{}, py::arg("clearance") = 0.1,
+      py::arg("snap_move") = 0.0, py::arg("snap_rotate_deg") = 0.0, py::arg("outer_iterations") = 4,
+      py::arg("seed") = 1,
+      "Nudges the `cameras` of `rig` within the limits to improve `objective` over target points, "
+      "as "
+      "`pandora suggest` does (docs/suggest.md). Per-camera limits: a value for all, a list in "
+      "`cameras` "
+      "order, or for hfov_range / rail / plane / mount_box a dict {id: value}.");
 
-  m.def("suggest", [](const PyScene& sc, PyRig& r, std::vector<std::string> cameras, const std::string& objective,
-                      int points, std::vector<std::string> target_surfaces, bool with_region, bool over_time,
-                      const py::object& max_move, const py::object& max_rotate_deg, const py::object& hfov_range,
-                      const py::object& rail, const py::object& plane, const py::object& mount_box,
-                      const std::vector<py::object>& keep_out, double clearance, double snap_move,
-                      double snap_rotate_deg, int outer_iterations, std::uint64_t seed) {
-    const Scene& scene = sc.scene();
-    if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
-    if (cameras.empty()) throw InputError("cameras", "", "which cameras may move?", "give cameras=[ids]");
-    app::SuggestArgs a;
-    a.scene = scene.path;
-    for (const std::string& id : cameras) a.cameras += (a.cameras.empty() ? "" : ",") + id;
-    a.objective = objective;
-    a.points = points;
-    a.target_surfaces = target_surfaces;
-    a.with_region = with_region;
-    a.over_time = over_time;
-    a.clearance = clearance;
-    a.snap_move = snap_move;
-    a.snap_rotate = snap_rotate_deg;
-    a.outer_iterations = outer_iterations;
-    a.seed = seed;
-    std::shared_ptr<app::SuggestProblem> problem;
-    try {
-      a.max_move = NumberOrList(max_move, "--max-move");
-      a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
-      a.hfov_range = PerCameraEntries(hfov_range, [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
-      a.rail = PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "--rail"); });
-      a.plane = PerCameraEntries(plane, [](const py::handle& v) { return Vector3Text(v, "--plane"); });
-      a.mount_box = PerCameraEntries(mount_box, [](const py::handle& v) { return BoxText(v, "--mount-box"); });
-      for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "--keep-out"));
-      if (!(outer_iterations >= 1 && outer_iterations <= 100)) throw InputError("--outer-iterations", "", "must be in [1, 100]");
-      if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
-        throw InputError("--clearance", "", "snap_move, snap_rotate_deg and clearance must be >= 0");
-      problem = app::PrepareSuggest(a, scene, r.rig());
-    } catch (const InputError& e) {
-      RethrowWithKeyword(e);
-    }
-    PySuggestion out;
-    out.study = sc.study;
-    out.session = r.session;
-    out.kind = "cameras";
-    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
-    {
-      py::gil_scoped_release release;
-      out.cameras = r.session->Suggest(problem->targets, problem->options);
-    }
-    out.improved = out.cameras->improved;
-    out.message = out.cameras->message;
-    out.json = SuggestionToJson(*out.cameras, scene, r.rig(), problem->options);
-    return out;
-  }, py::arg("scene"), py::arg("rig"), py::arg("cameras"), py::arg("objective") = "coverage2",
-     py::arg("points") = 1500, py::arg("target_surfaces") = std::vector<std::string>{}, py::arg("with_region") = false,
-     py::arg("over_time") = false, py::arg("max_move") = py::float_(0.3), py::arg("max_rotate_deg") = py::float_(10.0),
-     py::arg("hfov_range") = py::none(), py::arg("rail") = py::none(), py::arg("plane") = py::none(),
-     py::arg("mount_box") = py::none(), py::arg("keep_out") = std::vector<py::object>{}, py::arg("clearance") = 0.1,
-     py::arg("snap_move") = 0.0, py::arg("snap_rotate_deg") = 0.0, py::arg("outer_iterations") = 4, py::arg("seed") = 1,
-     "Nudges the `cameras` of `rig` within the limits to improve `objective` over target points, as "
-     "`pandora suggest` does (docs/suggest.md). Per-camera limits: a value for all, a list in `cameras` "
-     "order, or for hfov_range / rail / plane / mount_box a dict {id: value}.");
-
-  auto ptz_common = [](const PyScene& sc, PyRig& r, const char* option, const std::string& id, int points,
-                       const std::string& target_region, const std::vector<std::string>& surfaces, bool with_region,
+  auto ptz_common = [](const PyScene& sc, PyRig& r, const char* option, const std::string& id,
+                       int points, const std::string& target_region,
+                       const std::vector<std::string>& surfaces, bool with_region,
                        std::uint64_t seed, int* camera, std::vector<Vec3>* xyz) {
     if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
     *camera = app::PtzCameraOption(r.rig(), option, id);
-    for (const TargetPoint& t : Targets(sc.scene(), points, surfaces, with_region, target_region, seed)) xyz->push_back(t.p);
+    for (const TargetPoint& t :
+         Targets(sc.scene(), points, surfaces, with_region, target_region, seed))
+      xyz->push_back(t.p);
   };
 
-  m.def("suggest_ptz_preset", [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera, const std::string& preset,
-                                           int points, const std::string& target_region,
-                                           std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
-    int c = -1;
-    std::vector<Vec3> xyz;
-    ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region, seed, &c, &xyz);
-    const PtzHead& head = *r.rig().cameras[c].ptz;
-    int p = -1;
-    std::string names;
-    for (std::size_t i = 0; i < head.presets.size(); ++i) {
-      names += (names.empty() ? "" : ", ") + head.presets[i].name;
-      if (head.presets[i].name == preset) p = int(i);
-    }
-    if (p < 0) throw InputError("preset", "", "camera '" + camera + "' has no preset '" + preset + "'", "its presets: " + names);
-    PySuggestion out;
-    out.study = sc.study;
-    out.session = r.session;
-    out.kind = "ptz_preset";
-    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
-    out.ptz_camera = c;
-    out.ptz_preset = p;
-    {
-      py::gil_scoped_release release;
-      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal());
-      out.preset = SuggestPtzPreset(tester, c, p, xyz, sc.scene().study.ptz.min_px_per_m);
-    }
-    out.improved = out.preset->improved();
-    out.message = camera + " preset " + preset + ": sees " + std::to_string(out.preset->seen_before) + " -> " +
-                  std::to_string(out.preset->seen_after) + " of " + std::to_string(out.preset->points) + " target points";
-    out.json = PtzPresetSuggestionToJson(*out.preset, sc.scene(), r.rig());
-    return out;
-  }, py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("preset"), py::arg("points") = 1500,
-     py::arg("target_region") = "", py::arg("target_surfaces") = std::vector<std::string>{},
-     py::arg("with_region") = false, py::arg("seed") = 1,
-     "The pan, tilt and zoom of a PTZ camera's preset that see the most target points at the study's "
-     "PTZ density target (docs/ptz.md); `target_region`: one of study.regions.");
+  m.def(
+      "suggest_ptz_preset",
+      [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera,
+                   const std::string& preset, int points, const std::string& target_region,
+                   std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
+        int c = -1;
+        std::vector<Vec3> xyz;
+        ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region,
+                   seed, &c, &xyz);
+        const PtzHead& head = *r.rig().cameras[c].ptz;
+        int p = -1;
+        std::string names;
+        for (std::size_t i = 0; i < head.presets.size(); ++i) {
+          names += (names.empty() ? "" : ", ") + head.presets[i].name;
+          if (head.presets[i].name == preset) p = int(i);
+        }
+        if (p < 0)
+          throw InputError("preset", "", "camera '" + camera + "' has no preset '" + preset + "'",
+                           "its presets: " + names);
+        PySuggestion out;
+        out.study = sc.study;
+        out.session = r.session;
+        out.kind = "ptz_preset";
+        out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+        out.ptz_camera = c;
+        out.ptz_preset = p;
+        {
+          py::gil_scoped_release release;
+          const VisibilityTester tester(r.rig().cameras, sc.study->caster(),
+                                        sc.scene().ContentBounds().diagonal());
+          out.preset = SuggestPtzPreset(tester, c, p, xyz, sc.scene().study.ptz.min_px_per_m);
+        }
+        out.improved = out.preset->improved();
+        out.message = camera + " preset " + preset + ": sees " +
+                      std::to_string(out.preset->seen_before) + " -> " +
+                      std::to_string(out.preset->seen_after) + " of " +
+                      std::to_string(out.preset->points) + " target points";
+        out.json = PtzPresetSuggestionToJson(*out.preset, sc.scene(), r.rig());
+        return out;
+      },
+      py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("preset"),
+      py::arg("points") = 1500, py::arg("target_region") = "",
+      py::arg("target_surfaces") = std::vector<std::string>{}, py::arg("with_region") = false,
+      py::arg("seed") = 1,
+      "The pan, tilt and zoom of a PTZ camera's preset that see the most target points at the "
+      "study's "
+      "PTZ density target (docs/ptz.md); `target_region`: one of study.regions.");
 
-  m.def("suggest_ptz_tour", [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera, const std::string& objective,
-                                         int points, const std::string& target_region,
-                                         std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
-    if (objective != "mean" && objective != "max")
-      throw InputError("objective", "", "unknown tour objective '" + objective + "'", "use mean or max");
-    int c = -1;
-    std::vector<Vec3> xyz;
-    ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region, seed, &c, &xyz);
-    if (r.rig().cameras[c].ptz->tour.size() < 3)
-      throw InputError("camera", "", "camera '" + camera + "' has fewer than 3 tour stops: every order is the same cycle");
-    PySuggestion out;
-    out.study = sc.study;
-    out.session = r.session;
-    out.kind = "ptz_tour";
-    out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
-    out.ptz_camera = c;
-    {
-      py::gil_scoped_release release;
-      const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(sc.scene(), r.rig());
-      const VisibilityTester tester(r.rig().cameras, sc.study->caster(), sc.scene().ContentBounds().diagonal(),
-                                    surfaces.get());
-      out.tour = SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m,
-                                objective == "max" ? TourObjective::kMax : TourObjective::kMean);
-    }
-    out.improved = out.tour->improved();
-    char line[256];
-    std::snprintf(line, sizeof line, "%s tour: longest gap %.2f -> %.2f s, mean longest gap %.2f -> %.2f s",
-                  camera.c_str(), out.tour->gap_max_before, out.tour->gap_max_after, out.tour->gap_mean_before,
-                  out.tour->gap_mean_after);
-    out.message = line;
-    out.json = PtzTourSuggestionToJson(*out.tour, sc.scene(), r.rig());
-    return out;
-  }, py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("objective") = "mean", py::arg("points") = 1500,
-     py::arg("target_region") = "", py::arg("target_surfaces") = std::vector<std::string>{},
-     py::arg("with_region") = false, py::arg("seed") = 1,
-     "The order of a PTZ camera's tour stops that minimises the mean (or max) longest unwatched gap.");
+  m.def(
+      "suggest_ptz_tour",
+      [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera,
+                   const std::string& objective, int points, const std::string& target_region,
+                   std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
+        if (objective != "mean" && objective != "max")
+          throw InputError("objective", "", "unknown tour objective '" + objective + "'",
+                           "use mean or max");
+        int c = -1;
+        std::vector<Vec3> xyz;
+        ptz_common(sc, r, "camera", camera, points, target_region, target_surfaces, with_region,
+                   seed, &c, &xyz);
+        if (r.rig().cameras[c].ptz->tour.size() < 3)
+          throw InputError(
+              "camera", "",
+              "camera '" + camera + "' has fewer than 3 tour stops: every order is the same cycle");
+        PySuggestion out;
+        out.study = sc.study;
+        out.session = r.session;
+        out.kind = "ptz_tour";
+        out.from_unsaved_rig = !r.session->rig().Unsaved().empty();
+        out.ptz_camera = c;
+        {
+          py::gil_scoped_release release;
+          const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(sc.scene(), r.rig());
+          const VisibilityTester tester(r.rig().cameras, sc.study->caster(),
+                                        sc.scene().ContentBounds().diagonal(), surfaces.get());
+          out.tour =
+              SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m,
+                             objective == "max" ? TourObjective::kMax : TourObjective::kMean);
+        }
+        out.improved = out.tour->improved();
+        char line[256];
+        std::snprintf(line, sizeof line,
+                      "%s tour: longest gap %.2f -> %.2f s, mean longest gap %.2f -> %.2f s",
+                      camera.c_str(), out.tour->gap_max_before, out.tour->gap_max_after,
+                      out.tour->gap_mean_before, out.tour->gap_mean_after);
+        out.message = line;
+        out.json = PtzTourSuggestionToJson(*out.tour, sc.scene(), r.rig());
+        return out;
+      },
+      py::arg("scene"), py::arg("rig"), py::arg("camera"), py::arg("objective") = "mean",
+      py::arg("points") = 1500, py::arg("target_region") = "",
+      py::arg("target_surfaces") = std::vector<std::string>{}, py::arg("with_region") = false,
+      py::arg("seed") = 1,
+      "The order of a PTZ camera's tour stops that minimises the mean (or max) longest unwatched "
+      "gap.");
 
-  m.def("accept", [](const std::string& path, std::vector<std::string> cameras, bool force) {
-    AcceptOptions options;
-    options.cameras = cameras;
-    options.force = force;
-    return AcceptDict(AcceptSuggestion(path, options));
-  }, py::arg("path"), py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
-     "`pandora accept PATH`: writes a saved suggestion file into its scene file (backup kept).");
+  m.def(
+      "accept",
+      [](const std::string& path, std::vector<std::string> cameras, bool force) {
+        AcceptOptions options;
+        options.cameras = cameras;
+        options.force = force;
+        return AcceptDict(AcceptSuggestion(path, options));
+      },
+      py::arg("path"), py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
+      "`pandora accept PATH`: writes a saved suggestion file into its scene file (backup kept).");
 }
 
 }  // namespace pandora::python

@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
 #include "render/render.h"
 
 namespace pandora {
@@ -22,10 +22,12 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels ||
       (mask && image.cameras.size() != pixels) || image.resolution.size() != pixels ||
       image.sigma_max.size() != pixels || image.depth.size() != pixels)
-    throw std::invalid_argument("WriteExr: empty or inconsistent image (every layer needs a value per pixel)");
+    throw std::invalid_argument(
+        "WriteExr: empty or inconsistent image (every layer needs a value per pixel)");
   if (mask != (rig_cameras <= Image::kMaxMaskCameras))
-    throw std::invalid_argument(mask ? "WriteExr: a cameras layer for a rig of more than 64 cameras"
-                                     : "WriteExr: the image has no cameras layer, but the rig has at most 64 cameras");
+    throw std::invalid_argument(
+        mask ? "WriteExr: a cameras layer for a rig of more than 64 cameras"
+             : "WriteExr: the image has no cameras layer, but the rig has at most 64 cameras");
   // The camera set: a bitmask for rigs of at most 64 cameras; larger rigs have none (coverage
   // still counts them all).
   std::vector<uint32_t> lo, hi;
@@ -44,11 +46,12 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
       mask ? "cameras: bitmask (bit c = rig camera c, bits 32-63 in cameras_hi)"
            : "cameras: not written, the rig has " + std::to_string(rig_cameras) +
                  " cameras (a bitmask holds 64; coverage counts them all)";
-  header.insert("pandora_layers",
-                Imf::StringAttribute("R,G,B: linear light; coverage: cameras seeing the surface point; " +
-                                     cameras_meaning +
-                                     "; resolution: px/m; sigma_max: mm, inf = not triangulable; depth: "
-                                     "m along the eye ray, inf = no surface"));
+  header.insert(
+      "pandora_layers",
+      Imf::StringAttribute("R,G,B: linear light; coverage: cameras seeing the surface point; " +
+                           cameras_meaning +
+                           "; resolution: px/m; sigma_max: mm, inf = not triangulable; depth: "
+                           "m along the eye ray, inf = no surface"));
   Imf::FrameBuffer fb;
   const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
   auto add_float = [&](const char* name, const float* data, std::size_t x_stride) {

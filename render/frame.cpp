@@ -17,14 +17,14 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "analysis/error.h"
-#include "analysis/ptz.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "render/colormap.h"
 #include "render/image_overlays.h"
 #include "volume/active_set.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace internal {
@@ -278,8 +278,10 @@ inline void SetHit(const Vec3& eye, const RayHit& hit, const TriangleMesh& mesh,
   // off their surface that shadow themselves.
   double t = hit.t;
   const double dn = hit.normal.dot(smp->d);
-  if (hit.triangle >= 0 && std::size_t(hit.triangle) < mesh.triangles.size() && std::abs(dn) > 1e-9) {
-    const double plane_t = hit.normal.dot(mesh.vertices[mesh.triangles[hit.triangle][0]] - eye) / dn;
+  if (hit.triangle >= 0 && std::size_t(hit.triangle) < mesh.triangles.size() &&
+      std::abs(dn) > 1e-9) {
+    const double plane_t =
+        hit.normal.dot(mesh.vertices[mesh.triangles[hit.triangle][0]] - eye) / dn;
     if (std::abs(plane_t - t) <= 1e-5 * std::max(1.0, t)) t = plane_t;
   }
   smp->t = t;
@@ -727,7 +729,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
         const double budget = m.reach_budget[c];
         const int seconds = std::max(1, static_cast<int>(std::ceil(budget - 1e-9)));
         int k = 0;
-        while (k <= seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg)) ++k;
+        while (k <= seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg))
+          ++k;
         if (k > seconds) continue;  // not reachable within the budget
         const double tol = m.tester.Tolerance(c, seg.t_far);
         seg.t_near = tol;
@@ -999,7 +1002,8 @@ struct PixelPicker::Impl {
         width(view.width),
         height(view.height),
         tester(rig.cameras, *scene.caster, scene.scene_scale),
-        rays(view, rig, /*table=*/false, view.camera >= 0 ? tester.Tolerance(view.camera, 0.0) : 0.0) {}
+        rays(view, rig, /*table=*/false,
+             view.camera >= 0 ? tester.Tolerance(view.camera, 0.0) : 0.0) {}
   const internal::PreparedSceneData& scene;
   const Rig& rig;
   int width, height;
@@ -1022,7 +1026,8 @@ std::optional<PixelPick> PixelPicker::Pick(int x, int y) const {
   internal::Sample smp;
   if (!m.rays.Center(x, y, &smp.d, nullptr, nullptr)) return std::nullopt;
   const double t0 = m.rays.NearT(smp.d);  // from the cut plane, as the frame's rays
-  const auto hit = m.scene.caster->Intersect(Ray{Vec3(m.rays.eye() + t0 * smp.d), smp.d, 0.0, internal::kInf});
+  const auto hit =
+      m.scene.caster->Intersect(Ray{Vec3(m.rays.eye() + t0 * smp.d), smp.d, 0.0, internal::kInf});
   if (!hit) return std::nullopt;
   RayHit h = *hit;
   h.t += t0;  // from the eye

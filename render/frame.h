@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ray_caster.h"
+#include "analysis/geometry/ray_caster.h"
 #include "render/overlay_fields.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"

@@ -182,8 +182,10 @@ void DrawCameraOverlays(const Rig& rig, const Camera& view, const OverlayOptions
     const int x = px + 4 * scale + w + scale <= image->width ? px + 4 * scale : px - 4 * scale - w;
     for (int yy = std::max(0, y - scale); yy < std::min(image->height, y + 6 * scale); ++yy)
       for (int xx = std::max(0, x - scale); xx < std::min(image->width, x + w + scale); ++xx)
-        for (int ch = 0; ch < 3; ++ch) image->rgb[3 * (std::size_t(yy) * image->width + xx) + ch] *= 0.3f;
-    DrawText(image->rgb.data(), image->width, image->height, x, y, id, cam.color.cwiseMax(Vec3::Constant(0.35)), scale);
+        for (int ch = 0; ch < 3; ++ch)
+          image->rgb[3 * (std::size_t(yy) * image->width + xx) + ch] *= 0.3f;
+    DrawText(image->rgb.data(), image->width, image->height, x, y, id,
+             cam.color.cwiseMax(Vec3::Constant(0.35)), scale);
   }
 }
 

@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "analysis/camera.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/scene/scene.h"
 #include "render/render.h"
 
 namespace pandora::internal {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
 
 namespace pandora {
 

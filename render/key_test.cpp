@@ -1,6 +1,4 @@
 // The colour key in renders, the default brightness and the legends' units (docs/rendering.md).
-#include "analysis/palette.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,9 +6,10 @@
 #include <fstream>
 #include <set>
 
-#include "analysis/primitives.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/palette.h"
 #include "render/colormap.h"
 #include "render/render.h"
 

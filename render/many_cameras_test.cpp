@@ -8,14 +8,14 @@
 #include <cstdint>
 #include <random>
 
-#include "analysis/primitives.h"
-#include "analysis/scene.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/units.h"
 #include "render/light.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "render/test_options.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {

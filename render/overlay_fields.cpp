@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "render/isosurface.h"
 #include "volume/fields_vdb.h"
 #include "volume/vdb_io.h"
@@ -28,15 +28,15 @@ void WithGrid(const Fields& fields, const std::string& name, const char* option,
     have += (have.empty() ? "" : ", ") + grid->getName();
   }
   for (const auto& [extra, grid] : g.extra) have += (have.empty() ? "" : ", ") + extra;
-  throw InputError(option, "", "the fields have no grid '" + name + "' to show",
-                   have.empty() ? std::string("the fields file holds no value grids")
-                                : "available: " + have);
+  throw InputError(
+      option, "", "the fields have no grid '" + name + "' to show",
+      have.empty() ? std::string("the fields file holds no value grids") : "available: " + have);
 }
 
 // Fields whose small values are good (uncertainty); the rest are better when large.
 bool LowIsGood(const std::string& name) {
-  return name.rfind("sigma_", 0) == 0 || name == "condition" || name.rfind("ptz_reach_time", 0) == 0 ||
-         name.rfind("ptz_gap", 0) == 0;
+  return name.rfind("sigma_", 0) == 0 || name == "condition" ||
+         name.rfind("ptz_reach_time", 0) == 0 || name.rfind("ptz_gap", 0) == 0;
 }
 
 }  // namespace
@@ -47,7 +47,8 @@ FieldSlice SampleSlice(const Fields& fields, const std::string& name, int axis, 
     if (std::isfinite(position)) return;
     // The middle plane of the active voxels (of the lattice when there are none).
     const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
-    const int k = box.empty() ? fields.lattice.dims[axis] / 2 : (box.min()[axis] + box.max()[axis]) / 2;
+    const int k =
+        box.empty() ? fields.lattice.dims[axis] / 2 : (box.min()[axis] + box.max()[axis]) / 2;
     position = fields.lattice.origin[axis] + fields.lattice.voxel_size * k;
   });
   *plane = position;

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
 #include "volume/slice.h"
 
 namespace pandora {
@@ -22,8 +22,8 @@ FieldSlice SampleSlice(const Fields& fields, const std::string& name, int axis, 
 
 /// The isosurface value = `iso` of field `name` (OpenVDB volumeToMesh, triangles and split quads),
 /// world coordinates. Inactive voxels count as outside the set {value >= iso} for coverage-like
-/// fields and as outside {value <= iso} for uncertainty fields (sigma_*, condition), i.e. they never
-/// pass. Throws InputError (file "--iso") when the fields lack that grid.
+/// fields and as outside {value <= iso} for uncertainty fields (sigma_*, condition), i.e. they
+/// never pass. Throws InputError (file "--iso") when the fields lack that grid.
 TriangleMesh ExtractIsosurface(const Fields& fields, const std::string& name, double iso);
 
 }  // namespace pandora

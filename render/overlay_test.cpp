@@ -5,15 +5,15 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analysis/primitives.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/util/units.h"
 #include "render/colormap.h"
 #include "render/overlay_fields.h"
 #include "render/render.h"
+#include "tests/fixtures.h"
 #include "volume/fields_vdb.h"
 #include "volume/surface.h"
 #include "volume/vdb_io.h"
-#include "tests/fixtures.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -91,7 +91,8 @@ TEST(Overlay, SliceShowsTheVoxelValueWhereTheEyeRayCrossesThePlane) {
       bool border = false;
       for (int k : {0, 1}) border |= std::abs(ijk[k] - std::floor(ijk[k]) - 0.5) < 1e-6;
       if (border) continue;
-      const openvdb::Coord c(int(std::lround(ijk[0])), int(std::lround(ijk[1])), int(std::lround(ijk[2])));
+      const openvdb::Coord c(int(std::lround(ijk[0])), int(std::lround(ijk[1])),
+                             int(std::lround(ijk[2])));
       int value = 0;
       const Vec3 rgb = img.Rgb(x, y);
       if (!acc.probeValue(c, value)) {
@@ -99,7 +100,8 @@ TEST(Overlay, SliceShowsTheVoxelValueWhereTheEyeRayCrossesThePlane) {
         continue;
       }
       const Vec3 expected = 0.75 * ViridisLinear(value / 2.0);
-      EXPECT_LT((rgb - expected).cwiseAbs().maxCoeff(), 1e-5) << x << "," << y << " value " << value;
+      EXPECT_LT((rgb - expected).cwiseAbs().maxCoeff(), 1e-5)
+          << x << "," << y << " value " << value;
       ++checked;
       ++per_value[std::min(value, 2)];
     }
@@ -120,7 +122,8 @@ TEST(Overlay, IsosurfaceBracketsTheCoverageChange) {
   int straddling = 0;
   for (const Vec3& v : iso.vertices) {
     const openvdb::Vec3d ijk = grid.transform().worldToIndex(openvdb::Vec3d(v.x(), v.y(), v.z()));
-    const openvdb::Coord base(int(std::floor(ijk[0])), int(std::floor(ijk[1])), int(std::floor(ijk[2])));
+    const openvdb::Coord base(int(std::floor(ijk[0])), int(std::floor(ijk[1])),
+                              int(std::floor(ijk[2])));
     bool high = false, low = false;
     for (int dz = 0; dz <= 1; ++dz)
       for (int dy = 0; dy <= 1; ++dy)
@@ -164,7 +167,6 @@ TEST(Overlay, FieldsVdbRoundTrip) {
   EXPECT_EQ(s1.values, s2.values);
 }
 
-
 // The EXR layers of a trauma-room render, read back through OpenEXR, against the field maths at the
 // surface points the pixels show (PointEvaluator: the visibility rules with the surface normal, the
 // information matrix and eigenvalues exactly as EvaluateFields computes them). Each sampled pixel's
@@ -196,7 +198,8 @@ TEST(Render, ExrLayersMatchTheFieldValuesAtSampledPixels) {
     for (int x = 1; x < image.width; x += 4) {
       const std::size_t p = std::size_t(y) * image.width + x;
       if (!std::isfinite(image.depth[p])) continue;
-      const Vec3 d = (R.col(2) + ((x - cx) / f) * R.col(0) + ((y - cy) / f) * R.col(1)).normalized();
+      const Vec3 d =
+          (R.col(2) + ((x - cx) / f) * R.col(0) + ((y - cy) / f) * R.col(1)).normalized();
       const auto hit = caster->Intersect(Ray{view.from, d, 0.0, 1e9});
       ASSERT_TRUE(hit.has_value()) << x << "," << y;
       // The EXR depth is float: the rebuilt ray must land on the same surface point.

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <string>
 
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 #include "render/render.h"
 #include "render/test_options.h"
 
@@ -51,9 +51,11 @@ TEST(PlanView, FramesTheBoundsAtItsScaleAndIsOrthographic) {
       EXPECT_NEAR(X.y(), ey, 2.0 / kPlanDistance * std::abs(X.y() - c.y()) + 1e-9) << h;
     }
   // Elevations look along their axis with +z up.
-  const Ray south = *PixelRay(scene.rigs[0], *PlanView(bounds, "south", 600, 400, std::nan("")), 299.5, 199.5);
+  const Ray south =
+      *PixelRay(scene.rigs[0], *PlanView(bounds, "south", 600, 400, std::nan("")), 299.5, 199.5);
   EXPECT_NEAR(south.direction.y(), 1.0, 1e-12);
-  const Ray west = *PixelRay(scene.rigs[0], *PlanView(bounds, "west", 600, 400, std::nan("")), 299.5, 0);
+  const Ray west =
+      *PixelRay(scene.rigs[0], *PlanView(bounds, "west", 600, 400, std::nan("")), 299.5, 0);
   EXPECT_GT(west.direction.x(), 0.99);
   EXPECT_GT(west.direction.z(), 0.0);  // the top row looks up: +z is up
   EXPECT_FALSE(PlanView(bounds, "up", 600, 400, 0.0));
@@ -82,7 +84,8 @@ TEST(PlanView, RaysStartOnTheCutSoTheCeilingDoesNotHideTheFloor) {
   }
   // The 90 deg camera 2.5 m up lights a 5 x 3.75 m patch, clipped by the 6 x 4 m floor to 5 x 3.75:
   // about 18.75 / (6.3 x 4.2) of the frame.
-  const double expected = 5.0 * 3.75 / (2 * 1.05 * 3.0 * 2 * 1.05 * 3.0 * 200 / 300) * a.coverage.size();
+  const double expected =
+      5.0 * 3.75 / (2 * 1.05 * 3.0 * 2 * 1.05 * 3.0 * 200 / 300) * a.coverage.size();
   EXPECT_NEAR(lit_a, expected, 0.03 * expected);
   EXPECT_EQ(lit_b, 0);
 }
@@ -106,7 +109,8 @@ TEST(PlanView, LabelsAreDrawnBesideTheCamerasOnly) {
   for (int y = 0; y < 400; ++y)
     for (int x = 0; x < 600; ++x) {
       const std::size_t i = 3 * (std::size_t(y) * 600 + x);
-      if (plain.rgb[i] == labelled.rgb[i] && plain.rgb[i + 1] == labelled.rgb[i + 1] && plain.rgb[i + 2] == labelled.rgb[i + 2])
+      if (plain.rgb[i] == labelled.rgb[i] && plain.rgb[i + 1] == labelled.rgb[i + 1] &&
+          plain.rgb[i + 2] == labelled.rgb[i + 2])
         continue;
       ++changed;
       far += std::abs(y - py) > 20 || x < px - 5 || x > px + 120;

@@ -2,13 +2,13 @@
 #include <png.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <vector>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/input_file.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 #include "render/colormap.h"
 #include "render/render.h"
 
@@ -30,10 +30,14 @@ void WritePng(const Image& image, const std::string& path) {
   std::vector<uint8_t> bytes(3 * pixels);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     const float v = image.rgb[i];
-    if (!(v > 0.0f)) bytes[i] = 0;  // also NaN
-    else if (v >= 1.0f) bytes[i] = 255;
-    else if (v < 1.0f / 256) bytes[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(v)));
-    else bytes[i] = table[std::size_t(std::lround(double(v) * 65536.0))];
+    if (!(v > 0.0f))
+      bytes[i] = 0;  // also NaN
+    else if (v >= 1.0f)
+      bytes[i] = 255;
+    else if (v < 1.0f / 256)
+      bytes[i] = uint8_t(std::lround(255.0 * SrgbFromLinear(v)));
+    else
+      bytes[i] = table[std::size_t(std::lround(double(v) * 65536.0))];
   }
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
@@ -58,11 +62,13 @@ Image ReadPng(const std::string& path) {
   png.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&png, path.c_str()))
     throw InputError(path, "", std::string("cannot read the PNG file: ") + png.message);
-  // The header's size decides the allocation: a damaged or hostile header must not ask for gigabytes.
+  // The header's size decides the allocation: a damaged or hostile header must not ask for
+  // gigabytes.
   if (static_cast<std::uint64_t>(png.width) * png.height > (64ull << 20)) {
     png_image_free(&png);
-    throw InputError(path, "", "the PNG is " + std::to_string(png.width) + " x " + std::to_string(png.height) +
-                                   " pixels; at most 64 Mpx is read",
+    throw InputError(path, "",
+                     "the PNG is " + std::to_string(png.width) + " x " +
+                         std::to_string(png.height) + " pixels; at most 64 Mpx is read",
                      "scale the image down");
   }
   png.format = PNG_FORMAT_RGB;

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora {
 
@@ -28,8 +28,8 @@ struct PreparedOverlaysData;
 
 /// Which of each triangle's edges the hidden-line mode draws (Surface::kHiddenLine): edges between
 /// triangles more than 1 degree from coplanar, and boundary edges, matched by their exact end
-/// points. Bit i of entry t: the edge of triangle t opposite its vertex i. PreparedScene computes it
-/// once per scene; the GPU renderer of the viewer draws the same set.
+/// points. Bit i of entry t: the edge of triangle t opposite its vertex i. PreparedScene computes
+/// it once per scene; the GPU renderer of the viewer draws the same set.
 std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh);
 
 /// A scene prepared for rendering. Holds a copy of everything it derives from the Scene (the
@@ -64,8 +64,8 @@ class PreparedScene {
   void PrepareAll() const;
   /// The decoded diffuse textures (linear RGB, row 0 at the top, render/render.h's Image), decoded
   /// at the first call (as Surface::kMaterial's first frame does), and per object of the scene the
-  /// index of its texture, or -1 (no texture, no texture coordinates, or a texture that could not be
-  /// read). What the GPU renderer of the viewer uploads.
+  /// index of its texture, or -1 (no texture, no texture coordinates, or a texture that could not
+  /// be read). What the GPU renderer of the viewer uploads.
   const std::vector<Image>& Textures() const;
   const std::vector<int>& ObjectTextures() const;
 

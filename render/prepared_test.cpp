@@ -12,22 +12,25 @@
 #include <cstring>
 #include <thread>
 
-#include "analysis/error.h"
-#include "analysis/primitives.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "render/prepared_scene.h"
 #include "render/progressive.h"
 #include "render/render.h"
-#include "volume/fields.h"
 #include "tests/fixtures.h"
+#include "volume/fields.h"
 
 namespace pandora {
 namespace {
 
 Camera Cam(const std::string& id, const Vec3& from, const Vec3& at, double hfov_deg,
            const Vec3& color, LensModel lens = LensModel::kPinhole, double k1 = 0, double k2 = 0) {
-  Camera c = testing::WithIntrinsics(testing::TestCamera(id, from, at, hfov_deg, 64, 48, lens, Vec3(0, 0, 1)),
-                                     [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
+  Camera c = testing::WithIntrinsics(
+      testing::TestCamera(id, from, at, hfov_deg, 64, 48, lens, Vec3(0, 0, 1)), [&](Intrinsics& k) {
+        k.k1 = k1;
+        k.k2 = k2;
+      });
   c.color = color;
   return c;
 }

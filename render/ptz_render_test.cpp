@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "analysis/camera.h"
-#include "analysis/ptz.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 #include "render/render.h"
 #include "render/test_options.h"
 
@@ -122,7 +122,7 @@ struct Comparison {
   int lit_a = 0, lit_b = 0, lit_either = 0;
   int outline = 0;  // pixels both light with a 4-neighbour not lit by both (inner image)
   int only_a = 0, only_b = 0;
-  int far = 0;  // disagreeing pixels farther than N from an agreed-lit or an agreed-dark pixel
+  int far = 0;    // disagreeing pixels farther than N from an agreed-lit or an agreed-dark pixel
   int worst = 0;  // the largest such distance (Chebyshev pixels, capped at 20)
 };
 
@@ -213,10 +213,11 @@ void ExpectTraceMatchesLattice(const std::string& offset, double budget_s) {
   EXPECT_GT(c.lit_a, pixels / 20) << offset;
   EXPECT_LT(c.lit_a, pixels * 4 / 5) << offset;
   const double share = double(c.only_a + c.only_b) / c.lit_either;
-  std::printf("offset %s, budget %.2f s: %d lattice poses, lit all %d lattice %d, only all %d, "
-              "only lattice %d (%.2f %% of %d), %d beyond %d px (worst %d), outline %d\n",
-              offset.c_str(), budget_s, poses, c.lit_a, c.lit_b, c.only_a, c.only_b, 100 * share,
-              c.lit_either, c.far, kN, c.worst, c.outline);
+  std::printf(
+      "offset %s, budget %.2f s: %d lattice poses, lit all %d lattice %d, only all %d, "
+      "only lattice %d (%.2f %% of %d), %d beyond %d px (worst %d), outline %d\n",
+      offset.c_str(), budget_s, poses, c.lit_a, c.lit_b, c.only_a, c.only_b, 100 * share,
+      c.lit_either, c.far, kN, c.worst, c.outline);
   EXPECT_LT(c.only_a + c.only_b, kOutlineShare * c.outline) << offset;
   EXPECT_EQ(c.far, 0) << offset << ": worst distance " << c.worst;
 }

@@ -8,10 +8,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "render/frame.h"
 #include "render/prepared_scene.h"
-#include "analysis/units.h"
 
 namespace pandora {
 
@@ -29,8 +29,8 @@ std::string FieldUnitLabel(const std::string& field) {
   return field;
 }
 
-std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width, int height,
-                                   double cut, double* metres_per_pixel) {
+std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width,
+                                   int height, double cut, double* metres_per_pixel) {
   // Towards the eye, and the image's up.
   Vec3 out, up;
   if (side == "plan") {

@@ -2,10 +2,10 @@
 /// \file render.h
 /// Projective-light rendering (paper Fig. 2 and 4): the scene seen from a viewpoint, lit by every
 /// enabled camera of a rig as a projector of its own colour. A surface point seen by camera c under
-/// the visibility rules (analysis/visibility.h: working range, image bounds with distortion, facing
-/// the camera, not occluded) receives c's colour; contributions add; points no camera sees stay
-/// unlit. The renderer is the exact CPU reference: one primary ray per sample through Embree, then
-/// one occlusion segment per (sample, camera), traced in packets.
+/// the visibility rules (analysis/geometry/visibility.h: working range, image bounds with
+/// distortion, facing the camera, not occluded) receives c's colour; contributions add; points no
+/// camera sees stay unlit. The renderer is the exact CPU reference: one primary ray per sample
+/// through Embree, then one occlusion segment per (sample, camera), traced in packets.
 ///
 /// Two forms: the one-shot Render(scene, rig, caster, view, options, fields), which prepares the
 /// scene for that call, and Render(prepared, rig, view, options, overlays) over a PreparedScene
@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "analysis/geometry.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 #include "render/light.h"
 
 namespace pandora {
@@ -37,7 +37,8 @@ class PreparedOverlays;
 
 /// Where the image is seen from.
 struct RenderView {
-  /// Main view: a pinhole eye at `from` looking at `at`, `up` up, horizontal field of view `fov_deg`.
+  /// Main view: a pinhole eye at `from` looking at `at`, `up` up, horizontal field of view
+  /// `fov_deg`.
   Vec3 from = Vec3::Zero();
   Vec3 at = Vec3::UnitX();
   Vec3 up = Vec3::UnitZ();
@@ -67,11 +68,12 @@ RenderView ViewFromScene(const View& view, int width, int height, double default
 /// `cut` (a plan: the height; an elevation: the coordinate along its axis), nothing on the eye's
 /// side of it drawn (a ceiling, the near wall); NaN: no cut. An unknown side: nullopt.
 inline constexpr double kPlanDistance = 500.0;
-std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width, int height,
-                                   double cut, double* metres_per_pixel = nullptr);
+std::optional<RenderView> PlanView(const Aabb& bounds, const std::string& side, int width,
+                                   int height, double cut, double* metres_per_pixel = nullptr);
 /// The default cut of a plan or elevation of a study region `region` (`pandora render --plan`, the
 /// viewer's Plan and Elevation views): a plan at the region's top, an elevation at the region's
-/// face on its side (north: max y, south: min y, east: max x, west: min x). NaN for an unknown side.
+/// face on its side (north: max y, south: min y, east: max x, west: min x). NaN for an unknown
+/// side.
 double PlanDefaultCut(const Aabb& region, const std::string& side);
 
 /// How the surfaces themselves look under the projected light.
@@ -79,19 +81,19 @@ enum class Surface {
   kMaterial,    ///< Intrinsic material colour (Scene::materials), with a dim ambient term.
   kBlack,       ///< Black: only the projected light shows (analytic tests use this).
   kHiddenLine,  ///< Black with grey mesh edges, hidden lines removed (coplanar diagonals skipped).
-  kContours,    ///< Black with grey contours only: silhouette/crease/object boundaries in the image.
+  kContours,  ///< Black with grey contours only: silhouette/crease/object boundaries in the image.
 };
 
 /// Overlays drawn in the main view.
 struct OverlayOptions {
-  bool cameras = true;             ///< Each enabled camera as a small body plus its frustum wireframe.
-  bool labels = false;             ///< With `cameras`: each camera's id beside its centre (plans).
-  double frustum_length = 0.6;     ///< Metres along the axis (clipped to the camera's far distance).
+  bool cameras = true;          ///< Each enabled camera as a small body plus its frustum wireframe.
+  bool labels = false;          ///< With `cameras`: each camera's id beside its centre (plans).
+  double frustum_length = 0.6;  ///< Metres along the axis (clipped to the camera's far distance).
   /// Slice plane through the fields (needs `fields`): empty = none, else the field name, e.g.
   /// "coverage", "resolution", "sigma_max". Coloured with viridis between slice_min and slice_max
   /// (NaN: the field's range on the slice); a legend is drawn in the lower right corner.
   std::string slice_field;
-  int slice_axis = 2;              ///< 0 x, 1 y, 2 z: the plane is perpendicular to this axis.
+  int slice_axis = 2;  ///< 0 x, 1 y, 2 z: the plane is perpendicular to this axis.
   /// Plane position along slice_axis (m); NaN: the middle voxel layer of the field's active voxels.
   double slice_position = std::numeric_limits<double>::quiet_NaN();
   double slice_min = std::numeric_limits<double>::quiet_NaN();
@@ -156,20 +158,20 @@ struct Image {
   static constexpr int kMaxMaskCameras = 64;
 
   int width = 0, height = 0;
-  std::vector<float> rgb;          ///< Linear RGB, 3 per pixel, unclamped (>= 0).
+  std::vector<float> rgb;  ///< Linear RGB, 3 per pixel, unclamped (>= 0).
   /// Number of enabled cameras that see the surface point: exact for any number of cameras.
   std::vector<float> coverage;
   /// Bit c set when rig camera c sees the surface point, for rigs of at most kMaxMaskCameras
-  /// cameras. Empty for larger rigs: a per-pixel set of up to 1000 cameras would not fit a mask, and
-  /// a mask of the first 64 would read as the whole set. There, `coverage` still counts every camera
-  /// and PickPixel lists the cameras that see the point a pixel shows.
+  /// cameras. Empty for larger rigs: a per-pixel set of up to 1000 cameras would not fit a mask,
+  /// and a mask of the first 64 would read as the whole set. There, `coverage` still counts every
+  /// camera and PickPixel lists the cameras that see the point a pixel shows.
   std::vector<uint64_t> cameras;
-  std::vector<float> resolution;   ///< Best pixel density (px/m) among those cameras; 0 if none.
+  std::vector<float> resolution;  ///< Best pixel density (px/m) among those cameras; 0 if none.
   /// Worst-direction 1-sigma of the static triangulation (mm), as the sigma_max field;
   /// +inf where fewer than two cameras see the point or a direction is unobservable.
   std::vector<float> sigma_max;
-  std::vector<float> depth;        ///< Distance from the eye along the ray (m); +inf: no surface.
-  std::vector<int32_t> object;     ///< Scene object index hit, -1 for none.
+  std::vector<float> depth;     ///< Distance from the eye along the ray (m); +inf: no surface.
+  std::vector<int32_t> object;  ///< Scene object index hit, -1 for none.
 
   Vec3 Rgb(int x, int y) const {
     const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
@@ -188,16 +190,16 @@ Image Render(const PreparedScene& scene, const Rig& rig, const RenderView& view,
              const RenderOptions& options, const PreparedOverlays* overlays = nullptr);
 
 /// The one-shot convenience form: prepares `scene` over `caster` (no BVH is built) and, when
-/// options.overlays asks for them, the overlays from `fields`, then renders as above; the same image
-/// bit for bit. `caster` must be built from scene.AllTriangles(). `fields` may be null when no
-/// overlay needs it. Throws as above, and InputError when the fields lack the grid ("--slice",
+/// options.overlays asks for them, the overlays from `fields`, then renders as above; the same
+/// image bit for bit. `caster` must be built from scene.AllTriangles(). `fields` may be null when
+/// no overlay needs it. Throws as above, and InputError when the fields lack the grid ("--slice",
 /// "--iso"; the hint lists the grids present).
 Image Render(const Scene& scene, const Rig& rig, const RayCaster& caster, const RenderView& view,
              const RenderOptions& options, const Fields* fields = nullptr);
 
 /// Timing of Render's parts and the ray counts, for `pandora bench --render`.
 struct RenderStats {
-  double seconds = 0;          ///< Whole Render call (with the preparation in the one-shot form).
+  double seconds = 0;  ///< Whole Render call (with the preparation in the one-shot form).
   std::size_t primary_rays = 0;
   std::size_t shadow_rays = 0;  ///< Occlusion segments cast (after the geometric tests).
 };
@@ -216,14 +218,14 @@ Image RenderWithStats(const PreparedScene& scene, const Rig& rig, const RenderVi
 
 /// What the centre of output pixel (x, y) shows: the surface point and the cameras that see it.
 struct PixelPick {
-  Vec3 point;       ///< First surface hit of the pixel's centre ray (world, m).
-  Vec3 normal;      ///< Geometric unit normal there, turned towards the eye.
+  Vec3 point;   ///< First surface hit of the pixel's centre ray (world, m).
+  Vec3 normal;  ///< Geometric unit normal there, turned towards the eye.
   /// The point the cameras are tested at: `point` lifted off the surface along `normal` by a
   /// tenth of the visibility epsilon, as the renderer does, so float round-off in the hit cannot
   /// make a surface shadow itself.
   Vec3 lit_point;
-  double depth = 0;  ///< Distance from the eye along the ray, m.
-  int object = -1;   ///< Scene object index.
+  double depth = 0;   ///< Distance from the eye along the ray, m.
+  int object = -1;    ///< Scene object index.
   int triangle = -1;  ///< Index into scene.AllTriangles().
   /// Indices (rig order) of the enabled cameras that see lit_point (VisibilityTester::Test with the
   /// normal): the per-pixel camera set for rigs of any size; its size is the `coverage` layer.
@@ -256,8 +258,8 @@ class PixelPicker {
 std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, double y);
 
 /// PixelPicker(scene, rig, view).Pick(x, y), for a single pick.
-std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig, const RenderView& view,
-                                   int x, int y);
+std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,
+                                   const RenderView& view, int x, int y);
 
 /// 8-bit sRGB PNG of image.rgb (clamped to [0, 1], sRGB transfer curve). Written to a temporary
 /// name and renamed; throws InputError (file = path) when it cannot be written.

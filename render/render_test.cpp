@@ -1,7 +1,11 @@
 // Analytic image tests of the projective-light renderer: every expected pixel value is computed in
 // closed form here (ray-plane and ray-sphere intersection, the camera model's projection), not by
 // the renderer.
+#include "render/render.h"
+
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -9,19 +13,15 @@
 #include <fstream>
 #include <iterator>
 
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include "analysis/error.h"
-#include "analysis/primitives.h"
-#include "analysis/scene.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "render/colormap.h"
 #include "render/prepared_scene.h"
-#include "render/render.h"
 #include "tests/fixtures.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -30,7 +30,10 @@ Camera MakeCamera(const std::string& id, const Vec3& from, const Vec3& at, const
                   int h, double hfov_deg, const Vec3& color, LensModel lens = LensModel::kPinhole,
                   double k1 = 0, double k2 = 0) {
   Camera c = testing::WithIntrinsics(testing::TestCamera(id, from, at, hfov_deg, w, h, lens, up),
-                                     [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
+                                     [&](Intrinsics& k) {
+                                       k.k1 = k1;
+                                       k.k2 = k2;
+                                     });
   c.color = color;
   return c;
 }
@@ -143,8 +146,8 @@ TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {
         EXPECT_EQ(rgb, Vec3::Zero()) << "pixel " << x << "," << y;
         EXPECT_EQ(img.coverage[y * img.width + x], 0.0f);
       }
-      // Pixels the distorted footprint lights but the pinhole one (same intrinsics, k = 0) would not:
-      // the test must see the distortion.
+      // Pixels the distorted footprint lights but the pinhole one (same intrinsics, k = 0) would
+      // not: the test must see the distortion.
       const auto pm = BorderMargin(pin, *X);
       if (expected != (pm && *pm > 0)) ++curved;
     }
@@ -174,7 +177,8 @@ TEST(Render, StratifiedSamplesAverageTheFootprintInsideEachPixel) {
       bool undecided = false;
       for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i) {
-          const auto X = HitFloor(view.from, EyeRay(view, x - 0.5 + (i + 0.5) / 3, y - 0.5 + (j + 0.5) / 3));
+          const auto X =
+              HitFloor(view.from, EyeRay(view, x - 0.5 + (i + 0.5) / 3, y - 0.5 + (j + 0.5) / 3));
           ASSERT_TRUE(X);
           const auto margin = BorderMargin(cam, *X);
           if (margin && std::abs(*margin) < 1e-3) undecided = true;
@@ -215,7 +219,8 @@ TEST(Render, SphereCastsThePredictedShadow) {
   const Image img = Render(scene, rig, *caster, view, BlackOptions());
   const Camera& cam = rig.cameras[0];
   // The tessellated sphere lies between the sphere of radius r (its vertices) and the sphere of
-  // radius r cos^2(pi / segments) (its faces' nearest points, generously): decided outside that band.
+  // radius r cos^2(pi / segments) (its faces' nearest points, generously): decided outside that
+  // band.
   const double r_in = r * std::pow(std::cos(kPi / segments), 2);
   auto distance_to_segment = [&](const Vec3& a, const Vec3& b) {
     const Vec3 ab = b - a;
@@ -282,7 +287,8 @@ TEST(Render, OverlappingCamerasSumTheirColoursAndLayersMatchThePerPointComputati
       const auto ma = BorderMargin(rig.cameras[0], *X), mb = BorderMargin(rig.cameras[1], *X);
       if ((ma && std::abs(*ma) < 1e-3) || (mb && std::abs(*mb) < 1e-3)) continue;
       const bool sa = ma && *ma > 0, sb = mb && *mb > 0;
-      const Vec3 expected = 0.5 * ((sa ? Vec3(1, 0, 0) : Vec3::Zero()) + (sb ? Vec3(0, 1, 0) : Vec3::Zero()));
+      const Vec3 expected =
+          0.5 * ((sa ? Vec3(1, 0, 0) : Vec3::Zero()) + (sb ? Vec3(0, 1, 0) : Vec3::Zero()));
       EXPECT_EQ(img.Rgb(x, y), expected) << x << "," << y;
       const std::size_t p = std::size_t(y) * img.width + x;
       EXPECT_EQ(img.coverage[p], float(sa + sb));
@@ -373,9 +379,11 @@ TEST(Render, CameraOnAWallFaceSeesTheRoomAsItsFieldsDo) {
       const auto pick = PickPixel(prepared, rig, view, x, y);
       if (!pick) continue;
       // Never the wall the camera sits on (at depth 0): the floor, metres away.
-      EXPECT_NE(scene.objects[pick->object].name, "wall") << x << "," << y << " depth " << pick->depth;
+      EXPECT_NE(scene.objects[pick->object].name, "wall")
+          << x << "," << y << " depth " << pick->depth;
       EXPECT_GT(pick->depth, 0.5) << x << "," << y;
-      // The fields' rule says the camera sees the point the image shows there, and the image lights it.
+      // The fields' rule says the camera sees the point the image shows there, and the image lights
+      // it.
       EXPECT_EQ(tester.Test(0, pick->lit_point, &pick->normal), ViewResult::kSeen) << x << "," << y;
       EXPECT_GT(img.Rgb(x, y).x(), 0.0) << x << "," << y;
       ++floor_pixels;
@@ -472,8 +480,10 @@ TEST(Render, HiddenLineDrawsBoxEdgesButNotCoplanarDiagonals) {
       // The renderer linearises the projection at the hit point (ray differentials): second-order
       // differences within a pixel of the edge stay below 1e-3 here.
       EXPECT_NEAR(img.Rgb(x, y).x(), expected, 1e-3) << x << "," << y << " distance " << dist;
-      if (expected > 0) ++near_edges;
-      else ++interior;
+      if (expected > 0)
+        ++near_edges;
+      else
+        ++interior;
     }
   EXPECT_GT(near_edges, 150);
   EXPECT_GT(interior, 1000);
@@ -542,12 +552,12 @@ TEST(Render, EmbreeAndTheDoublePrecisionBruteForceCasterGiveTheSameImage) {
   scene.objects.push_back(box);
   Rig rig;
   rig.name = "three";
-  rig.cameras.push_back(MakeCamera("a", Vec3(1.5, -1.5, 2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 60,
-                                   Vec3(1, 0, 0), LensModel::kBrownConrady, -0.1, 0.01));
-  rig.cameras.push_back(
-      MakeCamera("b", Vec3(-1.5, -1.2, 1.8), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 70, Vec3(0, 1, 0)));
-  rig.cameras.push_back(MakeCamera("c", Vec3(0.2, 1.8, 2.2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48, 80,
-                                   Vec3(0, 0, 1), LensModel::kFisheye, 0.01));
+  rig.cameras.push_back(MakeCamera("a", Vec3(1.5, -1.5, 2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48,
+                                   60, Vec3(1, 0, 0), LensModel::kBrownConrady, -0.1, 0.01));
+  rig.cameras.push_back(MakeCamera("b", Vec3(-1.5, -1.2, 1.8), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64,
+                                   48, 70, Vec3(0, 1, 0)));
+  rig.cameras.push_back(MakeCamera("c", Vec3(0.2, 1.8, 2.2), Vec3(0, 0, 0.3), Vec3(0, 0, 1), 64, 48,
+                                   80, Vec3(0, 0, 1), LensModel::kFisheye, 0.01));
   const TriangleMesh all = scene.AllTriangles();
   const auto embree = MakeEmbreeRayCaster(all);
   const auto brute = MakeBruteForceRayCaster(all);
@@ -578,7 +588,8 @@ TEST(Render, EmbreeAndTheDoublePrecisionBruteForceCasterGiveTheSameImage) {
 TEST(Render, ViridisMatchesThePublishedTable) {
   // matplotlib's _viridis_data entries 0, 128 and 255.
   EXPECT_LT((ViridisSrgb(0.0) - Vec3(0.267004, 0.004874, 0.329415)).cwiseAbs().maxCoeff(), 0.012);
-  EXPECT_LT((ViridisSrgb(128.0 / 255) - Vec3(0.128729, 0.563265, 0.551229)).cwiseAbs().maxCoeff(), 0.012);
+  EXPECT_LT((ViridisSrgb(128.0 / 255) - Vec3(0.128729, 0.563265, 0.551229)).cwiseAbs().maxCoeff(),
+            0.012);
   EXPECT_LT((ViridisSrgb(1.0) - Vec3(0.993248, 0.906157, 0.143936)).cwiseAbs().maxCoeff(), 0.015);
   // Perceptually ordered: lightness (here luma) increases monotonically.
   double last = -1;
@@ -622,7 +633,8 @@ TEST(Render, ExrAndPngRoundTrip) {
   for (std::size_t i = 0; i < 3 * n; ++i) {
     const double expected = std::clamp(double(img.rgb[i]), 0.0, 1.0);
     // 8-bit sRGB: half a code step in sRGB space, mapped back to linear.
-    const double step = LinearFromSrgb(std::min(1.0, SrgbFromLinear(expected) + 0.5 / 255)) - expected;
+    const double step =
+        LinearFromSrgb(std::min(1.0, SrgbFromLinear(expected) + 0.5 / 255)) - expected;
     EXPECT_NEAR(p.rgb[i], expected, std::abs(step) + 1e-6) << i;
   }
 }
@@ -642,7 +654,7 @@ namespace {
 // intended change with PANDORA_UPDATE_RENDER_REFERENCES=1 and look at the images before committing.
 struct Reference {
   const char* file;
-  const char* view;     // scene view, or "" for the camera's-eye view of camera 0
+  const char* view;  // scene view, or "" for the camera's-eye view of camera 0
   Pattern pattern;
   Surface surface;
   int width, height;
@@ -661,7 +673,8 @@ TEST(RenderReference, TraumaRoomImagesMatchTheCommittedReferences) {
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const Reference refs[] = {
       {"trauma_overview_material.png", "overview", Pattern::kUniform, Surface::kMaterial, 192, 108},
-      {"trauma_overview_grid_hidden_line.png", "overview", Pattern::kGrid, Surface::kHiddenLine, 192, 108},
+      {"trauma_overview_grid_hidden_line.png", "overview", Pattern::kGrid, Surface::kHiddenLine,
+       192, 108},
       {"trauma_overview_contours.png", "overview", Pattern::kUniform, Surface::kContours, 192, 108},
       {"trauma_camera0_eye.png", "", Pattern::kUniform, Surface::kMaterial, 128, 96},
   };
@@ -748,8 +761,10 @@ TEST(Render, ObjTextureAppearsOnItsQuadrants) {
   const struct {
     double u, v;
     Vec3 texel;
-  } quadrants[] = {{0.25, 0.75, Vec3(1, 0, 0)}, {0.75, 0.75, Vec3(0, 1, 0)},
-                   {0.25, 0.25, Vec3(0, 0, 1)}, {0.75, 0.25, Vec3(1, 1, 1)}};
+  } quadrants[] = {{0.25, 0.75, Vec3(1, 0, 0)},
+                   {0.75, 0.75, Vec3(0, 1, 0)},
+                   {0.25, 0.25, Vec3(0, 0, 1)},
+                   {0.75, 0.25, Vec3(1, 1, 1)}};
   for (const auto& q : quadrants) {
     double best = 1e9;
     int bx = -1, by = -1;
@@ -784,7 +799,8 @@ TEST(ReadPng, SpecialFilesAndHugeHeadersAreRefused) {
     return "accepted";
   };
   EXPECT_NE(reason("/dev/zero").find("character device"), std::string::npos);
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("pandora_png_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("pandora_png_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string fifo = (dir / "fifo.png").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
@@ -803,7 +819,8 @@ TEST(ReadPng, SpecialFilesAndHugeHeadersAreRefused) {
   }
   ASSERT_GT(bytes.size(), 24u);
   const unsigned char big[4] = {0x00, 0x01, 0x86, 0xA0};  // 100000, big endian
-  for (int k = 0; k < 4; ++k) bytes[16 + k] = static_cast<char>(big[k]), bytes[20 + k] = static_cast<char>(big[k]);
+  for (int k = 0; k < 4; ++k)
+    bytes[16 + k] = static_cast<char>(big[k]), bytes[20 + k] = static_cast<char>(big[k]);
   std::uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of "IHDR" and its 13 data bytes (offsets 12..28)
   for (int i = 12; i < 29; ++i) {
     crc ^= static_cast<unsigned char>(bytes[i]);

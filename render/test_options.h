@@ -1,7 +1,8 @@
 #pragma once
 /// \file test_options.h
 /// Render options the render tests share: only the cameras' light on black surfaces and a black
-/// background, without camera bodies, key or layers (so a pixel is lit exactly where a camera sees).
+/// background, without camera bodies, key or layers (so a pixel is lit exactly where a camera
+/// sees).
 
 #include "render/render.h"
 

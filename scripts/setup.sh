@@ -10,6 +10,8 @@ PACKAGES=(
   libopenexr-dev openexr libpng-dev libassimp-dev libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libboost-iostreams-dev
   chromium libxml2-utils jq python3-openvdb
+  # The style checks (scripts/check_style.py, ctest style.*): formatting and function sizes.
+  clang-format universal-ctags
   # pandora analyze --mpi and its tests (docs/scale.md).
   libopenmpi-dev openmpi-bin
   # python/ (import pandora) and its tests.

@@ -1,21 +1,20 @@
 // Suggestions for a PTZ camera's controller: a preset's setting, a tour's order (docs/ptz.md).
 #include "suggest/ptz_suggest.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <numeric>
 
-#include "analysis/camera.h"
-#include "analysis/error.h"
-#include "analysis/sha256.h"
-#include "suggest/scene_text.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/scene/scene_text.h"
+#include "analysis/util/error.h"
+#include "analysis/util/sha256.h"
+#include "analysis/util/units.h"
 #include "suggest/suggestion_file.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -29,7 +28,8 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
 
 // The setting within the head's ranges (pan wrapped when continuous).
 PtzState Clamp(const PtzHead& h, PtzState s) {
-  s.pan_deg = h.ContinuousPan() ? h.WrapPan(s.pan_deg) : std::clamp(s.pan_deg, h.pan_min_deg, h.pan_max_deg);
+  s.pan_deg = h.ContinuousPan() ? h.WrapPan(s.pan_deg)
+                                : std::clamp(s.pan_deg, h.pan_min_deg, h.pan_max_deg);
   s.tilt_deg = std::clamp(s.tilt_deg, h.tilt_min_deg, h.tilt_max_deg);
   s.focal = std::clamp(s.focal, h.focal_min, h.focal_max);
   return s;
@@ -74,8 +74,9 @@ json StateJson(const PtzHead& h, const Camera& c, const PtzState& s) {
 json Header(const std::string& kind, const Scene& scene, const Rig& rig, bool improved) {
   return {{"pandora_suggestion", 1},
           {"kind", kind},
-          {"scene", {{"path", std::filesystem::absolute(scene.path).lexically_normal().string()},
-                     {"sha256", scene.sha256}}},
+          {"scene",
+           {{"path", std::filesystem::absolute(scene.path).lexically_normal().string()},
+            {"sha256", scene.sha256}}},
           {"rig", rig.name},
           {"improved", improved},
           {"cameras", json::array()}};
@@ -88,7 +89,8 @@ ordered_json& FindPtzBlock(ordered_json& root, const std::string& path, const st
   std::size_t r = 0;
   ordered_json& rig = scene_text::FindRig(root, path, rig_name, hint, &r);
   const std::string cameras = "$.rigs[" + std::to_string(r) + "].cameras";
-  if (!rig.contains("cameras") || !rig["cameras"].is_array()) throw InputError(path, cameras, "no cameras", hint);
+  if (!rig.contains("cameras") || !rig["cameras"].is_array())
+    throw InputError(path, cameras, "no cameras", hint);
   for (std::size_t c = 0; c < rig["cameras"].size(); ++c) {
     ordered_json& cam = rig["cameras"][c];
     if (!cam.is_object() || !cam.contains("id") || scene_text::IdOf(cam["id"]) != camera) continue;
@@ -102,9 +104,12 @@ ordered_json& FindPtzBlock(ordered_json& root, const std::string& path, const st
 
 }  // namespace
 
-PtzPointJudge::PtzPointJudge(const VisibilityTester& tester, int camera, const std::vector<Vec3>& points,
-                             double min_px_per_m)
-    : tester_(tester), camera_(camera), points_(points), min_px_per_m_(min_px_per_m),
+PtzPointJudge::PtzPointJudge(const VisibilityTester& tester, int camera,
+                             const std::vector<Vec3>& points, double min_px_per_m)
+    : tester_(tester),
+      camera_(camera),
+      points_(points),
+      min_px_per_m_(min_px_per_m),
       pivot_clear_(points.size(), -1) {}
 
 bool PtzPointJudge::Sees(std::size_t i, const PtzState& s) const {
@@ -147,7 +152,8 @@ PtzPresetSuggestion SuggestPtzPreset(const VisibilityTester& tester, int camera,
   // Zooms: 12 from the widest to the narrowest, evenly in log focal (one without a zoom range).
   std::vector<double> focals{h.focal_min};
   if (h.focal_max > h.focal_min)
-    for (int k = 1; k < 12; ++k) focals.push_back(h.focal_min * std::pow(h.focal_max / h.focal_min, k / 11.0));
+    for (int k = 1; k < 12; ++k)
+      focals.push_back(h.focal_min * std::pow(h.focal_max / h.focal_min, k / 11.0));
   // Centres: the centring setting of up to 64 target points (evenly through the list) and of
   // their mean.
   const PtzReach reach(cam, h, h.current);
@@ -155,7 +161,8 @@ PtzPresetSuggestion SuggestPtzPreset(const VisibilityTester& tester, int camera,
   const std::size_t stride = std::max<std::size_t>(1, points.size() / 64);
   for (std::size_t i = 0; i < points.size(); i += stride) aims.push_back(points[i]);
   if (!points.empty())
-    aims.push_back(std::accumulate(points.begin(), points.end(), Vec3(Vec3::Zero())) / double(points.size()));
+    aims.push_back(std::accumulate(points.begin(), points.end(), Vec3(Vec3::Zero())) /
+                   double(points.size()));
   std::vector<Candidate> best{start};
   for (const Vec3& X : aims) {
     const std::optional<PtzState> centre = reach.BestPose(X, 1e9);
@@ -214,15 +221,17 @@ std::vector<double> PtzTourGaps(const PtzPointJudge& judge, const std::vector<in
   std::vector<double> gaps;
   for (std::size_t i = 0; i < judge.size(); ++i) {
     const PtzTarget target = judge.target(i);
-    const PtzWatch w =
-        WatchTour(judge.head(), judge.camera(), legs, [&](const PtzState& s) { return judge.Sees(i, s); }, &target);
+    const PtzWatch w = WatchTour(
+        judge.head(), judge.camera(), legs, [&](const PtzState& s) { return judge.Sees(i, s); },
+        &target);
     gaps.push_back(w.longest_gap_s());
   }
   return gaps;
 }
 
-PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, const std::vector<Vec3>& points,
-                                 double min_px_per_m, TourObjective objective) {
+PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera,
+                                 const std::vector<Vec3>& points, double min_px_per_m,
+                                 TourObjective objective) {
   const auto t0 = std::chrono::steady_clock::now();
   const PtzPointJudge judge(tester, camera, points, min_px_per_m);
   const PtzHead& h = judge.head();
@@ -264,7 +273,8 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
   out.watchable = static_cast<int>(std::count(watchable.begin(), watchable.end(), 1));
   // An order's gaps: its legs' intervals laid end to end (the same sums as TourLegs and WatchTour).
   std::vector<std::pair<double, double>> v;
-  auto judge_order = [&](const std::vector<int>& order, double* gap_max, double* gap_mean, double* period) {
+  auto judge_order = [&](const std::vector<int>& order, double* gap_max, double* gap_mean,
+                         double* period) {
     ++out.orders;
     std::vector<double> start(n);
     double t = 0;
@@ -282,7 +292,8 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
         const int from = order[(k + n - 1) % n], to = order[k];
         const double m = move_s[from * n + to];
         if (m > 0)
-          for (const auto& [a, b] : moves[i][from * n + to]) v.emplace_back(start[k] + a, start[k] + b);
+          for (const auto& [a, b] : moves[i][from * n + to])
+            v.emplace_back(start[k] + a, start[k] + b);
         if (dwell[i][to]) v.emplace_back(start[k] + m, start[k] + m + h.tour[to].dwell_s);
       }
       const double g = LongestGap(v, t);
@@ -294,7 +305,8 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
   };
   judge_order(out.before, &out.gap_max_before, &out.gap_mean_before, &out.period_before);
   std::vector<int> best = out.before;
-  double best_max = out.gap_max_before, best_mean = out.gap_mean_before, best_period = out.period_before;
+  double best_max = out.gap_max_before, best_mean = out.gap_mean_before,
+         best_period = out.period_before;
   auto consider = [&](const std::vector<int>& order) {
     double gmax, gmean, period;
     judge_order(order, &gmax, &gmean, &period);
@@ -332,7 +344,8 @@ PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, con
   return out;
 }
 
-std::string PtzPresetSuggestionToJson(const PtzPresetSuggestion& s, const Scene& scene, const Rig& rig) {
+std::string PtzPresetSuggestionToJson(const PtzPresetSuggestion& s, const Scene& scene,
+                                      const Rig& rig) {
   const Camera* cam = &rig.cameras.at(static_cast<std::size_t>(rig.FindCamera(s.camera)));
   json j = Header("ptz_preset", scene, rig, s.improved());
   j["ptz"] = {{"camera", s.camera},
@@ -347,7 +360,8 @@ std::string PtzPresetSuggestionToJson(const PtzPresetSuggestion& s, const Scene&
   return j.dump(2) + "\n";
 }
 
-std::string PtzTourSuggestionToJson(const PtzTourSuggestion& s, const Scene& scene, const Rig& rig) {
+std::string PtzTourSuggestionToJson(const PtzTourSuggestion& s, const Scene& scene,
+                                    const Rig& rig) {
   const Camera* cam = &rig.cameras.at(static_cast<std::size_t>(rig.FindCamera(s.camera)));
   auto names = [&](const std::vector<int>& order) {
     json a = json::array();
@@ -375,9 +389,9 @@ std::string PtzTourSuggestionToJson(const PtzTourSuggestion& s, const Scene& sce
   return j.dump(2) + "\n";
 }
 
-std::string ReplacePtzPreset(const std::string& text, const std::string& path, const std::string& rig,
-                             const std::string& camera, const std::string& preset, const PtzState& state,
-                             double hfov_deg) {
+std::string ReplacePtzPreset(const std::string& text, const std::string& path,
+                             const std::string& rig, const std::string& camera,
+                             const std::string& preset, const PtzState& state, double hfov_deg) {
   ordered_json root = scene_text::ParseOrdered(text, path);
   std::string where;
   ordered_json& ptz = FindPtzBlock(root, path, rig, camera, &where);
@@ -389,7 +403,8 @@ std::string ReplacePtzPreset(const std::string& text, const std::string& path, c
       if (hfov_deg > 0) p["hfov_deg"] = scene_text::Number(scene_text::Clean(hfov_deg));
       return scene_text::DumpLike(root, text);
     }
-  throw InputError(path, where + ".presets", "no preset '" + preset + "'", "the scene file no longer matches the suggestion");
+  throw InputError(path, where + ".presets", "no preset '" + preset + "'",
+                   "the scene file no longer matches the suggestion");
 }
 
 std::string ReplacePtzTour(const std::string& text, const std::string& path, const std::string& rig,
@@ -398,7 +413,8 @@ std::string ReplacePtzTour(const std::string& text, const std::string& path, con
   std::string where;
   ordered_json& ptz = FindPtzBlock(root, path, rig, camera, &where);
   if (!ptz.contains("tour") || !ptz["tour"].is_array() || ptz["tour"].size() != order.size())
-    throw InputError(path, where + ".tour", "the tour does not have " + std::to_string(order.size()) + " stops",
+    throw InputError(path, where + ".tour",
+                     "the tour does not have " + std::to_string(order.size()) + " stops",
                      "the scene file no longer matches the suggestion");
   const ordered_json old = ptz["tour"];
   ordered_json tour = ordered_json::array();
@@ -407,8 +423,9 @@ std::string ReplacePtzTour(const std::string& text, const std::string& path, con
   return scene_text::DumpLike(root, text);
 }
 
-std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::string& suggestion_path,
-                                bool force, std::string* scene_path, std::string* what) {
+std::string AcceptPtzSuggestion(const std::string& suggestion_text,
+                                const std::string& suggestion_path, bool force,
+                                std::string* scene_path, std::string* what) {
   json j;
   try {
     j = json::parse(suggestion_text);
@@ -418,26 +435,32 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::s
   auto fail = [&](const std::string& at, const std::string& why) {
     throw InputError(suggestion_path, at, why, "is this a file written by pandora suggest?");
   };
-  if (!j.is_object() || !j.contains("kind") || !j["kind"].is_string()) fail("$.kind", "missing or not a string");
+  if (!j.is_object() || !j.contains("kind") || !j["kind"].is_string())
+    fail("$.kind", "missing or not a string");
   const std::string kind = j["kind"].get<std::string>();
   if (kind != "ptz_preset" && kind != "ptz_tour") fail("$.kind", "unknown kind '" + kind + "'");
   if (!j.contains("scene") || !j["scene"].is_object() || !j["scene"].contains("path") ||
-      !j["scene"]["path"].is_string() || !j["scene"].contains("sha256") || !j["scene"]["sha256"].is_string())
+      !j["scene"]["path"].is_string() || !j["scene"].contains("sha256") ||
+      !j["scene"]["sha256"].is_string())
     fail("$.scene", "expected {\"path\", \"sha256\"}");
   if (!j.contains("rig") || !j["rig"].is_string()) fail("$.rig", "missing or not a string");
-  if (!j.contains("improved") || !j["improved"].is_boolean()) fail("$.improved", "missing or not true/false");
+  if (!j.contains("improved") || !j["improved"].is_boolean())
+    fail("$.improved", "missing or not true/false");
   if (!j.contains("ptz") || !j["ptz"].is_object()) fail("$.ptz", "missing or not an object");
   const json& p = j["ptz"];
-  if (!p.contains("camera") || !p["camera"].is_string()) fail("$.ptz.camera", "missing or not a string");
+  if (!p.contains("camera") || !p["camera"].is_string())
+    fail("$.ptz.camera", "missing or not a string");
   if (!j["improved"].get<bool>())
-    throw InputError(suggestion_path, "$.improved", "the suggestion offers no improvement; nothing to accept",
+    throw InputError(suggestion_path, "$.improved",
+                     "the suggestion offers no improvement; nothing to accept",
                      "run pandora suggest with another target");
   const std::string rig = j["rig"].get<std::string>();
   const std::string camera = p["camera"].get<std::string>();
   *scene_path = j["scene"]["path"].get<std::string>();
   const std::string scene_text = scene_text::ReadJsonText(*scene_path, "scene file");
   if (Sha256Hex(scene_text) != j["scene"]["sha256"].get<std::string>() && !force)
-    throw InputError(*scene_path, "", "the scene file changed since the suggestion was made (SHA-256 differs)",
+    throw InputError(*scene_path, "",
+                     "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with --force");
   LoadOptions lo;
   lo.load_meshes = false;
@@ -456,7 +479,8 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::s
   int preset_index = -1;
   std::vector<int> order;
   if (kind == "ptz_preset") {
-    if (!p.contains("preset") || !p["preset"].is_string()) fail("$.ptz.preset", "missing or not a string");
+    if (!p.contains("preset") || !p["preset"].is_string())
+      fail("$.ptz.preset", "missing or not a string");
     const std::string preset = p["preset"].get<std::string>();
     for (std::size_t i = 0; i < head.presets.size(); ++i)
       if (head.presets[i].name == preset) preset_index = static_cast<int>(i);
@@ -465,52 +489,64 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::s
                        "the scene file no longer matches the suggestion");
     const json& a = p.value("after", json());
     for (const char* key : {"pan_deg", "tilt_deg", "hfov_deg"})
-      if (!a.is_object() || !a.contains(key) || !a[key].is_number() || !std::isfinite(a[key].get<double>()))
+      if (!a.is_object() || !a.contains(key) || !a[key].is_number() ||
+          !std::isfinite(a[key].get<double>()))
         fail(std::string("$.ptz.after.") + key, "missing or not a finite number");
     const Intrinsics& k = cam->model.intrinsics();
     const bool zooms = head.focal_max > head.focal_min;
     const double hfov = a["hfov_deg"].get<double>();
     expected_state = {a["pan_deg"].get<double>(), a["tilt_deg"].get<double>(),
-                      zooms ? FocalFromHfov(hfov * kPi / 180.0, k.width, k.model) : head.presets[preset_index].state.focal};
-    new_text = ReplacePtzPreset(scene_text, *scene_path, rig, camera, preset, expected_state, zooms ? hfov : 0.0);
+                      zooms ? FocalFromHfov(hfov * kPi / 180.0, k.width, k.model)
+                            : head.presets[preset_index].state.focal};
+    new_text = ReplacePtzPreset(scene_text, *scene_path, rig, camera, preset, expected_state,
+                                zooms ? hfov : 0.0);
     *what = camera + " preset " + preset;
   } else {
-    if (!p.contains("tour_after") || !p["tour_after"].is_array()) fail("$.ptz.tour_after", "missing or not an array");
+    if (!p.contains("tour_after") || !p["tour_after"].is_array())
+      fail("$.ptz.tour_after", "missing or not an array");
     std::vector<char> used(head.tour.size(), 0);
     for (const json& v : p["tour_after"]) {
-      if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() >= static_cast<long long>(head.tour.size()) ||
+      if (!v.is_number_integer() || v.get<long long>() < 0 ||
+          v.get<long long>() >= static_cast<long long>(head.tour.size()) ||
           used[v.get<std::size_t>()])
         fail("$.ptz.tour_after", "not an order of the tour's stops");
       used[v.get<std::size_t>()] = 1;
       order.push_back(v.get<int>());
     }
-    if (order.size() != head.tour.size()) fail("$.ptz.tour_after", "not an order of the tour's stops");
+    if (order.size() != head.tour.size())
+      fail("$.ptz.tour_after", "not an order of the tour's stops");
     new_text = ReplacePtzTour(scene_text, *scene_path, rig, camera, order);
     *what = camera + " tour";
   }
   // Read it back: that preset or tour changed as intended, every camera of every rig unchanged.
   const Scene after = ParseScene(new_text, *scene_path, lo);
   auto bad = [&](const std::string& at) {
-    throw InputError(*scene_path, at, "internal check failed: the rewritten PTZ block does not read back as intended",
-                     "the scene file was not changed");
+    throw InputError(
+        *scene_path, at,
+        "internal check failed: the rewritten PTZ block does not read back as intended",
+        "the scene file was not changed");
   };
   for (std::size_t ri = 0; ri < before.rigs.size(); ++ri)
     for (std::size_t c = 0; c < before.rigs[ri].cameras.size(); ++c) {
       const Camera& a = before.rigs[ri].cameras[c];
       const Camera& b = after.rigs[ri].cameras[c];
-      const std::string at = "$.rigs[" + std::to_string(ri) + "].cameras[" + std::to_string(c) + "]";
-      if (!(a.world_from_camera.matrix() - b.world_from_camera.matrix()).isZero(1e-12) || bool(a.ptz) != bool(b.ptz))
+      const std::string at =
+          "$.rigs[" + std::to_string(ri) + "].cameras[" + std::to_string(c) + "]";
+      if (!(a.world_from_camera.matrix() - b.world_from_camera.matrix()).isZero(1e-12) ||
+          bool(a.ptz) != bool(b.ptz))
         bad(at);
       if (!a.ptz) continue;
       const PtzHead& ha = *a.ptz;
       const PtzHead& hb = *b.ptz;
       const bool target = before.rigs[ri].name == rig && a.id == camera;
-      if (ha.presets.size() != hb.presets.size() || ha.tour.size() != hb.tour.size()) bad(at + ".ptz");
+      if (ha.presets.size() != hb.presets.size() || ha.tour.size() != hb.tour.size())
+        bad(at + ".ptz");
       for (std::size_t k = 0; k < ha.presets.size(); ++k) {
         PtzState want = ha.presets[k].state;
         if (target && static_cast<int>(k) == preset_index) want = expected_state;
         const PtzState got = hb.presets[k].state;
-        if (std::abs(got.pan_deg - want.pan_deg) > 1e-9 || std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
+        if (std::abs(got.pan_deg - want.pan_deg) > 1e-9 ||
+            std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
             std::abs(got.focal - want.focal) > 1e-9 * want.focal)
           bad(at + ".ptz.presets[" + std::to_string(k) + "]");
       }
@@ -520,7 +556,8 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::s
           bad(at + ".ptz.tour[" + std::to_string(k) + "]");
       }
     }
-  return ReplaceSceneFileWithBackup(*scene_path, scene_text, new_text, {{suggestion_path, "suggestion file"}});
+  return ReplaceSceneFileWithBackup(*scene_path, scene_text, new_text,
+                                    {{suggestion_path, "suggestion file"}});
 }
 
 }  // namespace pandora

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ptz.h"
-#include "analysis/scene.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora {
 
@@ -23,7 +23,8 @@ namespace pandora {
 class PtzPointJudge {
  public:
   /// `tester` holds the rig's cameras; `camera` indexes the PTZ camera among them.
-  PtzPointJudge(const VisibilityTester& tester, int camera, const std::vector<Vec3>& points, double min_px_per_m);
+  PtzPointJudge(const VisibilityTester& tester, int camera, const std::vector<Vec3>& points,
+                double min_px_per_m);
   const Camera& camera() const { return tester_.cameras()[camera_]; }
   const PtzHead& head() const { return *camera().ptz; }
   /// Points seen from setting `s`.
@@ -33,7 +34,9 @@ class PtzPointJudge {
   std::size_t size() const { return points_.size(); }
   const Vec3& point(std::size_t i) const { return points_[i]; }
   /// Point `i` as PtzSees tests it (WatchTour's exact move events).
-  PtzTarget target(std::size_t i) const { return {points_[i], min_px_per_m_, nullptr, &tester_, camera_}; }
+  PtzTarget target(std::size_t i) const {
+    return {points_[i], min_px_per_m_, nullptr, &tester_, camera_};
+  }
   std::int64_t rays() const { return rays_; }
 
  private:
@@ -84,13 +87,18 @@ struct PtzTourSuggestion {
   double gap_max_before = 0, gap_max_after = 0, gap_mean_before = 0, gap_mean_after = 0;
   double period_before = 0, period_after = 0;
   std::int64_t orders = 0;  ///< Orders judged.
-  bool exhaustive = false;  ///< Every order was judged (at most 8 stops), else 2-opt from every rotation.
+  bool exhaustive =
+      false;  ///< Every order was judged (at most 8 stops), else 2-opt from every rotation.
   double seconds = 0;
-  bool improved() const { return Better(gap_max_after, gap_mean_after, gap_max_before, gap_mean_before); }
+  bool improved() const {
+    return Better(gap_max_after, gap_mean_after, gap_max_before, gap_mean_before);
+  }
   /// True when (max, mean) a beats b under the objective (by more than 1e-9 s).
   bool Better(double max_a, double mean_a, double max_b, double mean_b) const {
-    const double a1 = objective == TourObjective::kMax ? max_a : mean_a, a2 = objective == TourObjective::kMax ? mean_a : max_a;
-    const double b1 = objective == TourObjective::kMax ? max_b : mean_b, b2 = objective == TourObjective::kMax ? mean_b : max_b;
+    const double a1 = objective == TourObjective::kMax ? max_a : mean_a,
+                 a2 = objective == TourObjective::kMax ? mean_a : max_a;
+    const double b1 = objective == TourObjective::kMax ? max_b : mean_b,
+                 b2 = objective == TourObjective::kMax ? mean_b : max_b;
     return a1 < b1 - 1e-9 || (a1 <= b1 + 1e-9 && a2 < b2 - 1e-9);
   }
 };
@@ -100,8 +108,9 @@ struct PtzTourSuggestion {
 /// point's watched intervals are computed once per preset (dwells) and per ordered pair of presets
 /// (moves, as PtzTourWatch samples them); an order is then judged by concatenating them. Every
 /// order for up to 8 stops, else a 2-opt descent.
-PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera, const std::vector<Vec3>& points,
-                                 double min_px_per_m, TourObjective objective = TourObjective::kMean);
+PtzTourSuggestion SuggestPtzTour(const VisibilityTester& tester, int camera,
+                                 const std::vector<Vec3>& points, double min_px_per_m,
+                                 TourObjective objective = TourObjective::kMean);
 
 /// The longest unwatched stretch of each point for tour order `order` of `judge`'s head, judged as
 /// PtzTourWatch does (the reference for SuggestPtzTour's fast path).
@@ -109,24 +118,27 @@ std::vector<double> PtzTourGaps(const PtzPointJudge& judge, const std::vector<in
 
 /// The suggestion file of a PTZ suggestion (docs/ptz.md): {"pandora_suggestion": 1, "kind":
 /// "ptz_preset" | "ptz_tour", scene {path, sha256}, rig, improved, cameras: [], ptz {...}}.
-std::string PtzPresetSuggestionToJson(const PtzPresetSuggestion& s, const Scene& scene, const Rig& rig);
+std::string PtzPresetSuggestionToJson(const PtzPresetSuggestion& s, const Scene& scene,
+                                      const Rig& rig);
 std::string PtzTourSuggestionToJson(const PtzTourSuggestion& s, const Scene& scene, const Rig& rig);
 
 /// The scene file text with preset `preset` of camera `camera` in rig `rig` set to `state`
-/// (pan_deg, tilt_deg, and hfov_deg when the head zooms) or, with `tour_order` non-empty, its tour's
-/// stops reordered; everything else kept (re-serialised with the file's indentation). Throws
+/// (pan_deg, tilt_deg, and hfov_deg when the head zooms) or, with `tour_order` non-empty, its
+/// tour's stops reordered; everything else kept (re-serialised with the file's indentation). Throws
 /// InputError (file = scene_path) when the rig, camera, preset or tour is not there.
-std::string ReplacePtzPreset(const std::string& scene_text, const std::string& scene_path, const std::string& rig,
-                             const std::string& camera, const std::string& preset, const PtzState& state,
-                             double hfov_deg);
-std::string ReplacePtzTour(const std::string& scene_text, const std::string& scene_path, const std::string& rig,
-                           const std::string& camera, const std::vector<int>& tour_order);
+std::string ReplacePtzPreset(const std::string& scene_text, const std::string& scene_path,
+                             const std::string& rig, const std::string& camera,
+                             const std::string& preset, const PtzState& state, double hfov_deg);
+std::string ReplacePtzTour(const std::string& scene_text, const std::string& scene_path,
+                           const std::string& rig, const std::string& camera,
+                           const std::vector<int>& tour_order);
 
 /// `pandora accept` of a PTZ suggestion file (its JSON text already read): checks it as
 /// AcceptSuggestion does (improved, scene unchanged unless `force`), rewrites the preset or the
 /// tour, parses the result back and checks that exactly that changed, then replaces the scene file
 /// with a backup. Returns the backup path; `what` receives e.g. "dome preset window".
-std::string AcceptPtzSuggestion(const std::string& suggestion_text, const std::string& suggestion_path,
-                                bool force, std::string* scene_path, std::string* what);
+std::string AcceptPtzSuggestion(const std::string& suggestion_text,
+                                const std::string& suggestion_path, bool force,
+                                std::string* scene_path, std::string* what);
 
 }  // namespace pandora

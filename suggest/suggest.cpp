@@ -1,5 +1,7 @@
 // Suggest (issue 5), the parts without Ceres: target points, the exact evaluation, objectives, the
 // pose chart of a selected camera, snapping, and the random-perturbation baseline.
+#include "suggest/suggest.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -13,22 +15,19 @@
 #include <set>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/inside_mesh.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
-#include "suggest/suggest.h"
-
-#include "analysis/surface_targets.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/surface_targets.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "suggest/suggest_internal.h"
-#include "analysis/units.h"
 
 namespace pandora {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
 
 std::string Format(const char* fmt, double v) {
   char buf[64];
@@ -100,16 +99,22 @@ std::optional<Objective> ParseObjective(const std::string& name) {
 
 std::string ObjectiveName(const Objective& o) {
   switch (o.kind) {
-    case ObjectiveKind::kCoverage: return "coverage" + std::to_string(o.k);
-    case ObjectiveKind::kSigmaMean: return "sigma-mean";
+    case ObjectiveKind::kCoverage:
+      return "coverage" + std::to_string(o.k);
+    case ObjectiveKind::kSigmaMean:
+      return "sigma-mean";
     case ObjectiveKind::kSigmaPercentile: {
       std::string p = Format("%g", o.percentile);
       return "sigma-p" + p;
     }
-    case ObjectiveKind::kResolution: return "resolution";
-    case ObjectiveKind::kMix: return "mix";
-    case ObjectiveKind::kCoverageN1: return "coverage" + std::to_string(o.k) + "-n1";
-    case ObjectiveKind::kCalibration: return "calibration";
+    case ObjectiveKind::kResolution:
+      return "resolution";
+    case ObjectiveKind::kMix:
+      return "mix";
+    case ObjectiveKind::kCoverageN1:
+      return "coverage" + std::to_string(o.k) + "-n1";
+    case ObjectiveKind::kCalibration:
+      return "calibration";
   }
   return "?";
 }
@@ -124,8 +129,9 @@ bool ObjectiveHigherIsBetter(const Objective& o) {
 std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
                                        const std::vector<std::string>& surfaces,
                                        bool include_region, std::uint64_t seed) {
-  if (count < 1) throw InputError(scene.path, "", "the number of target points must be positive",
-                                  "use --points 1000 or more");
+  if (count < 1)
+    throw InputError(scene.path, "", "the number of target points must be positive",
+                     "use --points 1000 or more");
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   std::vector<TargetPoint> out;
@@ -138,8 +144,8 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
     const Aabb& box = r.box;
     const Vec3 size = box.size();
     // Cells of equal volume: about region_count of them, stratified per axis.
-    const double volume = std::max(size.x(), 1e-300) * std::max(size.y(), 1e-300) *
-                          std::max(size.z(), 1e-300);
+    const double volume =
+        std::max(size.x(), 1e-300) * std::max(size.y(), 1e-300) * std::max(size.z(), 1e-300);
     const double h = std::cbrt(volume / region_count);
     Eigen::Vector3i n;
     for (int a = 0; a < 3; ++a)
@@ -165,8 +171,9 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
       for (int j = 0; j < n.y(); ++j)
         for (int k = 0; k < n.z(); ++k) {
           const Vec3 u(uni(rng), uni(rng), uni(rng));
-          const Vec3 p = box.min + Vec3((i + u.x()) / n.x() * size.x(), (j + u.y()) / n.y() * size.y(),
-                                        (k + u.z()) / n.z() * size.z());
+          const Vec3 p =
+              box.min + Vec3((i + u.x()) / n.x() * size.x(), (j + u.y()) / n.y() * size.y(),
+                             (k + u.z()) / n.z() * size.z());
           if (region_mesh && !region_mesh->Inside(p)) continue;
           bool solid = false;
           for (const auto& s : inside) solid = solid || s->Inside(p);
@@ -225,13 +232,14 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
     }
   }
   if (out.empty())
-    throw InputError(scene.path, "$.study.region", "no target point could be placed",
-                     "the region lies inside solid objects; move the region or name target surfaces");
+    throw InputError(
+        scene.path, "$.study.region", "no target point could be placed",
+        "the region lies inside solid objects; move the region or name target surfaces");
   return out;
 }
 
 // ---------------------------------------------------------------------------------------------
-// Perturbation (the Euler angles are analysis/pose.h)
+// Perturbation (the Euler angles are analysis/geometry/pose.h)
 
 Rig PerturbCameras(const Rig& rig, const std::vector<int>& cameras, double move, double rotate_deg,
                    std::uint64_t seed) {
@@ -253,7 +261,8 @@ Rig PerturbCameras(const Rig& rig, const std::vector<int>& cameras, double move,
     axis = axis - axis.dot(z) * z;
     if (axis.norm() < 1e-6) axis = z.unitOrthogonal();
     axis.normalize();
-    const Mat3 R = Eigen::AngleAxisd(Rad(rotate_deg), axis).toRotationMatrix() * c.world_from_camera.linear();
+    const Mat3 R =
+        Eigen::AngleAxisd(Rad(rotate_deg), axis).toRotationMatrix() * c.world_from_camera.linear();
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = R;
     pose.translation() = c.center() + t;
@@ -273,7 +282,8 @@ double RotationAngleDeg(const Mat3& a, const Mat3& b) {
 
 ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
                                const std::vector<TargetPoint>& targets, const Objective& objective,
-                               const std::vector<int>& selected, const std::vector<const RayCaster*>& sample_casters)
+                               const std::vector<int>& selected,
+                               const std::vector<const RayCaster*>& sample_casters)
     : caster_(caster), targets_(targets), objective_(objective) {
   casters_ = sample_casters;
   if (casters_.empty()) casters_.push_back(&caster_);
@@ -312,24 +322,25 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
   const bool n1 = objective_.kind == ObjectiveKind::kCoverageN1;
   if (n1) fixed_.seen_by.assign(n, {});
   const auto testers = Testers(fixed);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const TargetPoint& t = targets_[i];
-      const Vec3* normal = t.normal ? &*t.normal : nullptr;
-      const VisibilityTester& tester = *testers[Sample(i)];
-      for (int c = 0; c < static_cast<int>(fixed.size()); ++c) {
-        Mat23 A;
-        if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
-        const double s = PixelSigma(fixed[c]);
-        fixed_.count[i] += 1;
-        fixed_.J[i] += A.transpose() * A / (s * s);
-        const double d = PixelDensity(A);
-        fixed_.dmax[i] = std::max(fixed_.dmax[i], d);
-        fixed_.dpow[i] += std::pow(d / density_scale_, kSoftMaxPower);
-        if (n1) fixed_.seen_by[i].push_back(c);
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const TargetPoint& t = targets_[i];
+                        const Vec3* normal = t.normal ? &*t.normal : nullptr;
+                        const VisibilityTester& tester = *testers[Sample(i)];
+                        for (int c = 0; c < static_cast<int>(fixed.size()); ++c) {
+                          Mat23 A;
+                          if (tester.Test(c, t.p, normal, &A) != ViewResult::kSeen) continue;
+                          const double s = PixelSigma(fixed[c]);
+                          fixed_.count[i] += 1;
+                          fixed_.J[i] += A.transpose() * A / (s * s);
+                          const double d = PixelDensity(A);
+                          fixed_.dmax[i] = std::max(fixed_.dmax[i], d);
+                          fixed_.dpow[i] += std::pow(d / density_scale_, kSoftMaxPower);
+                          if (n1) fixed_.seen_by[i].push_back(c);
+                        }
+                      }
+                    });
 
   if (objective_.kind == ObjectiveKind::kCalibration) {
     if (!scene.study.calibration)
@@ -344,40 +355,48 @@ ExactEvaluator::ExactEvaluator(const Scene& scene, const Rig& rig, const RayCast
     calib_poses_ = SampleCalibrationPoses(scene, all, calib_spec_);
     const VisibilityTester fixed_tester(fixed, caster_, geometry_scale_);
     calib_fixed_.resize(fixed.size());
-    for (std::size_t c = 0; c < fixed.size(); ++c) calib_fixed_[c] = CalibrationBits(fixed_tester, static_cast<int>(c));
+    for (std::size_t c = 0; c < fixed.size(); ++c)
+      calib_fixed_[c] = CalibrationBits(fixed_tester, static_cast<int>(c));
     calib_fixed_shared_.assign(fixed.size(), std::vector<std::int64_t>(fixed.size(), 0));
     for (std::size_t a = 0; a < fixed.size(); ++a)
       for (std::size_t b = a; b < fixed.size(); ++b)
-        calib_fixed_shared_[a][b] = calib_fixed_shared_[b][a] = SharedBits(calib_fixed_[a], calib_fixed_[b]);
+        calib_fixed_shared_[a][b] = calib_fixed_shared_[b][a] =
+            SharedBits(calib_fixed_[a], calib_fixed_[b]);
   }
 }
 
-std::vector<std::uint64_t> ExactEvaluator::CalibrationBits(const VisibilityTester& tester, int camera) const {
+std::vector<std::uint64_t> ExactEvaluator::CalibrationBits(const VisibilityTester& tester,
+                                                           int camera) const {
   const std::size_t poses = calib_poses_.size();
   std::vector<std::uint8_t> seen(poses, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, poses, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t p = r.begin(); p != r.end(); ++p)
-      seen[p] = ObservesPose(tester, camera, calib_spec_, calib_poses_[p]) ? 1 : 0;
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, poses, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p)
+          seen[p] = ObservesPose(tester, camera, calib_spec_, calib_poses_[p]) ? 1 : 0;
+      });
   std::vector<std::uint64_t> bits((poses + 63) / 64, 0);
   for (std::size_t p = 0; p < poses; ++p)
     if (seen[p]) bits[p / 64] |= std::uint64_t(1) << (p % 64);
   return bits;
 }
 
-std::int64_t ExactEvaluator::SharedBits(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
+std::int64_t ExactEvaluator::SharedBits(const std::vector<std::uint64_t>& a,
+                                        const std::vector<std::uint64_t>& b) {
   std::int64_t n = 0;
   for (std::size_t w = 0; w < a.size() && w < b.size(); ++w) n += __builtin_popcountll(a[w] & b[w]);
   return n;
 }
 
-std::vector<std::unique_ptr<VisibilityTester>> ExactEvaluator::Testers(const std::vector<Camera>& cameras) const {
+std::vector<std::unique_ptr<VisibilityTester>> ExactEvaluator::Testers(
+    const std::vector<Camera>& cameras) const {
   std::vector<std::unique_ptr<VisibilityTester>> out;
-  for (const RayCaster* c : casters_) out.push_back(std::make_unique<VisibilityTester>(cameras, *c, geometry_scale_));
+  for (const RayCaster* c : casters_)
+    out.push_back(std::make_unique<VisibilityTester>(cameras, *c, geometry_scale_));
   return out;
 }
 
-void ExactEvaluator::OccludedByPoint(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) const {
+void ExactEvaluator::OccludedByPoint(const std::vector<Ray>& rays,
+                                     std::vector<uint8_t>* occluded) const {
   if (casters_.size() == 1) return casters_[0]->OccludedBatch(rays, occluded);
   const std::size_t n = targets_.size();
   occluded->assign(rays.size(), 0);
@@ -419,16 +438,19 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
   v.info.assign(n, Mat3::Zero());
   v.density.assign(n, 0.0);
   const double s = PixelSigma(cam);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const TargetPoint& t = targets_[i];
-      Mat23 A;
-      if (testers[Sample(i)]->Test(0, t.p, t.normal ? &*t.normal : nullptr, &A) != ViewResult::kSeen) continue;
-      v.seen[i] = 1;
-      v.info[i] = A.transpose() * A / (s * s);
-      v.density[i] = PixelDensity(A);
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const TargetPoint& t = targets_[i];
+                        Mat23 A;
+                        if (testers[Sample(i)]->Test(0, t.p, t.normal ? &*t.normal : nullptr, &A) !=
+                            ViewResult::kSeen)
+                          continue;
+                        v.seen[i] = 1;
+                        v.info[i] = A.transpose() * A / (s * s);
+                        v.density[i] = PixelDensity(A);
+                      }
+                    });
   if (objective_.kind == ObjectiveKind::kCalibration) {
     const VisibilityTester tester({cam}, caster_, geometry_scale_);
     v.calib = CalibrationBits(tester, 0);
@@ -436,7 +458,8 @@ CameraView ExactEvaluator::View(int c, const Eigen::Isometry3d& pose, double foc
   return v;
 }
 
-Metrics ExactEvaluator::Combine(const std::vector<const CameraView*>& views, bool objective_only) const {
+Metrics ExactEvaluator::Combine(const std::vector<const CameraView*>& views,
+                                bool objective_only) const {
   ++evaluations_;
   const bool counts_only = objective_.kind == ObjectiveKind::kCoverage ||
                            objective_.kind == ObjectiveKind::kCoverageN1 ||
@@ -476,10 +499,13 @@ Metrics ExactEvaluator::Summary(const std::vector<const CameraView*>& views) con
 }
 
 void ExactEvaluator::AddObjectiveMeasures(const std::vector<int>& count,
-                                          const std::vector<const CameraView*>& views, Metrics* m) const {
+                                          const std::vector<const CameraView*>& views,
+                                          Metrics* m) const {
   const std::size_t nfixed = fixed_rig_.size(), nsel = selected_rig_.size();
   auto id_of = [&](std::size_t c) { return c < nfixed ? fixed_ids_[c] : selected_[c - nfixed].id; };
-  auto rig_of = [&](std::size_t c) { return c < nfixed ? fixed_rig_[c] : selected_rig_[c - nfixed]; };
+  auto rig_of = [&](std::size_t c) {
+    return c < nfixed ? fixed_rig_[c] : selected_rig_[c - nfixed];
+  };
   if (objective_.kind == ObjectiveKind::kCoverageN1) {
     // A camera's failure loses exactly the points it sees that have k cameras, no more.
     const std::size_t n = count.size();
@@ -514,7 +540,8 @@ void ExactEvaluator::AddObjectiveMeasures(const std::vector<int>& count,
     };
     for (std::size_t a = 0; a < nc; ++a)
       for (std::size_t b = a; b < nc; ++b)
-        shared[a][b] = shared[b][a] = a < nfixed && b < nfixed ? calib_fixed_shared_[a][b] : SharedBits(bits(a), bits(b));
+        shared[a][b] = shared[b][a] =
+            a < nfixed && b < nfixed ? calib_fixed_shared_[a][b] : SharedBits(bits(a), bits(b));
     Metrics::Calibration r;
     r.poses = static_cast<std::int64_t>(calib_poses_.size());
     // The maximum spanning tree (Prim, complete graph): its weakest edge is the chain's strength.
@@ -554,19 +581,21 @@ void ExactEvaluator::AddObjectiveMeasures(const std::vector<int>& count,
 }
 
 Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
-                                  const std::vector<double>& dmax, const std::vector<const CameraView*>& views) const {
+                                  const std::vector<double>& dmax,
+                                  const std::vector<const CameraView*>& views) const {
   Metrics m;
   const std::size_t n = count.size();
   if (n == 0) return m;
   std::vector<double> sigma(n, kInf);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      if (count[i] < 2) continue;
-      const Information info = DecomposeInformation(J[i], false);
-      if (!info.observable) continue;
-      sigma[i] = 1000.0 / std::sqrt(info.eigenvalues(0));
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        if (count[i] < 2) continue;
+                        const Information info = DecomposeInformation(J[i], false);
+                        if (!info.observable) continue;
+                        sigma[i] = 1000.0 / std::sqrt(info.eigenvalues(0));
+                      }
+                    });
   std::size_t k_count = 0, two = 0, untri = 0;
   double sum = 0, min_res = kInf;
   for (std::size_t i = 0; i < n; ++i) {
@@ -590,10 +619,18 @@ Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vect
   m.sigma_p90 = rank(90);
   m.sigma_p95 = rank(95);
   switch (objective_.kind) {
-    case ObjectiveKind::kCoverage: m.objective = m.coverage_k; break;
-    case ObjectiveKind::kSigmaMean: m.objective = m.sigma_mean; break;
-    case ObjectiveKind::kSigmaPercentile: m.objective = rank(objective_.percentile); break;
-    case ObjectiveKind::kResolution: m.objective = m.min_resolution; break;
+    case ObjectiveKind::kCoverage:
+      m.objective = m.coverage_k;
+      break;
+    case ObjectiveKind::kSigmaMean:
+      m.objective = m.sigma_mean;
+      break;
+    case ObjectiveKind::kSigmaPercentile:
+      m.objective = rank(objective_.percentile);
+      break;
+    case ObjectiveKind::kResolution:
+      m.objective = m.min_resolution;
+      break;
     case ObjectiveKind::kMix: {
       const double s = ref_sigma_mean_ > 0 ? ref_sigma_mean_ : m.sigma_mean;
       const double r = ref_min_resolution_ > 0 ? ref_min_resolution_ : 0;
@@ -602,7 +639,8 @@ Metrics ExactEvaluator::Summarise(const std::vector<int>& count, const std::vect
       break;
     }
     case ObjectiveKind::kCoverageN1:
-    case ObjectiveKind::kCalibration: break;  // AddObjectiveMeasures
+    case ObjectiveKind::kCalibration:
+      break;  // AddObjectiveMeasures
   }
   AddObjectiveMeasures(count, views, &m);
   return m;
@@ -615,10 +653,12 @@ double ExactEvaluator::Score(const Metrics& m) const {
   if (objective_.kind == ObjectiveKind::kSigmaPercentile && std::isinf(m.objective))
     return -1e300 * (1.0 + m.untriangulable);
   // Between two chains of equal strength the one with more shared poses along its tree is better:
-  // the tree's total, as a fraction below 1, breaks the tie without changing the order of strengths.
+  // the tree's total, as a fraction below 1, breaks the tie without changing the order of
+  // strengths.
   if (objective_.kind == ObjectiveKind::kCalibration && m.calibration) {
     const double cams = static_cast<double>(fixed_rig_.size() + selected_rig_.size());
-    return m.objective + double(m.calibration->tree_total) / (cams * double(m.calibration->poses) + 1.0);
+    return m.objective +
+           double(m.calibration->tree_total) / (cams * double(m.calibration->poses) + 1.0);
   }
   return ObjectiveHigherIsBetter(objective_) ? m.objective : -m.objective;
 }
@@ -635,8 +675,12 @@ PoseChart PoseChart::Make(const Camera& camera, const CameraLimits& limits) {
   const Vec3 axis = limits.mount.axis.normalized();
   switch (limits.mount.kind) {
     case MountConstraint::Kind::kFree:
-    case MountConstraint::Kind::kBox: c.basis = Mat3::Identity(); break;
-    case MountConstraint::Kind::kLine: c.basis = axis; break;
+    case MountConstraint::Kind::kBox:
+      c.basis = Mat3::Identity();
+      break;
+    case MountConstraint::Kind::kLine:
+      c.basis = axis;
+      break;
     case MountConstraint::Kind::kPlane: {
       int a = 0;
       for (int i = 1; i < 3; ++i)
@@ -757,40 +801,48 @@ SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int targe
 void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options) {
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
   if (options.cameras.empty())
-    throw InputError(file, "--cameras", "no camera selected", "name the cameras to move, e.g. --cameras 3,5");
+    throw InputError(file, "--cameras", "no camera selected",
+                     "name the cameras to move, e.g. --cameras 3,5");
   if (options.limits.size() != 1 && options.limits.size() != options.cameras.size())
-    throw InputError(file, "--max-move", "one set of limits, or one per selected camera, is needed");
+    throw InputError(file, "--max-move",
+                     "one set of limits, or one per selected camera, is needed");
   std::set<int> seen;
   for (std::size_t i = 0; i < options.cameras.size(); ++i) {
     const int idx = options.cameras[i];
     if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
-      throw InputError(file, "--cameras", "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
+      throw InputError(file, "--cameras",
+                       "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
     const Camera& cam = rig.cameras[idx];
     if (!seen.insert(idx).second)
       throw InputError(file, "--cameras", "camera '" + cam.id + "' is selected twice");
     if (cam.ptz)  // its file pose is its home, not its current setting (docs/ptz.md)
       throw InputError(file, "--cameras", "camera '" + cam.id + "' is a PTZ camera",
-                       "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its \"ptz\" block");
+                       "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its "
+                       "\"ptz\" block");
     if (!cam.enabled)
       throw InputError(file, "--cameras", "camera '" + cam.id + "' is disabled",
                        "enable it in the scene file to move it");
     const CameraLimits& l = LimitsOf(options, i);
     if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
-      throw InputError(file, "--max-move", "the largest move must be a finite length >= 0 (got " +
-                                               Format("%g", l.max_move) + ")");
+      throw InputError(
+          file, "--max-move",
+          "the largest move must be a finite length >= 0 (got " + Format("%g", l.max_move) + ")");
     if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
-      throw InputError(file, "--max-rotate", "the largest rotation must be in [0, 180) degrees (got " +
-                                                 Format("%g", l.max_rotate_deg) + ")");
+      throw InputError(file, "--max-rotate",
+                       "the largest rotation must be in [0, 180) degrees (got " +
+                           Format("%g", l.max_rotate_deg) + ")");
     if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
       const Intrinsics& k = cam.model.intrinsics();
       const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
       if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
-        throw InputError(file, "--hfov-range", "the field-of-view range must satisfy 0 < MIN <= MAX < " +
-                                                    Format("%g", limit) + " degrees");
+        throw InputError(file, "--hfov-range",
+                         "the field-of-view range must satisfy 0 < MIN <= MAX < " +
+                             Format("%g", limit) + " degrees");
       const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
       if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
-        throw InputError(file, "--hfov-range", "camera '" + cam.id + "' has a field of view of " +
-                                                    Format("%.6g", hfov) + " degrees, outside the range",
+        throw InputError(file, "--hfov-range",
+                         "camera '" + cam.id + "' has a field of view of " + Format("%.6g", hfov) +
+                             " degrees, outside the range",
                          "the range must hold the current field of view");
     }
     const MountConstraint& m = l.mount;
@@ -820,7 +872,8 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
 
 std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
                                          const std::vector<Eigen::Isometry3d>& poses,
-                                         const SuggestOptions& options, const Placement& placement) {
+                                         const SuggestOptions& options,
+                                         const Placement& placement) {
   std::vector<Eigen::Isometry3d> out = poses;
   for (std::size_t c = 0; c < charts.size(); ++c) {
     const PoseChart& ch = charts[c];
@@ -852,7 +905,8 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
           if (k >= 0) {
             const double target = c0[k] + sign * y[i];  // the world coordinate
             double g = std::round(target / step);
-            if (toward_start) g = target > c0[k] ? std::floor(target / step) : std::ceil(target / step);
+            if (toward_start)
+              g = target > c0[k] ? std::floor(target / step) : std::ceil(target / step);
             r[i] = sign * (g * step - c0[k]);
           } else {
             const double q = y[i] / step;
@@ -863,7 +917,8 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
       };
       auto admissible = [&](const Vec3& centre) {
         if ((centre - c0).norm() > ch.max_move * (1 + 1e-12)) return false;
-        if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre)) return false;
+        if (ch.mount.kind == MountConstraint::Kind::kBox && !ch.mount.box.Contains(centre))
+          return false;
         return placement.Admissible(c, centre);
       };
       Vec3 centre = make(false);
@@ -887,7 +942,8 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
       };
       const double limit = Deg(ch.max_rotate) * (1 + 1e-9) + 1e-9;
       bool unchanged = true;
-      for (int i = 0; i < 3; ++i) unchanged = unchanged && std::round(delta[i] / options.snap_rotate_deg) == 0;
+      for (int i = 0; i < 3; ++i)
+        unchanged = unchanged && std::round(delta[i] / options.snap_rotate_deg) == 0;
       Mat3 R = unchanged ? ch.start.linear() : make(false);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = make(true);
       if (RotationAngleDeg(ch.start.linear(), R) > limit) R = ch.start.linear();
@@ -899,8 +955,9 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
 }
 
 void FillChanges(const Rig& rig, const SuggestOptions& options,
-                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
-                 const Placement& placement, Suggestion* s) {
+                 const std::vector<Eigen::Isometry3d>& poses,
+                 const std::vector<double>& focal_scales, const Placement& placement,
+                 Suggestion* s) {
   s->cameras.clear();
   for (std::size_t c = 0; c < options.cameras.size(); ++c) {
     const Camera& cam = rig.cameras[options.cameras[c]];
@@ -947,7 +1004,8 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   auto elapsed = [&]() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras, options.sample_casters);
+  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras,
+                    options.sample_casters);
   const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
@@ -985,8 +1043,8 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
       continue;
     }
     rejected_in_a_row = 0;
-    // The same fast exact evaluation as the nudge's screening: the objective alone (for coverage, no
-    // covariances), the full metrics only for a new best.
+    // The same fast exact evaluation as the nudge's screening: the objective alone (for coverage,
+    // no covariances), the full metrics only for a new best.
     for (std::size_t c = 0; c < charts.size(); ++c) {
       views[c] = ev.View(static_cast<int>(c), poses[c], scales[c]);
       view_ptrs[c] = &views[c];
@@ -1020,11 +1078,13 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
   return s;
 }
 
-std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector<TimeSample>& samples_in,
-                                           int points, std::uint64_t seed) {
+std::vector<TargetPoint> SampleTimeTargets(const Scene& scene,
+                                           const std::vector<TimeSample>& samples_in, int points,
+                                           std::uint64_t seed) {
   if (!scene.study.targets)
-    throw InputError(scene.path, "$.study.targets", "suggesting over time needs surface targets",
-                     "name the moving groups to see under \"study\": {\"targets\": {\"objects\": [...]}}");
+    throw InputError(
+        scene.path, "$.study.targets", "suggesting over time needs surface targets",
+        "name the moving groups to see under \"study\": {\"targets\": {\"objects\": [...]}}");
   const std::vector<TimeSample> samples = SamplesOrAsPlaced(samples_in);
   std::vector<TargetPoint> out;
   const std::vector<std::string>& names = scene.study.targets->names;

@@ -1,10 +1,11 @@
 #pragma once
 /// \file suggest.h
-/// Suggest and accept (issue 5): nudge the cameras the person selected, within the limits the person
-/// set, to improve an objective over target points; the other cameras stay fixed. The optimiser
-/// (Ceres, suggest/suggest_ceres.cpp) works on a smooth surrogate of visibility; every candidate is
-/// judged by the exact evaluation (the visibility rules of the volume fields), and a suggestion is
-/// offered only when the exact objective improved. This header is light: no Ceres, no JSON.
+/// Suggest and accept (issue 5): nudge the cameras the person selected, within the limits the
+/// person set, to improve an objective over target points; the other cameras stay fixed. The
+/// optimiser (Ceres, suggest/suggest_ceres.cpp) works on a smooth surrogate of visibility; every
+/// candidate is judged by the exact evaluation (the visibility rules of the volume fields), and a
+/// suggestion is offered only when the exact objective improved. This header is light: no Ceres, no
+/// JSON.
 ///
 /// Units: metres and radians inside; the CLI and the suggestion file speak metres and degrees.
 
@@ -13,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "analysis/camera.h"
-#include "analysis/geometry.h"
-#include "analysis/pose.h"  // the Euler angles snap_rotate_deg rounds
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/geometry/pose.h"  // the Euler angles snap_rotate_deg rounds
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora {
 
@@ -36,8 +37,9 @@ struct MountConstraint {
 
 /// The limits of one selected camera.
 struct CameraLimits {
-  double max_move = 0.3;         ///< Largest distance of the new centre from the start, metres (>= 0).
-  double max_rotate_deg = 10.0;  ///< Largest rotation angle between start and new orientation (>= 0).
+  double max_move = 0.3;  ///< Largest distance of the new centre from the start, metres (>= 0).
+  double max_rotate_deg =
+      10.0;  ///< Largest rotation angle between start and new orientation (>= 0).
   /// Zoom range: the horizontal field of view (degrees, FocalFromHfov for the camera's lens model)
   /// may change within [min_hfov_deg, max_hfov_deg], which must hold the current one. Both 0: the
   /// focal length stays. A zoom scales fx and fy together; principal point and distortion stay.
@@ -45,14 +47,16 @@ struct CameraLimits {
   MountConstraint mount;
 };
 
-/// What to optimise. Every objective is judged on the target points with the exact visibility rules.
+/// What to optimise. Every objective is judged on the target points with the exact visibility
+/// rules.
 enum class ObjectiveKind {
-  kCoverage,        ///< Share of target points seen by at least `k` cameras (higher is better).
-  kSigmaMean,       ///< Mean sigma_max in mm (lower); untriangulable points count as `sigma_cap`.
-  kSigmaPercentile, ///< The `percentile` of sigma_max in mm (lower); untriangulable points are +inf,
-                    ///< and while the percentile is +inf a smaller untriangulable share is better.
-  kResolution,      ///< Minimum over the points of the best pixel density, px/m (higher); unseen: 0.
-  kMix,             ///< Weighted mix of the three, each relative to its value at the start (higher).
+  kCoverage,         ///< Share of target points seen by at least `k` cameras (higher is better).
+  kSigmaMean,        ///< Mean sigma_max in mm (lower); untriangulable points count as `sigma_cap`.
+  kSigmaPercentile,  ///< The `percentile` of sigma_max in mm (lower); untriangulable points are
+                     ///< +inf, and while the percentile is +inf a smaller untriangulable share is
+                     ///< better.
+  kResolution,  ///< Minimum over the points of the best pixel density, px/m (higher); unseen: 0.
+  kMix,         ///< Weighted mix of the three, each relative to its value at the start (higher).
   /// N-1: the share of target points still seen by at least `k` cameras after the worst single
   /// camera failure (any enabled camera, selected or fixed, fails; the worst is the one that leaves
   /// the smallest share), as volume/robustness.h defines it for the fields (higher).
@@ -67,8 +71,8 @@ enum class ObjectiveKind {
 
 struct Objective {
   ObjectiveKind kind = ObjectiveKind::kCoverage;
-  int k = 2;                 ///< For coverage (and the mix's coverage term), >= 1.
-  double percentile = 90;    ///< For kSigmaPercentile, in (0, 100].
+  int k = 2;               ///< For coverage (and the mix's coverage term), >= 1.
+  double percentile = 90;  ///< For kSigmaPercentile, in (0, 100].
   /// Weights of the mix: coverage share, sigma (start mean / mean), resolution (min / start min).
   double w_coverage = 1, w_sigma = 1, w_resolution = 1;
 };
@@ -103,15 +107,15 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
 
 /// Exact measures over the target points.
 struct Metrics {
-  double objective = 0;        ///< The objective's value (see ObjectiveKind).
-  double coverage_k = 0;       ///< Share seen by >= objective.k cameras.
-  double coverage2 = 0;        ///< Share seen by >= 2 cameras.
+  double objective = 0;   ///< The objective's value (see ObjectiveKind).
+  double coverage_k = 0;  ///< Share seen by >= objective.k cameras.
+  double coverage2 = 0;   ///< Share seen by >= 2 cameras.
   /// sigma_max percentiles (mm) over all target points; +inf where the rank falls on an
   /// untriangulable point (written as null with "untriangulable" in files).
   double sigma_p50 = 0, sigma_p90 = 0, sigma_p95 = 0;
-  double sigma_mean = 0;       ///< Mean sigma_max (mm), untriangulable points counted as the cap.
-  double untriangulable = 0;   ///< Share of points that are not triangulable.
-  double min_resolution = 0;   ///< px/m; 0 when some point is seen by no camera.
+  double sigma_mean = 0;      ///< Mean sigma_max (mm), untriangulable points counted as the cap.
+  double untriangulable = 0;  ///< Share of points that are not triangulable.
+  double min_resolution = 0;  ///< px/m; 0 when some point is seen by no camera.
   /// With the N-1 objective: the share seen by >= k cameras after the worst single failure, and
   /// that camera's id (the first in rig order on a tie; empty without enabled cameras).
   struct N1 {
@@ -121,7 +125,7 @@ struct Metrics {
   std::optional<N1> n1;
   /// With the calibration objective: the co-visibility graph of the study's calibration poses.
   struct Calibration {
-    std::int64_t weakest = 0;     ///< The chain's strength, poses (the objective).
+    std::int64_t weakest = 0;          ///< The chain's strength, poses (the objective).
     std::string weakest_a, weakest_b;  ///< The cameras of that weakest spanning-tree edge.
     std::int64_t tree_total = 0;  ///< Shared poses summed over the maximum spanning tree's edges.
     int components = 0;           ///< Components of the graph of edges >= min_shared.
@@ -157,29 +161,29 @@ struct TracePoint {
 };
 
 struct SuggestOptions {
-  std::vector<int> cameras;           ///< Rig indices of the selected cameras (distinct, enabled).
+  std::vector<int> cameras;  ///< Rig indices of the selected cameras (distinct, enabled).
   /// With moving objects: the ray caster of each time sample (RigidPartsRayCaster::At); target
   /// point i is tested against sample_casters[targets[i].sample]. Empty: the static caster for all.
   /// The casters must outlive the call.
   std::vector<const RayCaster*> sample_casters;
-  std::vector<CameraLimits> limits;   ///< One per selected camera, or one for all.
-  std::vector<Aabb> keep_out;         ///< Boxes no selected camera centre may enter.
+  std::vector<CameraLimits> limits;  ///< One per selected camera, or one for all.
+  std::vector<Aabb> keep_out;        ///< Boxes no selected camera centre may enter.
   /// Metres every suggested camera centre keeps from every scene surface (any object's triangles:
   /// walls, floor, furniture, solid or not). A camera that starts closer may stay or move away but
   /// never closer than it starts. 0: no clearance.
   double clearance = 0.1;
   Objective objective;
-  int outer_iterations = 4;           ///< Occlusion re-evaluated between them.
-  int max_inner_iterations = 30;      ///< Ceres iterations per outer iteration.
+  int outer_iterations = 4;       ///< Occlusion re-evaluated between them.
+  int max_inner_iterations = 30;  ///< Ceres iterations per outer iteration.
   /// Candidate poses per active camera at each of the three radii of the exact screening before the
   /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives (N-1 included); the
-  /// others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge starts from the current
-  /// poses only.
+  /// others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge starts
+  /// from the current poses only.
   int screening_candidates = 200;
   /// Installable steps (0: none): each camera's centre is rounded per axis of its mount: along a
   /// mount direction that is a world axis (free and box mounts, axis-aligned rails and planes) to a
-  /// coordinate that is a multiple of snap_move (metres: so the scene file shows k * step), along an
-  /// oblique one to a move that is a multiple of it; its yaw / pitch / roll change (scene-format
+  /// coordinate that is a multiple of snap_move (metres: so the scene file shows k * step), along
+  /// an oblique one to a move that is a multiple of it; its yaw / pitch / roll change (scene-format
   /// Euler angles) to multiples of snap_rotate_deg. Never beyond the limits or the placement rules
   /// (the nearest grid point, else the one towards the start, else the start position); then
   /// evaluated again.
@@ -189,17 +193,17 @@ struct SuggestOptions {
 };
 
 struct Suggestion {
-  bool improved = false;      ///< The exact objective improved: the poses are worth offering.
-  std::string message;        ///< One line: what happened (always set).
+  bool improved = false;  ///< The exact objective improved: the poses are worth offering.
+  std::string message;    ///< One line: what happened (always set).
   Objective objective;
   std::vector<CameraChange> cameras;
-  Metrics before, after;      ///< Exact; `after` at the returned poses (the start when not improved).
+  Metrics before, after;  ///< Exact; `after` at the returned poses (the start when not improved).
   std::optional<Metrics> unsnapped;  ///< The optimum before snapping, when snapping was asked for.
-  int iterations = 0;         ///< Ceres iterations, all outer iterations together.
+  int iterations = 0;                ///< Ceres iterations, all outer iterations together.
   int outer_iterations = 0;
-  std::int64_t evaluations = 0;  ///< Surrogate + exact evaluations.
-  int screened = 0;              ///< Exact evaluations up to the end of the screening.
-  double screened_objective = 0; ///< The best exact objective at the end of the screening.
+  std::int64_t evaluations = 0;   ///< Surrogate + exact evaluations.
+  int screened = 0;               ///< Exact evaluations up to the end of the screening.
+  double screened_objective = 0;  ///< The best exact objective at the end of the screening.
   double seconds = 0;
   std::vector<TracePoint> trace;
   int target_points = 0;
@@ -215,8 +219,9 @@ Metrics EvaluateExact(const Scene& scene, const Rig& rig, const RayCaster& caste
 /// `points` per target spread by area (seeded), each moved with its group to every sample, with the
 /// sample's index. What a suggestion optimises to see moving bodies over time. Throws InputError
 /// (file = scene.path, "$.study.targets") when the study has no targets.
-std::vector<TargetPoint> SampleTimeTargets(const Scene& scene, const std::vector<TimeSample>& samples,
-                                           int points, std::uint64_t seed);
+std::vector<TargetPoint> SampleTimeTargets(const Scene& scene,
+                                           const std::vector<TimeSample>& samples, int points,
+                                           std::uint64_t seed);
 
 /// Checks the selection and the limits (throws InputError naming `options.scene_path` and the
 /// option) and runs the Ceres nudge. Every candidate pose keeps the limits, the keep-out boxes and
@@ -231,7 +236,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
 /// success, x1.5^-1/4 on failure). Same result structure and trace.
 Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& caster,
                           const std::vector<TargetPoint>& targets, const SuggestOptions& options,
-                          std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step = false);
+                          std::int64_t evaluation_budget, std::uint64_t seed,
+                          bool adaptive_step = false);
 
 /// Moves each listed camera `move` metres in a random direction and turns it `rotate_deg` about a
 /// random axis perpendicular to its optical axis (a pan / tilt away from where it looked; seeded),

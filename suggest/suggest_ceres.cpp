@@ -13,15 +13,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <random>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 
-#include "analysis/visibility.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/units.h"
 #include "suggest/suggest.h"
 #include "suggest/suggest_internal.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -30,9 +30,9 @@ using suggest_detail::ExactEvaluator;
 using suggest_detail::PoseChart;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPenalty = 10.0;      // weight of the limit and keep-out penalties (cost ~ 1)
-constexpr double kStep = 1e-4;         // central-difference step, in units of the limits
-constexpr double kCountWidth = 0.4;   // soft ">= k": width of the sigmoid in cameras
+constexpr double kPenalty = 10.0;    // weight of the limit and keep-out penalties (cost ~ 1)
+constexpr double kStep = 1e-4;       // central-difference step, in units of the limits
+constexpr double kCountWidth = 0.4;  // soft ">= k": width of the sigmoid in cameras
 constexpr double kIncidenceWidth = 0.1;
 // Soft image border: margin and width as a fraction of the image width, halved at each of the first
 // outer iterations (0.04, 0.02, then 0.01: about 41, 20, 10 px on a 1024 px image).
@@ -78,17 +78,31 @@ class Surrogate {
   Surrogate(const ExactEvaluator& ev, bool need_info) : ev_(ev), need_info_(need_info) {
     const Objective& o = ev.objective();
     switch (o.kind) {
-      case ObjectiveKind::kCoverage: weights_ = {1, 0, 0}; break;
+      case ObjectiveKind::kCoverage:
+        weights_ = {1, 0, 0};
+        break;
       case ObjectiveKind::kSigmaMean:
-      case ObjectiveKind::kSigmaPercentile: weights_ = {0, 1, 0}; break;
-      case ObjectiveKind::kResolution: weights_ = {0, 0, 1}; break;
-      case ObjectiveKind::kMix: weights_ = {o.w_coverage, o.w_sigma, o.w_resolution}; break;
+      case ObjectiveKind::kSigmaPercentile:
+        weights_ = {0, 1, 0};
+        break;
+      case ObjectiveKind::kResolution:
+        weights_ = {0, 0, 1};
+        break;
+      case ObjectiveKind::kMix:
+        weights_ = {o.w_coverage, o.w_sigma, o.w_resolution};
+        break;
       // N-1 has no smooth form of its own: a point seen by k + 1 cameras survives any one failure,
       // so the nudge pushes towards k + 1 (every step is judged by the exact N-1 share).
-      case ObjectiveKind::kCoverageN1: weights_ = {1, 0, 0}; k_ = o.k + 1; break;
+      case ObjectiveKind::kCoverageN1:
+        weights_ = {1, 0, 0};
+        k_ = o.k + 1;
+        break;
       // Calibration: more target points seen by >= 2 cameras means more shared calibration poses;
       // the screening's exact jumps and the judge of every step do the rest.
-      case ObjectiveKind::kCalibration: weights_ = {1, 0, 0}; k_ = 2; break;
+      case ObjectiveKind::kCalibration:
+        weights_ = {1, 0, 0};
+        k_ = 2;
+        break;
     }
     if (o.kind != ObjectiveKind::kCoverageN1 && o.kind != ObjectiveKind::kCalibration) k_ = o.k;
     for (int t = 0; t < 3; ++t)
@@ -137,14 +151,16 @@ class Surrogate {
     for (std::size_t i = 0; i < n; ++i) {
       o.clear[i] = clear(0, i);
       if (samples > 1)
-        for (int a = 0; a < 3; ++a) o.slope[i][a] = (clear(1 + 2 * a, i) - clear(2 + 2 * a, i)) / (2 * delta);
+        for (int a = 0; a < 3; ++a)
+          o.slope[i][a] = (clear(1 + 2 * a, i) - clear(2 + 2 * a, i)) / (2 * delta);
     }
   }
 
   // With a zoom the focal lengths are scaled about the principal point: pixel' = c + s (pixel - c)
-  // for every lens model (the distortion acts on normalised coordinates), so the lens's valid domain
-  // is unchanged and only the pixels and the Jacobian scale.
-  void Contribute(int c, const Eigen::Isometry3d& pose, double focal_scale, Contribution* out) const {
+  // for every lens model (the distortion acts on normalised coordinates), so the lens's valid
+  // domain is unchanged and only the pixels and the Jacobian scale.
+  void Contribute(int c, const Eigen::Isometry3d& pose, double focal_scale,
+                  Contribution* out) const {
     const Camera& cam = ev_.selected_cameras()[c];
     const auto& targets = ev_.targets();
     const std::size_t n = targets.size();
@@ -159,39 +175,40 @@ class Surrogate {
     const double sigma = ev_.PixelSigma(cam);
     const Occlusion& occl = occlusion_[c];
     const Vec3 dC = C - occl.centre;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        double o = 1.0;
-        if (!occl.clear.empty()) {
-          o = SoftClamp01(occl.clear[i] + occl.slope[i].dot(dC));
-          if (!(o > 0)) continue;
-        }
-        const Vec3 v = targets[i].p - C;
-        const double dist = v.norm();
-        Mat23 Jc;
-        std::optional<Vec2> px = cam.model.Project(Rt * v, &Jc);
-        if (!px) continue;
-        if (focal_scale != 1.0) {
-          const Vec2 pp(cam.model.intrinsics().cx, cam.model.intrinsics().cy);
-          px = pp + focal_scale * (*px - pp);
-          Jc *= focal_scale;
-        }
-        const double border = std::min(std::min(px->x() + 0.5, W - 0.5 - px->x()),
-                                       std::min(px->y() + 0.5, H - 0.5 - px->y()));
-        double w = Sigmoid((border - tau) / tau);
-        if (cam.near > 0) w *= Sigmoid((dist - cam.near) / range_width);
-        if (std::isfinite(cam.far)) w *= Sigmoid((cam.far - dist) / range_width);
-        if (targets[i].normal) {
-          const double cosine = targets[i].normal->dot(-v) / (targets[i].normal->norm() * dist);
-          w *= Sigmoid(cosine / kIncidenceWidth);
-        }
-        const Mat23 A = Jc * Rt;
-        w *= o;
-        out->w[i] = w;
-        out->d[i] = PixelDensity(A);
-        if (need_info_) out->info[i] = A.transpose() * A / (sigma * sigma);
-      }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            double o = 1.0;
+            if (!occl.clear.empty()) {
+              o = SoftClamp01(occl.clear[i] + occl.slope[i].dot(dC));
+              if (!(o > 0)) continue;
+            }
+            const Vec3 v = targets[i].p - C;
+            const double dist = v.norm();
+            Mat23 Jc;
+            std::optional<Vec2> px = cam.model.Project(Rt * v, &Jc);
+            if (!px) continue;
+            if (focal_scale != 1.0) {
+              const Vec2 pp(cam.model.intrinsics().cx, cam.model.intrinsics().cy);
+              px = pp + focal_scale * (*px - pp);
+              Jc *= focal_scale;
+            }
+            const double border = std::min(std::min(px->x() + 0.5, W - 0.5 - px->x()),
+                                           std::min(px->y() + 0.5, H - 0.5 - px->y()));
+            double w = Sigmoid((border - tau) / tau);
+            if (cam.near > 0) w *= Sigmoid((dist - cam.near) / range_width);
+            if (std::isfinite(cam.far)) w *= Sigmoid((cam.far - dist) / range_width);
+            if (targets[i].normal) {
+              const double cosine = targets[i].normal->dot(-v) / (targets[i].normal->norm() * dist);
+              w *= Sigmoid(cosine / kIncidenceWidth);
+            }
+            const Mat23 A = Jc * Rt;
+            w *= o;
+            out->w[i] = w;
+            out->d[i] = PixelDensity(A);
+            if (need_info_) out->info[i] = A.transpose() * A / (sigma * sigma);
+          }
+        });
   }
 
   // Unscaled residuals of every active term (rows() values).
@@ -201,31 +218,33 @@ class Surrogate {
     const double k = k_;
     const double eps = 1.0 / (ev_.region_scale() * ev_.region_scale());
     const double ds = ev_.density_scale();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        int row = 0;
-        for (int t : terms_) {
-          double value = 0;
-          if (t == 0) {
-            double s = fixed.count[i];
-            for (const Contribution* c : contributions) s += c->w[i];
-            value = 1.0 - Sigmoid((s - (k - 0.5)) / kCountWidth);
-          } else if (t == 1) {
-            Mat3 J = fixed.J[i] + eps * Mat3::Identity();
-            for (const Contribution* c : contributions) J += c->w[i] * c->info[i];
-            value = std::sqrt(std::max(0.0, J.inverse().trace()));
-          } else {
-            double p = fixed.dpow[i];
-            for (const Contribution* c : contributions)
-              p += std::pow(c->w[i] * c->d[i] / ds, suggest_detail::kSoftMaxPower);
-            const double res = std::pow(p, 1.0 / suggest_detail::kSoftMaxPower);  // in ds units
-            value = 1.0 / (res + 1e-3);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 128),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            int row = 0;
+            for (int t : terms_) {
+              double value = 0;
+              if (t == 0) {
+                double s = fixed.count[i];
+                for (const Contribution* c : contributions) s += c->w[i];
+                value = 1.0 - Sigmoid((s - (k - 0.5)) / kCountWidth);
+              } else if (t == 1) {
+                Mat3 J = fixed.J[i] + eps * Mat3::Identity();
+                for (const Contribution* c : contributions) J += c->w[i] * c->info[i];
+                value = std::sqrt(std::max(0.0, J.inverse().trace()));
+              } else {
+                double p = fixed.dpow[i];
+                for (const Contribution* c : contributions)
+                  p += std::pow(c->w[i] * c->d[i] / ds, suggest_detail::kSoftMaxPower);
+                const double res = std::pow(p, 1.0 / suggest_detail::kSoftMaxPower);  // in ds units
+                value = 1.0 / (res + 1e-3);
+              }
+              r[row * n + i] = value * scale_[t];
+              ++row;
+            }
           }
-          r[row * n + i] = value * scale_[t];
-          ++row;
-        }
-      }
-    });
+        });
     evaluations_.fetch_add(1);
   }
 
@@ -269,8 +288,8 @@ class Surrogate {
 // margin of 2 % of it so the nudge stays clear of the boundary the exact check enforces).
 int PenaltyRows(const std::vector<Aabb>& keep_out) { return 3 + static_cast<int>(keep_out.size()); }
 
-void Penalties(const PoseChart& chart, const suggest_detail::Placement& placement, std::size_t camera,
-               const double* x, double* r) {
+void Penalties(const PoseChart& chart, const suggest_detail::Placement& placement,
+               std::size_t camera, const double* x, double* r) {
   const std::vector<Aabb>& keep_out = placement.keep_out();
   double t2 = 0, w2 = 0;
   for (int i = 0; i < chart.dims_t; ++i) t2 += x[i] * x[i];
@@ -304,10 +323,12 @@ class SurrogateCost final : public ceres::CostFunction {
                 std::vector<Contribution>* frozen)
       : s_(surrogate), charts_(charts), active_(active), placement_(placement), frozen_(frozen) {
     for (int c : active_) mutable_parameter_block_sizes()->push_back(charts_[c].dims());
-    set_num_residuals(s_.rows() + static_cast<int>(active_.size()) * PenaltyRows(placement_.keep_out()));
+    set_num_residuals(s_.rows() +
+                      static_cast<int>(active_.size()) * PenaltyRows(placement_.keep_out()));
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
     const std::size_t na = active_.size();
     std::vector<Contribution> current(na);
     std::vector<const Contribution*> ptrs;
@@ -316,14 +337,16 @@ class SurrogateCost final : public ceres::CostFunction {
     const std::size_t base = ptrs.size();
     for (std::size_t a = 0; a < na; ++a) {
       const PoseChart& chart = charts_[active_[a]];
-      s_.Contribute(active_[a], chart.Pose(parameters[a]), chart.FocalScale(parameters[a]), &current[a]);
+      s_.Contribute(active_[a], chart.Pose(parameters[a]), chart.FocalScale(parameters[a]),
+                    &current[a]);
       ptrs.push_back(&current[a]);
     }
     const int rows = s_.rows();
     const int prow = PenaltyRows(placement_.keep_out());
     s_.Residuals(ptrs, residuals);
     for (std::size_t a = 0; a < na; ++a)
-      Penalties(charts_[active_[a]], placement_, active_[a], parameters[a], residuals + rows + a * prow);
+      Penalties(charts_[active_[a]], placement_, active_[a], parameters[a],
+                residuals + rows + a * prow);
     if (!jacobians) return true;
     const int total = num_residuals();
     std::vector<double> rp(total), rm(total), x;
@@ -374,7 +397,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   const std::size_t nsel = options.cameras.size();
-  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras, options.sample_casters);
+  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras,
+                    options.sample_casters);
   const Placement placement(scene, rig, options);
   SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
   const std::vector<PoseChart>& charts = begin.charts;
@@ -426,8 +450,9 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     if (wmax > 1e-12) {
       active.push_back(c);
     } else {
-      s.cameras[c].note = "sees none of the target points (outside its image or range, or occluded): "
-                          "no gradient, left in place";
+      s.cameras[c].note =
+          "sees none of the target points (outside its image or range, or occluded): "
+          "no gradient, left in place";
     }
   }
   const std::string no_gradient =
@@ -437,15 +462,16 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   const bool start_without_gradient = active.empty();
 
   // Screening (exact), before the Ceres nudge: look across the whole limits for a better start. The
-  // smooth surrogate sees occluders only through a local linearisation, so from the current poses it
-  // cannot cross the medics' occlusion shadows; exact jumps can, and they are cheap. A chain moves one
-  // active camera at a time: a candidate pose is tested once against the target points (a CameraView,
-  // one visibility test per point) and combined with the other cameras' cached views, which is one
-  // exact evaluation of the objective at a joint pose; a better one is kept at once. Each camera gets
-  // `screening_candidates` candidates uniform in the ball of radius 1 (the whole limits) around its
-  // best pose, then as many within 0.4 and within 0.15; last, joint moves of all movable cameras within
-  // 0.15 (some points are gained only when two selected cameras move together). Three independent
-  // chains from the current poses; the best end is polished below. Deterministic (fixed seed).
+  // smooth surrogate sees occluders only through a local linearisation, so from the current poses
+  // it cannot cross the medics' occlusion shadows; exact jumps can, and they are cheap. A chain
+  // moves one active camera at a time: a candidate pose is tested once against the target points (a
+  // CameraView, one visibility test per point) and combined with the other cameras' cached views,
+  // which is one exact evaluation of the objective at a joint pose; a better one is kept at once.
+  // Each camera gets `screening_candidates` candidates uniform in the ball of radius 1 (the whole
+  // limits) around its best pose, then as many within 0.4 and within 0.15; last, joint moves of all
+  // movable cameras within 0.15 (some points are gained only when two selected cameras move
+  // together). Three independent chains from the current poses; the best end is polished below.
+  // Deterministic (fixed seed).
   std::vector<std::vector<double>> screened_x;  // the screening's best, when it beat the start
   double screened_score = -kInf;
   if (options.screening_candidates > 0) {
@@ -623,7 +649,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
   for (int o = 0; o < outer; ++o) {
     // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
-    surrogate.set_border_width(o == 0 ? kBorderWidth : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
+    surrogate.set_border_width(o == 0 ? kBorderWidth
+                                      : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
     x = run_x;
     auto [poses, ok] = poses_of(x);
     (void)ok;
@@ -661,7 +688,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     so.max_num_iterations = std::max(1, options.max_inner_iterations);
     so.update_state_every_iteration = true;
     so.callbacks.push_back(&judge);
-    so.logging_type = std::getenv("PANDORA_SUGGEST_DEBUG") ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+    so.logging_type =
+        std::getenv("PANDORA_SUGGEST_DEBUG") ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
     so.minimizer_progress_to_stdout = std::getenv("PANDORA_SUGGEST_DEBUG") != nullptr;
     so.num_threads = 1;
     so.function_tolerance = 1e-7;
@@ -672,7 +700,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     ceres::Solve(so, &problem, &summary);
     s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
     s.outer_iterations = o + 1;
-    // The final state too (the callback saw every successful step already; this is cheap insurance).
+    // The final state too (the callback saw every successful step already; this is cheap
+    // insurance).
     judge.on_step();
     if (o >= 2 && !(run_score > score_before_outer)) break;  // converged at the final width
   }
@@ -686,8 +715,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
   // costs nothing: the screening's random turns leave a roll about the optical axis that coverage
   // rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
-  // orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25, judged
-  // exactly); the best is taken when it is no worse than the rolled pose.
+  // orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25,
+  // judged exactly); the best is taken when it is no worse than the rolled pose.
   if (best_score > start_score) {
     for (std::size_t c = 0; c < nsel; ++c) {
       const Mat3& R0 = start[c].linear();
@@ -743,15 +772,17 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
       extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
               Num("%.4g", s.before.untriangulable) + " to " + Num("%.4g", s.after.untriangulable);
     return finish(name + " improved from " + Num("%.6g", s.before.objective) + " to " +
-                  Num("%.6g", s.after.objective) + (higher ? " (higher is better)" : " (lower is better)") + extra);
+                  Num("%.6g", s.after.objective) +
+                  (higher ? " (higher is better)" : " (lower is better)") + extra);
   }
   if (s.unsnapped)
     return finish("no improvement found: the optimum improved " + name + " to " +
                   Num("%.6g", s.unsnapped->objective) +
                   " but the snapped poses do not; use finer snap steps");
   if (start_without_gradient) return finish(no_gradient);
-  return finish("no improvement found: the exact " + name + " did not improve within the limits (it stays " +
-                Num("%.6g", s.before.objective) + ")");
+  return finish("no improvement found: the exact " + name +
+                " did not improve within the limits (it stays " + Num("%.6g", s.before.objective) +
+                ")");
 }
 
 }  // namespace pandora

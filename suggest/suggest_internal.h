@@ -1,26 +1,27 @@
 #pragma once
 /// \file suggest_internal.h
 /// Shared by suggest.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
-/// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected camera.
+/// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected
+/// camera.
 
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "analysis/calibration.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/rig/calibration.h"
 #include "suggest/suggest.h"
-#include "analysis/surface_distance.h"
 
 namespace pandora::suggest_detail {
 
 /// Per target point: what the fixed (unselected, enabled) cameras contribute, exactly.
 struct FixedContribution {
-  std::vector<int> count;        ///< Cameras that see the point.
-  std::vector<Mat3> J;           ///< Information sum A^T A / sigma^2, 1/m^2.
-  std::vector<double> dmax;      ///< Best pixel density, px/m (0 when none sees it).
-  std::vector<double> dpow;      ///< Sum over seeing cameras of (d / density_scale)^kSoftMaxPower.
+  std::vector<int> count;    ///< Cameras that see the point.
+  std::vector<Mat3> J;       ///< Information sum A^T A / sigma^2, 1/m^2.
+  std::vector<double> dmax;  ///< Best pixel density, px/m (0 when none sees it).
+  std::vector<double> dpow;  ///< Sum over seeing cameras of (d / density_scale)^kSoftMaxPower.
   /// N-1 objective only: per point the fixed cameras (indices into the fixed list) that see it.
   std::vector<std::vector<int>> seen_by;
 };
@@ -28,7 +29,8 @@ struct FixedContribution {
 inline constexpr double kSoftMaxPower = 8.0;
 
 /// What one selected camera at one pose sees of the target points, exactly (the visibility rules of
-/// ExactEvaluator::Evaluate): lets a search that moves one camera at a time reuse the others' views.
+/// ExactEvaluator::Evaluate): lets a search that moves one camera at a time reuse the others'
+/// views.
 struct CameraView {
   std::vector<std::uint8_t> seen;  ///< 1 where the camera sees the point.
   std::vector<Mat3> info;          ///< A^T A / sigma^2 where seen (zero elsewhere), 1/m^2.
@@ -43,7 +45,8 @@ class ExactEvaluator {
  public:
   ExactEvaluator(const Scene& scene, const Rig& rig, const RayCaster& caster,
                  const std::vector<TargetPoint>& targets, const Objective& objective,
-                 const std::vector<int>& selected, const std::vector<const RayCaster*>& sample_casters = {});
+                 const std::vector<int>& selected,
+                 const std::vector<const RayCaster*>& sample_casters = {});
 
   /// Metrics with the selected cameras at `poses` (world_from_camera, one per selected camera) and,
   /// when given, their focal lengths scaled by `focal_scales`.
@@ -75,7 +78,9 @@ class ExactEvaluator {
   double region_scale() const { return region_scale_; }
   double density_scale() const { return density_scale_; }
   double sigma_cap_mm() const { return sigma_cap_mm_; }
-  double PixelSigma(const Camera& c) const { return c.pixel_sigma > 0 ? c.pixel_sigma : pixel_sigma_; }
+  double PixelSigma(const Camera& c) const {
+    return c.pixel_sigma > 0 ? c.pixel_sigma : pixel_sigma_;
+  }
   const RayCaster& caster() const { return caster_; }
   /// Occluded() of rays laid out as [k * targets().size() + i] (k any number of rounds), each
   /// against the caster of target i's time sample.
@@ -84,13 +89,15 @@ class ExactEvaluator {
 
  private:
   Metrics Summarise(const std::vector<int>& count, const std::vector<Mat3>& J,
-                    const std::vector<double>& dmax, const std::vector<const CameraView*>& views) const;
+                    const std::vector<double>& dmax,
+                    const std::vector<const CameraView*>& views) const;
   // The N-1 and calibration measures of the objectives that need them, from the counts and views.
-  void AddObjectiveMeasures(const std::vector<int>& count, const std::vector<const CameraView*>& views,
-                            Metrics* m) const;
+  void AddObjectiveMeasures(const std::vector<int>& count,
+                            const std::vector<const CameraView*>& views, Metrics* m) const;
   // Which calibration poses camera `camera` of `tester` observes, as bits.
   std::vector<std::uint64_t> CalibrationBits(const VisibilityTester& tester, int camera) const;
-  static std::int64_t SharedBits(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b);
+  static std::int64_t SharedBits(const std::vector<std::uint64_t>& a,
+                                 const std::vector<std::uint64_t>& b);
 
   // One tester per time sample's caster for `cameras`; target i uses testers[Sample(i)].
   std::vector<std::unique_ptr<VisibilityTester>> Testers(const std::vector<Camera>& cameras) const;
@@ -127,11 +134,11 @@ class ExactEvaluator {
 /// chart of SO(3) valid for angles below 180 degrees, so the rotation limit is a bound).
 struct PoseChart {
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
-  double max_move = 0, max_rotate = 0;  // metres, radians
+  double max_move = 0, max_rotate = 0;             // metres, radians
   Eigen::Matrix<double, 3, Eigen::Dynamic> basis;  // orthonormal columns (0 to 3)
   MountConstraint mount;
   int dims_t = 0, dims_r = 0, dims_f = 0;  // translation, rotation, zoom (last)
-  double log_focal_range = 0;  // the zoom parameter is ln(f / f0) / log_focal_range
+  double log_focal_range = 0;              // the zoom parameter is ln(f / f0) / log_focal_range
   int dims() const { return dims_t + dims_r + dims_f; }
   double FocalScale(const double* x) const {
     return dims_f > 0 ? std::exp(x[dims_t + dims_r] * log_focal_range) : 1.0;
@@ -154,7 +161,8 @@ class Placement {
  public:
   Placement(const Scene& scene, const Rig& rig, const SuggestOptions& options);
   /// Distance from `p` to the nearest scene surface, metres (capped at `limit`).
-  double SurfaceDistanceAt(const Vec3& p, double limit = std::numeric_limits<double>::infinity()) const {
+  double SurfaceDistanceAt(const Vec3& p,
+                           double limit = std::numeric_limits<double>::infinity()) const {
     return distance_.Distance(p, limit);
   }
   double required(std::size_t c) const { return required_[c]; }
@@ -198,8 +206,9 @@ std::vector<Eigen::Isometry3d> SnapPoses(const std::vector<PoseChart>& charts,
 
 /// Fills the per-camera change records (`focal_scales` empty: no zoom).
 void FillChanges(const Rig& rig, const SuggestOptions& options,
-                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& focal_scales,
-                 const Placement& placement, Suggestion* s);
+                 const std::vector<Eigen::Isometry3d>& poses,
+                 const std::vector<double>& focal_scales, const Placement& placement,
+                 Suggestion* s);
 
 /// The camera with its focal lengths scaled by `scale` (principal point and distortion kept).
 Camera Zoomed(const Camera& camera, double scale);

@@ -10,10 +10,10 @@
 #include <random>
 #include <string>
 
-#include "analysis/calibration.h"
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/rig/calibration.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "suggest/suggest.h"
 #include "suggest/suggest_internal.h"
 
@@ -32,7 +32,8 @@ std::string SceneText(const std::string& c5_look, const std::string& calibration
     {"id": "c2", "position": [0, 4, 2], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 50},
     {"id": "c3", "position": [-4, 0, 2], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 50},
     {"id": "c4", "position": [0, -4, 2], "look_at": [1.3, 0, 0.5], "resolution": [640, 480], "hfov_deg": 35},
-    {"id": "c5", "position": [2.8, -2.8, 2], "look_at": )" + c5_look + R"(, "resolution": [640, 480], "hfov_deg": 40}]}],
+    {"id": "c5", "position": [2.8, -2.8, 2], "look_at": )" +
+                  c5_look + R"(, "resolution": [640, 480], "hfov_deg": 40}]}],
   "study": {"region": {"box": {"min": [-0.6, -0.6, 0], "max": [0.6, 0.6, 1.2]}}, "voxel_size": 0.05)" +
                   (calibration.empty() ? "" : ", \"calibration\": " + calibration) + "}}";
   return t;
@@ -42,7 +43,8 @@ struct Fixture {
   Scene scene;
   std::unique_ptr<RayCaster> caster;
   std::vector<TargetPoint> targets;
-  explicit Fixture(const std::string& text, int points = 600) : scene(ParseScene(text, "objectives.json")) {
+  explicit Fixture(const std::string& text, int points = 600)
+      : scene(ParseScene(text, "objectives.json")) {
     caster = MakeEmbreeRayCaster(scene.AllTriangles());
     targets = SampleTargets(scene, points, {}, false, 11);
   }
@@ -79,7 +81,8 @@ TEST(SuggestObjectives, NamesParseAndRoundTrip) {
   EXPECT_EQ(ObjectiveName(*ParseObjective("calibration")), "calibration");
   EXPECT_TRUE(ObjectiveHigherIsBetter(*ParseObjective("coverage3-n1")));
   EXPECT_TRUE(ObjectiveHigherIsBetter(*ParseObjective("calibration")));
-  for (const char* bad : {"sigma-mean-n1", "coverage0-n1", "-n1", "coverage3-n2", "n1", "calibrations"})
+  for (const char* bad :
+       {"sigma-mean-n1", "coverage0-n1", "-n1", "coverage3-n2", "n1", "calibrations"})
     EXPECT_FALSE(ParseObjective(bad)) << bad;
 }
 
@@ -117,7 +120,9 @@ TEST(SuggestObjectives, N1EqualsDisablingEachCameraAndCountingAgain) {
     for (std::size_t c = 0; c < sel.size(); ++c) {
       Eigen::Isometry3d p = f.rig().cameras[sel[c]].world_from_camera;
       p.translation() += 0.2 * Vec3(n01(rng), n01(rng), n01(rng));
-      p.linear() = p.linear() * Eigen::AngleAxisd(0.15 * n01(rng), Vec3(n01(rng), n01(rng), n01(rng)).normalized()).toRotationMatrix();
+      p.linear() = p.linear() * Eigen::AngleAxisd(0.15 * n01(rng),
+                                                  Vec3(n01(rng), n01(rng), n01(rng)).normalized())
+                                    .toRotationMatrix();
       poses.push_back(p);
       moved.cameras[sel[c]].world_from_camera = p;
       views[c] = ev.View(static_cast<int>(c), p);
@@ -166,12 +171,14 @@ TEST(SuggestObjectives, CalibrationEqualsTheSimulationAndAThresholdSearch) {
     const Objective o = *ParseObjective("calibration");
     const Metrics m = EvaluateExact(f.scene, f.rig(), *f.caster, f.targets, o);
     ASSERT_TRUE(m.calibration);
-    const CalibrationResult sim = SimulateCalibration(f.scene, f.rig(), *f.caster, *f.scene.study.calibration);
+    const CalibrationResult sim =
+        SimulateCalibration(f.scene, f.rig(), *f.caster, *f.scene.study.calibration);
     EXPECT_EQ(m.calibration->poses, sim.poses);
     EXPECT_EQ(m.calibration->weakest, StrengthByThresholds(sim.shared)) << look;
     EXPECT_EQ(m.objective, double(m.calibration->weakest));
     EXPECT_EQ(m.calibration->components, static_cast<int>(sim.graph.components.size())) << look;
-    EXPECT_EQ(m.calibration->uncalibratable, static_cast<int>(sim.graph.uncalibratable.size())) << look;
+    EXPECT_EQ(m.calibration->uncalibratable, static_cast<int>(sim.graph.uncalibratable.size()))
+        << look;
     // Calibratable with the rest exactly when the chain is at least min_shared strong.
     EXPECT_EQ(sim.calibratable, m.calibration->weakest >= 15) << look;
     if (sim.calibratable) {
@@ -217,8 +224,10 @@ Rig Moved(const Rig& rig, const Suggestion& s) {
 // A camera that looks away from the calibration volume is turned back until it links to the rest;
 // the simulation of the returned rig agrees.
 TEST(SuggestObjectives, SuggestLinksACameraThatCannotBeCalibrated) {
-  Fixture f(SceneText("[4.5, 1.5, 1.2]", R"({"target": "wand", "samples": 600, "seed": 3, "min_shared": 15})"));
-  const CalibrationResult start = SimulateCalibration(f.scene, f.rig(), *f.caster, *f.scene.study.calibration);
+  Fixture f(SceneText("[4.5, 1.5, 1.2]",
+                      R"({"target": "wand", "samples": 600, "seed": 3, "min_shared": 15})"));
+  const CalibrationResult start =
+      SimulateCalibration(f.scene, f.rig(), *f.caster, *f.scene.study.calibration);
   ASSERT_FALSE(start.calibratable);
   const SuggestOptions o = Select(4, 0.3, 45, "calibration");
   const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
@@ -229,10 +238,12 @@ TEST(SuggestObjectives, SuggestLinksACameraThatCannotBeCalibrated) {
   EXPECT_LE(s.cameras[0].rotate_deg, 45 + 1e-6);
   EXPECT_LE(s.cameras[0].move_m, 0.3 * (1 + 1e-9));
   // The wand's poses do not depend on the rig: the simulation of the new rig is the same graph.
-  const CalibrationResult after = SimulateCalibration(f.scene, Moved(f.rig(), s), *f.caster, *f.scene.study.calibration);
+  const CalibrationResult after =
+      SimulateCalibration(f.scene, Moved(f.rig(), s), *f.caster, *f.scene.study.calibration);
   EXPECT_TRUE(after.calibratable);
   EXPECT_EQ(s.after.calibration->weakest, StrengthByThresholds(after.shared));
-  const Metrics check = EvaluateExact(f.scene, Moved(f.rig(), s), *f.caster, f.targets, o.objective);
+  const Metrics check =
+      EvaluateExact(f.scene, Moved(f.rig(), s), *f.caster, f.targets, o.objective);
   EXPECT_EQ(check.objective, s.after.objective);
 }
 

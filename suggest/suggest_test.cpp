@@ -3,25 +3,25 @@
 #include "suggest/suggest.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <set>
-#include <unistd.h>
 #include <sstream>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
-#include "analysis/sha256.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
+#include "analysis/util/sha256.h"
+#include "analysis/util/units.h"
 #include "suggest/suggest_internal.h"
 #include "suggest/suggestion_file.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -42,24 +42,26 @@ std::string Vec(double x, double y, double z, double s) {
 // Four cameras on a ring around a 1 m region with a pillar beside it; every length times `s`.
 // Camera c4 looks past the region (26.6 degrees off, half its 50 degree field of view), so a nudge
 // can bring it back. `c4_look` overrides where c4 looks (unscaled).
-std::string SceneText(double s, Vec3 c4_look = Vec3(2.0, 0.0, 0.5), const std::string& units = "m") {
+std::string SceneText(double s, Vec3 c4_look = Vec3(2.0, 0.0, 0.5),
+                      const std::string& units = "m") {
   std::string t = "{\n  \"pandora\": 1,\n  \"units\": \"" + units + "\",\n  \"objects\": [\n";
-  t += "    {\"name\": \"floor\", \"box\": {\"size\": " + Vec(8, 8, 0.1, s) + "}, \"position\": " +
-       Vec(0, 0, -0.05, s) + ", \"solid\": true},\n";
-  t += "    {\"name\": \"pillar\", \"box\": {\"size\": " + Vec(0.3, 0.3, 1.5, s) + "}, \"position\": " +
-       Vec(1.6, 1.6, 0.75, s) + ", \"solid\": true}\n  ],\n";
+  t += "    {\"name\": \"floor\", \"box\": {\"size\": " + Vec(8, 8, 0.1, s) +
+       "}, \"position\": " + Vec(0, 0, -0.05, s) + ", \"solid\": true},\n";
+  t += "    {\"name\": \"pillar\", \"box\": {\"size\": " + Vec(0.3, 0.3, 1.5, s) +
+       "}, \"position\": " + Vec(1.6, 1.6, 0.75, s) + ", \"solid\": true}\n  ],\n";
   t += "  \"rigs\": [\n    {\"name\": \"ring\", \"cameras\": [\n";
   const double pos[4][2] = {{4, 0}, {0, 4}, {-4, 0}, {0, -4}};
   for (int c = 0; c < 4; ++c) {
     const Vec3 look = c == 3 ? c4_look : Vec3(0, 0, 0.5);
-    t += "      {\"id\": \"c" + std::to_string(c + 1) + "\", \"position\": " +
-         Vec(pos[c][0], pos[c][1], 2.0, s) + ", \"look_at\": " + Vec(look.x(), look.y(), look.z(), s) +
+    t += "      {\"id\": \"c" + std::to_string(c + 1) +
+         "\", \"position\": " + Vec(pos[c][0], pos[c][1], 2.0, s) +
+         ", \"look_at\": " + Vec(look.x(), look.y(), look.z(), s) +
          ", \"resolution\": [640, 480], \"hfov_deg\": 50, \"range\": {\"near\": " + Num(0.2 * s) +
          ", \"far\": " + Num(12 * s) + "}}" + (c < 3 ? ",\n" : "\n");
   }
   t += "    ]}\n  ],\n";
-  t += "  \"study\": {\"region\": {\"box\": {\"min\": " + Vec(-0.5, -0.5, 0, s) + ", \"max\": " +
-       Vec(0.5, 0.5, 1.0, s) + "}}, \"voxel_size\": " + Num(0.05 * s) + "}\n}\n";
+  t += "  \"study\": {\"region\": {\"box\": {\"min\": " + Vec(-0.5, -0.5, 0, s) +
+       ", \"max\": " + Vec(0.5, 0.5, 1.0, s) + "}}, \"voxel_size\": " + Num(0.05 * s) + "}\n}\n";
   return t;
 }
 
@@ -105,7 +107,8 @@ void CheckContract(const Fixture& f, const SuggestOptions& o, const Suggestion& 
   if (s.improved && std::isinf(s.after.objective))  // sigma percentile on an untriangulable point
     EXPECT_LT(s.after.untriangulable, s.before.untriangulable);
   else if (s.improved)
-    EXPECT_TRUE(higher ? s.after.objective > s.before.objective : s.after.objective < s.before.objective);
+    EXPECT_TRUE(higher ? s.after.objective > s.before.objective
+                       : s.after.objective < s.before.objective);
   else
     EXPECT_EQ(s.after.objective, s.before.objective);
   EXPECT_FALSE(s.message.empty());
@@ -115,13 +118,15 @@ void CheckContract(const Fixture& f, const SuggestOptions& o, const Suggestion& 
     const CameraChange& ch = s.cameras[c];
     EXPECT_LE(ch.move_m, l.max_move * (1 + 1e-9) + 1e-15);
     EXPECT_LE(ch.rotate_deg, l.max_rotate_deg + 1e-6);
-    EXPECT_NEAR(ch.move_m, (ch.after.translation() - ch.before.translation()).norm(), 1e-12 * (1 + ch.move_m));
+    EXPECT_NEAR(ch.move_m, (ch.after.translation() - ch.before.translation()).norm(),
+                1e-12 * (1 + ch.move_m));
     EXPECT_TRUE(ch.after.matrix().allFinite());
     if (!s.improved) {
       EXPECT_TRUE(ch.after.isApprox(ch.before, 0.0)) << "not improved, yet a pose changed";
     }
   }
-  const Metrics check = EvaluateExact(f.scene, WithPoses(f.rig(), s), *f.caster, f.targets, o.objective);
+  const Metrics check =
+      EvaluateExact(f.scene, WithPoses(f.rig(), s), *f.caster, f.targets, o.objective);
   if (o.objective.kind != ObjectiveKind::kMix) {
     EXPECT_DOUBLE_EQ(check.objective, s.after.objective);
     EXPECT_DOUBLE_EQ(check.coverage2, s.after.coverage2);
@@ -190,7 +195,9 @@ TEST(SuggestExact, CombinedCameraViewsEqualEvaluate) {
       for (std::size_t c = 0; c < sel.size(); ++c) {
         Eigen::Isometry3d p = f.rig().cameras[sel[c]].world_from_camera;
         p.translation() += 0.1 * Vec3(n01(rng), n01(rng), n01(rng));
-        p.linear() = p.linear() * Eigen::AngleAxisd(0.1 * n01(rng), Vec3(n01(rng), n01(rng), n01(rng)).normalized()).toRotationMatrix();
+        p.linear() = p.linear() * Eigen::AngleAxisd(0.1 * n01(rng),
+                                                    Vec3(n01(rng), n01(rng), n01(rng)).normalized())
+                                      .toRotationMatrix();
         poses.push_back(p);
         scales.push_back(trial == 3 ? 1.2 : 1.0);  // a zoom too
         views[c] = ev.View(static_cast<int>(c), p, scales[c]);
@@ -260,23 +267,26 @@ TEST(Suggest, SurfaceTargetsEndCleanly) {
 }
 
 TEST(Suggest, RecoversTheObjectiveLostByATurnedCamera) {
-  // The same rig with c4 looking at the region is the reference; from the turned pose the nudge must
-  // recover at least 80% of the lost coverage.
+  // The same rig with c4 looking at the region is the reference; from the turned pose the nudge
+  // must recover at least 80% of the lost coverage.
   Fixture good(SceneText(1.0, Vec3(0, 0, 0.5)));
   Fixture f(SceneText(1.0));
   const SuggestOptions o = Options({3}, 0.3, 30);
-  const double reference = EvaluateExact(good.scene, good.rig(), *good.caster, f.targets, o.objective).objective;
+  const double reference =
+      EvaluateExact(good.scene, good.rig(), *good.caster, f.targets, o.objective).objective;
   const Suggestion s = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
   CheckContract(f, o, s);
   ASSERT_TRUE(s.improved) << s.message;
   const double lost = reference - s.before.objective;
   ASSERT_GT(lost, 0.05);
   EXPECT_GE(s.after.objective - s.before.objective, 0.8 * lost)
-      << "before " << s.before.objective << " after " << s.after.objective << " reference " << reference;
+      << "before " << s.before.objective << " after " << s.after.objective << " reference "
+      << reference;
   EXPECT_GT(s.cameras[0].rotate_deg, 5.0);
   EXPECT_GT(s.iterations, 0);
   EXPECT_FALSE(s.trace.empty());
-  for (std::size_t i = 1; i < s.trace.size(); ++i) EXPECT_GE(s.trace[i].objective, s.trace[i - 1].objective);
+  for (std::size_t i = 1; i < s.trace.size(); ++i)
+    EXPECT_GE(s.trace[i].objective, s.trace[i - 1].objective);
 }
 
 TEST(Suggest, TraumaRoomRecoveryFromPerturbedCameras) {
@@ -436,7 +446,8 @@ TEST(Suggest, SnapRoundsToInstallableSteps) {
   ASSERT_TRUE(s.improved) << s.message;  // this scene improves; the snapped result must be checked
   const CameraChange& c = s.cameras[0];
   const Vec3 d = c.after.translation() - c.before.translation();
-  for (int a = 0; a < 3; ++a) EXPECT_NEAR(d[a] / 0.05, std::round(d[a] / 0.05), 1e-9) << d.transpose();
+  for (int a = 0; a < 3; ++a)
+    EXPECT_NEAR(d[a] / 0.05, std::round(d[a] / 0.05), 1e-9) << d.transpose();
   const Vec3 y0 = YawPitchRollDeg(c.before.linear()), y1 = YawPitchRollDeg(c.after.linear());
   for (int a = 0; a < 3; ++a) {
     double delta = std::remainder(y1[a] - y0[a], 360.0);
@@ -450,7 +461,8 @@ TEST(Suggest, SnapRoundsToInstallableSteps) {
   CheckContract(g, o, t);
   ASSERT_TRUE(t.improved) << t.message;
   const Vec3 p = t.cameras[0].after.translation();
-  for (int a = 0; a < 3; ++a) EXPECT_NEAR(p[a] / 0.05, std::round(p[a] / 0.05), 1e-9) << p.transpose();
+  for (int a = 0; a < 3; ++a)
+    EXPECT_NEAR(p[a] / 0.05, std::round(p[a] / 0.05), 1e-9) << p.transpose();
   // On an oblique rail the camera stays on the rail and moves a multiple of the step along it.
   SuggestOptions r = o;
   r.limits[0].mount.kind = MountConstraint::Kind::kLine;
@@ -458,7 +470,8 @@ TEST(Suggest, SnapRoundsToInstallableSteps) {
   const Suggestion u = Suggest(g.scene, g.rig(), *g.caster, g.targets, r);
   CheckContract(g, r, u);
   const Vec3 m = u.cameras[0].after.translation() - u.cameras[0].before.translation();
-  EXPECT_NEAR(m.normalized().cwiseAbs().dot(Vec3(1, 1, 0).normalized()) * m.norm(), m.norm(), 1e-9 + 1e-9 * m.norm());
+  EXPECT_NEAR(m.normalized().cwiseAbs().dot(Vec3(1, 1, 0).normalized()) * m.norm(), m.norm(),
+              1e-9 + 1e-9 * m.norm());
   EXPECT_NEAR(m.norm() / 0.05, std::round(m.norm() / 0.05), 1e-9) << m.transpose();
 }
 
@@ -472,7 +485,9 @@ std::string WallText(double start_y) {
     {"name": "wall", "box": {"size": [6, 0.2, 3]}, "position": [0, -1.95, 1.5], "solid": true}],
   "rigs": [{"name": "r", "cameras": [
     {"id": "top", "position": [0, 0, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "resolution": [640, 480], "hfov_deg": 60},
-    {"id": "back", "position": [0, )" + Num(start_y) + R"(, 0.5], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 40}]}],
+    {"id": "back", "position": [0, )" +
+         Num(start_y) +
+         R"(, 0.5], "look_at": [0, 0, 0.5], "resolution": [640, 480], "hfov_deg": 40}]}],
   "study": {"region": {"box": {"min": [-1, -1, 0], "max": [1, 1, 1]}}, "voxel_size": 0.1}})";
 }
 
@@ -543,7 +558,8 @@ TEST(Suggest, TargetOutsideEveryFrustumEndsCleanly) {
   EXPECT_EQ(s.before.coverage2, 0.0);
   EXPECT_EQ(s.before.min_resolution, 0.0);
   EXPECT_TRUE(std::isinf(s.before.sigma_p50));
-  EXPECT_NE(s.message.find("no selected camera sees any target point"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("no selected camera sees any target point"), std::string::npos)
+      << s.message;
 }
 
 TEST(Suggest, MillimetreAndKilometreScenesBehaveAlike) {
@@ -578,7 +594,8 @@ TEST(Suggest, BadSelectionAndLimitsAreInputErrors) {
   Fixture f(SceneText(1.0));
   EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({}, 0.3, 10)), InputError);
   EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({7}, 0.3, 10)), InputError);
-  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1, 1}, 0.3, 10)), InputError);
+  EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1, 1}, 0.3, 10)),
+               InputError);
   EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1}, -0.1, 10)), InputError);
   EXPECT_THROW(Suggest(f.scene, f.rig(), *f.caster, f.targets, Options({1}, 0.1, 180)), InputError);
   SuggestOptions o = Options({3}, 0.3, 10);
@@ -604,8 +621,9 @@ TEST(Suggest, BaselineRespectsLimitsAndBudget) {
 class SuggestAcceptTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("pandora_accept_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("pandora_accept_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -642,7 +660,8 @@ class SuggestAcceptTest : public ::testing::Test {
   const Eigen::Quaterniond q(Mat3(got.linear().transpose() * want.linear()));
   const double angle = 2 * std::atan2(q.vec().norm(), std::abs(q.w()));
   if (dc <= 1e-9 && angle <= 1e-9) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "centre off by " << dc << " m, orientation by " << angle << " rad";
+  return ::testing::AssertionFailure()
+         << "centre off by " << dc << " m, orientation by " << angle << " rad";
 }
 
 std::vector<std::string> Keys(const nlohmann::ordered_json& cam) {
@@ -652,8 +671,10 @@ std::vector<std::string> Keys(const nlohmann::ordered_json& cam) {
 }
 
 // Everything but the pose keys of the named cameras is JSON-equal.
-void ExpectEqualButPoses(const std::string& a_text, const std::string& b_text, const std::set<std::string>& ids) {
-  nlohmann::ordered_json a = nlohmann::ordered_json::parse(a_text), b = nlohmann::ordered_json::parse(b_text);
+void ExpectEqualButPoses(const std::string& a_text, const std::string& b_text,
+                         const std::set<std::string>& ids) {
+  nlohmann::ordered_json a = nlohmann::ordered_json::parse(a_text),
+                         b = nlohmann::ordered_json::parse(b_text);
   for (auto* j : {&a, &b})
     for (auto& cam : (*j)["rigs"][0]["cameras"])
       if (ids.count(cam["id"].get<std::string>()))
@@ -680,12 +701,14 @@ TEST_F(SuggestAcceptTest, PartialAcceptWritesBackupAndOnlyThatPose) {
   ExpectEqualButPoses(original, updated, {"c4"});
   // The camera keeps its look_at form, in the same place; `up` follows look_at when the suggestion
   // rolled the camera (then accept says so).
-  const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(updated)["rigs"][0]["cameras"][3];
+  const nlohmann::ordered_json cam =
+      nlohmann::ordered_json::parse(updated)["rigs"][0]["cameras"][3];
   std::vector<std::string> keys = Keys(cam);
   const bool rolled = cam.contains("up");
   EXPECT_EQ(rolled, !r.notes.empty());
   if (rolled) keys.erase(std::find(keys.begin(), keys.end(), "up"));
-  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "hfov_deg", "range"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "hfov_deg",
+                                            "range"}));
 
   const Scene after = LoadScene(scene_path.string());
   const Scene before = ParseScene(original, scene_path.string());
@@ -733,10 +756,12 @@ TEST_F(SuggestAcceptTest, ZoomWritesFocalLengthInPlaceOfTheFieldOfView) {
   EXPECT_NEAR(k1.fy, k0.fy * s.cameras[0].focal_scale, 1e-9 * k0.fy);
   EXPECT_EQ(k1.cx, k0.cx);
   EXPECT_TRUE(SamePose(after.rigs[0].cameras[3].world_from_camera, s.cameras[0].after));
-  const nlohmann::ordered_json cam = nlohmann::ordered_json::parse(Read(scene_path))["rigs"][0]["cameras"][3];
+  const nlohmann::ordered_json cam =
+      nlohmann::ordered_json::parse(Read(scene_path))["rigs"][0]["cameras"][3];
   std::vector<std::string> keys = Keys(cam);
   if (cam.contains("up")) keys.erase(std::find(keys.begin(), keys.end(), "up"));
-  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "focal_px", "range"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"id", "position", "look_at", "resolution", "focal_px",
+                                            "range"}));
 }
 
 TEST_F(SuggestAcceptTest, UnknownCameraAndNoImprovementAreRefused) {
@@ -808,7 +833,8 @@ TEST_F(SuggestAcceptTest, AcceptKeepsEachCamerasFormAndWritesSnappedNumbers) {
   for (const std::string units : {"m", "cm"}) {
     SCOPED_TRACE(units);
     const double s_unit = units == "m" ? 1.0 : 100.0;
-    nlohmann::ordered_json j = nlohmann::ordered_json::parse(SceneText(s_unit, Vec3(2.0, 0.0, 0.5), units));
+    nlohmann::ordered_json j =
+        nlohmann::ordered_json::parse(SceneText(s_unit, Vec3(2.0, 0.0, 0.5), units));
     auto& cams = j["rigs"][0]["cameras"];
     cams[3]["up"] = {0, 0, 1};
     // c2 as Euler angles (it looks at the region's centre from (0, 4, 2): yaw -90, pitch down).
@@ -882,20 +908,25 @@ TEST(SuggestReplacePoses, LookAtKeepsUpOrSaysWhyNot) {
   std::vector<std::string> notes;
   std::string out = ReplacePoses(text, "x.json", "ring", {{"c1", pose, std::nullopt, 0}}, &notes);
   nlohmann::ordered_json cam = nlohmann::ordered_json::parse(out)["rigs"][0]["cameras"][0];
-  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "resolution", "hfov_deg", "range"}));
+  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "resolution",
+                                                 "hfov_deg", "range"}));
   EXPECT_TRUE(notes.empty());
-  const Vec3 t(cam["look_at"][0].get<double>(), cam["look_at"][1].get<double>(), cam["look_at"][2].get<double>());
+  const Vec3 t(cam["look_at"][0].get<double>(), cam["look_at"][1].get<double>(),
+               cam["look_at"][2].get<double>());
   EXPECT_NEAR((t - p).norm(), distance, 1e-9);  // the old look_at's distance, along the new axis
   EXPECT_NEAR((t - p).normalized().dot((target - p).normalized()), 1.0, 1e-15);
   EXPECT_TRUE(SamePose(ParseScene(out, "x.json").rigs[0].cameras[0].world_from_camera, pose));
   // Rolled 5 degrees about its optical axis: up cannot stay [0, 0, 1]; it becomes the camera's up.
   Eigen::Isometry3d rolled = pose;
-  rolled.linear() = pose.linear() * Eigen::AngleAxisd(5 * kPi / 180, Vec3::UnitZ()).toRotationMatrix();
+  rolled.linear() =
+      pose.linear() * Eigen::AngleAxisd(5 * kPi / 180, Vec3::UnitZ()).toRotationMatrix();
   out = ReplacePoses(text, "x.json", "ring", {{"c1", rolled, std::nullopt, 0}}, &notes);
   cam = nlohmann::ordered_json::parse(out)["rigs"][0]["cameras"][0];
-  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "up", "resolution", "hfov_deg", "range"}));
+  EXPECT_EQ(Keys(cam), (std::vector<std::string>{"id", "position", "look_at", "up", "resolution",
+                                                 "hfov_deg", "range"}));
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("c1: the suggestion also turns the camera 5 deg about its optical axis"), std::string::npos)
+  EXPECT_NE(notes[0].find("c1: the suggestion also turns the camera 5 deg about its optical axis"),
+            std::string::npos)
       << notes[0];
   EXPECT_TRUE(SamePose(ParseScene(out, "x.json").rigs[0].cameras[0].world_from_camera, rolled));
 }

@@ -5,11 +5,11 @@
 #include <memory>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/motion.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/motion.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "suggest/suggest.h"
 
 namespace pandora {

@@ -1,8 +1,6 @@
-// The suggestion file and `pandora accept`: the scene file changes only here, only in the pose fields
-// of the accepted cameras, after a backup.
+// The suggestion file and `pandora accept`: the scene file changes only here, only in the pose
+// fields of the accepted cameras, after a backup.
 #include "suggest/suggestion_file.h"
-
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,19 +10,20 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <sstream>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/input_file.h"
-#include "analysis/output_transaction.h"
-#include "analysis/sha256.h"
+#include "analysis/scene/scene_text.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
+#include "analysis/util/output_transaction.h"
+#include "analysis/util/sha256.h"
+#include "analysis/util/units.h"
 #include "suggest/ptz_suggest.h"
-#include "suggest/scene_text.h"
 #include "suggest/suggest.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -32,8 +31,8 @@ namespace {
 using json = nlohmann::json;
 using ordered_json = nlohmann::ordered_json;
 using scene_text::Clean;
-using scene_text::MetresPerUnit;
 using scene_text::IdOf;
+using scene_text::MetresPerUnit;
 using scene_text::Number;
 using scene_text::ParseOrdered;
 using scene_text::ReadJsonText;
@@ -41,13 +40,15 @@ using scene_text::ReadJsonText;
 json Finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json MetricsJson(const Metrics& m) {
-  json j{{"objective", Finite(m.objective)},
-         {"coverage_k", m.coverage_k},
-         {"coverage2", m.coverage2},
-         {"sigma_max_mm", {{"p50", Finite(m.sigma_p50)}, {"p90", Finite(m.sigma_p90)}, {"p95", Finite(m.sigma_p95)}}},
-         {"sigma_max_mean_mm", Finite(m.sigma_mean)},
-         {"untriangulable", m.untriangulable},
-         {"min_resolution_px_per_m", Finite(m.min_resolution)}};
+  json j{
+      {"objective", Finite(m.objective)},
+      {"coverage_k", m.coverage_k},
+      {"coverage2", m.coverage2},
+      {"sigma_max_mm",
+       {{"p50", Finite(m.sigma_p50)}, {"p90", Finite(m.sigma_p90)}, {"p95", Finite(m.sigma_p95)}}},
+      {"sigma_max_mean_mm", Finite(m.sigma_mean)},
+      {"untriangulable", m.untriangulable},
+      {"min_resolution_px_per_m", Finite(m.min_resolution)}};
   if (m.n1) j["n1"] = {{"coverage_k", m.n1->coverage_k}, {"worst_camera", m.n1->worst_camera}};
   if (m.calibration)
     j["calibration"] = {{"weakest_shared", m.calibration->weakest},
@@ -67,9 +68,6 @@ json PoseJson(const Eigen::Isometry3d& pose) {
 
 // A JSON file's text: a regular file of bounded size, nesting checked before any parser sees it.
 
-
-
-
 Vec3 ReadVec3(const json& j, const std::string& file, const std::string& path) {
   if (!j.is_array() || j.size() != 3) throw InputError(file, path, "expected [x, y, z]");
   Vec3 v;
@@ -85,10 +83,12 @@ Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::st
     throw InputError(file, path, "expected {\"position\", \"quaternion\"}");
   const Vec3 p = ReadVec3(j["position"], file, path + ".position");
   const json& q = j["quaternion"];
-  if (!q.is_array() || q.size() != 4) throw InputError(file, path + ".quaternion", "expected [w, x, y, z]");
+  if (!q.is_array() || q.size() != 4)
+    throw InputError(file, path + ".quaternion", "expected [w, x, y, z]");
   for (int i = 0; i < 4; ++i)
     if (!q[i].is_number()) throw InputError(file, path + ".quaternion", "expected numbers");
-  Eigen::Quaterniond quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>());
+  Eigen::Quaterniond quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(),
+                          q[3].get<double>());
   if (!(quat.norm() > 0.5)) throw InputError(file, path + ".quaternion", "not a unit quaternion");
   quat.normalize();
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -96,7 +96,6 @@ Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::st
   pose.translation() = p;
   return pose;
 }
-
 
 // A coordinate in file units: the multiple of `step` when it is one (within 1e-6 of a step).
 double OnGrid(double v, double step) {
@@ -107,8 +106,9 @@ double OnGrid(double v, double step) {
   return Clean(v);
 }
 
-
-ordered_json Array(const Vec3& v) { return ordered_json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
+ordered_json Array(const Vec3& v) {
+  return ordered_json::array({Number(v.x()), Number(v.y()), Number(v.z())});
+}
 
 std::optional<Vec3> FileVec3(const ordered_json& cam, const char* key) {
   if (!cam.contains(key)) return std::nullopt;
@@ -135,7 +135,8 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
   json j;
   j["pandora_suggestion"] = 1;
   std::error_code ec;
-  const std::string absolute = std::filesystem::absolute(scene.path, ec).lexically_normal().string();
+  const std::string absolute =
+      std::filesystem::absolute(scene.path, ec).lexically_normal().string();
   j["scene"] = {{"path", ec ? scene.path : absolute}, {"sha256", scene.sha256}};
   j["rig"] = rig.name;
   j["improved"] = s.improved;
@@ -158,11 +159,16 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
                    {"max_rotate_deg", l.max_rotate_deg},
                    {"mount", kinds[static_cast<int>(l.mount.kind)]}};
     if (l.max_hfov_deg > 0) limits["hfov_range_deg"] = {l.min_hfov_deg, l.max_hfov_deg};
-    json cj = {{"id", ch.id}, {"index", ch.index}, {"before", PoseJson(ch.before)},
-               {"after", PoseJson(ch.after)}, {"move_m", ch.move_m}, {"rotate_deg", ch.rotate_deg},
+    json cj = {{"id", ch.id},
+               {"index", ch.index},
+               {"before", PoseJson(ch.before)},
+               {"after", PoseJson(ch.after)},
+               {"move_m", ch.move_m},
+               {"rotate_deg", ch.rotate_deg},
                {"hfov_deg", {{"before", ch.hfov_before_deg}, {"after", ch.hfov_after_deg}}},
                {"surface_distance_m",
-                {{"before", Finite(ch.surface_distance_before)}, {"after", Finite(ch.surface_distance_after)}}},
+                {{"before", Finite(ch.surface_distance_before)},
+                 {"after", Finite(ch.surface_distance_after)}}},
                {"limits", limits}};
     if (ch.focal_scale != 1.0) {
       const Intrinsics& k = rig.cameras[ch.index].model.intrinsics();
@@ -172,14 +178,16 @@ std::string SuggestionToJson(const Suggestion& s, const Scene& scene, const Rig&
     cams.push_back(cj);
   }
   j["cameras"] = cams;
-  j["solver"] = {{"iterations", s.iterations},
-                 {"outer_iterations", s.outer_iterations},
-                 {"evaluations", s.evaluations},
-                 {"screening_evaluations", s.screened},
-                 {"screening_best_objective", s.screened > 0 ? Finite(s.screened_objective) : json(nullptr)},
-                 {"seconds", s.seconds}};
+  j["solver"] = {
+      {"iterations", s.iterations},
+      {"outer_iterations", s.outer_iterations},
+      {"evaluations", s.evaluations},
+      {"screening_evaluations", s.screened},
+      {"screening_best_objective", s.screened > 0 ? Finite(s.screened_objective) : json(nullptr)},
+      {"seconds", s.seconds}};
   json trace = json::array();
-  for (const TracePoint& t : s.trace) trace.push_back({t.seconds, t.evaluations, Finite(t.objective)});
+  for (const TracePoint& t : s.trace)
+    trace.push_back({t.seconds, t.evaluations, Finite(t.objective)});
   j["trace"] = {{"columns", {"seconds", "evaluations", "best_objective"}}, {"rows", trace}};
   return j.dump(1) + "\n";
 }
@@ -190,8 +198,8 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
   ordered_json root = ParseOrdered(text, scene_path);
   const double mpu = MetresPerUnit(root, scene_path);
   std::size_t rig_index = 0;
-  ordered_json* rig =
-      &scene_text::FindRig(root, scene_path, rig_name, "the scene file no longer matches the suggestion", &rig_index);
+  ordered_json* rig = &scene_text::FindRig(
+      root, scene_path, rig_name, "the scene file no longer matches the suggestion", &rig_index);
   ordered_json& cameras = (*rig)["cameras"];
   for (const PoseUpdate& update : poses) {
     bool found = false;
@@ -199,7 +207,8 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
       ordered_json& cam = cameras[c];
       if (!cam.is_object() || !cam.contains("id") || IdOf(cam["id"]) != update.id) continue;
       found = true;
-      const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
+      const std::string where =
+          "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
       if (!cam.contains("position"))
         throw InputError(scene_path, where, "the camera has no position");
       Vec3 p = update.pose.translation() / mpu;  // file units
@@ -231,18 +240,20 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
           orientation["up"] = Array(own);
           if (notes) {
             char line[200];
-            std::snprintf(line, sizeof line,
-                          "%s: the suggestion also turns the camera %.3g deg about its optical axis "
-                          "(a roll the old 'up' cannot express): 'up' is now [%.6g, %.6g, %.6g]",
-                          update.id.c_str(), kept ? AngleRad(kept->linear(), R) * kDegPerRad : 0.0,
-                          own.x(), own.y(), own.z());
+            std::snprintf(
+                line, sizeof line,
+                "%s: the suggestion also turns the camera %.3g deg about its optical axis "
+                "(a roll the old 'up' cannot express): 'up' is now [%.6g, %.6g, %.6g]",
+                update.id.c_str(), kept ? AngleRad(kept->linear(), R) * kDegPerRad : 0.0, own.x(),
+                own.y(), own.z());
             notes->push_back(line);
           }
         }
       } else if (cam.contains("euler_deg")) {
         const Vec3 ypr = YawPitchRollDeg(R);
-        orientation["euler_deg"] = ordered_json::object(
-            {{"yaw", Number(Clean(ypr.x()))}, {"pitch", Number(Clean(ypr.y()))}, {"roll", Number(Clean(ypr.z()))}});
+        orientation["euler_deg"] = ordered_json::object({{"yaw", Number(Clean(ypr.x()))},
+                                                         {"pitch", Number(Clean(ypr.y()))},
+                                                         {"roll", Number(Clean(ypr.z()))}});
       } else {
         const Eigen::Quaterniond q(R);
         orientation["quaternion"] = {q.w(), q.x(), q.y(), q.z()};
@@ -252,7 +263,8 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
         const std::string& key = it.key();
         if (key == "position") {
           rebuilt["position"] = Array(p);
-          for (auto o = orientation.begin(); o != orientation.end(); ++o) rebuilt[o.key()] = o.value();
+          for (auto o = orientation.begin(); o != orientation.end(); ++o)
+            rebuilt[o.key()] = o.value();
         } else if (key == "look_at" || key == "up" || key == "quaternion" || key == "euler_deg") {
           continue;
         } else if (update.focal_px && (key == "hfov_deg" || key == "focal_px" || key == "lens")) {
@@ -271,32 +283,39 @@ std::string ReplacePoses(const std::string& text, const std::string& scene_path,
   return scene_text::DumpLike(root, text);
 }
 
-std::string ReplacePtzHeads(const std::string& text, const std::string& scene_path, const std::string& rig_name,
-                            const std::vector<PtzHeadUpdate>& heads) {
+std::string ReplacePtzHeads(const std::string& text, const std::string& scene_path,
+                            const std::string& rig_name, const std::vector<PtzHeadUpdate>& heads) {
   ordered_json root = ParseOrdered(text, scene_path);
   std::size_t rig_index = 0;
-  ordered_json* rig =
-      &scene_text::FindRig(root, scene_path, rig_name, "the scene file no longer matches the session", &rig_index);
+  ordered_json* rig = &scene_text::FindRig(
+      root, scene_path, rig_name, "the scene file no longer matches the session", &rig_index);
   if (!rig->contains("cameras") || !(*rig)["cameras"].is_array())
     throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras", "no cameras",
                      "the scene file no longer matches the session");
   ordered_json& cameras = (*rig)["cameras"];
   for (const PtzHeadUpdate& u : heads) {
     std::size_t c = 0;
-    while (c < cameras.size() && !(cameras[c].is_object() && cameras[c].contains("id") && IdOf(cameras[c]["id"]) == u.id)) ++c;
-    const std::string where = "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
+    while (c < cameras.size() &&
+           !(cameras[c].is_object() && cameras[c].contains("id") && IdOf(cameras[c]["id"]) == u.id))
+      ++c;
+    const std::string where =
+        "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
     if (c == cameras.size())
       throw InputError(scene_path, "$.rigs[" + std::to_string(rig_index) + "].cameras",
-                       "no camera '" + u.id + "' in rig '" + rig_name + "'", "the scene file no longer matches the session");
+                       "no camera '" + u.id + "' in rig '" + rig_name + "'",
+                       "the scene file no longer matches the session");
     ordered_json& cam = cameras[c];
     if (!cam.contains("ptz") || !cam["ptz"].is_object())
       throw InputError(scene_path, where, "camera '" + u.id + "' has no \"ptz\" block in the file",
                        "the scene file no longer matches the session");
     const PtzHead& a = u.before;
     const PtzHead& b = u.after;
-    auto hfov = [&](double f) { return Number(Clean(HfovFromFocal(f, u.lens.width, u.lens.model) / kRadPerDeg)); };
+    auto hfov = [&](double f) {
+      return Number(Clean(HfovFromFocal(f, u.lens.width, u.lens.model) / kRadPerDeg));
+    };
     // A value that changed: written (a default that stays left out stays out).
-    auto set = [](ordered_json& obj, const char* key, double now, double before, double default_value) {
+    auto set = [](ordered_json& obj, const char* key, double now, double before,
+                  double default_value) {
       if (now == before) return;
       if (now == default_value && !obj.contains(key)) return;
       obj[key] = Number(Clean(now));
@@ -308,8 +327,10 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
       } else {
         ordered_json rebuilt = ordered_json::object();
         for (auto it = cam.begin(); it != cam.end(); ++it) {
-          if (it.key() == "focal_px" || it.key() == "lens") rebuilt["focal_px"] = {u.lens.fx, u.lens.fy};
-          else rebuilt[it.key()] = it.value();
+          if (it.key() == "focal_px" || it.key() == "lens")
+            rebuilt["focal_px"] = {u.lens.fx, u.lens.fy};
+          else
+            rebuilt[it.key()] = it.value();
         }
         cam = std::move(rebuilt);
       }
@@ -318,11 +339,14 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
     set(head, "pan_deg", b.current.pan_deg, a.current.pan_deg, 0.0);
     set(head, "tilt_deg", b.current.tilt_deg, a.current.tilt_deg, 0.0);
     if (b.pan_min_deg != a.pan_min_deg || b.pan_max_deg != a.pan_max_deg)
-      head["pan_range_deg"] = ordered_json::array({Number(Clean(b.pan_min_deg)), Number(Clean(b.pan_max_deg))});
+      head["pan_range_deg"] =
+          ordered_json::array({Number(Clean(b.pan_min_deg)), Number(Clean(b.pan_max_deg))});
     if (b.tilt_min_deg != a.tilt_min_deg || b.tilt_max_deg != a.tilt_max_deg)
-      head["tilt_range_deg"] = ordered_json::array({Number(Clean(b.tilt_min_deg)), Number(Clean(b.tilt_max_deg))});
+      head["tilt_range_deg"] =
+          ordered_json::array({Number(Clean(b.tilt_min_deg)), Number(Clean(b.tilt_max_deg))});
     if (b.home.linear() != a.home.linear() && !head.contains("pan_axis")) {
-      // The reader's default (analysis/scene.cpp ReadPtz): +z for a level image x axis, else home's up.
+      // The reader's default (analysis/scene/scene.cpp ReadPtz): +z for a level image x axis, else
+      // home's up.
       const Mat3& R = b.home.linear();
       const Vec3 fallback = std::abs(R(2, 0)) <= 1e-9 ? Vec3::UnitZ() : Vec3(-R.col(1));
       if ((fallback - b.pan_axis).norm() > 1e-12) {
@@ -332,21 +356,26 @@ std::string ReplacePtzHeads(const std::string& text, const std::string& scene_pa
       }
     }
     if (b.presets.size() != a.presets.size())
-      throw InputError(scene_path, where + ".ptz.presets", "the session changed the number of presets, which saving does not write");
+      throw InputError(scene_path, where + ".ptz.presets",
+                       "the session changed the number of presets, which saving does not write");
     if (!b.presets.empty()) {
-      if (!head.contains("presets") || !head["presets"].is_array() || head["presets"].size() != b.presets.size())
-        throw InputError(scene_path, where + ".ptz.presets", "the file's presets are not the session's",
+      if (!head.contains("presets") || !head["presets"].is_array() ||
+          head["presets"].size() != b.presets.size())
+        throw InputError(scene_path, where + ".ptz.presets",
+                         "the file's presets are not the session's",
                          "the scene file no longer matches the session");
       for (std::size_t i = 0; i < b.presets.size(); ++i) {
         ordered_json& p = head["presets"][i];
         const std::string at = where + ".ptz.presets[" + std::to_string(i) + "]";
         if (!p.is_object() || !p.contains("name") || p["name"] != b.presets[i].name)
-          throw InputError(scene_path, at, "not the preset '" + b.presets[i].name + "' the session has",
+          throw InputError(scene_path, at,
+                           "not the preset '" + b.presets[i].name + "' the session has",
                            "the scene file no longer matches the session");
         set(p, "pan_deg", b.presets[i].state.pan_deg, a.presets[i].state.pan_deg, 0.0);
         set(p, "tilt_deg", b.presets[i].state.tilt_deg, a.presets[i].state.tilt_deg, 0.0);
         // Without hfov_deg a preset takes the camera's zoom: keep its own when that changes.
-        if (!p.contains("hfov_deg") && b.current.focal != a.current.focal) p["hfov_deg"] = hfov(b.presets[i].state.focal);
+        if (!p.contains("hfov_deg") && b.current.focal != a.current.focal)
+          p["hfov_deg"] = hfov(b.presets[i].state.focal);
       }
     }
   }
@@ -367,9 +396,11 @@ std::string ReplaceStations(const std::string& text, const std::string& scene_pa
     if (!station.contains("display") || !station["display"].is_object())
       throw InputError(scene_path, where + ".display", "the station has no display");
     ordered_json& display = station["display"];
-    const std::optional<Vec3> center0 = FileVec3(display, "center"), facing0 = FileVec3(display, "facing");
+    const std::optional<Vec3> center0 = FileVec3(display, "center"),
+                              facing0 = FileVec3(display, "facing");
     if (!center0 || !facing0)
-      throw InputError(scene_path, where + ".display", "the display has no 'center' or 'facing' point");
+      throw InputError(scene_path, where + ".display",
+                       "the display has no 'center' or 'facing' point");
     Vec3 center = move.display_center / mpu, eye = move.eye / mpu;
     Vec3 facing = *facing0 + (center - *center0);
     for (int i = 0; i < 3; ++i) {
@@ -400,13 +431,16 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   };
   need("pandora_suggestion", &json::is_number);
   // A PTZ controller suggestion (a preset's setting or a tour's order; suggest/ptz_suggest.h).
-  if (j.is_object() && j.contains("kind") && j["kind"].is_string() && j["kind"].get<std::string>().rfind("ptz_", 0) == 0) {
+  if (j.is_object() && j.contains("kind") && j["kind"].is_string() &&
+      j["kind"].get<std::string>().rfind("ptz_", 0) == 0) {
     if (!options.cameras.empty())
-      throw InputError("--cameras", "", "a PTZ suggestion changes one camera's preset or tour: accept it whole",
+      throw InputError("--cameras", "",
+                       "a PTZ suggestion changes one camera's preset or tour: accept it whole",
                        "leave out --cameras");
     AcceptResult result;
     std::string what;
-    result.backup_path = AcceptPtzSuggestion(text, suggestion_path, options.force, &result.scene_path, &what);
+    result.backup_path =
+        AcceptPtzSuggestion(text, suggestion_path, options.force, &result.scene_path, &what);
     result.accepted.push_back(what);
     return result;
   }
@@ -418,12 +452,14 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
       !scene_j["sha256"].is_string())
     throw InputError(suggestion_path, "$.scene", "expected {\"path\", \"sha256\"}");
   if (!improved)
-    throw InputError(suggestion_path, "$.improved", "the suggestion offers no improvement; nothing to accept",
+    throw InputError(suggestion_path, "$.improved",
+                     "the suggestion offers no improvement; nothing to accept",
                      "run pandora suggest with other limits or cameras");
   if (j.contains("perturbed_for_benchmark") && j["perturbed_for_benchmark"] == true)
-    throw InputError(suggestion_path, "$.perturbed_for_benchmark",
-                     "this suggestion was made from perturbed poses (--perturb), not the scene file's",
-                     "run pandora suggest without --perturb");
+    throw InputError(
+        suggestion_path, "$.perturbed_for_benchmark",
+        "this suggestion was made from perturbed poses (--perturb), not the scene file's",
+        "run pandora suggest without --perturb");
   AcceptResult result;
   result.scene_path = scene_j["path"].get<std::string>();
   double snap_move = 0;
@@ -450,8 +486,8 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     }
     offered[id] = u;
     // Accepting everything leaves the cameras the search did not move as the user wrote them.
-    const bool moved = !(cams[c].value("move_m", 1.0) == 0.0 && cams[c].value("rotate_deg", 1.0) == 0.0 &&
-                         !u.focal_px);
+    const bool moved = !(cams[c].value("move_m", 1.0) == 0.0 &&
+                         cams[c].value("rotate_deg", 1.0) == 0.0 && !u.focal_px);
     if (moved || !options.cameras.empty()) order.push_back(id);
   }
   std::vector<std::string> chosen = options.cameras.empty() ? order : options.cameras;
@@ -460,7 +496,8 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     if (!offered.count(id)) {
       std::string list;
       for (const std::string& o : order) list += (list.empty() ? "" : ", ") + o;
-      throw InputError("--cameras", "", "camera '" + id + "' is not in the suggestion " + suggestion_path,
+      throw InputError("--cameras", "",
+                       "camera '" + id + "' is not in the suggestion " + suggestion_path,
                        "it offers: " + list);
     }
     if (unique.insert(id).second) updates.push_back(offered[id]);
@@ -471,7 +508,8 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with --force");
-  const std::string new_text = ReplacePoses(scene_text, result.scene_path, rig, updates, &result.notes);
+  const std::string new_text =
+      ReplacePoses(scene_text, result.scene_path, rig, updates, &result.notes);
 
   // Check the new text before touching any file: the accepted poses are there, nothing else moved.
   LoadOptions lo;
@@ -490,62 +528,23 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
         if (offered[a.id].focal_px) focal = *offered[a.id].focal_px;
       }
       const Vec2 focal_read(b.model.intrinsics().fx, b.model.intrinsics().fy);
-      const bool same = (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
-                        AngleRad(b.world_from_camera.linear(), expected.linear()) <= 1e-9 &&
-                        (focal_read - focal).norm() <= 1e-9 * focal.norm();
+      const bool same =
+          (b.world_from_camera.translation() - expected.translation()).norm() <= tol &&
+          AngleRad(b.world_from_camera.linear(), expected.linear()) <= 1e-9 &&
+          (focal_read - focal).norm() <= 1e-9 * focal.norm();
       if (!same)
-        throw InputError(result.scene_path, "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",
+        throw InputError(result.scene_path,
+                         "$.rigs[" + std::to_string(r) + "].cameras[" + std::to_string(c) + "]",
                          "internal check failed: the rewritten pose does not read back as intended",
                          "the scene file was not changed");
     }
   }
 
-  const std::string backup =
-      ReplaceSceneFileWithBackup(result.scene_path, scene_text, new_text,
-                                 {{suggestion_path, "suggestion file"}});
+  const std::string backup = ReplaceSceneFileWithBackup(result.scene_path, scene_text, new_text,
+                                                        {{suggestion_path, "suggestion file"}});
   result.backup_path = backup;
   for (const PoseUpdate& u : updates) result.accepted.push_back(u.id);
   return result;
-}
-
-std::string ReplaceSceneFileWithBackup(const std::string& scene_path, const std::string& old_text,
-                                       const std::string& new_text,
-                                       const std::vector<std::pair<std::string, std::string>>& inputs) {
-  // The backup and the new scene file appear together (OutputTransaction), the backup with the
-  // scene file's mode and owner, the scene file keeping its own. Through a symbolic link to the
-  // file it names; a read-only scene file is refused.
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path target = fs::canonical(scene_path, ec);
-  if (ec) throw InputError(scene_path, "", "cannot resolve the scene file: " + ec.message());
-  const fs::perms perms = fs::status(target, ec).permissions();
-  if (ec || (perms & fs::perms::owner_write) == fs::perms::none)
-    throw InputError(scene_path, "", "the scene file is read-only", "make it writable, then accept again");
-  const std::string path = target.string();
-  // Under the folder's lock, the file must still be what the caller read: a second writer that
-  // read the same text before the first one wrote is refused here, never applied over it.
-  FolderLock lock(path);
-  std::string on_disk;
-  try {
-    on_disk = ReadJsonText(path, "scene file");
-  } catch (const InputError&) {
-    throw InputError(scene_path, "", "the scene file vanished or became unreadable while it was being replaced",
-                     "check the file, then try again");
-  }
-  if (Sha256Hex(on_disk) != Sha256Hex(old_text))
-    throw InputError(scene_path, "",
-                     "the scene file was changed by another program while this one worked (SHA-256 differs); "
-                     "nothing was written",
-                     "look at the file, then run the command again");
-  std::string backup = path + ".bak";
-  for (int n = 1; fs::exists(backup, ec); ++n) backup = path + ".bak." + std::to_string(n);
-  OutputTransaction output;
-  for (const auto& [input, kind] : inputs) output.AddInput(input, kind);
-  output.AddInput(path, "scene file");
-  output.Write(backup, "", old_text, path);  // with the scene file's mode and owner
-  WriteFileAtomically(output.StageReplacement(path, ""), new_text);
-  output.Commit();
-  return backup;
 }
 
 }  // namespace pandora

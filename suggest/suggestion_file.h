@@ -2,15 +2,16 @@
 /// \file suggestion_file.h
 /// The suggestion file (`pandora suggest --out suggestion.json`) and the accept cycle
 /// (`pandora accept`): the scene file is rewritten only on accept, only the pose fields of the
-/// accepted cameras change, and the previous file is kept as a backup. No JSON types in this header.
+/// accepted cameras change, and the previous file is kept as a backup. No JSON types in this
+/// header.
 
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "analysis/ptz.h"
-#include "analysis/scene.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 #include "suggest/suggest.h"
 
 namespace pandora {
@@ -28,8 +29,8 @@ struct PoseUpdate {
   std::string id;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   std::optional<Vec2> focal_px;
-  /// The suggestion's --snap-move (metres; 0: none): position coordinates within 1e-6 of a step of a
-  /// multiple of it are written as that multiple (in the file's units).
+  /// The suggestion's --snap-move (metres; 0: none): position coordinates within 1e-6 of a step of
+  /// a multiple of it are written as that multiple (in the file's units).
   double snap_move = 0;
 };
 
@@ -44,8 +45,8 @@ struct PoseUpdate {
 ///  - `position` + `quaternion`: the new quaternion [w, x, y, z].
 /// Positions are in the file's units; every written number is the double nearest its 12-digit
 /// decimal (no 0.30000000000000004), and coordinates on the snap grid are written as multiples of
-/// the step. With `focal_px`, the focal-length key (`hfov_deg`, `focal_px` or `lens`) is replaced by
-/// `focal_px` [fx, fy] at its place. Everything else keeps its order and value; the text is
+/// the step. With `focal_px`, the focal-length key (`hfov_deg`, `focal_px` or `lens`) is replaced
+/// by `focal_px` [fx, fy] at its place. Everything else keeps its order and value; the text is
 /// re-serialised with the file's indentation. Throws InputError (file = scene_path) when the JSON,
 /// the rig or a camera cannot be found. `notes` (may be null) receives one line per camera whose
 /// `up` had to change.
@@ -66,11 +67,12 @@ struct PtzHeadUpdate {
 /// `focal_px` [fx, fy] at their place) and in the "ptz" block pan_deg and tilt_deg, and, where they
 /// changed (a re-centre), pan_range_deg, tilt_range_deg, each preset's pan_deg and tilt_deg, and
 /// pan_axis when the file leaves it out and the reader's default from the new home would differ. A
-/// preset without hfov_deg (which means "the camera's zoom") gets its zoom written when the camera's
-/// zoom changes. Angles are written as ReplacePoses writes numbers (12 significant digits); keys
-/// that did not change keep their text, new keys go last. Call after ReplacePoses, which writes the
-/// position (the pivot) and orientation (home). Throws InputError (file = scene_path, the camera's
-/// JSON path) when the camera, its "ptz" block or a preset cannot be found.
+/// preset without hfov_deg (which means "the camera's zoom") gets its zoom written when the
+/// camera's zoom changes. Angles are written as ReplacePoses writes numbers (12 significant
+/// digits); keys that did not change keep their text, new keys go last. Call after ReplacePoses,
+/// which writes the position (the pivot) and orientation (home). Throws InputError (file =
+/// scene_path, the camera's JSON path) when the camera, its "ptz" block or a preset cannot be
+/// found.
 std::string ReplacePtzHeads(const std::string& scene_text, const std::string& scene_path,
                             const std::string& rig, const std::vector<PtzHeadUpdate>& heads);
 
@@ -102,21 +104,12 @@ struct AcceptResult {
 };
 
 /// Reads the suggestion file, checks it (an improvement, the scene file unchanged since: same
-/// SHA-256, unless force), writes a backup of the scene file (`SCENE.bak`, or `SCENE.bak.N` with the
-/// first free N), then the scene file with the accepted poses (atomically), each in its camera's form
-/// (ReplacePoses). Before writing, the new text is parsed as a scene and checked: the accepted
-/// cameras have the suggested poses (centres to 1e-9 of the scene size, orientations to 1e-9 rad)
-/// and every other camera of every rig is unchanged. Throws InputError on any problem,
+/// SHA-256, unless force), writes a backup of the scene file (`SCENE.bak`, or `SCENE.bak.N` with
+/// the first free N), then the scene file with the accepted poses (atomically), each in its
+/// camera's form (ReplacePoses). Before writing, the new text is parsed as a scene and checked: the
+/// accepted cameras have the suggested poses (centres to 1e-9 of the scene size, orientations to
+/// 1e-9 rad) and every other camera of every rig is unchanged. Throws InputError on any problem,
 /// leaving every file as it was.
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options);
-
-/// Replaces the scene file `scene_path` (symbolic links followed) by `new_text`, keeping
-/// `old_text` as a backup (`SCENE.bak`, or `SCENE.bak.N` with the first free N, with the scene
-/// file's mode and owner); both appear together or neither does (OutputTransaction). `inputs` are
-/// other files of the command (path, kind) that no output may name. A read-only scene file is
-/// refused. Returns the backup's path. What `pandora accept` and a session's Save share.
-std::string ReplaceSceneFileWithBackup(const std::string& scene_path, const std::string& old_text,
-                                       const std::string& new_text,
-                                       const std::vector<std::pair<std::string, std::string>>& inputs = {});
 
 }  // namespace pandora

@@ -1,8 +1,8 @@
 #pragma once
 /// \file suggestion_text.h
 /// A suggestion as the text `pandora suggest` prints: per selected camera its move, rotation and
-/// positions, then the exact measures before and after, then what the optimisation spent. The viewer
-/// shows the same numbers (docs/suggest.md, "Reading the table").
+/// positions, then the exact measures before and after, then what the optimisation spent. The
+/// viewer shows the same numbers (docs/suggest.md, "Reading the table").
 
 #include <string>
 

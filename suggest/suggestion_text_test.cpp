@@ -62,16 +62,26 @@ TEST(SuggestionText, TableValue) {
 TEST(SuggestionText, TableRowsAndNotes) {
   const Suggestion s = TwoCameras();
   const std::string t = FormatSuggestion(s, {"pandora suggest", "scene.json", "ring"});
-  EXPECT_EQ(t.rfind("pandora suggest: scene scene.json, rig ring, objective sigma-p90 (lower is better), "
-                    "123 target points\n", 0), 0u) << t;
-  EXPECT_NE(t.find("left           0.250         4.50  (1.000, 2.000, 3.000)        (1.250, 2.000, 3.000)"),
-            std::string::npos) << t;
+  EXPECT_EQ(
+      t.rfind("pandora suggest: scene scene.json, rig ring, objective sigma-p90 (lower is better), "
+              "123 target points\n",
+              0),
+      0u)
+      << t;
+  EXPECT_NE(
+      t.find(
+          "left           0.250         4.50  (1.000, 2.000, 3.000)        (1.250, 2.000, 3.000)"),
+      std::string::npos)
+      << t;
   // Only the zoomed camera has a zoom line; only the one near a surface a surface line.
   EXPECT_EQ(Count(t, "zoom: horizontal field of view 60.00 -> 51.50 deg"), 1) << t;
   EXPECT_EQ(Count(t, "nearest surface: 0.300 m -> 0.250 m"), 1) << t;
   EXPECT_EQ(Count(t, "note: sees none of the target"), 1) << t;
-  EXPECT_NE(t.find("sigma_max p95 (mm)                    inf              4"), std::string::npos) << t;
-  EXPECT_NE(t.find("17 iterations (2 outer), 999 evaluations, 0.500 s\nimproved\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("sigma_max p95 (mm)                    inf              4"), std::string::npos)
+      << t;
+  EXPECT_NE(t.find("17 iterations (2 outer), 999 evaluations, 0.500 s\nimproved\n"),
+            std::string::npos)
+      << t;
   EXPECT_EQ(Count(t, "(inf: the percentile falls on a point that is not triangulable)"), 1);
   // coverage >= k appears only when k differs from 2; no screening line without screening.
   EXPECT_EQ(Count(t, "coverage >= "), 1);
@@ -93,10 +103,12 @@ TEST(SuggestionText, Recovery) {
   s.before.objective = 0.6;  // perturbed
   s.after.objective = 0.75;
   EXPECT_EQ(FormatRecovery(s, 0.8, "0.2,5"),
-            "perturbed by 0.2,5: objective at the original poses 0.8; recovered 0.15 of the lost 0.2 (75%)\n");
+            "perturbed by 0.2,5: objective at the original poses 0.8; recovered 0.15 of the lost "
+            "0.2 (75%)\n");
   s.before.objective = 0.8;  // nothing lost
   s.after.objective = 0.8;
-  EXPECT_NE(FormatRecovery(s, 0.8, "0,0").find("recovered 0 of the lost 0 (0%)"), std::string::npos);
+  EXPECT_NE(FormatRecovery(s, 0.8, "0,0").find("recovered 0 of the lost 0 (0%)"),
+            std::string::npos);
 }
 
 }  // namespace

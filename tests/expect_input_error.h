@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 
 namespace pandora::testing {
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <utility>
 
-#include "analysis/camera.h"
-#include "analysis/geometry.h"
-#include "analysis/primitives.h"
-#include "analysis/scene.h"
-#include "analysis/units.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/units.h"
 
 namespace pandora::testing {
 
@@ -74,8 +74,8 @@ inline Rig RingRig(int n, double radius, double height, const Vec3& centre = Vec
 }
 
 /// A scene object made of `mesh` moved by `offset` (world frame).
-inline SceneObject TestObject(const std::string& name, TriangleMesh mesh, const Vec3& offset = Vec3::Zero(),
-                              bool solid = false) {
+inline SceneObject TestObject(const std::string& name, TriangleMesh mesh,
+                              const Vec3& offset = Vec3::Zero(), bool solid = false) {
   for (Vec3& v : mesh.vertices) v += offset;
   SceneObject object;
   object.name = name;
@@ -115,7 +115,8 @@ inline Scene BoxRoom(const Vec3& size = Vec3(4, 4, 2.5), double voxel_size = 0.1
     R.col(1) = Vec3::UnitZ();
     R.col(2) = w.normal;
     for (Vec3& v : mesh.vertices) v = R * v;
-    scene.objects.push_back(TestObject(w.name, std::move(mesh), -w.half * w.normal + Vec3(0, 0, size.z() / 2)));
+    scene.objects.push_back(
+        TestObject(w.name, std::move(mesh), -w.half * w.normal + Vec3(0, 0, size.z() / 2)));
   }
   scene.study.region.kind = Region::Kind::kBox;
   scene.study.region.box.min = region_min;

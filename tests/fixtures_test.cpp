@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "analysis/ray_caster.h"
-#include "analysis/units.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/util/units.h"
 
 namespace pandora {
 namespace {
@@ -45,7 +45,8 @@ TEST(Fixtures, BoxRoomWallsFaceInward) {
   ASSERT_EQ(room.objects.size(), 5u);
   const auto caster = MakeBruteForceRayCaster(room.AllTriangles());
   const Vec3 centre(0, 0, 1);
-  for (const Vec3& d : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, -1)}) {
+  for (const Vec3& d :
+       {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, -1)}) {
     const auto hit = caster->Intersect({centre, d, 0, 100});
     ASSERT_TRUE(hit) << d.transpose();
     EXPECT_NEAR(hit->t, d.z() < 0 ? 1.0 : (d.x() != 0 ? 2.0 : 3.0), 1e-12) << d.transpose();

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
 
 namespace pandora::testing {
 
@@ -17,10 +17,11 @@ inline TriangleMesh RandomScene(std::mt19937_64& rng, double scale, const Vec3& 
   auto random_point = [&]() -> Vec3 { return offset + scale * Vec3(u(rng), u(rng), u(rng)); };
   for (int b = 0; b < boxes; ++b) {
     const Vec3 c = random_point();
-    const Vec3 half = scale * Vec3(0.02 + 0.08 * u(rng), 0.02 + 0.08 * u(rng), 0.02 + 0.08 * u(rng));
+    const Vec3 half =
+        scale * Vec3(0.02 + 0.08 * u(rng), 0.02 + 0.08 * u(rng), 0.02 + 0.08 * u(rng));
     const Mat3 r =
-        Eigen::Quaterniond(Eigen::Vector4d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5)
-                               .normalized())
+        Eigen::Quaterniond(
+            Eigen::Vector4d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).normalized())
             .toRotationMatrix();
     const int base = static_cast<int>(mesh.vertices.size());
     for (int i = 0; i < 8; ++i) {
@@ -48,7 +49,8 @@ inline TriangleMesh RandomScene(std::mt19937_64& rng, double scale, const Vec3& 
 }
 
 /// Distance between segments [p0, p1] and [q0, q1].
-inline double SegmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+inline double SegmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                     const Vec3& q1) {
   const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   double s = 0, t = 0;
@@ -89,10 +91,10 @@ inline double PointTriangleDistance(const Vec3& p, const Vec3& a, const Vec3& b,
                    SegmentSegmentDistance(p, p, c, a)});
 }
 
-/// True when the segment [p0, p1] comes within `tol` of any triangle edge, or either end lies within
-/// `tol` of any triangle (except `own_triangle`, the one a surface point lies on): the cases where
-/// single- and double-precision casters may legitimately disagree (grazing). Anything else has one
-/// right answer.
+/// True when the segment [p0, p1] comes within `tol` of any triangle edge, or either end lies
+/// within `tol` of any triangle (except `own_triangle`, the one a surface point lies on): the cases
+/// where single- and double-precision casters may legitimately disagree (grazing). Anything else
+/// has one right answer.
 inline bool IsGrazing(const TriangleMesh& mesh, const Vec3& p0, const Vec3& p1, double tol,
                       int own_triangle = -1) {
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {

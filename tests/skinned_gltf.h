@@ -10,13 +10,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "analysis/geometry.h"
-#include "analysis/units.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/util/units.h"
 
 namespace pandora::testing {
 
@@ -44,7 +43,8 @@ struct SkinnedTube {
     const double a = 0.5 * kPi * tau;
     const Vec3 p = vertices[v], j(joint, 0, 0);
     const Vec3 d = p - j;
-    const Vec3 turned = j + Vec3(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y(), d.z());
+    const Vec3 turned = j + Vec3(std::cos(a) * d.x() - std::sin(a) * d.y(),
+                                 std::sin(a) * d.x() + std::cos(a) * d.y(), d.z());
     const double s = weights[v].first + weights[v].second;
     return (weights[v].first * p + weights[v].second * turned) / s;
   }
@@ -63,7 +63,8 @@ inline std::string Base64(const std::string& bytes) {
   std::string out;
   std::size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const std::uint32_t n = (std::uint8_t(bytes[i]) << 16) | (std::uint8_t(bytes[i + 1]) << 8) | std::uint8_t(bytes[i + 2]);
+    const std::uint32_t n = (std::uint8_t(bytes[i]) << 16) | (std::uint8_t(bytes[i + 1]) << 8) |
+                            std::uint8_t(bytes[i + 2]);
     for (int s = 18; s >= 0; s -= 6) out += k[(n >> s) & 63];
   }
   if (i + 1 == bytes.size()) {
@@ -98,7 +99,8 @@ inline std::string SkinnedTube::Gltf() {
     for (int s = 0; s < segments; ++s) {
       const double a = 2 * kPi * s / segments;
       // Rounded to float here so the closed forms use what the file holds.
-      vertices.push_back(Vec3(Float(r.x), Float(radius * std::cos(a)), Float(radius * std::sin(a))));
+      vertices.push_back(
+          Vec3(Float(r.x), Float(radius * std::cos(a)), Float(radius * std::sin(a))));
       weights.emplace_back(r.w0, r.w1);
     }
   const std::uint32_t n = std::uint32_t(segments);
@@ -130,7 +132,8 @@ inline std::string SkinnedTube::Gltf() {
     views.push_back(v);
     return int(views.size()) - 1;
   };
-  auto accessor = [&](int v, int type, std::size_t count, const char* kind, json extra = json::object()) {
+  auto accessor = [&](int v, int type, std::size_t count, const char* kind,
+                      json extra = json::object()) {
     json a = {{"bufferView", v}, {"componentType", type}, {"count", count}, {"type", kind}};
     a.update(extra);
     accessors.push_back(a);
@@ -162,7 +165,8 @@ inline std::string SkinnedTube::Gltf() {
   start = buf.size();
   for (int b = 0; b < 2; ++b)
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) detail::Put(&buf, float(r == c ? 1.0 : (b == 1 && c == 3 && r == 0) ? -joint : 0.0));
+      for (int r = 0; r < 4; ++r)
+        detail::Put(&buf, float(r == c ? 1.0 : (b == 1 && c == 3 && r == 0) ? -joint : 0.0));
   const int ibm = accessor(view(start, 0), 5126, 2, "MAT4");
   // Clips.
   start = buf.size();
@@ -189,8 +193,9 @@ inline std::string SkinnedTube::Gltf() {
         {{"name", "bone1"}, {"translation", {joint, 0.0, 0.0}}}}},
       {"meshes",
        {{{"name", "tube"},
-         {"primitives", {{{"attributes", {{"POSITION", pos}, {"JOINTS_0", joints}, {"WEIGHTS_0", wts}}},
-                          {"indices", idx}}}}}}},
+         {"primitives",
+          {{{"attributes", {{"POSITION", pos}, {"JOINTS_0", joints}, {"WEIGHTS_0", wts}}},
+            {"indices", idx}}}}}}},
       {"skins", {{{"joints", {1, 2}}, {"inverseBindMatrices", ibm}, {"skeleton", 1}}}},
       {"animations",
        {{{"name", "bend"},
@@ -199,7 +204,9 @@ inline std::string SkinnedTube::Gltf() {
         {{"name", "lift"},
          {"samplers", {{{"input", lift_t}, {"output", lift_v}, {"interpolation", "LINEAR"}}}},
          {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}}},
-      {"buffers", {{{"byteLength", buf.size()}, {"uri", "data:application/octet-stream;base64," + detail::Base64(buf)}}}},
+      {"buffers",
+       {{{"byteLength", buf.size()},
+         {"uri", "data:application/octet-stream;base64," + detail::Base64(buf)}}}},
       {"bufferViews", views},
       {"accessors", accessors}};
   return g.dump(1);

@@ -6,7 +6,7 @@
 
 #include <cstdio>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 #include "volume/fields.h"
 
 namespace pandora {
@@ -30,9 +30,10 @@ TEST(TraumaRoom, PapersFindingHolds) {
   const double ring_with = CoverageGe2(with, "octagon");
   const double grid_without = CoverageGe2(without, "grid4x2");
   const double ring_without = CoverageGe2(without, "octagon");
-  std::printf("coverage.ge2 of the neck region: with medics grid4x2 %.3f octagon %.3f; "
-              "without medics grid4x2 %.3f octagon %.3f\n",
-              grid_with, ring_with, grid_without, ring_without);
+  std::printf(
+      "coverage.ge2 of the neck region: with medics grid4x2 %.3f octagon %.3f; "
+      "without medics grid4x2 %.3f octagon %.3f\n",
+      grid_with, ring_with, grid_without, ring_without);
   EXPECT_GT(grid_with, ring_with);
   EXPECT_GE(ring_without, grid_without);
   // The medics are what hurts the ring.

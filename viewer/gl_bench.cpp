@@ -10,8 +10,8 @@
 #include <sstream>
 #include <vector>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "viewer/gl_compare.h"
@@ -50,9 +50,10 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", verbose, "per-camera disagreement");
   app.add_option("--png", png_dir, "write CPU | GPU comparison PNGs into this folder");
   std::string csv_path;
-  app.add_option("--csv", csv_path,
-                 "also write map,gpu_ms,eye_only_ms,cpu_ms,differ_compared_pct,differ_all_pct per map size "
-                 "(what `pandora accuracy --gpu` reads)");
+  app.add_option(
+      "--csv", csv_path,
+      "also write map,gpu_ms,eye_only_ms,cpu_ms,differ_compared_pct,differ_all_pct per map size "
+      "(what `pandora accuracy --gpu` reads)");
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = scene_path == "lens_room" ? testing::LensRoom() : LoadScene(scene_path);
@@ -151,7 +152,8 @@ int main(int argc, char** argv) {
         WriteComparisonPng(cpu, gpu, png_dir + "/compare_" + std::to_string(map) + ".png");
       char row[256];
       std::snprintf(row, sizeof row, "%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", map, 1e3 * Median(total),
-                    1e3 * Median(eye_only), 1e3 * Median(cpu_times), 100 * c.mask_share(), 100 * c.mask_share_all());
+                    1e3 * Median(eye_only), 1e3 * Median(cpu_times), 100 * c.mask_share(),
+                    100 * c.mask_share_all());
       csv += row;
     }
     if (!csv_path.empty()) WriteFileAtomically(csv_path, csv);

@@ -25,10 +25,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "analysis/color.h"
+#include "analysis/util/color.h"
+#include "analysis/util/units.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
@@ -208,7 +208,7 @@ struct Lens {
   float max_radius;
 };
 
-// CameraModel::Project (analysis/camera.cpp) in float: camera-frame point to distorted pixel.
+// CameraModel::Project (analysis/geometry/camera.cpp) in float: camera-frame point to distorted pixel.
 bool Project(Lens L, vec3 p, out vec2 px) {
   px = vec2(0.0);
 #if FISHEYE
@@ -893,12 +893,13 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
       if (im.width <= 0 || im.height <= 0 || im.width > max_size || im.height > max_size) continue;
       std::vector<unsigned char> texels(std::size_t(3) * im.width * im.height);
       for (std::size_t k = 0; k < texels.size(); ++k)
-        texels[k] = static_cast<unsigned char>(
-            std::lround(255.0 * std::clamp(SrgbFromLinear(std::clamp(double(im.rgb[k]), 0.0, 1.0)), 0.0, 1.0)));
+        texels[k] = static_cast<unsigned char>(std::lround(
+            255.0 * std::clamp(SrgbFromLinear(std::clamp(double(im.rgb[k]), 0.0, 1.0)), 0.0, 1.0)));
       glGenTextures(1, &m.texture_ids[i]);
       glBindTexture(GL_TEXTURE_2D, m.texture_ids[i]);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, im.width, im.height, 0, GL_RGB, GL_UNSIGNED_BYTE, texels.data());
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, im.width, im.height, 0, GL_RGB, GL_UNSIGNED_BYTE,
+                   texels.data());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
@@ -906,8 +907,8 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
     }
     for (std::size_t o = 0; o < object_texture.size() && o < of_object.size(); ++o)
-      if (of_object[o] >= 0 && of_object[o] < int(m.texture_ids.size()) && m.texture_ids[of_object[o]] != 0 &&
-          m.mesh.corner_uvs.size() == m.mesh.triangles.size())
+      if (of_object[o] >= 0 && of_object[o] < int(m.texture_ids.size()) &&
+          m.texture_ids[of_object[o]] != 0 && m.mesh.corner_uvs.size() == m.mesh.triangles.size())
         object_texture[o] = of_object[o];
   }
   std::vector<int> order(m.mesh.triangles.size());
@@ -935,7 +936,8 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
         for (int k = 0; k < 3; ++k) data.push_back(float((*v)(k)));
       data.push_back(float(triangle_object[t]));
       data.push_back(float(drawn[t]));
-      const Eigen::Vector2d uv = texture >= 0 ? m.mesh.corner_uvs[t][corner] : Eigen::Vector2d::Zero();
+      const Eigen::Vector2d uv =
+          texture >= 0 ? m.mesh.corner_uvs[t][corner] : Eigen::Vector2d::Zero();
       data.push_back(float(uv.x()));
       data.push_back(float(uv.y()));
     }
@@ -950,8 +952,9 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
   const GLsizei stride = 13 * sizeof(float);
   for (int k = 0; k < 5; ++k) {
     glEnableVertexAttribArray(k);
-    glVertexAttribPointer(k, k < 3 ? 3 : 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(std::size_t(k < 4 ? 3 * k : 11) * sizeof(float)));
+    glVertexAttribPointer(
+        k, k < 3 ? 3 : 2, GL_FLOAT, GL_FALSE, stride,
+        reinterpret_cast<const void*>(std::size_t(k < 4 ? 3 * k : 11) * sizeof(float)));
   }
   glGenVertexArrays(1, &m.empty_vao);
   m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
@@ -1089,7 +1092,8 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     glActiveTexture(GL_TEXTURE0);
     glBindVertexArray(m.vao);
     for (const Impl::Draw& d : m.draws) {
-      glUniform1i(Loc(m.gbuffer_program, "textured"), d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
+      glUniform1i(Loc(m.gbuffer_program, "textured"),
+                  d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
       glBindTexture(GL_TEXTURE_2D, d.texture);
       glDrawArrays(GL_TRIANGLES, d.first, d.count);
     }

@@ -7,8 +7,8 @@
 /// (docs/rendering.md, "The light rule"). Per camera, a fragment's surface point is tested as
 /// VisibilityTester does: working range, projection through the camera's lens model in the
 /// fragment shader (pinhole, Brown-Conrady k1 k2 p1 p2 k3 with its monotonic domain and Jacobian
-/// test, fisheye k1..k4: the formulas of analysis/camera.cpp), the image bounds, facing, and, in
-/// place of the occlusion segment, one distance map per camera (docs/viewer.md).
+/// test, fisheye k1..k4: the formulas of analysis/geometry/camera.cpp), the image bounds, facing,
+/// and, in place of the occlusion segment, one distance map per camera (docs/viewer.md).
 ///
 /// Light header: no GL. Every call needs a current GL 3.3 context (viewer/gl_context.h) on the
 /// calling thread, the one the renderer was created on.
@@ -18,8 +18,8 @@
 #include <memory>
 #include <vector>
 
-#include "analysis/geometry.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/geometry.h"
+#include "analysis/scene/scene.h"
 #include "render/light.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"

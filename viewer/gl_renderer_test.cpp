@@ -15,7 +15,7 @@
 #include <memory>
 #include <string>
 
-#include "analysis/primitives.h"
+#include "analysis/geometry/primitives.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "tests/fixtures.h"
@@ -279,8 +279,8 @@ TEST(GlRenderer, TexturesMatchCpu) {
     std::filesystem::create_directories(out);
     WriteComparisonPng(cpu, gpu, std::string(out) + "/textured_floor.png");
   }
-  std::printf("textured floor: sets differ on %.4f %%, colour mean %.2e, max %.2e\n", 100 * c.mask_share(),
-              c.rgb_mean, c.rgb_max);
+  std::printf("textured floor: sets differ on %.4f %%, colour mean %.2e, max %.2e\n",
+              100 * c.mask_share(), c.rgb_mean, c.rgb_max);
   EXPECT_GT(c.compared, c.pixels / 2);
   EXPECT_LE(c.mask_share(), kMaxMaskShare);
   EXPECT_LE(c.rgb_mean, 5e-4);
@@ -434,7 +434,8 @@ void ExpectPlanAgreement(const std::string& side, const char* name) {
   uncut.clip_near = 0;
   GlRenderer renderer(scene);
   const GlComparison c = Compare(r.cpu, renderer.Render(rig, uncut, GlRenderOptions()));
-  std::printf("%s without the cut: camera sets differ on %.2f %% of all pixels\n", name, 100 * c.mask_share_all());
+  std::printf("%s without the cut: camera sets differ on %.2f %% of all pixels\n", name,
+              100 * c.mask_share_all());
   EXPECT_GT(c.mask_share_all(), kPlanMaxMaskShareAll);
 }
 

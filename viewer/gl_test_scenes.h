@@ -2,8 +2,8 @@
 // Scenes the GPU renderer is measured on besides the examples (viewer test and bench): a room
 // lit by distorted cameras of every lens model the shaders implement.
 
-#include "analysis/palette.h"
-#include "analysis/primitives.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/util/palette.h"
 #include "tests/fixtures.h"
 
 namespace pandora::testing {

@@ -5,16 +5,16 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
-#include "analysis/error.h"
-#include "analysis/units.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 
 namespace pandora {
 
@@ -133,7 +133,8 @@ Aabb BlockCentreBox(const VoxelLattice& lattice, const Block& block) {
 std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& region,
                                   const std::vector<const InsideMesh*>& solids,
                                   const InsideMesh* region_mesh, const FrustumCuller& culler,
-                                  int camera_count, ActiveSetStats* stats, const BlockColumns* tile) {
+                                  int camera_count, ActiveSetStats* stats,
+                                  const BlockColumns* tile) {
   const Eigen::Vector3i nb = (lattice.dims + Eigen::Vector3i::Constant(7)) / 8;
   // The columns to build: all, or the tile's (clipped to the lattice).
   BlockColumns cols{0, nb.x(), 0, nb.y()};
@@ -158,7 +159,8 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
   region_box.max += Vec3::Constant(1e-9 * h);
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, block_columns, 1), [&](const auto& range) {
     for (std::int64_t bc = range.begin(); bc != range.end(); ++bc) {
-      // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block column.
+      // Per mesh (the solids, then the region's mesh), per voxel column (x, y) of this block
+      // column.
       std::vector<std::vector<std::optional<InsideMesh::Column>>> columns(solids.size() + 1);
       const auto column = [&](std::size_t mesh, int x, int y) -> const InsideMesh::Column& {
         std::vector<std::optional<InsideMesh::Column>>& c = columns[mesh];
@@ -176,8 +178,8 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         const std::int64_t b = bc * nb.z() + bz;
         Block& block = all[b];
         block.origin = Eigen::Vector3i(8 * bx, 8 * by, 8 * bz);
-        const Eigen::Vector3i last =
-            (block.origin + Eigen::Vector3i::Constant(7)).cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
+        const Eigen::Vector3i last = (block.origin + Eigen::Vector3i::Constant(7))
+                                         .cwiseMin(lattice.dims - Eigen::Vector3i::Ones());
         // Box of the voxel centres of this block (only centres are evaluated).
         Aabb box;
         box.Extend(lattice.Center(block.origin.x(), block.origin.y(), block.origin.z()));
@@ -205,7 +207,8 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
         }
 
         block.extent = last - block.origin + Eigen::Vector3i::Ones();
-        const std::int64_t n_vox = std::int64_t(block.extent.x()) * block.extent.y() * block.extent.z();
+        const std::int64_t n_vox =
+            std::int64_t(block.extent.x()) * block.extent.y() * block.extent.z();
         if (region_class == InsideMesh::BoxClass::kInside && crossing.empty()) {
           // Fast path: the whole block is one thing, no per-voxel test.
           (all_solid ? block.solid_voxels : block.free_voxels) = n_vox;
@@ -277,12 +280,14 @@ std::vector<Block> BuildActiveSet(const VoxelLattice& lattice, const Region& reg
 std::vector<std::uint8_t> PartitionBlocks(const std::vector<Block>& blocks,
                                           const std::vector<std::vector<std::int32_t>>& candidates,
                                           int count, int rank) {
-  if (count < 1 || rank < 0 || rank >= count) throw std::logic_error("PartitionBlocks: bad partition");
+  if (count < 1 || rank < 0 || rank >= count)
+    throw std::logic_error("PartitionBlocks: bad partition");
   // Cost of a block: its (voxel, candidate camera) pairs plus a constant for the block's own work
   // (deriving, leaves), so culled blocks are spread too.
   std::vector<std::pair<std::int64_t, std::size_t>> cost(blocks.size());
   for (std::size_t b = 0; b < blocks.size(); ++b)
-    cost[b] = {std::int64_t(blocks[b].free_voxels) * std::int64_t(candidates[b].size() + 1) + 64, b};
+    cost[b] = {std::int64_t(blocks[b].free_voxels) * std::int64_t(candidates[b].size() + 1) + 64,
+               b};
   std::sort(cost.begin(), cost.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });

@@ -1,8 +1,9 @@
 #pragma once
 /// \file active_set.h
-/// The sparse active set: which voxels of the study region are evaluated, in blocks of 8^3 voxels (the
-/// size of an OpenVDB leaf). Whole blocks outside every camera's frustum or working range, outside the
-/// region, or inside a solid are decided before any ray is cast. No OpenVDB here: plain geometry.
+/// The sparse active set: which voxels of the study region are evaluated, in blocks of 8^3 voxels
+/// (the size of an OpenVDB leaf). Whole blocks outside every camera's frustum or working range,
+/// outside the region, or inside a solid are decided before any ray is cast. No OpenVDB here: plain
+/// geometry.
 
 #include <algorithm>
 #include <array>
@@ -10,14 +11,14 @@
 #include <memory>
 #include <vector>
 
-#include "analysis/camera.h"
-#include "analysis/inside_mesh.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora {
 
-/// Voxel lattice over the region: voxel (i, j, k) has its centre at origin + voxel_size * (i, j, k),
-/// for 0 <= i < dims.x() and so on; `origin` is region.min + voxel_size / 2.
+/// Voxel lattice over the region: voxel (i, j, k) has its centre at origin + voxel_size * (i, j,
+/// k), for 0 <= i < dims.x() and so on; `origin` is region.min + voxel_size / 2.
 struct VoxelLattice {
   Vec3 origin = Vec3::Zero();
   double voxel_size = 0;
@@ -28,10 +29,10 @@ struct VoxelLattice {
   std::int64_t voxel_count() const { return std::int64_t(dims.x()) * dims.y() * dims.z(); }
 };
 
-/// Builds the lattice for `region` at `voxel_size` (the count per axis is ceil(extent / voxel_size),
-/// at least 1; centres beyond the region's max are excluded by BuildActiveSet). Throws InputError
-/// (path "$.study.voxel_size") when an axis would need more than 2^30 voxels or the whole lattice
-/// more than 2^50.
+/// Builds the lattice for `region` at `voxel_size` (the count per axis is ceil(extent /
+/// voxel_size), at least 1; centres beyond the region's max are excluded by BuildActiveSet). Throws
+/// InputError (path "$.study.voxel_size") when an axis would need more than 2^30 voxels or the
+/// whole lattice more than 2^50.
 VoxelLattice MakeLattice(const Aabb& region, double voxel_size, const std::string& scene_path,
                          const std::string& json_path = "$.study.voxel_size");
 
@@ -58,8 +59,9 @@ class FrustumCuller {
 
 /// What is known about one 8^3 block before any ray is cast.
 struct Block {
-  Eigen::Vector3i origin;      ///< Index of its first voxel (multiples of 8).
-  std::vector<std::int32_t> cameras;  ///< Cameras (rig indices, ascending) whose frustum may meet it.
+  Eigen::Vector3i origin;  ///< Index of its first voxel (multiples of 8).
+  std::vector<std::int32_t>
+      cameras;  ///< Cameras (rig indices, ascending) whose frustum may meet it.
   Eigen::Vector3i extent = Eigen::Vector3i::Constant(8);  ///< Voxels per axis (< 8 at the edge).
   bool full = false;  ///< All 8^3 voxels are free region voxels (no solid, not at the edge).
   /// Per voxel, at Offset(x, y, z): 1 when it is a free region voxel to evaluate. Empty when every
@@ -93,7 +95,8 @@ struct BlockColumns {
   /// The lattice's voxels these columns hold (clipped to the lattice).
   Eigen::Vector3i VoxelMin() const { return {8 * x0, 8 * y0, 0}; }
   Eigen::Vector3i VoxelEnd(const VoxelLattice& lattice) const {
-    return {std::min(8 * x1, lattice.dims.x()), std::min(8 * y1, lattice.dims.y()), lattice.dims.z()};
+    return {std::min(8 * x1, lattice.dims.x()), std::min(8 * y1, lattice.dims.y()),
+            lattice.dims.z()};
   }
 };
 

@@ -6,13 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <map>
 #include <atomic>
 #include <cstdio>
+#include <map>
 #include <random>
 
-#include "analysis/error.h"
-#include "analysis/primitives.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/util/error.h"
 #include "tests/fixtures.h"
 #include "volume/fields.h"
 #include "volume/fields_transfer.h"
@@ -69,7 +69,8 @@ void ExpectSameFields(const Fields& inc, const Fields& full, const std::string& 
 // A 320 x 240 test camera (tests/fixtures.h) with a working range and, for distorting lenses, k1.
 Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, double hfov_deg,
                   LensModel model, double k1 = 0, double scale = 1) {
-  Camera cam = testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 320, 240, model),
+  Camera cam =
+      testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 320, 240, model),
                               [&](Intrinsics& k) { k.k1 = k1; });
   cam.near = 0.05 * scale;
   cam.far = 20 * scale;
@@ -161,11 +162,10 @@ void RunRandomEdits(const Scene& scene, const Rig& start, int steps, std::uint64
   FieldOptions options;
   options.fields = scene.study.fields.empty() ? FieldNames() : scene.study.fields;
   if (!scene.study.motion) {
-    options.fields.erase(std::remove_if(options.fields.begin(), options.fields.end(),
-                                        [](const std::string& f) {
-                                          return f.find("steady") != std::string::npos;
-                                        }),
-                         options.fields.end());
+    options.fields.erase(
+        std::remove_if(options.fields.begin(), options.fields.end(),
+                       [](const std::string& f) { return f.find("steady") != std::string::npos; }),
+        options.fields.end());
   }
   FieldEvaluator evaluator(scene, *caster, options);
   Rig rig = start;
@@ -281,7 +281,8 @@ TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
   VoxelLattice column = lattice;
   column.dims = Eigen::Vector3i(8, 8, lattice.dims.z());
   const double per_column = EstimateFieldBytes(column, all.fields, 0);
-  const std::vector<BlockColumns> by_budget = PlanTiles(lattice, all.fields, 2 * 3.5 * per_column, 0);
+  const std::vector<BlockColumns> by_budget =
+      PlanTiles(lattice, all.fields, 2 * 3.5 * per_column, 0);
   EXPECT_GE(by_budget.size(), std::size_t(nbx * nby / 3));
   EXPECT_EQ(PlanTiles(lattice, all.fields, 1e15, 0).size(), 1u);  // all fits: one tile
   for (const int most : {3, 9}) {  // columns per tile: the budget's 3.5, or 3 x 3 blocks of side
@@ -296,7 +297,8 @@ TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), nbx * nby);
   }
 
-  const std::vector<BlockColumns> tiles = PlanTiles(lattice, all.fields, 0, 3 * 8 * lattice.voxel_size);
+  const std::vector<BlockColumns> tiles =
+      PlanTiles(lattice, all.fields, 0, 3 * 8 * lattice.voxel_size);
   ASSERT_GT(tiles.size(), 2u);
   FieldStats sum;
   std::map<std::string, std::int64_t> voxels;
@@ -307,7 +309,8 @@ TEST(FieldEvaluator, TilesAddUpToTheFullEvaluation) {
     const Fields::Impl& a = full.impl();
     const Fields::Impl& b = part.impl();
     const auto inside = [&](const openvdb::Coord& c) {
-      return c.x() >= 8 * tile.x0 && c.x() < 8 * tile.x1 && c.y() >= 8 * tile.y0 && c.y() < 8 * tile.y1;
+      return c.x() >= 8 * tile.x0 && c.x() < 8 * tile.x1 && c.y() >= 8 * tile.y0 &&
+             c.y() < 8 * tile.y1;
     };
     auto full_cov = a.coverage->getConstAccessor();
     ForEachActiveVoxel(*b.coverage, [&](const openvdb::Coord& c, std::int32_t v) {
@@ -401,7 +404,8 @@ TEST(FieldEvaluator, KeptStateIsHeldToTheBudget) {
     kept.Update(scene.rigs[0]);
     ADD_FAILURE() << "kept state over the budget of " << budget << " bytes was allowed";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("incremental updates of rig"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("incremental updates of rig"), std::string::npos)
+        << e.what();
   }
   options.memory_budget_bytes = 32 * budget;
   FieldEvaluator roomy(scene, *caster, options, /*keep_state=*/true);
@@ -469,10 +473,11 @@ TEST(FieldEvaluator, AThousandCameras) {
   rig.name = "dome";
   for (int i = 0; i < 1000; ++i) {
     const double z = 0.2 + 2.5 * (i + 0.5) / 1000.0;  // a spiral on a dome of radius ~4 m
-    const double a = i * 2.399963;                     // the golden angle
+    const double a = i * 2.399963;                    // the golden angle
     const double r = std::sqrt(std::max(0.5, 16.0 - z * z));
-    rig.cameras.push_back(MakeCamera("cam" + std::to_string(i), Vec3(r * std::cos(a), r * std::sin(a), z),
-                                     Vec3(0, 0, 0.1), 40 + (i % 5) * 10, LensModel::kPinhole));
+    rig.cameras.push_back(MakeCamera("cam" + std::to_string(i),
+                                     Vec3(r * std::cos(a), r * std::sin(a), z), Vec3(0, 0, 0.1),
+                                     40 + (i % 5) * 10, LensModel::kPinhole));
   }
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   FieldOptions options;
@@ -502,7 +507,8 @@ TEST(FieldEvaluator, AThousandCameras) {
 // bit for bit, with the same topology and statistics (the sigma lists as multisets: the merge
 // joins them partition by partition). Each block is evaluated by exactly one partition, and the
 // largest partition's cost is within the longest-processing-time bound of 4/3 of the best.
-void ExpectPartitionsMergeToTheWhole(const Scene& scene, const Rig& rig, const std::vector<std::string>& names) {
+void ExpectPartitionsMergeToTheWhole(const Scene& scene, const Rig& rig,
+                                     const std::vector<std::string>& names) {
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   FieldOptions options;
   options.fields = names;
@@ -528,7 +534,8 @@ void ExpectPartitionsMergeToTheWhole(const Scene& scene, const Rig& rig, const s
     if (::testing::Test::HasFatalFailure()) return;
   }
   const Fields part = EvaluateFields(scene, rig, *caster, options);
-  EXPECT_THROW(MergePartialFields("not a partition", const_cast<Fields*>(&part)), std::runtime_error);
+  EXPECT_THROW(MergePartialFields("not a partition", const_cast<Fields*>(&part)),
+               std::runtime_error);
   std::string cut = SerializePartialFields(part);
   cut.resize(cut.size() / 2);
   EXPECT_THROW(MergePartialFields(cut, const_cast<Fields*>(&part)), std::runtime_error);

@@ -1,5 +1,4 @@
 #include "volume/fields.h"
-#include "volume/solid_trees.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
@@ -10,22 +9,23 @@
 #include <array>
 #include <atomic>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 
-#include "analysis/error.h"
-#include "analysis/inside_mesh.h"
-#include "analysis/ptz.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "volume/fields_vdb.h"
 #include "volume/information_sum.h"
-#include "analysis/units.h"
+#include "volume/solid_trees.h"
 
 namespace pandora {
 
@@ -52,9 +52,11 @@ static double LatticeBlocks(const VoxelLattice& lattice) {
   return n;
 }
 // EstimateFieldBytes for a number of voxels (the blocks that hold free voxels, or a box's).
-static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count);
+static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields,
+                                     int camera_count);
 // What each camera adds to that (FieldEvaluator::Update checks both against the budget).
-static double PerCameraBytes(const VoxelLattice& lattice, double blocks, const std::vector<std::string>& fields, bool kept);
+static double PerCameraBytes(const VoxelLattice& lattice, double blocks,
+                             const std::vector<std::string>& fields, bool kept);
 
 Fields::Fields() : impl_(std::make_unique<Impl>()) {}
 Fields::~Fields() = default;
@@ -163,25 +165,25 @@ inline double AtanNonNegative(double t) {
   const double z = x * x;
   return base +
          (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z -
-          3.33329491539e-1) * z * x +
+          3.33329491539e-1) *
+             z * x +
          x;
 }
 
-// The triangulation angle of `count` voxels at (x, y, z) (block offsets `offset`): the largest angle
-// in degrees between two rays from camera centres that see the voxel. `sees[e]` is the 512-bit
-// mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). The best pair is
-// the one with the smallest dot product of the unit directions, ties to the first pair in (a, b)
-// order; it is returned in best_dot / best_a / best_b (indices into `sees`).
-// With `changed` null every pair is tried. With `changed` (per camera, 1 for cameras that moved),
-// best_* come in as the best pair among the unchanged cameras (a previous result that involves no
-// changed camera) and only pairs with a changed camera are tried, keeping the lexicographically
-// smallest (dot, a, b): the same pair, so the same bits, as trying all pairs.
-// Vectorised over voxels, in tiles of 64 that keep every camera's directions in L1: per camera the
-// unit directions (into `dirs`, 3 * 64 per camera; NaN where the camera does not see the voxel, so
-// every comparison with it fails), per camera pair the dot product, then the angle as
-// atan2(|cross|, dot) (both keep their relative accuracy, so tiny and near-180 degree angles are as
-// exact as at 90). The file is compiled without floating-point contraction, so scalar and vector
-// code give the same bits. No per-ray storage.
+// The triangulation angle of `count` voxels at (x, y, z) (block offsets `offset`): the largest
+// angle in degrees between two rays from camera centres that see the voxel. `sees[e]` is the
+// 512-bit mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). The best
+// pair is the one with the smallest dot product of the unit directions, ties to the first pair in
+// (a, b) order; it is returned in best_dot / best_a / best_b (indices into `sees`). With `changed`
+// null every pair is tried. With `changed` (per camera, 1 for cameras that moved), best_* come in
+// as the best pair among the unchanged cameras (a previous result that involves no changed camera)
+// and only pairs with a changed camera are tried, keeping the lexicographically smallest (dot, a,
+// b): the same pair, so the same bits, as trying all pairs. Vectorised over voxels, in tiles of 64
+// that keep every camera's directions in L1: per camera the unit directions (into `dirs`, 3 * 64
+// per camera; NaN where the camera does not see the voxel, so every comparison with it fails), per
+// camera pair the dot product, then the angle as atan2(|cross|, dot) (both keep their relative
+// accuracy, so tiny and near-180 degree angles are as exact as at 90). The file is compiled without
+// floating-point contraction, so scalar and vector code give the same bits. No per-ray storage.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
@@ -242,9 +244,9 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
           for (int m = 0; m < n; ++m) {
             const double dot = ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] +
                                ad[m + 2 * kTile] * bd[m + 2 * kTile];
-            const bool take = dot < best_dot[m] ||
-                              (dot == best_dot[m] &&
-                               (a < best_a[m] || (a == best_a[m] && b < best_b[m])));
+            const bool take =
+                dot < best_dot[m] ||
+                (dot == best_dot[m] && (a < best_a[m] || (a == best_a[m] && b < best_b[m])));
             best_dot[m] = take ? dot : best_dot[m];
             best_a[m] = take ? a : best_a[m];
             best_b[m] = take ? b : best_b[m];
@@ -288,16 +290,17 @@ inline int PopcountInline(std::uint64_t x) {
 }
 
 // What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,
-// its information contribution A^T A (six doubles, AddCameraInformation on zeros) and pixel density.
+// its information contribution A^T A (six doubles, AddCameraInformation on zeros) and pixel
+// density.
 struct CameraEntry {
   std::int32_t camera = 0;
   std::int32_t rays = 0;  // occlusion segments cast
   std::int32_t seen = 0;  // bits set
   Bits bits{};
   std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
-  std::vector<double> information;  // with an information field
-  std::vector<std::uint8_t> band;   // with an information field: Band() of each contribution
-  std::vector<float> density;       // with resolution
+  std::vector<double> information;            // with an information field
+  std::vector<std::uint8_t> band;  // with an information field: Band() of each contribution
+  std::vector<float> density;      // with resolution
   double Bytes() const {
     return sizeof(CameraEntry) + information.capacity() * sizeof(double) + band.capacity() +
            density.capacity() * sizeof(float);
@@ -380,7 +383,7 @@ struct FieldEvaluator::State {
   std::vector<std::uint8_t> owned;  // with a partition: the blocks this process evaluates
   ActiveSetStats active_stats;
   double active_set_seconds = 0;
-  Rig rig;  // as of the last update
+  Rig rig;                                                          // as of the last update
   std::array<openvdb::FloatGrid*, kFloatFieldCount> float_grids{};  // in fields, by FloatField
   bool evaluated = false;
   Fields fields;
@@ -536,8 +539,9 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
                                    const std::vector<Vec3>& centres, BlockState* next,
                                    BlockLeaves* leaves, bool in_place) {
   // Entries that see nothing take no part.
-  view.erase(std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
-             view.end());
+  view.erase(
+      std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
+      view.end());
   Fields::Impl& g = fields.impl();
   const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
   const VoxelLattice& lattice = fields.lattice;
@@ -634,7 +638,8 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   std::array<std::int32_t, 512> cover;
   Bits rescan_density{}, rescan_info{};
   const std::array<BandScale, 64>& scales = BandScales();
-  const auto walk = [](const CameraEntry& e, auto&& f) __attribute__((always_inline)) {  // every seen voxel, with its index
+  const auto walk = [](const CameraEntry& e, auto&& f)
+      __attribute__((always_inline)) {  // every seen voxel, with its index
     int index = 0;
     for (int w = 0; w < kWords; ++w)
       for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
@@ -648,38 +653,40 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
     for (const CameraEntry* e : view) {
       if (!is_changed[e->camera]) continue;
-      walk(*e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
-        ++cover[o];
-        if (want_resolution && e->density[index] > next->best_density[o]) {
-          next->best_density[o] = e->density[index];
-          next->best_camera[o] = e->camera;
-        }
-        if (want_information && !TestBit(rescan_info, o)) {
-          const std::uint8_t b = e->band[index], k = next->sum_band[o];
-          if (k == kNotExact || b > k) {
-            SetBit(rescan_info, o);
-          } else {
-            if (b == k) ++next->band_count[o];
-            Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
-          }
-        }
-      });
+      walk(
+          *e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
+            ++cover[o];
+            if (want_resolution && e->density[index] > next->best_density[o]) {
+              next->best_density[o] = e->density[index];
+              next->best_camera[o] = e->camera;
+            }
+            if (want_information && !TestBit(rescan_info, o)) {
+              const std::uint8_t b = e->band[index], k = next->sum_band[o];
+              if (k == kNotExact || b > k) {
+                SetBit(rescan_info, o);
+              } else {
+                if (b == k) ++next->band_count[o];
+                Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
+              }
+            }
+          });
     }
     for (const CameraEntry& e : old.entries) {
       if (!is_changed[e.camera] || e.seen == 0) continue;
-      walk(e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
-        --cover[o];
-        if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
-        if (want_information && !TestBit(rescan_info, o)) {
-          const std::uint8_t b = e.band[index], k = next->sum_band[o];
-          if (k == kNotExact || b > k) {
-            SetBit(rescan_info, o);
-          } else {
-            if (b == k) --next->band_count[o];
-            Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
-          }
-        }
-      });
+      walk(
+          e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
+            --cover[o];
+            if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
+            if (want_information && !TestBit(rescan_info, o)) {
+              const std::uint8_t b = e.band[index], k = next->sum_band[o];
+              if (k == kNotExact || b > k) {
+                SetBit(rescan_info, o);
+              } else {
+                if (b == k) --next->band_count[o];
+                Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
+              }
+            }
+          });
     }
     if (want_information)
       for (int w = 0; w < kWords; ++w)
@@ -693,13 +700,15 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   Bits rescan = rescan_density;
   for (int w = 0; w < kWords; ++w) rescan[w] |= rescan_info[w];
   if (fresh) rescan = dirty;
-  const auto walk_masked = [](const CameraEntry& e, const Bits& mask, auto&& f) __attribute__((always_inline)) {
+  const auto walk_masked =
+      [](const CameraEntry& e, const Bits& mask, auto&& f) __attribute__((always_inline)) {
     for (int w = 0; w < kWords; ++w) {
       const std::uint64_t seen = e.bits[w], wanted = seen & mask[w];
       if (!wanted) continue;
       if (wanted == seen) {
         int index = e.before[w];
-        for (std::uint64_t bits = seen; bits; bits &= bits - 1) f(64 * w + __builtin_ctzll(bits), index++);
+        for (std::uint64_t bits = seen; bits; bits &= bits - 1)
+          f(64 * w + __builtin_ctzll(bits), index++);
       } else {
         for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
           const int bit = __builtin_ctzll(bits);
@@ -729,22 +738,23 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       }
     }
     for (const CameraEntry* e : view)
-      walk_masked(*e, rescan, [&](int o, int index) __attribute__((always_inline)) {
-        if (fresh) ++cover[o];
-        if (TestBit(rescan_density, o) && e->density[index] > next->best_density[o]) {
-          next->best_density[o] = e->density[index];
-          next->best_camera[o] = e->camera;
-        }
-        if (TestBit(rescan_info, o)) {
-          const std::uint8_t b = e->band[index];
-          if (b > next->sum_band[o]) {
-            next->sum_band[o] = b;
-            next->band_count[o] = 1;
-          } else if (b == next->sum_band[o]) {
-            ++next->band_count[o];
-          }
-        }
-      });
+      walk_masked(
+          *e, rescan, [&](int o, int index) __attribute__((always_inline)) {
+            if (fresh) ++cover[o];
+            if (TestBit(rescan_density, o) && e->density[index] > next->best_density[o]) {
+              next->best_density[o] = e->density[index];
+              next->best_camera[o] = e->camera;
+            }
+            if (TestBit(rescan_info, o)) {
+              const std::uint8_t b = e->band[index];
+              if (b > next->sum_band[o]) {
+                next->sum_band[o] = b;
+                next->band_count[o] = 1;
+              } else if (b == next->sum_band[o]) {
+                ++next->band_count[o];
+              }
+            }
+          });
     bool any_info = false;
     for (int w = 0; w < kWords; ++w) {
       for (std::uint64_t bits = rescan_info[w]; bits; bits &= bits - 1) {
@@ -763,15 +773,16 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     }
     if (any_info)
       for (const CameraEntry* e : view)
-        walk_masked(*e, rescan_info, [&](int o, int index) __attribute__((always_inline)) {
-          const double* c = &e->information[6 * index];
-          if (TestBit(in_double, o)) {
-            std::array<double, 6>& d = double_sum[double_index[o]];
-            for (int k = 0; k < 6; ++k) d[k] += c[k];
-          } else {
-            Accumulate(next->sums[o], c, scales[next->sum_band[o]], true);
-          }
-        });
+        walk_masked(
+            *e, rescan_info, [&](int o, int index) __attribute__((always_inline)) {
+              const double* c = &e->information[6 * index];
+              if (TestBit(in_double, o)) {
+                std::array<double, 6>& d = double_sum[double_index[o]];
+                for (int k = 0; k < 6; ++k) d[k] += c[k];
+              } else {
+                Accumulate(next->sums[o], c, scales[next->sum_band[o]], true);
+              }
+            });
   }
 
   int candidate_count = 0;
@@ -877,8 +888,8 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     if (want_steady) {
       const double frame = frame_period;
       for (int k = 0; k < 3; ++k)
-        SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(),
-                                stats[kVar0 + k].data(), candidate_count, scene.study.steady_prior);
+        SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(), stats[kVar0 + k].data(),
+                                candidate_count, scene.study.steady_prior);
       SteadyStatistics(candidate_count, stats_ptr);
     }
   }
@@ -959,7 +970,8 @@ void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled
   for (std::size_t b = 0; b < states.size(); ++b) {
     const BlockState& s = states[b];
     if (s.candidates.empty()) ++st->active_set.culled_blocks;
-    for (std::size_t k = 0; k < s.histogram.size(); ++k) st->coverage_histogram[k] += s.histogram[k];
+    for (std::size_t k = 0; k < s.histogram.size(); ++k)
+      st->coverage_histogram[k] += s.histogram[k];
     st->seen_voxels += s.seen;
     st->triangulable_voxels += s.triangulable;
     st->unobservable_voxels += s.unobservable;
@@ -1022,10 +1034,11 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
     // Memory scales with 1/h^3: the smallest voxel size that fits.
     const double h_min = study.voxel_size * std::cbrt(estimate / opt.memory_budget_bytes) * 1.01;
     std::ostringstream reason, hint;
-    reason << (opt.tile ? "one streamed tile of the region needs about " : "the region needs about ")
-           << std::llround(estimate / 1048576.0)
-           << " MiB at voxel size " << study.voxel_size << " m, over the budget of "
-           << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
+    reason << (opt.tile ? "one streamed tile of the region needs about "
+                        : "the region needs about ")
+           << std::llround(estimate / 1048576.0) << " MiB at voxel size " << study.voxel_size
+           << " m, over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
+           << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
          << "(--memory-budget or study.memory_budget_mb)";
     if (opt.voxel_size_option.empty() && !opt.memory_budget_option.empty())
@@ -1041,7 +1054,8 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
 
   S.want_coverage = Wants(opt.fields, "coverage");
   S.want_cameras = Wants(opt.fields, "cameras");
-  for (int f = 0; f < kFloatFieldCount; ++f) S.want_float[f] = Wants(opt.fields, kFloatFieldNames[f]);
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    S.want_float[f] = Wants(opt.fields, kFloatFieldNames[f]);
   S.want_resolution = S.want_float[kResolution];
   S.want_static = S.want_float[kSigmaMax] || S.want_float[kSigmaMean] || S.want_float[kCondition];
   S.want_steady = S.want_float[kSigmaMaxSteady] || S.want_float[kSigmaMeanSteady];
@@ -1060,14 +1074,16 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
   std::vector<const InsideMesh*> solids(solid_objects.size(), nullptr);
   const SolidTrees* kept = S.options.solid_trees;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      if (kept) solids[i] = kept->Object(scene, std::size_t(solid_objects[i] - scene.objects.data()));
-      if (solids[i]) continue;
-      solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
-      solids[i] = solid_meshes[i].get();
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          if (kept)
+            solids[i] = kept->Object(scene, std::size_t(solid_objects[i] - scene.objects.data()));
+          if (solids[i]) continue;
+          solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
+          solids[i] = solid_meshes[i].get();
+        }
+      });
   std::unique_ptr<InsideMesh> own_region_mesh;
   const InsideMesh* region_mesh = nullptr;
   if (study.region.kind == Region::Kind::kMesh) {
@@ -1083,23 +1099,25 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   if (sparse) check_budget(EstimateBytesForVoxels(512.0 * double(S.blocks.size()), opt.fields, 0));
   if (opt.voxel_filter) {
     // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4), [&](const auto& range) {
-      for (std::size_t b = range.begin(); b != range.end(); ++b) {
-        Block& block = S.blocks[b];
-        std::vector<std::uint8_t> mask(512, 0);
-        block.free_voxels = 0;
-        for (int x = 0; x < block.extent.x(); ++x)
-          for (int y = 0; y < block.extent.y(); ++y)
-            for (int z = 0; z < block.extent.z(); ++z)
-              if (block.IsFree(x, y, z) &&
-                  opt.voxel_filter(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z)) {
-                mask[Block::Offset(x, y, z)] = 1;
-                ++block.free_voxels;
-              }
-        block.mask = std::move(mask);
-        block.full = false;
-      }
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4),
+                      [&](const auto& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                          Block& block = S.blocks[b];
+                          std::vector<std::uint8_t> mask(512, 0);
+                          block.free_voxels = 0;
+                          for (int x = 0; x < block.extent.x(); ++x)
+                            for (int y = 0; y < block.extent.y(); ++y)
+                              for (int z = 0; z < block.extent.z(); ++z)
+                                if (block.IsFree(x, y, z) &&
+                                    opt.voxel_filter(block.origin.x() + x, block.origin.y() + y,
+                                                     block.origin.z() + z)) {
+                                  mask[Block::Offset(x, y, z)] = 1;
+                                  ++block.free_voxels;
+                                }
+                          block.mask = std::move(mask);
+                          block.full = false;
+                        }
+                      });
     std::vector<Block> kept_blocks;
     S.active_stats.region_voxels = 0;
     for (Block& block : S.blocks) {
@@ -1185,19 +1203,25 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     // SceneStructureBytes). The program itself (code and libraries, about 45 MiB resident before
     // any input) comes on top; summary.json's timing.peak_rss_mib shows the whole.
     const double scene_bytes = SceneStructureBytes(S.scene);
-    const double need = S.fields.stats.estimated_bytes + scene_bytes +
-                        double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
+    const double need =
+        S.fields.stats.estimated_bytes + scene_bytes +
+        double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
     if (need > opt.memory_budget_bytes) {
       std::ostringstream reason;
-      reason << "the run needs about " << std::llround(need / 1048576.0) << " MiB (the region's fields with the rig's "
-             << new_count << " cameras";
+      reason << "the run needs about " << std::llround(need / 1048576.0)
+             << " MiB (the region's fields with the rig's " << new_count << " cameras";
       if (scene_bytes >= 1048576.0)
-        reason << ", the scene's meshes and BVH " << std::llround(scene_bytes / 1048576.0) << " MiB of it";
-      reason << "), over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
-      const std::string hint = Wants(opt.fields, "cameras")
-                                   ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
-                                   : "raise the budget (--memory-budget or study.memory_budget_mb), or use fewer cameras";
-      if (!opt.memory_budget_option.empty()) throw InputError(opt.memory_budget_option, "", reason.str(), hint);
+        reason << ", the scene's meshes and BVH " << std::llround(scene_bytes / 1048576.0)
+               << " MiB of it";
+      reason << "), over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
+             << " MiB";
+      const std::string hint =
+          Wants(opt.fields, "cameras")
+              ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
+              : "raise the budget (--memory-budget or study.memory_budget_mb), or use fewer "
+                "cameras";
+      if (!opt.memory_budget_option.empty())
+        throw InputError(opt.memory_budget_option, "", reason.str(), hint);
       throw InputError(S.file, "$.study.memory_budget_mb", reason.str(), hint);
     }
   }
@@ -1217,31 +1241,33 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     for (int c : changed) v[c] = 1;
     return v;
   }();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& range) {
-    for (std::size_t b = range.begin(); b != range.end(); ++b) {
-      const BlockState& s = S.states[b];
-      std::vector<std::int32_t>& next = candidates[b];
-      bool dirty = !S.evaluated;
-      for (std::int32_t c : s.candidates) {
-        if (is_changed[c]) {
-          dirty = true;
-          continue;
-        }
-        next.push_back(c);
-      }
-      const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
-      for (int c : changed)
-        if (c < new_count && rd.culler->MayIntersect(c, box)) {
-          next.push_back(c);
-          dirty = true;
-        }
-      std::sort(next.begin(), next.end());
-      dirty_block[b] = dirty;
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16),
+                    [&](const auto& range) {
+                      for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                        const BlockState& s = S.states[b];
+                        std::vector<std::int32_t>& next = candidates[b];
+                        bool dirty = !S.evaluated;
+                        for (std::int32_t c : s.candidates) {
+                          if (is_changed[c]) {
+                            dirty = true;
+                            continue;
+                          }
+                          next.push_back(c);
+                        }
+                        const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
+                        for (int c : changed)
+                          if (c < new_count && rd.culler->MayIntersect(c, box)) {
+                            next.push_back(c);
+                            dirty = true;
+                          }
+                        std::sort(next.begin(), next.end());
+                        dirty_block[b] = dirty;
+                      }
+                    });
   if (opt.partition_count > 1) {
     if (S.evaluated || S.keep)
-      throw std::logic_error("FieldEvaluator: a partitioned evaluation is one full update without kept state");
+      throw std::logic_error(
+          "FieldEvaluator: a partitioned evaluation is one full update without kept state");
     S.owned = PartitionBlocks(S.blocks, candidates, opt.partition_count, opt.partition_rank);
     for (std::size_t b = 0; b < S.blocks.size(); ++b) dirty_block[b] &= S.owned[b];
   }
@@ -1259,7 +1285,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     double bytes = 0;
     for (std::size_t b = 0; b < S.blocks.size(); ++b)
       bytes += 512.0 * per_voxel + double(candidates[b].size()) *
-                                (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
+                                       (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
     const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(S.scene);
     if (total > opt.memory_budget_bytes) {
       std::ostringstream reason;
@@ -1340,7 +1366,9 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       n.counts.clear();
       for (const CameraEntry& e : cast[i]) n.counts.push_back({e.camera, e.rays, e.seen});
       std::sort(n.counts.begin(), n.counts.end(),
-                [](const BlockState::CameraCount& a, const BlockState::CameraCount& b) { return a.camera < b.camera; });
+                [](const BlockState::CameraCount& a, const BlockState::CameraCount& b) {
+                  return a.camera < b.camera;
+                });
       std::vector<CameraEntry>().swap(cast[i]);
       std::vector<std::int32_t>().swap(next[i].coverage);
       std::vector<std::uint8_t>().swap(next[i].status);
@@ -1407,7 +1435,8 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   if (S.want_cameras && new_count != static_cast<int>(g.visible.size())) {
     const std::size_t had = g.visible.size();
     g.visible.resize(new_count);
-    for (std::size_t c = had; c < g.visible.size(); ++c) MakeGrid(g.visible[c], "visible", g.transform);
+    for (std::size_t c = had; c < g.visible.size(); ++c)
+      MakeGrid(g.visible[c], "visible", g.transform);
   }
   // Each grid's leaves go in by a task of their own (the trees are independent), then the states.
   std::vector<std::function<void()>> grid_tasks;
@@ -1443,7 +1472,8 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   if (S.want_cameras) {
     for (std::size_t i = 0; i < dirty.size(); ++i) {
       for (const CameraEntry& e : S.states[dirty[i]].entries)
-        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0) camera_removed[e.camera].push_back(i);
+        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0)
+          camera_removed[e.camera].push_back(i);
       for (auto& [camera, leaf] : leaves[i].visible) camera_added[camera].push_back(leaf);
     }
     for (int c = 0; c < new_count; ++c)
@@ -1456,7 +1486,8 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         });
   }
   tbb::parallel_for(std::size_t(0), grid_tasks.size(), [&](std::size_t t) { grid_tasks[t](); });
-  for (std::size_t b = 0; b < S.blocks.size(); ++b) S.states[b].candidates = std::move(candidates[b]);
+  for (std::size_t b = 0; b < S.blocks.size(); ++b)
+    S.states[b].candidates = std::move(candidates[b]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 16), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       BlockState& s = S.states[dirty[i]];
@@ -1514,20 +1545,25 @@ double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::st
   return EstimateBytesForVoxels(512.0 * LatticeBlocks(lattice), fields, camera_count);
 }
 
-static double PerCameraBytes(const VoxelLattice& lattice, double blocks, const std::vector<std::string>& fields,
-                      bool kept) {
+static double PerCameraBytes(const VoxelLattice& lattice, double blocks,
+                             const std::vector<std::string>& fields, bool kept) {
   // Per block while evaluated: two candidate indices, a count, the per-camera statistics record.
-  double bytes = 1.15 * blocks * (2.0 * sizeof(std::int32_t) + sizeof(std::int64_t) + sizeof(BlockState::CameraCount)) + 64.0;
+  double bytes =
+      1.15 * blocks *
+          (2.0 * sizeof(std::int32_t) + sizeof(std::int64_t) + sizeof(BlockState::CameraCount)) +
+      64.0;
   if (Wants(fields, "cameras")) {
-    // One BoolGrid per camera: the grid, its root, metadata and writing (20 kB; 2,000 cameras measured 16), every internal node the region
-    // touches (32^3 and 16^3 entries of 8 bytes and their masks), and at most one 192-byte leaf per
-    // block (where the camera sees it).
+    // One BoolGrid per camera: the grid, its root, metadata and writing (20 kB; 2,000 cameras
+    // measured 16), every internal node the region touches (32^3 and 16^3 entries of 8 bytes and
+    // their masks), and at most one 192-byte leaf per block (where the camera sees it).
     auto nodes = [&](int span) {
       double n = 1;
-      for (int a = 0; a < 3; ++a) n *= std::ceil(double(std::max(lattice.dims[a], 1)) / span);  // index 0 starts a node
+      for (int a = 0; a < 3; ++a)
+        n *= std::ceil(double(std::max(lattice.dims[a], 1)) / span);  // index 0 starts a node
       return n;
     };
-    bytes += 20480.0 + nodes(4096) * (32768.0 * 8 + 2 * 4096) + nodes(128) * (4096.0 * 8 + 2 * 512) + blocks * 192.0;
+    bytes += 20480.0 + nodes(4096) * (32768.0 * 8 + 2 * 4096) +
+             nodes(128) * (4096.0 * 8 + 2 * 512) + blocks * 192.0;
   }
   // Kept state (sessions) is bounded apart, at each update (its entries cover only the blocks a
   // camera's frustum meets): "incremental updates of rig ... need up to".
@@ -1535,7 +1571,8 @@ static double PerCameraBytes(const VoxelLattice& lattice, double blocks, const s
   return bytes;
 }
 
-static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields, int camera_count) {
+static double EstimateBytesForVoxels(double voxels, const std::vector<std::string>& fields,
+                                     int camera_count) {
   const double blocks = voxels / 512.0 + 1.0;
   // Per 8^3 block while it is evaluated: its Block record and a 512-byte mask where it is partial,
   // its state and the next one (both arrays live until the serial phase), its new leaves' record,
@@ -1543,16 +1580,18 @@ static double EstimateBytesForVoxels(double voxels, const std::vector<std::strin
   // the allocator's headers), plus 15 % for the allocator's rounding. Measured against the
   // 10^9-voxel hall of docs/scale.md (coverage alone): 8.22 bytes per voxel at the peak, this
   // estimate 8.6.
-  const double per_block = sizeof(Block) + 512.0 + 2.0 * sizeof(BlockState) + sizeof(BlockLeaves) + 256.0 +
-                           (2.0 * sizeof(std::int32_t) + sizeof(std::int64_t) + sizeof(BlockState::CameraCount)) *
-                               camera_count;
+  const double per_block =
+      sizeof(Block) + 512.0 + 2.0 * sizeof(BlockState) + sizeof(BlockLeaves) + 256.0 +
+      (2.0 * sizeof(std::int32_t) + sizeof(std::int64_t) + sizeof(BlockState::CameraCount)) *
+          camera_count;
   double bytes = blocks * 1.15 * per_block;
   for (const std::string& f : fields) bytes += voxels * BytesPerVoxel(f);
   return bytes + 64.0 * camera_count;
 }
 
-std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice, const std::vector<std::string>& fields,
-                                    double budget_bytes, double tile_side) {
+std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice,
+                                    const std::vector<std::string>& fields, double budget_bytes,
+                                    double tile_side) {
   const int nbx = (lattice.dims.x() + 7) / 8, nby = (lattice.dims.y() + 7) / 8;
   int sx = 1, sy = 1;  // tile size in block columns
   if (tile_side > 0) {
@@ -1575,7 +1614,8 @@ std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice, const std::vect
   }
   std::vector<BlockColumns> tiles;
   for (int x = 0; x < nbx; x += sx)
-    for (int y = 0; y < nby; y += sy) tiles.push_back({x, std::min(x + sx, nbx), y, std::min(y + sy, nby)});
+    for (int y = 0; y < nby; y += sy)
+      tiles.push_back({x, std::min(x + sx, nbx), y, std::min(y + sy, nby)});
   return tiles;
 }
 

@@ -11,26 +11,28 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 #include "volume/active_set.h"
 
 namespace pandora {
 
 class SolidTrees;
 
-/// The fields (names from FieldNames(), analysis/scene.h):
+/// The fields (names from FieldNames(), analysis/scene/scene.h):
 ///  - "coverage"   Int32: number of cameras that see the voxel centre. Active on every free region
 ///                 voxel (0 where none sees it); culled blocks are stored as constant tiles.
 ///  - "cameras"    the set of cameras that see each voxel, kept sparse: one BoolGrid per camera of
-///                 the rig (Fields::Impl::visible[c], active and true where camera c sees the voxel;
-///                 written to fields.vdb as "visible/<id>"). Any number of cameras.
-///  - "resolution" Float, px/m: the best pixel density (PixelDensity of the projection Jacobian) among
+///                 the rig (Fields::Impl::visible[c], active and true where camera c sees the
+///                 voxel; written to fields.vdb as "visible/<id>"). Any number of cameras.
+///  - "resolution" Float, px/m: the best pixel density (PixelDensity of the projection Jacobian)
+///  among
 ///                 the cameras that see the voxel. Active where at least one camera sees it.
 ///  - "sigma_max", "sigma_mean" Float, mm: worst-direction and RMS 1-sigma of the static
-///                 triangulation covariance (analysis/uncertainty.h); "triangulation_angle" Float,
-///                 degrees: largest angle between two rays that see the voxel; "condition" Float:
-///                 cond(J). Active where the voxel is triangulable (>= 2 cameras, observable).
+///                 triangulation covariance (analysis/geometry/uncertainty.h);
+///                 "triangulation_angle" Float, degrees: largest angle between two rays that see
+///                 the voxel; "condition" Float: cond(J). Active where the voxel is triangulable
+///                 (>= 2 cameras, observable).
 ///  - "sigma_max_steady", "sigma_mean_steady" Float, mm: the same for the steady-state Kalman
 ///                 covariance under study.motion.
 /// Options of EvaluateFields.
@@ -53,13 +55,13 @@ struct FieldOptions {
   /// then blames that option, unless the voxel size came from an option too.
   std::string memory_budget_option;
   /// Distributed evaluation (`pandora analyze --mpi`, docs/scale.md): this process evaluates only
-  /// the blocks of partition `partition_rank` of `partition_count`, a static load balance that every
-  /// process computes alike (blocks by estimated cost, free voxels times candidate cameras, largest
-  /// first, each to the least loaded partition). The other blocks' voxels stay inactive and out of
-  /// the statistics until MergePartialFields (volume/fields_transfer.h) adds them. For one full
-  /// evaluation (EvaluateFields, or an evaluator without kept state); 1: every block.
+  /// the blocks of partition `partition_rank` of `partition_count`, a static load balance that
+  /// every process computes alike (blocks by estimated cost, free voxels times candidate cameras,
+  /// largest first, each to the least loaded partition). The other blocks' voxels stay inactive and
+  /// out of the statistics until MergePartialFields (volume/fields_transfer.h) adds them. For one
+  /// full evaluation (EvaluateFields, or an evaluator without kept state); 1: every block.
   int partition_count = 1, partition_rank = 0;
-  /// Coarse-to-fine refinement (suggest/accuracy.h RunRefineStudy): when set, only the lattice
+  /// Coarse-to-fine refinement (app/session/accuracy.h RunRefineStudy): when set, only the lattice
   /// voxels (i, j, k) it returns true for are evaluated; the others stay inactive and out of the
   /// statistics. The evaluated voxels get exactly the values a full evaluation gives them. Called
   /// once per free region voxel while the active set is built, from worker threads.
@@ -77,9 +79,9 @@ struct FieldOptions {
 /// Counts and timing of one evaluation.
 struct FieldStats {
   ActiveSetStats active_set;
-  std::int64_t seen_voxels = 0;                ///< Voxels seen by at least one camera.
-  std::int64_t triangulable_voxels = 0;        ///< >= 2 cameras and observable (when computed).
-  std::int64_t unobservable_voxels = 0;        ///< >= 2 cameras but a direction unobservable.
+  std::int64_t seen_voxels = 0;          ///< Voxels seen by at least one camera.
+  std::int64_t triangulable_voxels = 0;  ///< >= 2 cameras and observable (when computed).
+  std::int64_t unobservable_voxels = 0;  ///< >= 2 cameras but a direction unobservable.
   /// sigma_max (mm) of every triangulable voxel, unsorted; filled when an uncertainty field is
   /// computed (for percentiles). Likewise sigma_max_steady when a motion model is set.
   std::vector<float> sigma_max_mm, sigma_max_steady_mm;
@@ -91,8 +93,8 @@ struct FieldStats {
   /// CPU time of the process during the evaluation (all threads). On a shared machine it is less
   /// disturbed by other work than the wall time; `pandora bench` prints ratios of both.
   double cpu_seconds = 0;
-  double active_set_seconds = 0;        ///< Of which building the active set.
-  double estimated_bytes = 0;           ///< The memory estimate checked against the budget.
+  double active_set_seconds = 0;  ///< Of which building the active set.
+  double estimated_bytes = 0;     ///< The memory estimate checked against the budget.
 };
 
 /// Opaque holder of the evaluated grids (OpenVDB inside).
@@ -115,8 +117,8 @@ class Fields {
   std::unique_ptr<Impl> impl_;
 };
 
-/// An upper bound of the memory the fields of `lattice` may need (grids at full density plus working
-/// buffers), in bytes.
+/// An upper bound of the memory the fields of `lattice` may need (grids at full density plus
+/// working buffers), in bytes.
 double EstimateFieldBytes(const VoxelLattice& lattice, const std::vector<std::string>& fields,
                           int camera_count);
 
@@ -131,13 +133,14 @@ double SceneStructureBytes(const Scene& scene);
 /// otherwise the tiles are as few and as square as keep each one's EstimateFieldBytes within half
 /// of `budget_bytes` (the other half for the scene, its BVH and search trees, and writing). A
 /// single column over that target still makes a tile of its own (the evaluation then refuses it).
-std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice, const std::vector<std::string>& fields,
-                                    double budget_bytes, double tile_side);
+std::vector<BlockColumns> PlanTiles(const VoxelLattice& lattice,
+                                    const std::vector<std::string>& fields, double budget_bytes,
+                                    double tile_side);
 
 /// What one FieldEvaluator::Update did.
 struct FieldUpdate {
-  bool full = false;            ///< Every camera was evaluated (the first update, or all changed).
-  int changed_cameras = 0;      ///< Cameras re-cast: moved, re-aimed, new intrinsics, (dis)abled.
+  bool full = false;        ///< Every camera was evaluated (the first update, or all changed).
+  int changed_cameras = 0;  ///< Cameras re-cast: moved, re-aimed, new intrinsics, (dis)abled.
   std::int64_t dirty_blocks = 0;  ///< 8^3 blocks inside a changed camera's old or new frustum.
   std::int64_t dirty_voxels = 0;  ///< Voxels whose values were recomputed.
   std::int64_t rays = 0;          ///< Occlusion segments cast by this update.
@@ -157,9 +160,9 @@ struct FieldUpdate {
 /// outlive the evaluator.
 class FieldEvaluator {
  public:
-  /// Checks the field list and the memory budget as EvaluateFields does (same InputErrors) and builds
-  /// the active set's region and solid classification once. `keep_state` false: one evaluation
-  /// only, the per-pair data is dropped block by block (EvaluateFields' memory).
+  /// Checks the field list and the memory budget as EvaluateFields does (same InputErrors) and
+  /// builds the active set's region and solid classification once. `keep_state` false: one
+  /// evaluation only, the per-pair data is dropped block by block (EvaluateFields' memory).
   FieldEvaluator(const Scene& scene, const RayCaster& caster, FieldOptions options,
                  bool keep_state = true);
   ~FieldEvaluator();

@@ -6,25 +6,29 @@
 #include <filesystem>
 #include <random>
 
-#include "analysis/error.h"
-#include "analysis/inside_mesh.h"
-#include "analysis/primitives.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
+#include "tests/fixtures.h"
 #include "tests/random_scene.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 #include "volume/vdb_io.h"
-#include "tests/fixtures.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
 Camera MakeCamera(const Vec3& position, const Vec3& target, double hfov_deg, LensModel model,
                   double k1 = 0, double k2 = 0, const Vec3& up = Vec3(0, 0, 1)) {
-  Camera cam = testing::WithIntrinsics(testing::TestCamera("cam", position, target, hfov_deg, 640, 480, model, up),
-                                       [&](Intrinsics& k) { k.k1 = k1; k.k2 = k2; });
+  Camera cam = testing::WithIntrinsics(
+      testing::TestCamera("cam", position, target, hfov_deg, 640, 480, model, up),
+      [&](Intrinsics& k) {
+        k.k1 = k1;
+        k.k2 = k2;
+      });
   cam.name.clear();
   cam.near = 0.05;
   cam.far = 20;
@@ -49,10 +53,13 @@ Scene TestScene() {
   Rig rig;
   rig.name = "mixed";
   rig.cameras.push_back(MakeCamera(Vec3(3, 0, 1), Vec3(0, 0, 0), 50, LensModel::kPinhole));
-  rig.cameras.push_back(MakeCamera(Vec3(0, 3, 2), Vec3(0, 0, 0), 70, LensModel::kBrownConrady, -0.25, 0.05));
-  rig.cameras.push_back(MakeCamera(Vec3(-2, -2, 1.5), Vec3(0, 0, 0), 190, LensModel::kFisheye, 0.02, -0.005));
+  rig.cameras.push_back(
+      MakeCamera(Vec3(0, 3, 2), Vec3(0, 0, 0), 70, LensModel::kBrownConrady, -0.25, 0.05));
+  rig.cameras.push_back(
+      MakeCamera(Vec3(-2, -2, 1.5), Vec3(0, 0, 0), 190, LensModel::kFisheye, 0.02, -0.005));
   rig.cameras.push_back(MakeCamera(Vec3(0, 0, 4), Vec3(0.2, 0.1, 0), 30, LensModel::kPinhole));
-  rig.cameras.push_back(MakeCamera(Vec3(-3, 0, 0.5), Vec3(-4, 0, 0), 60, LensModel::kPinhole));  // away
+  rig.cameras.push_back(
+      MakeCamera(Vec3(-3, 0, 0.5), Vec3(-4, 0, 0), 60, LensModel::kPinhole));  // away
   for (std::size_t i = 0; i < rig.cameras.size(); ++i) rig.cameras[i].id = "c" + std::to_string(i);
   scene.rigs.push_back(rig);
   scene.study.region.box.min = Vec3(-1, -1, -0.5);
@@ -162,8 +169,9 @@ TEST(Fields, UncertaintyMatchesPerPointComputation) {
   const Rig& rig = scene.rigs[0];
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   FieldOptions options;
-  options.fields = {"coverage",  "cameras",          "sigma_max",        "sigma_mean",
-                    "condition", "triangulation_angle", "sigma_max_steady", "sigma_mean_steady"};
+  options.fields = {"coverage",         "cameras",          "sigma_max",
+                    "sigma_mean",       "condition",        "triangulation_angle",
+                    "sigma_max_steady", "sigma_mean_steady"};
   const Fields fields = EvaluateFields(scene, rig, *caster, options);
   const Fields::Impl& g = fields.impl();
   for (const char* name : {"sigma_max", "sigma_mean", "condition", "triangulation_angle",
@@ -171,7 +179,8 @@ TEST(Fields, UncertaintyMatchesPerPointComputation) {
     ASSERT_TRUE(g.Float(name)) << name;
   EXPECT_FALSE(g.Float("resolution"));
 
-  // Every voxel seen by >= 2 cameras is triangulable here; the uncertainty grids hold exactly those.
+  // Every voxel seen by >= 2 cameras is triangulable here; the uncertainty grids hold exactly
+  // those.
   const std::int64_t two_or_more = fields.stats.seen_voxels - fields.stats.coverage_histogram[1];
   EXPECT_EQ(fields.stats.triangulable_voxels + fields.stats.unobservable_voxels, two_or_more);
   EXPECT_EQ(static_cast<std::int64_t>(g.Float("sigma_max")->activeVoxelCount()),
@@ -208,7 +217,8 @@ TEST(Fields, UncertaintyMatchesPerPointComputation) {
     // Float grid (6e-8) and an atan polynomial good to 2.1e-8: 3e-7 relative.
     const double reference = MaxTriangulationAngle(directions) * 180 / kPi;
     EXPECT_NEAR(angle.getValue(xyz), reference, 3e-7 * reference);
-    const SteadyUncertainty st = SteadyFromInformation(info, builder.cameras(), *scene.study.motion);
+    const SteadyUncertainty st =
+        SteadyFromInformation(info, builder.cameras(), *scene.study.motion);
     EXPECT_NEAR(steady_max.getValue(xyz), 1e3 * st.sigma_max, 1e-6 * 1e3 * st.sigma_max);
     EXPECT_NEAR(steady_mean.getValue(xyz), 1e3 * st.sigma_mean, 1e-6 * 1e3 * st.sigma_mean);
     EXPECT_LT(st.sigma_max, s.sigma_max);  // filtering over frames helps
@@ -225,12 +235,12 @@ TEST(Fields, UncertaintyMatchesPerPointComputation) {
                    values[static_cast<std::size_t>(std::ceil(0.5 * values.size())) - 1]);
   EXPECT_DOUBLE_EQ(u["sigma_max_mm"]["p99"].get<double>(),
                    values[static_cast<std::size_t>(std::ceil(0.99 * values.size())) - 1]);
-  const double meets = double(std::count_if(values.begin(), values.end(),
-                                             [](float v) { return v <= 5.0f; })) /
-                       double(fields.stats.active_set.region_voxels);
+  const double meets =
+      double(std::count_if(values.begin(), values.end(), [](float v) { return v <= 5.0f; })) /
+      double(fields.stats.active_set.region_voxels);
   EXPECT_DOUBLE_EQ(u["meets_max_sigma"].get<double>(), meets);
-  EXPECT_DOUBLE_EQ(u["triangulable"].get<double>(),
-                   double(fields.stats.triangulable_voxels) / fields.stats.active_set.region_voxels);
+  EXPECT_DOUBLE_EQ(u["triangulable"].get<double>(), double(fields.stats.triangulable_voxels) /
+                                                        fields.stats.active_set.region_voxels);
   EXPECT_TRUE(u.contains("sigma_max_steady_mm"));
 }
 
@@ -291,7 +301,8 @@ TEST(Fields, SinglePinholeClosedForm) {
   EXPECT_EQ(wide.stats.seen_voxels, expected);
   const double f = rig.cameras[0].model.intrinsics().fx;
   auto res = fields.impl().Float("resolution")->getConstAccessor();
-  for (const auto& ijk : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(10, 3, 19), Eigen::Vector3i(19, 19, 7)}) {
+  for (const auto& ijk :
+       {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(10, 3, 19), Eigen::Vector3i(19, 19, 7)}) {
     const Vec3 p = fields.lattice.Center(ijk.x(), ijk.y(), ijk.z());
     const double Z = 2.0 - p.z();
     const double r2 = (p.x() * p.x() + p.y() * p.y()) / (Z * Z);
@@ -362,7 +373,8 @@ TEST(Fields, MemoryBudgetIsCheckedBeforeAllocating) {
 TEST(Fields, MemoryBudgetCountsTheBlocksWithFreeVoxels) {
   Scene scene = TestScene();
   scene.study.voxel_size = 0.02;
-  // x from -1.3 to 0.7 over the whole region in y and z: free only for x > 0.7 (3 of 13 block columns).
+  // x from -1.3 to 0.7 over the whole region in y and z: free only for x > 0.7 (3 of 13 block
+  // columns).
   scene.objects.push_back(Object("block", MakeBox(Vec3(2.0, 2.6, 1.8)), Vec3(-0.3, 0, 0.15), true));
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   FieldOptions options;
@@ -420,7 +432,8 @@ TEST(Fields, VdbRoundTrip) {
   EXPECT_EQ(coverage->tree().activeTileCount(), fields.impl().coverage->tree().activeTileCount());
   EXPECT_NEAR(coverage->voxelSize().x(), 0.05, 1e-15);
   auto cov = fields.impl().coverage->getConstAccessor();
-  for (auto it = coverage->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, float(cov.getValue(it.getCoord())));
+  for (auto it = coverage->cbeginValueOn(); it; ++it)
+    ASSERT_EQ(*it, float(cov.getValue(it.getCoord())));
   // Camera c's grid in the file is its grid in memory.
   for (int c = 0; c < cameras; ++c) {
     auto seen = openvdb::gridPtrCast<openvdb::BoolGrid>(by_name["visible/" + std::to_string(c)]);
@@ -437,7 +450,8 @@ TEST(Fields, VdbRoundTrip) {
   ASSERT_EQ(back.impl().visible.size(), fields.impl().visible.size());
   EXPECT_EQ(back.impl().coverage->activeVoxelCount(), fields.impl().coverage->activeVoxelCount());
   EXPECT_TRUE(back.impl().coverage->tree().hasSameTopology(fields.impl().coverage->tree()));
-  for (auto it = back.impl().coverage->cbeginValueOn(); it; ++it) ASSERT_EQ(*it, cov.getValue(it.getCoord()));
+  for (auto it = back.impl().coverage->cbeginValueOn(); it; ++it)
+    ASSERT_EQ(*it, cov.getValue(it.getCoord()));
   for (std::size_t c = 0; c < back.impl().visible.size(); ++c)
     EXPECT_TRUE(back.impl().visible[c]->tree().hasSameTopology(fields.impl().visible[c]->tree()));
   auto a = fields.impl().Float("resolution")->getConstAccessor();

@@ -1,10 +1,9 @@
 #include "volume/fields_transfer.h"
 
-#include <algorithm>
-
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <sstream>
@@ -50,7 +49,8 @@ class Reader {
   template <typename T>
   std::vector<T> Vector() {
     const std::int64_t n = I64();
-    if (n < 0 || std::uint64_t(n) > (in_.size() - at_) / sizeof(T)) throw std::runtime_error("partial fields: bad length");
+    if (n < 0 || std::uint64_t(n) > (in_.size() - at_) / sizeof(T))
+      throw std::runtime_error("partial fields: bad length");
     std::vector<T> v(static_cast<std::size_t>(n));
     if (n > 0) Bytes(v.data(), v.size() * sizeof(T));
     return v;
@@ -88,8 +88,10 @@ void AddFieldStats(FieldStats* into, const FieldStats& part) {
   into->rays += part.rays;
   add(&into->coverage_histogram, part.coverage_histogram);
   add(&into->per_camera_seen, part.per_camera_seen);
-  into->sigma_max_mm.insert(into->sigma_max_mm.end(), part.sigma_max_mm.begin(), part.sigma_max_mm.end());
-  into->sigma_max_steady_mm.insert(into->sigma_max_steady_mm.end(), part.sigma_max_steady_mm.begin(),
+  into->sigma_max_mm.insert(into->sigma_max_mm.end(), part.sigma_max_mm.begin(),
+                            part.sigma_max_mm.end());
+  into->sigma_max_steady_mm.insert(into->sigma_max_steady_mm.end(),
+                                   part.sigma_max_steady_mm.begin(),
                                    part.sigma_max_steady_mm.end());
   into->seconds += part.seconds;
   into->cpu_seconds += part.cpu_seconds;
@@ -101,7 +103,8 @@ std::string SerializePartialFields(const Fields& fields) {
   const FieldStats& s = fields.stats;
   Writer w;
   w.Bytes(kMagic, sizeof kMagic);
-  for (std::int64_t v : {s.seen_voxels, s.triangulable_voxels, s.unobservable_voxels, s.point_camera_tests, s.rays})
+  for (std::int64_t v :
+       {s.seen_voxels, s.triangulable_voxels, s.unobservable_voxels, s.point_camera_tests, s.rays})
     w.I64(v);
   w.Vector(s.coverage_histogram);
   w.Vector(s.per_camera_seen);
@@ -120,7 +123,8 @@ std::string SerializePartialFields(const Fields& fields) {
   };
   if (g.coverage) add(g.coverage, "coverage");
   for (const auto& [name, grid] : g.floats) add(grid, "float/" + name);
-  for (std::size_t c = 0; c < g.visible.size(); ++c) add(g.visible[c], "visible/" + std::to_string(c));
+  for (std::size_t c = 0; c < g.visible.size(); ++c)
+    add(g.visible[c], "visible/" + std::to_string(c));
   std::ostringstream vdb(std::ios::binary);
   openvdb::io::Stream(vdb).write(grids);
   w.str() += vdb.str();
@@ -132,7 +136,8 @@ void MergePartialFields(const std::string& bytes, Fields* fields) {
   Reader r(bytes);
   char magic[sizeof kMagic];
   r.Bytes(magic, sizeof magic);
-  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("partial fields: not a partition");
+  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw std::runtime_error("partial fields: not a partition");
   FieldStats& s = fields->stats;
   s.seen_voxels += r.I64();
   s.triangulable_voxels += r.I64();
@@ -141,7 +146,8 @@ void MergePartialFields(const std::string& bytes, Fields* fields) {
   s.rays += r.I64();
   const auto histogram = r.Vector<std::int64_t>();
   const auto per_camera = r.Vector<std::int64_t>();
-  if (histogram.size() != s.coverage_histogram.size() || per_camera.size() != s.per_camera_seen.size())
+  if (histogram.size() != s.coverage_histogram.size() ||
+      per_camera.size() != s.per_camera_seen.size())
     throw std::runtime_error("partial fields: another camera count");
   for (std::size_t k = 0; k < histogram.size(); ++k) s.coverage_histogram[k] += histogram[k];
   for (std::size_t c = 0; c < per_camera.size(); ++c) s.per_camera_seen[c] += per_camera[c];
@@ -150,7 +156,8 @@ void MergePartialFields(const std::string& bytes, Fields* fields) {
   s.sigma_max_mm.insert(s.sigma_max_mm.end(), sigma.begin(), sigma.end());
   s.sigma_max_steady_mm.insert(s.sigma_max_steady_mm.end(), steady.begin(), steady.end());
   const std::int64_t nx = r.I64(), ny = r.I64(), nz = r.I64();
-  if (nx != fields->lattice.dims.x() || ny != fields->lattice.dims.y() || nz != fields->lattice.dims.z())
+  if (nx != fields->lattice.dims.x() || ny != fields->lattice.dims.y() ||
+      nz != fields->lattice.dims.z())
     throw std::runtime_error("partial fields: another lattice");
 
   std::istringstream vdb(r.Rest(), std::ios::binary);

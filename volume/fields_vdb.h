@@ -25,9 +25,10 @@ struct Fields::Impl {
   std::vector<openvdb::BoolGrid::Ptr> visible;
   /// resolution, sigma_max, ...: the requested float fields by name.
   std::map<std::string, openvdb::FloatGrid::Ptr> floats;
-  /// Grids beyond FieldNames(), written to fields.vdb after the others by name (the fields over time:
-  /// "coverage_min", "coverage_time_share"; volume/time_fields.h; "coverage_n1"; the PTZ grids).
-  /// Read back as they are (float grids with the fields' transform) for slices and isosurfaces.
+  /// Grids beyond FieldNames(), written to fields.vdb after the others by name (the fields over
+  /// time: "coverage_min", "coverage_time_share"; volume/time_fields.h; "coverage_n1"; the PTZ
+  /// grids). Read back as they are (float grids with the fields' transform) for slices and
+  /// isosurfaces.
   std::map<std::string, openvdb::FloatGrid::Ptr> extra;
 
   /// The float grid `name`, or null when it was not requested.

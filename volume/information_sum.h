@@ -15,11 +15,11 @@ namespace pandora::information {
 
 // Rows of the per-candidate statistics arrays.
 enum StatRow {
-  kObservable,    // 1 or 0
-  kSigmaMaxMm,    // sqrt of the largest variance, mm
-  kSigmaMeanMm,   // sqrt(trace / 3), mm
-  kCond,          // largest / smallest eigenvalue of J
-  kVar0,          // variances 1 / lambda_k, m^2 (descending); the steady pass overwrites them
+  kObservable,   // 1 or 0
+  kSigmaMaxMm,   // sqrt of the largest variance, mm
+  kSigmaMeanMm,  // sqrt(trace / 3), mm
+  kCond,         // largest / smallest eigenvalue of J
+  kVar0,         // variances 1 / lambda_k, m^2 (descending); the steady pass overwrites them
   kVar1,
   kVar2,
   kSteadyMaxMm,
@@ -107,7 +107,7 @@ inline Int128 ToFixed(double c, int q) {
   if (e != 0)
     m |= std::uint64_t{1} << 52;
   else
-    e = 1;  // subnormal
+    e = 1;                         // subnormal
   const int shift = e - 1075 - q;  // |c| / 2^q = m 2^shift
   Int128 v;
   if (shift >= 0) {
@@ -150,6 +150,5 @@ inline void Accumulate(Sum6& sum, const double* c, const BandScale& scale, bool 
     sum.v[k] = add ? sum.v[k] + v : sum.v[k] - v;
   }
 }
-
 
 }  // namespace pandora::information

@@ -6,19 +6,21 @@
 #include <algorithm>
 #include <chrono>
 
-#include "analysis/error.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
 
-std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig, const Fields& fields,
-                                                    int min_cameras, Fields* grids) {
+std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig,
+                                                     const Fields& fields, int min_cameras,
+                                                     Fields* grids) {
   std::vector<PixelTargetSummary> out;
   if (scene.study.pixel_targets.empty()) return out;
   const Fields::Impl& g = fields.impl();
   if (g.visible.empty() || !g.coverage)
-    throw InputError(scene.path, "$.study.pixel_targets", "pixel targets need the coverage and cameras fields",
+    throw InputError(scene.path, "$.study.pixel_targets",
+                     "pixel targets need the coverage and cameras fields",
                      "add \"coverage\" and \"cameras\" to the study's fields");
   const int kmax = std::max(3, min_cameras);
   const auto t0 = std::chrono::steady_clock::now();
@@ -38,17 +40,20 @@ std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const R
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const openvdb::Vec3d w = g.visible[c]->indexToWorld(voxels[i]);
         Mat23 J;
-        if (tester.TestGeometry(int(c), Vec3(w.x(), w.y(), w.z()), nullptr, nullptr, &J) == ViewResult::kSeen)
+        if (tester.TestGeometry(int(c), Vec3(w.x(), w.y(), w.z()), nullptr, nullptr, &J) ==
+            ViewResult::kSeen)
           density[i] = PixelDensity(J);
       }
     });
     for (std::size_t t = 0; t < targets.size(); ++t) {
       auto acc = counts[t]->getAccessor();
       for (std::size_t i = 0; i < voxels.size(); ++i)
-        if (density[i] >= targets[t].px_per_m()) acc.setValue(voxels[i], acc.getValue(voxels[i]) + 1);
+        if (density[i] >= targets[t].px_per_m())
+          acc.setValue(voxels[i], acc.getValue(voxels[i]) + 1);
     }
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (std::size_t t = 0; t < targets.size(); ++t) {
     PixelTargetSummary s;
     s.target = targets[t];
@@ -82,7 +87,8 @@ DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids
   const Fields::Impl& g = fields.impl();
   const openvdb::FloatGrid::Ptr resolution = g.Float("resolution");
   if (!resolution || !g.coverage)
-    throw InputError(scene.path, "$.study.dori", "DORI classes need the coverage and resolution fields",
+    throw InputError(scene.path, "$.study.dori",
+                     "DORI classes need the coverage and resolution fields",
                      "add \"coverage\" and \"resolution\" to the study's fields");
   DoriSummary s;
   std::int64_t& total = s.voxels;

@@ -4,14 +4,15 @@
 /// as many cameras as triangulation needs; and the surveillance DORI classes of EN 62676-4 (the
 /// best camera's pixel density at least 25 / 62.5 / 125 / 250 px/m: detection, observation,
 /// recognition, identification). Computed after the fields from the per-camera visibility grids
-/// and each camera's projection Jacobian (analysis/visibility.h PixelDensity): no ray is cast again.
+/// and each camera's projection Jacobian (analysis/geometry/visibility.h PixelDensity): no ray is
+/// cast again.
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 #include "volume/fields.h"
 
 namespace pandora {
@@ -51,8 +52,9 @@ inline constexpr double kDoriPxPerM[4] = {25.0, 62.5, 125.0, 250.0};
 /// `rig`; when `grids` is not null, adds per target a float grid "pixels_<name>" (cameras that meet
 /// it, whole numbers) to its Fields::Impl::extra. Throws InputError (path "$.study.pixel_targets")
 /// when the cameras field is missing.
-std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig, const Fields& fields,
-                                                    int min_cameras, Fields* grids);
+std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig,
+                                                     const Fields& fields, int min_cameras,
+                                                     Fields* grids);
 
 /// The DORI shares from the resolution field (InputError "$.study.dori" when it is missing); with
 /// `grids`, adds a float grid "dori" (the class 0 .. 4 reached, active on the free region voxels).

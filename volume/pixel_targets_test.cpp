@@ -4,10 +4,10 @@
 
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/ray_caster.h"
-#include "analysis/visibility.h"
-#include "analysis/primitives.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
@@ -40,14 +40,16 @@ TEST(PixelTargets, EqualABruteForceLoopWithOcclusionRays) {
   options.fields = scene.study.fields;
   const Fields fields = EvaluateFields(scene, rig, *caster, options);
   Fields grids;
-  const std::vector<PixelTargetSummary> result = EvaluatePixelTargets(scene, rig, fields, 3, &grids);
+  const std::vector<PixelTargetSummary> result =
+      EvaluatePixelTargets(scene, rig, fields, 3, &grids);
   ASSERT_EQ(result.size(), 2u);
   const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
   for (std::size_t t = 0; t < 2; ++t) {
     const double need = scene.study.pixel_targets[t].px_per_m();
     std::vector<double> share(3, 0.0);
     std::int64_t voxels = 0, differ = 0;
-    auto acc = grids.impl().extra.at("pixels_" + scene.study.pixel_targets[t].name)->getConstAccessor();
+    auto acc =
+        grids.impl().extra.at("pixels_" + scene.study.pixel_targets[t].name)->getConstAccessor();
     for (auto it = fields.impl().coverage->cbeginValueOn(); it; ++it) {
       openvdb::CoordBBox box;
       it.getBoundingBox(box);
@@ -56,7 +58,8 @@ TEST(PixelTargets, EqualABruteForceLoopWithOcclusionRays) {
         int n = 0;
         for (int cam = 0; cam < 3; ++cam) {
           Mat23 J;
-          n += tester.Test(cam, Vec3(w.x(), w.y(), w.z()), nullptr, &J) == ViewResult::kSeen && PixelDensity(J) >= need;
+          n += tester.Test(cam, Vec3(w.x(), w.y(), w.z()), nullptr, &J) == ViewResult::kSeen &&
+               PixelDensity(J) >= need;
         }
         for (int j = 1; j <= std::min(n, 3); ++j) share[j - 1] += 1;
         differ += acc.getValue(*c) != float(n);
@@ -64,7 +67,8 @@ TEST(PixelTargets, EqualABruteForceLoopWithOcclusionRays) {
       }
     }
     EXPECT_EQ(differ, 0);
-    for (int j = 0; j < 3; ++j) EXPECT_DOUBLE_EQ(result[t].share_ge[j], share[j] / double(voxels)) << j;
+    for (int j = 0; j < 3; ++j)
+      EXPECT_DOUBLE_EQ(result[t].share_ge[j], share[j] / double(voxels)) << j;
   }
   // The marker (286 px/m) is met more widely than the face (500 px/m), and neither everywhere.
   EXPECT_GT(result[0].share_ge[0], result[1].share_ge[0]);

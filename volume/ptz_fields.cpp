@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "analysis/camera.h"
+#include "analysis/geometry/camera.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
@@ -77,8 +77,9 @@ double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, d
   return hi;
 }
 
-PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera, const std::vector<PtzHead::TourLeg>& legs,
-                      const Vec3& X, double min_px_per_m, std::int64_t* rays) {
+PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera,
+                      const std::vector<PtzHead::TourLeg>& legs, const Vec3& X, double min_px_per_m,
+                      std::int64_t* rays) {
   const Camera& base = tester.cameras()[camera];
   const PtzHead& head = *base.ptz;
   const bool fixed_centre = head.offset.isZero(0.0);
@@ -110,14 +111,17 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
   const std::size_t n = voxels.size();
   out.region_voxels = static_cast<std::int64_t>(n);
   const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
-  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal(), surfaces.get());
+  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal(),
+                                surfaces.get());
   std::vector<int> ptz;
   for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c)
     if (rig.cameras[c].enabled && rig.cameras[c].ptz) ptz.push_back(c);
   std::vector<float> rig_min(n, std::numeric_limits<float>::infinity());
   std::atomic<std::int64_t> rays{0};
   const double px = out.min_px_per_m;
-  auto share = [n](std::int64_t count) { return n ? static_cast<double>(count) / static_cast<double>(n) : 0.0; };
+  auto share = [n](std::int64_t count) {
+    return n ? static_cast<double>(count) / static_cast<double>(n) : 0.0;
+  };
   auto make_grid = [&](const std::string& name) {
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
     grid->setName(name);
@@ -159,7 +163,8 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
       if (!std::isfinite(reach[i])) continue;
       finite.push_back(reach[i]);
       rig_min[i] = std::min(rig_min[i], reach[i]);
-      for (std::size_t k = 0; k < out.within_s.size(); ++k) within[k] += reach[i] <= out.within_s[k];
+      for (std::size_t k = 0; k < out.within_s.size(); ++k)
+        within[k] += reach[i] <= out.within_s[k];
       within_trace += reach[i] <= head.trace_s;
     }
     f.reachable_voxels = static_cast<std::int64_t>(finite.size());
@@ -207,7 +212,8 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(rig_min[i])) continue;
     ++reachable;
-    for (std::size_t k = 0; k < out.within_s.size(); ++k) within[k] += rig_min[i] <= out.within_s[k];
+    for (std::size_t k = 0; k < out.within_s.size(); ++k)
+      within[k] += rig_min[i] <= out.within_s[k];
   }
   out.reachable_share = share(reachable);
   for (std::int64_t w : within) out.within.push_back(share(w));
@@ -224,7 +230,9 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
 }
 
 void to_json(nlohmann::json& j, const PtzFieldsSummary& s) {
-  const auto value = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  const auto value = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
   nlohmann::json cameras = nlohmann::json::array();
   for (const PtzCameraFields& f : s.cameras) {
     nlohmann::json tour;
@@ -278,22 +286,25 @@ std::string FormatPtzFields(const PtzFieldsSummary& s) {
   }
   out += "PTZ reach (" + density + "), within " + budgets + " s:\n";
   for (const PtzCameraFields& f : s.cameras) {
-    std::snprintf(line, sizeof line, "  %-10s reaches %s of the region (longest move %.2g s), within: %s; median %s\n",
-                  f.id.c_str(), Percent(f.reachable_share).c_str(), f.max_time_s, shares(f.within).c_str(),
-                  Seconds(f.reach_p50_s).c_str());
+    std::snprintf(line, sizeof line,
+                  "  %-10s reaches %s of the region (longest move %.2g s), within: %s; median %s\n",
+                  f.id.c_str(), Percent(f.reachable_share).c_str(), f.max_time_s,
+                  shares(f.within).c_str(), Seconds(f.reach_p50_s).c_str());
     out += line;
     if (f.tour) {
-      std::snprintf(line, sizeof line,
-                    "  %-10s tour %.3g s (%d stops): watched %s of the time on average, %s at some time; "
-                    "longest unwatched p50 %s, max %s\n",
-                    "", f.period_s, f.stops, Percent(f.watched_mean).c_str(), Percent(f.watched_share).c_str(),
-                    Seconds(f.gap_p50_s).c_str(), Seconds(f.gap_max_s).c_str());
+      std::snprintf(
+          line, sizeof line,
+          "  %-10s tour %.3g s (%d stops): watched %s of the time on average, %s at some time; "
+          "longest unwatched p50 %s, max %s\n",
+          "", f.period_s, f.stops, Percent(f.watched_mean).c_str(),
+          Percent(f.watched_share).c_str(), Seconds(f.gap_p50_s).c_str(),
+          Seconds(f.gap_max_s).c_str());
       out += line;
     }
   }
   if (s.cameras.size() > 1) {
-    std::snprintf(line, sizeof line, "  %-10s reaches %s, within: %s\n", "any PTZ", Percent(s.reachable_share).c_str(),
-                  shares(s.within).c_str());
+    std::snprintf(line, sizeof line, "  %-10s reaches %s, within: %s\n", "any PTZ",
+                  Percent(s.reachable_share).c_str(), shares(s.within).c_str());
     out += line;
   }
   return out;

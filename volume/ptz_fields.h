@@ -9,17 +9,16 @@
 
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "analysis/ptz.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
-#include "analysis/surface_distance.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 #include "volume/fields.h"
 
 namespace pandora {
@@ -27,8 +26,8 @@ namespace pandora {
 /// One PTZ camera over the region. Shares are of the free region voxels.
 struct PtzCameraFields {
   std::string id;
-  int camera = -1;          ///< Rig index.
-  double max_time_s = 0;    ///< The longest move from the current setting (PtzReach::MaxTime).
+  int camera = -1;        ///< Rig index.
+  double max_time_s = 0;  ///< The longest move from the current setting (PtzReach::MaxTime).
   std::int64_t reachable_voxels = 0;  ///< With a finite reach time.
   double reachable_share = 0;
   std::vector<double> within;  ///< Share with reach time <= PtzFieldsSummary::within_s[i].
@@ -78,15 +77,17 @@ double PtzReachTime(const VisibilityTester& tester, int camera, const Vec3& X, d
 /// The watched intervals of X over the tour of rig camera `camera` (WatchTour with PtzSees at the
 /// density target and the occlusion from each setting's centre; one segment when the offset is
 /// zero, the pivot being the centre of every setting).
-PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera, const std::vector<PtzHead::TourLeg>& legs,
-                      const Vec3& X, double min_px_per_m, std::int64_t* rays = nullptr);
+PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera,
+                      const std::vector<PtzHead::TourLeg>& legs, const Vec3& X, double min_px_per_m,
+                      std::int64_t* rays = nullptr);
 
 /// Evaluates the PTZ fields of the enabled PTZ cameras of `rig` over the free region voxels of
 /// `fields` (its coverage grid; nothing is computed without it or without a PTZ camera: the
-/// summary then has no cameras). With `grids`, adds to its Fields::Impl::extra: "ptz_reach_time/<id>"
-/// (s, active where reachable), "ptz_reach_time" (the minimum over the PTZ cameras), and for a
-/// camera with a tour "ptz_watched/<id>" (fraction of the period, every region voxel) and
-/// "ptz_gap/<id>" (longest unwatched stretch, s, active where watched at some time). Parallel (TBB).
+/// summary then has no cameras). With `grids`, adds to its Fields::Impl::extra:
+/// "ptz_reach_time/<id>" (s, active where reachable), "ptz_reach_time" (the minimum over the PTZ
+/// cameras), and for a camera with a tour "ptz_watched/<id>" (fraction of the period, every region
+/// voxel) and "ptz_gap/<id>" (longest unwatched stretch, s, active where watched at some time).
+/// Parallel (TBB).
 PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
                                    const Fields& fields, Fields* grids);
 

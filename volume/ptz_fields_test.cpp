@@ -1,8 +1,8 @@
 // PTZ fields (issue 13): the reach time at a density target equals the closed form of the zoom
-// (both axes moving, the zoom deciding) on an empty scene and is never where a wall blocks the pivot;
-// tour watch fractions and longest gaps equal a brute-force time loop over the tour (with and
-// without a centre offset, occluders in the room); the field grids and shares are those values per
-// voxel.
+// (both axes moving, the zoom deciding) on an empty scene and is never where a wall blocks the
+// pivot; tour watch fractions and longest gaps equal a brute-force time loop over the tour (with
+// and without a centre offset, occluders in the room); the field grids and shares are those values
+// per voxel.
 #include "volume/ptz_fields.h"
 
 #include <gtest/gtest.h>
@@ -13,37 +13,41 @@
 #include <random>
 #include <string>
 
-#include "analysis/camera.h"
-#include "analysis/ptz.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
-#include "analysis/surface_distance.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/camera.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/units.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
-#include "analysis/units.h"
 
 namespace pandora {
 namespace {
 
-
-// A room with optional objects; PTZ "p" at (0, 0, 3) looking along +y at home; `ptz` is the block's body.
-Scene PtzScene(const std::string& ptz, const std::string& objects = "", const std::string& study_extra = "",
-               const std::string& more_cameras = "") {
+// A room with optional objects; PTZ "p" at (0, 0, 3) looking along +y at home; `ptz` is the block's
+// body.
+Scene PtzScene(const std::string& ptz, const std::string& objects = "",
+               const std::string& study_extra = "", const std::string& more_cameras = "") {
   const std::string text = R"({"pandora": 1, "objects": [)" + objects + R"(],
     "rigs": [{"name": "r", "cameras": [{"id": "p", "position": [0, 0, 3], "look_at": [0, 5, 3],
-      "resolution": [400, 300], "hfov_deg": 60, "ptz": {)" + ptz + "}}" + more_cameras + R"(]}],
-    "study": {"region": {"box": {"min": [-5, -5, 0], "max": [5, 5, 3]}}, "voxel_size": 0.5)" + study_extra + "}}";
+      "resolution": [400, 300], "hfov_deg": 60, "ptz": {)" +
+                           ptz + "}}" + more_cameras + R"(]}],
+    "study": {"region": {"box": {"min": [-5, -5, 0], "max": [5, 5, 3]}}, "voxel_size": 0.5)" +
+                           study_extra + "}}";
   return ParseScene(text, "ptz.json");
 }
 
 // Both axes move at once; the zoom decides. The reach time is the earliest at which some setting
 // sees the point at the density (issue 27: off-centre settings included): a pinhole's density at
-// an angle theta off the axis is f / (d cos^1.5 theta), so the least zoom puts the point in an image
-// corner, R pixels from the principal point: f = D cos^1.5(atan(R / f)), D = density x distance the
-// zoom the centred point needs. The pan and tilt to that corner take far less than the zoom.
+// an angle theta off the axis is f / (d cos^1.5 theta), so the least zoom puts the point in an
+// image corner, R pixels from the principal point: f = D cos^1.5(atan(R / f)), D = density x
+// distance the zoom the centred point needs. The pan and tilt to that corner take far less than the
+// zoom.
 TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
-  const Scene scene = PtzScene(R"("pan_speed_deg_s": 300, "tilt_speed_deg_s": 200, "zoom_hfov_deg": [60, 5],
+  const Scene scene =
+      PtzScene(R"("pan_speed_deg_s": 300, "tilt_speed_deg_s": 200, "zoom_hfov_deg": [60, 5],
                                    "zoom_speed_pct_s": 20)");
   const Rig& rig = scene.rigs[0];
   const auto empty = MakeBruteForceRayCaster(TriangleMesh());
@@ -53,8 +57,10 @@ TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
   ASSERT_NEAR(h.current.focal, f0, 1e-9);
   const double rate = 0.2 * (h.focal_max - h.focal_min);
   const Intrinsics k = rig.cameras[0].model.intrinsics();
-  const double R = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx), std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
-  for (const auto& [az, d, density] : {std::tuple{30.0, 8.0, 200.0}, {-75.0, 6.0, 300.0}, {140.0, 4.0, 500.0}}) {
+  const double R = std::hypot(std::max(k.cx + 0.5, k.width - 0.5 - k.cx),
+                              std::max(k.cy + 0.5, k.height - 0.5 - k.cy));
+  for (const auto& [az, d, density] :
+       {std::tuple{30.0, 8.0, 200.0}, {-75.0, 6.0, 300.0}, {140.0, 4.0, 500.0}}) {
     const Vec3 X = Vec3(0, 0, 3) + d * Vec3(-std::sin(Rad(az)), std::cos(Rad(az)), 0);
     const double D = density * d;
     double lo = 0, hi = D;  // f - D cos^1.5(atan(R / f)) rises from -D to > 0
@@ -64,7 +70,7 @@ TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
     }
     const double expected = (hi - f0) / rate;
     const double centred = (D - f0) / rate;
-    ASSERT_LT(expected, centred - 0.02);  // the corner wins by tens of milliseconds
+    ASSERT_LT(expected, centred - 0.02);             // the corner wins by tens of milliseconds
     ASSERT_GT(expected, std::abs(az) / 300 + 0.05);  // the zoom decides
     EXPECT_NEAR(PtzReachTime(tester, 0, X, density, 1e-6), expected, 1e-5) << az;
   }
@@ -85,8 +91,10 @@ TEST(PtzFields, ReachTimeAtADensityTargetIsTheZoomsClosedForm) {
 // only be later than the truth, by about its pitch over the speeds (0.25 / 30 s) or its zoom step
 // over the zoom rate; the reach time may not be later than the lattice's.
 TEST(PtzFields, ReachTimeEqualsABruteForceLatticeSearch) {
-  for (const std::string& zoom : {std::string(R"("zoom_hfov_deg": [60, 10], "zoom_speed_pct_s": 30,)"), std::string()}) {
-    const Scene scene = PtzScene(R"("pan_speed_deg_s": 30, "tilt_speed_deg_s": 30, )" + zoom + R"("tilt_range_deg": [-60, 20])");
+  for (const std::string& zoom :
+       {std::string(R"("zoom_hfov_deg": [60, 10], "zoom_speed_pct_s": 30,)"), std::string()}) {
+    const Scene scene = PtzScene(R"("pan_speed_deg_s": 30, "tilt_speed_deg_s": 30, )" + zoom +
+                                 R"("tilt_range_deg": [-60, 20])");
     const Rig& rig = scene.rigs[0];
     const auto empty = MakeBruteForceRayCaster(TriangleMesh());
     const VisibilityTester tester(rig.cameras, *empty, 10.0);
@@ -100,10 +108,15 @@ TEST(PtzFields, ReachTimeEqualsABruteForceLatticeSearch) {
       const double t = PtzReachTime(tester, 0, X, density, 1e-5);
       // The angles that centre X from the pivot.
       const Vec3 e = X - Vec3(0, 0, 3);
-      const double az = std::atan2(-e.x(), e.y()) * 180 / kPi, el = std::atan2(e.z(), std::hypot(e.x(), e.y())) * 180 / kPi;
+      const double az = std::atan2(-e.x(), e.y()) * 180 / kPi,
+                   el = std::atan2(e.z(), std::hypot(e.x(), e.y())) * 180 / kPi;
       auto lattice_sees = [&](double time) {
-        const double f_lo = zoom_rate > 0 ? std::max(h.focal_min, h.current.focal - zoom_rate * time) : h.current.focal;
-        const double f_hi = zoom_rate > 0 ? std::min(h.focal_max, h.current.focal + zoom_rate * time) : h.current.focal;
+        const double f_lo = zoom_rate > 0
+                                ? std::max(h.focal_min, h.current.focal - zoom_rate * time)
+                                : h.current.focal;
+        const double f_hi = zoom_rate > 0
+                                ? std::min(h.focal_max, h.current.focal + zoom_rate * time)
+                                : h.current.focal;
         for (double pan = az - 40; pan <= az + 40; pan += 0.25) {
           if (std::abs(pan - h.current.pan_deg) > h.pan_speed_deg_s * time) continue;
           for (double tilt = el - 40; tilt <= el + 40; tilt += 0.25) {
@@ -126,9 +139,11 @@ TEST(PtzFields, ReachTimeEqualsABruteForceLatticeSearch) {
         const double mid = 0.5 * (lo + hi);
         (lattice_sees(mid) ? hi : lo) = mid;
       }
-      SCOPED_TRACE(zoom + " X " + std::to_string(X.x()) + " " + std::to_string(X.y()) + " " + std::to_string(X.z()));
+      SCOPED_TRACE(zoom + " X " + std::to_string(X.x()) + " " + std::to_string(X.y()) + " " +
+                   std::to_string(X.z()));
       EXPECT_LE(t, hi + 1e-3);
-      EXPECT_GE(t, hi - 0.25 / 30 - (zoom_rate > 0 ? (h.focal_max - h.focal_min) / 23.0 / zoom_rate : 0) - 1e-3);
+      EXPECT_GE(t, hi - 0.25 / 30 -
+                       (zoom_rate > 0 ? (h.focal_max - h.focal_min) / 23.0 / zoom_rate : 0) - 1e-3);
       // And the setting it reports sees the point then.
       const PtzReach reach(base, h, h.current, density);
       PtzState pose;
@@ -141,8 +156,9 @@ TEST(PtzFields, ReachTimeEqualsABruteForceLatticeSearch) {
 
 // A wall between the pivot and a point: never reached (the pivot is every setting's centre).
 TEST(PtzFields, AWallBlocksTheReachForEverySetting) {
-  const Scene scene = PtzScene(R"("pan_speed_deg_s": 90)",
-                               R"({"name": "wall", "box": {"size": [2, 0.2, 3.5]}, "position": [0, 2.1, 1.75]})");
+  const Scene scene =
+      PtzScene(R"("pan_speed_deg_s": 90)",
+               R"({"name": "wall", "box": {"size": [2, 0.2, 3.5]}, "position": [0, 2.1, 1.75]})");
   const Rig& rig = scene.rigs[0];
   const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
   const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
@@ -165,8 +181,8 @@ struct Brute {
   int changes = 0;
   double short_s = 0;  // total length of the watched runs shorter than `short_run`
 };
-Brute BruteForceTour(const VisibilityTester& tester, const std::vector<PtzHead::TourLeg>& legs, const Vec3& X,
-                     double px, double dt, double short_run) {
+Brute BruteForceTour(const VisibilityTester& tester, const std::vector<PtzHead::TourLeg>& legs,
+                     const Vec3& X, double px, double dt, double short_run) {
   const Camera& cam = tester.cameras()[0];
   const PtzHead& h = *cam.ptz;
   const double period = legs.back().end();
@@ -215,17 +231,20 @@ Brute BruteForceTour(const VisibilityTester& tester, const std::vector<PtzHead::
 }
 
 TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
-  const std::string objects = R"({"name": "pillar", "box": {"size": [0.4, 0.4, 3]}, "position": [1.2, 1.7, 1.5]},
+  const std::string objects =
+      R"({"name": "pillar", "box": {"size": [0.4, 0.4, 3]}, "position": [1.2, 1.7, 1.5]},
       {"name": "cabinet", "box": {"size": [0.5, 2, 1.8]}, "position": [-2.75, 0, 0.9]})";
   int compared = 0, partial = 0;
   for (const char* offset : {"[0, 0, 0]", "[0.03, -0.05, 0.12]"}) {
-    const Scene scene = PtzScene(std::string(R"("pan_speed_deg_s": 60, "tilt_speed_deg_s": 30, "zoom_hfov_deg": [60, 10],
-        "zoom_speed_pct_s": 50, "tilt_range_deg": [-80, 10], "offset_m": )") + offset + R"(,
+    const Scene scene = PtzScene(
+        std::string(R"("pan_speed_deg_s": 60, "tilt_speed_deg_s": 30, "zoom_hfov_deg": [60, 10],
+        "zoom_speed_pct_s": 50, "tilt_range_deg": [-80, 10], "offset_m": )") +
+            offset + R"(,
         "presets": [{"name": "a", "pan_deg": 0, "tilt_deg": -30, "hfov_deg": 40},
                     {"name": "b", "pan_deg": 100, "tilt_deg": -50, "hfov_deg": 20},
                     {"name": "c", "pan_deg": -120, "tilt_deg": -20, "hfov_deg": 60}],
         "tour": [{"preset": "a", "dwell_s": 2}, {"preset": "b", "dwell_s": 1}, {"preset": "c", "dwell_s": 3}])",
-                                 objects);
+        objects);
     const Rig& rig = scene.rigs[0];
     const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
     const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
@@ -233,7 +252,8 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
     ASSERT_EQ(surfaces == nullptr, exact);  // only a moving centre needs the triangles
     // The tester that certifies the moving centre's occlusion, and one without the triangles, which
     // samples it (what every head did before).
-    const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal(), surfaces.get());
+    const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal(),
+                                  surfaces.get());
     const VisibilityTester sampling(rig.cameras, *caster, scene.ContentBounds().diagonal());
     const PtzHead& h = *rig.cameras[0].ptz;
     const std::vector<PtzHead::TourLeg> legs = h.TourLegs();
@@ -252,7 +272,8 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
     // Sampling the occlusion every SampleStep (a quarter of the narrower field of view) instead may
     // miss a glimpse of a point behind the pillar's edge shorter than that.
     double step = 0;
-    for (const PtzHead::TourLeg& leg : legs) step = std::max(step, h.SampleStep(rig.cameras[0], leg.from, leg.to));
+    for (const PtzHead::TourLeg& leg : legs)
+      step = std::max(step, h.SampleStep(rig.cameras[0], leg.from, leg.to));
     int missed = 0;
     for (int i = 0; i < 40; ++i) {
       const Vec3 X(4.5 * u(rng), 4.5 * u(rng), 1.0 + 0.9 * u(rng));
@@ -268,7 +289,8 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
         const PtzWatch ws = PtzTourWatch(sampling, 0, legs, X, px);
         const double sampled_tol = (b.changes + 1) * (1e-3 + dt);
         missed += b.short_s > 0 && std::abs(ws.watched_s() - b.watched) > sampled_tol;
-        EXPECT_NEAR(ws.watched_s(), b.watched, sampled_tol + b.short_s) << offset << " point " << X.transpose();
+        EXPECT_NEAR(ws.watched_s(), b.watched, sampled_tol + b.short_s)
+            << offset << " point " << X.transpose();
       }
       ++compared;
       partial += w.watched_s() > 0.05 && w.watched_s() < w.period - 0.05;
@@ -282,9 +304,9 @@ TEST(PtzFields, TourWatchEqualsABruteForceTimeLoop) {
 // The moving centre's occlusion, exact: a head whose centre sits 0.2 m in front of its pivot pans
 // from -10 to +10 deg at 10 deg/s; a point 5 m ahead stays in view throughout, behind a thin wall
 // with a 2 mm slit. The segment from the centre to the point crosses the wall's two faces at x =
-// c_x (5 - y) / (5 - c_y) (the centre (-0.2 sin p, 0.2 cos p) in x, y): the point is seen while both
-// crossings lie in the slit, a window of about a tenth of a second, found here from that closed
-// form by bisection. The move's sampling step is over a second: sampling misses it.
+// c_x (5 - y) / (5 - c_y) (the centre (-0.2 sin p, 0.2 cos p) in x, y): the point is seen while
+// both crossings lie in the slit, a window of about a tenth of a second, found here from that
+// closed form by bisection. The move's sampling step is over a second: sampling misses it.
 TEST(PtzFields, TourFindsAGlimpseThroughASlitAsTheCentreMoves) {
   const double slit_x = 0.0, slit = 0.002, wall_y = 2.5, wall_t = 0.001;
   // The crossing at y of the segment from the centre at pan p (degrees).
@@ -302,19 +324,22 @@ TEST(PtzFields, TourFindsAGlimpseThroughASlitAsTheCentreMoves) {
                    {"name": "right", "box": {"size": [4, %.17g, 4]}, "position": [%.17g, %.17g, 2]})",
                 wall_t, x0 - 0.5 * slit - 2.0, wall_y, wall_t, x0 + 0.5 * slit + 2.0, wall_y);
   (void)slit_x;
-  const Scene scene = PtzScene(R"("pan_speed_deg_s": 10, "tilt_speed_deg_s": 10, "offset_m": [0, 0, 0.2],
+  const Scene scene =
+      PtzScene(R"("pan_speed_deg_s": 10, "tilt_speed_deg_s": 10, "offset_m": [0, 0, 0.2],
       "presets": [{"name": "a", "pan_deg": -10, "tilt_deg": 0}, {"name": "b", "pan_deg": 10, "tilt_deg": 0}],
       "tour": [{"preset": "a", "dwell_s": 1}, {"preset": "b", "dwell_s": 1}])",
-                               objects);
+               objects);
   const Rig& rig = scene.rigs[0];
   const Camera& cam = rig.cameras[0];
   const PtzHead& h = *cam.ptz;
   for (double p : {-10.0, -3.0, 7.0})
-    ASSERT_LT((h.Pose(PtzState{p, 0, h.current.focal}).translation() - centre(p)).norm(), 1e-12) << p;
+    ASSERT_LT((h.Pose(PtzState{p, 0, h.current.focal}).translation() - centre(p)).norm(), 1e-12)
+        << p;
   const auto caster = MakeBruteForceRayCaster(scene.AllTriangles());
   const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
   ASSERT_TRUE(surfaces);
-  const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal(), surfaces.get());
+  const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal(),
+                                surfaces.get());
   const VisibilityTester sampling(rig.cameras, *caster, scene.ContentBounds().diagonal());
   const std::vector<PtzHead::TourLeg> legs = h.TourLegs();
   const Vec3 X(0, 5, 3);
@@ -345,8 +370,10 @@ TEST(PtzFields, TourFindsAGlimpseThroughASlitAsTheCentreMoves) {
   ASSERT_EQ(w.intervals.size(), 2u);
   EXPECT_NEAR(w.watched_s(), 2 * window, 1e-5);
   const double mid_ab = 0.5 * (p_a + p_b) + 10.0;  // degrees into the move from -10
-  EXPECT_NEAR(0.5 * (w.intervals[0].first + w.intervals[0].second), legs[0].start + (20.0 - mid_ab) / 10.0, 1e-5);
-  EXPECT_NEAR(0.5 * (w.intervals[1].first + w.intervals[1].second), legs[1].start + mid_ab / 10.0, 1e-5);
+  EXPECT_NEAR(0.5 * (w.intervals[0].first + w.intervals[0].second),
+              legs[0].start + (20.0 - mid_ab) / 10.0, 1e-5);
+  EXPECT_NEAR(0.5 * (w.intervals[1].first + w.intervals[1].second), legs[1].start + mid_ab / 10.0,
+              1e-5);
   // Sampling the occlusion alone misses both glimpses.
   EXPECT_EQ(PtzTourWatch(sampling, 0, legs, X, 0.0).watched_s(), 0.0);
 }
@@ -379,8 +406,10 @@ TEST(PtzFields, TourFindsAGlimpseShorterThanTheSampleStep) {
   EXPECT_NEAR(w.watched_s(), 2 * window, 4e-6);
   // The windows are centred where the pan passes 0: 60 / 90 s into each move.
   for (int i = 0; i < 2; ++i)
-    EXPECT_NEAR(0.5 * (w.intervals[i].first + w.intervals[i].second), legs[i].start + 60.0 / 90.0, 2e-6);
-  const PtzWatch sampled = WatchTour(h, cam, legs, [&](const PtzState& s) { return PtzSees(cam, h, s, X); });
+    EXPECT_NEAR(0.5 * (w.intervals[i].first + w.intervals[i].second), legs[i].start + 60.0 / 90.0,
+                2e-6);
+  const PtzWatch sampled =
+      WatchTour(h, cam, legs, [&](const PtzState& s) { return PtzSees(cam, h, s, X); });
   EXPECT_EQ(sampled.watched_s(), 0.0);  // what sampling alone gave
 
   // The density: at the point's azimuth (centred horizontally, on the midline) it needs
@@ -392,7 +421,8 @@ TEST(PtzFields, TourFindsAGlimpseShorterThanTheSampleStep) {
   const double target = base_density / ratio;
   const PtzWatch d = PtzTourWatch(tester, 0, legs, Y, target);
   const double gap = 2 * Deg(std::acos(std::pow(ratio, 2.0 / 3.0))) / 90.0;
-  const double side = Deg(std::atan((k.cx + 0.5) / k.fx));  // where Y leaves the image, off the axis
+  const double side =
+      Deg(std::atan((k.cx + 0.5) / k.fx));  // where Y leaves the image, off the axis
   // Each move: watched from entering (phi = side) to -gap/2 of the azimuth, and from +gap/2 to the
   // other side, the dwells not (at +-60 deg Y is outside the 30 deg half view).
   const double per_move = 2 * (side / 90.0 - 0.5 * gap);
@@ -421,7 +451,8 @@ TEST(PtzFields, GridsAndSharesAreThePerVoxelValues) {
   const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
   const Fields::Impl& g = fields.impl();
   const auto reach_p = g.extra.at("ptz_reach_time/p"), reach_q = g.extra.at("ptz_reach_time/q");
-  const auto reach = g.extra.at("ptz_reach_time"), watched = g.extra.at("ptz_watched/p"), gap = g.extra.at("ptz_gap/p");
+  const auto reach = g.extra.at("ptz_reach_time"), watched = g.extra.at("ptz_watched/p"),
+             gap = g.extra.at("ptz_gap/p");
   EXPECT_EQ(g.extra.count("ptz_watched/q"), 0u);  // no tour
   const std::vector<PtzHead::TourLeg> legs = rig.cameras[0].ptz->TourLegs();
   std::int64_t voxels = 0, reach_p_count = 0, within_p[2] = {0, 0}, either = 0;

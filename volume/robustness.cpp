@@ -12,9 +12,9 @@
 #include <iterator>
 #include <stdexcept>
 
-#include "analysis/text.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/text.h"
 #include "volume/fields_vdb.h"
 #include "volume/information_sum.h"
 #include "volume/summary.h"
@@ -43,7 +43,8 @@ struct Partial {
   std::vector<std::array<std::int64_t, 4>> exactly;
   std::vector<std::int64_t> seen;
   // Per rig camera: the voxels it sees that are triangulable intact (indices into the intact
-  // sigma_max list: removed when it fails) and sigma_max (mm) where they are after it fails (added).
+  // sigma_max list: removed when it fails) and sigma_max (mm) where they are after it fails
+  // (added).
   std::vector<std::vector<std::int64_t>> removed;
   std::vector<std::vector<float>> added;
   explicit Partial(std::size_t cameras)
@@ -101,7 +102,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   std::unique_ptr<VisibilityTester> tester;
   std::vector<std::array<double, 9>> whitened(camera_count);
   if (table.uncertainty) {
-    tester = std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
+    tester =
+        std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
     for (std::size_t c = 0; c < camera_count; ++c) {
       const Camera& cam = rig.cameras[c];
       const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene.study.pixel_sigma;
@@ -120,7 +122,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     }
     // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
     if (base.back() != static_cast<std::int64_t>(sigma_grid->activeVoxelCount()))
-      throw std::invalid_argument("ComputeCriticality: the sigma_max field does not match the camera sets");
+      throw std::invalid_argument(
+          "ComputeCriticality: the sigma_max field does not match the camera sets");
     intact.resize(static_cast<std::size_t>(base.back()));
   }
 
@@ -192,7 +195,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
         }
         if (count[o] < 3) continue;
         // The seeing cameras' contributions, ascending camera (the evaluator's view order).
-        const int x = origin.x() + (o >> 6), y = origin.y() + ((o >> 3) & 7), z = origin.z() + (o & 7);
+        const int x = origin.x() + (o >> 6), y = origin.y() + ((o >> 3) & 7),
+                  z = origin.z() + (o & 7);
         const Vec3 p = fields.lattice.Center(x, y, z);
         contribution.clear();
         band.clear();
@@ -201,8 +205,10 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
           if (!(bits[e][o >> 6] >> (o & 63) & 1)) continue;
           Ray segment;
           Mat23 jacobian;
-          if (tester->TestGeometryCameraFrame(cams[e], p, nullptr, &segment, &jacobian) != ViewResult::kSeen)
-            throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
+          if (tester->TestGeometryCameraFrame(cams[e], p, nullptr, &segment, &jacobian) !=
+              ViewResult::kSeen)
+            throw std::invalid_argument(
+                "ComputeCriticality: the fields were evaluated for another rig");
           double c6[6] = {0, 0, 0, 0, 0, 0};
           AddCameraInformation(jacobian, whitened[cams[e]].data(), c6);
           contribution.insert(contribution.end(), c6, c6 + 6);
@@ -236,7 +242,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
           if (full_exact && (band[f] < top || top_count > 1)) {
             // The others' band is still `top`: the exact sum less f's rounded contribution.
             for (int q = 0; q < 6; ++q)
-              row[q] = ToDouble(full.v[q] - fixed[6 * f + q]) * scales[top].up[0] * scales[top].up[1];
+              row[q] =
+                  ToDouble(full.v[q] - fixed[6 * f + q]) * scales[top].up[0] * scales[top].up[1];
           } else {
             // As Derive re-sums a voxel: the others' largest band, or in double in rig order.
             std::uint8_t b = 0;
@@ -251,7 +258,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
               Sum6 s{};
               for (int a = 0; a < m; ++a)
                 if (a != f) Accumulate(s, &contribution[6 * a], scales[b], true);
-              for (int q = 0; q < 6; ++q) row[q] = ToDouble(s.v[q]) * scales[b].up[0] * scales[b].up[1];
+              for (int q = 0; q < 6; ++q)
+                row[q] = ToDouble(s.v[q]) * scales[b].up[0] * scales[b].up[1];
             }
           }
           upper_rows.push_back(row);
@@ -298,7 +306,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   // held twice (a camera's list at most).
   for (std::size_t c = 0; c < camera_count; ++c) {
     std::size_t n_removed = 0, n_added = 0;
-    for (const Partial& p : partials) n_removed += p.removed[c].size(), n_added += p.added[c].size();
+    for (const Partial& p : partials)
+      n_removed += p.removed[c].size(), n_added += p.added[c].size();
     removed[c].reserve(n_removed);
     added[c].reserve(n_added);
     for (Partial& p : partials) {
@@ -323,25 +332,27 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     table.rows.push_back(row);
   }
   if (table.uncertainty) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table.rows.size(), 1), [&](const auto& range) {
-      for (std::size_t r = range.begin(); r != range.end(); ++r) {
-        CriticalityRow& row = table.rows[r];
-        const std::vector<std::int64_t>& out = removed[row.camera];
-        const std::vector<float>& in = added[row.camera];
-        // The multiset intact - out + in: the sigma_max list of the rig without this camera.
-        std::vector<unsigned char> gone(intact.size(), 0);
-        for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
-        std::vector<float> after;
-        after.reserve(intact.size() - out.size() + in.size());
-        for (std::size_t v = 0; v < intact.size(); ++v)
-          if (!gone[v]) after.push_back(intact[v]);
-        after.insert(after.end(), in.begin(), in.end());
-        row.triangulable_voxels = static_cast<std::int64_t>(after.size());
-        row.triangulable = Fraction(row.triangulable_voxels, region);
-        row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
-        row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
-      }
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table.rows.size(), 1),
+                      [&](const auto& range) {
+                        for (std::size_t r = range.begin(); r != range.end(); ++r) {
+                          CriticalityRow& row = table.rows[r];
+                          const std::vector<std::int64_t>& out = removed[row.camera];
+                          const std::vector<float>& in = added[row.camera];
+                          // The multiset intact - out + in: the sigma_max list of the rig without
+                          // this camera.
+                          std::vector<unsigned char> gone(intact.size(), 0);
+                          for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
+                          std::vector<float> after;
+                          after.reserve(intact.size() - out.size() + in.size());
+                          for (std::size_t v = 0; v < intact.size(); ++v)
+                            if (!gone[v]) after.push_back(intact[v]);
+                          after.insert(after.end(), in.begin(), in.end());
+                          row.triangulable_voxels = static_cast<std::int64_t>(after.size());
+                          row.triangulable = Fraction(row.triangulable_voxels, region);
+                          row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
+                          row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
+                        }
+                      });
   }
   double sum = 0;
   for (const CriticalityRow& row : table.rows) sum += row.ge_k;
@@ -372,7 +383,9 @@ void AddCoverageN1Grid(Fields* fields) {
 }
 
 void to_json(nlohmann::json& j, const CriticalityTable& t) {
-  const auto value = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  const auto value = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
   nlohmann::json rows = nlohmann::json::array();
   for (const CriticalityRow& r : t.rows)
     rows.push_back({{"id", r.id},
@@ -386,7 +399,8 @@ void to_json(nlohmann::json& j, const CriticalityTable& t) {
                     {"sigma_max_p90_mm", value(r.sigma_max_p90_mm)}});
   nlohmann::json worst;
   if (t.worst >= 0)
-    worst = {{"camera", t.rows[t.worst].id}, {"ge_k", t.rows[t.worst].ge_k}, {"loss", t.worst_loss()}};
+    worst = {
+        {"camera", t.rows[t.worst].id}, {"ge_k", t.rows[t.worst].ge_k}, {"loss", t.worst_loss()}};
   j = {{"k", t.k},
        {"ge_k", t.ge_k},
        {"worst", worst},
@@ -398,9 +412,11 @@ void to_json(nlohmann::json& j, const CriticalityTable& t) {
 std::string FormatCriticality(const CriticalityTable& t, int rows) {
   std::string out;
   if (t.worst < 0) return "N-1: no enabled camera\n";
-  out += Format("N-1 (one camera fails), seen by >= %d: intact %.1f%%, worst %s %.1f%% (-%.1f points), mean %.1f%%\n",
-                t.k, 100 * t.ge_k, t.rows[t.worst].id.c_str(), 100 * t.rows[t.worst].ge_k, 100 * t.worst_loss(),
-                100 * t.mean_ge_k);
+  out += Format(
+      "N-1 (one camera fails), seen by >= %d: intact %.1f%%, worst %s %.1f%% (-%.1f points), mean "
+      "%.1f%%\n",
+      t.k, 100 * t.ge_k, t.rows[t.worst].id.c_str(), 100 * t.rows[t.worst].ge_k,
+      100 * t.worst_loss(), 100 * t.mean_ge_k);
   const std::vector<int> order = t.MostCritical();
   const bool k_column = t.k > 3;  // ge1..ge3 already show k <= 3
   out += Format("  %-12s %7s %7s %7s%s%s\n", "fails", ">=1", ">=2", ">=3",
@@ -408,12 +424,15 @@ std::string FormatCriticality(const CriticalityTable& t, int rows) {
                 t.uncertainty ? "  triangulable  sigma_max p50 / p90 mm" : "");
   for (int i = 0; i < rows && i < static_cast<int>(order.size()); ++i) {
     const CriticalityRow& r = t.rows[order[i]];
-    std::string line = Format("  %-12s %6.1f%% %6.1f%% %6.1f%%", r.id.c_str(), 100 * r.ge1, 100 * r.ge2, 100 * r.ge3);
+    std::string line = Format("  %-12s %6.1f%% %6.1f%% %6.1f%%", r.id.c_str(), 100 * r.ge1,
+                              100 * r.ge2, 100 * r.ge3);
     if (k_column) line += Format(" %6.1f%%", 100 * r.ge_k);
     if (t.uncertainty) {
-      const auto cell = [](const std::optional<double>& v) { return v ? Format("%.3g", *v) : std::string("-"); };
-      line += Format("  %11.1f%%  %s / %s", 100 * r.triangulable.value_or(0), cell(r.sigma_max_p50_mm).c_str(),
-                     cell(r.sigma_max_p90_mm).c_str());
+      const auto cell = [](const std::optional<double>& v) {
+        return v ? Format("%.3g", *v) : std::string("-");
+      };
+      line += Format("  %11.1f%%  %s / %s", 100 * r.triangulable.value_or(0),
+                     cell(r.sigma_max_p50_mm).c_str(), cell(r.sigma_max_p90_mm).c_str());
     }
     out += line + "\n";
   }

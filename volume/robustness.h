@@ -1,23 +1,22 @@
 #pragma once
 /// \file robustness.h
 /// N-1 robustness: what the rig loses when any one camera fails (unplugged, bumped, occluded by a
-/// new rack), computed from the per-voxel camera sets of an evaluation (the "cameras" field) without
-/// casting a ray. Coverage after a failure is exact from the counts (a voxel camera c sees loses
-/// one camera). The uncertainty after a failure is re-derived at the voxels c sees from the other
-/// cameras that see them: their projection Jacobians, the same per-camera information contribution,
-/// exact fixed-point sum, eigenvalue solver and statistics as the field evaluation
+/// new rack), computed from the per-voxel camera sets of an evaluation (the "cameras" field)
+/// without casting a ray. Coverage after a failure is exact from the counts (a voxel camera c sees
+/// loses one camera). The uncertainty after a failure is re-derived at the voxels c sees from the
+/// other cameras that see them: their projection Jacobians, the same per-camera information
+/// contribution, exact fixed-point sum, eigenvalue solver and statistics as the field evaluation
 /// (volume/information_sum.h), so every row equals a full evaluation of the rig with that camera
 /// disabled, bit for bit (test volume/robustness_test.cpp). docs/failures.md.
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 #include "volume/fields.h"
 
 namespace pandora {
@@ -27,7 +26,8 @@ struct CriticalityRow {
   int camera = -1;  ///< Rig index.
   std::string id;
   std::int64_t seen_voxels = 0;  ///< Voxels the camera sees (intact).
-  double ge1 = 0, ge2 = 0, ge3 = 0, ge_k = 0;  ///< Shares seen by >= 1, 2, 3, k cameras after it fails.
+  double ge1 = 0, ge2 = 0, ge3 = 0,
+         ge_k = 0;  ///< Shares seen by >= 1, 2, 3, k cameras after it fails.
   /// With the sigma_max field: the share triangulable after it fails and the nearest-rank sigma_max
   /// percentiles (mm) over those voxels (nullopt when none is triangulable).
   std::optional<double> triangulable;
@@ -37,10 +37,10 @@ struct CriticalityRow {
 
 /// Every enabled camera's failure, and the region-level N-1 numbers.
 struct CriticalityTable {
-  int k = 3;                        ///< The study's camera count (Scene::TimeMinCameras()).
-  std::int64_t region_voxels = 0;   ///< Free region voxels.
-  double ge_k = 0;                  ///< Intact share seen by >= k cameras.
-  bool uncertainty = false;         ///< The rows carry the sigma_max columns.
+  int k = 3;                         ///< The study's camera count (Scene::TimeMinCameras()).
+  std::int64_t region_voxels = 0;    ///< Free region voxels.
+  double ge_k = 0;                   ///< Intact share seen by >= k cameras.
+  bool uncertainty = false;          ///< The rows carry the sigma_max columns.
   std::vector<CriticalityRow> rows;  ///< Enabled cameras, rig order.
   /// Index into `rows` of the worst single failure (the lowest ge_k; ties: the lowest triangulable
   /// share, then the highest sigma_max p90, then rig order); -1 when there are no rows.
@@ -70,8 +70,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
 /// Needs the coverage field; does nothing without it.
 void AddCoverageN1Grid(Fields* fields);
 
-/// {k, ge_k, worst {camera, ge_k, loss}, mean_ge_k, seconds, per_camera [{id, seen_voxels, ge1, ge2,
-/// ge3, ge_k, triangulable, sigma_max_p50_mm, sigma_max_p90_mm}]}; the uncertainty columns are
+/// {k, ge_k, worst {camera, ge_k, loss}, mean_ge_k, seconds, per_camera [{id, seen_voxels, ge1,
+/// ge2, ge3, ge_k, triangulable, sigma_max_p50_mm, sigma_max_p90_mm}]}; the uncertainty columns are
 /// null without the sigma_max field, worst is null without rows.
 void to_json(nlohmann::json& j, const CriticalityTable& table);
 

@@ -2,20 +2,21 @@
 // enabled camera of three rigs, the row computed from the per-voxel camera sets equals a full
 // EvaluateFields of the rig with that camera disabled — coverage shares, triangulable voxels and
 // sigma_max percentiles exactly (the same contribution, exact sum and eigen solver as the fields).
+#include "volume/robustness.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "analysis/primitives.h"
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
+#include "tests/fixtures.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
-#include "volume/robustness.h"
 #include "volume/summary.h"
-#include "tests/fixtures.h"
 
 namespace pandora {
 namespace {
@@ -29,8 +30,8 @@ double AtLeast(const FieldStats& st, int j) {
 
 // Checks every row of ComputeCriticality against a full evaluation without that camera, and
 // returns the table.
-CriticalityTable ExpectRowsEqualRecompute(const Scene& scene, const Rig& rig, const FieldOptions& options,
-                                          int k) {
+CriticalityTable ExpectRowsEqualRecompute(const Scene& scene, const Rig& rig,
+                                          const FieldOptions& options, int k) {
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const Fields fields = EvaluateFields(scene, rig, *caster, options);
   const CriticalityTable table = ComputeCriticality(scene, rig, fields, *caster, k);
@@ -38,7 +39,8 @@ CriticalityTable ExpectRowsEqualRecompute(const Scene& scene, const Rig& rig, co
   EXPECT_EQ(table.region_voxels, fields.stats.active_set.region_voxels);
   EXPECT_EQ(table.ge_k, AtLeast(fields.stats, k));
   EXPECT_EQ(int(table.rows.size()), rig.enabled_count());
-  const bool sigma = std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
+  const bool sigma =
+      std::find(options.fields.begin(), options.fields.end(), "sigma_max") != options.fields.end();
   EXPECT_EQ(table.uncertainty, sigma);
   for (const CriticalityRow& row : table.rows) {
     SCOPED_TRACE(scene.path + " " + rig.name + " without " + row.id);
@@ -56,7 +58,8 @@ CriticalityTable ExpectRowsEqualRecompute(const Scene& scene, const Rig& rig, co
       continue;
     }
     EXPECT_EQ(row.triangulable_voxels, after.stats.triangulable_voxels);
-    EXPECT_EQ(row.triangulable.value_or(-1), double(after.stats.triangulable_voxels) / double(after.stats.active_set.region_voxels));
+    EXPECT_EQ(row.triangulable.value_or(-1), double(after.stats.triangulable_voxels) /
+                                                 double(after.stats.active_set.region_voxels));
     // Bit for bit: nearest-rank percentiles are values of the list.
     EXPECT_EQ(row.sigma_max_p50_mm, NearestRankPercentile(after.stats.sigma_max_mm, 50));
     EXPECT_EQ(row.sigma_max_p90_mm, NearestRankPercentile(after.stats.sigma_max_mm, 90));
@@ -80,7 +83,8 @@ TEST(Robustness, EachRowEqualsRemovingThatCameraInTheLab) {
   scene.study.voxel_size = 0.1;
   FieldOptions options;
   options.fields = {"coverage", "cameras", "resolution", "sigma_max"};
-  const CriticalityTable table = ExpectRowsEqualRecompute(scene, scene.FindRig("lab10"), options, 3);
+  const CriticalityTable table =
+      ExpectRowsEqualRecompute(scene, scene.FindRig("lab10"), options, 3);
   // Not a trivial table: every camera sees part of the region, losing one costs coverage >= 3
   // somewhere, and the re-derived uncertainty differs from the intact one for some camera.
   const Fields intact = [&] {
@@ -124,7 +128,8 @@ TEST(Robustness, EachRowEqualsRemovingThatCameraInTheTraumaRoom) {
   scene.study.voxel_size = 0.008;
   FieldOptions options;
   options.fields = scene.study.fields;  // all nine, the steady ones included
-  const CriticalityTable table = ExpectRowsEqualRecompute(scene, scene.FindRig("octagon"), options, 3);
+  const CriticalityTable table =
+      ExpectRowsEqualRecompute(scene, scene.FindRig("octagon"), options, 3);
   EXPECT_EQ(table.rows.size(), 8u);
 }
 
@@ -140,7 +145,8 @@ TEST(Robustness, EachRowEqualsRemovingThatCameraAtExtremeScales) {
     SCOPED_TRACE("scale " + std::to_string(s));
     Scene scene;
     scene.path = "synthetic.json";
-    scene.objects.push_back(testing::TestObject("post", MakeBox(s * Vec3(0.15, 0.15, 0.9)), s * Vec3(0.1, 0, 0.45), true));
+    scene.objects.push_back(testing::TestObject("post", MakeBox(s * Vec3(0.15, 0.15, 0.9)),
+                                                s * Vec3(0.1, 0, 0.45), true));
     scene.study.region.box.min = s * Vec3(-0.5, -0.5, 0);
     scene.study.region.box.max = s * Vec3(0.5, 0.5, 1);
     scene.study.voxel_size = 0.08 * s;
@@ -167,7 +173,8 @@ TEST(Robustness, CoverageOnlyHasNoUncertaintyColumns) {
   scene.study.voxel_size = 0.15;
   FieldOptions options;
   options.fields = {"coverage", "cameras"};
-  const CriticalityTable table = ExpectRowsEqualRecompute(scene, scene.FindRig("lab10"), options, 2);
+  const CriticalityTable table =
+      ExpectRowsEqualRecompute(scene, scene.FindRig("lab10"), options, 2);
   nlohmann::json j = table;
   ASSERT_EQ(j["per_camera"].size(), 10u);
   EXPECT_TRUE(j["per_camera"][0]["sigma_max_p50_mm"].is_null());
@@ -184,7 +191,8 @@ TEST(Robustness, NeedsTheCameraSets) {
   options.fields = {"coverage"};
   const Fields fields = EvaluateFields(scene, scene.FindRig("lab10"), *caster, options);
   EXPECT_FALSE(HasCameraSets(fields));
-  EXPECT_THROW(ComputeCriticality(scene, scene.FindRig("lab10"), fields, *caster, 3), std::invalid_argument);
+  EXPECT_THROW(ComputeCriticality(scene, scene.FindRig("lab10"), fields, *caster, 3),
+               std::invalid_argument);
 }
 
 TEST(Robustness, CoverageN1GridIsCoverageLessOne) {

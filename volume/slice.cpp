@@ -11,9 +11,12 @@
 namespace pandora {
 
 double FieldSlice::Sample(const Vec3& p) const {
-  if (width <= 0 || height <= 0 || !(voxel_size > 0)) return std::numeric_limits<double>::quiet_NaN();
-  const double fu = (p[u_axis()] - u_min) / voxel_size + 0.5, fv = (p[v_axis()] - v_min) / voxel_size + 0.5;
-  if (!(fu >= 0 && fv >= 0 && fu < width && fv < height)) return std::numeric_limits<double>::quiet_NaN();
+  if (width <= 0 || height <= 0 || !(voxel_size > 0))
+    return std::numeric_limits<double>::quiet_NaN();
+  const double fu = (p[u_axis()] - u_min) / voxel_size + 0.5,
+               fv = (p[v_axis()] - v_min) / voxel_size + 0.5;
+  if (!(fu >= 0 && fv >= 0 && fu < width && fv < height))
+    return std::numeric_limits<double>::quiet_NaN();
   const std::size_t o = static_cast<std::size_t>(height - 1 - int(fv)) * width + int(fu);
   return has_value[o] ? values[o] : std::numeric_limits<double>::quiet_NaN();
 }
@@ -28,8 +31,10 @@ FieldSlice SliceField(const Fields& fields, const std::string& field, int axis, 
   if (field != kCoverageGrid) {
     float_grid = g.Float(field);
     if (!float_grid)
-      if (auto it = g.extra.find(field); it != g.extra.end()) float_grid = it->second;  // a derived grid
-    if (!float_grid) throw std::invalid_argument("SliceField: field '" + field + "' was not evaluated");
+      if (auto it = g.extra.find(field); it != g.extra.end())
+        float_grid = it->second;  // a derived grid
+    if (!float_grid)
+      throw std::invalid_argument("SliceField: field '" + field + "' was not evaluated");
   }
   const VoxelLattice& L = fields.lattice;
   FieldSlice s;
@@ -45,7 +50,8 @@ FieldSlice SliceField(const Fields& fields, const std::string& field, int axis, 
   if (misses && !clamp) {
     s.index = -1;
   } else {
-    s.index = static_cast<int>(std::clamp<double>(std::isnan(nearest) ? 0 : nearest, 0, n_axis - 1));
+    s.index =
+        static_cast<int>(std::clamp<double>(std::isnan(nearest) ? 0 : nearest, 0, n_axis - 1));
   }
   s.coordinate = s.index >= 0 ? L.origin[axis] + h * s.index : coordinate;
   s.width = L.dims[u_axis];

@@ -16,9 +16,9 @@ namespace pandora {
 /// row 0 at the largest coordinate (the top of a figure).
 struct FieldSlice {
   std::string field;
-  int axis = 2;             ///< Normal of the plane: 0 x, 1 y, 2 z.
-  int index = 0;            ///< Voxel index along `axis`.
-  double coordinate = 0;    ///< World coordinate of the plane (voxel centres), m.
+  int axis = 2;           ///< Normal of the plane: 0 x, 1 y, 2 z.
+  int index = 0;          ///< Voxel index along `axis`.
+  double coordinate = 0;  ///< World coordinate of the plane (voxel centres), m.
   int width = 0, height = 0;
   double u_min = 0, u_max = 0, v_min = 0, v_max = 0;  ///< In-plane extent of the voxel centres, m.
   /// Row-major width * height. `inside`: the voxel is a free region voxel (the coverage grid has it
@@ -26,8 +26,8 @@ struct FieldSlice {
   /// fields). `values`: the grid value there, 0 elsewhere.
   std::vector<unsigned char> inside, has_value;
   std::vector<double> values;
-  double voxel_size = 0;            ///< The lattice's, m.
-  double min = 0, max = 0;          ///< Range of `values` where has_value (0, 0 when none).
+  double voxel_size = 0;    ///< The lattice's, m.
+  double min = 0, max = 0;  ///< Range of `values` where has_value (0, 0 when none).
 
   int u_axis() const { return axis == 0 ? 1 : 0; }
   int v_axis() const { return axis == 2 ? 1 : 2; }

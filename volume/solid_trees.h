@@ -1,8 +1,8 @@
 #pragma once
 /// \file solid_trees.h
-/// The search trees of a scene's solids and region mesh (InsideMesh: CGAL AABB trees), built on first
-/// use and kept: an acceleration structure of the static scene, like the ray caster's BVH. A study
-/// (app/session/study.h) owns one, so a session, `pandora bench` or `pandora accuracy` that
+/// The search trees of a scene's solids and region mesh (InsideMesh: CGAL AABB trees), built on
+/// first use and kept: an acceleration structure of the static scene, like the ray caster's BVH. A
+/// study (app/session/study.h) owns one, so a session, `pandora bench` or `pandora accuracy` that
 /// evaluates the fields many times builds each tree once; an evaluation without one builds the
 /// trees it needs itself (FieldOptions::solid_trees).
 
@@ -11,8 +11,8 @@
 #include <mutex>
 #include <vector>
 
-#include "analysis/inside_mesh.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora {
 

@@ -1,12 +1,12 @@
 #include "volume/summary.h"
 
 #include <algorithm>
-#include <memory>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
-#include "analysis/inside_mesh.h"
-#include "analysis/text.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/util/text.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
@@ -57,7 +57,8 @@ std::vector<float> GridActiveValues(const Fields& fields, const std::string& nam
   return values;
 }
 
-std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, const std::string& name,
+std::vector<std::optional<double>> GridPercentileValues(const Fields& fields,
+                                                        const std::string& name,
                                                         const std::vector<int>& percentiles) {
   const std::vector<float> values = GridActiveValues(fields, name);
   std::vector<std::optional<double>> out;
@@ -101,8 +102,9 @@ std::vector<RegionCounts> CountRegions(const Scene& scene, const Fields& fields)
 }
 
 RegionSummary FinishRegion(const std::string& name, const RegionCounts& counts, bool has_resolution,
-                           bool has_sigma, std::int64_t sigma_count, std::optional<double> resolution_p10,
-                           std::optional<double> sigma_p50, std::optional<double> sigma_p90) {
+                           bool has_sigma, std::int64_t sigma_count,
+                           std::optional<double> resolution_p10, std::optional<double> sigma_p50,
+                           std::optional<double> sigma_p90) {
   RegionSummary r;
   r.name = name;
   r.voxels = counts.voxels;
@@ -123,13 +125,14 @@ std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fi
   std::vector<RegionSummary> out;
   const std::vector<RegionCounts> counts = CountRegions(scene, fields);
   const Fields::Impl& g = fields.impl();
-  const bool has_resolution = g.Float("resolution") != nullptr, has_sigma = g.Float("sigma_max") != nullptr;
+  const bool has_resolution = g.Float("resolution") != nullptr,
+             has_sigma = g.Float("sigma_max") != nullptr;
   for (std::size_t i = 0; i < counts.size(); ++i) {
     const RegionCounts& r = counts[i];
-    out.push_back(FinishRegion(scene.study.regions[i].first, r, has_resolution, has_sigma,
-                               static_cast<std::int64_t>(r.sigmas.size()),
-                               NearestRankPercentile(r.densities, 10), NearestRankPercentile(r.sigmas, 50),
-                               NearestRankPercentile(r.sigmas, 90)));
+    out.push_back(FinishRegion(
+        scene.study.regions[i].first, r, has_resolution, has_sigma,
+        static_cast<std::int64_t>(r.sigmas.size()), NearestRankPercentile(r.densities, 10),
+        NearestRankPercentile(r.sigmas, 50), NearestRankPercentile(r.sigmas, 90)));
   }
   return out;
 }
@@ -162,7 +165,8 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
   s.coverage.ge3 = Fraction(at_least[3], region);
   s.coverage.histogram = st.coverage_histogram;
   if (std::find(field_names.begin(), field_names.end(), "resolution") != field_names.end()) {
-    const std::vector<std::optional<double>> p = GridPercentileValues(fields, "resolution", {10, 50, 90});
+    const std::vector<std::optional<double>> p =
+        GridPercentileValues(fields, "resolution", {10, 50, 90});
     s.resolution_px_per_m = ResolutionPercentiles{p[0], p[1], p[2]};
   }
 
@@ -270,7 +274,9 @@ void to_json(nlohmann::json& j, const Summary& s) {
                     {"path", w.json_path},
                     {"message", w.reason}});
   j["warnings"] = list;
-  auto opt = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
   if (s.time) {
     const TimeSummary& t = *s.time;
     nlohmann::json rows = nlohmann::json::array();
@@ -285,35 +291,42 @@ void to_json(nlohmann::json& j, const Summary& s) {
                       {"sigma_max_p50_mm", opt(r.sigma_max_p50)},
                       {"sigma_max_p90_mm", opt(r.sigma_max_p90)},
                       {"seconds", r.seconds}});
-    j["time"] = {{"min_cameras", t.min_cameras},
-                 {"samples", rows},
-                 {"voxels", t.voxels},
-                 {"always", t.always},
-                 {"mean", t.mean},
-                 {"worst_sample", t.samples.empty() ? nlohmann::json() : nlohmann::json(t.samples[t.worst_sample].label)},
-                 {"sigma_max_mm", {{"p50", opt(t.sigma_max_p50)}, {"p90", opt(t.sigma_max_p90)}, {"p99", opt(t.sigma_max_p99)}}},
-                 {"seconds", t.seconds},
-                 {"parts_seconds", t.parts_seconds}};
+    j["time"] = {
+        {"min_cameras", t.min_cameras},
+        {"samples", rows},
+        {"voxels", t.voxels},
+        {"always", t.always},
+        {"mean", t.mean},
+        {"worst_sample",
+         t.samples.empty() ? nlohmann::json() : nlohmann::json(t.samples[t.worst_sample].label)},
+        {"sigma_max_mm",
+         {{"p50", opt(t.sigma_max_p50)},
+          {"p90", opt(t.sigma_max_p90)},
+          {"p99", opt(t.sigma_max_p99)}}},
+        {"seconds", t.seconds},
+        {"parts_seconds", t.parts_seconds}};
   }
   if (!s.targets.empty()) {
     nlohmann::json targets = nlohmann::json::array();
     for (const SurfaceTargetResult& r : s.targets) {
       nlohmann::json per_sample = nlohmann::json::array();
       for (std::size_t k = 0; k < r.sample_share.size(); ++k)
-        per_sample.push_back({{"label", k < s.sample_labels.size() ? s.sample_labels[k] : "as placed"},
-                              {"share", r.sample_share[k]}});
+        per_sample.push_back(
+            {{"label", k < s.sample_labels.size() ? s.sample_labels[k] : "as placed"},
+             {"share", r.sample_share[k]}});
       nlohmann::json per_camera = nlohmann::json::array();
       for (std::size_t c = 0; c < r.per_camera.size() && c < s.per_camera.size(); ++c)
         per_camera.push_back({{"id", s.per_camera[c].id}, {"share", r.per_camera[c]}});
-      targets.push_back({{"name", r.name},
-                         {"points", r.points},
-                         {"samples", r.samples},
-                         {"share_ge", r.share_ge},
-                         {"always", r.always},
-                         {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
-                         {"per_sample", per_sample},
-                         {"per_camera", per_camera},
-                         {"seconds", r.seconds}});
+      targets.push_back(
+          {{"name", r.name},
+           {"points", r.points},
+           {"samples", r.samples},
+           {"share_ge", r.share_ge},
+           {"always", r.always},
+           {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
+           {"per_sample", per_sample},
+           {"per_camera", per_camera},
+           {"seconds", r.seconds}});
       if (!r.pixel_share.empty()) {
         nlohmann::json pixel = nlohmann::json::object();
         for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
@@ -391,60 +404,84 @@ std::string PercentileCells(const std::vector<std::pair<const char*, std::option
 }  // namespace
 
 std::string FormatSummary(const Summary& s) {
-  std::string out = Format("rig %s: %d cameras, voxel %.4g m, %lld free region voxels (and %lld inside solids)\n",
-                           s.rig.c_str(), s.cameras, s.voxel_size_m, static_cast<long long>(s.region_voxels),
-                           static_cast<long long>(s.solid_voxels));
+  std::string out =
+      Format("rig %s: %d cameras, voxel %.4g m, %lld free region voxels (and %lld inside solids)\n",
+             s.rig.c_str(), s.cameras, s.voxel_size_m, static_cast<long long>(s.region_voxels),
+             static_cast<long long>(s.solid_voxels));
   out += Format("coverage  >=1 %5.1f%%   >=2 %5.1f%%   >=3 %5.1f%%\n", 100 * s.coverage.ge1,
                 100 * s.coverage.ge2, 100 * s.coverage.ge3);
   if (s.resolution_px_per_m) {
     const ResolutionPercentiles& r = *s.resolution_px_per_m;
-    out += "resolution px/m  " + PercentileCells({{"p10", r.p10}, {"p50", r.p50}, {"p90", r.p90}}, "%.0f") +
+    out += "resolution px/m  " +
+           PercentileCells({{"p10", r.p10}, {"p50", r.p50}, {"p90", r.p90}}, "%.0f") +
            "   (voxels seen by >= 1 camera, best camera)\n";
   }
   if (s.uncertainty) {
     const SigmaPercentiles& p = s.uncertainty->sigma_max_mm;
-    out += "sigma_max mm     " + PercentileCells({{"p50", p.p50}, {"p90", p.p90}, {"p99", p.p99}}, "%.3g") +
-           Format("   (triangulable voxels: %.1f%% of the region)\n", 100 * s.uncertainty->triangulable);
+    out += "sigma_max mm     " +
+           PercentileCells({{"p50", p.p50}, {"p90", p.p90}, {"p99", p.p99}}, "%.3g") +
+           Format("   (triangulable voxels: %.1f%% of the region)\n",
+                  100 * s.uncertainty->triangulable);
   }
   out += Format("%-12s %-20s %8s   %-15s %s\n", "camera", "name", "sees", "FOV h x v deg",
                 "(nominal, no distortion)");
   for (const CameraSummary& c : s.per_camera) {
     const std::string fov = Format("%.1f x %.1f", c.lens.hfov_deg, c.lens.vfov_deg);
-    const std::string nominal = Format("(%.1f x %.1f)", c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg);
-    out += Format("%-12s %-20s %7.1f%%   %-15s %s%s\n", c.id.c_str(), c.name.c_str(), 100 * c.visible_fraction,
-                  fov.c_str(), nominal.c_str(), c.enabled ? "" : "  (disabled)");
+    const std::string nominal =
+        Format("(%.1f x %.1f)", c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg);
+    out += Format("%-12s %-20s %7.1f%%   %-15s %s%s\n", c.id.c_str(), c.name.c_str(),
+                  100 * c.visible_fraction, fov.c_str(), nominal.c_str(),
+                  c.enabled ? "" : "  (disabled)");
   }
   if (s.time) {
     const TimeSummary& t = *s.time;
-    out += Format("over %zu time samples (seen by >= %d cameras): always %.1f%%, on average %.1f%%, worst %s %.1f%%; %.2f s\n",
-                  t.samples.size(), t.min_cameras, 100 * t.always, 100 * t.mean,
-                  t.samples.empty() ? "-" : t.samples[t.worst_sample].label.c_str(),
-                  t.samples.empty() ? 0.0 : 100 * t.samples[t.worst_sample].ge_k, t.seconds);
+    out += Format(
+        "over %zu time samples (seen by >= %d cameras): always %.1f%%, on average %.1f%%, worst %s "
+        "%.1f%%; %.2f s\n",
+        t.samples.size(), t.min_cameras, 100 * t.always, 100 * t.mean,
+        t.samples.empty() ? "-" : t.samples[t.worst_sample].label.c_str(),
+        t.samples.empty() ? 0.0 : 100 * t.samples[t.worst_sample].ge_k, t.seconds);
     for (const TimeSampleSummary& r : t.samples)
-      out += Format("  %-24s >=1 %5.1f%%  >=2 %5.1f%%  >=3 %5.1f%%%s\n", r.label.c_str(), 100 * r.ge1, 100 * r.ge2,
-                    100 * r.ge3, r.sigma_max_p90 ? Format("  sigma_max p90 %.3g mm", *r.sigma_max_p90).c_str() : "");
+      out += Format(
+          "  %-24s >=1 %5.1f%%  >=2 %5.1f%%  >=3 %5.1f%%%s\n", r.label.c_str(), 100 * r.ge1,
+          100 * r.ge2, 100 * r.ge3,
+          r.sigma_max_p90 ? Format("  sigma_max p90 %.3g mm", *r.sigma_max_p90).c_str() : "");
   }
   for (const RegionSummary& r : s.regions)
-    out += Format("region    %-12s %lld voxels: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%%s\n", r.name.c_str(),
-                  static_cast<long long>(r.voxels), 100 * r.ge1, 100 * r.ge2, 100 * r.ge3,
-                  r.sigma_max_p90 ? Format("; sigma_max p50 %.3g, p90 %.3g mm", *r.sigma_max_p50, *r.sigma_max_p90).c_str() : "");
+    out += Format(
+        "region    %-12s %lld voxels: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%%s\n", r.name.c_str(),
+        static_cast<long long>(r.voxels), 100 * r.ge1, 100 * r.ge2, 100 * r.ge3,
+        r.sigma_max_p90
+            ? Format("; sigma_max p50 %.3g, p90 %.3g mm", *r.sigma_max_p50, *r.sigma_max_p90)
+                  .c_str()
+            : "");
   for (const PixelTargetSummary& p : s.pixel_targets)
-    out += Format("pixels    %-12s (%.4g m over >= %.4g px: >= %.0f px/m) by >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%% of the region\n",
-                  p.target.name.c_str(), p.target.size_m, p.target.min_px, p.target.px_per_m(), 100 * p.share_ge[0],
-                  100 * p.share_ge[1], 100 * p.share_ge[2]);
+    out += Format(
+        "pixels    %-12s (%.4g m over >= %.4g px: >= %.0f px/m) by >=1 %.1f%%, >=2 %.1f%%, >=3 "
+        "%.1f%% of the region\n",
+        p.target.name.c_str(), p.target.size_m, p.target.min_px, p.target.px_per_m(),
+        100 * p.share_ge[0], 100 * p.share_ge[1], 100 * p.share_ge[2]);
   if (s.dori)
-    out += Format("DORI      detection %.1f%%, observation %.1f%%, recognition %.1f%%, identification %.1f%% of the region\n",
-                  100 * s.dori->detection, 100 * s.dori->observation, 100 * s.dori->recognition,
-                  100 * s.dori->identification);
+    out += Format(
+        "DORI      detection %.1f%%, observation %.1f%%, recognition %.1f%%, identification %.1f%% "
+        "of the region\n",
+        100 * s.dori->detection, 100 * s.dori->observation, 100 * s.dori->recognition,
+        100 * s.dori->identification);
   for (const SurfaceTargetResult& r : s.targets) {
     const int k = s.time ? s.time->min_cameras : 3;
-    out += Format("target %-16s %d points x %d samples: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%; >= %d in every sample %.1f%%",
-                  r.name.c_str(), r.points, r.samples, 100 * r.share_ge[0], 100 * r.share_ge[1], 100 * r.share_ge[2], k,
-                  100 * r.always);
+    out += Format(
+        "target %-16s %d points x %d samples: >=1 %.1f%%, >=2 %.1f%%, >=3 %.1f%%; >= %d in every "
+        "sample %.1f%%",
+        r.name.c_str(), r.points, r.samples, 100 * r.share_ge[0], 100 * r.share_ge[1],
+        100 * r.share_ge[2], k, 100 * r.always);
     for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
-      out += Format("; %s size by >= %d: %.1f%%", s.pixel_targets[p].target.name.c_str(), k, 100 * r.pixel_share[p]);
+      out += Format("; %s size by >= %d: %.1f%%", s.pixel_targets[p].target.name.c_str(), k,
+                    100 * r.pixel_share[p]);
     if (r.samples > 1)
-      out += Format(", worst %s %.1f%%", r.worst_sample < int(s.sample_labels.size()) ? s.sample_labels[r.worst_sample].c_str() : "-",
+      out += Format(", worst %s %.1f%%",
+                    r.worst_sample < int(s.sample_labels.size())
+                        ? s.sample_labels[r.worst_sample].c_str()
+                        : "-",
                     100 * r.sample_share[r.worst_sample]);
     out += "\n";
   }

@@ -6,16 +6,15 @@
 /// inside the region and outside every solid object).
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "analysis/calibration.h"
-#include "analysis/rig_check.h"
-#include "analysis/scene.h"
-#include "analysis/surface_targets.h"
+#include "analysis/rig/calibration.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/scene/scene.h"
+#include "analysis/scene/surface_targets.h"
 #include "volume/fields.h"
 #include "volume/pixel_targets.h"
 #include "volume/ptz_fields.h"
@@ -85,9 +84,10 @@ struct RegionSummary {
   std::string name;
   std::int64_t voxels = 0;
   double ge1 = 0, ge2 = 0, ge3 = 0;
-  std::optional<double> resolution_p10;            ///< px/m, with the resolution field.
-  std::optional<double> sigma_max_p50, sigma_max_p90;  ///< mm, with sigma_max; over its triangulable voxels.
-  double triangulable = 0;                         ///< Share with a sigma_max (with sigma_max).
+  std::optional<double> resolution_p10;  ///< px/m, with the resolution field.
+  std::optional<double> sigma_max_p50,
+      sigma_max_p90;        ///< mm, with sigma_max; over its triangulable voxels.
+  double triangulable = 0;  ///< Share with a sigma_max (with sigma_max).
 };
 
 /// The named sub-regions of `scene`'s study over `fields`.
@@ -105,8 +105,9 @@ std::vector<RegionCounts> CountRegions(const Scene& scene, const Fields& fields)
 /// A region's summary from its counts; `resolution_p10`, `sigma_p50`, `sigma_p90`: the percentiles
 /// of its values (nullopt when none), used when the fields had `has_resolution` / `has_sigma`.
 RegionSummary FinishRegion(const std::string& name, const RegionCounts& counts, bool has_resolution,
-                           bool has_sigma, std::int64_t sigma_count, std::optional<double> resolution_p10,
-                           std::optional<double> sigma_p50, std::optional<double> sigma_p90);
+                           bool has_sigma, std::int64_t sigma_count,
+                           std::optional<double> resolution_p10, std::optional<double> sigma_p50,
+                           std::optional<double> sigma_p90);
 
 /// Everything summary.json holds, typed.
 struct Summary {
@@ -115,7 +116,7 @@ struct Summary {
   int cameras = 0;  ///< Enabled cameras.
   std::vector<std::string> fields;
   double voxel_size_m = 0;
-  Aabb region;                      ///< The study region's box (a mesh region's bounds).
+  Aabb region;  ///< The study region's box (a mesh region's bounds).
   Eigen::Vector3i region_dims = Eigen::Vector3i::Zero();  ///< Lattice size, voxels per axis.
   Region::Kind region_kind = Region::Kind::kBox;
   std::int64_t region_voxels = 0, solid_voxels = 0;
@@ -128,8 +129,8 @@ struct Summary {
   TimingSummary timing;
   /// With moving objects: the fields over the study's time samples (volume/time_fields.h).
   std::optional<TimeSummary> time;
-  /// With surface targets: each target's shares (analysis/surface_targets.h; `cameras` left out
-  /// of the JSON).
+  /// With surface targets: each target's shares (analysis/scene/surface_targets.h; `cameras` left
+  /// out of the JSON).
   std::vector<SurfaceTargetResult> targets;
   std::vector<std::string> sample_labels;  ///< The time samples' labels (for the targets' rows).
   /// With study.pixel_targets: each over the region (volume/pixel_targets.h).
@@ -138,8 +139,8 @@ struct Summary {
   std::optional<DoriSummary> dori;
   /// With study.regions: each named sub-region (Summarize fills it).
   std::vector<RegionSummary> regions;
-  /// The calibration simulation (analysis/calibration.h) when the study asks for one; the caller
-  /// sets it (Summarize does not: it needs the ray caster).
+  /// The calibration simulation (analysis/rig/calibration.h) when the study asks for one; the
+  /// caller sets it (Summarize does not: it needs the ray caster).
   std::optional<CalibrationResult> calibration;
   /// N-1 robustness (volume/robustness.h) when the "cameras" field was evaluated; the caller sets
   /// it (ComputeCriticality needs the ray caster).
@@ -165,7 +166,7 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
 /// steady]]}, timing {seconds, active_set_seconds, rays, rays_per_second, point_camera_tests,
 /// tests_per_second, threads}, fields, region {min, max, dims, kind}, scene, scene_sha256,
 /// warnings [{kind, camera, path, message}] (always present, empty when none), calibration
-/// (analysis/calibration.h's to_json), robustness (volume/robustness.h's to_json) and ptz
+/// (analysis/rig/calibration.h's to_json), robustness (volume/robustness.h's to_json) and ptz
 /// (volume/ptz_fields.h's to_json) when set. Percentiles without a value are null.
 void to_json(nlohmann::json& j, const Summary& summary);
 
@@ -188,7 +189,8 @@ std::vector<float> GridActiveValues(const Fields& fields, const std::string& nam
 /// Nearest-rank percentiles of the active values of the float grid `name` of `fields` (tiles count
 /// once per voxel they cover), one per entry of `percentiles` (each in [0, 100]); nullopt values
 /// when the grid is missing or has no active value.
-std::vector<std::optional<double>> GridPercentileValues(const Fields& fields, const std::string& name,
+std::vector<std::optional<double>> GridPercentileValues(const Fields& fields,
+                                                        const std::string& name,
                                                         const std::vector<int>& percentiles);
 
 /// The same as {"pNN": value} (null where there is none).

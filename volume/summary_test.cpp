@@ -1,8 +1,8 @@
 // The typed summary (volume/summary.h) against closed forms and brute force: nearest-rank
 // percentiles of known lists, the free-voxel count of a box region around a solid cube, coverage
 // and per-camera counts from VisibilityTester on every voxel centre, the sigma_max and resolution
-// percentiles from the per-point evaluation (analysis/uncertainty.h), and summary.json as the
-// typed value's JSON form.
+// percentiles from the per-point evaluation (analysis/geometry/uncertainty.h), and summary.json as
+// the typed value's JSON form.
 #include "volume/summary.h"
 
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <filesystem>
 #include <random>
 
-#include "analysis/primitives.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
 #include "tests/fixtures.h"
 #include "volume/active_set.h"
 #include "volume/value_spill.h"
@@ -24,7 +24,7 @@ namespace {
 
 TEST(NearestRankPercentile, KnownLists) {
   std::vector<float> v{10, 1, 9, 2, 8, 3, 7, 4, 6, 5};  // 1..10 shuffled
-  EXPECT_EQ(*NearestRankPercentile(v, 50), 5.0);   // ceil(0.5 * 10) = 5th smallest
+  EXPECT_EQ(*NearestRankPercentile(v, 50), 5.0);        // ceil(0.5 * 10) = 5th smallest
   EXPECT_EQ(*NearestRankPercentile(v, 90), 9.0);
   EXPECT_EQ(*NearestRankPercentile(v, 99), 10.0);  // ceil(9.9) = 10th
   EXPECT_EQ(*NearestRankPercentile(v, 0), 1.0);    // at least the first
@@ -54,11 +54,11 @@ TEST(ValueSpill, EqualsNearestRankPercentileAndCounts) {
     for (std::size_t i = 0; i < piece; ++i) {
       const int kind = int(rng() % 5);
       float v = 0;
-      if (kind == 0) v = float(rng() % 40) * 0.25f;                   // ties
-      if (kind == 1) v = 1.0f + float(rng() % 1000) * 1e-7f;         // same upper 16 bits
+      if (kind == 0) v = float(rng() % 40) * 0.25f;           // ties
+      if (kind == 1) v = 1.0f + float(rng() % 1000) * 1e-7f;  // same upper 16 bits
       if (kind == 2) v = std::ldexp(float(rng() % 1000 + 1), int(rng() % 60) - 30);  // magnitudes
-      if (kind == 3) v = -float(rng() % 1000) * 0.125f;              // negatives
-      if (kind == 4) v = (rng() % 2) ? 0.0f : -0.0f;                 // both zeros
+      if (kind == 3) v = -float(rng() % 1000) * 0.125f;                              // negatives
+      if (kind == 4) v = (rng() % 2) ? 0.0f : -0.0f;                                 // both zeros
       part.push_back(v);
     }
     spill.Append(part);
@@ -79,9 +79,11 @@ TEST(ValueSpill, EqualsNearestRankPercentileAndCounts) {
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += y[i];
     return x;
   };
-  const PercentileBins selection = SelectPercentileBins(add(part_a.HighCounts(), part_b.HighCounts()), ps);
+  const PercentileBins selection =
+      SelectPercentileBins(add(part_a.HighCounts(), part_b.HighCounts()), ps);
   const std::vector<std::optional<double>> merged = ResolvePercentiles(
-      selection, add(part_a.LowCounts(selection.bins), part_b.LowCounts(selection.bins)), ps.size());
+      selection, add(part_a.LowCounts(selection.bins), part_b.LowCounts(selection.bins)),
+      ps.size());
   for (std::size_t i = 0; i < ps.size(); ++i) EXPECT_EQ(merged[i], got[i]) << ps[i];
   EXPECT_GT(part_a.size(), 1000);
   EXPECT_GT(part_b.size(), 1000);
@@ -98,7 +100,8 @@ struct RoomSetup {
   std::unique_ptr<RayCaster> caster;
   RoomSetup() {
     scene = testing::BoxRoom(Vec3(4, 4, 2.5), 0.1);
-    scene.objects.push_back(testing::TestObject("cube", MakeBox(Vec3(0.35, 0.35, 0.35)), Vec3(0, 0, 0.5), true));
+    scene.objects.push_back(
+        testing::TestObject("cube", MakeBox(Vec3(0.35, 0.35, 0.35)), Vec3(0, 0, 0.5), true));
     scene.study.pixel_sigma = 0.5;
     scene.study.max_sigma_mm = 2.0;
     rig = testing::RingRig(6, 1.8, 1.2, Vec3(0, 0, 0.5), 70);
@@ -183,7 +186,8 @@ TEST(Summarize, CountsAndPercentilesMatchBruteForce) {
     ASSERT_TRUE(value) << p;
     EXPECT_NEAR(*value, *NearestRankPercentile(sigma_mm, p), 1e-5 * *value) << p;
   }
-  const double meets = std::count_if(sigma_mm.begin(), sigma_mm.end(), [](float v) { return v <= 2.0; });
+  const double meets =
+      std::count_if(sigma_mm.begin(), sigma_mm.end(), [](float v) { return v <= 2.0; });
   EXPECT_NEAR(*summary.uncertainty->meets_max_sigma, meets / free, 2.0 / free);
   EXPECT_FALSE(summary.uncertainty->motion);
   ASSERT_TRUE(summary.resolution_px_per_m);
@@ -200,7 +204,8 @@ TEST(Summarize, JsonIsTheTypedValue) {
   FieldOptions options;
   options.fields = names;
   const Fields fields = EvaluateFields(s.scene, s.rig, *s.caster, options);
-  std::vector<Warning> warnings{{Warning::Kind::kSeesNoRegion, "c9", "$.rigs[0].cameras[9]", "sees nothing"}};
+  std::vector<Warning> warnings{
+      {Warning::Kind::kSeesNoRegion, "c9", "$.rigs[0].cameras[9]", "sees nothing"}};
   const Summary typed = Summarize(s.scene, s.rig, fields, names, 2, warnings);
   const nlohmann::json j = MakeSummary(s.scene, s.rig, fields, names, 2, warnings);
   EXPECT_EQ(j, nlohmann::json(typed));
@@ -212,7 +217,8 @@ TEST(Summarize, JsonIsTheTypedValue) {
   EXPECT_EQ(u["sigma_max_mm"]["p90"].get<double>(), *typed.uncertainty->sigma_max_mm.p90);
   EXPECT_EQ(u["motion"]["rate_hz"].get<double>(), 60.0);
   EXPECT_EQ(u["motion"]["covariance"], "posterior");
-  EXPECT_EQ(u["sigma_max_steady_mm"]["p50"].get<double>(), *typed.uncertainty->sigma_max_steady_mm.p50);
+  EXPECT_EQ(u["sigma_max_steady_mm"]["p50"].get<double>(),
+            *typed.uncertainty->sigma_max_steady_mm.p50);
   EXPECT_EQ(u["max_sigma_mm"].get<double>(), 2.0);
   EXPECT_TRUE(u.contains("meets_max_sigma_steady"));
   // The steady state is tighter than one frame.
@@ -272,15 +278,18 @@ TEST(FormatSummary, TheTableAnalyzePrints) {
   s.timing.rays = 1000000;
   s.timing.point_camera_tests = 2000000;
   const std::string t = FormatSummary(s);
-  EXPECT_EQ(t,
-            "rig ring: 1 cameras, voxel 0.05 m, 1000 free region voxels (and 64 inside solids)\n"
-            "coverage  >=1  90.0%   >=2  50.0%   >=3  12.5%\n"
-            "resolution px/m    p10    1134  p50    1229  p90       -   (voxels seen by >= 1 camera, best camera)\n"
-            "sigma_max mm       p50   0.991  p90    3.48  p99    4.72   (triangulable voxels: 50.0% of the region)\n"
-            "camera       name                     sees   FOV h x v deg   (nominal, no distortion)\n"
-            "c0           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)\n"
-            "c1           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)  (disabled)\n"
-            "0.500 s, 1e+06 rays (2e+06 rays/s), 2e+06 point-camera tests\n");
+  EXPECT_EQ(
+      t,
+      "rig ring: 1 cameras, voxel 0.05 m, 1000 free region voxels (and 64 inside solids)\n"
+      "coverage  >=1  90.0%   >=2  50.0%   >=3  12.5%\n"
+      "resolution px/m    p10    1134  p50    1229  p90       -   (voxels seen by >= 1 camera, "
+      "best camera)\n"
+      "sigma_max mm       p50   0.991  p90    3.48  p99    4.72   (triangulable voxels: 50.0% of "
+      "the region)\n"
+      "camera       name                     sees   FOV h x v deg   (nominal, no distortion)\n"
+      "c0           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)\n"
+      "c1           left                    59.5%   40.4 x 30.7     (40.0 x 30.5)  (disabled)\n"
+      "0.500 s, 1e+06 rays (2e+06 rays/s), 2e+06 point-camera tests\n");
   // Without the resolution and uncertainty fields their lines are left out.
   s.resolution_px_per_m.reset();
   s.uncertainty.reset();

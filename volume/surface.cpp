@@ -8,12 +8,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "analysis/atomic_file.h"
-#include "analysis/seeded.h"
-#include "analysis/error.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
-#include "analysis/color.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/color.h"
+#include "analysis/util/error.h"
+#include "analysis/util/seeded.h"
 
 namespace pandora {
 namespace {
@@ -59,8 +59,8 @@ bool Faces(const std::vector<Vec3>& extremes, const Vec3& a, const Vec3& b, cons
   return false;
 }
 
-bool Selected(SurfaceSelection selection, const std::vector<Vec3>& extremes, const TriangleMesh& mesh,
-              const Eigen::Vector3i& t) {
+bool Selected(SurfaceSelection selection, const std::vector<Vec3>& extremes,
+              const TriangleMesh& mesh, const Eigen::Vector3i& t) {
   return selection == SurfaceSelection::kAll ||
          Faces(extremes, mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
 }
@@ -75,8 +75,8 @@ std::vector<Vec3> EnabledCentres(const Rig* rig) {
 
 }  // namespace
 
-bool FacesRegionOrViewpoints(const Region& region, const std::vector<Vec3>& viewpoints, const Vec3& a,
-                             const Vec3& b, const Vec3& c) {
+bool FacesRegionOrViewpoints(const Region& region, const std::vector<Vec3>& viewpoints,
+                             const Vec3& a, const Vec3& b, const Vec3& c) {
   return Faces(Extremes(region, viewpoints), a, b, c);
 }
 
@@ -98,12 +98,11 @@ std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing, st
   const double area = SurfaceArea(scene, selection, rig);
   const double expected = area / (spacing * spacing);
   if (expected > kMaxSurfaceSamples)
-    throw InputError(option, "",
-                     "spacing " + Number(spacing) + " m gives about " + Number(expected) +
-                         " samples over " + Number(area) + " m^2 of surface, over the limit of " +
-                         Number(kMaxSurfaceSamples),
-                     "use a spacing of at least " +
-                         Number(std::sqrt(area / kMaxSurfaceSamples) * 1.01) + " m");
+    throw InputError(
+        option, "",
+        "spacing " + Number(spacing) + " m gives about " + Number(expected) + " samples over " +
+            Number(area) + " m^2 of surface, over the limit of " + Number(kMaxSurfaceSamples),
+        "use a spacing of at least " + Number(std::sqrt(area / kMaxSurfaceSamples) * 1.01) + " m");
 
   // Counts first (per object, per triangle), then the points: the output order is object, triangle,
   // sample, whatever the thread count.
@@ -168,7 +167,8 @@ PointValues PointEvaluator::Evaluate(const Vec3& point, const Vec3* normal) cons
   for (int c = 0; c < cameras; ++c) {
     Ray segment;
     Mat23 Jc;
-    if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen) continue;
+    if (tester.TestGeometryCameraFrame(c, point, normal, &segment, &Jc) != ViewResult::kSeen)
+      continue;
     if (segment.t_far > segment.t_near && tester.caster().Occluded(segment)) continue;
     ++v.coverage;
     v.cameras.push_back(c);
@@ -221,7 +221,8 @@ void WriteSurfacePly(const std::string& path, const std::vector<SurfaceSample>& 
     header += "comment " + c + "\n";
   }
   header += "element vertex " + std::to_string(samples.size()) + "\n";
-  for (const char* p : {"x", "y", "z", "nx", "ny", "nz"}) header += std::string("property float ") + p + "\n";
+  for (const char* p : {"x", "y", "z", "nx", "ny", "nz"})
+    header += std::string("property float ") + p + "\n";
   header +=
       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       "property float coverage\nproperty float resolution\nproperty float sigma_max\n"

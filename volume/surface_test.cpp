@@ -2,7 +2,10 @@
 // uniformity, determinism), per-sample values equal to the volume grids at voxel centres and to an
 // independent brute-force loop on surfaces (back faces excluded), slices, and the PLY file read
 // back byte by byte.
+#include "volume/surface.h"
+
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,19 +15,16 @@
 #include <map>
 #include <sstream>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/primitives.h"
-#include "analysis/uncertainty.h"
-#include "analysis/visibility.h"
-#include "volume/fields_vdb.h"
-#include "volume/slice.h"
-#include "analysis/color.h"
-#include "volume/surface.h"
+#include "analysis/geometry/primitives.h"
+#include "analysis/geometry/uncertainty.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/color.h"
+#include "analysis/util/error.h"
 #include "tests/fixtures.h"
 #include "tests/random_scene.h"
-
-#include <unistd.h>
+#include "volume/fields_vdb.h"
+#include "volume/slice.h"
 
 namespace pandora {
 namespace {
@@ -32,8 +32,9 @@ namespace {
 // A 640 x 480 camera (tests/fixtures.h) with a working range of 5 cm to 20 m and an optional k1.
 Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& target, double hfov_deg,
                   LensModel model = LensModel::kPinhole, double k1 = 0) {
-  Camera cam = testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 640, 480, model),
-                                       [&](Intrinsics& k) { k.k1 = k1; });
+  Camera cam =
+      testing::WithIntrinsics(testing::TestCamera(id, position, target, hfov_deg, 640, 480, model),
+                              [&](Intrinsics& k) { k.k1 = k1; });
   cam.near = 0.05;
   cam.far = 20;
   return cam;
@@ -44,16 +45,21 @@ Camera MakeCamera(const std::string& id, const Vec3& position, const Vec3& targe
 Scene TestScene() {
   Scene scene;
   scene.path = "test.json";
-  scene.objects.push_back(testing::TestObject("floor", MakePlane(Vec2(2.0, 2.0)), Vec3(0, 0, -0.01), false));
-  scene.objects.push_back(testing::TestObject("ball", MakeSphere(0.3, 24), Vec3(0.1, 0.0, 0.35), true));
-  scene.objects.push_back(testing::TestObject("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true));
+  scene.objects.push_back(
+      testing::TestObject("floor", MakePlane(Vec2(2.0, 2.0)), Vec3(0, 0, -0.01), false));
+  scene.objects.push_back(
+      testing::TestObject("ball", MakeSphere(0.3, 24), Vec3(0.1, 0.0, 0.35), true));
+  scene.objects.push_back(
+      testing::TestObject("post", MakeBox(Vec3(0.1, 0.1, 1.5)), Vec3(-0.5, 0.6, 0), true));
   Rig rig;
   rig.name = "mixed";
   rig.cameras.push_back(MakeCamera("c0", Vec3(3, 0, 1.5), Vec3(0, 0, 0), 50));
-  rig.cameras.push_back(MakeCamera("c1", Vec3(0, 3, 2), Vec3(0, 0, 0), 70, LensModel::kBrownConrady, -0.2));
+  rig.cameras.push_back(
+      MakeCamera("c1", Vec3(0, 3, 2), Vec3(0, 0, 0), 70, LensModel::kBrownConrady, -0.2));
   rig.cameras.push_back(MakeCamera("c2", Vec3(-2, -2, 1.5), Vec3(0, 0, 0.2), 80));
-  rig.cameras.push_back(MakeCamera("c3", Vec3(0.2, 0.1, -2), Vec3(0, 0, 0), 60));  // below the floor
-  rig.cameras.push_back(MakeCamera("c4", Vec3(-3, 0, 0.5), Vec3(-4, 0, 0), 60));   // looks away
+  rig.cameras.push_back(
+      MakeCamera("c3", Vec3(0.2, 0.1, -2), Vec3(0, 0, 0), 60));                   // below the floor
+  rig.cameras.push_back(MakeCamera("c4", Vec3(-3, 0, 0.5), Vec3(-4, 0, 0), 60));  // looks away
   rig.cameras[1].pixel_sigma = 0.8;
   scene.rigs.push_back(rig);
   scene.study.region.box.min = Vec3(-1, -1, 0.0);
@@ -98,9 +104,10 @@ TEST(SurfaceSampling, CountsPositionsNormalsAndDeterminism) {
     const TriangleMesh& mesh = scene.objects[o].mesh;
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const Vec3& a = mesh.vertices[mesh.triangles[t][0]];
-      const double e = 0.5 * (mesh.vertices[mesh.triangles[t][1]] - a)
-                                 .cross(mesh.vertices[mesh.triangles[t][2]] - a)
-                                 .norm() /
+      const double e = 0.5 *
+                       (mesh.vertices[mesh.triangles[t][1]] - a)
+                           .cross(mesh.vertices[mesh.triangles[t][2]] - a)
+                           .norm() /
                        (spacing * spacing);
       const int got = per_triangle[{int(o), int(t)}];
       EXPECT_TRUE(got == std::floor(e) || got == std::floor(e) + 1) << o << " " << t << " " << e;
@@ -114,7 +121,8 @@ TEST(SurfaceSampling, CountsPositionsNormalsAndDeterminism) {
   // Same seed, same samples; another seed, other positions.
   const std::vector<SurfaceSample> again = SampleSurfaces(scene, spacing, 7);
   ASSERT_EQ(again.size(), samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) ASSERT_EQ(again[i].position, samples[i].position);
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    ASSERT_EQ(again[i].position, samples[i].position);
   const std::vector<SurfaceSample> other = SampleSurfaces(scene, spacing, 8);
   ASSERT_FALSE(other.empty());
   EXPECT_NE(other[0].position, samples[0].position);
@@ -125,7 +133,8 @@ TEST(SurfaceSampling, UniformOverAPlane) {
   // 24 degrees of freedom below its 0.999 quantile (51.2). Sampling without the square root in the
   // barycentric map crowds the points towards one corner and fails this by far.
   Scene scene;
-  scene.objects.push_back(testing::TestObject("plane", MakePlane(Vec2(1.0, 1.0)), Vec3(0, 0, 0), false));
+  scene.objects.push_back(
+      testing::TestObject("plane", MakePlane(Vec2(1.0, 1.0)), Vec3(0, 0, 0), false));
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, 0.01, 3);
   ASSERT_NEAR(double(samples.size()), 10000.0, 3.0);
   std::vector<double> cells(25, 0.0);
@@ -147,7 +156,8 @@ TEST(SurfaceSampling, UniformOverAPlane) {
 // brings that face back. Sheets (single-sided planes) facing into a room are kept, facing out not.
 TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
   Scene scene;
-  scene.objects.push_back(testing::TestObject("cube", MakeBox(Vec3(1, 1, 1)), Vec3(2.5, 0, 0), true));
+  scene.objects.push_back(
+      testing::TestObject("cube", MakeBox(Vec3(1, 1, 1)), Vec3(2.5, 0, 0), true));
   scene.study.region.box.min = Vec3(-1, -1, -1);
   scene.study.region.box.max = Vec3(1, 1, 1);
   EXPECT_NEAR(SurfaceArea(scene, SurfaceSelection::kAll), 6.0, 1e-12);
@@ -177,8 +187,8 @@ TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
   room.box.min = Vec3(-1, -1, 0);
   room.box.max = Vec3(1, 1, 2);
   const Vec3 a(-3, -3, 0), b(3, -3, 0), c(3, 3, 0), up(0, 0, 3);
-  EXPECT_TRUE(FacesRegionOrViewpoints(room, {}, a, b, c));             // the floor, facing up
-  EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a, c, b));            // its underside
+  EXPECT_TRUE(FacesRegionOrViewpoints(room, {}, a, b, c));                  // the floor, facing up
+  EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a, c, b));                 // its underside
   EXPECT_FALSE(FacesRegionOrViewpoints(room, {}, a + up, b + up, c + up));  // a ceiling's top
   EXPECT_TRUE(FacesRegionOrViewpoints(room, {}, a + up, c + up, b + up));   // its underside
   // Touching the region's top face from above, facing away: no point strictly in front.
@@ -192,7 +202,8 @@ TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
 // faces, the facing selection drops samples, yet its seen samples are exactly those of all.
 TEST(SurfaceSampling, FacingDropsNoSeenSample) {
   Scene scene = TestScene();
-  scene.objects.push_back(testing::TestObject("crate", MakeBox(Vec3(1, 1, 1)), Vec3(0, -3, 0.5), true));
+  scene.objects.push_back(
+      testing::TestObject("crate", MakeBox(Vec3(1, 1, 1)), Vec3(0, -3, 0.5), true));
   const Rig& rig = scene.rigs[0];
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const PointEvaluator evaluator(scene, rig, *caster);
@@ -329,7 +340,8 @@ TEST(PointEvaluator, SurfaceSamplesMatchABruteForceLoop) {
   const auto embree = MakeEmbreeRayCaster(all);
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, 0.06, 11);
   ASSERT_GT(samples.size(), 1000u);
-  const std::vector<PointValues> values = PointEvaluator(scene, rig, *embree).EvaluateSamples(samples);
+  const std::vector<PointValues> values =
+      PointEvaluator(scene, rig, *embree).EvaluateSamples(samples);
   ASSERT_EQ(values.size(), samples.size());
   std::size_t mismatched = 0, triangulable = 0, floor_seen_from_below = 0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -345,8 +357,9 @@ TEST(PointEvaluator, SurfaceSamplesMatchABruteForceLoop) {
       for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
         if (v.Sees(int(c)) == ref.Sees(int(c))) continue;
         Ray seg;
-        ASSERT_EQ(rules.TestGeometry(static_cast<int>(c), samples[i].position, &samples[i].normal, &seg),
-                  ViewResult::kSeen);
+        ASSERT_EQ(
+            rules.TestGeometry(static_cast<int>(c), samples[i].position, &samples[i].normal, &seg),
+            ViewResult::kSeen);
         const Vec3 a = seg.origin + seg.t_near * seg.direction;
         const Vec3 b = seg.origin + seg.t_far * seg.direction;
         const bool shallow = std::abs(samples[i].normal.normalized().dot(seg.direction)) < 0.01;
@@ -387,7 +400,8 @@ TEST(PointEvaluator, TwoOrthogonalPinholesClosedForm) {
   rig.cameras.push_back(MakeCamera("y", Vec3(0, d, 0), Vec3(0, 0, 0), 60));
   scene.rigs.push_back(rig);
   scene.study.pixel_sigma = sigma;
-  scene.objects.push_back(testing::TestObject("far", MakeBox(Vec3(0.1, 0.1, 0.1)), Vec3(5, 5, 5), true));
+  scene.objects.push_back(
+      testing::TestObject("far", MakeBox(Vec3(0.1, 0.1, 0.1)), Vec3(5, 5, 5), true));
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const PointValues v = PointEvaluator(scene, rig, *caster).Evaluate(Vec3::Zero());
   const double f = rig.cameras[0].model.intrinsics().fx;
@@ -403,8 +417,9 @@ TEST(SurfacePly, HeaderAndRecordsReadBack) {
   const std::vector<SurfaceSample> samples = SampleSurfaces(scene, 0.1, 1);
   const std::vector<PointValues> values =
       PointEvaluator(scene, scene.rigs[0], *caster).EvaluateSamples(samples);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("surface_test_" + std::to_string(::getpid()) + ".ply")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("surface_test_" + std::to_string(::getpid()) + ".ply"))
+                               .string();
   WriteSurfacePly(path, samples, values, 4, {"units: metres", "two\nlines"});
   EXPECT_FALSE(std::filesystem::exists(TemporaryPath(path)));
   std::ifstream in(path, std::ios::binary);
@@ -415,13 +430,15 @@ TEST(SurfacePly, HeaderAndRecordsReadBack) {
   const std::size_t end = file.find("end_header\n");
   ASSERT_NE(end, std::string::npos);
   const std::string header = file.substr(0, end);
-  const std::string start = "ply\nformat binary_little_endian 1.0\ncomment units: metres\n"
-                            "comment two lines\nelement vertex " + std::to_string(samples.size()) + "\n";
+  const std::string start =
+      "ply\nformat binary_little_endian 1.0\ncomment units: metres\n"
+      "comment two lines\nelement vertex " +
+      std::to_string(samples.size()) + "\n";
   EXPECT_EQ(header.rfind(start, 0), 0u) << header;
-  for (const char* p : {"property float x\n", "property float nz\n", "property uchar red\n",
-                        "property float coverage\n", "property float resolution\n",
-                        "property float sigma_max\n", "property uchar triangulable\n",
-                        "property int object\n"})
+  for (const char* p :
+       {"property float x\n", "property float nz\n", "property uchar red\n",
+        "property float coverage\n", "property float resolution\n", "property float sigma_max\n",
+        "property uchar triangulable\n", "property int object\n"})
     EXPECT_NE(header.find(p), std::string::npos) << p;
   const std::size_t record = 24 + 3 + 12 + 1 + 4;
   const char* data = file.data() + end + std::strlen("end_header\n");
@@ -486,7 +503,7 @@ TEST(FieldSlice, PicksTheNearestPlaneAndMarksTheRegion) {
       }
       solid += !s.inside[o];
     }
-  EXPECT_GT(solid, 20);  // the ball's cross-section
+  EXPECT_GT(solid, 20);                                            // the ball's cross-section
   const FieldSlice y = SliceField(fields, "sigma_max", 1, 100.0);  // clamped to the last plane
   EXPECT_EQ(y.index, fields.lattice.dims.y() - 1);
   EXPECT_EQ(y.width, fields.lattice.dims.x());

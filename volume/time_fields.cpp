@@ -4,7 +4,7 @@
 #include <chrono>
 #include <limits>
 
-#include "analysis/ray_caster.h"
+#include "analysis/geometry/ray_caster.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
@@ -13,13 +13,15 @@ namespace pandora {
 FieldOptions OverTimeOptions(FieldOptions options) {
   options.partition_count = 1;
   options.partition_rank = 0;
-  options.fields.erase(std::remove(options.fields.begin(), options.fields.end(), "cameras"), options.fields.end());
+  options.fields.erase(std::remove(options.fields.begin(), options.fields.end(), "cameras"),
+                       options.fields.end());
   return options;
 }
 
-TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
-                                        const std::vector<TimeSample>& samples, const FieldOptions& options_in,
-                                        int min_cameras) {
+TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
+                                        const RigidPartsRayCaster& parts,
+                                        const std::vector<TimeSample>& samples,
+                                        const FieldOptions& options_in, int min_cameras) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   TimeFieldsResult result;
@@ -30,7 +32,8 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
     options.fields.insert(options.fields.begin(), "coverage");
   const std::function<void(double)> progress = options.progress;
   openvdb::Int32Grid::Ptr min_grid = openvdb::Int32Grid::create(std::numeric_limits<int>::max());
-  openvdb::Int32Grid::Ptr free_grid = openvdb::Int32Grid::create(0), good_grid = openvdb::Int32Grid::create(0);
+  openvdb::Int32Grid::Ptr free_grid = openvdb::Int32Grid::create(0),
+                          good_grid = openvdb::Int32Grid::create(0);
   auto min_acc = min_grid->getAccessor();
   auto free_acc = free_grid->getAccessor();
   auto good_acc = good_grid->getAccessor();
@@ -70,8 +73,10 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
     if (coverage) {
       if (!transform) transform = coverage->transformPtr()->copy();
       ForEachActiveVoxel(*coverage, [&](const openvdb::Coord& c, int value) {
-        if (value < min_acc.getValue(c)) min_acc.setValue(c, value);
-        else min_acc.setValueOn(c);
+        if (value < min_acc.getValue(c))
+          min_acc.setValue(c, value);
+        else
+          min_acc.setValueOn(c);
         free_acc.setValue(c, free_acc.getValue(c) + 1);
         if (value >= min_cameras) good_acc.setValue(c, good_acc.getValue(c) + 1);
         ++free_pairs;
@@ -82,7 +87,8 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, cons
     out.samples.push_back(row);
   }
   // The combined grids, active on every voxel free in some sample.
-  openvdb::FloatGrid::Ptr min_out = openvdb::FloatGrid::create(0.0f), share_out = openvdb::FloatGrid::create(0.0f);
+  openvdb::FloatGrid::Ptr min_out = openvdb::FloatGrid::create(0.0f),
+                          share_out = openvdb::FloatGrid::create(0.0f);
   auto mo = min_out->getAccessor();
   auto so = share_out->getAccessor();
   std::int64_t voxels = 0, always = 0;

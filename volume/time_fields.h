@@ -1,18 +1,18 @@
 #pragma once
 /// \file time_fields.h
 /// Fields over time: the study's fields evaluated at every time sample of a scene with moving
-/// objects (analysis/motion.h), each sample over the scene as it is then (the moved objects occlude,
-/// a solid body's inside is not free space while it is there), with the sample's ray caster from the
-/// scene's rigid parts (no BVH rebuilt). Combined per voxel into the worst case and the share of
-/// time, and per sample into the summary's rows. docs/time.md.
+/// objects (analysis/scene/motion.h), each sample over the scene as it is then (the moved objects
+/// occlude, a solid body's inside is not free space while it is there), with the sample's ray
+/// caster from the scene's rigid parts (no BVH rebuilt). Combined per voxel into the worst case and
+/// the share of time, and per sample into the summary's rows. docs/time.md.
 
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "analysis/motion.h"
-#include "analysis/scene.h"
+#include "analysis/scene/motion.h"
+#include "analysis/scene/scene.h"
 #include "volume/fields.h"
 
 namespace pandora {
@@ -23,7 +23,7 @@ class RigidPartsRayCaster;
 struct TimeSampleSummary {
   std::string label;
   double time = 0;
-  std::int64_t region_voxels = 0;  ///< Free region voxels at this sample.
+  std::int64_t region_voxels = 0;              ///< Free region voxels at this sample.
   double ge1 = 0, ge2 = 0, ge3 = 0, ge_k = 0;  ///< Shares seen by >= 1, 2, 3, min_cameras cameras.
   std::optional<double> sigma_max_p50, sigma_max_p90;  ///< mm, with an uncertainty field.
   double seconds = 0;
@@ -58,9 +58,10 @@ struct TimeFieldsResult {
 
 /// Evaluates `options.fields` for `rig` at every sample and combines them. `parts` is
 /// MakeSceneParts(scene). Throws as EvaluateFields.
-TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
-                                        const std::vector<TimeSample>& samples, const FieldOptions& options,
-                                        int min_cameras);
+TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
+                                        const RigidPartsRayCaster& parts,
+                                        const std::vector<TimeSample>& samples,
+                                        const FieldOptions& options, int min_cameras);
 
 /// The options of EvaluateFieldsOverTime from a run's fields options: the samples evaluated whole
 /// (one partition: under MPI rank 0 evaluates them, docs/scale.md), without the per-camera sets

@@ -7,18 +7,18 @@
 #include <map>
 #include <string>
 
-#include "analysis/ray_caster.h"
-#include "analysis/surface_targets.h"
-#include "analysis/visibility.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/scene/surface_targets.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
 namespace pandora {
 namespace {
 
-// A room with two moving groups: a keyframed cart and a "person" (a capsule and a sphere, solid) that
-// walks through the region, four cameras in the corners; the study samples five times and targets
-// both groups' surfaces.
+// A room with two moving groups: a keyframed cart and a "person" (a capsule and a sphere, solid)
+// that walks through the region, four cameras in the corners; the study samples five times and
+// targets both groups' surfaces.
 Scene TestScene() {
   return ParseScene(R"({"pandora": 1,
     "objects": [
@@ -95,7 +95,8 @@ TEST(TimeFields, EqualABruteForceLoopOverSamples) {
     EXPECT_EQ(share_acc.getValue(xyz), float(double(good[c]) / free[c]));
     always += n >= k;
   }
-  EXPECT_EQ(result.grids.impl().extra.at("coverage_min")->activeVoxelCount(), openvdb::Index64(least.size()));
+  EXPECT_EQ(result.grids.impl().extra.at("coverage_min")->activeVoxelCount(),
+            openvdb::Index64(least.size()));
   const TimeSummary& t = result.summary;
   EXPECT_EQ(t.voxels, std::int64_t(least.size()));
   EXPECT_DOUBLE_EQ(t.always, double(always) / double(least.size()));
@@ -115,7 +116,8 @@ TEST(SurfaceTargets, EqualVisibilityTestsOnEachSamplesOwnScene) {
   const std::vector<TimeSample> samples = scene.TimeSamples();
   const auto parts = MakeSceneParts(scene);
   const int k = scene.TimeMinCameras();
-  const std::vector<SurfaceTargetResult> results = EvaluateSurfaceTargets(scene, rig, *parts, samples, k);
+  const std::vector<SurfaceTargetResult> results =
+      EvaluateSurfaceTargets(scene, rig, *parts, samples, k);
   ASSERT_EQ(results.size(), 2u);
   std::size_t differ = 0, total = 0;
   for (std::size_t g = 0; g < results.size(); ++g) {
@@ -134,7 +136,8 @@ TEST(SurfaceTargets, EqualVisibilityTestsOnEachSamplesOwnScene) {
       const Scene at = SceneAtSample(scene, samples[s]);
       const auto caster = MakeEmbreeRayCaster(at.AllTriangles());
       const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
-      const Eigen::Isometry3d T = PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
+      const Eigen::Isometry3d T =
+          PoseTransform(samples[s].poses[motion], scene.motions[motion].anchor);
       for (std::size_t i = 0; i < points.size(); ++i) {
         const Vec3 X = T * points[i], n = T.linear() * normals[i];
         int count = 0;
@@ -159,7 +162,8 @@ TEST(SurfaceTargets, EqualVisibilityTestsOnEachSamplesOwnScene) {
 TEST(SurfaceTargets, SamplesAreUniformByArea) {
   // Two unit squares, one four times the other's area: a fifth of the points on the small one.
   TriangleMesh mesh;
-  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {5, 0, 0}, {7, 0, 0}, {7, 2, 0}, {5, 2, 0}};
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                   {5, 0, 0}, {7, 0, 0}, {7, 2, 0}, {5, 2, 0}};
   mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
   std::vector<Vec3> p, n;
   SampleSurface(mesh, 20000, 9, &p, &n);

@@ -10,7 +10,7 @@
 #include <cstring>
 #include <map>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 
 namespace pandora {
 namespace {
@@ -57,7 +57,9 @@ void ValueSpill::Append(const std::vector<float>& values) {
   if (std::fseek(file_, 0, SEEK_END) != 0 ||
       std::fwrite(values.data(), sizeof(float), values.size(), file_) != values.size() ||
       std::fflush(file_) != 0)
-    throw InputError(blame_, "", std::string("cannot write a temporary file of values: ") + std::strerror(errno));
+    throw InputError(
+        blame_, "",
+        std::string("cannot write a temporary file of values: ") + std::strerror(errno));
   count_ += static_cast<std::int64_t>(values.size());
 }
 
@@ -65,7 +67,8 @@ template <typename Fn>
 void ValueSpill::ForEachChunk(Fn&& fn) const {
   std::vector<float> chunk(kChunk);
   if (std::fseek(file_, 0, SEEK_SET) != 0)
-    throw InputError(blame_, "", std::string("cannot read back a temporary file: ") + std::strerror(errno));
+    throw InputError(blame_, "",
+                     std::string("cannot read back a temporary file: ") + std::strerror(errno));
   std::int64_t left = count_;
   while (left > 0) {
     const std::size_t want = static_cast<std::size_t>(std::min<std::int64_t>(left, kChunk));
@@ -98,11 +101,13 @@ std::vector<std::int64_t> ValueSpill::LowCounts(const std::vector<std::uint32_t>
     }
   });
   for (std::size_t i = 0; i < bins.size(); ++i)
-    std::copy(by_bin[bins[i]].begin(), by_bin[bins[i]].end(), low.begin() + (std::ptrdiff_t(i) << 16));
+    std::copy(by_bin[bins[i]].begin(), by_bin[bins[i]].end(),
+              low.begin() + (std::ptrdiff_t(i) << 16));
   return low;
 }
 
-PercentileBins SelectPercentileBins(const std::vector<std::int64_t>& high, const std::vector<double>& p) {
+PercentileBins SelectPercentileBins(const std::vector<std::int64_t>& high,
+                                    const std::vector<double>& p) {
   PercentileBins out;
   std::int64_t count = 0;
   for (std::int64_t c : high) count += c;

@@ -28,8 +28,8 @@ class ValueSpill {
   std::int64_t size() const { return count_; }
 
   /// The nearest-rank percentiles `p` (in [0, 100]) of every value appended, each equal to
-  /// NearestRankPercentile(all values, p); nullopt when there are none. Two passes over the file: the
-  /// upper 16 bits of each value's order-preserving key, then the lower 16 within the bins the
+  /// NearestRankPercentile(all values, p); nullopt when there are none. Two passes over the file:
+  /// the upper 16 bits of each value's order-preserving key, then the lower 16 within the bins the
   /// ranks fall in.
   std::vector<std::optional<double>> Percentiles(const std::vector<double>& p) const;
   /// The number of values v with v <= limit (compared in double, as summary.json's shares are).
@@ -57,7 +57,8 @@ struct PercentileBins {
   std::vector<std::uint32_t> bins;
   std::vector<std::int64_t> inside;
 };
-PercentileBins SelectPercentileBins(const std::vector<std::int64_t>& high, const std::vector<double>& p);
+PercentileBins SelectPercentileBins(const std::vector<std::int64_t>& high,
+                                    const std::vector<double>& p);
 /// The percentiles (nullopt when there are no values), from the (summed) LowCounts(selection.bins).
 std::vector<std::optional<double>> ResolvePercentiles(const PercentileBins& selection,
                                                       const std::vector<std::int64_t>& low,

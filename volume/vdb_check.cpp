@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 
 namespace pandora {
 namespace {
@@ -784,9 +784,11 @@ void CheckSameRunAsSummary(const FieldsProvenance& p, const std::string& path) {
   const auto run = p.metadata.find("run_id");
   if (run == p.metadata.end() || run->second.empty()) return;  // an older file: nothing to compare
   // The summary.json written with it: beside a fields.vdb, one folder up from a streamed tile.
-  std::string folder = path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/'));
+  std::string folder =
+      path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/'));
   if (folder.empty() && path.find('/') == std::string::npos) folder = ".";
-  const std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+  const std::string name =
+      path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
   std::string summary = folder + "/summary.json";
   if (name.rfind("tile_", 0) == 0) summary = folder + "/../summary.json";
   struct stat st {};
@@ -798,13 +800,15 @@ void CheckSameRunAsSummary(const FieldsProvenance& p, const std::string& path) {
   std::fclose(f);
   text.resize(got);
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("run_id") || !j["run_id"].is_string()) return;
+  if (j.is_discarded() || !j.is_object() || !j.contains("run_id") || !j["run_id"].is_string())
+    return;
   const std::string other = j["run_id"].get<std::string>();
   if (other != run->second)
-    throw InputError(path, "",
-                     "the fields belong to another run than " + summary + " beside them (run ids " +
-                         run->second + " and " + other + "): one of the two is stale",
-                     "run pandora analyze again into that folder, or give fields with their own summary");
+    throw InputError(
+        path, "",
+        "the fields belong to another run than " + summary + " beside them (run ids " +
+            run->second + " and " + other + "): one of the two is stale",
+        "run pandora analyze again into that folder, or give fields with their own summary");
 }
 
 std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
@@ -877,8 +881,10 @@ std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
       if (!changed.empty()) what += "changed " + changed;
       if (!added.empty()) what += std::string(what.empty() ? "" : "; ") + "added " + added;
       if (!removed.empty()) what += std::string(what.empty() ? "" : "; ") + "removed " + removed;
-      if (!disabled.empty()) what += std::string(what.empty() ? "" : "; ") + "off here, on for the fields: " + disabled;
-      if (!enabled.empty()) what += std::string(what.empty() ? "" : "; ") + "on here, off for the fields: " + enabled;
+      if (!disabled.empty())
+        what += std::string(what.empty() ? "" : "; ") + "off here, on for the fields: " + disabled;
+      if (!enabled.empty())
+        what += std::string(what.empty() ? "" : "; ") + "on here, off for the fields: " + enabled;
       if (what.empty() && order_before != order_after) what = "the same cameras in another order";
       if (!what.empty())
         warnings.push_back("the cameras of rig '" + rig.name + "' differ from those " + path +

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 #include "volume/active_set.h"
 
 namespace pandora {
@@ -21,8 +21,9 @@ namespace pandora {
 /// it, so a damaged or hostile file can neither exhaust memory nor make the reader loop for long.
 struct VdbLimits {
   std::uint64_t max_file_bytes = std::uint64_t(1) << 32;  ///< 4 GiB.
-  int max_grids = SceneLimits::kMaxCameras + 16;  ///< 9 fields + a rig's cameras, with room to spare.
-  std::int64_t max_index = 1 << 20;  ///< Every node lies in [0, max_index)^3 (index space).
+  int max_grids =
+      SceneLimits::kMaxCameras + 16;  ///< 9 fields + a rig's cameras, with room to spare.
+  std::int64_t max_index = 1 << 20;   ///< Every node lies in [0, max_index)^3 (index space).
   /// Product of any two extents of a grid's active index box [0, max]: bounds a slice image.
   std::int64_t max_face_voxels = std::int64_t(1) << 28;
   /// Active voxels of a grid, tiles counted voxel by voxel: bounds anything that densifies.

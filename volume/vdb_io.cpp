@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <cstdio>
+#include <fstream>
 #include <istream>
 #include <map>
 #include <mutex>
@@ -15,8 +15,8 @@
 #include <set>
 #include <streambuf>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 
 namespace pandora {
@@ -53,7 +53,8 @@ void Describe(openvdb::GridBase& grid) {
       {"condition", {"1", "condition number of the information matrix J"}},
       {"sigma_max_steady", {"mm", "worst-direction 1-sigma of the steady-state Kalman covariance"}},
       {"sigma_mean_steady", {"mm", "sqrt(trace/3) of the steady-state Kalman covariance"}},
-      {"coverage_min", {"cameras", "fewest cameras that see the voxel over the time samples where it is free"}},
+      {"coverage_min",
+       {"cameras", "fewest cameras that see the voxel over the time samples where it is free"}},
       {"coverage_time_share",
        {"1", "share of the time samples (where the voxel is free) in which enough cameras see it"}},
   };
@@ -67,7 +68,8 @@ void Describe(openvdb::GridBase& grid) {
 // file. This writes the same archive (seekable, with grid offsets) through a stream it checks.
 class CheckedVdbWriter : public openvdb::io::Archive {
  public:
-  void Write(const std::string& path, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) {
+  void Write(const std::string& path, const openvdb::GridPtrVec& grids,
+             const openvdb::MetaMap& meta) {
     std::ofstream os(path, std::ios::binary | std::ios::trunc);
     if (!os) throw InputError(path, "", "cannot create the VDB file", "check the output folder");
     openvdb::io::Archive::write(os, grids, /*seekable=*/true, meta);
@@ -82,7 +84,6 @@ class CheckedVdbWriter : public openvdb::io::Archive {
     return openvdb::io::Archive::Ptr(new CheckedVdbWriter(*this));
   }
 };
-
 
 // Camera ids in rig order from the "rig" metadata (RigToJson); empty when absent or unusable.
 std::vector<std::string> CameraIds(const std::map<std::string, std::string>& metadata) {
@@ -204,9 +205,9 @@ std::string TypeWord(const std::string& tree_type) {
 
 namespace {
 
-// The coverage grid as floats, made leaf by leaf from the integer grid, which loses each leaf as its
-// float copy is made (the converting copy of the whole tree would hold both at once). Active tiles
-// keep their level and value; voxel values and masks are copied as they are.
+// The coverage grid as floats, made leaf by leaf from the integer grid, which loses each leaf as
+// its float copy is made (the converting copy of the whole tree would hold both at once). Active
+// tiles keep their level and value; voxel values and masks are copied as they are.
 openvdb::FloatGrid::Ptr TakeCoverageAsFloat(openvdb::Int32Grid& grid) {
   using IntLeaf = openvdb::Int32Tree::LeafNodeType;
   using FloatLeafT = openvdb::FloatTree::LeafNodeType;
@@ -224,19 +225,22 @@ openvdb::FloatGrid::Ptr TakeCoverageAsFloat(openvdb::Int32Grid& grid) {
   for (const openvdb::Coord& origin : origins) {
     std::unique_ptr<IntLeaf> leaf(src.stealNode<IntLeaf>(origin, src.background(), false));
     auto* copy = new FloatLeafT(origin, static_cast<float>(src.background()), false);
-    for (openvdb::Index i = 0; i < IntLeaf::SIZE; ++i) copy->setValueOnly(i, static_cast<float>(leaf->getValue(i)));
+    for (openvdb::Index i = 0; i < IntLeaf::SIZE; ++i)
+      copy->setValueOnly(i, static_cast<float>(leaf->getValue(i)));
     copy->setValueMask(leaf->getValueMask());
     dst.addLeaf(copy);
   }
   return out;
 }
 
-void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage, const std::string& path,
+void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage,
+                        const std::string& path,
                         const std::map<std::string, std::string>& metadata);
 
 }  // namespace
 
-void WriteFieldsVdb(Fields&& fields, const std::string& path, const std::map<std::string, std::string>& metadata) {
+void WriteFieldsVdb(Fields&& fields, const std::string& path,
+                    const std::map<std::string, std::string>& metadata) {
   InitializeOpenVdb();
   Fields::Impl& g = fields.impl();
   openvdb::FloatGrid::Ptr coverage;
@@ -263,7 +267,8 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
 
 namespace {
 
-void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage, const std::string& path,
+void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage,
+                        const std::string& path,
                         const std::map<std::string, std::string>& metadata) {
   const Fields::Impl& g = fields.impl();
   openvdb::GridPtrVec grids;
@@ -332,7 +337,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
   std::vector<const VdbGridInfo*> cameras_info;
   std::set<std::int64_t> indices;
   const VdbGridInfo* first = nullptr;
-  int known = 0;  // grids of FieldNames(), coverage and cameras (a file of derived grids alone is not ours)
+  int known =
+      0;  // grids of FieldNames(), coverage and cameras (a file of derived grids alone is not ours)
   for (const VdbGridInfo& grid : info.grids) {
     const std::string& name = grid.name;
     std::vector<std::string> expected;
@@ -346,7 +352,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     } else if (std::find(FieldNames().begin(), FieldNames().end(), name) != FieldNames().end()) {
       expected = {"Tree_float_5_4_3"};
     } else if (grid.tree_type == "Tree_float_5_4_3") {
-      expected = {"Tree_float_5_4_3"};  // a derived grid (coverage_n1, ptz_reach_time, ...): Fields::Impl::extra
+      expected = {"Tree_float_5_4_3"};  // a derived grid (coverage_n1, ptz_reach_time, ...):
+                                        // Fields::Impl::extra
       --known;
     } else {
       --known;
@@ -374,7 +381,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     if (!first) first = &grid;
     by_name[name] = &grid;
   }
-  if (by_name.empty() || known <= 0) Refuse(path, "the VDB file holds none of Pandora's field grids");
+  if (by_name.empty() || known <= 0)
+    Refuse(path, "the VDB file holds none of Pandora's field grids");
   if (by_name.count(kCamerasGrid) && !cameras_info.empty())
     Refuse(path, "the file holds both a 'cameras' grid and per-camera 'visible/' grids");
 
@@ -418,8 +426,8 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     }
     if (!g.transform) g.transform = base->transformPtr();
   }
-  if ((by_name.count(kCoverageGrid) && !g.coverage) ||
-      (by_name.count(kCamerasGrid) && !bitmask) || visible.size() != cameras_info.size())
+  if ((by_name.count(kCoverageGrid) && !g.coverage) || (by_name.count(kCamerasGrid) && !bitmask) ||
+      visible.size() != cameras_info.size())
     Refuse(path, "OpenVDB read a grid of another type than the file declares");
   if (!visible.empty()) {
     // Indices 0..n-1 each once: a rig's cameras.

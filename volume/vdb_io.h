@@ -26,7 +26,8 @@ void WriteFieldsVdb(const Fields& fields, const std::string& path,
 /// The same file, consuming `fields` (what `pandora analyze` does last): the coverage grid becomes
 /// floats leaf by leaf, each integer leaf freed as its copy is made, so writing does not hold a
 /// second copy of it (docs/scale.md: 4 bytes per region voxel off the peak).
-void WriteFieldsVdb(Fields&& fields, const std::string& path, const std::map<std::string, std::string>& metadata);
+void WriteFieldsVdb(Fields&& fields, const std::string& path,
+                    const std::map<std::string, std::string>& metadata);
 
 /// Reads a .vdb written by WriteFieldsVdb back into Fields: exactly the grids that were written
 /// (coverage back to Int32, the per-camera grids back to the Int64 bitmask; files of the earlier

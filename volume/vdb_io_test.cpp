@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 #include "volume/vdb_check.h"
 
@@ -59,7 +59,8 @@ Fields MakeFields(int cameras = 64) {
   resolution->setName("resolution");
   auto sigma = openvdb::FloatGrid::create(0);
   sigma->setName("sigma_max");
-  for (auto grid : openvdb::GridPtrVec{g.coverage, resolution, sigma}) grid->setTransform(g.transform);
+  for (auto grid : openvdb::GridPtrVec{g.coverage, resolution, sigma})
+    grid->setTransform(g.transform);
   for (auto& grid : g.visible) grid->setTransform(g.transform);
   std::mt19937_64 rng(7);
   auto cov = g.coverage->getAccessor();
@@ -187,7 +188,8 @@ TEST(VdbIo, ConsumingWriterWritesTheSameFile) {
   WriteFieldsVdb(std::move(g), b.string(), meta);
   ExpectSameFields(ReadFieldsVdb(a.string()), ReadFieldsVdb(b.string()));
   ExpectSameFields(f, ReadFieldsVdb(b.string()));
-  EXPECT_FALSE(g.impl().coverage);  // NOLINT(bugprone-use-after-move): the writer's documented effect
+  EXPECT_FALSE(
+      g.impl().coverage);  // NOLINT(bugprone-use-after-move): the writer's documented effect
 }
 
 TEST(VdbIo, OneBoolGridPerCameraNamedByItsEncodedId) {
@@ -247,8 +249,7 @@ TEST(VdbIo, ReadsTheEarlierLayout) {
       bitmask->tree().setValueOn(
           it.getCoord(), std::int64_t(std::uint64_t(bitmask->tree().getValue(it.getCoord())) |
                                       (std::uint64_t{1} << c)));
-  file.write(openvdb::GridPtrVec{f.impl().coverage, bitmask,
-                                 f.impl().floats.at("resolution"),
+  file.write(openvdb::GridPtrVec{f.impl().coverage, bitmask, f.impl().floats.at("resolution"),
                                  f.impl().floats.at("sigma_max")});
   file.close();
   ExpectSameFields(f, ReadFieldsVdb(path.string()));

@@ -4,9 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <system_error>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/input_file.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 
 namespace pandora::session {
 
@@ -62,7 +62,8 @@ std::optional<Autosave> ReadAutosave(const std::string& path, const Study& study
   if (!found) throw InputError(path, "$.rig", "the scene has no rig '" + a.rig + "'");
   const Rig& rig = *found;
   // The cameras, through the scene file's own checks (a rig needs a name and >= 1 camera).
-  if (j["cameras"].empty()) throw InputError(path, "$.cameras", "an autosave lists at least one camera");
+  if (j["cameras"].empty())
+    throw InputError(path, "$.cameras", "an autosave lists at least one camera");
   const json as_rig = {{"name", a.rig}, {"cameras", j["cameras"]}};
   a.cameras = ParseRigJson(as_rig, path, "$").cameras;
   for (std::size_t i = 0; i < a.cameras.size(); ++i)
@@ -76,12 +77,14 @@ std::optional<Autosave> ReadAutosave(const std::string& path, const Study& study
 std::vector<std::string> RecoverAutosave(Session& session, const Autosave& autosave,
                                          const std::string& path) {
   if (autosave.stale)
-    throw InputError(path, "$.scene_sha256", "the scene file changed since this autosave was written",
+    throw InputError(path, "$.scene_sha256",
+                     "the scene file changed since this autosave was written",
                      "delete the autosave file, or restore the scene file it was made for");
   EditableRig& rig = session.rig();
   if (autosave.rig != rig.rig().name)
-    throw InputError(path, "$.rig", "the autosave is of rig '" + autosave.rig + "', the session edits '" +
-                                        rig.rig().name + "'");
+    throw InputError(path, "$.rig",
+                     "the autosave is of rig '" + autosave.rig + "', the session edits '" +
+                         rig.rig().name + "'");
   Edit edit;
   std::vector<std::string> ids;
   for (const Camera& camera : autosave.cameras) {

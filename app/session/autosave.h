@@ -34,8 +34,8 @@ struct Autosave {
   std::vector<Camera> cameras;  ///< As saved; ids are the rig's.
 };
 
-/// Reads `path`: nullopt when there is no such file; InputError naming the file and JSON path when it
-/// is damaged (not JSON, wrong version, a camera that fails the scene file's checks, an id the
+/// Reads `path`: nullopt when there is no such file; InputError naming the file and JSON path when
+/// it is damaged (not JSON, wrong version, a camera that fails the scene file's checks, an id the
 /// study's rig lacks).
 std::optional<Autosave> ReadAutosave(const std::string& path, const Study& study);
 

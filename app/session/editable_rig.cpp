@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "app/session/ptz_edit.h"
 
 namespace pandora::session {
@@ -51,13 +51,15 @@ bool EditableRig::CanAmend(const std::vector<int>& cameras) const {
 void EditableRig::Amend(const Edit& edit) {
   std::vector<int> cameras;
   for (const CameraEdit& c : edit.changes) cameras.push_back(c.index);
-  if (!CanAmend(cameras)) throw std::logic_error("edit '" + edit.label + "': not the cameras of the last edit");
+  if (!CanAmend(cameras))
+    throw std::logic_error("edit '" + edit.label + "': not the cameras of the last edit");
   for (const CameraEdit& c : edit.changes)
     if (!SameCamera(rig_.cameras[c.index], c.before))
       throw std::logic_error("edit '" + edit.label + "': camera " + rig_.cameras[c.index].id +
                              " changed since the edit was made");
   Set(edit.changes, true);
-  for (std::size_t i = 0; i < edit.changes.size(); ++i) undo_.back().changes[i].after = edit.changes[i].after;
+  for (std::size_t i = 0; i < edit.changes.size(); ++i)
+    undo_.back().changes[i].after = edit.changes[i].after;
   redo_.clear();
 }
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora::session {
 
@@ -60,8 +60,8 @@ class EditableRig {
   void SetPose(int index, const Eigen::Isometry3d& world_from_camera);
   void SetEnabled(int index, bool enabled);
   void SetIntrinsics(int index, const Intrinsics& intrinsics);
-  /// Several poses (and focal lengths) at once, by camera id, as one undo step: a suggestion applied
-  /// in memory. Throws InputError(file, "", ...) for an id the rig lacks.
+  /// Several poses (and focal lengths) at once, by camera id, as one undo step: a suggestion
+  /// applied in memory. Throws InputError(file, "", ...) for an id the rig lacks.
   struct Pose {
     std::string id;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -81,6 +81,5 @@ class EditableRig {
   std::vector<std::int64_t> camera_versions_;
   std::vector<Edit> undo_, redo_;
 };
-
 
 }  // namespace pandora::session

@@ -39,9 +39,9 @@ const char* JobStateName(JobState state);
 
 struct JobStatus {
   JobState state = JobState::kIdle;
-  std::int64_t id = 0;   ///< Of the job the state describes (0: none yet).
-  double progress = 0;   ///< Of the running job.
-  std::string error;     ///< With kFailed: the message.
+  std::int64_t id = 0;  ///< Of the job the state describes (0: none yet).
+  double progress = 0;  ///< Of the running job.
+  std::string error;    ///< With kFailed: the message.
   /// With kFailed: the exception itself, so a caller that waits can rethrow it (a command turns an
   /// InputError into its one-line message and exit code 2).
   std::exception_ptr exception;

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ptz.h"
-#include "analysis/scene.h"
+#include "analysis/scene/ptz.h"
+#include "analysis/scene/scene.h"
 #include "render/render.h"
 
 namespace pandora::session {
@@ -27,15 +27,16 @@ bool SamePtzHead(const PtzHead* a, const PtzHead* b);
 /// clamped to [focal_min, focal_max].
 PtzState ClampPtzState(const PtzHead& head, PtzState s);
 
-/// The PTZ camera `camera` at setting `s` (clamped): a new head with current = s, the pose and focal
-/// lengths of PtzHead::CameraAt. std::logic_error for a fixed camera.
+/// The PTZ camera `camera` at setting `s` (clamped): a new head with current = s, the pose and
+/// focal lengths of PtzHead::CameraAt. std::logic_error for a fixed camera.
 Camera WithPtzState(const Camera& camera, const PtzState& s);
 
 /// The setting whose optical axis is nearest the orientation `world_from_camera_rotation`'s (not
 /// clamped): pan = the axis's azimuth about the pan axis from home's, tilt = its elevation minus
 /// home's. A head cannot roll: the orientation's roll is ignored. When the axis is along the pan
 /// axis (straight up or down), the pan stays `keep_pan`.
-PtzState PtzStateFacing(const PtzHead& head, const Mat3& world_from_camera_rotation, double keep_pan);
+PtzState PtzStateFacing(const PtzHead& head, const Mat3& world_from_camera_rotation,
+                        double keep_pan);
 
 /// What a gizmo, a typed position or orientation, an aim or the gamepad asks of a PTZ camera,
 /// made mechanical: `requested` is `before` with a new pose (and maybe focal lengths and other

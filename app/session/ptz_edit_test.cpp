@@ -2,6 +2,8 @@
 // the head's ranges and undoable; re-centre keeps every preset's pose and the camera's; a gizmo's
 // pose made mechanical (pivot moves, pan and tilt follow); saving writes pivot, home, zoom and the
 // ptz block with a backup, and the file read back has the session's head.
+#include "app/session/ptz_edit.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,11 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "app/session/autosave.h"
-#include "app/session/ptz_edit.h"
 #include "app/session/session.h"
-#include "analysis/units.h"
 
 namespace pandora::session {
 namespace {
@@ -34,7 +35,8 @@ void Write(const fs::path& p, const std::string& text) {
 }
 
 // examples/ptz_home/scene.json in a fresh folder, optionally edited by one string replacement.
-fs::path CopyPtzScene(const std::string& name, const std::string& from = "", const std::string& to = "") {
+fs::path CopyPtzScene(const std::string& name, const std::string& from = "",
+                      const std::string& to = "") {
   const fs::path dir = fs::path(::testing::TempDir()) / ("ptz_session_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -73,7 +75,8 @@ void ExpectSameHead(const PtzHead& a, const PtzHead& b) {
     EXPECT_EQ(a.presets[i].name, b.presets[i].name);
     EXPECT_NEAR(a.presets[i].state.pan_deg, b.presets[i].state.pan_deg, 1e-9);
     EXPECT_NEAR(a.presets[i].state.tilt_deg, b.presets[i].state.tilt_deg, 1e-9);
-    EXPECT_NEAR(a.presets[i].state.focal, b.presets[i].state.focal, 1e-9 * b.presets[i].state.focal);
+    EXPECT_NEAR(a.presets[i].state.focal, b.presets[i].state.focal,
+                1e-9 * b.presets[i].state.focal);
   }
   ASSERT_EQ(a.tour.size(), b.tour.size());
 }
@@ -107,7 +110,10 @@ TEST(PtzSession, SetStateIsClampedAndOneUndoStep) {
   EXPECT_DOUBLE_EQ(h.current.pan_deg, -160);
   EXPECT_EQ(h.current.tilt_deg, -75);
   EXPECT_DOUBLE_EQ(h.current.focal, Focal(before, 60));
-  EXPECT_DOUBLE_EQ(HfovFromFocal(session.rig().rig().cameras[0].model.intrinsics().fx, 1280, LensModel::kPinhole) / kRadPerDeg, 60);
+  EXPECT_DOUBLE_EQ(HfovFromFocal(session.rig().rig().cameras[0].model.intrinsics().fx, 1280,
+                                 LensModel::kPinhole) /
+                       kRadPerDeg,
+                   60);
 
   ASSERT_TRUE(session.rig().Undo());
   ASSERT_TRUE(session.rig().Undo());
@@ -156,7 +162,8 @@ TEST(PtzSession, RecentreKeepsEveryPresetPoseAndShiftsTheRanges) {
     EXPECT_EQ(h.presets[i].name, h0.presets[i].name);
     EXPECT_DOUBLE_EQ(h.presets[i].state.pan_deg, h0.presets[i].state.pan_deg - 63);
     EXPECT_DOUBLE_EQ(h.presets[i].state.tilt_deg, h0.presets[i].state.tilt_deg + 3);
-    EXPECT_LT(PoseDistance(h.Pose(h.presets[i].state), h0.Pose(h0.presets[i].state)), 1e-12) << h.presets[i].name;
+    EXPECT_LT(PoseDistance(h.Pose(h.presets[i].state), h0.Pose(h0.presets[i].state)), 1e-12)
+        << h.presets[i].name;
   }
   // The west door preset is now straight ahead.
   EXPECT_NEAR(h.presets[1].state.pan_deg, 0, 1e-12);
@@ -185,7 +192,9 @@ TEST(PtzSession, RecentreRefusesAHomeStraightUpOrDown) {
     const std::string what = e.what();
     EXPECT_NE(what.find(path.string()), std::string::npos) << what;
     EXPECT_NE(what.find("$.rigs[0].cameras[0].ptz.tilt_range_deg"), std::string::npos) << what;
-    EXPECT_NE(what.find("would make its home look straight up, along the pan axis"), std::string::npos) << what;
+    EXPECT_NE(what.find("would make its home look straight up, along the pan axis"),
+              std::string::npos)
+        << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
   EXPECT_EQ(session.rig().undo_label(), "pan/tilt/zoom dome");  // nothing applied
@@ -211,13 +220,15 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
   Camera moved = cam;
   moved.world_from_camera.translation() += Vec3(0.5, -0.25, 0.1);
   const Camera m = PtzFollow(cam, moved);
-  EXPECT_LT((m.ptz->home.translation() - (h.home.translation() + Vec3(0.5, -0.25, 0.1))).norm(), 1e-15);
+  EXPECT_LT((m.ptz->home.translation() - (h.home.translation() + Vec3(0.5, -0.25, 0.1))).norm(),
+            1e-15);
   EXPECT_EQ(m.ptz->current.pan_deg, h.current.pan_deg);
   EXPECT_EQ(m.ptz->current.tilt_deg, h.current.tilt_deg);
   EXPECT_EQ(m.ptz->home.linear(), h.home.linear());
   // A turn of 25 degrees about the pan axis and a roll: pan 25, tilt 0, the roll dropped.
   Camera turned = cam;
-  turned.world_from_camera.linear() = Eigen::AngleAxisd(25 * kRadPerDeg, Vec3::UnitZ()) * cam.world_from_camera.linear() *
+  turned.world_from_camera.linear() = Eigen::AngleAxisd(25 * kRadPerDeg, Vec3::UnitZ()) *
+                                      cam.world_from_camera.linear() *
                                       Eigen::AngleAxisd(7 * kRadPerDeg, Vec3::UnitZ());
   bool clamped = true;
   const Camera t = PtzFollow(cam, turned, &clamped);
@@ -227,13 +238,15 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
   EXPECT_LT(PoseDistance(t.world_from_camera, h.Pose({25, 0, h.current.focal})), 1e-12);
   // Aimed 50 degrees below home's axis: tilt -50; 20 above: clamped at the range's 10.
   Camera down = cam;
-  down.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(-50 * kRadPerDeg, Vec3::UnitX());
+  down.world_from_camera.linear() =
+      cam.world_from_camera.linear() * Eigen::AngleAxisd(-50 * kRadPerDeg, Vec3::UnitX());
   const Camera d = PtzFollow(cam, down, &clamped);
   EXPECT_FALSE(clamped);
   EXPECT_NEAR(d.ptz->current.tilt_deg, -50, 1e-12);
   EXPECT_NEAR(d.ptz->current.pan_deg, 0, 1e-12);
   Camera up = cam;
-  up.world_from_camera.linear() = cam.world_from_camera.linear() * Eigen::AngleAxisd(20 * kRadPerDeg, Vec3::UnitX());
+  up.world_from_camera.linear() =
+      cam.world_from_camera.linear() * Eigen::AngleAxisd(20 * kRadPerDeg, Vec3::UnitX());
   const Camera u = PtzFollow(cam, up, &clamped);
   EXPECT_TRUE(clamped);
   EXPECT_EQ(u.ptz->current.tilt_deg, 10);
@@ -251,8 +264,9 @@ TEST(PtzSession, GizmoPosesBecomePivotMovesAndPanTilt) {
 TEST(PtzSession, SaveWritesPivotHomeZoomAndTheHeadWithABackup) {
   // The window preset without its own zoom: it means "the camera's zoom" (30), which must stay 30
   // when the camera zooms to 40.
-  const fs::path path = CopyPtzScene("save", "{\"name\": \"window\", \"pan_deg\": 0, \"tilt_deg\": 0, \"hfov_deg\": 30}",
-                                     "{\"name\": \"window\"}");
+  const fs::path path = CopyPtzScene(
+      "save", "{\"name\": \"window\", \"pan_deg\": 0, \"tilt_deg\": 0, \"hfov_deg\": 30}",
+      "{\"name\": \"window\"}");
   const std::string original = Read(path);
   Session session(Study::Load(path.string()), {});
   const Camera start = session.rig().rig().cameras[0];
@@ -271,16 +285,19 @@ TEST(PtzSession, SaveWritesPivotHomeZoomAndTheHeadWithABackup) {
   ASSERT_TRUE(back.ptz);
   ExpectSameHead(*back.ptz, *edited.ptz);
   EXPECT_LT(PoseDistance(back.world_from_camera, edited.world_from_camera), 1e-9);
-  EXPECT_NEAR(back.model.intrinsics().fx, edited.model.intrinsics().fx, 1e-9 * edited.model.intrinsics().fx);
+  EXPECT_NEAR(back.model.intrinsics().fx, edited.model.intrinsics().fx,
+              1e-9 * edited.model.intrinsics().fx);
   EXPECT_NEAR(back.ptz->presets[0].state.focal, Focal(start, 30), 1e-9 * Focal(start, 30));
   // The file keeps its form: position + look_at (at the old distance along the new home axis),
   // hfov_deg for the zoom; everything but the dome of rig "home" is as it was.
-  const nlohmann::json before = nlohmann::json::parse(original), after = nlohmann::json::parse(Read(path));
+  const nlohmann::json before = nlohmann::json::parse(original),
+                       after = nlohmann::json::parse(Read(path));
   const nlohmann::json& dome = after["rigs"][0]["cameras"][0];
   EXPECT_TRUE(dome.contains("look_at"));
   EXPECT_FALSE(dome.contains("quaternion"));
   EXPECT_DOUBLE_EQ(dome["hfov_deg"].get<double>(), 40);
-  EXPECT_EQ(dome["position"], before["rigs"][0]["cameras"][0]["position"]);  // the pivot did not move
+  EXPECT_EQ(dome["position"],
+            before["rigs"][0]["cameras"][0]["position"]);  // the pivot did not move
   EXPECT_EQ(dome["ptz"]["pan_deg"], -10);
   EXPECT_EQ(dome["ptz"]["tilt_deg"], 5);
   EXPECT_EQ(dome["ptz"]["tilt_range_deg"], nlohmann::json::parse("[-72, 13]"));
@@ -325,17 +342,19 @@ TEST(PtzSession, SavingASettingKeepsThePoseKeysText) {
   const auto reloaded = Study::Load(path.string());
   const Camera& back = reloaded->FindRig("home").cameras[0];
   EXPECT_EQ(back.ptz->home.matrix(), start.ptz->home.matrix());
-  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera), 1e-12);
+  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera),
+            1e-12);
 }
 
 TEST(PtzSession, SaveWritesThePanAxisWhenTheReadersDefaultWouldChange) {
   // A head mounted rolled (its home image x axis not horizontal): the pan axis defaults to home's
   // up. After a re-centre with a tilt, home's up is another direction, so the file must say it.
-  const fs::path path = CopyPtzScene("pan_axis", "\"look_at\": [0, 2.5, 1.5], ", "\"look_at\": [0, 2.5, 1.5], \"up\": [0.5, 0, 1], ");
+  const fs::path path = CopyPtzScene("pan_axis", "\"look_at\": [0, 2.5, 1.5], ",
+                                     "\"look_at\": [0, 2.5, 1.5], \"up\": [0.5, 0, 1], ");
   Session session(Study::Load(path.string()), {});
   const Camera start = session.rig().rig().cameras[0];
   const Vec3 axis0 = start.ptz->pan_axis;
-  EXPECT_GT(std::abs(start.ptz->home.linear()(2, 0)), 0.1);  // rolled
+  EXPECT_GT(std::abs(start.ptz->home.linear()(2, 0)), 0.1);            // rolled
   EXPECT_LT((axis0 + start.ptz->home.linear().col(1)).norm(), 1e-12);  // the default: home's up
   session.SetPtzState(0, {10, -20, start.ptz->current.focal});
   session.RecentrePtz(0);
@@ -348,9 +367,12 @@ TEST(PtzSession, SaveWritesThePanAxisWhenTheReadersDefaultWouldChange) {
   const auto reloaded = Study::Load(path.string());
   const Camera& back = reloaded->FindRig("home").cameras[0];
   ExpectSameHead(*back.ptz, h);
-  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera), 1e-9);
+  EXPECT_LT(PoseDistance(back.world_from_camera, session.rig().rig().cameras[0].world_from_camera),
+            1e-9);
   for (std::size_t i = 0; i < h.presets.size(); ++i)
-    EXPECT_LT(PoseDistance(back.ptz->Pose(back.ptz->presets[i].state), start.ptz->Pose(start.ptz->presets[i].state)), 1e-9);
+    EXPECT_LT(PoseDistance(back.ptz->Pose(back.ptz->presets[i].state),
+                           start.ptz->Pose(start.ptz->presets[i].state)),
+              1e-9);
 }
 
 TEST(PtzSession, AutosaveKeepsARecentredHead) {
@@ -378,7 +400,8 @@ TEST(PtzSession, TracedRigsAsRenderHasThem) {
   EXPECT_TRUE(any);
   ASSERT_EQ(path.cameras.size(), 3u);
   EXPECT_EQ(path.cameras[2].id, "dome@2-end");
-  EXPECT_LT(PoseDistance(path.cameras[2].world_from_camera, rig.cameras[0].world_from_camera), 1e-15);
+  EXPECT_LT(PoseDistance(path.cameras[2].world_from_camera, rig.cameras[0].world_from_camera),
+            1e-15);
   EXPECT_TRUE(all.empty());
   const Rig traced = PtzTracedRig(rig, "all", 1.5, &all);
   ASSERT_EQ(all.size(), 1u);

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 
-#include "analysis/error.h"
-#include "analysis/input_file.h"
-#include "analysis/motion.h"
-#include "analysis/ray_caster.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/motion.h"
+#include "analysis/scene/scene_text.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 #include "app/session/ptz_edit.h"
 #include "render/progressive.h"
 #include "suggest/suggestion_file.h"
@@ -60,8 +61,9 @@ bool Session::TryReadFields(const std::function<void(const Fields&, std::int64_t
   return true;
 }
 
-std::optional<TimeSummary> Session::EvaluateOverTime(const Rig& rig, const std::atomic<bool>* cancel,
-                                                    const std::function<void(double)>& progress) const {
+std::optional<TimeSummary> Session::EvaluateOverTime(
+    const Rig& rig, const std::atomic<bool>* cancel,
+    const std::function<void(double)>& progress) const {
   const Scene& scene = study_->scene();
   if (!scene.Animated() && !scene.study.targets) return std::nullopt;
   const std::vector<TimeSample> samples = scene.TimeSamples();
@@ -71,7 +73,8 @@ std::optional<TimeSummary> Session::EvaluateOverTime(const Rig& rig, const std::
   FieldOptions options = OverTimeOptions(options_.fields);
   options.progress = progress;
   options.cancel = cancel;
-  TimeFieldsResult r = EvaluateFieldsOverTime(scene, rig, *parts_, samples, options, scene.TimeMinCameras());
+  TimeFieldsResult r =
+      EvaluateFieldsOverTime(scene, rig, *parts_, samples, options, scene.TimeMinCameras());
   if (cancel && cancel->load()) return std::nullopt;
   return std::move(r.summary);
 }
@@ -140,7 +143,7 @@ std::int64_t Session::RenderInBackground(
 }
 
 std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, SuggestOptions options,
-                                         std::shared_ptr<const void> keep) {
+                                          std::shared_ptr<const void> keep) {
   auto rig = std::make_shared<Rig>(rig_.rig());
   auto data = std::make_shared<std::pair<std::vector<TargetPoint>, SuggestOptions>>(
       std::move(targets), std::move(options));
@@ -148,12 +151,14 @@ std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, Sugg
     std::lock_guard<std::mutex> lock(suggestion_mutex_);
     suggestion_.reset();
   }
-  const std::int64_t job = jobs_.Submit("suggest", [this, rig, data, keep = std::move(keep)](JobContext& context) {
-    Suggestion s = pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
-    if (context.cancelled()) return;  // a newer suggestion was asked for
-    std::lock_guard<std::mutex> lock(suggestion_mutex_);
-    suggestion_ = std::move(s);
-  });
+  const std::int64_t job =
+      jobs_.Submit("suggest", [this, rig, data, keep = std::move(keep)](JobContext& context) {
+        Suggestion s =
+            pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
+        if (context.cancelled()) return;  // a newer suggestion was asked for
+        std::lock_guard<std::mutex> lock(suggestion_mutex_);
+        suggestion_ = std::move(s);
+      });
   std::lock_guard<std::mutex> lock(suggestion_mutex_);
   suggestion_job_ = job;
   return job;
@@ -191,7 +196,8 @@ std::string Session::CameraJsonPath(int index) const {
 void Session::SetPtzState(int index, const PtzState& state) {
   const Camera& before = rig_.rig().cameras.at(index);
   if (!before.ptz)
-    throw InputError(study_->scene().path, CameraJsonPath(index), "camera '" + before.id + "' has no pan-tilt-zoom head",
+    throw InputError(study_->scene().path, CameraJsonPath(index),
+                     "camera '" + before.id + "' has no pan-tilt-zoom head",
                      "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
   rig_.Apply({"pan/tilt/zoom " + before.id, {{index, before, WithPtzState(before, state)}}});
 }
@@ -224,7 +230,8 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
     k.fx = q.fx;
     k.fy = q.fy;
     other.model = CameraModel(k);
-    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color || !a.ptz != !b.ptz) {
+    if (!SameCameraGeometry(other, b) || a.name != b.name || a.color != b.color ||
+        !a.ptz != !b.ptz) {
       unsupported += (unsupported.empty() ? "" : ", ") + b.id;
       continue;
     }
@@ -244,9 +251,10 @@ SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {
     poses.push_back(std::move(u));
   }
   if (!unsupported.empty())
-    throw InputError(scene.path, "", "cameras " + unsupported +
-                                         " have changes other than pose and focal length, which "
-                                         "saving does not write yet",
+    throw InputError(scene.path, "",
+                     "cameras " + unsupported +
+                         " have changes other than pose and focal length, which "
+                         "saving does not write yet",
                      "undo those changes or edit the scene file by hand");
   SaveResult result;
   result.scene_path = scene.path;

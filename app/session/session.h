@@ -31,7 +31,7 @@ struct SessionOptions {
   /// is saved. `disable_option` names the option in errors.
   std::vector<std::string> disable;
   std::string disable_option = "--disable";
-  FieldOptions fields;     ///< The fields to keep (names, budget, messages).
+  FieldOptions fields;  ///< The fields to keep (names, budget, messages).
   /// Keep the evaluator's per-pair state so that edits update incrementally (an interactive
   /// session); false for one evaluation (a command), which then needs no more memory than
   /// EvaluateFields.
@@ -40,9 +40,9 @@ struct SessionOptions {
 
 struct SaveResult {
   std::string scene_path, backup_path;
-  std::vector<std::string> saved;  ///< Camera ids written.
+  std::vector<std::string> saved;           ///< Camera ids written.
   std::vector<std::string> saved_stations;  ///< Viewing stations written.
-  std::vector<std::string> notes;  ///< As `pandora accept`'s (an `up` that changed, ...).
+  std::vector<std::string> notes;           ///< As `pandora accept`'s (an `up` that changed, ...).
 };
 
 class Session {
@@ -82,8 +82,9 @@ class Session {
   /// The same summary for any `rig`, on the calling thread (the viewer's Compare), over the
   /// session's moving parts (built once); nothing for a study without time samples, or when
   /// `cancel` was set.
-  std::optional<TimeSummary> EvaluateOverTime(const Rig& rig, const std::atomic<bool>* cancel = nullptr,
-                                              const std::function<void(double)>& progress = {}) const;
+  std::optional<TimeSummary> EvaluateOverTime(
+      const Rig& rig, const std::atomic<bool>* cancel = nullptr,
+      const std::function<void(double)>& progress = {}) const;
 
   /// Runs Suggest on the rig as it is now, on the calling thread (what `pandora suggest` does).
   Suggestion Suggest(const std::vector<TargetPoint>& targets, const SuggestOptions& options) const;
@@ -127,8 +128,8 @@ class Session {
   /// Throws InputError (the scene file, the camera's JSON path) for a fixed camera.
   void SetPtzState(int index, const PtzState& state);
   /// "Re-centre" a PTZ camera (RecentredPtz in app/session/ptz_edit.h): home becomes the current
-  /// view, pan and tilt 0, presets and ranges shifted; the camera's pose is unchanged. One undo step.
-  /// Throws InputError when the shifted tilt range would fail the scene reader's check.
+  /// view, pan and tilt 0, presets and ranges shifted; the camera's pose is unchanged. One undo
+  /// step. Throws InputError when the shifted tilt range would fail the scene reader's check.
   void RecentrePtz(int index);
   /// "$.rigs[r].cameras[c]": camera `index` of the edited rig in the scene file.
   std::string CameraJsonPath(int index) const;
@@ -144,8 +145,8 @@ class Session {
   /// shifted ranges and presets) through ReplacePtzHeads; the rest of its block keeps its text.
   SaveResult Save(bool force = false, const std::vector<StationMove>& stations = {});
   /// The scene file now holds `text` and the edited rig as it is now is what it says (an accept
-  /// written outside the session, e.g. by AcceptSuggestion after ApplySuggestion): the rig counts as
-  /// saved and the next Save compares the file on disk with `text`.
+  /// written outside the session, e.g. by AcceptSuggestion after ApplySuggestion): the rig counts
+  /// as saved and the next Save compares the file on disk with `text`.
   void MarkSaved(std::string text);
 
  private:

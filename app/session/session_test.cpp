@@ -2,6 +2,8 @@
 // cancellation and failures reported; a session's fields follow its edits (in the background too)
 // and equal a full evaluation of the rig as edited; saving writes the poses with a backup and
 // refuses what it cannot write or a file changed on disk.
+#include "app/session/session.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,9 +12,8 @@
 #include <sstream>
 #include <thread>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "app/session/autosave.h"
-#include "app/session/session.h"
 #include "volume/fields.h"
 
 namespace pandora::session {
@@ -104,12 +105,16 @@ TEST(EditableRig, AmendKeepsADragOneUndoStep) {
     Camera after = now;
     after.world_from_camera = Moved(original.cameras[0], Vec3(0.01 * step, 0, 0));
     Edit e{"move a", {{0, now, after}}};
-    if (step == 1) rig.Apply(e);
-    else rig.Amend(e);
+    if (step == 1)
+      rig.Apply(e);
+    else
+      rig.Amend(e);
   }
   EXPECT_EQ(rig.version(), 3);
   EXPECT_EQ(rig.camera_version(0), 3);
-  EXPECT_LT((rig.rig().cameras[0].center() - (original.cameras[0].center() + Vec3(0.03, 0, 0))).norm(), 1e-12);
+  EXPECT_LT(
+      (rig.rig().cameras[0].center() - (original.cameras[0].center() + Vec3(0.03, 0, 0))).norm(),
+      1e-12);
   ASSERT_TRUE(rig.Undo());
   EXPECT_TRUE(SameRig(rig.rig(), original));  // one step back to the start of the drag
   EXPECT_FALSE(rig.Undo());
@@ -134,7 +139,10 @@ TEST(Jobs, LatestWinsAndFailuresAreReported) {
   });
   while (started == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   // Two more while it runs: the second is replaced by the third before it starts.
-  jobs.Submit("fields", [&](JobContext&) { ++started; ++finished; });
+  jobs.Submit("fields", [&](JobContext&) {
+    ++started;
+    ++finished;
+  });
   const std::int64_t last = jobs.Submit("fields", [&](JobContext& job) {
     job.Progress(0.5);
     ++started;
@@ -222,7 +230,8 @@ TEST(Session, DisabledCamerasAreOffForTheSessionOnly) {
   Rig expected = file_rig;
   expected.cameras[1].enabled = false;
   ExpectFieldsOf(session, expected, options.fields);
-  session.ReadFields([&](const Fields& f, std::int64_t) { EXPECT_EQ(f.stats.per_camera_seen[1], 0); });
+  session.ReadFields(
+      [&](const Fields& f, std::int64_t) { EXPECT_EQ(f.stats.per_camera_seen[1], 0); });
 
   options.disable = {file_rig.cameras[0].id, "no-such-camera"};
   try {
@@ -231,7 +240,9 @@ TEST(Session, DisabledCamerasAreOffForTheSessionOnly) {
   } catch (const InputError& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("--disable"), std::string::npos) << message;
-    EXPECT_NE(message.find("no camera 'no-such-camera' in rig '" + file_rig.name + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find("no camera 'no-such-camera' in rig '" + file_rig.name + "'"),
+              std::string::npos)
+        << message;
     EXPECT_NE(message.find(file_rig.CameraIds()), std::string::npos) << message;
   }
 }
@@ -259,7 +270,8 @@ TEST(Session, SuggestInTheBackgroundThenApplyAndUndo) {
   ASSERT_TRUE(s) << JobStateName(status.state) << " " << status.error;
   ASSERT_EQ(s->cameras.size(), 1u);
   session.ApplySuggestion(*s);
-  EXPECT_EQ(session.rig().rig().cameras[0].world_from_camera.matrix(), s->cameras[0].after.matrix());
+  EXPECT_EQ(session.rig().rig().cameras[0].world_from_camera.matrix(),
+            s->cameras[0].after.matrix());
   EXPECT_EQ(session.rig().undo_label(), "accept suggestion (1 cameras)");
   // The fields follow the accepted poses.
   session.UpdateFields();
@@ -331,7 +343,8 @@ TEST(Session, RenderInTheBackgroundRefinesToTheExactFrameOfTheNewestRig) {
   EXPECT_EQ(last.cameras, exact.cameras);
   EXPECT_EQ(last.sigma_max, exact.sigma_max);
   // The session's frame is the one-shot renderer's for the edited rig.
-  const Image one_shot = pandora::Render(study->scene(), session.rig().rig(), study->caster(), view, options);
+  const Image one_shot =
+      pandora::Render(study->scene(), session.rig().rig(), study->caster(), view, options);
   EXPECT_EQ(one_shot.rgb, exact.rgb);
   // ...and differs from the original rig's (camera 0 lit part of the block).
   const Image before = pandora::Render(study->scene(), original, study->caster(), view, options);
@@ -393,15 +406,17 @@ TEST(Autosave, WritesOnlyEditedCamerasAndRecoversThemAsOneUndoStep) {
   expect_error("{not json", "$");
   expect_error("[]", "$");
   expect_error(R"({"pandora_autosave": 2})", "$.pandora_autosave");
-  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": "nope", "cameras": []})", "$.rig");
+  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": "nope", "cameras": []})",
+               "$.rig");
   expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": ")" + original.name +
                    R"(", "cameras": [{"id": "zz", "position": [0, 0, 1], "look_at": [1, 0, 1],
                    "resolution": [64, 48], "hfov_deg": 60}]})",
                "$.cameras[0].id");
-  expect_error(R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": ")" + original.name +
-                   R"(", "cameras": [{"id": ")" + original.cameras[0].id +
-                   R"(", "position": [0, 0, "one"], "look_at": [1, 0, 1], "resolution": [64, 48], "hfov_deg": 60}]})",
-               "$.cameras[0].position[2]");
+  expect_error(
+      R"({"pandora_autosave": 1, "scene_sha256": "x", "rig": ")" + original.name +
+          R"(", "cameras": [{"id": ")" + original.cameras[0].id +
+          R"(", "position": [0, 0, "one"], "look_at": [1, 0, 1], "resolution": [64, 48], "hfov_deg": 60}]})",
+      "$.cameras[0].position[2]");
   std::ofstream(path, std::ios::binary)
       << R"({"pandora_autosave": 1, "scene_sha256": "0000", "rig": ")" + original.name +
              R"(", "cameras": [{"id": ")" + original.cameras[0].id +

@@ -4,8 +4,8 @@
 #include <malloc.h>
 #endif
 
-#include "analysis/error.h"
-#include "analysis/input_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 
 namespace pandora::session {
 
@@ -37,7 +37,8 @@ std::shared_ptr<const Study> Study::FromScene(Scene scene, std::string text) {
 }
 
 const PreparedScene& Study::prepared() const {
-  std::call_once(prepared_once_, [this] { prepared_ = std::make_unique<PreparedScene>(scene_, *caster_); });
+  std::call_once(prepared_once_,
+                 [this] { prepared_ = std::make_unique<PreparedScene>(scene_, *caster_); });
   return *prepared_;
 }
 
@@ -51,7 +52,8 @@ const Rig& Study::FindRig(const std::string& name, const std::string& option) co
   if (!option.empty())
     throw InputError(option, "", "no rig named '" + name + "' in " + scene_.path,
                      "rigs in this scene: " + names);
-  throw InputError(scene_.path, "$.rigs", "no rig named '" + name + "'", "rigs in this scene: " + names);
+  throw InputError(scene_.path, "$.rigs", "no rig named '" + name + "'",
+                   "rigs in this scene: " + names);
 }
 
 Rig DisableCameras(Rig rig, const std::vector<std::string>& ids, const std::string& option) {
@@ -59,7 +61,8 @@ Rig DisableCameras(Rig rig, const std::vector<std::string>& ids, const std::stri
     if (id.empty()) throw InputError(option, "", "an empty camera id", "e.g. " + option + " c1,c2");
     const int index = rig.FindCamera(id);
     if (index < 0)
-      throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'", "cameras: " + rig.CameraIds());
+      throw InputError(option, "", "no camera '" + id + "' in rig '" + rig.name + "'",
+                       "cameras: " + rig.CameraIds());
     rig.cameras[index].enabled = false;
   }
   return rig;

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 #include "render/prepared_scene.h"
 #include "volume/solid_trees.h"
 

@@ -1,14 +1,14 @@
 // Reads FILE.fbx (the two-bone bar of tests/skinned_gltf.h after a round trip through Blender: glTF
-// in, FBX out, in centimetres) with LoadSkinnedMeshFile and compares its "bend" clip with the closed
-// form at clip times 0, 0.5 and 1 s: the vertices, scaled by 1/100, within 1e-5 m. (Between those
-// keys Blender's exported curves interpolate quaternion components, not slerp: about 1 degree apart
-// at 0.25 s, so only the key times and the midpoint, where both agree, are compared.)
+// in, FBX out, in centimetres) with LoadSkinnedMeshFile and compares its "bend" clip with the
+// closed form at clip times 0, 0.5 and 1 s: the vertices, scaled by 1/100, within 1e-5 m. (Between
+// those keys Blender's exported curves interpolate quaternion components, not slerp: about 1 degree
+// apart at 0.25 s, so only the key times and the midpoint, where both agree, are compared.)
 #include <algorithm>
 #include <cstdio>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/mesh_io.h"
+#include "analysis/scene/mesh_io.h"
+#include "analysis/util/error.h"
 #include "tests/skinned_gltf.h"
 
 int main(int argc, char** argv) {
@@ -42,13 +42,16 @@ int main(int argc, char** argv) {
     double worst = 0;
     for (double tau : {0.0, 0.5, 1.0}) {
       const std::vector<Vec3> v = skin.Skin(file.skeleton->Globals(clip, tau));
-      for (std::size_t i = 0; i < v.size(); ++i) worst = std::max(worst, (v[i] / 100 - bar.BendPose(match[i], tau)).norm());
+      for (std::size_t i = 0; i < v.size(); ++i)
+        worst = std::max(worst, (v[i] / 100 - bar.BendPose(match[i], tau)).norm());
     }
     if (!(worst < 1e-5) || start.size() < bar.vertices.size()) {
-      std::printf("FAIL: the FBX bend clip is %.3g m from the closed form (%zu vertices)\n", worst, start.size());
+      std::printf("FAIL: the FBX bend clip is %.3g m from the closed form (%zu vertices)\n", worst,
+                  start.size());
       return 1;
     }
-    std::printf("ok: FBX through Blender, %zu vertices within %.2g m of the closed form\n", start.size(), worst);
+    std::printf("ok: FBX through Blender, %zu vertices within %.2g m of the closed form\n",
+                start.size(), worst);
   } catch (const InputError& e) {
     std::printf("FAIL: %s\n", e.what());
     return 1;

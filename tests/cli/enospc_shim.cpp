@@ -1,9 +1,9 @@
 // A full disk, simulated: loaded with LD_PRELOAD, this makes writes to regular files fail with
 // ENOSPC once PANDORA_ENOSPC_AFTER bytes have been written to regular files by the process (writes
-// to terminals and pipes pass). Used by tests/cli/check_transactions.sh where a small tmpfs cannot be
-// mounted. With PANDORA_ENOSPC_FILE set, only writes to files whose path contains that text count
-// and fail (the disk fills while that file is written, and space is freed afterwards). Covers write,
-// writev, pwrite and pwrite64, which libstdc++'s file streams use.
+// to terminals and pipes pass). Used by tests/cli/check_transactions.sh where a small tmpfs cannot
+// be mounted. With PANDORA_ENOSPC_FILE set, only writes to files whose path contains that text
+// count and fail (the disk fills while that file is written, and space is freed afterwards). Covers
+// write, writev, pwrite and pwrite64, which libstdc++'s file streams use.
 #include <dlfcn.h>
 #include <errno.h>
 #include <stdio.h>

@@ -2,8 +2,8 @@
 #include <cstdint>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "tests/fuzz/fuzz_targets.h"
 #include "volume/fields.h"
 #include "volume/vdb_io.h"

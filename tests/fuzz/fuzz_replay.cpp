@@ -17,14 +17,16 @@
 #include <string>
 #include <vector>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "tests/fuzz/fuzz_targets.h"
 
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: fuzz_replay fields|scene|script|rig [--timeout SECONDS] FILE_OR_FOLDER...\n");
+    std::fprintf(
+        stderr,
+        "usage: fuzz_replay fields|scene|script|rig [--timeout SECONDS] FILE_OR_FOLDER...\n");
     return 1;
   }
   const std::string target = argv[1];

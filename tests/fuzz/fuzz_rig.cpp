@@ -1,13 +1,14 @@
-// libFuzzer target for the calibrated-rig readers of `pandora import-rig` (analysis/rig_formats.h):
-// the first byte picks the reader (even: OpenCV YAML; odd: COLMAP, the rest split at the first
+// libFuzzer target for the calibrated-rig readers of `pandora import-rig`
+// (analysis/rig/rig_formats.h): the first byte picks the reader (even: OpenCV YAML; odd: COLMAP,
+// the rest split at the first
 // "\n@images\n" into cameras.txt and images.txt). Every rig read must hold finite values only.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/rig_formats.h"
+#include "analysis/rig/rig_formats.h"
+#include "analysis/util/error.h"
 #include "tests/fuzz/fuzz_targets.h"
 
 namespace pandora::fuzz {
@@ -22,7 +23,8 @@ void RigTarget(const std::uint8_t* data, std::size_t size) {
     const std::string marker = "\n@images\n";
     const std::size_t at = text.find(marker);
     const std::string cameras = at == std::string::npos ? text : text.substr(0, at);
-    const std::string images = at == std::string::npos ? std::string() : text.substr(at + marker.size());
+    const std::string images =
+        at == std::string::npos ? std::string() : text.substr(at + marker.size());
     rig = ParseColmap(cameras, "cameras.txt", images, "images.txt", "fuzz");
   }
   for (const Camera& c : rig.cameras) {

@@ -3,8 +3,8 @@
 #include <cstdint>
 #include <string>
 
-#include "analysis/error.h"
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "tests/fuzz/fuzz_targets.h"
 
 #ifndef PANDORA_FUZZ_MESH_DIR

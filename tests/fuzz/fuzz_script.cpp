@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
 #include "tests/fuzz/fuzz_targets.h"
 #include "viewer/core/script.h"
 

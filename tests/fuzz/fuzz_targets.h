@@ -17,7 +17,8 @@ void FieldsTarget(const std::uint8_t* data, std::size_t size);
 /// references resolve in tests/fuzz/meshes. Parses and validates only (no ray caster, no fields).
 void SceneTarget(const std::uint8_t* data, std::size_t size);
 
-/// Bytes as a viewer script (`pandora view --script`): viewer::ParseScript, parse and validate only.
+/// Bytes as a viewer script (`pandora view --script`): viewer::ParseScript, parse and validate
+/// only.
 void ScriptTarget(const std::uint8_t* data, std::size_t size);
 
 /// Bytes as a calibrated rig (`pandora import-rig`): the first byte picks OpenCV YAML (even) or a

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "analysis/color.h"
-#include "analysis/error.h"
+#include "analysis/util/color.h"
+#include "analysis/util/error.h"
 #include "render/render.h"
 
 namespace {
@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (a.width != b.width || a.height != b.height) {
-    std::printf("%s: %dx%d, %s: %dx%d: the sizes differ\n", argv[1], a.width, a.height, argv[2], b.width, b.height);
+    std::printf("%s: %dx%d, %s: %dx%d: the sizes differ\n", argv[1], a.width, a.height, argv[2],
+                b.width, b.height);
     return 1;
   }
   const std::size_t n = std::size_t(a.width) * a.height;
@@ -42,12 +43,15 @@ int main(int argc, char** argv) {
   int largest = 0;
   for (std::size_t i = 0; i < n; ++i) {
     int d = 0;
-    for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(Srgb8(a.rgb[3 * i + k]) - Srgb8(b.rgb[3 * i + k])));
+    for (int k = 0; k < 3; ++k)
+      d = std::max(d, std::abs(Srgb8(a.rgb[3 * i + k]) - Srgb8(b.rgb[3 * i + k])));
     largest = std::max(largest, d);
     if (d > tolerance) ++differing;
   }
   const double percent = n ? 100.0 * differing / n : 0.0;
-  std::printf("%s vs %s: %.3f%% of %zu pixels differ by more than %d/255 (largest %d/255; allowed %.3f%%)\n",
-              argv[1], argv[2], percent, n, tolerance, largest, max_percent);
+  std::printf(
+      "%s vs %s: %.3f%% of %zu pixels differ by more than %d/255 (largest %d/255; allowed "
+      "%.3f%%)\n",
+      argv[1], argv[2], percent, n, tolerance, largest, max_percent);
   return percent <= max_percent ? 0 : 1;
 }

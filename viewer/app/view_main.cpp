@@ -2,7 +2,6 @@
 // interactive simulator (docs/viewer.md). With --script it replays actions (viewer/core/script.h)
 // in a window, writes --screenshot and --log, and exits: what the CI's scripted session does.
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,9 +9,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "analysis/atomic_file.h"
-#include "analysis/error.h"
-#include "analysis/output_transaction.h"
+#include "analysis/util/atomic_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/output_transaction.h"
 #include "app/session/autosave.h"
 #include "app/session/study.h"
 #include "viewer/app/viewer_app.h"
@@ -24,9 +23,10 @@ namespace {
 std::pair<int, int> ParseSize(const std::string& text) {
   int w = 0, h = 0;
   char x = 0, rest = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X') || w < 320 ||
-      h < 240 || w > 8192 || h > 8192)
-    throw pandora::InputError("--size", "", "expected WxH, each from 320x240 to 8192", "e.g. --size 1280x720");
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X') ||
+      w < 320 || h < 240 || w > 8192 || h > 8192)
+    throw pandora::InputError("--size", "", "expected WxH, each from 320x240 to 8192",
+                              "e.g. --size 1280x720");
   return {w, h};
 }
 
@@ -34,11 +34,11 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-// `pandora bench --viewer`: whole frames of the window (GPU light, overlays, panels, swap) while the
-// eye orbits (each camera's shadow maps reused) and while every camera moves (maps redrawn each
+// `pandora bench --viewer`: whole frames of the window (GPU light, overlays, panels, swap) while
+// the eye orbits (each camera's shadow maps reused) and while every camera moves (maps redrawn each
 // frame, the fields updating in the background), against the exact CPU renderer of the same view.
-int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& window, int frames, double scale,
-          double target_hz) {
+int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& window, int frames,
+          double scale, double target_hz) {
   using pandora::viewer::Action;
   model.session().WaitFields();
   window.Frame();  // first frame: programs, maps
@@ -80,24 +80,31 @@ int Bench(pandora::viewer::ViewerModel& model, pandora::viewer::ViewerApp& windo
   }
   char how[160];
   if (target_hz > 0)
-    std::snprintf(how, sizeof how, "while moving drawn at an adaptive scale aiming at %.0f Hz (reached %.2f navigating, %.2f cameras moving)",
+    std::snprintf(how, sizeof how,
+                  "while moving drawn at an adaptive scale aiming at %.0f Hz (reached %.2f "
+                  "navigating, %.2f cameras moving)",
                   target_hz, scales[0], scales[1]);
   else
     std::snprintf(how, sizeof how, "while moving drawn at %.2f of the resolution", scale);
-  std::printf("pandora bench --viewer: %s, rig %s (%d enabled cameras), %dx%d, %d frames each (median); %s\n",
-              model.scene().path.c_str(), model.rig().name.c_str(), model.rig().enabled_count(), model.width,
-              model.height, frames, how);
-  std::printf("  navigating (eye orbits, shadow maps reused)       %8.1f ms  %6.2f frames/s\n", 1000 * navigate,
-              1 / navigate);
-  std::printf("  all cameras moving (maps redrawn, fields live)    %8.1f ms  %6.2f frames/s\n", 1000 * moving,
-              1 / moving);
-  std::printf("  exact CPU renderer, same view (best of 3)         %8.1f ms  %6.2f frames/s\n", 1000 * cpu, 1 / cpu);
-  std::printf("  ratio window frame / CPU frame: navigating %.3f, cameras moving %.3f\n", navigate / cpu, moving / cpu);
+  std::printf(
+      "pandora bench --viewer: %s, rig %s (%d enabled cameras), %dx%d, %d frames each (median); "
+      "%s\n",
+      model.scene().path.c_str(), model.rig().name.c_str(), model.rig().enabled_count(),
+      model.width, model.height, frames, how);
+  std::printf("  navigating (eye orbits, shadow maps reused)       %8.1f ms  %6.2f frames/s\n",
+              1000 * navigate, 1 / navigate);
+  std::printf("  all cameras moving (maps redrawn, fields live)    %8.1f ms  %6.2f frames/s\n",
+              1000 * moving, 1 / moving);
+  std::printf("  exact CPU renderer, same view (best of 3)         %8.1f ms  %6.2f frames/s\n",
+              1000 * cpu, 1 / cpu);
+  std::printf("  ratio window frame / CPU frame: navigating %.3f, cameras moving %.3f\n",
+              navigate / cpu, moving / cpu);
   return 0;
 }
 
 int Run(int argc, char** argv) {
-  CLI::App app{"Pandora's interactive simulator: move cameras, watch their light, fields and suggestions"};
+  CLI::App app{
+      "Pandora's interactive simulator: move cameras, watch their light, fields and suggestions"};
   app.name("pandora view");
   std::string scene, rig, fields, script, screenshot, log, size = "1280x720";
   bool hidden = false, recover = false, discard = false, no_autosave = false;
@@ -106,14 +113,19 @@ int Run(int argc, char** argv) {
   app.add_option("scene", scene, "Scene file (JSON)")->required();
   app.add_option("--rig", rig, "Rig to edit (default: the first)");
   std::vector<std::string> disable;
-  app.add_option("--disable", disable, "Camera ids to disable for this session, comma-separated or repeated "
-                                       "(not saved)")->delimiter(',');
-  app.add_option("--fields", fields, "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
-  app.add_option("--script", script, "Replay these actions (a JSON array; docs/viewer.md), then exit");
+  app.add_option("--disable", disable,
+                 "Camera ids to disable for this session, comma-separated or repeated "
+                 "(not saved)")
+      ->delimiter(',');
+  app.add_option("--fields", fields,
+                 "Live fields, comma-separated (default: coverage,cameras,resolution,sigma_max)");
+  app.add_option("--script", script,
+                 "Replay these actions (a JSON array; docs/viewer.md), then exit");
   app.add_option("--screenshot", screenshot, "With --script: the window at the end, as PNG");
   app.add_option("--log", log, "With --script: the state after each action, as JSON");
   app.add_option("--size", size, "Window size WxH")->capture_default_str();
-  app.add_option("--shadow-map", shadow_map, "Shadow map size per camera, 512 to 4096")->capture_default_str()
+  app.add_option("--shadow-map", shadow_map, "Shadow map size per camera, 512 to 4096")
+      ->capture_default_str()
       ->check(CLI::Range(512, 4096));
   app.add_option("--target-hz", target_hz,
                  "While the view or cameras move, draw at a resolution adapted to this frame rate "
@@ -121,8 +133,9 @@ int Run(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 240.0));
   app.add_flag("--hidden", hidden, "No visible window (scripts, tests)");
-  app.add_option("--bench", bench_frames, "Measure frame rates over this many frames (navigating; all cameras moving) "
-                                          "against the exact CPU renderer, print them and exit")
+  app.add_option("--bench", bench_frames,
+                 "Measure frame rates over this many frames (navigating; all cameras moving) "
+                 "against the exact CPU renderer, print them and exit")
       ->check(CLI::Range(2, 10000));
   app.add_flag("--recover", recover, "Apply the autosave of a session that ended without saving");
   app.add_flag("--discard-autosave", discard, "Delete that autosave and start from the scene file");
@@ -155,8 +168,9 @@ int Run(int argc, char** argv) {
   if (!no_autosave) vo.autosave_path = autosave;
   const auto saved = pandora::session::ReadAutosave(autosave, *study);
   if (saved && !recover && !discard)
-    throw pandora::InputError(autosave, "", "unsaved edits of an earlier session are kept here",
-                              "start with --recover to apply them, or --discard-autosave to delete them");
+    throw pandora::InputError(
+        autosave, "", "unsaved edits of an earlier session are kept here",
+        "start with --recover to apply them, or --discard-autosave to delete them");
   pandora::viewer::ViewerModel model(study, vo);
   if (saved && recover) {
     const auto ids = pandora::session::RecoverAutosave(model.session(), *saved, autosave);
@@ -171,13 +185,15 @@ int Run(int argc, char** argv) {
   ao.shadow_map_size = shadow_map;
   ao.target_hz = target_hz;
   ao.show_timing = script.empty();
-  if (!script.empty()) ao.motion_scale = 1.0;  // every scripted frame in full: reproducible pictures
+  if (!script.empty())
+    ao.motion_scale = 1.0;  // every scripted frame in full: reproducible pictures
   if (bench_frames > 0) ao.visible = false, ao.show_timing = false, ao.motion_scale = 1.0;
   if (bench_frames > 0) {
     // Full resolution throughout, then as interaction draws it (reduced while moving).
     pandora::viewer::ViewerApp window(model, ao);
     // Full resolution throughout, a fixed half, then what the window does: adaptive, 30 Hz.
-    for (const auto& [scale, hz] : {std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{0.5, 30.0}}) {
+    for (const auto& [scale, hz] :
+         {std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{0.5, 30.0}}) {
       window.SetMotionScale(scale, hz);
       Bench(model, window, bench_frames, scale, hz);
     }

@@ -7,9 +7,9 @@
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
+#include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 #include <imgui_internal.h>  // BringWindowToDisplayFront: the status bar above the panels
-#include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
 #include <array>
@@ -22,9 +22,10 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "analysis/error.h"
-#include "analysis/pose.h"
-#include "analysis/color.h"
+#include "analysis/geometry/pose.h"
+#include "analysis/util/color.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "render/isosurface.h"
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
@@ -33,14 +34,14 @@
 #include "volume/fields.h"
 #include "volume/slice.h"
 #include "volume/summary.h"
-#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
 
-
 std::string g_glfw_error;
-void OnGlfwError(int code, const char* text) { g_glfw_error = std::string(text) + " (" + std::to_string(code) + ")"; }
+void OnGlfwError(int code, const char* text) {
+  g_glfw_error = std::string(text) + " (" + std::to_string(code) + ")";
+}
 
 unsigned char ToSrgb8(double linear) {
   return static_cast<unsigned char>(std::lround(255.0 * SrgbFromLinear(linear)));
@@ -81,7 +82,9 @@ struct Projector {
     cx = 0.5 * v.width - 0.5;
     cy = 0.5 * v.height - 0.5;
   }
-  ImVec2 Pixel(const Vec3& c) const { return ImVec2(float(cx + f * c.x() / c.z() + 0.5), float(cy + f * c.y() / c.z() + 0.5)); }
+  ImVec2 Pixel(const Vec3& c) const {
+    return ImVec2(float(cx + f * c.x() / c.z() + 0.5), float(cy + f * c.y() / c.z() + 0.5));
+  }
   // The segment a-b clipped to the half space in front of the eye; false when none of it is.
   bool Segment(const Vec3& a, const Vec3& b, ImVec2* pa, ImVec2* pb) const {
     Vec3 p = camera_from_world * a, q = camera_from_world * b;
@@ -116,7 +119,8 @@ std::vector<Vec3> FrustumBorder(const Camera& cam, double length) {
   const double w = m.width() - 0.5, h = m.height() - 0.5;
   const int n = m.intrinsics().model == LensModel::kPinhole ? 1 : 8;
   auto add = [&](double u, double v) {
-    if (const auto d = m.Unproject(Vec2(u, v))) out.push_back(cam.world_from_camera * (*d * length));
+    if (const auto d = m.Unproject(Vec2(u, v)))
+      out.push_back(cam.world_from_camera * (*d * length));
   };
   for (int i = 0; i < n; ++i) add(-0.5 + (w + 0.5) * i / n, -0.5);
   for (int i = 0; i < n; ++i) add(w, -0.5 + (h + 0.5) * i / n);
@@ -130,9 +134,11 @@ enum class Drag { kNone, kOrbit, kPan, kAxis, kRing, kClick };
 // The report's HTML labels and values as plain text for the panels ("&ge;" -> ">=", ...).
 std::string PlainText(std::string s) {
   static const std::pair<const char*, const char*> entities[] = {
-      {"&ge;", ">="}, {"&le;", "<="}, {"&sigma;", "sigma"}, {"<sub>", "_"}, {"</sub>", ""}, {"&mdash;", "-"}, {"&amp;", "&"}};
+      {"&ge;", ">="}, {"&le;", "<="},   {"&sigma;", "sigma"}, {"<sub>", "_"},
+      {"</sub>", ""}, {"&mdash;", "-"}, {"&amp;", "&"}};
   for (const auto& [from, to] : entities)
-    for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + std::strlen(to)))
+    for (std::size_t at = s.find(from); at != std::string::npos;
+         at = s.find(from, at + std::strlen(to)))
       s.replace(at, std::strlen(from), to);
   return s;
 }
@@ -146,14 +152,14 @@ struct ViewerApp::Impl {
   std::unique_ptr<GlRenderer> gl;
   GlRenderOptions gl_options;
   GLuint main_texture = 0;
-  std::string main_key;  // what the main texture shows
+  std::string main_key;    // what the main texture shows
   bool main_full = false;  // ... at full resolution
   bool full_now = false;   // a screenshot: draw in full whatever moved just before
   std::chrono::steady_clock::time_point last_change, last_rig_change;
   std::int64_t main_rig_version = -1;
-  double motion_now = 0.5;       // the scale of the next moving frame (adapted to AppOptions::target_hz)
-  double overhead_seconds = 0;   // the frame's time besides the main picture (running mean)
-  double frame_gl_seconds = 0;   // this frame's main picture, 0 when it was kept
+  double motion_now = 0.5;  // the scale of the next moving frame (adapted to AppOptions::target_hz)
+  double overhead_seconds = 0;  // the frame's time besides the main picture (running mean)
+  double frame_gl_seconds = 0;  // this frame's main picture, 0 when it was kept
   static constexpr double kMinMotionScale = 0.2;
   int shadow_map_size = 2048;
   InputState input;
@@ -163,7 +169,7 @@ struct ViewerApp::Impl {
 
   // 3D interaction.
   Drag drag = Drag::kNone;
-  int drag_handle = -1;   // axis 0..2
+  int drag_handle = -1;  // axis 0..2
   double press_x = 0, press_y = 0, last_x = 0, last_y = 0;
   Ray drag_ray;
   double applied = 0;     // metres or degrees already applied in this drag
@@ -174,7 +180,8 @@ struct ViewerApp::Impl {
   std::string station;
   bool station_display = false;
   Vec3 station_start = Vec3::Zero();  // where the point was when the drag began
-  std::optional<std::pair<Vec3, double>> script_gizmo;  // a script's gizmo drag: origin, length at its press
+  std::optional<std::pair<Vec3, double>>
+      script_gizmo;  // a script's gizmo drag: origin, length at its press
 
   // Camera views (exact, CPU) of the selected cameras.
   struct CameraView {
@@ -195,14 +202,15 @@ struct ViewerApp::Impl {
   // Suggest panel settings.
   int objective = 0;
   float max_move = 0.3f, max_rotate = 10.0f;
-  int points = 1500;  // pandora suggest's --points
+  int points = 1500;       // pandora suggest's --points
   std::string error;       // the last action's error, shown in the status bar (all of it on hover)
   std::string error_line;  // ... its reason and hint, first in the status bar
 
   Impl(ViewerModel& m, AppOptions o) : model(m), options(o) { motion_now = o.motion_scale; }
 
   void Do(const Action& a) {
-    if (a.kind == Action::Kind::kSelect && !a.cameras.empty()) station.clear();  // the gizmo goes to the cameras
+    if (a.kind == Action::Kind::kSelect && !a.cameras.empty())
+      station.clear();  // the gizmo goes to the cameras
     try {
       error.clear();
       model.Do(a, nullptr);
@@ -229,8 +237,10 @@ struct ViewerApp::Impl {
   std::vector<std::string> ToggledSelection(const std::string& id) const {
     std::vector<std::string> ids = input.ctrl ? SelectedIds() : std::vector<std::string>();
     const auto it = std::find(ids.begin(), ids.end(), id);
-    if (it != ids.end()) ids.erase(it);
-    else ids.push_back(id);
+    if (it != ids.end())
+      ids.erase(it);
+    else
+      ids.push_back(id);
     return ids;
   }
   std::optional<Ray> MouseRay(double x, double y) const {
@@ -256,7 +266,8 @@ struct ViewerApp::Impl {
   }
 
   // The "all" PTZ trace rendered in the background: each completed pass of the progressive CPU
-  // frame (coarse first) is uploaded on the next frame. Shared with the job, which may outlive a frame.
+  // frame (coarse first) is uploaded on the next frame. Shared with the job, which may outlive a
+  // frame.
   struct AllTraceSlot {
     std::mutex mutex;
     Image image;
@@ -271,7 +282,8 @@ struct ViewerApp::Impl {
     if (!all_trace->fresh) return;
     all_trace->fresh = false;
     if (model.ptz_trace != "all") return;  // a pass that finished after the mode changed
-    Upload(&main_texture, all_trace->image.width, all_trace->image.height, ToRgba8(all_trace->image.rgb));
+    Upload(&main_texture, all_trace->image.width, all_trace->image.height,
+           ToRgba8(all_trace->image.rgb));
   }
 
   void RenderMain() {
@@ -283,20 +295,26 @@ struct ViewerApp::Impl {
     UploadAllTrace();
     RenderView view = model.MainView();
     char key[512];
-    std::snprintf(key, sizeof key, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g %.17g %.17g %.17g %.17g",
-                  static_cast<long long>(model.session().rig().version()), view.from.x(), view.from.y(),
-                  view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg, view.width, view.height,
-                  int(model.display.pattern), model.display.grid_pixels, model.display.brightness,
-                  int(model.display.surface), shadow_map_size, model.ptz_trace.c_str(), model.ptz_trace_s,
-                  view.clip_near, view.up.x(), view.up.y(), view.up.z());
+    std::snprintf(key, sizeof key,
+                  "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d %d %d %d %.17g %d %d %s %.17g "
+                  "%.17g %.17g %.17g %.17g",
+                  static_cast<long long>(model.session().rig().version()), view.from.x(),
+                  view.from.y(), view.from.z(), view.at.x(), view.at.y(), view.at.z(), view.fov_deg,
+                  view.width, view.height, int(model.display.pattern), model.display.grid_pixels,
+                  model.display.brightness, int(model.display.surface), shadow_map_size,
+                  model.ptz_trace.c_str(), model.ptz_trace_s, view.clip_near, view.up.x(),
+                  view.up.y(), view.up.z());
     const auto now = std::chrono::steady_clock::now();
     if (key != main_key) last_change = now;
     const std::int64_t rig_version = model.session().rig().version();
     if (rig_version != main_rig_version) last_rig_change = now;
     main_rig_version = rig_version;
-    auto since = [&](std::chrono::steady_clock::time_point t) { return std::chrono::duration<double>(now - t).count(); };
+    auto since = [&](std::chrono::steady_clock::time_point t) {
+      return std::chrono::duration<double>(now - t).count();
+    };
     // Reduced while things move, full once idle.
-    const bool moving = options.motion_scale < 1 && !full_now && (drag != Drag::kNone || since(last_change) < 0.3);
+    const bool moving =
+        options.motion_scale < 1 && !full_now && (drag != Drag::kNone || since(last_change) < 0.3);
     if (key == main_key && main_texture && (moving || main_full)) return;
     main_key = key;
     main_full = !moving;
@@ -307,7 +325,8 @@ struct ViewerApp::Impl {
     // Maps: at most 1024 texels while the eye moves (drawn once, then reused), 512 while cameras
     // move (their maps are drawn every frame).
     gl_options.shadow_map_size =
-        !moving ? shadow_map_size : std::min(shadow_map_size, since(last_rig_change) < 0.3 ? 512 : 1024);
+        !moving ? shadow_map_size
+                : std::min(shadow_map_size, since(last_rig_change) < 0.3 ? 512 : 1024);
     gl_options.pattern = model.display.pattern;
     gl_options.surface = model.display.surface;
     gl_options.brightness = model.display.brightness;
@@ -330,7 +349,8 @@ struct ViewerApp::Impl {
       if (full_now) {
         next_generation();
         model.session().jobs().Cancel("render");
-        const Image image = RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
+        const Image image =
+            RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
         Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
         all_trace_key = key;
       } else if (key != all_trace_key) {
@@ -338,13 +358,14 @@ struct ViewerApp::Impl {
         all_trace_key = key;
         const std::int64_t generation = next_generation();
         auto slot = all_trace;
-        model.session().RenderInBackground(traced, model.MainView(), o, nullptr,
-                                           [slot, generation](const Image& image, int, std::int64_t) {
-                                             std::lock_guard<std::mutex> lock(slot->mutex);
-                                             if (slot->generation != generation) return;
-                                             slot->image = image;
-                                             slot->fresh = true;
-                                           });
+        model.session().RenderInBackground(
+            traced, model.MainView(), o, nullptr,
+            [slot, generation](const Image& image, int, std::int64_t) {
+              std::lock_guard<std::mutex> lock(slot->mutex);
+              if (slot->generation != generation) return;
+              slot->image = image;
+              slot->fresh = true;
+            });
       }
       main_full = true;  // the background frame refines itself
     } else {
@@ -353,7 +374,8 @@ struct ViewerApp::Impl {
       GlRenderOptions o = gl_options;
       if (model.ptz_trace != "single" && std::isnan(o.brightness))
         o.brightness = DefaultBrightness(model.rig().enabled_count());
-      const GlImage image = gl->Render(model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o);
+      const GlImage image =
+          gl->Render(model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o);
       Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
     }
     gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -364,7 +386,8 @@ struct ViewerApp::Impl {
     // [kMinMotionScale, 1].
     if (moving && options.target_hz > 0) {
       const double total = gl_seconds + overhead_seconds;
-      const double factor = std::clamp(std::sqrt((1.0 / options.target_hz) / std::max(total, 1e-4)), 0.7, 1.3);
+      const double factor =
+          std::clamp(std::sqrt((1.0 / options.target_hz) / std::max(total, 1e-4)), 0.7, 1.3);
       motion_now = std::clamp(motion_now * factor, kMinMotionScale, 1.0);
     }
   }
@@ -392,7 +415,8 @@ struct ViewerApp::Impl {
 
   void RenderCameraView(int c) {
     CameraView& v = camera_views[c];
-    const std::int64_t version = model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
+    const std::int64_t version =
+        model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
     if (v.texture && v.version == version) return;
     const CameraModel& m = model.rig().cameras[c].model;
     const double scale = std::min(1.0, 256.0 / m.width());
@@ -409,8 +433,8 @@ struct ViewerApp::Impl {
 
   // Overlay lines and points tested against the scene: each line is cut into pieces of about
   // 8 pixels and each piece (each point) is hidden when the scene is between the eye and its middle
-  // (one occlusion ray, exact, as the isosurface's triangles); hidden ones are drawn faded. Collected
-  // while the overlays are drawn, tested in one batch and drawn by FlushOverlayPieces.
+  // (one occlusion ray, exact, as the isosurface's triangles); hidden ones are drawn faded.
+  // Collected while the overlays are drawn, tested in one batch and drawn by FlushOverlayPieces.
   struct OverlayPiece {
     Vec3 mid;
     ImVec2 a, b;
@@ -440,16 +464,20 @@ struct ViewerApp::Impl {
       const Vec3 d = pieces[i].mid - eye;
       const double len = d.norm();
       // Short of the point by a millimetre or 1e-4 of the distance: a line on a wall stays visible.
-      rays[i] = Ray{eye, d / std::max(len, 1e-12), 0.0, std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
+      rays[i] =
+          Ray{eye, d / std::max(len, 1e-12), 0.0, std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
     }
     std::vector<uint8_t> hidden;
     model.session().study().caster().OccludedBatch(rays, &hidden);
     for (std::size_t i = 0; i < pieces.size(); ++i) {
       const OverlayPiece& p = pieces[i];
       ImU32 col = p.color;
-      if (hidden[i]) col = (col & 0x00FFFFFF) | (ImU32((col >> 24) * 0.3) << 24);  // a third of the opacity
-      if (p.radius > 0) dl->AddCircleFilled(p.a, hidden[i] ? 0.75f * p.radius : p.radius, col);
-      else dl->AddLine(p.a, p.b, col, hidden[i] ? std::max(1.0f, 0.7f * p.width) : p.width);
+      if (hidden[i])
+        col = (col & 0x00FFFFFF) | (ImU32((col >> 24) * 0.3) << 24);  // a third of the opacity
+      if (p.radius > 0)
+        dl->AddCircleFilled(p.a, hidden[i] ? 0.75f * p.radius : p.radius, col);
+      else
+        dl->AddLine(p.a, p.b, col, hidden[i] ? std::max(1.0f, 0.7f * p.width) : p.width);
     }
     pieces.clear();
   }
@@ -458,7 +486,9 @@ struct ViewerApp::Impl {
   void DrawOverlays(ImDrawList* dl) {
     const Projector P(model.MainView());
     const Rig& rig = model.rig();
-    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) { Line(P, a, b, col, width); };
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
+      Line(P, a, b, col, width);
+    };
     // The slice: its voxels as translucent quads in the plane.
     if (!model.display.overlays.slice_field.empty()) DrawSlice(dl, P);
     if (!model.display.overlays.iso_field.empty()) DrawIso(dl, P);
@@ -473,7 +503,8 @@ struct ViewerApp::Impl {
     for (int c = 0; c < int(rig.cameras.size()); ++c) {
       const Camera& cam = rig.cameras[c];
       const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
-      const ImU32 col = cam.enabled ? Color(cam.color, selected ? 1.0 : 0.8) : IM_COL32(110, 110, 110, 160);
+      const ImU32 col =
+          cam.enabled ? Color(cam.color, selected ? 1.0 : 0.8) : IM_COL32(110, 110, 110, 160);
       frustum(cam, col, selected ? 2.5f : 1.2f);
       Dot(P, cam.center(), col, selected ? 6.0f : 4.0f);
       if (const auto p = P.Point(cam.center())) {
@@ -489,11 +520,14 @@ struct ViewerApp::Impl {
         line(ch.before.translation(), ch.after.translation(), IM_COL32(255, 255, 255, 160), 1.0f);
       }
     DrawStations(dl, P);
-    // The suggest panel's keep-out boxes (red) and the box mount (white), while the panel uses them.
+    // The suggest panel's keep-out boxes (red) and the box mount (white), while the panel uses
+    // them.
     auto box = [&](const float* b, ImU32 col) {
       const Vec3 lo(std::min(b[0], b[3]), std::min(b[1], b[4]), std::min(b[2], b[5]));
       const Vec3 hi(std::max(b[0], b[3]), std::max(b[1], b[4]), std::max(b[2], b[5]));
-      auto corner = [&](int k) { return Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z()); };
+      auto corner = [&](int k) {
+        return Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+      };
       for (int k = 0; k < 8; ++k)
         for (int bit : {1, 2, 4})
           if (!(k & bit)) line(corner(k), corner(k | bit), col, 1.5f);
@@ -508,10 +542,13 @@ struct ViewerApp::Impl {
   // display (exact CPU renderer, the display's off-axis camera), the eye's lines to the display's
   // corners, and the tracker's range as a red wireframe.
   void DrawStations(ImDrawList* dl, const Projector& P) {
-    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) { Line(P, a, b, col, width); };
+    auto line = [&](const Vec3& a, const Vec3& b, ImU32 col, float width) {
+      Line(P, a, b, col, width);
+    };
     for (const auto& [name, st] : model.stations) {
       CameraView& v = station_views[name];
-      const std::int64_t version = model.session().rig().version() * 1000003 + model.stations_version;
+      const std::int64_t version =
+          model.session().rig().version() * 1000003 + model.stations_version;
       if (!v.texture || v.version != version) {
         Rig rig = model.rig();
         rig.cameras.push_back(DisplayCamera(st));
@@ -532,8 +569,9 @@ struct ViewerApp::Impl {
       for (int k = 0; k < 4; ++k) visible &= bool(q[k] = P.Point(c[k]));
       // The textured face only when its front (the viewer's side) faces the main view's eye.
       if (visible && (model.view.Eye() - st.display_center).dot(st.display_normal) > 0)
-        dl->AddImageQuad(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)), *q[0], *q[1], *q[2], *q[3],
-                         ImVec2(0, 0), ImVec2(1, 0), ImVec2(1, 1), ImVec2(0, 1));
+        dl->AddImageQuad(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)), *q[0],
+                         *q[1], *q[2], *q[3], ImVec2(0, 0), ImVec2(1, 0), ImVec2(1, 1),
+                         ImVec2(0, 1));
       for (int k = 0; k < 4; ++k) {
         line(c[k], c[(k + 1) % 4], IM_COL32(230, 230, 230, 255), 2.0f);
         line(st.eye, c[k], IM_COL32(230, 230, 230, 90), 1.0f);
@@ -541,12 +579,15 @@ struct ViewerApp::Impl {
       if (const auto d = P.Point(st.display_center)) {
         const bool picked = station == name && station_display;
         const float r = picked ? 5.0f : 3.5f;
-        dl->AddRectFilled(ImVec2(d->x - r, d->y - r), ImVec2(d->x + r, d->y + r), IM_COL32(255, 255, 255, 255));
+        dl->AddRectFilled(ImVec2(d->x - r, d->y - r), ImVec2(d->x + r, d->y + r),
+                          IM_COL32(255, 255, 255, 255));
       }
       if (const auto e = P.Point(st.eye)) {
-        if (station == name && !station_display) dl->AddCircle(*e, 8.0f, IM_COL32(255, 255, 255, 230), 0, 1.5f);
+        if (station == name && !station_display)
+          dl->AddCircle(*e, 8.0f, IM_COL32(255, 255, 255, 230), 0, 1.5f);
         dl->AddCircleFilled(*e, 4.0f, IM_COL32(255, 255, 255, 255));
-        dl->AddText(ImVec2(e->x + 6, e->y - 7), IM_COL32(255, 255, 255, 255), (name + " eye").c_str());
+        dl->AddText(ImVec2(e->x + 6, e->y - 7), IM_COL32(255, 255, 255, 255),
+                    (name + " eye").c_str());
       }
       if (st.has_tracker) {
         const std::array<Vec3, 8> t = TrackerCorners(st);
@@ -565,13 +606,20 @@ struct ViewerApp::Impl {
     const OverlayOptions& ov = model.display.overlays;
     std::int64_t version = -1;
     char key[256];
-    std::snprintf(key, sizeof key, "%s %d %.17g", ov.slice_field.c_str(), ov.slice_axis, ov.slice_position);
+    std::snprintf(key, sizeof key, "%s %d %.17g", ov.slice_field.c_str(), ov.slice_axis,
+                  ov.slice_position);
     version = slice_version;
     model.session().TryReadFields([&](const Fields& f, std::int64_t v) {  // busy: keep the last one
       version = v;
       if (v == slice_version && key == slice_key) return;
       try {
-        slice = SliceField(f, ov.slice_field, ov.slice_axis, std::isnan(ov.slice_position) ? f.lattice.origin[ov.slice_axis] + 0.5 * f.lattice.voxel_size * (f.lattice.dims[ov.slice_axis] - 1) : ov.slice_position, false);
+        slice =
+            SliceField(f, ov.slice_field, ov.slice_axis,
+                       std::isnan(ov.slice_position)
+                           ? f.lattice.origin[ov.slice_axis] +
+                                 0.5 * f.lattice.voxel_size * (f.lattice.dims[ov.slice_axis] - 1)
+                           : ov.slice_position,
+                       false);
       } catch (const std::exception&) {
         slice = FieldSlice();
       }
@@ -587,8 +635,9 @@ struct ViewerApp::Impl {
     // the opacity; tested again only when the view or the slice changes.
     const RenderView view = model.MainView();
     char vkey[512];
-    std::snprintf(vkey, sizeof vkey, "%s %lld %.17g %.17g %.17g", key, static_cast<long long>(slice_version),
-                  view.from.x(), view.from.y(), view.from.z());
+    std::snprintf(vkey, sizeof vkey, "%s %lld %.17g %.17g %.17g", key,
+                  static_cast<long long>(slice_version), view.from.x(), view.from.y(),
+                  view.from.z());
     if (vkey != slice_view_key) {
       slice_view_key = vkey;
       std::vector<Ray> rays(std::size_t(slice.width) * slice.height);
@@ -601,7 +650,8 @@ struct ViewerApp::Impl {
           const Vec3 d = c - view.from;
           const double len = d.norm();
           rays[std::size_t(row) * slice.width + col] =
-              Ray{view.from, d / std::max(len, 1e-12), 0.0, std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
+              Ray{view.from, d / std::max(len, 1e-12), 0.0,
+                  std::max(0.0, len - std::max(1e-3, 1e-4 * len))};
         }
       model.session().study().caster().OccludedBatch(rays, &slice_hidden);
     }
@@ -624,14 +674,16 @@ struct ViewerApp::Impl {
         std::optional<ImVec2> q[4];
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) ok = bool(q[k] = P.Point(corners[k]));
-        if (ok) dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3], Color(rgb, ov.slice_opacity * (slice_hidden[o] ? 0.33 : 1.0)));
+        if (ok)
+          dl->AddQuadFilled(*q[0], *q[1], *q[2], *q[3],
+                            Color(rgb, ov.slice_opacity * (slice_hidden[o] ? 0.33 : 1.0)));
       }
   }
 
   // The isosurface of the live fields as translucent triangles, back to front, shaded as the CPU
-  // renderer shades it (0.35 + 0.65 |n . d|); where the scene hides a triangle (its centre) from the
-  // eye it is drawn at a quarter of the opacity. The mesh is extracted again only when the fields or
-  // the iso choice change; the order and the hidden flags only when the view does.
+  // renderer shades it (0.35 + 0.65 |n . d|); where the scene hides a triangle (its centre) from
+  // the eye it is drawn at a quarter of the opacity. The mesh is extracted again only when the
+  // fields or the iso choice change; the order and the hidden flags only when the view does.
   void DrawIso(ImDrawList* dl, const Projector& P) {
     const OverlayOptions& ov = model.display.overlays;
     char key[256];
@@ -651,18 +703,20 @@ struct ViewerApp::Impl {
     if (n == 0) return;
     const RenderView view = model.MainView();
     char vkey[256];
-    std::snprintf(vkey, sizeof vkey, "%.17g %.17g %.17g %d %d", view.from.x(), view.from.y(), view.from.z(),
-                  view.width, view.height);
+    std::snprintf(vkey, sizeof vkey, "%.17g %.17g %.17g %d %d", view.from.x(), view.from.y(),
+                  view.from.z(), view.width, view.height);
     if (vkey != iso_view_key) {
       iso_view_key = vkey;
       std::vector<std::pair<double, int>> depth(n);
       std::vector<Ray> rays(n);
       for (std::size_t i = 0; i < n; ++i) {
         const Eigen::Vector3i& t = iso_mesh.triangles[i];
-        const Vec3 c = (iso_mesh.vertices[t[0]] + iso_mesh.vertices[t[1]] + iso_mesh.vertices[t[2]]) / 3.0;
+        const Vec3 c =
+            (iso_mesh.vertices[t[0]] + iso_mesh.vertices[t[1]] + iso_mesh.vertices[t[2]]) / 3.0;
         const double d = (c - view.from).norm();
         depth[i] = {-d, int(i)};
-        rays[i] = Ray{view.from, (c - view.from) / std::max(d, 1e-12), 0.0, std::max(0.0, d - 1e-3)};
+        rays[i] =
+            Ray{view.from, (c - view.from) / std::max(d, 1e-12), 0.0, std::max(0.0, d - 1e-3)};
       }
       std::sort(depth.begin(), depth.end());  // farthest first
       model.session().study().caster().OccludedBatch(rays, &iso_hidden);
@@ -671,7 +725,8 @@ struct ViewerApp::Impl {
       for (std::size_t i = 0; i < n; ++i) {
         iso_order[i] = depth[i].second;
         const Eigen::Vector3i& t = iso_mesh.triangles[depth[i].second];
-        const Vec3 a = iso_mesh.vertices[t[0]], b = iso_mesh.vertices[t[1]], c = iso_mesh.vertices[t[2]];
+        const Vec3 a = iso_mesh.vertices[t[0]], b = iso_mesh.vertices[t[1]],
+                   c = iso_mesh.vertices[t[2]];
         const Vec3 normal = (b - a).cross(c - a).normalized();
         iso_shade[i] = 0.35 + 0.65 * std::abs(normal.dot(rays[depth[i].second].direction));
       }
@@ -704,20 +759,25 @@ struct ViewerApp::Impl {
     const Vec3 o = *origin;
     const bool rings = !StationPoint();  // a station point only moves
     const double len = GizmoLength();
-    const ImU32 axis_col[3] = {IM_COL32(230, 60, 60, 255), IM_COL32(60, 200, 60, 255), IM_COL32(70, 110, 240, 255)};
+    const ImU32 axis_col[3] = {IM_COL32(230, 60, 60, 255), IM_COL32(60, 200, 60, 255),
+                               IM_COL32(70, 110, 240, 255)};
     for (int k = 0; k < 3; ++k) {
       ImVec2 a, b;
-      const bool hot = (drag == Drag::kAxis && drag_handle == k) || (drag == Drag::kNone && hover_handle == k);
-      if (P.Segment(o, o + len * Vec3::Unit(k), &a, &b)) dl->AddLine(a, b, axis_col[k], hot ? 4.0f : 2.5f);
+      const bool hot =
+          (drag == Drag::kAxis && drag_handle == k) || (drag == Drag::kNone && hover_handle == k);
+      if (P.Segment(o, o + len * Vec3::Unit(k), &a, &b))
+        dl->AddLine(a, b, axis_col[k], hot ? 4.0f : 2.5f);
       // The ring in the plane normal to axis k.
       if (!rings) continue;
       const Vec3 u = Vec3::Unit((k + 1) % 3), v = Vec3::Unit((k + 2) % 3);
-      const bool ring_hot = (drag == Drag::kRing && drag_handle == k) || (drag == Drag::kNone && hover_handle == k + 3);
+      const bool ring_hot = (drag == Drag::kRing && drag_handle == k) ||
+                            (drag == Drag::kNone && hover_handle == k + 3);
       for (int i = 0; i < 48; ++i) {
         const double t0 = 2 * kPi * i / 48, t1 = 2 * kPi * (i + 1) / 48;
         const Vec3 p0 = o + 0.8 * len * (std::cos(t0) * u + std::sin(t0) * v);
         const Vec3 p1 = o + 0.8 * len * (std::cos(t1) * u + std::sin(t1) * v);
-        if (P.Segment(p0, p1, &a, &b)) dl->AddLine(a, b, axis_col[k] & 0xB0FFFFFF, ring_hot ? 3.5f : 1.5f);
+        if (P.Segment(p0, p1, &a, &b))
+          dl->AddLine(a, b, axis_col[k] & 0xB0FFFFFF, ring_hot ? 3.5f : 1.5f);
       }
     }
   }
@@ -878,8 +938,9 @@ struct ViewerApp::Impl {
         std::string seen;
         for (int k : pick->cameras) seen += (seen.empty() ? "" : ", ") + model.rig().cameras[k].id;
         model.status = "object '" + model.scene().objects[pick->object].name + "' at (" +
-                       std::to_string(pick->point.x()).substr(0, 6) + ", " + std::to_string(pick->point.y()).substr(0, 6) +
-                       ", " + std::to_string(pick->point.z()).substr(0, 6) + "), seen by " +
+                       std::to_string(pick->point.x()).substr(0, 6) + ", " +
+                       std::to_string(pick->point.y()).substr(0, 6) + ", " +
+                       std::to_string(pick->point.z()).substr(0, 6) + "), seen by " +
                        (seen.empty() ? "no camera" : seen);
       }
     }
@@ -890,16 +951,23 @@ struct ViewerApp::Impl {
   void Keys() {
     for (int key : input.pressed) {
       if (ImGui::GetIO().WantCaptureKeyboard) break;
-      if (input.ctrl && key == GLFW_KEY_Z) Do(Make(input.shift ? Action::Kind::kRedo : Action::Kind::kUndo));
-      else if (input.ctrl && key == GLFW_KEY_Y) Do(Make(Action::Kind::kRedo));
-      else if (input.ctrl && key == GLFW_KEY_S) Do(Make(Action::Kind::kSave));
-      else if (key == GLFW_KEY_ESCAPE) station.clear(), Do(Make(Action::Kind::kSelect));
-      else if (key == GLFW_KEY_F) model.plan.clear(), model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
+      if (input.ctrl && key == GLFW_KEY_Z)
+        Do(Make(input.shift ? Action::Kind::kRedo : Action::Kind::kUndo));
+      else if (input.ctrl && key == GLFW_KEY_Y)
+        Do(Make(Action::Kind::kRedo));
+      else if (input.ctrl && key == GLFW_KEY_S)
+        Do(Make(Action::Kind::kSave));
+      else if (key == GLFW_KEY_ESCAPE)
+        station.clear(), Do(Make(Action::Kind::kSelect));
+      else if (key == GLFW_KEY_F)
+        model.plan.clear(),
+            model.view = OrbitView::Framing(model.scene().Bounds(), model.view.fov_deg);
     }
     input.pressed.clear();
     // Fly with W A S D Q E while the right button is held.
     if (input.down[1] && !ImGui::GetIO().WantCaptureKeyboard) {
-      const Vec3 fly(input.keys[GLFW_KEY_D] - input.keys[GLFW_KEY_A], input.keys[GLFW_KEY_E] - input.keys[GLFW_KEY_Q],
+      const Vec3 fly(input.keys[GLFW_KEY_D] - input.keys[GLFW_KEY_A],
+                     input.keys[GLFW_KEY_E] - input.keys[GLFW_KEY_Q],
                      input.keys[GLFW_KEY_W] - input.keys[GLFW_KEY_S]);
       if (fly != Vec3::Zero()) model.LeavePlan();  // flying is 3D
       const double step = 0.02 * model.view.distance;
@@ -910,7 +978,8 @@ struct ViewerApp::Impl {
   // A connected gamepad moves the primary camera (or, with none selected, flies the view).
   void Gamepad() {
     GLFWgamepadstate s;
-    if (!glfwJoystickIsGamepad(GLFW_JOYSTICK_1) || !glfwGetGamepadState(GLFW_JOYSTICK_1, &s)) return;
+    if (!glfwJoystickIsGamepad(GLFW_JOYSTICK_1) || !glfwGetGamepadState(GLFW_JOYSTICK_1, &s))
+      return;
     GamepadAxes g;
     g.left_x = s.axes[GLFW_GAMEPAD_AXIS_LEFT_X];
     g.left_y = s.axes[GLFW_GAMEPAD_AXIS_LEFT_Y];
@@ -918,8 +987,9 @@ struct ViewerApp::Impl {
     g.right_y = s.axes[GLFW_GAMEPAD_AXIS_RIGHT_Y];
     g.left_trigger = s.axes[GLFW_GAMEPAD_AXIS_LEFT_TRIGGER];
     g.right_trigger = s.axes[GLFW_GAMEPAD_AXIS_RIGHT_TRIGGER];
-    const bool active = StickCurve(g.left_x) != 0 || StickCurve(g.left_y) != 0 || StickCurve(g.right_x) != 0 ||
-                        StickCurve(g.right_y) != 0 || g.left_trigger > -0.9 || g.right_trigger > -0.9;
+    const bool active = StickCurve(g.left_x) != 0 || StickCurve(g.left_y) != 0 ||
+                        StickCurve(g.right_x) != 0 || StickCurve(g.right_y) != 0 ||
+                        g.left_trigger > -0.9 || g.right_trigger > -0.9;
     if (!active) return;
     const double dt = std::clamp(frame_seconds, 1e-3, 0.1);
     if (Primary() < 0) {
@@ -942,7 +1012,8 @@ struct ViewerApp::Impl {
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(250, 300), ImGuiCond_FirstUseEver);
     ImGui::Begin("Rig");
-    ImGui::Text("%s: %d of %zu cameras on", rig.name.c_str(), rig.enabled_count(), rig.cameras.size());
+    ImGui::Text("%s: %d of %zu cameras on", rig.name.c_str(), rig.enabled_count(),
+                rig.cameras.size());
     if (ImGui::Button("Undo")) Do(Make(Action::Kind::kUndo));
     ImGui::SameLine();
     if (ImGui::Button("Redo")) Do(Make(Action::Kind::kRedo));
@@ -953,7 +1024,8 @@ struct ViewerApp::Impl {
     // The proposal views of `pandora render --plan` / `--elevation SIDE` (docs/viewer.md).
     auto plan_button = [&](const char* label, const char* view, const char* side) {
       const bool on = model.plan == (side[0] ? side : "plan");
-      if (on) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyleColorVec4(ImGuiCol_ButtonActive));
+      if (on)
+        ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyleColorVec4(ImGuiCol_ButtonActive));
       if (ImGui::SmallButton(label)) {
         Action a = Make(Action::Kind::kView);
         a.text = view;
@@ -977,10 +1049,12 @@ struct ViewerApp::Impl {
       const Camera& cam = rig.cameras[c];
       ImGui::PushID(c);
       bool on = cam.enabled;
-      if (ImGui::Checkbox("##on", &on)) Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
+      if (ImGui::Checkbox("##on", &on))
+        Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
       ImGui::SameLine();
-      ImGui::ColorButton("##col", ImVec4(float(cam.color.x()), float(cam.color.y()), float(cam.color.z()), 1.0f),
-                         ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+      ImGui::ColorButton(
+          "##col", ImVec4(float(cam.color.x()), float(cam.color.y()), float(cam.color.z()), 1.0f),
+          ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
       ImGui::SameLine();
       const bool selected = std::count(model.selection.begin(), model.selection.end(), c) > 0;
       if (ImGui::Selectable(cam.id.c_str(), selected)) {
@@ -1001,21 +1075,26 @@ struct ViewerApp::Impl {
       const int c = model.selection[i];
       RenderCameraView(c);
       const CameraView& v = camera_views[c];
-      ImGui::SetNextWindowPos(ImVec2(float(model.width - v.width - 24), float(8 + i * (v.height + 44))),
-                              ImGuiCond_FirstUseEver);
-      ImGui::Begin(("View " + rig.cameras[c].id).c_str(), nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-      ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)), ImVec2(float(v.width), float(v.height)));
+      ImGui::SetNextWindowPos(
+          ImVec2(float(model.width - v.width - 24), float(8 + i * (v.height + 44))),
+          ImGuiCond_FirstUseEver);
+      ImGui::Begin(("View " + rig.cameras[c].id).c_str(), nullptr,
+                   ImGuiWindowFlags_AlwaysAutoResize);
+      ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(v.texture)),
+                   ImVec2(float(v.width), float(v.height)));
       ImGui::End();
     }
 
     // Status bar.
     ImGui::SetNextWindowPos(ImVec2(0, float(model.height - 28)));
     ImGui::SetNextWindowSize(ImVec2(float(model.width), 28));
-    ImGui::Begin("##status", nullptr,
-                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
+    ImGui::Begin(
+        "##status", nullptr,
+        ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
     const session::JobStatus f = model.session().jobs().Status("fields");
     const std::string undo = edit.can_undo() ? "undo: " + edit.undo_label() : "nothing to undo";
-    const std::string timing = options.show_timing ? " | GPU frame " + std::to_string(int(1000 * gl_seconds)) + " ms" : "";
+    const std::string timing =
+        options.show_timing ? " | GPU frame " + std::to_string(int(1000 * gl_seconds)) + " ms" : "";
     // The status bar stays on top of the panels (one may have been dragged over it).
     ImGui::BringWindowToDisplayFront(ImGui::GetCurrentWindow());
     if (!error.empty()) {
@@ -1024,9 +1103,13 @@ struct ViewerApp::Impl {
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", error.c_str());
       ImGui::SameLine();
     }
-    ImGui::Text("%s%s | fields %s%s%s%s%s", error.empty() ? "" : "| ", undo.c_str(), session::JobStateName(f.state),
-                f.state == session::JobState::kRunning ? (" " + std::to_string(int(100 * f.progress)) + "%").c_str() : "",
-                timing.c_str(), error.empty() && !model.status.empty() ? " | " : "", error.empty() ? model.status.c_str() : "");
+    ImGui::Text("%s%s | fields %s%s%s%s%s", error.empty() ? "" : "| ", undo.c_str(),
+                session::JobStateName(f.state),
+                f.state == session::JobState::kRunning
+                    ? (" " + std::to_string(int(100 * f.progress)) + "%").c_str()
+                    : "",
+                timing.c_str(), error.empty() && !model.status.empty() ? " | " : "",
+                error.empty() ? model.status.c_str() : "");
     ImGui::End();
   }
 
@@ -1041,8 +1124,8 @@ struct ViewerApp::Impl {
       return;
     }
     const Camera& cam = model.rig().cameras[c];
-    ImGui::Text("%s (%s), %dx%d %s", cam.id.c_str(), cam.name.c_str(), cam.model.width(), cam.model.height(),
-                LensModelName(cam.model.intrinsics().model));
+    ImGui::Text("%s (%s), %dx%d %s", cam.id.c_str(), cam.name.c_str(), cam.model.width(),
+                cam.model.height(), LensModelName(cam.model.intrinsics().model));
     float p[3] = {float(cam.center().x()), float(cam.center().y()), float(cam.center().z())};
     if (ImGui::DragFloat3("position m", p, 0.005f, -1e4f, 1e4f, "%.3f")) {
       Action a = Make(Action::Kind::kMove, {cam.id});
@@ -1061,7 +1144,8 @@ struct ViewerApp::Impl {
     }
     const Intrinsics& k = cam.model.intrinsics();
     float hfov = float(HfovFromFocal(k.fx, k.width, k.model) / kRadPerDeg);
-    if (ImGui::DragFloat("hfov deg", &hfov, 0.1f, 1.0f, k.model == LensModel::kFisheye ? 359.0f : 179.0f, "%.1f")) {
+    if (ImGui::DragFloat("hfov deg", &hfov, 0.1f, 1.0f,
+                         k.model == LensModel::kFisheye ? 359.0f : 179.0f, "%.1f")) {
       Action a = Make(Action::Kind::kHfov, {cam.id});
       a.number = hfov;
       Do(a);
@@ -1070,7 +1154,8 @@ struct ViewerApp::Impl {
     LensControls(cam);
     ImGui::DragFloat("snap move m", &move_step, 0.005f, 0.0f, 1.0f, "%.3f");
     ImGui::DragFloat("snap turn deg", &rotate_step, 0.5f, 0.0f, 45.0f, "%.1f");
-    ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)", model.selection.size());
+    ImGui::TextDisabled("%zu selected: drag the gizmo (axes move, rings turn)",
+                        model.selection.size());
     ImGui::End();
   }
 
@@ -1083,21 +1168,24 @@ struct ViewerApp::Impl {
     const Intrinsics& k = cam.model.intrinsics();
     auto hfov = [&](double f) { return float(HfovFromFocal(f, k.width, k.model) / kRadPerDeg); };
     const Vec3 pivot = h.home.translation();
-    ImGui::TextDisabled("pivot %.3f %.3f %.3f, home elevation %.1f deg", pivot.x(), pivot.y(), pivot.z(),
-                        h.HomeElevationDeg());
-    float pan = float(h.current.pan_deg), tilt = float(h.current.tilt_deg), zoom = hfov(h.current.focal);
+    ImGui::TextDisabled("pivot %.3f %.3f %.3f, home elevation %.1f deg", pivot.x(), pivot.y(),
+                        pivot.z(), h.HomeElevationDeg());
+    float pan = float(h.current.pan_deg), tilt = float(h.current.tilt_deg),
+          zoom = hfov(h.current.focal);
     Action a = Make(Action::Kind::kPtz, {cam.id});
     a.drag = true;
     if (ImGui::SliderFloat("pan deg", &pan, float(h.pan_min_deg), float(h.pan_max_deg), "%.1f")) {
       a.pan_deg = pan;
       Do(a);
     }
-    if (ImGui::SliderFloat("tilt deg", &tilt, float(h.tilt_min_deg), float(h.tilt_max_deg), "%.1f")) {
+    if (ImGui::SliderFloat("tilt deg", &tilt, float(h.tilt_min_deg), float(h.tilt_max_deg),
+                           "%.1f")) {
       a.tilt_deg = tilt;
       Do(a);
     }
     if (h.focal_max > h.focal_min) {
-      if (ImGui::SliderFloat("zoom hfov deg", &zoom, hfov(h.focal_min), hfov(h.focal_max), "%.1f")) {
+      if (ImGui::SliderFloat("zoom hfov deg", &zoom, hfov(h.focal_min), hfov(h.focal_max),
+                             "%.1f")) {
         a.hfov_deg = zoom;
         Do(a);
       }
@@ -1117,7 +1205,9 @@ struct ViewerApp::Impl {
     }
     if (ImGui::Button("Re-centre")) Do(Make(Action::Kind::kRecentre, {cam.id}));
     if (ImGui::IsItemHovered())
-      ImGui::SetTooltip("home := the current view; presets and ranges shift so that every preset stays where it is");
+      ImGui::SetTooltip(
+          "home := the current view; presets and ranges shift so that every preset stays where it "
+          "is");
     ImGui::TextUnformatted("trace:");
     for (const char* mode : {"single", "path", "all"}) {
       ImGui::SameLine();
@@ -1129,7 +1219,8 @@ struct ViewerApp::Impl {
       }
     }
     float budget = std::isnan(model.ptz_trace_s) ? float(h.trace_s) : float(model.ptz_trace_s);
-    if (ImGui::DragFloat("budget s", &budget, 0.05f, 0.0f, 60.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+    if (ImGui::DragFloat("budget s", &budget, 0.05f, 0.0f, 60.0f, "%.2f",
+                         ImGuiSliderFlags_AlwaysClamp)) {
       trace_seconds = budget;
       Action t = Make(Action::Kind::kTrace, {});
       t.text = model.ptz_trace;
@@ -1137,19 +1228,22 @@ struct ViewerApp::Impl {
       Do(t);
     }
     ImGui::TextDisabled(model.ptz_trace == "all" ? "all: exact CPU picture (slow while moving)"
-                                                  : "path: one light per second home -> current");
+                                                 : "path: one light per second home -> current");
   }
 
   // On/off, colour, resolution, lens model and coefficients, working range: each a script action.
   void LensControls(const Camera& cam) {
     const Intrinsics& k = cam.model.intrinsics();
     bool on = cam.enabled;
-    if (ImGui::Checkbox("on", &on)) Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
+    if (ImGui::Checkbox("on", &on))
+      Do(Make(on ? Action::Kind::kEnable : Action::Kind::kDisable, {cam.id}));
     ImGui::SameLine();
     float rgb[3] = {float(cam.color.x()), float(cam.color.y()), float(cam.color.z())};
-    if (ImGui::ColorEdit3("colour", rgb, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float)) {
+    if (ImGui::ColorEdit3("colour", rgb,
+                          ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float)) {
       Action a = Make(Action::Kind::kColor, {cam.id});
-      a.a = Vec3(std::clamp(rgb[0], 0.0f, 1.0f), std::clamp(rgb[1], 0.0f, 1.0f), std::clamp(rgb[2], 0.0f, 1.0f));
+      a.a = Vec3(std::clamp(rgb[0], 0.0f, 1.0f), std::clamp(rgb[1], 0.0f, 1.0f),
+                 std::clamp(rgb[2], 0.0f, 1.0f));
       a.drag = true;
       Do(a);
     }
@@ -1163,7 +1257,8 @@ struct ViewerApp::Impl {
     }
     if (limited) {
       float n = float(cam.near), f = float(cam.far);
-      if (ImGui::DragFloatRange2("range m", &n, &f, 0.01f, 0.0f, 1e4f, "%.2f", "%.2f", ImGuiSliderFlags_AlwaysClamp)) {
+      if (ImGui::DragFloatRange2("range m", &n, &f, 0.01f, 0.0f, 1e4f, "%.2f", "%.2f",
+                                 ImGuiSliderFlags_AlwaysClamp)) {
         Action a = Make(Action::Kind::kRange, {cam.id});
         a.near = n;
         a.far = std::max(f, n + 1e-3f);
@@ -1187,7 +1282,8 @@ struct ViewerApp::Impl {
       resolution[1] = k.height;
       resolution_camera = cam.id;
     }
-    const bool entered = ImGui::InputInt2("resolution", resolution, ImGuiInputTextFlags_EnterReturnsTrue);
+    const bool entered =
+        ImGui::InputInt2("resolution", resolution, ImGuiInputTextFlags_EnterReturnsTrue);
     resolution_active = ImGui::IsItemActive();
     if (entered && (resolution[0] != k.width || resolution[1] != k.height)) {
       Action a = Make(Action::Kind::kIntrinsics, {cam.id});
@@ -1207,7 +1303,8 @@ struct ViewerApp::Impl {
     for (int i = 0; i < 6; ++i) {
       if (!LensHasCoefficient(name, i)) continue;
       float v = float(values[i]);
-      if (ImGui::DragFloat(kCoefficientNames[i], &v, i == 2 || i == 3 ? 0.0001f : 0.001f, -10.0f, 10.0f, "%.4f")) {
+      if (ImGui::DragFloat(kCoefficientNames[i], &v, i == 2 || i == 3 ? 0.0001f : 0.001f, -10.0f,
+                           10.0f, "%.4f")) {
         Action a = Make(Action::Kind::kIntrinsics, {cam.id});
         a.coefficients[i] = v;
         a.drag = true;
@@ -1225,7 +1322,8 @@ struct ViewerApp::Impl {
   VoxelLattice fields_lattice;
 
   void FieldsPanel() {
-    ImGui::SetNextWindowPos(ImVec2(266, float(std::max(40, model.height - 230))), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(266, float(std::max(40, model.height - 230))),
+                            ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(250, 195), ImGuiCond_FirstUseEver);
     ImGui::Begin("Fields");
     // The numbers of the fields' latest version, worked out once per version (the median copies
@@ -1246,20 +1344,23 @@ struct ViewerApp::Impl {
     });
     const VoxelLattice& lattice = fields_lattice;
     const std::string numbers =
-        fields_numbers + (fields_numbers_version == model.session().rig().version() ? "" : "\n(updating)");
+        fields_numbers +
+        (fields_numbers_version == model.session().rig().version() ? "" : "\n(updating)");
     ImGui::TextUnformatted(fields_numbers_version == -2 ? "evaluating..." : numbers.c_str());
     // With people (time samples): the live fields above are the empty volume's; these are the
     // numbers with the people at every sample, as `pandora analyze` reports them.
     if (const auto time = model.session().TimeNumbers()) {
       const TimeSummary& t = time->first;
       const double worst = t.samples.empty() ? 0.0 : t.samples[t.worst_sample].ge_k;
-      ImGui::Text("with people, %zu samples, >=%d:\nalways %.1f%%  worst sample %.1f%%%s", t.samples.size(),
-                  t.min_cameras, 100.0 * t.always, 100.0 * worst,
+      ImGui::Text("with people, %zu samples, >=%d:\nalways %.1f%%  worst sample %.1f%%%s",
+                  t.samples.size(), t.min_cameras, 100.0 * t.always, 100.0 * worst,
                   time->second == model.session().rig().version() ? "" : " (updating)");
       if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("The fields above are the static scene's (the volume without the moving objects).\n"
-                          "These are over the time samples with them: the share of voxels covered by >= %d\n"
-                          "cameras at every sample where they are free, and in the worst sample.", t.min_cameras);
+        ImGui::SetTooltip(
+            "The fields above are the static scene's (the volume without the moving objects).\n"
+            "These are over the time samples with them: the share of voxels covered by >= %d\n"
+            "cameras at every sample where they are free, and in the worst sample.",
+            t.min_cameras);
     }
     const char* fields[] = {"", "coverage", "resolution", "sigma_max"};
     const OverlayOptions& ov = model.display.overlays;
@@ -1267,15 +1368,19 @@ struct ViewerApp::Impl {
     for (int i = 1; i < 4; ++i)
       if (ov.slice_field == fields[i]) current = i;
     int axis = ov.slice_axis;
-    float at = std::isnan(ov.slice_position) ? float(lattice.origin[axis] + 0.5 * lattice.voxel_size * (lattice.dims[axis] - 1))
-                                              : float(ov.slice_position);
+    float at =
+        std::isnan(ov.slice_position)
+            ? float(lattice.origin[axis] + 0.5 * lattice.voxel_size * (lattice.dims[axis] - 1))
+            : float(ov.slice_position);
     bool changed = ImGui::Combo("slice", &current, "off\0coverage\0resolution\0sigma_max\0");
     changed |= ImGui::RadioButton("x", &axis, 0);
     ImGui::SameLine();
     changed |= ImGui::RadioButton("y", &axis, 1);
     ImGui::SameLine();
     changed |= ImGui::RadioButton("z", &axis, 2);
-    const float lo = float(lattice.origin[axis]), hi = float(lattice.origin[axis] + lattice.voxel_size * std::max(0, lattice.dims[axis] - 1));
+    const float lo = float(lattice.origin[axis]),
+                hi = float(lattice.origin[axis] +
+                           lattice.voxel_size * std::max(0, lattice.dims[axis] - 1));
     changed |= ImGui::SliderFloat("at m", &at, lo, std::max(hi, lo + 1e-3f), "%.3f");
     if (changed) {
       Action a = Make(Action::Kind::kSlice);
@@ -1336,7 +1441,9 @@ struct ViewerApp::Impl {
         ImGui::TableSetupColumn("", ImGuiTableColumnFlags_WidthFixed, 170.0f);
         for (const std::string& r : cmp->rigs) {
           const auto open = r.rfind(" (");
-          const std::string head = open != std::string::npos && r.back() == ')' ? r.substr(open + 2, r.size() - open - 3) : r;
+          const std::string head = open != std::string::npos && r.back() == ')'
+                                       ? r.substr(open + 2, r.size() - open - 3)
+                                       : r;
           ImGui::TableSetupColumn(head.c_str(), ImGuiTableColumnFlags_WidthStretch);
         }
         ImGui::TableHeadersRow();
@@ -1348,7 +1455,8 @@ struct ViewerApp::Impl {
           ImGui::Text("%d", cmp->enabled_cameras[i]);
         }
         for (const report::ComparisonRow& row : cmp->rows) {
-          if (std::none_of(row.values.begin(), row.values.end(), [](const std::optional<double>& v) { return v.has_value(); }))
+          if (std::none_of(row.values.begin(), row.values.end(),
+                           [](const std::optional<double>& v) { return v.has_value(); }))
             continue;  // a row no rig has (a field that is not live)
           ImGui::TableNextRow();
           ImGui::TableSetColumnIndex(0);
@@ -1356,34 +1464,40 @@ struct ViewerApp::Impl {
           for (int i = 0; i < n; ++i) {
             ImGui::TableSetColumnIndex(i + 1);
             const std::string text = PlainText(row.Text(i));
-            if (row.best[i]) ImGui::TextColored(ImVec4(0.4f, 0.95f, 0.45f, 1.0f), "%s", text.c_str());
-            else ImGui::TextUnformatted(text.c_str());
+            if (row.best[i])
+              ImGui::TextColored(ImVec4(0.4f, 0.95f, 0.45f, 1.0f), "%s", text.c_str());
+            else
+              ImGui::TextUnformatted(text.c_str());
           }
         }
         ImGui::EndTable();
       }
     } else {
-      ImGui::TextDisabled("the edited rig's live fields against the rig as saved\n(evaluated once on the button)");
+      ImGui::TextDisabled(
+          "the edited rig's live fields against the rig as saved\n(evaluated once on the button)");
     }
     ImGui::End();
   }
   int compare_other = 0;
 
   void SuggestPanel() {
-    ImGui::SetNextWindowPos(ImVec2(float(model.width - 290), float(model.height - 290)), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(float(model.width - 290), float(model.height - 290)),
+                            ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(280, 250), ImGuiCond_FirstUseEver);
     ImGui::Begin("Suggest");
-    const char* objectives[] = {"coverage2", "coverage3", "sigma-p90", "sigma-mean", "resolution",
-                                "coverage3-n1", "calibration", "mix"};
+    const char* objectives[] = {"coverage2",  "coverage3",    "sigma-p90",   "sigma-mean",
+                                "resolution", "coverage3-n1", "calibration", "mix"};
     if (model.suggestion) {  // the panel shows what the suggestion on screen was asked for
       for (int i = 0; i < IM_ARRAYSIZE(objectives); ++i)
         if (ObjectiveName(model.suggestion->objective) == objectives[i]) objective = i;
       over_time = model.suggestion_over_time;
     }
     ImGui::Combo("objective", &objective, objectives, IM_ARRAYSIZE(objectives));
-    if (std::string(objectives[objective]) == "mix") ImGui::DragFloat3("weights c s r", weights, 0.05f, 0.0f, 100.0f, "%.2f");
+    if (std::string(objectives[objective]) == "mix")
+      ImGui::DragFloat3("weights c s r", weights, 0.05f, 0.0f, 100.0f, "%.2f");
     // The points the objective is evaluated on, as `pandora suggest`: the study region, named
-    // surfaces (--target-surface, with --with-region), or the study's targets over time (--over-time).
+    // surfaces (--target-surface, with --with-region), or the study's targets over time
+    // (--over-time).
     const bool has_targets = model.scene().study.targets.has_value();
     if (!has_targets) over_time = false;
     if (has_targets) ImGui::Checkbox("over time (the study's targets)", &over_time);
@@ -1396,7 +1510,8 @@ struct ViewerApp::Impl {
     ImGui::DragInt("points", &points, 10, 50, 20000);
     // Mount of the selected cameras: free, on a rail (a line), on a plane (a wall), or in a box.
     ImGui::Combo("mount", &mount, "free\0rail\0plane\0box\0");
-    if (mount == 1 || mount == 2) ImGui::DragFloat3(mount == 1 ? "rail direction" : "plane normal", mount_axis, 0.05f);
+    if (mount == 1 || mount == 2)
+      ImGui::DragFloat3(mount == 1 ? "rail direction" : "plane normal", mount_axis, 0.05f);
     if (mount == 3) {
       ImGui::DragFloat3("box min m", mount_box, 0.01f);
       ImGui::DragFloat3("box max m", mount_box + 3, 0.01f);
@@ -1416,20 +1531,23 @@ struct ViewerApp::Impl {
     if (ImGui::Button("add keep-out box")) {
       // Around the view's target, half a metre each way, floor to 2 m.
       const Vec3 t = model.view.target;
-      keep_outs.push_back({float(t.x() - 0.5), float(t.y() - 0.5), 0.0f, float(t.x() + 0.5), float(t.y() + 0.5), 2.0f});
+      keep_outs.push_back({float(t.x() - 0.5), float(t.y() - 0.5), 0.0f, float(t.x() + 0.5),
+                           float(t.y() + 0.5), 2.0f});
     }
     ImGui::DragFloat("clearance m", &clearance, 0.005f, 0.0f, 2.0f, "%.3f");
     ImGui::Checkbox("zoom", &zoom_on);
     if (zoom_on) ImGui::DragFloat2("hfov range deg", zoom, 0.5f, 1.0f, 179.0f, "%.1f");
     const session::JobStatus s = model.session().jobs().Status("suggest");
-    const bool running = s.state == session::JobState::kRunning || s.state == session::JobState::kQueued;
+    const bool running =
+        s.state == session::JobState::kRunning || s.state == session::JobState::kQueued;
     if (model.selection.empty()) {
       ImGui::TextDisabled("select the cameras that may move");
     } else if (running) {
       ImGui::Text("suggesting...");
       ImGui::SameLine();
       if (ImGui::Button("Cancel")) model.session().jobs().Cancel("suggest");
-    } else if (ImGui::Button(("Suggest for " + std::to_string(model.selection.size()) + " cameras").c_str())) {
+    } else if (ImGui::Button(("Suggest for " + std::to_string(model.selection.size()) + " cameras")
+                                 .c_str())) {
       Action a = Make(Action::Kind::kSuggest, SelectedIds());
       a.text = objectives[objective];
       a.number = max_move;
@@ -1454,7 +1572,8 @@ struct ViewerApp::Impl {
         a.min_hfov = zoom[0];
         a.max_hfov = zoom[1];
       }
-      if (std::string(objectives[objective]) == "mix") a.weights = Vec3(weights[0], weights[1], weights[2]);
+      if (std::string(objectives[objective]) == "mix")
+        a.weights = Vec3(weights[0], weights[1], weights[2]);
       a.over_time = over_time;
       if (!over_time) {
         std::string list = surfaces, item;
@@ -1479,8 +1598,8 @@ struct ViewerApp::Impl {
     if (model.suggestion) {
       const Suggestion& g = *model.suggestion;
       ImGui::Separator();
-      ImGui::Text("%s: %.4g -> %.4g%s", ObjectiveName(g.objective).c_str(), g.before.objective, g.after.objective,
-                  g.improved ? "" : " (no improvement)");
+      ImGui::Text("%s: %.4g -> %.4g%s", ObjectiveName(g.objective).c_str(), g.before.objective,
+                  g.after.objective, g.improved ? "" : " (no improvement)");
       ImGui::TextDisabled("over %s", model.suggestion_targets.c_str());
       if (!g.improved) {  // as `pandora accept`: nothing to accept
         if (ImGui::Button("Reject")) Do(Make(Action::Kind::kReject));
@@ -1527,10 +1646,17 @@ struct ViewerApp::Impl {
     int surface = int(model.display.surface);
     changed |= ImGui::Combo("surfaces", &surface, "material\0black\0hidden-line\0contours\0");
     bool automatic = std::isnan(model.display.brightness);
-    float brightness = automatic ? float(DefaultBrightness(model.rig().enabled_count())) : float(model.display.brightness);
+    float brightness = automatic ? float(DefaultBrightness(model.rig().enabled_count()))
+                                 : float(model.display.brightness);
     changed |= ImGui::Checkbox("auto brightness", &automatic);
-    if (!automatic) changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f");
-    if (ImGui::Combo("shadow map", &map_index, "512\0" "1024\0" "2048\0" "4096\0")) shadow_map_size = 512 << map_index;
+    if (!automatic)
+      changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f");
+    if (ImGui::Combo("shadow map", &map_index,
+                     "512\0"
+                     "1024\0"
+                     "2048\0"
+                     "4096\0"))
+      shadow_map_size = 512 << map_index;
     if (changed) {
       Action a = Make(Action::Kind::kLight);
       a.text = pattern ? "grid" : "uniform";
@@ -1566,7 +1692,8 @@ struct ViewerApp::Impl {
     io.KeyCtrl = input.ctrl;
     io.KeyShift = input.shift;
     io.KeyAlt = input.alt;
-    for (int k = 0; k <= GLFW_KEY_LAST && k < int(IM_ARRAYSIZE(io.KeysDown)); ++k) io.KeysDown[k] = input.keys[k];
+    for (int k = 0; k <= GLFW_KEY_LAST && k < int(IM_ARRAYSIZE(io.KeysDown)); ++k)
+      io.KeysDown[k] = input.keys[k];
     for (unsigned ch : input.chars) io.AddInputCharacter(ch);
     input.chars.clear();
   }
@@ -1578,7 +1705,8 @@ struct ViewerApp::Impl {
     // The last frame's time besides its picture, while frames follow each other (not after a wait
     // for input).
     if (frame_gl_seconds > 0 && frame_seconds < 1.0)
-      overhead_seconds = 0.7 * overhead_seconds + 0.3 * std::max(0.0, frame_seconds - frame_gl_seconds);
+      overhead_seconds =
+          0.7 * overhead_seconds + 0.3 * std::max(0.0, frame_seconds - frame_gl_seconds);
     frame_gl_seconds = 0;
     int w = 0, h = 0;
     glfwGetWindowSize(window, &w, &h);
@@ -1629,7 +1757,8 @@ void OnChar(GLFWwindow*, unsigned c) { g_app->input.chars.push_back(c); }
 
 }  // namespace
 
-ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_unique<Impl>(model, options)) {
+ViewerApp::ViewerApp(ViewerModel& model, AppOptions options)
+    : impl_(std::make_unique<Impl>(model, options)) {
   Impl& m = *impl_;
   glfwSetErrorCallback(OnGlfwError);
   if (!glfwInit())
@@ -1642,7 +1771,8 @@ ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_u
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   model.width = options.width;
   model.height = options.height;
-  m.window = glfwCreateWindow(options.width, options.height, ("Pandora: " + model.scene().path).c_str(), nullptr, nullptr);
+  m.window = glfwCreateWindow(options.width, options.height,
+                              ("Pandora: " + model.scene().path).c_str(), nullptr, nullptr);
   if (!m.window) {
     glfwTerminate();
     throw std::runtime_error("pandora view: no OpenGL 3.3 core context (" + g_glfw_error +
@@ -1681,7 +1811,10 @@ ViewerApp::ViewerApp(ViewerModel& model, AppOptions options) : impl_(std::make_u
   ImGui_ImplOpenGL3_Init("#version 330 core");
   m.gl = std::make_unique<GlRenderer>(model.scene(), &model.session().study().prepared());
   m.shadow_map_size = options.shadow_map_size;
-  m.map_index = options.shadow_map_size >= 4096 ? 3 : options.shadow_map_size >= 2048 ? 2 : options.shadow_map_size >= 1024 ? 1 : 0;
+  m.map_index = options.shadow_map_size >= 4096   ? 3
+                : options.shadow_map_size >= 2048 ? 2
+                : options.shadow_map_size >= 1024 ? 1
+                                                  : 0;
 }
 
 ViewerApp::~ViewerApp() {
@@ -1775,7 +1908,9 @@ void ViewerApp::Input(ViewerModel&, const Action& a) {
         // point would be after moving d metres along the axis (turning d degrees on a ring).
         if (a.text == "press" || !m.script_gizmo) {
           const auto o = m.GizmoOrigin();
-          if (!o) throw InputError(a.where, "", "no gizmo: select a camera or pick a station point first");
+          if (!o)
+            throw InputError(a.where, "",
+                             "no gizmo: select a camera or pick a station point first");
           m.script_gizmo = std::make_pair(*o, m.GizmoLength());
         }
         const auto [o, len] = *m.script_gizmo;
@@ -1811,19 +1946,30 @@ void ViewerApp::Input(ViewerModel&, const Action& a) {
         const auto plus = key.find('+');
         if (plus == std::string::npos) break;
         const std::string mod = key.substr(0, plus);
-        if (mod == "ctrl") m.input.ctrl = true;
-        else if (mod == "shift") m.input.shift = true;
-        else if (mod == "alt") m.input.alt = true;
-        else throw InputError(a.where, "", "unknown modifier '" + mod + "'", "use ctrl, shift, alt");
+        if (mod == "ctrl")
+          m.input.ctrl = true;
+        else if (mod == "shift")
+          m.input.shift = true;
+        else if (mod == "alt")
+          m.input.alt = true;
+        else
+          throw InputError(a.where, "", "unknown modifier '" + mod + "'", "use ctrl, shift, alt");
         key = key.substr(plus + 1);
       }
-      static const std::map<std::string, int> named = {{"escape", GLFW_KEY_ESCAPE}, {"enter", GLFW_KEY_ENTER},
-                                                       {"tab", GLFW_KEY_TAB}, {"delete", GLFW_KEY_DELETE}};
+      static const std::map<std::string, int> named = {{"escape", GLFW_KEY_ESCAPE},
+                                                       {"enter", GLFW_KEY_ENTER},
+                                                       {"tab", GLFW_KEY_TAB},
+                                                       {"delete", GLFW_KEY_DELETE}};
       int code = -1;
-      if (key.size() == 1 && std::isalpha(static_cast<unsigned char>(key[0]))) code = GLFW_KEY_A + (std::tolower(key[0]) - 'a');
-      else if (key.size() == 1 && std::isdigit(static_cast<unsigned char>(key[0]))) code = GLFW_KEY_0 + (key[0] - '0');
-      else if (named.count(key)) code = named.at(key);
-      if (code < 0) throw InputError(a.where, "", "unknown key '" + key + "'", "a letter, a digit, escape, enter, tab or delete");
+      if (key.size() == 1 && std::isalpha(static_cast<unsigned char>(key[0])))
+        code = GLFW_KEY_A + (std::tolower(key[0]) - 'a');
+      else if (key.size() == 1 && std::isdigit(static_cast<unsigned char>(key[0])))
+        code = GLFW_KEY_0 + (key[0] - '0');
+      else if (named.count(key))
+        code = named.at(key);
+      if (code < 0)
+        throw InputError(a.where, "", "unknown key '" + key + "'",
+                         "a letter, a digit, escape, enter, tab or delete");
       m.input.keys[code] = true;
       m.input.pressed.push_back(code);
       Frame();

@@ -17,7 +17,8 @@ struct AppOptions {
   int width = 1280, height = 720;  ///< Window size (the main view fills it).
   bool visible = true;             ///< false: a hidden window (scripts, tests).
   int shadow_map_size = 2048;
-  /// Frame times in the status bar (off in scripts, whose screenshots are compared with references).
+  /// Frame times in the status bar (off in scripts, whose screenshots are compared with
+  /// references).
   bool show_timing = true;
   /// While the view or the rig changes (and for 0.3 s after), the main view is drawn at this
   /// fraction of the window's resolution and with shadow maps of at most 1024 texels, then again
@@ -40,8 +41,8 @@ class ViewerApp : public Frontend {
   bool Frame();
   /// Frames until the window closes.
   void Loop();
-  /// AppOptions::motion_scale and target_hz from now on (the frame-rate bench measures both in one window: a
-  /// second window would reconnect to the X server while it resets after the first).
+  /// AppOptions::motion_scale and target_hz from now on (the frame-rate bench measures both in one
+  /// window: a second window would reconnect to the X server while it resets after the first).
   void SetMotionScale(double scale, double target_hz = 0);
   /// The scale the next moving frame is drawn at (adapted when target_hz is set).
   double MotionScaleNow() const;

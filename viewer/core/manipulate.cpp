@@ -1,9 +1,10 @@
 #include "viewer/core/manipulate.h"
-#include "analysis/units.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "analysis/util/units.h"
 
 namespace pandora::viewer {
 
@@ -17,7 +18,8 @@ std::optional<double> AxisParameter(const Ray& ray, const Vec3& origin, const Ve
   return (b * d.dot(w) - a.dot(w)) / denom;
 }
 
-std::optional<double> SweptAngle(const Ray& from, const Ray& to, const Vec3& origin, const Vec3& axis) {
+std::optional<double> SweptAngle(const Ray& from, const Ray& to, const Vec3& origin,
+                                 const Vec3& axis) {
   const Vec3 n = axis.normalized();
   auto hit = [&](const Ray& r) -> std::optional<Vec3> {
     const double dn = r.direction.dot(n);
@@ -33,10 +35,13 @@ std::optional<double> SweptAngle(const Ray& from, const Ray& to, const Vec3& ori
   return std::atan2(n.dot(a->cross(*b)), a->dot(*b));
 }
 
-double Snap(double value, double step) { return step > 0 ? step * std::round(value / step) : value; }
+double Snap(double value, double step) {
+  return step > 0 ? step * std::round(value / step) : value;
+}
 
-std::vector<Eigen::Isometry3d> MoveRigidly(const std::vector<Eigen::Isometry3d>& poses, const Vec3& pivot,
-                                           const Vec3& move, const Mat3& rotation) {
+std::vector<Eigen::Isometry3d> MoveRigidly(const std::vector<Eigen::Isometry3d>& poses,
+                                           const Vec3& pivot, const Vec3& move,
+                                           const Mat3& rotation) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = rotation;
   t.translation() = pivot + move - rotation * pivot;
@@ -71,8 +76,8 @@ double StickCurve(double x, double deadzone) {
   return std::copysign(u * u * u * u, x);
 }
 
-Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const GamepadAxes& axes, double dt,
-                              double metres_per_second, double degrees_per_second) {
+Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const GamepadAxes& axes,
+                              double dt, double metres_per_second, double degrees_per_second) {
   const Mat3 R = world_from_camera.linear();
   // Horizontal forward and right of the camera (its z and x axes projected on the floor).
   Vec3 forward = R.col(2);
@@ -87,8 +92,10 @@ Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const 
   const Vec3 move = step * (StickCurve(axes.left_x) * right - StickCurve(axes.left_y) * forward +
                             lift * Vec3::UnitZ());
   const double turn = degrees_per_second * dt * kPi / 180.0;
-  const Mat3 yaw = Eigen::AngleAxisd(-turn * StickCurve(axes.right_x), Vec3::UnitZ()).toRotationMatrix();
-  const Mat3 pitch = Eigen::AngleAxisd(-turn * StickCurve(axes.right_y), R.col(0)).toRotationMatrix();
+  const Mat3 yaw =
+      Eigen::AngleAxisd(-turn * StickCurve(axes.right_x), Vec3::UnitZ()).toRotationMatrix();
+  const Mat3 pitch =
+      Eigen::AngleAxisd(-turn * StickCurve(axes.right_y), R.col(0)).toRotationMatrix();
   Eigen::Isometry3d out = world_from_camera;
   out.linear() = yaw * pitch * R;
   out.translation() += move;

@@ -8,8 +8,8 @@
 #include <optional>
 #include <vector>
 
-#include "analysis/ray_caster.h"
-#include "analysis/scene.h"
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora::viewer {
 
@@ -18,9 +18,10 @@ namespace pandora::viewer {
 std::optional<double> AxisParameter(const Ray& ray, const Vec3& origin, const Vec3& axis);
 
 /// The signed angle (radians, right-handed about the unit `axis`) swept about `origin` from where
-/// ray `from` meets the plane through `origin` normal to `axis` to where ray `to` meets it: a drag on
-/// a gizmo's rotation ring. nullopt when a ray misses the plane or hits it at the origin.
-std::optional<double> SweptAngle(const Ray& from, const Ray& to, const Vec3& origin, const Vec3& axis);
+/// ray `from` meets the plane through `origin` normal to `axis` to where ray `to` meets it: a drag
+/// on a gizmo's rotation ring. nullopt when a ray misses the plane or hits it at the origin.
+std::optional<double> SweptAngle(const Ray& from, const Ray& to, const Vec3& origin,
+                                 const Vec3& axis);
 
 /// `value` rounded to a multiple of `step` (step <= 0: unchanged).
 double Snap(double value, double step);
@@ -28,8 +29,9 @@ double Snap(double value, double step);
 /// A rigid move of a group of cameras: each pose P becomes T P with T = rotate `rotation` about
 /// `pivot`, then translate by `move` (world frame). One camera with pivot at its centre turns in
 /// place.
-std::vector<Eigen::Isometry3d> MoveRigidly(const std::vector<Eigen::Isometry3d>& poses, const Vec3& pivot,
-                                           const Vec3& move, const Mat3& rotation);
+std::vector<Eigen::Isometry3d> MoveRigidly(const std::vector<Eigen::Isometry3d>& poses,
+                                           const Vec3& pivot, const Vec3& move,
+                                           const Mat3& rotation);
 
 /// The camera whose body (a sphere of `radius` metres around its centre) `ray` meets first, or -1.
 /// Disabled cameras can be picked too (to turn them back on).
@@ -50,7 +52,7 @@ struct GamepadAxes {
 /// (camera frame, horizontal), triggers down/up (world Z), right stick yaw (about world Z, keeps
 /// the horizon level) and pitch (about the camera's x axis); speeds at full deflection. Returns the
 /// new world_from_camera.
-Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const GamepadAxes& axes, double dt,
-                              double metres_per_second, double degrees_per_second);
+Eigen::Isometry3d GamepadMove(const Eigen::Isometry3d& world_from_camera, const GamepadAxes& axes,
+                              double dt, double metres_per_second, double degrees_per_second);
 
 }  // namespace pandora::viewer

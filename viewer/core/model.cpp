@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <stdexcept>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
-#include "analysis/error.h"
-#include "analysis/output_transaction.h"
-#include "analysis/pose.h"
-#include "analysis/rig_check.h"
+#include "analysis/geometry/pose.h"
+#include "analysis/rig/rig_check.h"
+#include "analysis/util/error.h"
+#include "analysis/util/output_transaction.h"
+#include "analysis/util/units.h"
 #include "app/session/autosave.h"
 #include "app/session/ptz_edit.h"
 #include "app/suggest_options.h"
@@ -17,20 +18,22 @@
 #include "viewer/core/manipulate.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
-#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
 
-
-std::vector<std::string> DefaultFields() { return {"coverage", "cameras", "resolution", "sigma_max"}; }
+std::vector<std::string> DefaultFields() {
+  return {"coverage", "cameras", "resolution", "sigma_max"};
+}
 
 Vec3 UpFor(const Vec3& from, const Vec3& at) {
   return std::abs((at - from).normalized().z()) > 0.99 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
 }
 
 LensModel LensFromName(const std::string& name) {
-  return name == "brown_conrady" ? LensModel::kBrownConrady : name == "fisheye" ? LensModel::kFisheye : LensModel::kPinhole;
+  return name == "brown_conrady" ? LensModel::kBrownConrady
+         : name == "fisheye"     ? LensModel::kFisheye
+                                 : LensModel::kPinhole;
 }
 
 // What differs between a camera as saved and as edited that Session::Save cannot write (it writes
@@ -43,8 +46,10 @@ std::string UnsavableChanges(const Camera& saved, const Camera& now) {
   if (p.cx != q.cx || p.cy != q.cy) {
     if (p.width == q.width && p.height == q.height) what.push_back("principal point");
   }
-  if (p.model != q.model) what.push_back("lens model");
-  else if (p.k1 != q.k1 || p.k2 != q.k2 || p.p1 != q.p1 || p.p2 != q.p2 || p.k3 != q.k3 || p.k4 != q.k4)
+  if (p.model != q.model)
+    what.push_back("lens model");
+  else if (p.k1 != q.k1 || p.k2 != q.k2 || p.p1 != q.p1 || p.p2 != q.p2 || p.k3 != q.k3 ||
+           p.k4 != q.k4)
     what.push_back("distortion");
   if (saved.near != now.near || saved.far != now.far) what.push_back("range");
   if (saved.color != now.color) what.push_back("colour");
@@ -59,9 +64,11 @@ std::string UnsavableChanges(const Camera& saved, const Camera& now) {
 std::string PtzStatus(const Camera& cam, bool clamped) {
   const PtzState& s = cam.ptz->current;
   char line[200];
-  std::snprintf(line, sizeof line, "%s (PTZ): pan %.1f, tilt %.1f, hfov %.1f deg%s", cam.id.c_str(), s.pan_deg,
-                s.tilt_deg, HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kRadPerDeg,
-                clamped ? " (limited by its ranges)" : "");
+  std::snprintf(
+      line, sizeof line, "%s (PTZ): pan %.1f, tilt %.1f, hfov %.1f deg%s", cam.id.c_str(),
+      s.pan_deg, s.tilt_deg,
+      HfovFromFocal(s.focal, cam.model.width(), cam.model.intrinsics().model) / kRadPerDeg,
+      clamped ? " (limited by its ranges)" : "");
   return line;
 }
 
@@ -112,10 +119,12 @@ app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
     return option;
   };
   auto rename = [&](const std::string& text) {
-    return app::ReplaceOptionNames(text, [&](const std::string& option) { return "'" + key(option) + "'"; });
+    return app::ReplaceOptionNames(
+        text, [&](const std::string& option) { return "'" + key(option) + "'"; });
   };
   if (e.file().rfind("--", 0) != 0) throw e;  // the scene's own (a surface name, its targets)
-  throw InputError(where + "." + key(e.file()), e.json_path(), rename(e.reason()), rename(e.hint()));
+  throw InputError(where + "." + key(e.file()), e.json_path(), rename(e.reason()),
+                   rename(e.hint()));
 }
 
 }  // namespace
@@ -141,11 +150,13 @@ void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, 
   options.layers = false;
   options.pixel_sigma = model.scene().study.pixel_sigma;
   RenderView view = model.MainView();
-  if (camera < 0 && !model.plan.empty()) options.overlays.labels = true;  // camera ids, as render --plan
+  if (camera < 0 && !model.plan.empty())
+    options.overlays.labels = true;  // camera ids, as render --plan
   if (camera >= 0) {
     // The camera's own image, scaled to fit the main view's size.
     const CameraModel& m = model.rig().cameras[camera].model;
-    const double scale = std::min({1.0, double(model.width) / m.width(), double(model.height) / m.height()});
+    const double scale =
+        std::min({1.0, double(model.width) / m.width(), double(model.height) / m.height()});
     view = RenderView();
     view.camera = camera;
     view.width = std::max(16, int(std::lround(m.width() * scale)));
@@ -158,9 +169,12 @@ void CpuFrontend::Screenshot(const ViewerModel& model, const std::string& path, 
     });
   if (camera < 0 && model.ptz_trace != "single") {
     // The traces light the main view, at the rig's brightness (as `pandora render --ptz`).
-    if (std::isnan(options.brightness)) options.brightness = DefaultBrightness(model.rig().enabled_count());
+    if (std::isnan(options.brightness))
+      options.brightness = DefaultBrightness(model.rig().enabled_count());
     const Rig traced = model.TracedRig(&options.ptz_all);
-    WritePng(RenderWithStats(model.session().study().prepared(), traced, view, options, overlays.get(), nullptr), path);
+    WritePng(RenderWithStats(model.session().study().prepared(), traced, view, options,
+                             overlays.get(), nullptr),
+             path);
     return;
   }
   WritePng(model.session().Render(view, options, overlays.get()), path);
@@ -188,7 +202,8 @@ ViewerModel::ViewerModel(std::shared_ptr<const session::Study> study, ViewerOpti
   if (!s.views.empty()) {
     // The scene's "overview" when it has one, else its first view (by name).
     const auto named = s.views.find("overview");
-    const RenderView v = ViewFromScene((named != s.views.end() ? named : s.views.begin())->second, width, height, 50.0);
+    const RenderView v = ViewFromScene((named != s.views.end() ? named : s.views.begin())->second,
+                                       width, height, 50.0);
     view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
   } else {
     view = OrbitView::Framing(s.Bounds());
@@ -264,7 +279,8 @@ int ViewerModel::CameraIndex(const std::string& id, const Action& action) const 
   return c;
 }
 
-std::vector<int> ViewerModel::CameraIndices(const std::vector<std::string>& ids, const Action& action) const {
+std::vector<int> ViewerModel::CameraIndices(const std::vector<std::string>& ids,
+                                            const Action& action) const {
   std::vector<int> out;
   for (const std::string& id : ids) out.push_back(CameraIndex(id, action));
   return out;
@@ -296,7 +312,9 @@ void ViewerModel::Compare(const Action& a) {
       if (r.name == name) found = &r;
       list += (list.empty() ? "" : ", ") + r.name;
     }
-    if (!found) throw InputError(a.where, "", "no rig '" + name + "' in " + scene().path, "compare with saved or " + list);
+    if (!found)
+      throw InputError(a.where, "", "no rig '" + name + "' in " + scene().path,
+                       "compare with saved or " + list);
     others.push_back(found);
   }
   // The edited rig: its live fields once they have caught up.
@@ -304,7 +322,9 @@ void ViewerModel::Compare(const Action& a) {
   if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
   // Moving objects: the numbers over the time samples too, as `pandora analyze` gives them (the
   // live fields are the static scene's: the volume without the people).
-  auto over_time = [&](const Rig& r, Summary* summary) { summary->time = session_->EvaluateOverTime(r); };
+  auto over_time = [&](const Rig& r, Summary* summary) {
+    summary->time = session_->EvaluateOverTime(r);
+  };
   std::vector<Summary> summaries;
   session_->ReadFields([&](const Fields& f, std::int64_t) {
     summaries.push_back(Summarize(scene(), rig(), f, names, 1));
@@ -375,14 +395,17 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       }
       e.changes.push_back(std::move(ce));
     }
-    if (a.drag && drag == label && edit.CanAmend(cams)) edit.Amend(e);
-    else edit.Apply(std::move(e));
+    if (a.drag && drag == label && edit.CanAmend(cams))
+      edit.Amend(e);
+    else
+      edit.Apply(std::move(e));
     if (a.drag) drag_label_ = label;
     Edited();
   };
   auto label = [&](const char* verb, const std::vector<int>& cams) {
     return std::string(verb) + " " +
-           (cams.size() == 1 ? rig().cameras[cams[0]].id : std::to_string(cams.size()) + " cameras");
+           (cams.size() == 1 ? rig().cameras[cams[0]].id
+                             : std::to_string(cams.size()) + " cameras");
   };
   status.clear();
   switch (a.kind) {
@@ -396,7 +419,8 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         scene().CheckReach(target, a.where, "the camera position");
       }
       apply(cams, label("move", cams), [&](Camera& cam) {
-        cam.world_from_camera.translation() = a.flag ? a.a : Vec3(cam.world_from_camera.translation() + a.a);
+        cam.world_from_camera.translation() =
+            a.flag ? a.a : Vec3(cam.world_from_camera.translation() + a.a);
       });
       break;
     }
@@ -441,7 +465,8 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         Intrinsics k = cam.model.intrinsics();
         const double fx = FocalFromHfov(a.number * kRadPerDeg, k.width, k.model);
         if (k.model != LensModel::kFisheye && a.number >= 180)
-          throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+          throw InputError(a.where, "",
+                           "a pinhole or Brown-Conrady lens sees less than 180 degrees");
         k.fy *= fx / k.fx;
         k.fx = fx;
         cam.model = CameraModel(k);
@@ -450,13 +475,16 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
     }
     case Kind::kIntrinsics: {
       const std::vector<int> cams = CameraIndices(a.cameras, a);
-      const bool lens_changed = !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
-                                                               [](double v) { return !std::isnan(v); });
+      const bool lens_changed =
+          !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
+                                         [](double v) { return !std::isnan(v); });
       apply(cams, label("lens", cams), [&](Camera& cam) {
         Intrinsics k = cam.model.intrinsics();
         if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
-          throw InputError(a.where, "", "camera '" + cam.id + "' is a PTZ camera: its zoom range is in pixels of its "
-                                            "resolution and lens, which the viewer does not convert",
+          throw InputError(a.where, "",
+                           "camera '" + cam.id +
+                               "' is a PTZ camera: its zoom range is in pixels of its "
+                               "resolution and lens, which the viewer does not convert",
                            "change its resolution or lens model in the scene file");
         if (a.width > 0) {
           // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
@@ -474,8 +502,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
             // Keep the nominal field of view across the projection's change.
             const double hfov = HfovFromFocal(k.fx, k.width, k.model);
             if (to != LensModel::kFisheye && !(hfov < kPi))
-              throw InputError(a.where, "", "camera '" + cam.id + "' sees " + std::to_string(int(std::lround(hfov / kRadPerDeg))) +
-                                                " degrees; a " + a.lens + " lens sees less than 180",
+              throw InputError(a.where, "",
+                               "camera '" + cam.id + "' sees " +
+                                   std::to_string(int(std::lround(hfov / kRadPerDeg))) +
+                                   " degrees; a " + a.lens + " lens sees less than 180",
                                "narrow its field of view (hfov) first");
             const double fx = FocalFromHfov(hfov, k.width, to);
             k.fy *= fx / k.fx;
@@ -489,10 +519,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         for (int i = 0; i < 6; ++i) {
           if (std::isnan(a.coefficients[i])) continue;
           if (!LensHasCoefficient(model, i))
-            throw InputError(a.where, "", "camera '" + cam.id + "' has a " + model + " lens, which has no coefficient " +
-                                              kCoefficientNames[i],
-                             model == "pinhole" ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
-                                                : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
+            throw InputError(a.where, "",
+                             "camera '" + cam.id + "' has a " + model +
+                                 " lens, which has no coefficient " + kCoefficientNames[i],
+                             model == "pinhole"
+                                 ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
+                                 : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
           *c[i] = a.coefficients[i];
         }
         cam.model = CameraModel(k);
@@ -502,10 +534,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
           if (lc.domain_ends_inside_image) {
             char share[32];
             std::snprintf(share, sizeof share, "%.1f", 100 * lc.unreachable_fraction);
-            throw InputError(a.where, "", "camera '" + cam.id + "': this " + model +
-                                              " distortion folds back inside the image (its valid domain ends there; " +
-                                              share + " % of the pixels would see nothing)",
-                             "use smaller coefficients");
+            throw InputError(
+                a.where, "",
+                "camera '" + cam.id + "': this " + model +
+                    " distortion folds back inside the image (its valid domain ends there; " +
+                    share + " % of the pixels would see nothing)",
+                "use smaller coefficients");
           }
         }
       });
@@ -517,8 +551,9 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         const double near = std::isnan(a.near) ? cam.near : a.near;
         const double far = std::isnan(a.far) ? cam.far : a.far;
         if (!(far > near))
-          throw InputError(a.where, "", "camera '" + cam.id + "': far (" + std::to_string(far) +
-                                            " m) must be greater than near (" + std::to_string(near) + " m)");
+          throw InputError(a.where, "",
+                           "camera '" + cam.id + "': far (" + std::to_string(far) +
+                               " m) must be greater than near (" + std::to_string(near) + " m)");
         cam.near = near;
         cam.far = far;
       });
@@ -544,11 +579,13 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
     case Kind::kIso: {
       const bool slice = a.kind == Kind::kSlice;
       if (!a.flag) {
-        const std::vector<std::string> live = options_.fields.empty() ? DefaultFields() : options_.fields;
+        const std::vector<std::string> live =
+            options_.fields.empty() ? DefaultFields() : options_.fields;
         if (std::find(live.begin(), live.end(), a.text) == live.end()) {
           std::string list;
           for (const std::string& f : live) list += (list.empty() ? "" : ", ") + f;
-          throw InputError(a.where, "", "'" + a.text + "' is not a live field of this session", "live: " + list);
+          throw InputError(a.where, "", "'" + a.text + "' is not a live field of this session",
+                           "live: " + list);
         }
       }
       if (slice) {
@@ -604,12 +641,14 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (a.text == "fields") {
         for (const char* kind : {"fields", "time"}) {
           const session::JobStatus s = session_->jobs().Wait(kind);
-          if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+          if (s.state == session::JobState::kFailed && s.exception)
+            std::rethrow_exception(s.exception);
         }
       } else if (a.text == "suggest") {
         session::JobStatus s;
         suggestion = session_->WaitSuggestion(&s);
-        if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+        if (s.state == session::JobState::kFailed && s.exception)
+          std::rethrow_exception(s.exception);
         if (suggestion) status = suggestion->message;
       } else {
         session_->jobs().Wait("render");
@@ -625,18 +664,21 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       problem->options.scene_path = a.where;  // the library's checks name the action
       suggestion.reset();
       suggestion_over_time = a.over_time;
-      suggestion_targets = std::to_string(problem->targets.size()) + " points " +
-                           (a.over_time ? "on the study's targets at " +
-                                              std::to_string(problem->sample_casters.size()) + " time samples"
-                            : a.target_surfaces.empty() ? std::string("of the study region")
-                                                        : std::string("on the target surfaces") +
-                                                              (a.with_region ? " and in the region" : ""));
+      suggestion_targets =
+          std::to_string(problem->targets.size()) + " points " +
+          (a.over_time ? "on the study's targets at " +
+                             std::to_string(problem->sample_casters.size()) + " time samples"
+           : a.target_surfaces.empty() ? std::string("of the study region")
+                                       : std::string("on the target surfaces") +
+                                             (a.with_region ? " and in the region" : ""));
       session_->SuggestInBackground(problem->targets, problem->options, problem);
       status = "suggesting";
       break;
     }
     case Kind::kAccept: {
-      if (!suggestion) throw InputError(a.where, "", "there is no suggestion to accept", "suggest first, then wait for it");
+      if (!suggestion)
+        throw InputError(a.where, "", "there is no suggestion to accept",
+                         "suggest first, then wait for it");
       // As `pandora accept`: a suggestion that does not improve its objective is not offered.
       if (!suggestion->improved)
         throw InputError(a.where, "", "the suggestion offers no improvement; nothing to accept",
@@ -645,14 +687,18 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       take.cameras.clear();
       keep.cameras.clear();
       for (const CameraChange& c : suggestion->cameras)
-        (a.cameras.empty() || std::count(a.cameras.begin(), a.cameras.end(), c.id) ? take : keep).cameras.push_back(c);
+        (a.cameras.empty() || std::count(a.cameras.begin(), a.cameras.end(), c.id) ? take : keep)
+            .cameras.push_back(c);
       for (const std::string& id : a.cameras)
-        if (std::none_of(take.cameras.begin(), take.cameras.end(), [&](const CameraChange& c) { return c.id == id; }))
+        if (std::none_of(take.cameras.begin(), take.cameras.end(),
+                         [&](const CameraChange& c) { return c.id == id; }))
           throw InputError(a.where, "", "camera '" + id + "' is not in the suggestion");
       session_->ApplySuggestion(take);
       Edited();
-      if (keep.cameras.empty()) suggestion.reset();
-      else suggestion = keep;
+      if (keep.cameras.empty())
+        suggestion.reset();
+      else
+        suggestion = keep;
       status = "accepted " + std::to_string(take.cameras.size()) + " cameras (not saved yet)";
       break;
     }
@@ -664,10 +710,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       std::string unsavable;
       for (int c : edit.Unsaved()) {
         const std::string what = UnsavableChanges(edit.saved().cameras[c], rig().cameras[c]);
-        if (!what.empty()) unsavable += (unsavable.empty() ? "" : "; ") + rig().cameras[c].id + "'s " + what;
+        if (!what.empty())
+          unsavable += (unsavable.empty() ? "" : "; ") + rig().cameras[c].id + "'s " + what;
       }
       if (!unsavable.empty())
-        throw InputError(file, "", "not saved: saving writes poses and focal lengths only, not " + unsavable,
+        throw InputError(file, "",
+                         "not saved: saving writes poses and focal lengths only, not " + unsavable,
                          "undo them, or copy them into the scene file by hand");
       std::vector<StationMove> moved;
       for (const auto& [name, st] : stations) {
@@ -677,7 +725,8 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       }
       const session::SaveResult r = session_->Save(a.flag, moved);
       saved_stations = stations;
-      if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
+      if (!options_.autosave_path.empty())
+        session::WriteAutosave(*session_, options_.autosave_path);
       std::string what;
       auto count = [](std::size_t n, const std::string& what) {
         return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
@@ -686,7 +735,8 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (!r.saved_stations.empty())
         what += (what.empty() ? "" : " and ") + count(r.saved_stations.size(), "viewing station");
       status = what.empty() ? "nothing to save"
-                            : "saved " + what + " into " + r.scene_path + " (previous file kept as " + r.backup_path + ")";
+                            : "saved " + what + " into " + r.scene_path +
+                                  " (previous file kept as " + r.backup_path + ")";
       break;
     }
     case Kind::kScreenshot: {
@@ -726,8 +776,10 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       }
       ViewingStation moved = it->second;
       scene().CheckReach(a.a, a.where, a.flag ? "the display" : "the eye");
-      if (a.flag) moved.display_center = a.a;
-      else moved.eye = a.a;
+      if (a.flag)
+        moved.display_center = a.a;
+      else
+        moved.eye = a.a;
       if (!((moved.eye - moved.display_center).dot(moved.display_normal) > 0))
         throw InputError(a.where, "", "the eye would be behind the display or in its plane");
       it->second = moved;
@@ -758,26 +810,34 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
         if (!std::isnan(a.hfov_deg)) {
           const Intrinsics& k = cam.model.intrinsics();
           if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
-            throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+            throw InputError(a.where, "",
+                             "a pinhole or Brown-Conrady lens sees less than 180 degrees");
           s.focal = FocalFromHfov(a.hfov_deg * kRadPerDeg, k.width, k.model);
         }
       }
       const PtzState want = s;
       const PtzState got = session::ClampPtzState(*cam.ptz, want);
-      apply({c}, label("pan/tilt/zoom", {c}), [&](Camera& x) { x = session::WithPtzState(x, want); });
-      const bool clamped = std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 || std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
-                           (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
-      status = PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
+      apply({c}, label("pan/tilt/zoom", {c}),
+            [&](Camera& x) { x = session::WithPtzState(x, want); });
+      const bool clamped =
+          std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
+          std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
+          (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
+      status =
+          PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
       break;
     }
     case Kind::kRecentre: {
       const int c = CameraIndex(a.cameras[0], a);
       const std::string where = session_->CameraJsonPath(c);
-      apply({c}, label("re-centre", {c}), [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
+      apply({c}, label("re-centre", {c}),
+            [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
       const PtzHead& h = *rig().cameras[c].ptz;
       char line[200];
-      std::snprintf(line, sizeof line, "%s: home is now the current view (pan [%.1f, %.1f], tilt [%.1f, %.1f] deg)",
-                    rig().cameras[c].id.c_str(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg, h.tilt_max_deg);
+      std::snprintf(line, sizeof line,
+                    "%s: home is now the current view (pan [%.1f, %.1f], tilt [%.1f, %.1f] deg)",
+                    rig().cameras[c].id.c_str(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg,
+                    h.tilt_max_deg);
       status = line;
       break;
     }
@@ -827,7 +887,9 @@ nlohmann::json ViewerModel::StateJson() const {
       const Vec3 pivot = h.home.translation();
       const Eigen::Quaterniond q(h.home.rotation());
       json presets = json::array();
-      for (const PtzPreset& p : h.presets) presets.push_back({{"name", p.name}, {"pan_deg", p.state.pan_deg}, {"tilt_deg", p.state.tilt_deg}});
+      for (const PtzPreset& p : h.presets)
+        presets.push_back(
+            {{"name", p.name}, {"pan_deg", p.state.pan_deg}, {"tilt_deg", p.state.tilt_deg}});
       cameras.back()["ptz"] = {{"pan_deg", h.current.pan_deg},
                                {"tilt_deg", h.current.tilt_deg},
                                {"pivot", {pivot.x(), pivot.y(), pivot.z()}},
@@ -850,13 +912,14 @@ nlohmann::json ViewerModel::StateJson() const {
   // With people: the numbers over the time samples (the live fields are the empty volume's).
   if (const auto time = session_->TimeNumbers()) {
     const TimeSummary& t = time->first;
-    fields["time"] = {{"rig_version", time->second},
-                      {"min_cameras", t.min_cameras},
-                      {"samples", t.samples.size()},
-                      {"always", t.always},
-                      {"mean", t.mean},
-                      {"worst_sample", t.samples.empty() ? json() : json(t.samples[t.worst_sample].ge_k)},
-                      {"sigma_max_p90_mm", t.sigma_max_p90 ? json(*t.sigma_max_p90) : json()}};
+    fields["time"] = {
+        {"rig_version", time->second},
+        {"min_cameras", t.min_cameras},
+        {"samples", t.samples.size()},
+        {"always", t.always},
+        {"mean", t.mean},
+        {"worst_sample", t.samples.empty() ? json() : json(t.samples[t.worst_sample].ge_k)},
+        {"sigma_max_p90_mm", t.sigma_max_p90 ? json(*t.sigma_max_p90) : json()}};
   }
   json j = {{"rig", rig().name},
             {"ptz_trace", ptz_trace},
@@ -872,8 +935,9 @@ nlohmann::json ViewerModel::StateJson() const {
   if (!stations.empty()) {
     json st = json::object();
     for (const auto& [name, s] : stations)
-      st[name] = {{"eye", {s.eye.x(), s.eye.y(), s.eye.z()}},
-                  {"display_center", {s.display_center.x(), s.display_center.y(), s.display_center.z()}}};
+      st[name] = {
+          {"eye", {s.eye.x(), s.eye.y(), s.eye.z()}},
+          {"display_center", {s.display_center.x(), s.display_center.y(), s.display_center.z()}}};
     j["stations"] = st;
   }
   if (comparison) j["comparison"] = *comparison;
@@ -884,13 +948,14 @@ nlohmann::json ViewerModel::StateJson() const {
       const Vec3 p = c.after.translation();
       positions[c.id] = {p.x(), p.y(), p.z()};
     }
-    j["suggestion"] = {{"cameras", ids},
-                       {"objective", ObjectiveName(suggestion->objective)},
-                       {"before", suggestion->before.objective},
-                       {"after", suggestion->after.objective},
-                       {"improved", suggestion->improved},
-                       {"positions", positions},  // the suggested centres, to compare with `pandora suggest`'s
-                       {"targets", suggestion_targets}};
+    j["suggestion"] = {
+        {"cameras", ids},
+        {"objective", ObjectiveName(suggestion->objective)},
+        {"before", suggestion->before.objective},
+        {"after", suggestion->after.objective},
+        {"improved", suggestion->improved},
+        {"positions", positions},  // the suggested centres, to compare with `pandora suggest`'s
+        {"targets", suggestion_targets}};
   }
   return j;
 }

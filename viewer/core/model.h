@@ -11,14 +11,13 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json_fwd.hpp>
-
+#include "app/report/rig_comparison.h"
 #include "app/session/session.h"
-#include "render/report/rig_comparison.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
 
@@ -37,11 +36,14 @@ class Frontend {
   /// Writes `path` (PNG): the main view, or camera `camera`'s own view when it is >= 0.
   virtual void Screenshot(const ViewerModel& model, const std::string& path, int camera) = 0;
   /// Mouse, key, scroll and frame actions (the GL front end feeds them to GLFW and Dear ImGui).
-  virtual void Input(ViewerModel& model, const Action& action) { (void)model; (void)action; }
+  virtual void Input(ViewerModel& model, const Action& action) {
+    (void)model;
+    (void)action;
+  }
 };
 
-/// The exact CPU renderer as a front end: screenshots through Session::Render with the model's view,
-/// settings and slice / isosurface over the current fields. Raw input is refused.
+/// The exact CPU renderer as a front end: screenshots through Session::Render with the model's
+/// view, settings and slice / isosurface over the current fields. Raw input is refused.
 class CpuFrontend : public Frontend {
  public:
   void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;
@@ -49,11 +51,13 @@ class CpuFrontend : public Frontend {
 };
 
 struct ViewerOptions {
-  std::string rig;                  ///< Empty: the first.
-  std::vector<std::string> disable;  ///< Camera ids disabled for the session (--disable; not saved).
-  std::vector<std::string> fields;  ///< Live fields; empty: coverage, cameras, resolution, sigma_max.
-  std::string autosave_path;        ///< Empty: no autosave.
-  int width = 1280, height = 720;   ///< The main view.
+  std::string rig;  ///< Empty: the first.
+  std::vector<std::string>
+      disable;  ///< Camera ids disabled for the session (--disable; not saved).
+  std::vector<std::string>
+      fields;                 ///< Live fields; empty: coverage, cameras, resolution, sigma_max.
+  std::string autosave_path;  ///< Empty: no autosave.
+  int width = 1280, height = 720;  ///< The main view.
 };
 
 class ViewerModel {
@@ -76,20 +80,21 @@ class ViewerModel {
   // What the front end draws.
   OrbitView view;
   int width = 1280, height = 720;
-  RenderOptions display;                ///< Pattern, surface, brightness, grid, slice and isosurface.
-  std::vector<int> selection;           ///< Rig indices.
-  std::optional<Suggestion> suggestion; ///< Suggested poses waiting for accept or reject (ghosts).
+  RenderOptions display;       ///< Pattern, surface, brightness, grid, slice and isosurface.
+  std::vector<int> selection;  ///< Rig indices.
+  std::optional<Suggestion> suggestion;  ///< Suggested poses waiting for accept or reject (ghosts).
   /// What the suggestion asked for last is evaluated on, in words ("1500 points of the study
   /// region", "the study's targets at 6 time samples"), for the Suggest panel.
   std::string suggestion_targets;
-  bool suggestion_over_time = false;  ///< It was asked for over time (the panel shows what was asked).
-  std::string status;                   ///< The last action's one-line message.
+  bool suggestion_over_time =
+      false;           ///< It was asked for over time (the panel shows what was asked).
+  std::string status;  ///< The last action's one-line message.
   /// The scene's viewing stations as placed in this session; Save writes the moved ones (eye and
   /// display centre) into the scene file with the cameras. Station moves are not undo steps.
   std::map<std::string, ViewingStation> stations;
   /// The stations as loaded or last saved.
   std::map<std::string, ViewingStation> saved_stations;
-  std::int64_t stations_version = 0;    ///< Bumps when a station moves.
+  std::int64_t stations_version = 0;  ///< Bumps when a station moves.
   /// The last "compare": the edited rig (its live fields, as they were) first, then the rig as last
   /// saved and / or other rigs of the scene (each evaluated once and kept while it stays the same).
   std::optional<report::RigComparison> comparison;
@@ -128,7 +133,8 @@ class ViewerModel {
   /// The main view as the renderer takes it.
   RenderView MainView() const;
   /// The state as JSON, for `pandora view --log`: rig version, undo label, selection, cameras'
-  /// poses, fields (version, shares seen by at least 1, 2, ... cameras, sigma_max median), the pending suggestion.
+  /// poses, fields (version, shares seen by at least 1, 2, ... cameras, sigma_max median), the
+  /// pending suggestion.
   nlohmann::json StateJson() const;
   /// Called after each action that edited the rig (the GL front end re-uploads cameras).
   std::function<void()> on_edit;

@@ -1,8 +1,9 @@
 #include "viewer/core/navigation.h"
-#include "analysis/units.h"
 
 #include <algorithm>
 #include <cmath>
+
+#include "analysis/util/units.h"
 
 namespace pandora::viewer {
 namespace {
@@ -16,7 +17,8 @@ double ClampDistance(double d) { return std::clamp(d, 1e-3, 1e5); }
 
 Vec3 OrbitView::Eye() const {
   const double y = yaw_deg * kRadPerDeg, p = pitch_deg * kRadPerDeg;
-  return target + distance * Vec3(std::cos(p) * std::cos(y), std::cos(p) * std::sin(y), std::sin(p));
+  return target +
+         distance * Vec3(std::cos(p) * std::cos(y), std::cos(p) * std::sin(y), std::sin(p));
 }
 
 Vec3 OrbitView::Forward() const { return (target - Eye()).normalized(); }
@@ -40,7 +42,8 @@ void OrbitView::Orbit(double dx_px, double dy_px) {
 }
 
 void OrbitView::Pan(double dx_px, double dy_px, int width_px) {
-  const double metres_per_px = 2 * distance * std::tan(0.5 * fov_deg * kRadPerDeg) / std::max(width_px, 1);
+  const double metres_per_px =
+      2 * distance * std::tan(0.5 * fov_deg * kRadPerDeg) / std::max(width_px, 1);
   target += metres_per_px * (-dx_px * Right() + dy_px * Up());
 }
 
@@ -55,7 +58,8 @@ void OrbitView::Look(double dyaw_deg, double dpitch_deg) {
   const Vec3 eye = Eye();
   const double yaw = yaw_deg + 180.0 + dyaw_deg;  // direction eye -> target
   const double pitch = ClampPitch(-pitch_deg + dpitch_deg);
-  const Vec3 d(std::cos(pitch * kRadPerDeg) * std::cos(yaw * kRadPerDeg), std::cos(pitch * kRadPerDeg) * std::sin(yaw * kRadPerDeg),
+  const Vec3 d(std::cos(pitch * kRadPerDeg) * std::cos(yaw * kRadPerDeg),
+               std::cos(pitch * kRadPerDeg) * std::sin(yaw * kRadPerDeg),
                std::sin(pitch * kRadPerDeg));
   target = eye + distance * d;
   yaw_deg = std::remainder(yaw - 180.0, 360.0);
@@ -80,7 +84,8 @@ OrbitView OrbitView::FromLookAt(const Vec3& from, const Vec3& at, double fov_deg
   const Vec3 d = from - at;
   v.distance = ClampDistance(d.norm());
   v.yaw_deg = std::atan2(d.y(), d.x()) / kRadPerDeg;
-  v.pitch_deg = ClampPitch(std::asin(std::clamp(d.z() / std::max(d.norm(), 1e-300), -1.0, 1.0)) / kRadPerDeg);
+  v.pitch_deg =
+      ClampPitch(std::asin(std::clamp(d.z() / std::max(d.norm(), 1e-300), -1.0, 1.0)) / kRadPerDeg);
   return v;
 }
 

@@ -1,10 +1,10 @@
 #pragma once
 /// \file navigation.h
-/// The viewer's main-view camera, without GL: orbit, pan and dolly around a target point (Z up), and
-/// fly (move and turn the eye). What the mouse, the keyboard, the gamepad and a script do to the view
-/// is a call here, so it is unit-tested and replayable.
+/// The viewer's main-view camera, without GL: orbit, pan and dolly around a target point (Z up),
+/// and fly (move and turn the eye). What the mouse, the keyboard, the gamepad and a script do to
+/// the view is a call here, so it is unit-tested and replayable.
 
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
 #include "render/render.h"
 
 namespace pandora::viewer {
@@ -13,8 +13,9 @@ struct OrbitView {
   Vec3 target = Vec3::Zero();
   double distance = 5.0;   ///< Eye to target, m (kept in [1e-3, 1e5]).
   double yaw_deg = -60.0;  ///< Azimuth of the eye about +Z, from +X towards +Y.
-  double pitch_deg = 30.0; ///< Elevation of the eye above the target's horizontal plane, [-89, 89].
-  double fov_deg = 50.0;   ///< Horizontal field of view.
+  double pitch_deg =
+      30.0;               ///< Elevation of the eye above the target's horizontal plane, [-89, 89].
+  double fov_deg = 50.0;  ///< Horizontal field of view.
 
   Vec3 Eye() const;
   /// Unit vectors of the view: forward (eye to target), right, up (screen up).

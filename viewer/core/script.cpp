@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "analysis/error.h"
-#include "analysis/input_file.h"
+#include "analysis/util/error.h"
+#include "analysis/util/input_file.h"
 
 namespace pandora::viewer {
 namespace {
@@ -17,9 +17,11 @@ using Kind = Action::Kind;
 // One action object: typed reads of its keys, each failing with the file and the JSON path.
 class Entry {
  public:
-  Entry(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {}
+  Entry(const json& j, std::string path, const std::string& file)
+      : j_(j), path_(std::move(path)), file_(file) {}
 
-  [[noreturn]] void Fail(const std::string& key, const std::string& reason, const std::string& hint = "") const {
+  [[noreturn]] void Fail(const std::string& key, const std::string& reason,
+                         const std::string& hint = "") const {
     throw InputError(file_, key.empty() ? path_ : path_ + "." + key, reason, hint);
   }
   bool Has(const std::string& key) const { return j_.contains(key); }
@@ -64,11 +66,14 @@ class Entry {
   Vec3 Vector(const std::string& key, int n = 3) const {
     if (!Has(key)) Fail(key, "missing");
     const json& v = j_.at(key);
-    if (!v.is_array() || int(v.size()) != n) Fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    if (!v.is_array() || int(v.size()) != n)
+      Fail(key, "expected an array of " + std::to_string(n) + " numbers");
     Vec3 out = Vec3::Zero();
     for (int i = 0; i < n; ++i) {
-      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || std::abs(v[i].get<double>()) > 1e7)
-        Fail(key + "[" + std::to_string(i) + "]", "expected a finite number of at most 1e7 in size");
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) ||
+          std::abs(v[i].get<double>()) > 1e7)
+        Fail(key + "[" + std::to_string(i) + "]",
+             "expected a finite number of at most 1e7 in size");
       out[i] = v[i].get<double>();
     }
     return out;
@@ -80,7 +85,8 @@ class Entry {
   }
   Aabb Box(std::size_t i) const { return BoxOf(j_.at(i), "[" + std::to_string(i) + "]"); }
   // A camera id or a list of them.
-  std::vector<std::string> Ids(const std::string& key, bool allow_empty, const std::string& what = "camera") const {
+  std::vector<std::string> Ids(const std::string& key, bool allow_empty,
+                               const std::string& what = "camera") const {
     const json& v = j_.at(key);
     std::vector<std::string> out;
     if (v.is_string()) {
@@ -89,7 +95,8 @@ class Entry {
       if (v.size() > 10000) Fail(key, "more than 10000 " + what + "s");
       for (std::size_t i = 0; i < v.size(); ++i) {
         if (!v[i].is_string() || v[i].get<std::string>().empty())
-          Fail(key + "[" + std::to_string(i) + "]", "expected a " + what + " id (a non-empty string)");
+          Fail(key + "[" + std::to_string(i) + "]",
+               "expected a " + what + " id (a non-empty string)");
         out.push_back(v[i].get<std::string>());
       }
     } else {
@@ -108,7 +115,8 @@ class Entry {
     if (!v.is_array() || v.size() != 6) fail("", "expected a box [x0, y0, z0, x1, y1, z1]");
     Aabb b;
     for (int i = 0; i < 6; ++i) {
-      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) || std::abs(v[i].get<double>()) > 1e7)
+      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) ||
+          std::abs(v[i].get<double>()) > 1e7)
         fail("[" + std::to_string(i) + "]", "expected a finite number of at most 1e7 in size");
       (i < 3 ? b.min : b.max)[i % 3] = v[i].get<double>();
     }
@@ -126,19 +134,44 @@ class Entry {
 };
 
 const std::map<std::string, Kind>& Kinds() {
-  static const std::map<std::string, Kind> kinds = {
-      {"select", Kind::kSelect}, {"move", Kind::kMove},       {"rotate", Kind::kRotate},
-      {"aim", Kind::kAim},       {"orient", Kind::kOrient},   {"enable", Kind::kEnable},   {"disable", Kind::kDisable},
-      {"hfov", Kind::kHfov},     {"intrinsics", Kind::kIntrinsics}, {"range", Kind::kRange},
-      {"color", Kind::kColor},   {"compare", Kind::kCompare}, {"undo", Kind::kUndo},       {"redo", Kind::kRedo},
-      {"slice", Kind::kSlice},   {"iso", Kind::kIso},         {"view", Kind::kView},
-      {"orbit", Kind::kOrbit},   {"pan", Kind::kPan},         {"dolly", Kind::kDolly},
-      {"eye", Kind::kEye},       {"light", Kind::kLight},     {"wait", Kind::kWait},
-      {"suggest", Kind::kSuggest}, {"accept", Kind::kAccept}, {"reject", Kind::kReject},
-      {"save", Kind::kSave},     {"screenshot", Kind::kScreenshot}, {"size", Kind::kSize},
-      {"mouse", Kind::kMouse},   {"key", Kind::kKey},         {"scroll", Kind::kScroll},
-      {"gamepad", Kind::kGamepad}, {"frames", Kind::kFrames}, {"station", Kind::kStation},
-      {"ptz", Kind::kPtz},       {"recentre", Kind::kRecentre}, {"trace", Kind::kTrace}};
+  static const std::map<std::string, Kind> kinds = {{"select", Kind::kSelect},
+                                                    {"move", Kind::kMove},
+                                                    {"rotate", Kind::kRotate},
+                                                    {"aim", Kind::kAim},
+                                                    {"orient", Kind::kOrient},
+                                                    {"enable", Kind::kEnable},
+                                                    {"disable", Kind::kDisable},
+                                                    {"hfov", Kind::kHfov},
+                                                    {"intrinsics", Kind::kIntrinsics},
+                                                    {"range", Kind::kRange},
+                                                    {"color", Kind::kColor},
+                                                    {"compare", Kind::kCompare},
+                                                    {"undo", Kind::kUndo},
+                                                    {"redo", Kind::kRedo},
+                                                    {"slice", Kind::kSlice},
+                                                    {"iso", Kind::kIso},
+                                                    {"view", Kind::kView},
+                                                    {"orbit", Kind::kOrbit},
+                                                    {"pan", Kind::kPan},
+                                                    {"dolly", Kind::kDolly},
+                                                    {"eye", Kind::kEye},
+                                                    {"light", Kind::kLight},
+                                                    {"wait", Kind::kWait},
+                                                    {"suggest", Kind::kSuggest},
+                                                    {"accept", Kind::kAccept},
+                                                    {"reject", Kind::kReject},
+                                                    {"save", Kind::kSave},
+                                                    {"screenshot", Kind::kScreenshot},
+                                                    {"size", Kind::kSize},
+                                                    {"mouse", Kind::kMouse},
+                                                    {"key", Kind::kKey},
+                                                    {"scroll", Kind::kScroll},
+                                                    {"gamepad", Kind::kGamepad},
+                                                    {"frames", Kind::kFrames},
+                                                    {"station", Kind::kStation},
+                                                    {"ptz", Kind::kPtz},
+                                                    {"recentre", Kind::kRecentre},
+                                                    {"trace", Kind::kTrace}};
   return kinds;
 }
 
@@ -150,7 +183,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
   for (const auto& item : j.items())
     if (Kinds().count(item.key())) {
       if (!name.empty())
-        throw InputError(file, where, "two actions in one object ('" + name + "' and '" + item.key() + "')",
+        throw InputError(file, where,
+                         "two actions in one object ('" + name + "' and '" + item.key() + "')",
                          "give each action its own object");
       name = item.key();
     }
@@ -174,7 +208,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.cameras = e.Ids("move", false);
       if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
       a.flag = e.Has("to");
-      if (a.flag && a.cameras.size() != 1) e.Fail("to", "'to' places one camera; use 'by' for a group");
+      if (a.flag && a.cameras.size() != 1)
+        e.Fail("to", "'to' places one camera; use 'by' for a group");
       a.a = e.Vector(a.flag ? "to" : "by");
       a.has_a = true;
       break;
@@ -213,8 +248,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.cameras = e.Ids("intrinsics", false);
       if (e.Has("resolution")) {
         const Vec3 v = e.Vector("resolution", 2);
-        if (v.x() < 1 || v.y() < 1 || v.x() > 65536 || v.y() > 65536 || v.x() != std::floor(v.x()) ||
-            v.y() != std::floor(v.y()))
+        if (v.x() < 1 || v.y() < 1 || v.x() > 65536 || v.y() > 65536 ||
+            v.x() != std::floor(v.x()) || v.y() != std::floor(v.y()))
           e.Fail("resolution", "expected [width, height], whole numbers of pixels from 1 to 65536");
         a.width = int(v.x());
         a.height = int(v.y());
@@ -226,21 +261,28 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
         if (!e.Has(key)) continue;
         if (!a.lens.empty() && !LensHasCoefficient(a.lens, i))
           e.Fail(key, "a " + a.lens + " lens has no coefficient " + key,
-                 a.lens == "pinhole" ? "pinhole: no distortion" : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4" : "brown_conrady: k1 k2 p1 p2 k3");
+                 a.lens == "pinhole"   ? "pinhole: no distortion"
+                 : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4"
+                                       : "brown_conrady: k1 k2 p1 p2 k3");
         a.coefficients[i] = e.Number(key, -1000, 1000);
         any = true;
       }
-      if (!any) e.Fail("", "nothing to change", "give resolution, model or coefficients (k1 k2 p1 p2 k3 k4)");
+      if (!any)
+        e.Fail("", "nothing to change",
+               "give resolution, model or coefficients (k1 k2 p1 p2 k3 k4)");
       break;
     }
     case Kind::kRange: {
       e.Keys({"range", "near", "far"});
       a.cameras = e.Ids("range", false);
-      if (!e.Has("near") && !e.Has("far")) e.Fail("", "nothing to change", "give near, far or both (metres)");
+      if (!e.Has("near") && !e.Has("far"))
+        e.Fail("", "nothing to change", "give near, far or both (metres)");
       if (e.Has("near")) a.near = e.Number("near", 0, 1e7);
       if (e.Has("far")) {
-        if (j.at("far").is_null()) a.far = INFINITY;
-        else a.far = e.Number("far", 1e-9, 1e7);
+        if (j.at("far").is_null())
+          a.far = INFINITY;
+        else
+          a.far = e.Number("far", 1e-9, 1e7);
         if (a.far <= a.near) e.Fail("far", "far must be greater than near");
       }
       break;
@@ -287,8 +329,10 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       // is one of the scene's views.
       e.Keys({"view", "side"});
       a.text = e.String("view");
-      if (a.text == "elevation") a.text2 = e.OneOf("side", {"north", "south", "east", "west"});
-      else if (e.Has("side")) e.Fail("side", "only with \"view\": \"elevation\"");
+      if (a.text == "elevation")
+        a.text2 = e.OneOf("side", {"north", "south", "east", "west"});
+      else if (e.Has("side"))
+        e.Fail("side", "only with \"view\": \"elevation\"");
       break;
     case Kind::kOrbit:
     case Kind::kPan:
@@ -311,16 +355,18 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.text = e.OneOf("light", {"uniform", "grid"});
       a.number = e.Number("grid", 1, 100000, 32);
       a.number2 = e.Has("brightness") ? e.Number("brightness", 1e-6, 1e6) : NAN;
-      a.text2 = e.Has("surface") ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"}) : "material";
+      a.text2 = e.Has("surface")
+                    ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"})
+                    : "material";
       break;
     case Kind::kWait:
       e.Keys({"wait"});
       a.text = e.OneOf("wait", {"fields", "suggest", "render"});
       break;
     case Kind::kSuggest:
-      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane", "box",
-              "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate", "outer",
-              "target_surface", "with_region", "over_time"});
+      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane",
+              "box", "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate",
+              "outer", "target_surface", "with_region", "over_time"});
       a.cameras = e.Ids("suggest", false);
       a.text = e.Has("objective") ? e.String("objective") : "coverage2";
       a.number = e.Number("max_move", 0, 1e4, 0.3);
@@ -340,7 +386,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.with_region = e.Has("with_region") && j.at("with_region").get<bool>();
       a.over_time = e.Has("over_time") && j.at("over_time").get<bool>();
       if (a.over_time && !a.target_surfaces.empty())
-        e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene", "give one of them");
+        e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene",
+               "give one of them");
       a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
       if (int(e.Has("rail")) + int(e.Has("plane")) + int(e.Has("box")) > 1)
         e.Fail("", "give at most one mount: 'rail', 'plane' or 'box'");
@@ -356,7 +403,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       }
       if (e.Has("keep_out")) {
         const json& boxes = j.at("keep_out");
-        if (!boxes.is_array() || boxes.size() > 1000) e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
+        if (!boxes.is_array() || boxes.size() > 1000)
+          e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
         for (std::size_t i = 0; i < boxes.size(); ++i) {
           const Entry box(boxes, where + ".keep_out", file);
           a.keep_out.push_back(box.Box(i));
@@ -365,7 +413,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       if (e.Has("clearance")) a.clearance = e.Number("clearance", 0, 1e4);
       if (e.Has("hfov_range")) {
         const Vec3 r = e.Vector("hfov_range", 2);
-        if (!(r.x() > 0 && r.x() <= r.y() && r.y() < 360)) e.Fail("hfov_range", "expected [min, max] degrees, 0 < min <= max < 360");
+        if (!(r.x() > 0 && r.x() <= r.y() && r.y() < 360))
+          e.Fail("hfov_range", "expected [min, max] degrees, 0 < min <= max < 360");
         a.min_hfov = r.x();
         a.max_hfov = r.y();
       }
@@ -398,7 +447,9 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.text = e.OneOf("mouse", {"press", "release", "move"});
       a.text2 = e.Has("button") ? e.OneOf("button", {"left", "right", "middle"}) : "left";
       if (int(e.Has("x") || e.Has("y")) + int(e.Has("at")) + int(e.Has("gizmo")) != 1)
-        e.Fail("", "give the pointer as one of 'x' and 'y' (pixels), 'at' (a world point) or 'gizmo' (a handle)");
+        e.Fail("",
+               "give the pointer as one of 'x' and 'y' (pixels), 'at' (a world point) or 'gizmo' "
+               "(a handle)");
       if (e.Has("at")) {
         a.a = e.Vector("at");
         a.has_a = true;
@@ -435,7 +486,8 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
     case Kind::kStation:
       e.Keys({"station", "eye_at", "display_at"});
       a.text = e.String("station");
-      if (e.Has("eye_at") == e.Has("display_at")) e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
+      if (e.Has("eye_at") == e.Has("display_at"))
+        e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
       a.flag = e.Has("display_at");
       a.a = e.Vector(a.flag ? "display_at" : "eye_at");
       break;
@@ -490,11 +542,13 @@ std::vector<Action> ParseScript(const std::string& text, const std::string& path
   } catch (const std::exception& e) {
     throw InputError(path, "$", std::string("malformed JSON: ") + e.what());
   }
-  if (!j.is_array()) throw InputError(path, "$", "a script is an array of actions", "e.g. [{\"undo\": 1}]");
+  if (!j.is_array())
+    throw InputError(path, "$", "a script is an array of actions", "e.g. [{\"undo\": 1}]");
   if (j.size() > 100000) throw InputError(path, "$", "more than 100000 actions");
   std::vector<Action> out;
   out.reserve(j.size());
-  for (std::size_t i = 0; i < j.size(); ++i) out.push_back(ParseAction(j[i], "$[" + std::to_string(i) + "]", path));
+  for (std::size_t i = 0; i < j.size(); ++i)
+    out.push_back(ParseAction(j[i], "$[" + std::to_string(i) + "]", path));
   return out;
 }
 

@@ -1,20 +1,23 @@
 #pragma once
 /// \file script.h
-/// The viewer's actions as data: every UI action (select, move, rotate, enable, zoom a camera, undo,
-/// slice, suggest, accept, save, navigate, screenshot) is an Action, whether it came from a click or
-/// from a script line, so `pandora view --script FILE` replays what a person does and the unit tests
-/// run sessions without GL (docs/viewer.md, "Scripts").
+/// The viewer's actions as data: every UI action (select, move, rotate, enable, zoom a camera,
+/// undo, slice, suggest, accept, save, navigate, screenshot) is an Action, whether it came from a
+/// click or from a script line, so `pandora view --script FILE` replays what a person does and the
+/// unit tests run sessions without GL (docs/viewer.md, "Scripts").
 ///
 /// A script is a JSON array of objects, each naming one action by its first key:
 ///     [{"select": ["c03"]},
-///      {"move": ["c03"], "by": [0.2, 0, 0]},           // world metres; "to": [x, y, z] for one camera
-///                                                      // "drag": true continues the last drag step
+///      {"move": ["c03"], "by": [0.2, 0, 0]},           // world metres; "to": [x, y, z] for one
+///      camera
+///                                                      // "drag": true continues the last drag
+///                                                      step
 ///      {"rotate": ["c03"], "axis": [0, 0, 1], "deg": 10},  // about the cameras' centroid
 ///      {"aim": "c03", "at": [0, 0, 1]},                 // turn to look at a point (Z up)
 ///      {"orient": "c03", "ypr_deg": [30, -10, 0]},      // the scene file's yaw, pitch, roll
 ///      {"enable": ["c01"]}, {"disable": ["c01"]},
 ///      {"hfov": ["c03"], "deg": 55},                    // zoom (focal lengths scaled)
-///      {"intrinsics": "c03", "resolution": [1280, 720],  // same field of view (fx fy cx cy scaled)
+///      {"intrinsics": "c03", "resolution": [1280, 720],  // same field of view (fx fy cx cy
+///      scaled)
 ///       "model": "brown_conrady", "k1": -0.1, "k2": 0.01, "p1": 0, "p2": 0, "k3": 0},
 ///                                                      // fisheye: k1..k4; pinhole: none
 ///      {"range": "c03", "near": 0.3, "far": 5},         // "far": null: no far limit
@@ -31,8 +34,8 @@
 ///      {"light": "grid", "grid": 16, "brightness": 0.5, "surface": "material"},
 ///      {"wait": "fields"},                              // or "suggest", "render"
 ///      {"suggest": ["c03"], "objective": "coverage2", "max_move": 0.3, "max_rotate": 10,
-///       "points": 600, "seed": 1, "rail": [1, 0, 0],   // or "plane": [0, 0, 1], or "box": [x0, y0,
-///       "keep_out": [[x0, y0, z0, x1, y1, z1]],         // z0, x1, y1, z1]; all optional
+///       "points": 600, "seed": 1, "rail": [1, 0, 0],   // or "plane": [0, 0, 1], or "box": [x0,
+///       y0, "keep_out": [[x0, y0, z0, x1, y1, z1]],         // z0, x1, y1, z1]; all optional
 ///       "clearance": 0.1, "hfov_range": [40, 60],
 ///       "weights": [1, 1, 0], "snap_move": 0.05, "snap_rotate": 5, "outer": 4,
 ///       "target_surface": ["actor"], "with_region": true,  // or "over_time": true (the
@@ -43,7 +46,8 @@
 ///      {"size": [1280, 720]},                           // the main view's size in pixels
 ///      {"mouse": "press", "button": "left", "x": 640, "y": 360},  // raw input, GL front end only
 ///      {"mouse": "press", "at": [x, y, z]},   // ... at the pixel where a world point appears
-///      {"mouse": "press", "gizmo": "x"},      // ... on the gizmo's x handle (x, y, z; "rx"... rings)
+///      {"mouse": "press", "gizmo": "x"},      // ... on the gizmo's x handle (x, y, z; "rx"...
+///      rings)
 ///      {"mouse": "move", "gizmo": "x", "by": 0.25},  // ... where the handle is 0.25 m further
 ///      {"key": "ctrl+z"}, {"scroll": 1.0, "x": 640, "y": 360},
 ///      {"gamepad": "c03", "left": [0, -1], "right": [0, 0], "seconds": 0.5},
@@ -63,23 +67,60 @@
 #include <string>
 #include <vector>
 
-#include "analysis/geometry.h"
+#include "analysis/geometry/geometry.h"
 
 namespace pandora::viewer {
 
 struct Action {
   enum class Kind {
-    kSelect, kMove, kRotate, kAim, kOrient, kEnable, kDisable, kHfov, kIntrinsics, kRange, kColor, kCompare, kUndo, kRedo, kSlice, kIso, kView,
-    kOrbit, kPan, kDolly, kEye, kLight, kWait, kSuggest, kAccept, kReject, kSave, kScreenshot, kSize,
-    kMouse, kKey, kScroll, kGamepad, kFrames, kStation, kPtz, kRecentre, kTrace,
+    kSelect,
+    kMove,
+    kRotate,
+    kAim,
+    kOrient,
+    kEnable,
+    kDisable,
+    kHfov,
+    kIntrinsics,
+    kRange,
+    kColor,
+    kCompare,
+    kUndo,
+    kRedo,
+    kSlice,
+    kIso,
+    kView,
+    kOrbit,
+    kPan,
+    kDolly,
+    kEye,
+    kLight,
+    kWait,
+    kSuggest,
+    kAccept,
+    kReject,
+    kSave,
+    kScreenshot,
+    kSize,
+    kMouse,
+    kKey,
+    kScroll,
+    kGamepad,
+    kFrames,
+    kStation,
+    kPtz,
+    kRecentre,
+    kTrace,
   };
   Kind kind = Kind::kFrames;
   std::string where;                 ///< "$[i]": for messages while running.
   std::vector<std::string> cameras;  ///< Camera ids (select, move, ... accept; empty accept: all);
                                      ///< compare: "saved" or rig names.
-  std::string text;    ///< Field, view, wait target, objective, path, key, mouse action, light pattern.
-  std::string text2;   ///< slice axis "x"/"y"/"z", surface mode, mouse button, screenshot camera.
-  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  ///< by/to/axis/at/eye; gamepad left (x, y), right (x, y).
+  std::string
+      text;  ///< Field, view, wait target, objective, path, key, mouse action, light pattern.
+  std::string text2;  ///< slice axis "x"/"y"/"z", surface mode, mouse button, screenshot camera.
+  Vec3 a = Vec3::Zero(),
+       b = Vec3::Zero();  ///< by/to/axis/at/eye; gamepad left (x, y), right (x, y).
   bool has_a = false, has_b = false;
   double number = 0;   ///< deg, at, value, dolly steps, seconds, frames, scroll, grid, max_move ...
   double number2 = 0;  ///< max_rotate, brightness, mouse y ...
@@ -113,7 +154,8 @@ struct Action {
   double snap_move = 0, snap_rotate = 0;
   int outer_iterations = 4;
   /// mouse: the gizmo handle aimed at (0..2 axes x y z, 3..5 rings; -1: none) and "by" along it
-  /// (metres, or degrees on a ring; in `number`); with `has_a`, the world point `a` instead of x, y.
+  /// (metres, or degrees on a ring; in `number`); with `has_a`, the world point `a` instead of x,
+  /// y.
   int gizmo = -1;
   /// ptz: pan, tilt and horizontal field of view in degrees (NaN: kept) and a preset name ("":
   /// none; the angles are then not given). trace: `text` the mode, `number` the budget (NaN: each

@@ -1,7 +1,8 @@
 #include "viewer/core/station.h"
-#include "analysis/units.h"
 
 #include <cmath>
+
+#include "analysis/util/units.h"
 
 namespace pandora::viewer {
 

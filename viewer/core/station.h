@@ -1,12 +1,13 @@
 #pragma once
 /// \file station.h
-/// Viewing-station design (the Pandora paper's Section 5): the display placed in the scene shows the
-/// scene as the viewer's eye sees it through the display rectangle (an off-axis perspective, as a
-/// head-tracked display renders it), and the head tracker's angular range is drawn as a wireframe.
+/// Viewing-station design (the Pandora paper's Section 5): the display placed in the scene shows
+/// the scene as the viewer's eye sees it through the display rectangle (an off-axis perspective, as
+/// a head-tracked display renders it), and the head tracker's angular range is drawn as a
+/// wireframe.
 
 #include <array>
 
-#include "analysis/scene.h"
+#include "analysis/scene/scene.h"
 
 namespace pandora::viewer {
 

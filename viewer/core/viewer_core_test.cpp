@@ -10,18 +10,18 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analysis/error.h"
+#include "analysis/util/error.h"
+#include "analysis/util/units.h"
 #include "app/session/autosave.h"
+#include "render/isosurface.h"
 #include "tests/fixtures.h"
 #include "viewer/core/manipulate.h"
 #include "viewer/core/model.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
-#include "render/isosurface.h"
 #include "viewer/core/station.h"
 #include "volume/fields.h"
 #include "volume/summary.h"
-#include "analysis/units.h"
 
 namespace pandora::viewer {
 namespace {
@@ -91,7 +91,8 @@ TEST(Manipulate, AxisDragFollowsTheClosestPoint) {
   ASSERT_TRUE(t);
   EXPECT_NEAR(*t, 2.0, 1e-12);
   // Skew lines: the axis z through (1, 0, 0), the ray along x at height 3, y = 0.
-  const auto s = AxisParameter(Ray{Vec3(-4, 0, 3), Vec3(1, 0, 0), 0, 1e30}, Vec3(1, 0, 0), Vec3(0, 0, 1));
+  const auto s =
+      AxisParameter(Ray{Vec3(-4, 0, 3), Vec3(1, 0, 0), 0, 1e30}, Vec3(1, 0, 0), Vec3(0, 0, 1));
   ASSERT_TRUE(s);
   EXPECT_NEAR(*s, 3.0, 1e-12);
   EXPECT_FALSE(AxisParameter(Ray{Vec3(0, 1, 0), Vec3(1, 0, 0), 0, 1}, Vec3::Zero(), Vec3(1, 0, 0)));
@@ -105,7 +106,8 @@ TEST(Manipulate, RingDragSweepsTheAngleAboutTheAxis) {
   EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), Vec3::UnitZ()), kPi / 2, 1e-12);
   EXPECT_NEAR(*SweptAngle(b, a, Vec3::Zero(), Vec3::UnitZ()), -kPi / 2, 1e-12);
   EXPECT_NEAR(*SweptAngle(a, b, Vec3::Zero(), -Vec3::UnitZ()), -kPi / 2, 1e-12);
-  EXPECT_FALSE(SweptAngle(Ray{eye, Vec3(1, 0, 0), 0, 1}, b, Vec3::Zero(), Vec3::UnitZ()));  // parallel
+  EXPECT_FALSE(
+      SweptAngle(Ray{eye, Vec3(1, 0, 0), 0, 1}, b, Vec3::Zero(), Vec3::UnitZ()));  // parallel
   EXPECT_EQ(Snap(0.26, 0.1), 0.30000000000000004);
   EXPECT_EQ(Snap(-0.24, 0.1), -0.2);
   EXPECT_EQ(Snap(0.26, 0), 0.26);
@@ -119,7 +121,9 @@ TEST(Manipulate, GroupsMoveRigidlyAndPickingFindsTheNearestBody) {
   const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, Vec3::Zero(), Vec3(0, 0, 0.5), R);
   // A quarter turn about the ring's axis takes camera i to camera i + 1's place, lifted 0.5 m.
   for (int i = 0; i < 4; ++i) {
-    EXPECT_LT((moved[i].translation() - (poses[(i + 1) % 4].translation() + Vec3(0, 0, 0.5))).norm(), 1e-12);
+    EXPECT_LT(
+        (moved[i].translation() - (poses[(i + 1) % 4].translation() + Vec3(0, 0, 0.5))).norm(),
+        1e-12);
     EXPECT_LT((moved[i].linear() - poses[(i + 1) % 4].linear()).norm(), 1e-12);
   }
   // Pairwise distances are kept.
@@ -128,7 +132,8 @@ TEST(Manipulate, GroupsMoveRigidlyAndPickingFindsTheNearestBody) {
   // A ray from outside through camera 0 (at (2, 0, 1)) and on to camera 2 picks camera 0 first.
   const Ray ray{Vec3(5, 0, 1), Vec3(-1, 0, 0), 0, 1e30};
   EXPECT_EQ(PickCamera(rig, ray, 0.1), 0);
-  EXPECT_EQ(PickCamera(rig, Ray{Vec3(5, 0, 1.2), Vec3(-1, 0, 0), 0, 1e30}, 0.1), -1);  // passes above
+  EXPECT_EQ(PickCamera(rig, Ray{Vec3(5, 0, 1.2), Vec3(-1, 0, 0), 0, 1e30}, 0.1),
+            -1);  // passes above
   EXPECT_EQ(PickCamera(rig, Ray{Vec3(5, 0, 1.05), Vec3(-1, 0, 0), 0, 1e30}, 0.1), 0);
 }
 
@@ -136,7 +141,7 @@ TEST(Manipulate, FourthPowerStickMapping) {
   EXPECT_EQ(StickCurve(0.05), 0.0);  // dead zone
   EXPECT_EQ(StickCurve(1.0), 1.0);
   EXPECT_EQ(StickCurve(-1.0), -1.0);
-  EXPECT_EQ(StickCurve(2.0), 1.0);  // clamped
+  EXPECT_EQ(StickCurve(2.0), 1.0);                         // clamped
   EXPECT_NEAR(StickCurve(0.55), std::pow(0.5, 4), 1e-15);  // halfway through the travel: 1/16
   EXPECT_NEAR(StickCurve(-0.55), -std::pow(0.5, 4), 1e-15);
   // One second full forward at 0.5 m/s moves a level camera 0.5 m along its view; full right stick
@@ -173,7 +178,8 @@ TEST(Station, TheDisplayImageIsTheViewThroughTheDisplay) {
   EXPECT_LT((corners[0] - Vec3(1, 0.3, 1.4)).norm(), 1e-12);
   // Every corner projects onto the matching image corner; so does any point on the eye's ray
   // through a display point, wherever it lies in the scene.
-  const Vec2 expected[4] = {Vec2(-0.5, -0.5), Vec2(299.5, -0.5), Vec2(299.5, 199.5), Vec2(-0.5, 199.5)};
+  const Vec2 expected[4] = {Vec2(-0.5, -0.5), Vec2(299.5, -0.5), Vec2(299.5, 199.5),
+                            Vec2(-0.5, 199.5)};
   for (int i = 0; i < 4; ++i) {
     const auto p = cam.model.Project(cam.world_from_camera.inverse() * corners[i]);
     ASSERT_TRUE(p);
@@ -225,7 +231,8 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
     {"accept": "all"}, {"accept": ["a"]}, {"reject": 1}, {"save": "force"},
     {"screenshot": "x.png", "camera": "a"}, {"size": [640, 360]}, {"mouse": "press", "x": 1, "y": 2},
     {"key": "ctrl+z"}, {"scroll": -1}, {"gamepad": "a", "left": [0, -1], "seconds": 0.5}, {"frames": 2}
-  ])", "s.json");
+  ])",
+                                            "s.json");
   ASSERT_EQ(s.size(), 32u);
   EXPECT_EQ(s[1].kind, Action::Kind::kMove);
   EXPECT_FALSE(s[1].flag);
@@ -262,7 +269,8 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   const std::vector<Action> m = ParseScript(
       R"([{"suggest": ["a"], "rail": [1, 0, 0], "keep_out": [[0, 0, 0, 1, 1, 1], [2, 2, 2, 3, 3, 3]],
            "clearance": 0.2, "hfov_range": [30, 50]},
-          {"suggest": ["a"], "box": [-1, -1, 0, 1, 1, 2]}])", "s.json");
+          {"suggest": ["a"], "box": [-1, -1, 0, 1, 1, 2]}])",
+      "s.json");
   EXPECT_EQ(m[0].mount, "rail");
   ASSERT_EQ(m[0].keep_out.size(), 2u);
   EXPECT_EQ(m[0].keep_out[1].min, Vec3(2, 2, 2));
@@ -273,14 +281,16 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   ExpectScriptError(R"([{"suggest": ["a"], "rail": [1, 0, 0], "plane": [0, 0, 1]}])", "$[0]");
   ExpectScriptError(R"([{"suggest": ["a"], "rail": [0, 0, 0]}])", "$[0].rail");
   ExpectScriptError(R"([{"suggest": ["a"], "box": [1, 0, 0, 0, 1, 1]}])", "$[0].box");
-  ExpectScriptError(R"([{"suggest": ["a"], "keep_out": [[0, 0, 0, 1, 1, 1], [0, 0, "x", 1, 1, 1]]}])",
-                    "$[0].keep_out[1][2]");
+  ExpectScriptError(
+      R"([{"suggest": ["a"], "keep_out": [[0, 0, 0, 1, 1, 1], [0, 0, "x", 1, 1, 1]]}])",
+      "$[0].keep_out[1][2]");
   ExpectScriptError(R"([{"suggest": ["a"], "hfov_range": [50, 30]}])", "$[0].hfov_range");
   // `pandora suggest`'s other options, with its defaults.
   const std::vector<Action> o = ParseScript(
       R"([{"suggest": ["a"], "objective": "mix", "weights": [1, 0.5, 0], "snap_move": 0.05, "snap_rotate": 5,
            "outer": 2, "target_surface": ["actor", "table"], "with_region": true},
-          {"suggest": "a", "over_time": true}])", "s.json");
+          {"suggest": "a", "over_time": true}])",
+      "s.json");
   EXPECT_EQ(o[0].weights, Vec3(1, 0.5, 0));
   EXPECT_EQ(o[0].snap_move, 0.05);
   EXPECT_EQ(o[0].snap_rotate, 5);
@@ -289,12 +299,13 @@ TEST(Script, ParsesEveryActionAndRefusesBadOnesWithTheirPath) {
   EXPECT_TRUE(o[0].with_region);
   EXPECT_FALSE(o[0].over_time);
   EXPECT_TRUE(o[1].over_time);
-  EXPECT_EQ(o[1].number3, 1500);  // --points
+  EXPECT_EQ(o[1].number3, 1500);        // --points
   EXPECT_EQ(o[1].outer_iterations, 4);  // --outer
   EXPECT_TRUE(std::isnan(o[1].weights.x()));
   ExpectScriptError(R"([{"suggest": ["a"], "weights": [0, 0, 0]}])", "$[0].weights");
   ExpectScriptError(R"([{"suggest": ["a"], "over_time": 1}])", "$[0].over_time");
-  ExpectScriptError(R"([{"suggest": ["a"], "over_time": true, "target_surface": "x"}])", "$[0].over_time");
+  ExpectScriptError(R"([{"suggest": ["a"], "over_time": true, "target_surface": "x"}])",
+                    "$[0].over_time");
   ExpectScriptError(R"([{"suggest": ["a"], "target_surface": [""]}])", "$[0].target_surface[0]");
   ExpectScriptError(R"([{"suggest": ["a"], "outer": 0}])", "$[0].outer");
   // The pointer as a world point or a gizmo handle.
@@ -321,7 +332,8 @@ TEST(Script, CameraPanelActionsParseAndRefuseBadValuesWithTheirPath) {
     {"intrinsics": "a", "k4": 0.01},
     {"range": "a", "near": 0.3, "far": 5}, {"range": ["a"], "far": null}, {"range": "a", "near": 1},
     {"color": "a", "rgb": [1, 0.5, 0]}
-  ])", "s.json");
+  ])",
+                                            "s.json");
   ASSERT_EQ(s.size(), 7u);
   EXPECT_EQ(s[0].kind, Action::Kind::kIntrinsics);
   EXPECT_EQ(s[0].width, 320);
@@ -396,14 +408,19 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
   const Vec3 start = m.rig().cameras[1].center();
   const fs::path dir = scene.parent_path();
   m.Run(ParseScript(R"([{"wait": "fields"}, {"slice": "coverage", "axis": "z", "at": 0.5},
-                        {"screenshot": ")" + (dir / "before.png").string() + R"("}])", "s.json"),
+                        {"screenshot": ")" +
+                        (dir / "before.png").string() + R"("}])",
+                    "s.json"),
         &cpu);
   const double before = CoverageGe4(m);
   EXPECT_GT(before, 0);
   // Turn camera 1 partly away from the region: coverage >= 4 drops, the fields follow in the
   // background.
-  m.Run(ParseScript(R"([{"select": [")" + c + R"("]}, {"rotate": [")" + c + R"("], "axis": [0, 0, 1], "deg": 30},
-                        {"wait": "fields"}, {"screenshot": ")" + (dir / "turned.png").string() + R"("}])", "s.json"),
+  m.Run(ParseScript(R"([{"select": [")" + c + R"("]}, {"rotate": [")" + c +
+                        R"("], "axis": [0, 0, 1], "deg": 30},
+                        {"wait": "fields"}, {"screenshot": ")" +
+                        (dir / "turned.png").string() + R"("}])",
+                    "s.json"),
         &cpu);
   EXPECT_EQ(m.StateJson()["undo"], "rotate " + c);
   EXPECT_EQ(m.StateJson()["selection"], nlohmann::json::array({c}));
@@ -423,8 +440,10 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
   EXPECT_EQ(Read(scene), original_text);
 
   // Suggest for the turned camera, accept it: coverage recovers; undo takes it back.
-  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "objective": "coverage4", "max_move": 0.2, "max_rotate": 45,
-                        "points": 300}, {"wait": "suggest"}])", "s.json"),
+  m.Run(ParseScript(R"([{"suggest": [")" + c +
+                        R"("], "objective": "coverage4", "max_move": 0.2, "max_rotate": 45,
+                        "points": 300}, {"wait": "suggest"}])",
+                    "s.json"),
         &cpu);
   ASSERT_TRUE(m.suggestion);
   EXPECT_TRUE(m.suggestion->improved) << m.suggestion->message;
@@ -446,21 +465,31 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
   EXPECT_TRUE(backup);
   const Scene reloaded = LoadScene(scene.string());
   const Camera& saved = reloaded.rigs[0].cameras[1];
-  EXPECT_LT((saved.world_from_camera.matrix() - m.rig().cameras[1].world_from_camera.matrix()).norm(), 1e-6);
-  EXPECT_GT((saved.center() - start).norm() + (saved.world_from_camera.linear() - Mat3::Identity()).norm(), 0);
+  EXPECT_LT(
+      (saved.world_from_camera.matrix() - m.rig().cameras[1].world_from_camera.matrix()).norm(),
+      1e-6);
+  EXPECT_GT((saved.center() - start).norm() +
+                (saved.world_from_camera.linear() - Mat3::Identity()).norm(),
+            0);
 
   // A camera's own view renders too; an output onto the scene file is refused.
-  m.Run(ParseScript(R"([{"screenshot": ")" + (dir / "cam.png").string() + R"(", "camera": ")" + c + R"("}])", "s.json"),
+  m.Run(ParseScript(R"([{"screenshot": ")" + (dir / "cam.png").string() + R"(", "camera": ")" + c +
+                        R"("}])",
+                    "s.json"),
         &cpu);
   EXPECT_TRUE(fs::exists(dir / "cam.png"));
-  EXPECT_THROW(m.Run(ParseScript(R"([{"screenshot": ")" + scene.string() + R"("}])", "s.json"), &cpu), InputError);
+  EXPECT_THROW(
+      m.Run(ParseScript(R"([{"screenshot": ")" + scene.string() + R"("}])", "s.json"), &cpu),
+      InputError);
   EXPECT_EQ(Read(scene), Read(scene));  // still readable
   EXPECT_THROW(m.Run(ParseScript(R"([{"select": ["nope"]}])", "s.json"), &cpu), InputError);
   EXPECT_THROW(m.Run(ParseScript(R"([{"accept": "all"}])", "s.json"), &cpu), InputError);
   // A suggestion that cannot improve (nothing may move) is refused, as `pandora accept` refuses it.
-  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "max_move": 0, "max_rotate": 0, "points": 100},
-                        {"wait": "suggest"}])", "s.json"),
-        &cpu);
+  m.Run(
+      ParseScript(R"([{"suggest": [")" + c + R"("], "max_move": 0, "max_rotate": 0, "points": 100},
+                        {"wait": "suggest"}])",
+                  "s.json"),
+      &cpu);
   ASSERT_TRUE(m.suggestion);
   EXPECT_FALSE(m.suggestion->improved);
   const std::int64_t version = m.session().rig().version();
@@ -471,8 +500,10 @@ TEST(ViewerModel, ScriptedSessionMoveSuggestAcceptUndoSave) {
     EXPECT_NE(std::string(e.what()).find("offers no improvement"), std::string::npos) << e.what();
   }
   EXPECT_EQ(m.session().rig().version(), version);
-  EXPECT_THROW(m.Run(ParseScript(R"([{"slice": "resolution"}])", "s.json"), &cpu), InputError);  // not live
-  EXPECT_THROW(m.Run(ParseScript(R"([{"mouse": "press", "x": 1, "y": 1}])", "s.json"), &cpu), InputError);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"slice": "resolution"}])", "s.json"), &cpu),
+               InputError);  // not live
+  EXPECT_THROW(m.Run(ParseScript(R"([{"mouse": "press", "x": 1, "y": 1}])", "s.json"), &cpu),
+               InputError);
 }
 
 TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
@@ -483,14 +514,19 @@ TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
   ViewerModel m(session::Study::Load("examples/trauma_room/viewing_station.json"), options);
   ASSERT_EQ(m.stations.count("remote consult"), 1u);
   const Vec3 eye = m.stations.at("remote consult").eye;
-  m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.6, -1.3, 1.35]}])", "s.json"), nullptr);
+  m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.6, -1.3, 1.35]}])", "s.json"),
+        nullptr);
   EXPECT_LT((m.stations.at("remote consult").eye - Vec3(0.6, -1.3, 1.35)).norm(), 1e-12);
   EXPECT_EQ(m.stations_version, 1);
   EXPECT_NE(eye, m.stations.at("remote consult").eye);
   // Behind the display (it faces -y), an unknown station: refused, nothing moves.
-  EXPECT_THROW(m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.56, 0.5, 1.2]}])", "s.json"), nullptr),
-               InputError);
-  EXPECT_THROW(m.Run(ParseScript(R"([{"station": "lobby", "eye_at": [0, 0, 1]}])", "s.json"), nullptr), InputError);
+  EXPECT_THROW(
+      m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.56, 0.5, 1.2]}])", "s.json"),
+            nullptr),
+      InputError);
+  EXPECT_THROW(
+      m.Run(ParseScript(R"([{"station": "lobby", "eye_at": [0, 0, 1]}])", "s.json"), nullptr),
+      InputError);
   EXPECT_EQ(m.stations_version, 1);
   // The display's image is the scene through the display: its centre pixel shows what the eye's
   // ray through the display's centre hits first.
@@ -507,7 +543,8 @@ TEST(ViewerModel, ViewingStationsMoveAndTheirDisplayShowsTheScene) {
       Ray{st.eye, (st.display_center - st.eye).normalized(), 0.0, 1e30});
   ASSERT_TRUE(hit);
   const double depth = image.depth[std::size_t(view.height / 2) * view.width + view.width / 2];
-  EXPECT_NEAR(depth, hit->t, 0.02 * hit->t);  // the centre pixel is half a pixel off the exact centre
+  EXPECT_NEAR(depth, hit->t,
+              0.02 * hit->t);  // the centre pixel is half a pixel off the exact centre
   m.session().WaitFields();
 }
 
@@ -528,8 +565,9 @@ TEST(ViewerModel, SaveWritesMovedViewingStationsWithABackup) {
   const Vec3 center = st0.display_center + Vec3(0.25, 0.0, -0.1);
   m.Run(ParseScript(R"([{"station": "remote consult", "eye_at": [0.6, -1.3, 1.35]},
                         {"station": "remote consult", "display_at": [)" +
-                        std::to_string(center.x()) + "," + std::to_string(center.y()) + "," + std::to_string(center.z()) +
-                        R"(]}, {"save": 1}])", "s.json"),
+                        std::to_string(center.x()) + "," + std::to_string(center.y()) + "," +
+                        std::to_string(center.z()) + R"(]}, {"save": 1}])",
+                    "s.json"),
         nullptr);
   EXPECT_NE(m.status.find("saved 1 viewing station into"), std::string::npos) << m.status;
   // The file reloads with the moved eye and display, the display turned as before; a backup keeps
@@ -542,7 +580,8 @@ TEST(ViewerModel, SaveWritesMovedViewingStationsWithABackup) {
   EXPECT_LT((st.display_up - st0.display_up).norm(), 1e-9);
   EXPECT_EQ(st.display_width, st0.display_width);
   for (std::size_t c = 0; c < before.rigs[0].cameras.size(); ++c)
-    EXPECT_EQ(after.rigs[0].cameras[c].world_from_camera.matrix(), before.rigs[0].cameras[c].world_from_camera.matrix());
+    EXPECT_EQ(after.rigs[0].cameras[c].world_from_camera.matrix(),
+              before.rigs[0].cameras[c].world_from_camera.matrix());
   bool backup = false;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path() != scene && Read(e.path()) == original) backup = true;
@@ -558,11 +597,14 @@ TEST(ViewerModel, SuggestKeepsTheMountAndTheKeepOutBox) {
   ViewerOptions options;
   options.fields = {"coverage"};
   ViewerModel m(session::Study::Load(scene.string()), options);
-  const std::string c = m.rig().cameras[3].id;  // the ring's camera that looks away (suggest_ring.json)
+  const std::string c =
+      m.rig().cameras[3].id;  // the ring's camera that looks away (suggest_ring.json)
   const Vec3 start = m.rig().cameras[3].center();
-  m.Run(ParseScript(R"([{"suggest": [")" + c + R"("], "objective": "coverage4", "max_move": 0.5, "max_rotate": 60,
+  m.Run(ParseScript(R"([{"suggest": [")" + c +
+                        R"("], "objective": "coverage4", "max_move": 0.5, "max_rotate": 60,
                          "points": 200, "rail": [1, 0, 0], "keep_out": [[-10, -10, -10, -0.05, 10, 10]]},
-                        {"wait": "suggest"}])", "s.json"),
+                        {"wait": "suggest"}])",
+                    "s.json"),
         nullptr);
   ASSERT_TRUE(m.suggestion);
   ASSERT_EQ(m.suggestion->cameras.size(), 1u);
@@ -582,17 +624,25 @@ TEST(ViewerModel, GroupEditsAreOneUndoStep) {
   const Rig original = m.rig();
   const std::string a = original.cameras[0].id, b = original.cameras[2].id;
   m.Run(ParseScript(R"([{"move": [")" + a + R"(", ")" + b + R"("], "by": [0, 0, 0.25]},
-                        {"hfov": [")" + a + R"("], "deg": 30}, {"disable": [")" + b + R"("]},
-                        {"gamepad": ")" + a + R"(", "left": [0, -1], "seconds": 1}])", "s.json"),
+                        {"hfov": [")" +
+                        a + R"("], "deg": 30}, {"disable": [")" + b + R"("]},
+                        {"gamepad": ")" +
+                        a + R"(", "left": [0, -1], "seconds": 1}])",
+                    "s.json"),
         nullptr);
   EXPECT_NEAR(m.rig().cameras[2].center().z() - original.cameras[2].center().z(), 0.25, 1e-12);
-  EXPECT_NEAR(HfovFromFocal(m.rig().cameras[0].model.intrinsics().fx, m.rig().cameras[0].model.width(),
-                            LensModel::kPinhole) / kRadPerDeg, 30, 1e-9);
+  EXPECT_NEAR(HfovFromFocal(m.rig().cameras[0].model.intrinsics().fx,
+                            m.rig().cameras[0].model.width(), LensModel::kPinhole) /
+                  kRadPerDeg,
+              30, 1e-9);
   EXPECT_FALSE(m.rig().cameras[2].enabled);
   // A drag of three steps on one camera is one undo step; a new drag starts a new one.
   m.Run(ParseScript(R"([{"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true},
-                        {"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true},
-                        {"move": ")" + b + R"(", "by": [0.1, 0, 0], "drag": true}])", "s.json"),
+                        {"move": ")" +
+                        b + R"(", "by": [0.1, 0, 0], "drag": true},
+                        {"move": ")" +
+                        b + R"(", "by": [0.1, 0, 0], "drag": true}])",
+                    "s.json"),
         nullptr);
   EXPECT_NEAR(m.rig().cameras[2].center().x() - original.cameras[2].center().x(), 0.3, 1e-12);
   ASSERT_TRUE(m.session().rig().Undo());
@@ -633,7 +683,8 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
               HfovFromFocal(full.model.intrinsics().fx, 640, LensModel::kPinhole), 1e-12);
 
   // A Brown-Conrady lens on two cameras at once: one undo step.
-  run(R"([{"intrinsics": [")" + a + R"(", ")" + b + R"("], "model": "brown_conrady", "k1": -0.1, "p1": 0.001}])");
+  run(R"([{"intrinsics": [")" + a + R"(", ")" + b +
+      R"("], "model": "brown_conrady", "k1": -0.1, "p1": 0.001}])");
   for (int c : {0, 1}) {
     const Intrinsics& k = m.rig().cameras[c].model.intrinsics();
     EXPECT_EQ(k.model, LensModel::kBrownConrady);
@@ -661,9 +712,11 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
     EXPECT_EQ(m.session().rig().version(), version) << text;  // nothing applied
     EXPECT_EQ(m.StateJson()["undo"], undo);
   };
-  // Barrel distortion so strong that the radial map turns inside the image: refused, nothing changes.
+  // Barrel distortion so strong that the radial map turns inside the image: refused, nothing
+  // changes.
   refused(R"([{"intrinsics": ")" + b + R"(", "k1": -1.5}])", "folds back inside the image");
-  refused(R"([{"intrinsics": ")" + b + R"(", "k4": 0.1}])", "no coefficient k4");  // a Brown-Conrady lens
+  refused(R"([{"intrinsics": ")" + b + R"(", "k4": 0.1}])",
+          "no coefficient k4");  // a Brown-Conrady lens
   refused(R"([{"intrinsics": ")" + original.cameras[2].id + R"(", "k1": 0.1}])", "pinhole lens");
   refused(R"([{"range": ")" + a + R"(", "near": 100}])", "must be greater than near");
   refused(R"([{"intrinsics": "nope", "k1": 0.1}])", "no camera 'nope'");
@@ -703,7 +756,9 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
   } catch (const InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("not saved: saving writes poses and focal lengths only, not " + a +
-                       "'s resolution, lens model, range, colour; "), std::string::npos) << what;
+                        "'s resolution, lens model, range, colour; "),
+              std::string::npos)
+        << what;
     EXPECT_NE(what.find(b + "'s lens model, range; "), std::string::npos) << what;
   }
   EXPECT_EQ(Read(scene), original_text);
@@ -721,20 +776,23 @@ TEST(ViewerModel, CameraPanelEditsLensRangeColourAsOneUndoStepEach) {
 }
 
 // The isosurface the window draws: the iso action picks a live field and value ("" hides it and
-// keeps the value); FieldIsosurface gives the renderer's mesh of the live fields, inside the lattice.
+// keeps the value); FieldIsosurface gives the renderer's mesh of the live fields, inside the
+// lattice.
 TEST(ViewerModel, IsoActionAndTheLiveFieldsIsosurface) {
   const fs::path scene = CopyScene("iso");
   ViewerOptions options;
   options.fields = {"coverage"};
   ViewerModel m(session::Study::Load(scene.string()), options);
-  m.Run(ParseScript(R"([{"wait": "fields"}, {"iso": "coverage", "value": 2.5}])", "s.json"), nullptr);
+  m.Run(ParseScript(R"([{"wait": "fields"}, {"iso": "coverage", "value": 2.5}])", "s.json"),
+        nullptr);
   EXPECT_EQ(m.display.overlays.iso_field, "coverage");
   EXPECT_EQ(m.display.overlays.iso_value, 2.5);
   m.session().ReadFields([&](const Fields& f, std::int64_t) {
     const TriangleMesh mesh = FieldIsosurface(f, "coverage", 2.5);
     ASSERT_GT(mesh.triangles.size(), 0u);
-    const Vec3 lo = f.lattice.origin, hi = f.lattice.Center(f.lattice.dims.x() - 1, f.lattice.dims.y() - 1,
-                                                             f.lattice.dims.z() - 1);
+    const Vec3 lo = f.lattice.origin,
+               hi = f.lattice.Center(f.lattice.dims.x() - 1, f.lattice.dims.y() - 1,
+                                     f.lattice.dims.z() - 1);
     for (const Vec3& v : mesh.vertices)
       for (int k = 0; k < 3; ++k) {
         EXPECT_GE(v[k], lo[k] - f.lattice.voxel_size);
@@ -747,13 +805,16 @@ TEST(ViewerModel, IsoActionAndTheLiveFieldsIsosurface) {
   m.Run(ParseScript(R"([{"iso": ""}])", "s.json"), nullptr);
   EXPECT_TRUE(m.display.overlays.iso_field.empty());
   EXPECT_EQ(m.display.overlays.iso_value, 2.5);
-  EXPECT_THROW(m.Run(ParseScript(R"([{"iso": "sigma_max", "value": 1}])", "s.json"), nullptr), InputError);
+  EXPECT_THROW(m.Run(ParseScript(R"([{"iso": "sigma_max", "value": 1}])", "s.json"), nullptr),
+               InputError);
 }
 
 // The Compare panel's numbers: the edited rig (its live fields) against the rig as saved, with the
-// saved rig evaluated once (a full evaluation's numbers) and nothing evaluated while nothing differs.
+// saved rig evaluated once (a full evaluation's numbers) and nothing evaluated while nothing
+// differs.
 TEST(ViewerModel, CompareTheEditedRigWithTheSavedOne) {
-  const std::vector<Action> s = ParseScript(R"([{"compare": "saved"}, {"compare": ["saved", "grid4x2"]}])", "s.json");
+  const std::vector<Action> s =
+      ParseScript(R"([{"compare": "saved"}, {"compare": ["saved", "grid4x2"]}])", "s.json");
   EXPECT_EQ(s[0].kind, Action::Kind::kCompare);
   EXPECT_EQ(s[1].cameras, (std::vector<std::string>{"saved", "grid4x2"}));
   ExpectScriptError(R"([{"compare": []}])", "$[0].compare");
@@ -776,7 +837,8 @@ TEST(ViewerModel, CompareTheEditedRigWithTheSavedOne) {
   ASSERT_TRUE(m.comparison);
   EXPECT_EQ(m.comparison->rigs, (std::vector<std::string>{"ring (edited)", "ring (saved)"}));
   EXPECT_GT(value("coverage_ge3", 0), 0);
-  for (const char* key : {"coverage_ge1", "coverage_ge2", "coverage_ge3", "resolution_p50_px_per_m", "sigma_max_p90_mm"})
+  for (const char* key : {"coverage_ge1", "coverage_ge2", "coverage_ge3", "resolution_p50_px_per_m",
+                          "sigma_max_p90_mm"})
     EXPECT_EQ(value(key, 0), value(key, 1)) << key;
   EXPECT_EQ(m.StateJson()["comparison"]["rigs"][1], "ring (saved)");
 
@@ -815,7 +877,10 @@ namespace {
 // becoming pan, presets, re-centre, save, and the traces lighting the main view.
 TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
   // The script actions and their refusals with the JSON path.
-  EXPECT_EQ(ParseScript(R"([{"ptz": "dome", "pan_deg": 63, "tilt_deg": -3, "hfov_deg": 40}])", "s.json")[0].pan_deg, 63);
+  EXPECT_EQ(ParseScript(R"([{"ptz": "dome", "pan_deg": 63, "tilt_deg": -3, "hfov_deg": 40}])",
+                        "s.json")[0]
+                .pan_deg,
+            63);
   EXPECT_EQ(ParseScript(R"([{"ptz": "dome", "preset": "window"}])", "s.json")[0].preset, "window");
   EXPECT_EQ(ParseScript(R"([{"trace": "all", "seconds": 1.5}])", "s.json")[0].number, 1.5);
   EXPECT_TRUE(std::isnan(ParseScript(R"([{"trace": "path"}])", "s.json")[0].number));
@@ -847,7 +912,11 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
   CpuFrontend cpu;
   const PtzHead h0 = *m.rig().cameras[0].ptz;
   auto head = [&]() -> const PtzHead& { return *m.rig().cameras[0].ptz; };
-  m.Run(ParseScript(R"([{"select": "dome"}, {"ptz": "dome", "pan_deg": 30, "tilt_deg": -10, "hfov_deg": 40}])", "s.json"), &cpu);
+  m.Run(
+      ParseScript(
+          R"([{"select": "dome"}, {"ptz": "dome", "pan_deg": 30, "tilt_deg": -10, "hfov_deg": 40}])",
+          "s.json"),
+      &cpu);
   EXPECT_EQ(head().current.pan_deg, 30);
   EXPECT_EQ(head().current.tilt_deg, -10);
   EXPECT_EQ(m.status, "dome (PTZ): pan 30.0, tilt -10.0, hfov 40.0 deg");
@@ -873,7 +942,9 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
     m.Run(ParseScript(R"([{"ptz": "dome", "preset": "garage"}])", "s.json"), &cpu);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("presets: window, west_door, east_door"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("presets: window, west_door, east_door"),
+              std::string::npos)
+        << e.what();
   }
   // A resolution or lens model change would leave the zoom range in the old pixels: refused.
   for (const char* script : {R"([{"intrinsics": "dome", "resolution": [640, 360]}])",
@@ -882,14 +953,17 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
       m.Run(ParseScript(script, "s.json"), &cpu);
       ADD_FAILURE() << script;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("is a PTZ camera: its zoom range is in pixels"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is a PTZ camera: its zoom range is in pixels"),
+                std::string::npos)
+          << e.what();
     }
   }
   EXPECT_EQ(m.rig().cameras[0].model.width(), 1280);
   // Re-centre: the view stays, the west door preset is home now.
   const Eigen::Isometry3d pose = m.rig().cameras[0].world_from_camera;
   m.Run(ParseScript(R"([{"recentre": "dome"}])", "s.json"), &cpu);
-  EXPECT_LT((m.rig().cameras[0].world_from_camera.matrix() - pose.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((m.rig().cameras[0].world_from_camera.matrix() - pose.matrix()).cwiseAbs().maxCoeff(),
+            1e-12);
   EXPECT_NEAR(head().presets[1].state.pan_deg, 0, 1e-12);
   EXPECT_EQ(m.session().rig().undo_label(), "re-centre dome");
   m.Run(ParseScript(R"([{"ptz": "dome", "pan_deg": -20}])", "s.json"), &cpu);
@@ -897,8 +971,10 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
   // Traces: path and all light parts of the room the current view does not (pixels brighter than
   // the single trace's by more than 0.05 in linear RGB summed).
   m.Run(ParseScript(R"([{"screenshot": ")" + (dir / "single.png").string() + R"("},
-                        {"trace": "path"}, {"screenshot": ")" + (dir / "path.png").string() + R"("},
-                        {"trace": "all", "seconds": 1.5}, {"screenshot": ")" + (dir / "all.png").string() + R"("}])",
+                        {"trace": "path"}, {"screenshot": ")" +
+                        (dir / "path.png").string() + R"("},
+                        {"trace": "all", "seconds": 1.5}, {"screenshot": ")" +
+                        (dir / "all.png").string() + R"("}])",
                     "s.json"),
         &cpu);
   EXPECT_EQ(m.ptz_trace, "all");
@@ -926,7 +1002,10 @@ TEST(ViewerModel, PtzCameraPanTiltRecentreSaveAndTraces) {
   EXPECT_NEAR(back.ptz->current.pan_deg, -20, 1e-9);
   EXPECT_NEAR(back.ptz->current.tilt_deg, 0, 1e-9);
   EXPECT_NEAR(back.ptz->presets[1].state.pan_deg, 0, 1e-9);
-  EXPECT_LT((back.world_from_camera.matrix() - m.rig().cameras[0].world_from_camera.matrix()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((back.world_from_camera.matrix() - m.rig().cameras[0].world_from_camera.matrix())
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-9);
   EXPECT_EQ(Read(dir / "scene.json.bak"), original);
   m.session().WaitFields();
 }
@@ -988,7 +1067,8 @@ TEST(ViewerModel, PlanAndElevationViewsAreRenderPlansAndPanWithinThem) {
   // Dolly magnifies: the half field's tangent x 0.85^2, the eye and the cut stay.
   const RenderView panned = m.MainView();
   run(R"([{"dolly": 2}])");
-  EXPECT_NEAR(std::tan(0.5 * m.MainView().fov_deg * kRadPerDeg), 0.85 * 0.85 * std::tan(0.5 * panned.fov_deg * kRadPerDeg), 1e-12);
+  EXPECT_NEAR(std::tan(0.5 * m.MainView().fov_deg * kRadPerDeg),
+              0.85 * 0.85 * std::tan(0.5 * panned.fov_deg * kRadPerDeg), 1e-12);
   EXPECT_LT((m.MainView().from - panned.from).norm(), 1e-9);
   // Orbit leaves the plan for a perspective view from above the panned centre, then turns.
   run(R"([{"orbit": [0, 0]}])");
