@@ -95,9 +95,9 @@ std::string HeadlineTable(const ReportData& data) {
   for (int cameras : c.enabled_cameras) s += "<td>" + std::to_string(cameras) + "</td>";
   s += "</tr>\n";
   for (const ComparisonRow& row : c.rows) {
-    s += "<tr><td>" + row.label + "</td>";
+    s += "<tr><td>" + ComparisonHtml(row.label) + "</td>";
     for (std::size_t i = 0; i < n; ++i) {
-      const std::string text = row.Text(i);
+      const std::string text = ComparisonHtml(row.Text(i));
       s += row.best[i] ? "<td class=\"best\">" + text + "</td>" : "<td>" + text + "</td>";
     }
     s += "</tr>\n";

@@ -24,7 +24,7 @@
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/output_transaction.h"
-#include "app/report/rig_comparison.h"
+#include "volume/rig_comparison.h"
 #include "volume/fields.h"
 #include "volume/slice.h"
 #include "volume/summary.h"

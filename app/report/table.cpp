@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
+#include <utility>
 
 namespace pandora::report {
 
@@ -29,6 +31,18 @@ std::string HtmlEscape(const std::string& s) {
     }
   }
   return out;
+}
+
+std::string ComparisonHtml(const std::string& plain) {
+  if (plain == "-") return "&mdash;";
+  std::string s = HtmlEscape(plain);
+  static const std::pair<const char*, const char*> kMarkup[] = {
+      {"&gt;=", "&ge;"}, {"&lt;=", "&le;"}, {"sigma_max", "&sigma;<sub>max</sub>"}};
+  for (const auto& [from, to] : kMarkup)
+    for (std::size_t at = s.find(from); at != std::string::npos;
+         at = s.find(from, at + std::strlen(to)))
+      s.replace(at, std::strlen(from), to);
+  return s;
 }
 namespace {
 

@@ -13,6 +13,11 @@ namespace pandora::report {
 /// `s` with & < > " replaced by their HTML entities, for text and attribute values in the report.
 std::string HtmlEscape(const std::string& s);
 
+/// A plain-text label or value of the rig comparison (volume/rig_comparison.h) as the report's
+/// HTML: escaped, then ">=" as &ge;, "<=" as &le;, "sigma_max" as &sigma;<sub>max</sub>, and a
+/// value of "-" alone (none) as &mdash;.
+std::string ComparisonHtml(const std::string& plain);
+
 /// A table of already formatted cells.
 class Table {
  public:

@@ -9,6 +9,20 @@
 namespace pandora::report {
 namespace {
 
+TEST(ComparisonHtml, WritesTheRigComparisonsPlainTextAsTheReportsHtml) {
+  // The labels volume/rig_comparison.cpp writes, as the report showed them before they were plain.
+  EXPECT_EQ(ComparisonHtml("Coverage >= 2 cameras"), "Coverage &ge; 2 cameras");
+  EXPECT_EQ(ComparisonHtml("sigma_max p90 (mm)"), "&sigma;<sub>max</sub> p90 (mm)");
+  EXPECT_EQ(ComparisonHtml("Meets sigma_max <= 2 mm"), "Meets &sigma;<sub>max</sub> &le; 2 mm");
+  EXPECT_EQ(ComparisonHtml("Covered at every time sample (>= 3 cameras)"),
+            "Covered at every time sample (&ge; 3 cameras)");
+  // A value: "-" alone is none; a negative number stays as it is.
+  EXPECT_EQ(ComparisonHtml("-"), "&mdash;");
+  EXPECT_EQ(ComparisonHtml("-0.500"), "-0.500");
+  // Anything else is escaped.
+  EXPECT_EQ(ComparisonHtml("a < b & c > d"), "a &lt; b &amp; c &gt; d");
+}
+
 TEST(Table, TextAlignsColumnsCountingUtf8Characters) {
   Table t({"name", "σ mm"});
   t.AddRow({"a", "1.5"});

@@ -131,18 +131,6 @@ std::vector<Vec3> FrustumBorder(const Camera& cam, double length) {
 
 enum class Drag { kNone, kOrbit, kPan, kAxis, kRing, kClick };
 
-// The report's HTML labels and values as plain text for the panels ("&ge;" -> ">=", ...).
-std::string PlainText(std::string s) {
-  static const std::pair<const char*, const char*> entities[] = {
-      {"&ge;", ">="}, {"&le;", "<="},   {"&sigma;", "sigma"}, {"<sub>", "_"},
-      {"</sub>", ""}, {"&mdash;", "-"}, {"&amp;", "&"}};
-  for (const auto& [from, to] : entities)
-    for (std::size_t at = s.find(from); at != std::string::npos;
-         at = s.find(from, at + std::strlen(to)))
-      s.replace(at, std::strlen(from), to);
-  return s;
-}
-
 }  // namespace
 
 struct ViewerApp::Impl {
@@ -1429,7 +1417,7 @@ struct ViewerApp::Impl {
       if (compare_other > 0) a.cameras.push_back(rigs[compare_other]);
       Do(a);
     }
-    const std::optional<report::RigComparison>& cmp = model.comparison;
+    const std::optional<RigComparison>& cmp = model.comparison;
     if (cmp) {
       if (model.comparison_rig_version != model.session().rig().version()) {
         ImGui::SameLine();
@@ -1454,16 +1442,16 @@ struct ViewerApp::Impl {
           ImGui::TableSetColumnIndex(i + 1);
           ImGui::Text("%d", cmp->enabled_cameras[i]);
         }
-        for (const report::ComparisonRow& row : cmp->rows) {
+        for (const ComparisonRow& row : cmp->rows) {
           if (std::none_of(row.values.begin(), row.values.end(),
                            [](const std::optional<double>& v) { return v.has_value(); }))
             continue;  // a row no rig has (a field that is not live)
           ImGui::TableNextRow();
           ImGui::TableSetColumnIndex(0);
-          ImGui::TextUnformatted(PlainText(row.label).c_str());
+          ImGui::TextUnformatted(row.label.c_str());
           for (int i = 0; i < n; ++i) {
             ImGui::TableSetColumnIndex(i + 1);
-            const std::string text = PlainText(row.Text(i));
+            const std::string text = row.Text(i);
             if (row.best[i])
               ImGui::TextColored(ImVec4(0.4f, 0.95f, 0.45f, 1.0f), "%s", text.c_str());
             else

@@ -361,7 +361,7 @@ void ViewerModel::Compare(const Action& a) {
     summary.rig = a.cameras[i] == "saved" ? other.name + " (saved)" : other.name;
     summaries.push_back(std::move(summary));
   }
-  comparison = report::CompareRigs(summaries, scene().study);
+  comparison = CompareRigs(summaries, scene().study);
   comparison_rig_version = session_->rig().version();
   status = "compared " + std::to_string(summaries.size()) + " rigs";
 }

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "app/report/rig_comparison.h"
 #include "app/session/session.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
+#include "volume/rig_comparison.h"
 
 namespace pandora::viewer {
 
@@ -97,7 +97,7 @@ class ViewerModel {
   std::int64_t stations_version = 0;  ///< Bumps when a station moves.
   /// The last "compare": the edited rig (its live fields, as they were) first, then the rig as last
   /// saved and / or other rigs of the scene (each evaluated once and kept while it stays the same).
-  std::optional<report::RigComparison> comparison;
+  std::optional<RigComparison> comparison;
   std::int64_t comparison_rig_version = -1;  ///< The edited rig's version it was made for.
 
   /// PTZ traces of the main view (docs/ptz.md): "single", "path" (one light per second home ->

@@ -828,7 +828,7 @@ TEST(ViewerModel, CompareTheEditedRigWithTheSavedOne) {
   ViewerModel m(session::Study::Load(scene.string()), options);
   auto run = [&](const std::string& text) { m.Run(ParseScript(text, "s.json"), nullptr); };
   auto value = [&](const std::string& key, std::size_t rig) {
-    const report::ComparisonRow* row = m.comparison->Find(key);
+    const ComparisonRow* row = m.comparison->Find(key);
     EXPECT_TRUE(row) << key;
     return row && row->values[rig] ? *row->values[rig] : NAN;
   };

@@ -1,10 +1,10 @@
 // The rig comparison (app/report/rig_comparison.h) on hand-made summaries: the best rig of each
 // row, decided on the values as shown, and the JSON form.
-#include "app/report/rig_comparison.h"
+#include "volume/rig_comparison.h"
 
 #include <gtest/gtest.h>
 
-namespace pandora::report {
+namespace pandora {
 namespace {
 
 Summary FakeSummary(const std::string& rig, double ge2, double p50_mm, int cameras = 4) {
@@ -58,7 +58,7 @@ TEST(RigComparison, OneRigAndMissingValues) {
   none.uncertainty->sigma_max_mm = {};  // nothing triangulable
   const RigComparison one = CompareRigs({none}, Study());
   for (const ComparisonRow& row : one.rows) EXPECT_FALSE(row.best[0]) << row.key;
-  EXPECT_EQ(one.Find("sigma_max_p90_mm")->Text(0), "&mdash;");
+  EXPECT_EQ(one.Find("sigma_max_p90_mm")->Text(0), "-");
   EXPECT_TRUE(std::isnan(one.Find("sigma_max_p90_mm")->Shown(0)));
   // A rig without a value is never best; the other one is when it beats a shown value.
   const RigComparison two =
@@ -77,11 +77,11 @@ TEST(RigComparison, TargetAndMotionRowsAndJson) {
   b.uncertainty->sigma_max_steady_mm = {0.8, 1.8, 2.7};
   const RigComparison c = CompareRigs({a, b}, study);
   EXPECT_EQ(c.rows.size(), 15u);
-  EXPECT_EQ(c.Find("meets_max_sigma")->label, "Meets &sigma;<sub>max</sub> &le; 2 mm");
+  EXPECT_EQ(c.Find("meets_max_sigma")->label, "Meets sigma_max <= 2 mm");
   EXPECT_EQ(c.Find("meets_max_sigma")->best, (std::vector<bool>{false, true}));
   EXPECT_EQ(c.Find("sigma_max_steady_p50_mm")->best, (std::vector<bool>{false, true}));
   EXPECT_EQ(c.Find("sigma_max_steady_p90_mm")->best, (std::vector<bool>{false, false}));
-  EXPECT_EQ(c.Find("meets_max_sigma_steady")->Text(0), "&mdash;");  // not in the summaries
+  EXPECT_EQ(c.Find("meets_max_sigma_steady")->Text(0), "-");  // not in the summaries
 
   const nlohmann::json j = c;
   EXPECT_EQ(j["rigs"], nlohmann::json({"a", "b"}));
@@ -96,4 +96,4 @@ TEST(RigComparison, TargetAndMotionRowsAndJson) {
 }
 
 }  // namespace
-}  // namespace pandora::report
+}  // namespace pandora

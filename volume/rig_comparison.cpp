@@ -1,5 +1,5 @@
-// The rigs compared on their headline numbers (app/report/rig_comparison.h).
-#include "app/report/rig_comparison.h"
+// The rigs compared on their headline numbers (volume/rig_comparison.h).
+#include "volume/rig_comparison.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <functional>
 
-namespace pandora::report {
+namespace pandora {
 namespace {
 
 std::string Fmt(const char* format, double v) {
@@ -27,7 +27,7 @@ std::optional<double> Uncertainty(
 
 std::string ComparisonRow::Text(std::size_t rig) const {
   const std::optional<double>& v = values[rig];
-  if (!v || !std::isfinite(*v)) return "&mdash;";
+  if (!v || !std::isfinite(*v)) return "-";
   return format.empty() ? Fmt("%.1f%%", 100.0 * *v) : Fmt(format.c_str(), *v);
 }
 
@@ -50,11 +50,11 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
     Getter get;
   };
   std::vector<Spec> specs{
-      {"coverage_ge1", "Coverage &ge; 1 camera", "", true,
+      {"coverage_ge1", "Coverage >= 1 camera", "", true,
        [](const Summary& s) { return std::optional(s.coverage.ge1); }},
-      {"coverage_ge2", "Coverage &ge; 2 cameras", "", true,
+      {"coverage_ge2", "Coverage >= 2 cameras", "", true,
        [](const Summary& s) { return std::optional(s.coverage.ge2); }},
-      {"coverage_ge3", "Coverage &ge; 3 cameras", "", true,
+      {"coverage_ge3", "Coverage >= 3 cameras", "", true,
        [](const Summary& s) { return std::optional(s.coverage.ge3); }},
       {"resolution_p10_px_per_m", "Resolution p10 (px/m)", "%.0f", true,
        [](const Summary& s) {
@@ -73,49 +73,47 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
          return Uncertainty(
              s, [](const UncertaintySummary& u) { return std::optional(u.triangulable); });
        }},
-      {"sigma_max_p50_mm", "&sigma;<sub>max</sub> p50 (mm)", "%.3f", false,
+      {"sigma_max_p50_mm", "sigma_max p50 (mm)", "%.3f", false,
        [](const Summary& s) {
          return Uncertainty(s, [](const UncertaintySummary& u) { return u.sigma_max_mm.p50; });
        }},
-      {"sigma_max_p90_mm", "&sigma;<sub>max</sub> p90 (mm)", "%.3f", false,
+      {"sigma_max_p90_mm", "sigma_max p90 (mm)", "%.3f", false,
        [](const Summary& s) {
          return Uncertainty(s, [](const UncertaintySummary& u) { return u.sigma_max_mm.p90; });
        }},
-      {"sigma_max_p99_mm", "&sigma;<sub>max</sub> p99 (mm)", "%.3f", false,
+      {"sigma_max_p99_mm", "sigma_max p99 (mm)", "%.3f", false,
        [](const Summary& s) {
          return Uncertainty(s, [](const UncertaintySummary& u) { return u.sigma_max_mm.p99; });
        }},
   };
   if (study.max_sigma_mm)
-    specs.push_back({"meets_max_sigma",
-                     "Meets &sigma;<sub>max</sub> &le; " + Fmt("%g", *study.max_sigma_mm) + " mm",
-                     "", true, [](const Summary& s) {
-                       return Uncertainty(
-                           s, [](const UncertaintySummary& u) { return u.meets_max_sigma; });
-                     }});
+    specs.push_back(
+        {"meets_max_sigma", "Meets sigma_max <= " + Fmt("%g", *study.max_sigma_mm) + " mm", "",
+         true, [](const Summary& s) {
+           return Uncertainty(s, [](const UncertaintySummary& u) { return u.meets_max_sigma; });
+         }});
   if (study.motion) {
-    specs.push_back({"sigma_max_steady_p50_mm", "Steady-state &sigma;<sub>max</sub> p50 (mm)",
-                     "%.3f", false, [](const Summary& s) {
+    specs.push_back({"sigma_max_steady_p50_mm", "Steady-state sigma_max p50 (mm)", "%.3f", false,
+                     [](const Summary& s) {
                        return Uncertainty(s, [](const UncertaintySummary& u) {
                          return u.sigma_max_steady_mm.p50;
                        });
                      }});
-    specs.push_back({"sigma_max_steady_p90_mm", "Steady-state &sigma;<sub>max</sub> p90 (mm)",
-                     "%.3f", false, [](const Summary& s) {
+    specs.push_back({"sigma_max_steady_p90_mm", "Steady-state sigma_max p90 (mm)", "%.3f", false,
+                     [](const Summary& s) {
                        return Uncertainty(s, [](const UncertaintySummary& u) {
                          return u.sigma_max_steady_mm.p90;
                        });
                      }});
-    specs.push_back({"sigma_max_steady_p99_mm", "Steady-state &sigma;<sub>max</sub> p99 (mm)",
-                     "%.3f", false, [](const Summary& s) {
+    specs.push_back({"sigma_max_steady_p99_mm", "Steady-state sigma_max p99 (mm)", "%.3f", false,
+                     [](const Summary& s) {
                        return Uncertainty(s, [](const UncertaintySummary& u) {
                          return u.sigma_max_steady_mm.p99;
                        });
                      }});
     if (study.max_sigma_mm)
       specs.push_back({"meets_max_sigma_steady",
-                       "Steady state meets &sigma;<sub>max</sub> &le; " +
-                           Fmt("%g", *study.max_sigma_mm) + " mm",
+                       "Steady state meets sigma_max <= " + Fmt("%g", *study.max_sigma_mm) + " mm",
                        "", true, [](const Summary& s) {
                          return Uncertainty(s, [](const UncertaintySummary& u) {
                            return u.meets_max_sigma_steady;
@@ -132,7 +130,7 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
     int k = 3;
     for (const Summary& s : summaries)
       if (s.time) k = s.time->min_cameras;
-    const std::string cams = " (&ge; " + std::to_string(k) + " cameras)";
+    const std::string cams = " (>= " + std::to_string(k) + " cameras)";
     specs.push_back({"time_always", "Covered at every time sample" + cams, "", true,
                      time([](const TimeSummary& t) { return std::optional(t.always); })});
     specs.push_back({"time_mean", "Covered, mean over the samples" + cams, "", true,
@@ -142,8 +140,8 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
                        return t.samples.empty() ? std::nullopt
                                                 : std::optional(t.samples[t.worst_sample].ge_k);
                      })});
-    specs.push_back({"time_sigma_max_p90_mm", "&sigma;<sub>max</sub> p90 over time (mm)", "%.3f",
-                     false, time([](const TimeSummary& t) { return t.sigma_max_p90; })});
+    specs.push_back({"time_sigma_max_p90_mm", "sigma_max p90 over time (mm)", "%.3f", false,
+                     time([](const TimeSummary& t) { return t.sigma_max_p90; })});
   }
 
   RigComparison c;
@@ -200,4 +198,4 @@ void to_json(nlohmann::json& j, const RigComparison& c) {
        {"rows", rows}};
 }
 
-}  // namespace pandora::report
+}  // namespace pandora

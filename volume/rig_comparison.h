@@ -2,7 +2,8 @@
 /// \file rig_comparison.h
 /// The rigs of a scene compared on their headline numbers (the report's "Rigs compared" table): a
 /// typed value built from each rig's Summary (volume/summary.h), with the best rig of each row
-/// decided on the values as shown, and its JSON form.
+/// decided on the values as shown, and its JSON form. Labels and values are plain ASCII text (the
+/// viewer shows them as they are; the report writes ">=", "<=" and "sigma_max" as HTML).
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -13,13 +14,12 @@
 #include "analysis/scene/scene.h"
 #include "volume/summary.h"
 
-namespace pandora::report {
+namespace pandora {
 
 /// One headline number across the rigs.
 struct ComparisonRow {
-  std::string key;  ///< Stable name, e.g. "coverage_ge2", "sigma_max_p50_mm".
-  std::string
-      label;  ///< As the HTML table shows it (HTML entities), e.g. "Coverage &ge; 2 cameras".
+  std::string key;    ///< Stable name, e.g. "coverage_ge2", "sigma_max_p50_mm".
+  std::string label;  ///< Plain text, e.g. "Coverage >= 2 cameras", "sigma_max p50 (mm)".
   /// printf format of a value ("%.3f"), or empty: a fraction shown as a percentage with one
   /// decimal.
   std::string format;
@@ -29,8 +29,8 @@ struct ComparisonRow {
   /// rig shows a worse one (never with a single rig, never where every rig shows the same).
   std::vector<bool> best;
 
-  /// The value as the table prints it: Format(format, v), or "12.3%" for a fraction; "&mdash;" for
-  /// none or a non-finite value.
+  /// The value as the table prints it: Format(format, v), or "12.3%" for a fraction; "-" for none
+  /// or a non-finite value.
   std::string Text(std::size_t rig) const;
   /// The value rounded to the precision printed (what "best" compares); NaN for none.
   double Shown(std::size_t rig) const;
@@ -61,4 +61,4 @@ RigComparison CompareRigs(const std::vector<Summary>& summaries, const Study& st
 /// "best": [bool]}]} (labels and formats are presentation and stay out).
 void to_json(nlohmann::json& j, const RigComparison& comparison);
 
-}  // namespace pandora::report
+}  // namespace pandora
