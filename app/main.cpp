@@ -18,6 +18,7 @@
 
 #include "analysis/util/error.h"
 #include "app/commands.h"
+#include "app/flags.h"
 #include "app/mpi_session.h"
 
 #ifndef PANDORA_VERSION
@@ -574,7 +575,8 @@ int main(int argc, char** argv) {
     if (*ac) return RunAccept(accept);
     if (*rg) return RunRig(rig_args);
   } catch (const pandora::InputError& e) {
-    if (!pandora::app::MpiQuietErrors()) std::fprintf(stderr, "pandora: error: %s\n", e.what());
+    if (!pandora::app::MpiQuietErrors())
+      std::fprintf(stderr, "pandora: error: %s\n", pandora::app::ForCommandLine(e).what());
     return 2;
   } catch (const std::bad_alloc&) {
     // Budgets are checked before the work starts; this is what is left: another process took the

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "analysis/util/error.h"
+#include "app/flags.h"
 
 #ifdef PANDORA_HAVE_MPI
 #include <mpi.h>
@@ -61,7 +62,8 @@ void MpiSession::ThrowIfAnyFailed(std::exception_ptr failure) const {
   if (rank_ == first) {
     try {
       std::rethrow_exception(failure);
-    } catch (const InputError& e) {
+    } catch (const InputError& original) {
+      const InputError e = ForCommandLine(original);  // the flags, as main() prints them
       text = e.file() + '\0' + e.json_path() + '\0' + e.reason() + '\0' + e.hint();
     } catch (const std::bad_alloc&) {
       text = std::string("") + '\0' + "" + '\0' + "out of memory" + '\0' +

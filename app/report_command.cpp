@@ -60,11 +60,6 @@ void DisableInReportRigs(Scene* scene, const std::vector<std::string>& rigs,
 }  // namespace
 
 int RunReport(const ReportArgs& args) {
-  const FlagNames flags{{"rigs", "--rig"},
-                        {"voxel_size", "--voxel-size"},
-                        {"view_width", "--width"},
-                        {"camera_width", "--camera-width"},
-                        {"brightness", "--brightness"}};
   const auto study = session::Study::Load(args.scene);  // the scene and its ray caster, once
   const Scene& scene = study->scene();
   report::ReportOptions options;
@@ -76,7 +71,7 @@ int RunReport(const ReportArgs& args) {
   std::optional<ProgressBar> bar;  // one per rig's field evaluation
   options.rig_started = [&](const std::string& rig) { bar.emplace("report " + rig, !args.quiet); };
   options.progress = [&](double fraction) { bar->Update(fraction); };
-  WithFlagNames(flags, [&] { options.Check(scene); });
+  options.Check(scene);
   // --disable applies to a copy of the scene whose rigs the report evaluates.
   Scene disabled;
   if (!args.disable.empty()) {
@@ -89,8 +84,7 @@ int RunReport(const ReportArgs& args) {
   AddSceneInputs(output, scene);
   const report::ReportTarget target = report::StageReport(output, args.out, "--out");
   const RayCaster* caster = &study->caster();
-  const report::ReportData data =
-      WithFlagNames(flags, [&] { return report::ComputeReport(report_scene, *caster, options); });
+  const report::ReportData data = report::ComputeReport(report_scene, *caster, options);
   bar.reset();
   const report::ReportFile file = report::WriteReport(report_scene, *caster, data, options, target);
   output.Commit();

@@ -23,13 +23,13 @@ int RunExportRig(const ExportRigArgs& args) {
   LoadOptions load;
   load.load_meshes = f == "gltf";
   const Scene scene = LoadScene(args.scene, load);
-  const Rig& rig = WithFlagNames({{"--rig", "--rig"}}, [&]() -> const Rig& {
+  const Rig& rig = [&]() -> const Rig& {
     try {
       return scene.FindRig(args.rig);
     } catch (const InputError& e) {
       throw InputError("--rig", "", e.reason(), e.hint());
     }
-  });
+  }();
   OutputTransaction output;
   AddSceneInputs(output, scene);
   std::vector<std::string> written;

@@ -35,7 +35,7 @@ std::vector<std::size_t> Targets(const char* option, const std::string& entry, c
   if (which.empty() && colon != std::string::npos)
     throw InputError(
         option, "",
-        "camera '" + entry.substr(0, colon) + "' is not among the selected cameras (--cameras)");
+        "camera '" + entry.substr(0, colon) + "' is not among the selected cameras ({cameras})");
   return which;
 }
 
@@ -83,7 +83,7 @@ std::vector<TargetPoint> SampleTargetsInRegion(const Scene& scene, const std::st
 session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
   session::SessionOptions o;
   o.rig = args.rig;
-  o.rig_option = "--rig";
+  o.rig_option = "{rig}";
   o.disable = args.disable;
   return o;
 }
@@ -92,18 +92,18 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   SuggestOptions options;
   options.scene_path = scene.path;
   for (const std::string& id : SplitList(args.cameras))
-    options.cameras.push_back(CameraOption(rig, "--cameras", id));
+    options.cameras.push_back(CameraOption(rig, "{cameras}", id));
   const std::size_t n = options.cameras.size();
 
-  const std::vector<double> moves = PerCamera("--max-move", args.max_move, n);
-  const std::vector<double> rotations = PerCamera("--max-rotate", args.max_rotate, n);
+  const std::vector<double> moves = PerCamera("{max_move}", args.max_move, n);
+  const std::vector<double> rotations = PerCamera("{max_rotate_deg}", args.max_rotate, n);
   options.limits.assign(n, CameraLimits());
   for (std::size_t c = 0; c < n; ++c) {
     if (!(moves[c] >= 0))
-      throw InputError("--max-move", "", "must be a finite length >= 0 in metres");
-    scene.CheckLength(moves[c], "--max-move", "the move");
+      throw InputError("{max_move}", "", "must be a finite length >= 0 in metres");
+    scene.CheckLength(moves[c], "{max_move}", "the move");
     if (!(rotations[c] >= 0) || !(rotations[c] < 180))
-      throw InputError("--max-rotate", "", "must be an angle in [0, 180) degrees");
+      throw InputError("{max_rotate_deg}", "", "must be an angle in [0, 180) degrees");
     options.limits[c].max_move = moves[c];
     options.limits[c].max_rotate_deg = rotations[c];
   }
@@ -123,37 +123,37 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
           throw InputError(option, "", "the direction must be a non-zero vector");
       }
       if (++mounts[c] > 1)
-        throw InputError(option, "", "give at most one of --rail, --plane, --mount-box per camera");
+        throw InputError(option, "", "give at most one of {rail}, {plane}, {mount_box} per camera");
     }
   };
-  for (const std::string& e : args.rail) add_mount("--rail", e, MountConstraint::Kind::kLine);
-  for (const std::string& e : args.plane) add_mount("--plane", e, MountConstraint::Kind::kPlane);
+  for (const std::string& e : args.rail) add_mount("{rail}", e, MountConstraint::Kind::kLine);
+  for (const std::string& e : args.plane) add_mount("{plane}", e, MountConstraint::Kind::kPlane);
   for (const std::string& e : args.mount_box)
-    add_mount("--mount-box", e, MountConstraint::Kind::kBox);
+    add_mount("{mount_box}", e, MountConstraint::Kind::kBox);
   for (const std::string& e : args.hfov_range) {
     std::string value;
-    for (std::size_t c : Targets("--hfov-range", e, rig, options.cameras, &value)) {
-      const std::vector<double> v = ParseNumbers("--hfov-range", value, 2);
+    for (std::size_t c : Targets("{hfov_range}", e, rig, options.cameras, &value)) {
+      const std::vector<double> v = ParseNumbers("{hfov_range}", value, 2);
       if (!(v[0] > 0) || !(v[1] >= v[0]))
-        throw InputError("--hfov-range", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
+        throw InputError("{hfov_range}", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
       options.limits[c].min_hfov_deg = v[0];
       options.limits[c].max_hfov_deg = v[1];
     }
   }
   for (const std::string& box : args.keep_out)
-    options.keep_out.push_back(ParseBox(scene, "--keep-out", box));
+    options.keep_out.push_back(ParseBox(scene, "{keep_out}", box));
 
   const std::optional<Objective> objective = ParseObjective(args.objective);
   if (!objective)
     throw InputError(
-        "--objective", "", "unknown objective '" + args.objective + "'",
+        "{objective}", "", "unknown objective '" + args.objective + "'",
         "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution, mix, "
         "coverage3-n1 (coverageK-n1: after the worst camera failure) or calibration");
   options.objective = *objective;
   if (!args.weights.empty()) {
-    const std::vector<double> w = ParseNumbers("--weights", args.weights, 3);
+    const std::vector<double> w = ParseNumbers("{weights}", args.weights, 3);
     if (w[0] < 0 || w[1] < 0 || w[2] < 0 || w[0] + w[1] + w[2] <= 0)
-      throw InputError("--weights", "", "the weights must be >= 0 and not all zero");
+      throw InputError("{weights}", "", "the weights must be >= 0 and not all zero");
     options.objective.w_coverage = w[0];
     options.objective.w_sigma = w[1];
     options.objective.w_resolution = w[2];
@@ -162,44 +162,25 @@ SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scen
   // scene's scale here.
   options.snap_move = args.snap_move;
   options.snap_rotate_deg = args.snap_rotate;
-  scene.CheckLength(options.snap_move, "--snap-move", "the snap step");
+  scene.CheckLength(options.snap_move, "{snap_move}", "the snap step");
   options.outer_iterations = args.outer_iterations;
   options.clearance = args.clearance;
-  scene.CheckLength(options.clearance, "--clearance", "the clearance");
+  scene.CheckLength(options.clearance, "{clearance}", "the clearance");
   return options;
-}
-
-std::string ReplaceOptionNames(const std::string& text,
-                               const std::function<std::string(const std::string&)>& name) {
-  auto lower = [&](std::size_t i) {
-    return std::islower(static_cast<unsigned char>(text[i])) != 0;
-  };
-  std::string out;
-  for (std::size_t i = 0; i < text.size();) {
-    if (text.compare(i, 2, "--") == 0 && i + 2 < text.size() && lower(i + 2)) {
-      std::size_t j = i + 2;
-      while (j < text.size() && (lower(j) || text[j] == '-')) ++j;
-      out += name(text.substr(i, j - i));
-      i = j;
-    } else {
-      out += text[i++];
-    }
-  }
-  return out;
 }
 
 std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene,
                                                const Rig& rig) {
   if (args.cameras.empty())
-    throw InputError("--cameras", "", "which cameras may move?",
-                     "give --cameras ID,... (or --ptz-preset / --ptz-tour)");
+    throw InputError("{cameras}", "", "which cameras may move?",
+                     "give {cameras} ID,... (or {ptz_preset} / {ptz_tour})");
   auto problem = std::make_shared<SuggestProblem>();
   problem->options = SuggestOptionsFromArgs(args, scene, rig);
   if (args.over_time) {
     // The study's surface targets at every sample, each against its sample's caster.
     if (!args.target_surfaces.empty())
-      throw InputError("--over-time", "",
-                       "takes the study's targets; --target-surface is for a static scene",
+      throw InputError("{over_time}", "",
+                       "takes the study's targets; {target_surfaces} is for a static scene",
                        "give one of them");
     const std::vector<TimeSample> samples = scene.TimeSamples();
     problem->targets = SampleTimeTargets(scene, samples, args.points, args.seed);

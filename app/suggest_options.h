@@ -2,7 +2,8 @@
 /// \file suggest_options.h
 /// `pandora suggest`'s options turned into the library's SuggestOptions: the selection by camera
 /// id, per-camera limits ("one value, or one per selected camera"), mounts and zoom ranges ("ID:"
-/// prefixes), keep-out boxes, the objective. Every error names the option the user typed.
+/// prefixes), keep-out boxes, the objective. Every error names the option as its field
+/// (`{max_move}`), which each front end writes its own way (analysis/util/error.h).
 
 #include <functional>
 #include <memory>
@@ -21,12 +22,6 @@ session::SessionOptions SuggestSessionOptions(const SuggestArgs& args);
 
 SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig);
 
-/// `text` (an error's file, reason or hint) with every command-line option in it ("--max-move")
-/// replaced by `name(option)`: how Python and the viewer's scripts name `pandora suggest`'s options
-/// in the errors of PrepareSuggest.
-std::string ReplaceOptionNames(const std::string& text,
-                               const std::function<std::string(const std::string&)>& name);
-
 /// Everything a camera suggestion runs on: the options and the target points and, over time
 /// (`--over-time`), the moving parts and one ray caster per time sample (options.sample_casters
 /// points into them, so the problem is kept whole while a suggestion runs).
@@ -40,7 +35,7 @@ struct SuggestProblem {
 /// The one door to a camera suggestion's problem: `pandora suggest`, Python's suggest() and the
 /// viewer's Suggest panel all build it here from the same options, so that they optimise the same
 /// objective over the same points (region, named surfaces, or the study's targets at every time
-/// sample). Throws InputError naming the option (--cameras, --over-time, --target-surface, ...).
+/// sample). Throws InputError naming the option ({cameras}, {over_time}, {target_surfaces}, ...).
 std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene,
                                                const Rig& rig);
 

@@ -23,6 +23,7 @@
 #include "analysis/util/error.h"
 #include "app/session/study.h"
 #include "python/bindings.h"
+#include "python/keywords.h"
 #include "render/render.h"
 #include "volume/fields.h"
 #include "volume/fields_vdb.h"
@@ -111,7 +112,9 @@ PYBIND11_MODULE(pandora, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const InputError& e) {
+    } catch (const InputError& original) {
+      // Options as the keyword arguments a script passes (python/keywords.h).
+      const InputError e = RenameOptions(original, python::Keyword);
       py::object err = py::handle(input_error.ptr())(py::str(e.what()));
       // The parts of the one-line message, for scripts that act on them.
       err.attr("file") = e.file();

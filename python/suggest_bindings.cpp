@@ -50,22 +50,6 @@ struct PySuggestion {
   int ptz_camera = -1, ptz_preset = -1;
 };
 
-// `pandora suggest`'s option names in errors become the keyword arguments' ("--max-move" ->
-// "max_move").
-std::string Keywords(const std::string& text) {
-  return app::ReplaceOptionNames(text, [](const std::string& option) {
-    std::string word = option.substr(2);
-    std::replace(word.begin(), word.end(), '-', '_');
-    if (word == "max_rotate" || word == "snap_rotate") word += "_deg";
-    if (word == "target_surface") word += "s";
-    return word;
-  });
-}
-
-[[noreturn]] void RethrowWithKeyword(const InputError& e) {
-  throw InputError(Keywords(e.file()), e.json_path(), Keywords(e.reason()), Keywords(e.hint()));
-}
-
 std::string Num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", v);
@@ -458,26 +442,24 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
         a.outer_iterations = outer_iterations;
         a.seed = seed;
         std::shared_ptr<app::SuggestProblem> problem;
-        try {
-          a.max_move = NumberOrList(max_move, "--max-move");
-          a.max_rotate = NumberOrList(max_rotate_deg, "--max-rotate");
+        {
+          a.max_move = NumberOrList(max_move, "{max_move}");
+          a.max_rotate = NumberOrList(max_rotate_deg, "{max_rotate_deg}");
           a.hfov_range = PerCameraEntries(
-              hfov_range, [](const py::handle& v) { return RangeText(v, "--hfov-range"); });
+              hfov_range, [](const py::handle& v) { return RangeText(v, "{hfov_range}"); });
           a.rail =
-              PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "--rail"); });
+              PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "{rail}"); });
           a.plane = PerCameraEntries(plane,
-                                     [](const py::handle& v) { return Vector3Text(v, "--plane"); });
+                                     [](const py::handle& v) { return Vector3Text(v, "{plane}"); });
           a.mount_box = PerCameraEntries(
-              mount_box, [](const py::handle& v) { return BoxText(v, "--mount-box"); });
-          for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "--keep-out"));
+              mount_box, [](const py::handle& v) { return BoxText(v, "{mount_box}"); });
+          for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "{keep_out}"));
           if (!(outer_iterations >= 1 && outer_iterations <= 100))
-            throw InputError("--outer-iterations", "", "must be in [1, 100]");
+            throw InputError("{outer_iterations}", "", "must be in [1, 100]");
           if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
-            throw InputError("--clearance", "",
+            throw InputError("{clearance}", "",
                              "snap_move, snap_rotate_deg and clearance must be >= 0");
           problem = app::PrepareSuggest(a, scene, r.rig());
-        } catch (const InputError& e) {
-          RethrowWithKeyword(e);
         }
         PySuggestion out;
         out.study = sc.study;

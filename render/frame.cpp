@@ -294,14 +294,14 @@ inline void SetHit(const Vec3& eye, const RayHit& hit, const TriangleMesh& mesh,
 
 void CheckView(const RenderView& view, const Rig& rig) {
   if (view.width <= 0 || view.height <= 0)
-    throw InputError("--size", "", "the image size must be positive");
+    throw InputError("{size}", "", "the image size must be positive");
   if (view.camera >= int(rig.cameras.size()))
-    throw InputError("--camera", "", "no camera " + std::to_string(view.camera) + " in the rig");
+    throw InputError("{camera}", "", "no camera " + std::to_string(view.camera) + " in the rig");
   if (view.camera < 0) {
     if (!(view.fov_deg > 0 && view.fov_deg < 180))
-      throw InputError("--fov", "", "must be in (0, 180) degrees");
+      throw InputError("{fov_deg}", "", "must be in (0, 180) degrees");
     if (!LookAt(view.from, view.at, view.up))
-      throw InputError("--at", "",
+      throw InputError("{at}", "",
                        "'at' equals 'from', or 'up' is parallel to the viewing direction");
   }
 }
@@ -417,7 +417,7 @@ PreparedOverlays::PreparedOverlays(const Fields& fields, const OverlayOptions& o
   d.iso_value = ov.iso_value;
   if (!ov.slice_field.empty()) {
     if (ov.slice_axis < 0 || ov.slice_axis > 2)
-      throw InputError("--slice-axis", "", "must be x, y or z");
+      throw InputError("{slice_axis}", "", "must be x, y or z");
     d.slice = SampleSlice(fields, ov.slice_field, ov.slice_axis, ov.slice_position, &d.slice_plane);
     d.have_slice = true;
   }
@@ -507,7 +507,7 @@ FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, cons
   const OverlayOptions& ov = options.overlays;
   const bool want_overlays = !ov.slice_field.empty() || !ov.iso_field.empty();
   if (want_overlays && !overlays)
-    throw InputError("--fields", "", "the slice and isosurface overlays need a fields file",
+    throw InputError("{fields}", "", "the slice and isosurface overlays need a fields file",
                      "run `pandora analyze` and pass its fields.vdb");
   if (want_overlays && !overlays->Matches(ov))
     throw std::invalid_argument(

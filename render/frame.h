@@ -68,8 +68,8 @@ struct PreparedOverlaysData {
   std::unique_ptr<RayCaster> iso_caster;  // null when no isosurface (or an empty one)
 };
 
-/// Checks what a frame needs of the view: InputError naming "--size", "--camera", "--fov" or
-/// "--at".
+/// Checks what a frame needs of the view: InputError naming "{size}", "{camera}", "{fov_deg}" or
+/// "{at}".
 void CheckView(const RenderView& view, const Rig& rig);
 
 /// The per-pixel outputs of the groups: the image and the centre rays' facing normals (contours).

@@ -14,7 +14,7 @@ class Fields;
 /// The surface value = `iso` of field `name` of `fields`, world coordinates, exactly the mesh the
 /// renderer's isosurface overlay draws (OpenVDB volumeToMesh; inactive voxels never pass: outside
 /// {value >= iso} for coverage-like fields, outside {value <= iso} for sigma_* and condition).
-/// Throws InputError (file "--iso") when the fields lack that grid.
+/// Throws InputError (file "{iso_field}") when the fields lack that grid.
 TriangleMesh FieldIsosurface(const Fields& fields, const std::string& name, double iso);
 
 }  // namespace pandora

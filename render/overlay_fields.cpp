@@ -43,7 +43,7 @@ bool LowIsGood(const std::string& name) {
 
 FieldSlice SampleSlice(const Fields& fields, const std::string& name, int axis, double position,
                        double* plane) {
-  WithGrid(fields, name, "--slice", [&](const auto& grid) {
+  WithGrid(fields, name, "{slice_field}", [&](const auto& grid) {
     if (std::isfinite(position)) return;
     // The middle plane of the active voxels (of the lattice when there are none).
     const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
@@ -58,7 +58,7 @@ FieldSlice SampleSlice(const Fields& fields, const std::string& name, int axis, 
 TriangleMesh ExtractIsosurface(const Fields& fields, const std::string& name, double iso) {
   TriangleMesh mesh;
   const bool low_good = LowIsGood(name);
-  WithGrid(fields, name, "--iso", [&](const auto& grid) {
+  WithGrid(fields, name, "{iso_field}", [&](const auto& grid) {
     // A float copy in which the set {good} is {value > level}; inactive voxels are well outside.
     const double level = low_good ? -iso : iso;
     const float outside = float(level - std::max(1.0, std::abs(level)));

@@ -85,8 +85,8 @@ class PreparedOverlays {
  public:
   /// Prepares what `overlays` asks for (its slice_field, slice_axis, slice_position, iso_field,
   /// iso_value); nothing when both field names are empty. Throws InputError like Render does: file
-  /// "--slice-axis" for a bad axis, "--slice" / "--iso" when the fields lack the grid (the hint
-  /// lists the grids present).
+  /// "{slice_axis}" for a bad axis, "{slice_field}" / "{iso_field}" when the fields lack the grid
+  /// (the hint lists the grids present).
   PreparedOverlays(const Fields& fields, const OverlayOptions& overlays);
   ~PreparedOverlays();
   PreparedOverlays(PreparedOverlays&&) noexcept;

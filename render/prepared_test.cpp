@@ -241,7 +241,7 @@ TEST(PreparedScene, FieldOverlaysPreparedOnceMatchTheOneShotOverlays) {
     Render(prepared, w.rig(), view, options, nullptr);
     ADD_FAILURE() << "no error without overlays";
   } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), "--fields");
+    EXPECT_EQ(e.file(), "{fields}");
   }
   // A grid the fields lack: named at preparation.
   RenderOptions missing;
@@ -250,7 +250,7 @@ TEST(PreparedScene, FieldOverlaysPreparedOnceMatchTheOneShotOverlays) {
     PreparedOverlays bad(fields, missing.overlays);
     ADD_FAILURE() << "no error for a missing grid";
   } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), "--slice");
+    EXPECT_EQ(e.file(), "{slice_field}");
   }
 }
 
@@ -328,7 +328,7 @@ TEST(PreparedScene, OwnsOrSharesItsCasterAndRefusesAForeignOne) {
     Render(prepared, w.rig(), bad, RenderOptions());
     ADD_FAILURE() << "no error for fov 180";
   } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), "--fov");
+    EXPECT_EQ(e.file(), "{fov_deg}");
   }
 }
 

@@ -149,7 +149,7 @@ Image RenderWithStats(const Scene& scene, const Rig& rig, const RayCaster& caste
   std::unique_ptr<PreparedOverlays> overlays;
   if (!ov.slice_field.empty() || !ov.iso_field.empty()) {
     if (!fields)
-      throw InputError("--fields", "", "the slice and isosurface overlays need a fields file",
+      throw InputError("{fields}", "", "the slice and isosurface overlays need a fields file",
                        "run `pandora analyze` and pass its fields.vdb");
     overlays = std::make_unique<PreparedOverlays>(*fields, ov);
   }

@@ -182,8 +182,8 @@ struct Image {
 /// Renders one frame of a prepared scene lit by the enabled cameras of `rig`: only per-frame work
 /// (the view's rays, the rig's visibility tests, shading, overlays). `overlays` (may be null) holds
 /// the prepared slice and isosurface that options.overlays asks for. Any number of cameras.
-/// Throws InputError for a bad view ("--size", "--fov", "--at", "--camera") and when an overlay
-/// needs fields and `overlays` is null (file "--fields"); std::invalid_argument when `overlays` was
+/// Throws InputError for a bad view ("{size}", "{fov_deg}", "{at}", "{camera}") and when an overlay
+/// needs fields and `overlays` is null (file "{fields}"); std::invalid_argument when `overlays` was
 /// prepared for another slice or isosurface (PreparedOverlays::Matches). Parallel over image tiles
 /// (TBB); safe to call from several threads at once on the same PreparedScene.
 Image Render(const PreparedScene& scene, const Rig& rig, const RenderView& view,
@@ -192,8 +192,9 @@ Image Render(const PreparedScene& scene, const Rig& rig, const RenderView& view,
 /// The one-shot convenience form: prepares `scene` over `caster` (no BVH is built) and, when
 /// options.overlays asks for them, the overlays from `fields`, then renders as above; the same
 /// image bit for bit. `caster` must be built from scene.AllTriangles(). `fields` may be null when
-/// no overlay needs it. Throws as above, and InputError when the fields lack the grid ("--slice",
-/// "--iso"; the hint lists the grids present).
+/// no overlay needs it. Throws as above, and InputError when the fields lack the grid
+/// ("{slice_field}",
+/// "{iso_field}"; the hint lists the grids present).
 Image Render(const Scene& scene, const Rig& rig, const RayCaster& caster, const RenderView& view,
              const RenderOptions& options, const Fields* fields = nullptr);
 

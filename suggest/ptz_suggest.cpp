@@ -461,7 +461,7 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text,
   if (Sha256Hex(scene_text) != j["scene"]["sha256"].get<std::string>() && !force)
     throw InputError(*scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
-                     "run pandora suggest again, or accept with --force");
+                     "run pandora suggest again, or accept with {force}");
   LoadOptions lo;
   lo.load_meshes = false;
   const Scene before = ParseScene(scene_text, *scene_path, lo);

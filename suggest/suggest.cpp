@@ -131,7 +131,7 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
                                        bool include_region, std::uint64_t seed) {
   if (count < 1)
     throw InputError(scene.path, "", "the number of target points must be positive",
-                     "use --points 1000 or more");
+                     "use {points} 1000 or more");
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   std::vector<TargetPoint> out;
@@ -206,12 +206,12 @@ std::vector<TargetPoint> SampleTargets(const Scene& scene, int count,
       if (!found) {
         std::string names;
         for (const SceneObject& o : scene.objects) names += (names.empty() ? "" : ", ") + o.name;
-        throw InputError("--target-surface", "", "no object called '" + name + "' in " + scene.path,
-                         "objects: " + names);
+        throw InputError("{target_surfaces}", "",
+                         "no object called '" + name + "' in " + scene.path, "objects: " + names);
       }
     }
     if (tris.empty())
-      throw InputError("--target-surface", "", "the target surfaces have no area",
+      throw InputError("{target_surfaces}", "", "the target surfaces have no area",
                        "name objects with triangles");
     std::vector<double> cumulative;
     double total = 0;
@@ -801,46 +801,46 @@ SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int targe
 void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options) {
   const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
   if (options.cameras.empty())
-    throw InputError(file, "--cameras", "no camera selected",
-                     "name the cameras to move, e.g. --cameras 3,5");
+    throw InputError(file, "{cameras}", "no camera selected",
+                     "name the cameras to move, e.g. {cameras} 3,5");
   if (options.limits.size() != 1 && options.limits.size() != options.cameras.size())
-    throw InputError(file, "--max-move",
+    throw InputError(file, "{max_move}",
                      "one set of limits, or one per selected camera, is needed");
   std::set<int> seen;
   for (std::size_t i = 0; i < options.cameras.size(); ++i) {
     const int idx = options.cameras[i];
     if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
-      throw InputError(file, "--cameras",
+      throw InputError(file, "{cameras}",
                        "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
     const Camera& cam = rig.cameras[idx];
     if (!seen.insert(idx).second)
-      throw InputError(file, "--cameras", "camera '" + cam.id + "' is selected twice");
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is selected twice");
     if (cam.ptz)  // its file pose is its home, not its current setting (docs/ptz.md)
-      throw InputError(file, "--cameras", "camera '" + cam.id + "' is a PTZ camera",
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is a PTZ camera",
                        "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its "
                        "\"ptz\" block");
     if (!cam.enabled)
-      throw InputError(file, "--cameras", "camera '" + cam.id + "' is disabled",
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is disabled",
                        "enable it in the scene file to move it");
     const CameraLimits& l = LimitsOf(options, i);
     if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
       throw InputError(
-          file, "--max-move",
+          file, "{max_move}",
           "the largest move must be a finite length >= 0 (got " + Format("%g", l.max_move) + ")");
     if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
-      throw InputError(file, "--max-rotate",
+      throw InputError(file, "{max_rotate_deg}",
                        "the largest rotation must be in [0, 180) degrees (got " +
                            Format("%g", l.max_rotate_deg) + ")");
     if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
       const Intrinsics& k = cam.model.intrinsics();
       const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
       if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
-        throw InputError(file, "--hfov-range",
+        throw InputError(file, "{hfov_range}",
                          "the field-of-view range must satisfy 0 < MIN <= MAX < " +
                              Format("%g", limit) + " degrees");
       const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
       if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
-        throw InputError(file, "--hfov-range",
+        throw InputError(file, "{hfov_range}",
                          "camera '" + cam.id + "' has a field of view of " + Format("%.6g", hfov) +
                              " degrees, outside the range",
                          "the range must hold the current field of view");
@@ -848,23 +848,23 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
     const MountConstraint& m = l.mount;
     if ((m.kind == MountConstraint::Kind::kLine || m.kind == MountConstraint::Kind::kPlane) &&
         !(m.axis.norm() > 0 && m.axis.allFinite()))
-      throw InputError(file, m.kind == MountConstraint::Kind::kLine ? "--rail" : "--plane",
+      throw InputError(file, m.kind == MountConstraint::Kind::kLine ? "{rail}" : "{plane}",
                        "the direction must be a non-zero vector");
     if (m.kind == MountConstraint::Kind::kBox && !m.box.Contains(cam.center()))
-      throw InputError(file, "--mount-box", "camera '" + cam.id + "' is outside its mounting box",
+      throw InputError(file, "{mount_box}", "camera '" + cam.id + "' is outside its mounting box",
                        "the box must hold the camera's current centre");
     if (InKeepOut(options.keep_out, cam.center()))
-      throw InputError(file, "--keep-out", "camera '" + cam.id + "' is inside a keep-out box",
+      throw InputError(file, "{keep_out}", "camera '" + cam.id + "' is inside a keep-out box",
                        "a keep-out box must not hold a selected camera's current centre");
   }
   if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
-    throw InputError(file, "--clearance", "must be a finite length >= 0 (metres)");
+    throw InputError(file, "{clearance}", "must be a finite length >= 0 (metres)");
   if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
-    throw InputError(file, "--snap-move", "must be a finite length >= 0");
+    throw InputError(file, "{snap_move}", "must be a finite length >= 0");
   if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
-    throw InputError(file, "--snap-rotate", "must be a finite angle >= 0");
+    throw InputError(file, "{snap_rotate_deg}", "must be a finite angle >= 0");
   if (options.objective.k < 1 || options.objective.k > 64)
-    throw InputError(file, "--objective", "k must be in 1..64");
+    throw InputError(file, "{objective}", "k must be in 1..64");
 }
 
 // ---------------------------------------------------------------------------------------------

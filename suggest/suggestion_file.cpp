@@ -434,9 +434,9 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   if (j.is_object() && j.contains("kind") && j["kind"].is_string() &&
       j["kind"].get<std::string>().rfind("ptz_", 0) == 0) {
     if (!options.cameras.empty())
-      throw InputError("--cameras", "",
+      throw InputError("{cameras}", "",
                        "a PTZ suggestion changes one camera's preset or tour: accept it whole",
-                       "leave out --cameras");
+                       "leave out {cameras}");
     AcceptResult result;
     std::string what;
     result.backup_path =
@@ -458,8 +458,8 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   if (j.contains("perturbed_for_benchmark") && j["perturbed_for_benchmark"] == true)
     throw InputError(
         suggestion_path, "$.perturbed_for_benchmark",
-        "this suggestion was made from perturbed poses (--perturb), not the scene file's",
-        "run pandora suggest without --perturb");
+        "this suggestion was made from perturbed poses ({perturb}), not the scene file's",
+        "run pandora suggest without {perturb}");
   AcceptResult result;
   result.scene_path = scene_j["path"].get<std::string>();
   double snap_move = 0;
@@ -496,7 +496,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
     if (!offered.count(id)) {
       std::string list;
       for (const std::string& o : order) list += (list.empty() ? "" : ", ") + o;
-      throw InputError("--cameras", "",
+      throw InputError("{cameras}", "",
                        "camera '" + id + "' is not in the suggestion " + suggestion_path,
                        "it offers: " + list);
     }
@@ -507,7 +507,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   if (Sha256Hex(scene_text) != scene_j["sha256"].get<std::string>() && !options.force)
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
-                     "run pandora suggest again, or accept with --force");
+                     "run pandora suggest again, or accept with {force}");
   const std::string new_text =
       ReplacePoses(scene_text, result.scene_path, rig, updates, &result.notes);
 

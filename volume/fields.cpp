@@ -1040,7 +1040,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
            << " m, over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
            << " MiB";
     hint << "use voxel_size >= " << h_min << " m, a smaller region, or raise the budget "
-         << "(--memory-budget or study.memory_budget_mb)";
+         << "({memory_budget_mb} or study.memory_budget_mb)";
     if (opt.voxel_size_option.empty() && !opt.memory_budget_option.empty())
       throw InputError(opt.memory_budget_option, "", reason.str(), hint.str());
     throw InputError(size_file, size_path, reason.str(), hint.str());
@@ -1218,7 +1218,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       const std::string hint =
           Wants(opt.fields, "cameras")
               ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
-              : "raise the budget (--memory-budget or study.memory_budget_mb), or use fewer "
+              : "raise the budget ({memory_budget_mb} or study.memory_budget_mb), or use fewer "
                 "cameras";
       if (!opt.memory_budget_option.empty())
         throw InputError(opt.memory_budget_option, "", reason.str(), hint);

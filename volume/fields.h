@@ -49,7 +49,7 @@ struct FieldOptions {
   /// Used in error messages.
   std::string scene_path;
   /// Where the voxel size came from, for error messages: empty for the scene file's
-  /// $.study.voxel_size, else the command-line option (e.g. "--voxel-size").
+  /// $.study.voxel_size, else the command-line option (e.g. "{voxel_size}").
   std::string voxel_size_option;
   /// Set when the memory budget came from a command-line option (its name): an over-budget error
   /// then blames that option, unless the voxel size came from an option too.

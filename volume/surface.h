@@ -52,11 +52,11 @@ double SurfaceArea(const Scene& scene, SurfaceSelection selection = SurfaceSelec
 /// Deterministic: the random numbers are a hash of (seed, object, triangle, sample), independent of
 /// threads and platform, so a selection's samples are exactly the kAll samples on its triangles.
 /// With kFacing and `rig`, no sample a camera of the rig sees is left out (a camera sees a surface
-/// point only from in front of it). Throws InputError (file `option`, e.g. "--spacing") when
+/// point only from in front of it). Throws InputError (file `option`, e.g. "{spacing}") when
 /// spacing is not a positive finite number or the expected count exceeds kMaxSurfaceSamples.
 std::vector<SurfaceSample> SampleSurfaces(const Scene& scene, double spacing,
                                           std::uint64_t seed = 1,
-                                          const std::string& option = "--spacing",
+                                          const std::string& option = "{spacing}",
                                           SurfaceSelection selection = SurfaceSelection::kAll,
                                           const Rig* rig = nullptr);
 

@@ -165,7 +165,7 @@ TEST(SurfaceSampling, FacingKeepsTheSidesTheRegionOrACameraCanSee) {
   const double spacing = 0.05;
   const std::vector<SurfaceSample> all = SampleSurfaces(scene, spacing, 5);
   const std::vector<SurfaceSample> facing =
-      SampleSurfaces(scene, spacing, 5, "--spacing", SurfaceSelection::kFacing);
+      SampleSurfaces(scene, spacing, 5, "{spacing}", SurfaceSelection::kFacing);
   // Exactly the samples of `all` that are not on the far face, in the same order.
   std::vector<SurfaceSample> expected;
   for (const SurfaceSample& x : all)
@@ -216,7 +216,7 @@ TEST(SurfaceSampling, FacingDropsNoSeenSample) {
   };
   const std::vector<SurfaceSample> all = SampleSurfaces(scene, 0.03, 2);
   const std::vector<SurfaceSample> facing =
-      SampleSurfaces(scene, 0.03, 2, "--spacing", SurfaceSelection::kFacing, &rig);
+      SampleSurfaces(scene, 0.03, 2, "{spacing}", SurfaceSelection::kFacing, &rig);
   EXPECT_LT(facing.size() + 900, all.size());  // the crate's far side: 1 m^2 = 1111 samples
   const std::vector<Vec3> a = seen(all), f = seen(facing);
   EXPECT_GT(a.size(), 100u);
@@ -230,7 +230,7 @@ TEST(SurfaceSampling, BadSpacingIsAnInputError) {
       SampleSurfaces(scene, bad);
       FAIL() << "no error for spacing " << bad;
     } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), "--spacing");
+      EXPECT_EQ(e.file(), "{spacing}");
     }
   }
   try {

@@ -826,8 +826,8 @@ std::vector<std::string> CheckFieldsProvenance(const FieldsProvenance& p,
     throw InputError(path, "",
                      "the fields were computed for rig " + Quote(p.rig_name) + ", not for rig " +
                          Quote(rig.name),
-                     "render with --rig " + p.rig_name + ", or run `pandora analyze " + scene.path +
-                         " --rig " + rig.name + "` for these fields");
+                     "render with {rig} " + p.rig_name + ", or analyze " + scene.path +
+                         " with {rig} " + rig.name + " for these fields");
   if (!p.scene_sha256.empty() && p.scene_sha256 != scene.sha256)
     warnings.push_back(path + " was computed from a different version of the scene file (SHA-256 " +
                        p.scene_sha256.substr(0, 12) + "..., " + scene.path + " is " +

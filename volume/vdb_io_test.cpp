@@ -744,7 +744,7 @@ TEST_F(Provenance, AnotherRigIsRefusedWithAHintNamingRig) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.file(), "f.vdb");
     EXPECT_NE(e.reason().find("'ring'"), std::string::npos) << e.what();
-    EXPECT_NE(e.hint().find("--rig ring"), std::string::npos) << e.what();
+    EXPECT_NE(e.hint().find("{rig} ring"), std::string::npos) << e.what();
   }
 }
 

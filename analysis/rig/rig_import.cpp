@@ -91,13 +91,13 @@ Rig ReadCalibratedRig(const std::string& format, const std::string& from,
     std::error_code ec;
     if (!fs::is_directory(from, ec))
       throw InputError(from, "", "not a folder",
-                       "--from colmap takes the model's folder (cameras.txt, images.txt)");
+                       "{from} colmap takes the model's folder (cameras.txt, images.txt)");
     const std::string cameras = (fs::path(from) / "cameras.txt").string();
     const std::string images = (fs::path(from) / "images.txt").string();
     return ParseColmap(ReadInputFile(cameras, kMaxBytes, "COLMAP cameras file"), cameras,
                        ReadInputFile(images, kMaxBytes, "COLMAP images file"), images, rig_name);
   }
-  throw InputError("--from", "", "unknown format '" + format + "'", "opencv or colmap");
+  throw InputError("{from}", "", "unknown format '" + format + "'", "opencv or colmap");
 }
 
 std::string WriteRigIntoSceneText(const std::string& text, const std::string& scene_path,
@@ -109,8 +109,8 @@ std::string WriteRigIntoSceneText(const std::string& text, const std::string& sc
       throw InputError(scene_path, "$.rigs", "the scene file has no rigs array");
     for (const ordered_json& r : root["rigs"])
       if (r.is_object() && r.contains("name") && r["name"] == target)
-        throw InputError("--as", "", "the scene already has a rig named '" + target + "'",
-                         "choose another name, or leave --as out to replace its cameras");
+        throw InputError("{as}", "", "the scene already has a rig named '" + target + "'",
+                         "choose another name, or leave {as} out to replace its cameras");
     ordered_json cameras = ordered_json::array();
     for (const Camera& camera : imported.cameras) {
       ordered_json c = ordered_json::object();
@@ -146,11 +146,11 @@ std::string WriteRigIntoSceneText(const std::string& text, const std::string& sc
     if (!found)
       throw InputError(scene_path, rig_path,
                        "the imported camera '" + camera.id + "' is not in rig '" + target + "'",
-                       "import as a new rig with --as NAME, or give the cameras the design's ids");
+                       "import as a new rig with {as} NAME, or give the cameras the design's ids");
     const std::string path = rig_path + ".cameras[" + std::to_string(index) + "]";
     if (found->contains("ptz"))
       throw InputError(scene_path, path, "camera '" + camera.id + "' is a PTZ camera",
-                       "import the calibration as a new rig with --as NAME");
+                       "import the calibration as a new rig with {as} NAME");
     const auto keys = CameraKeys(camera, mpu);
     const auto value = [&](const std::string& k) -> const ordered_json* {
       for (const auto& [key, v] : keys)
@@ -206,7 +206,7 @@ RigImportResult ImportRig(const RigImportOptions& options) {
       try {
         before.FindRig(options.rig);
       } catch (const InputError& e) {
-        throw InputError("--rig", "", e.reason(), e.hint());  // names the scene's rigs
+        throw InputError("{rig}", "", e.reason(), e.hint());  // names the scene's rigs
       }
     }
     result.rig_written = options.as;

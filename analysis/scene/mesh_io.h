@@ -39,7 +39,7 @@ std::vector<MeshPart> LoadMeshFile(const std::string& path);
 /// The user's memory budget for reading mesh files, while it lives (the innermost one counts): each
 /// import may then hold at most `bytes` at once (besides its own cap from the file's size, which
 /// guards against damaged files); past it the import ends in InputError naming the mesh file, the
-/// budget and `where` ("--memory-budget", or "$.study.memory_budget_mb of scene.json"). The mesh
+/// budget and `where` ("{memory_budget_mb}", or "$.study.memory_budget_mb of scene.json"). The mesh
 /// import's transient peak (assimp reading a 1M-triangle OBJ holds ~560 MiB) comes before any
 /// triangle count is known, so this is the only check that can bound it. Not thread-safe: set by
 /// a command around its scene loading.

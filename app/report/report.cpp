@@ -198,9 +198,10 @@ void CheckWidth(const char* option, int value) {
 
 // Name i of `rigs`: not empty, not listed before.
 void CheckRigName(const std::vector<std::string>& rigs, std::size_t i) {
-  if (rigs[i].empty()) throw InputError("rigs", "", "an empty rig name", "name a rig of the scene");
+  if (rigs[i].empty())
+    throw InputError("{rigs}", "", "an empty rig name", "name a rig of the scene");
   if (std::find(rigs.begin(), rigs.begin() + i, rigs[i]) != rigs.begin() + i)
-    throw InputError("rigs", "", "rig '" + rigs[i] + "' listed twice");
+    throw InputError("{rigs}", "", "rig '" + rigs[i] + "' listed twice");
 }
 
 }  // namespace
@@ -208,12 +209,12 @@ void CheckRigName(const std::vector<std::string>& rigs, std::size_t i) {
 void ReportOptions::Check() const {
   for (std::size_t i = 0; i < rigs.size(); ++i) CheckRigName(rigs, i);
   if (!std::isnan(voxel_size) && !(voxel_size > 0 && std::isfinite(voxel_size)))
-    throw InputError("voxel_size", "",
+    throw InputError("{voxel_size}", "",
                      "must be a number of metres, greater than 0, got " + Fmt("%g", voxel_size));
-  CheckWidth("view_width", view_width);
-  CheckWidth("camera_width", camera_width);
+  CheckWidth("{view_width}", view_width);
+  CheckWidth("{camera_width}", camera_width);
   if (!std::isnan(brightness) && !(brightness > 0 && brightness <= kMaxBrightness))
-    throw InputError("brightness", "",
+    throw InputError("{brightness}", "",
                      "must be a number of times one camera's light, in (0, " +
                          Fmt("%g", kMaxBrightness) + "], got " + Fmt("%g", brightness));
 }
@@ -228,7 +229,7 @@ void ReportOptions::Check(const Scene& scene) const {
       continue;
     std::string names;
     for (const Rig& r : scene.rigs) names += (names.empty() ? "'" : ", '") + r.name + "'";
-    throw InputError("rigs", "", "no rig named '" + name + "' in " + scene.path,
+    throw InputError("{rigs}", "", "no rig named '" + name + "' in " + scene.path,
                      "rigs in this scene: " + names);
   }
   Check();
@@ -276,7 +277,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
     field_options.scene_path = scene.path;
     field_options.fields = data.field_names;
     field_options.memory_budget_bytes = scene.study.memory_budget_bytes;
-    if (adjusted) field_options.voxel_size_option = "voxel_size";
+    if (adjusted) field_options.voxel_size_option = "{voxel_size}";
     field_options.progress = options.progress;
     if (options.rig_started) options.rig_started(rig->name);
     RigReport r;

@@ -49,30 +49,30 @@ TEST(ReportOptions, ErrorsNameTheOptionNeverAFlag) {
   };
   ReportOptions twice;
   twice.rigs = {"a", "b", "a"};
-  expect(twice, "rigs", "rig 'a' listed twice");
+  expect(twice, "{rigs}", "rig 'a' listed twice");
   ReportOptions empty;
   empty.rigs = {""};
-  expect(empty, "rigs", "empty rig name");
+  expect(empty, "{rigs}", "empty rig name");
   ReportOptions voxel;
   voxel.voxel_size = 0;
-  expect(voxel, "voxel_size", "must be a number of metres, greater than 0");
+  expect(voxel, "{voxel_size}", "must be a number of metres, greater than 0");
   voxel.voxel_size = std::numeric_limits<double>::infinity();
-  expect(voxel, "voxel_size", "greater than 0");
+  expect(voxel, "{voxel_size}", "greater than 0");
   ReportOptions narrow;
   narrow.view_width = 15;
-  expect(narrow, "view_width", "in [16, 8192], got 15");
+  expect(narrow, "{view_width}", "in [16, 8192], got 15");
   ReportOptions wide;
   wide.camera_width = 8193;
-  expect(wide, "camera_width", "in [16, 8192]");
+  expect(wide, "{camera_width}", "in [16, 8192]");
   ReportOptions dark;
   dark.brightness = -1;
-  expect(dark, "brightness", "in (0, 1e+06]");
+  expect(dark, "{brightness}", "in (0, 1e+06]");
 
   const Scene scene = TwoRigRoom();
   ReportOptions unknown;
   unknown.rigs = {"ring4", "ring5"};
   const InputError e = ErrorOf([&] { unknown.Check(scene); });
-  EXPECT_EQ(e.file(), "rigs");
+  EXPECT_EQ(e.file(), "{rigs}");
   EXPECT_EQ(e.reason(), "no rig named 'ring5' in box_room.json");
   EXPECT_EQ(e.hint(), "rigs in this scene: 'ring4', 'ring6'");
 }
@@ -272,7 +272,7 @@ TEST(ReportCompute, VoxelSizeOptionAndRigOrder) {
   Scene small = scene;
   small.study.memory_budget_bytes = 1024;
   const InputError e = ErrorOf([&] { ComputeReport(small, *caster, options); });
-  EXPECT_EQ(e.file(), "voxel_size");
+  EXPECT_EQ(e.file(), "{voxel_size}");
   EXPECT_NE(e.reason().find("over the budget"), std::string::npos);
 }
 

@@ -26,11 +26,11 @@ namespace pandora::session {
 
 struct SessionOptions {
   std::string rig;         ///< Rig to edit; empty: the first.
-  std::string rig_option;  ///< The option that named it ("--rig"), for errors.
+  std::string rig_option;  ///< The option that named it ("{rig}"), for errors.
   /// Camera ids disabled in the rig for this session (DisableCameras), not an edit: nothing of it
   /// is saved. `disable_option` names the option in errors.
   std::vector<std::string> disable;
-  std::string disable_option = "--disable";
+  std::string disable_option = "{disable}";
   FieldOptions fields;  ///< The fields to keep (names, budget, messages).
   /// Keep the evaluator's per-pair state so that edits update incrementally (an interactive
   /// session); false for one evaluation (a command), which then needs no more memory than

@@ -239,7 +239,7 @@ TEST(Session, DisabledCamerasAreOffForTheSessionOnly) {
     ADD_FAILURE() << "no error for an unknown id";
   } catch (const InputError& e) {
     const std::string message = e.what();
-    EXPECT_NE(message.find("--disable"), std::string::npos) << message;
+    EXPECT_NE(message.find("{disable}"), std::string::npos) << message;
     EXPECT_NE(message.find("no camera 'no-such-camera' in rig '" + file_rig.name + "'"),
               std::string::npos)
         << message;

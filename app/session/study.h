@@ -41,7 +41,7 @@ class Study {
   const PreparedScene& prepared() const;
 
   /// The rig named `name`, or the first rig when `name` is empty. An unknown name throws
-  /// InputError blaming `option` (e.g. "--rig") when given, else the scene's "$.rigs".
+  /// InputError blaming `option` (e.g. "{rig}") when given, else the scene's "$.rigs".
   const Rig& FindRig(const std::string& name, const std::string& option = {}) const;
 
  private:

@@ -12,6 +12,7 @@
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "analysis/util/output_transaction.h"
+#include "app/flags.h"
 #include "app/session/autosave.h"
 #include "app/session/study.h"
 #include "viewer/app/viewer_app.h"
@@ -246,7 +247,7 @@ int main(int argc, char** argv) {
   try {
     return Run(argc, argv);
   } catch (const pandora::InputError& e) {
-    std::fprintf(stderr, "pandora view: error: %s\n", e.what());
+    std::fprintf(stderr, "pandora view: error: %s\n", pandora::app::ForCommandLine(e).what());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pandora view: error: %s\n", e.what());

@@ -202,7 +202,8 @@ struct ViewerApp::Impl {
     try {
       error.clear();
       model.Do(a, nullptr);
-    } catch (const InputError& e) {
+    } catch (const InputError& original) {
+      const InputError e = RenameOptions(original, ActionKey);  // options as the scripts' keys
       error = e.what();
       error_line = e.reason() + (e.hint().empty() ? "" : " (" + e.hint() + ")");
     }

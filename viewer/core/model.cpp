@@ -108,26 +108,32 @@ app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
   return s;
 }
 
-// An error of `pandora suggest`'s options, renamed to the action's keys ("--max-move" ->
-// "$[8].max_move").
+// An error of `pandora suggest`'s options, renamed to the action's keys ("{max_move}" ->
+// "$[8].max_move", and 'max_move' in the reason and hint).
 [[noreturn]] void RethrowAsAction(const InputError& e, const std::string& where) {
-  auto key = [](std::string option) {
-    option = option.substr(2);
-    if (option == "cameras") return std::string("suggest");
-    if (option == "mount-box") return std::string("box");
-    std::replace(option.begin(), option.end(), '-', '_');
-    return option;
-  };
-  auto rename = [&](const std::string& text) {
-    return app::ReplaceOptionNames(
-        text, [&](const std::string& option) { return "'" + key(option) + "'"; });
-  };
-  if (e.file().rfind("--", 0) != 0) throw e;  // the scene's own (a surface name, its targets)
-  throw InputError(where + "." + key(e.file()), e.json_path(), rename(e.reason()),
-                   rename(e.hint()));
+  const std::string& f = e.file();
+  if (f.size() < 3 || f.front() != '{' || f.back() != '}')
+    throw e;  // the scene's own (a surface name, its targets)
+  const InputError named =
+      RenameOptions(e, [](const std::string& field) { return "'" + ActionKey(field) + "'"; });
+  throw InputError(where + "." + ActionKey(f.substr(1, f.size() - 2)), named.json_path(),
+                   named.reason(), named.hint());
 }
 
 }  // namespace
+
+std::string ActionKey(const std::string& field) {
+  // Only where the key differs from the field.
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"cameras", "suggest"},
+      {"mount_box", "box"},
+      {"max_rotate_deg", "max_rotate"},
+      {"snap_rotate_deg", "snap_rotate"},
+      {"target_surfaces", "target_surface"}};
+  for (const auto& [name, key] : kKeys)
+    if (field == name) return key;
+  return field;
+}
 
 std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram) {
   std::int64_t total = 0;

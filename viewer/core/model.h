@@ -27,6 +27,11 @@ class ViewerModel;
 
 /// Shares of the voxels of a field evaluation's coverage histogram seen by at least k cameras:
 /// entry k - 1 for k = 1, 2, ... (0 for an empty histogram).
+/// The script action key of an option field (`{field}` in a library's error,
+/// analysis/util/error.h): the viewer's one table, e.g. "max_rotate_deg" -> "max_rotate", "cameras"
+/// -> "suggest"; else the field itself.
+std::string ActionKey(const std::string& field);
+
 std::vector<double> CoverageAtLeast(const std::vector<std::int64_t>& histogram);
 
 /// What a front end does for the actions that need a window: screenshots, raw input, frames.

@@ -1,0 +1,64 @@
+// The libraries' option fields as the command line's flags (app/flags.h).
+#include "app/flags.h"
+
+namespace pandora::app {
+
+const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
+  static const std::vector<std::pair<std::string, std::string>> kFlags{
+      // Suggest (SuggestArgs, SuggestOptions, CameraLimits) and accept.
+      {"cameras", "--cameras"},
+      {"max_move", "--max-move"},
+      {"max_rotate_deg", "--max-rotate"},
+      {"hfov_range", "--hfov-range"},
+      {"rail", "--rail"},
+      {"plane", "--plane"},
+      {"mount_box", "--mount-box"},
+      {"keep_out", "--keep-out"},
+      {"clearance", "--clearance"},
+      {"snap_move", "--snap-move"},
+      {"snap_rotate_deg", "--snap-rotate"},
+      {"objective", "--objective"},
+      {"weights", "--weights"},
+      {"outer_iterations", "--outer-iterations"},
+      {"over_time", "--over-time"},
+      {"target_surfaces", "--target-surface"},
+      {"points", "--points"},
+      {"perturb", "--perturb"},
+      {"ptz_preset", "--ptz-preset"},
+      {"ptz_tour", "--ptz-tour"},
+      {"force", "--force"},
+      // The study and its rig (SessionOptions, FieldOptions, ReportOptions).
+      {"rig", "--rig"},
+      {"rigs", "--rig"},
+      {"disable", "--disable"},
+      {"voxel_size", "--voxel-size"},
+      {"memory_budget_mb", "--memory-budget"},
+      {"spacing", "--spacing"},
+      // Pictures (RenderView, overlays, ReportOptions).
+      {"fields", "--fields"},
+      {"size", "--size"},
+      {"camera", "--camera"},
+      {"fov_deg", "--fov"},
+      {"at", "--at"},
+      {"slice_field", "--slice"},
+      {"slice_axis", "--slice-axis"},
+      {"iso_field", "--iso"},
+      {"view_width", "--width"},
+      {"camera_width", "--camera-width"},
+      {"brightness", "--brightness"},
+      // Rig import (ImportRigOptions).
+      {"from", "--from"},
+      {"as", "--as"},
+  };
+  return kFlags;
+}
+
+std::string CommandLineFlag(const std::string& field) {
+  for (const auto& [name, flag] : CommandLineFlags())
+    if (name == field) return flag;
+  return {};
+}
+
+InputError ForCommandLine(const InputError& e) { return RenameOptions(e, CommandLineFlag); }
+
+}  // namespace pandora::app
