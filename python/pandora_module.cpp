@@ -194,9 +194,7 @@ PYBIND11_MODULE(pandora, m) {
              d["fy"] = k.fy;
              d["cx"] = k.cx;
              d["cy"] = k.cy;
-             d["model"] = k.model == LensModel::kPinhole        ? "pinhole"
-                          : k.model == LensModel::kBrownConrady ? "brown_conrady"
-                                                                : "fisheye";
+             d["model"] = LensModelName(k.model);
              d["k"] = std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
              d["enabled"] = c.enabled;
              d["ptz"] = bool(c.ptz);

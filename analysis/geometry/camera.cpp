@@ -362,6 +362,12 @@ const char* LensModelName(LensModel model) {
   return "unknown";
 }
 
+std::optional<LensModel> LensModelFromName(const std::string& name) {
+  for (LensModel m : {LensModel::kPinhole, LensModel::kBrownConrady, LensModel::kFisheye})
+    if (name == LensModelName(m)) return m;
+  return std::nullopt;
+}
+
 double FocalFromHfov(double hfov_rad, int width, LensModel model) {
   const double half_width = 0.5 * width;
   if (model == LensModel::kFisheye) return half_width / (0.5 * hfov_rad);

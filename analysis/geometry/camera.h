@@ -35,6 +35,8 @@ enum class LensModel { kPinhole, kBrownConrady, kFisheye };
 
 /// Returns "pinhole", "brown_conrady" or "fisheye".
 const char* LensModelName(LensModel model);
+/// The lens model LensModelName calls `name`; nullopt for any other text.
+std::optional<LensModel> LensModelFromName(const std::string& name);
 
 /// Intrinsic parameters. Units: pixels for focal lengths and principal point.
 struct Intrinsics {

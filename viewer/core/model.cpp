@@ -31,9 +31,7 @@ Vec3 UpFor(const Vec3& from, const Vec3& at) {
 }
 
 LensModel LensFromName(const std::string& name) {
-  return name == "brown_conrady" ? LensModel::kBrownConrady
-         : name == "fisheye"     ? LensModel::kFisheye
-                                 : LensModel::kPinhole;
+  return LensModelFromName(name).value_or(LensModel::kPinhole);
 }
 
 // What differs between a camera as saved and as edited that Session::Save cannot write (it writes
