@@ -131,6 +131,80 @@ std::map<std::string, std::string> FieldsMetadata(const Scene& scene, const Rig&
   };
 }
 
+// The session options of an in-memory run: the rig, --disable, the fields and this process's
+// partition of the blocks.
+session::SessionOptions AnalyzeSessionOptions(const AnalyzeArgs& args, const Scene& scene,
+                                              const MpiSession& mpi) {
+  session::SessionOptions so;
+  so.rig = args.rig;
+  so.rig_option = "--rig";
+  so.disable = args.disable;
+  so.incremental = false;  // one evaluation: no per-pair state
+  so.fields = AnalyzeFieldOptions(args, scene);
+  so.fields.partition_count = mpi.size();
+  so.fields.partition_rank = mpi.rank();
+  return so;
+}
+
+// Stages fields.vdb and summary.json beside the scene's inputs (rank 0), and removes an earlier
+// run's streamed tiles.
+void StageAnalyzeOutputs(OutputTransaction& output, const Scene& scene,
+                         const std::filesystem::path& out, std::string& vdb_path,
+                         std::string& summary_path) {
+  AddSceneInputs(output, scene);
+  vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
+  summary_path = output.Stage((out / "summary.json").string(), "--out");
+  RemoveStaleOutputs(output, out, /*streamed=*/false, 0);
+}
+
+// Gathers every partition's fields at rank 0, merged into `fields`, with the per-rank statistics in
+// `mpi_summary`; false on the other ranks (they are done).
+bool MergeAtRoot(const MpiSession& mpi, Fields& fields, nlohmann::json& mpi_summary) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const nlohmann::json mine{{"seconds", fields.stats.seconds},
+                            {"rays", fields.stats.rays},
+                            {"point_camera_tests", fields.stats.point_camera_tests}};
+  const std::vector<std::string> parts =
+      mpi.GatherToRoot(mine.dump() + '\n' + SerializePartialFields(fields));
+  if (mpi.rank() != 0) return false;
+  mpi_summary = {{"ranks", mpi.size()}, {"per_rank", nlohmann::json::array()}};
+  mpi_summary["per_rank"].push_back(mine);
+  for (std::size_t r = 1; r < parts.size(); ++r) {
+    const std::size_t newline = parts[r].find('\n');
+    mpi_summary["per_rank"].push_back(nlohmann::json::parse(parts[r].substr(0, newline)));
+    MergePartialFields(parts[r].substr(newline + 1), &fields);
+  }
+  mpi_summary["merge_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return true;
+}
+
+// The fields at every time sample (their grids added to `fields`, their summary in `time`), the
+// surface targets at each, and the samples' labels.
+void EvaluateOverTime(const AnalyzeArgs& args, const Scene& scene, const Rig& rig,
+                      const FieldOptions& options, Fields& fields, std::optional<TimeSummary>& time,
+                      std::vector<SurfaceTargetResult>& targets,
+                      std::vector<std::string>& sample_labels) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto parts = MakeSceneParts(scene);
+  const double parts_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::vector<TimeSample> samples = scene.TimeSamples();
+  for (const TimeSample& s : samples) sample_labels.push_back(s.label);
+  if (!samples.empty()) {
+    FieldOptions over_time = OverTimeOptions(options);
+    ProgressBar time_bar("over " + std::to_string(samples.size()) + " time samples", !args.quiet);
+    over_time.progress = [&time_bar](double f) { time_bar.Update(f); };
+    TimeFieldsResult result =
+        EvaluateFieldsOverTime(scene, rig, *parts, samples, over_time, scene.TimeMinCameras());
+    time_bar.Finish();
+    result.summary.parts_seconds = parts_seconds;
+    time = result.summary;
+    AddTimeGrids(&fields, &result);
+  }
+  targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
+}
+
 }  // namespace
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
@@ -166,24 +240,13 @@ int RunAnalyze(const AnalyzeArgs& args) {
       const auto import_budget = ImportBudget(args);
       study = LoadStudyWithVoxelSize(args.scene, args.voxel_size);
     }
-    so.rig = args.rig;
-    so.rig_option = "--rig";
-    so.disable = args.disable;
-    so.incremental = false;  // one evaluation: no per-pair state
-    so.fields = AnalyzeFieldOptions(args, study->scene());
-    so.fields.partition_count = mpi.size();
-    so.fields.partition_rank = mpi.rank();
+    so = AnalyzeSessionOptions(args, study->scene(), mpi);
     bar.emplace("analyze " + study->FindRig(args.rig, "--rig").name +
                     (mpi.active() ? " (rank 0 of " + std::to_string(mpi.size()) + ")" : ""),
                 !quiet);
     so.fields.progress = [&bar](double f) { bar->Update(f); };
     session_holder.emplace(study, so);
-    if (root) {
-      AddSceneInputs(output, study->scene());
-      vdb_path = output.Stage((out / "fields.vdb").string(), "--out");
-      summary_path = output.Stage((out / "summary.json").string(), "--out");
-      RemoveStaleOutputs(output, out, /*streamed=*/false, 0);
-    }
+    if (root) StageAnalyzeOutputs(output, study->scene(), out, vdb_path, summary_path);
   } catch (...) {
     failure = std::current_exception();
   }
@@ -206,48 +269,13 @@ int RunAnalyze(const AnalyzeArgs& args) {
   bar->Finish();
   // The partitions meet at rank 0: grids merged, statistics added (volume/fields_transfer.h).
   nlohmann::json mpi_summary;
-  if (mpi.active()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const nlohmann::json mine{{"seconds", fields.stats.seconds},
-                              {"rays", fields.stats.rays},
-                              {"point_camera_tests", fields.stats.point_camera_tests}};
-    const std::vector<std::string> parts =
-        mpi.GatherToRoot(mine.dump() + '\n' + SerializePartialFields(fields));
-    if (!root) return 0;
-    mpi_summary = {{"ranks", mpi.size()}, {"per_rank", nlohmann::json::array()}};
-    mpi_summary["per_rank"].push_back(mine);
-    for (std::size_t r = 1; r < parts.size(); ++r) {
-      const std::size_t newline = parts[r].find('\n');
-      mpi_summary["per_rank"].push_back(nlohmann::json::parse(parts[r].substr(0, newline)));
-      MergePartialFields(parts[r].substr(newline + 1), &fields);
-    }
-    mpi_summary["merge_seconds"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  if (mpi.active() && !MergeAtRoot(mpi, fields, mpi_summary)) return 0;
   // Moving objects: the fields at every time sample; surface targets at each (docs/time.md).
   std::optional<TimeSummary> time;
   std::vector<SurfaceTargetResult> targets;
   std::vector<std::string> sample_labels;
-  if (scene.Animated() || scene.study.targets) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto parts = MakeSceneParts(scene);
-    const double parts_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const std::vector<TimeSample> samples = scene.TimeSamples();
-    for (const TimeSample& s : samples) sample_labels.push_back(s.label);
-    if (!samples.empty()) {
-      FieldOptions over_time = OverTimeOptions(options);
-      ProgressBar time_bar("over " + std::to_string(samples.size()) + " time samples", !args.quiet);
-      over_time.progress = [&time_bar](double f) { time_bar.Update(f); };
-      TimeFieldsResult result =
-          EvaluateFieldsOverTime(scene, rig, *parts, samples, over_time, scene.TimeMinCameras());
-      time_bar.Finish();
-      result.summary.parts_seconds = parts_seconds;
-      time = result.summary;
-      AddTimeGrids(&fields, &result);
-    }
-    targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
-  }
+  if (scene.Animated() || scene.study.targets)
+    EvaluateOverTime(args, scene, rig, options, fields, time, targets, sample_labels);
   // Pixel-size targets and DORI classes, from the fields without casting again.
   std::vector<PixelTargetSummary> pixel_targets =
       EvaluatePixelTargets(scene, rig, fields, scene.TimeMinCameras(), &fields);
@@ -448,165 +476,162 @@ StreamSetup PrepareStream(const AnalyzeArgs& args) {
   return setup;
 }
 
-}  // namespace
-
-int RunStreamedAnalyze(const AnalyzeArgs& args) {
-  // Under mpirun every process evaluates its share of the tiles and writes them itself (into rank
-  // 0's staging folder: the processes share a file system); rank 0 adds up the statistics and
-  // writes the summary (docs/scale.md). Every process reads its own copy of the inputs, then rank
-  // 0 stages the outputs: one collective check after both, so an error on any process ends them
-  // all with its one line.
-  const MpiSession mpi(args.mpi);
-  const bool root = mpi.rank() == 0;
-  StreamSetup setup;
-  // Every tile and the summary appear together (summary.json last), or none does.
-  const std::filesystem::path out(args.out);
-  OutputTransaction output;
-  std::vector<std::string> tile_files, tile_paths;
-  std::string summary_path, staged;
-  std::exception_ptr failure;
-  try {
-    setup = PrepareStream(args);
-    for (std::size_t t = 0; t < setup.tiles.size(); ++t) {
-      char name[48];
-      std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
-      tile_files.push_back(name);
-    }
-    if (root) {
-      AddSceneInputs(output, setup.study->scene());
-      for (const std::string& name : tile_files) {
-        tile_paths.push_back(output.Stage((out / name).string(), "--out"));
-        staged += tile_paths.back() + '\n';
-      }
-      summary_path = output.Stage((out / "summary.json").string(), "--out");
-      RemoveStaleOutputs(output, out, /*streamed=*/true, setup.tiles.size());
-      staged += output.run_id();
-    }
-  } catch (...) {
-    failure = std::current_exception();
+// The tiles' files under --out: fields/tile_NNNN.vdb.
+std::vector<std::string> TileFileNames(std::size_t count) {
+  std::vector<std::string> tile_files;
+  for (std::size_t t = 0; t < count; ++t) {
+    char name[48];
+    std::snprintf(name, sizeof name, "fields/tile_%04zu.vdb", t);
+    tile_files.push_back(name);
   }
-  mpi.ThrowIfAnyFailed(failure);
+  return tile_files;
+}
+
+// Stages every tile and summary.json beside the scene's inputs (rank 0) and removes an earlier
+// run's outputs this run does not replace; returns the staged tile paths and the run id, one a
+// line, for the other processes.
+std::string StageStreamOutputs(OutputTransaction& output, const Scene& scene,
+                               const std::filesystem::path& out,
+                               const std::vector<std::string>& tile_files,
+                               std::vector<std::string>& tile_paths, std::string& summary_path) {
+  std::string staged;
+  AddSceneInputs(output, scene);
+  for (const std::string& name : tile_files) {
+    tile_paths.push_back(output.Stage((out / name).string(), "--out"));
+    staged += tile_paths.back() + '\n';
+  }
+  summary_path = output.Stage((out / "summary.json").string(), "--out");
+  RemoveStaleOutputs(output, out, /*streamed=*/true, tile_files.size());
+  staged += output.run_id();
+  return staged;
+}
+
+// A process's tiles added up: their statistics, the tile list for the summary, and the values
+// behind the summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
+struct StreamTotals {
+  explicit StreamTotals(std::size_t region_count)
+      : regions(region_count), region_spills(2 * region_count) {}
+  std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
+  FieldStats total;
+  DoriSummary dori;
+  // The named sub-regions: counts added up, values spilled (density, sigma_max per region).
+  std::vector<RegionCounts> regions;
+  std::vector<std::unique_ptr<ValueSpill>> region_spills;
+  nlohmann::json tile_list = nlohmann::json::array();
+};
+
+// Evaluates this process's tiles (every size-th) one at a time, each written to its staged path
+// and then dropped; adds them up in `totals`, the values spilled into `spill_folder`.
+void EvaluateStreamTiles(const StreamSetup& setup, const MpiSession& mpi,
+                         const std::vector<std::string>& tile_files,
+                         const std::vector<std::string>& tile_paths,
+                         const std::map<std::string, std::string>& meta,
+                         const std::string& spill_folder, bool want_resolution, ProgressBar& bar,
+                         StreamTotals& totals) {
   const auto& study = setup.study;
   const Scene& scene = study->scene();
   const Rig& rig = setup.rig;
   const FieldOptions& options = setup.options;
   const std::vector<BlockColumns>& tiles = setup.tiles;
   const VoxelLattice& lattice = setup.lattice;
-  // The staged paths and the run id, from rank 0 to every process.
-  std::string run_id = output.run_id();
-  if (mpi.active()) {
-    std::istringstream lines(mpi.Broadcast(staged));
-    tile_paths.assign(tiles.size(), {});
-    for (std::string& path : tile_paths) std::getline(lines, path);
-    std::getline(lines, run_id);
-  }
-
-  const bool want_resolution =
-      std::find(options.fields.begin(), options.fields.end(), "resolution") != options.fields.end();
-  const std::map<std::string, std::string> meta = FieldsMetadata(scene, rig, run_id);
-  // This process's tiles (every size-th), their statistics added up, the values behind the
-  // summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
-  const std::string spill_folder = std::filesystem::path(tile_paths[0]).parent_path().string();
-  std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
-  FieldStats total;
-  DoriSummary dori;
-  // The named sub-regions: counts added up, values spilled (density, sigma_max per region).
-  const std::size_t region_count = scene.study.regions.size();
-  std::vector<RegionCounts> regions(region_count);
-  std::vector<std::unique_ptr<ValueSpill>> region_spills(2 * region_count);
-  nlohmann::json tile_list = nlohmann::json::array();
+  auto& spills = totals.spills;
+  FieldStats& total = totals.total;
+  DoriSummary& dori = totals.dori;
+  std::vector<RegionCounts>& regions = totals.regions;
+  auto& region_spills = totals.region_spills;
+  nlohmann::json& tile_list = totals.tile_list;
   std::vector<std::size_t> mine;
   for (std::size_t t = std::size_t(mpi.rank()); t < tiles.size(); t += std::size_t(mpi.size()))
     mine.push_back(t);
-  ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
-                      (mpi.active() ? ", rank 0 of " + std::to_string(mpi.size()) : "") + ")",
-                  !(args.quiet || !root));
-  try {
-    for (auto& spill : spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
-    for (auto& spill : region_spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
-    for (std::size_t i = 0; i < mine.size(); ++i) {
-      const std::size_t t = mine[i];
-      FieldOptions o = options;
-      o.tile = tiles[t];
-      o.progress = [&bar, i, n = mine.size()](double f) {
-        bar.Update((double(i) + f) / double(n));
-      };
-      Fields f = EvaluateFields(scene, rig, study->caster(), o);
-      FieldStats& st = f.stats;
-      // DORI classes: the tile's grid, and its counts added up (the shares at the end).
-      if (scene.study.dori) {
-        const DoriSummary d = EvaluateDori(scene, f, &f);
-        dori.voxels += d.voxels;
-        for (int k = 0; k < 4; ++k) dori.reached[k] += d.reached[k];
-      }
-      const std::vector<RegionCounts> tile_regions = CountRegions(scene, f);
-      for (std::size_t r = 0; r < tile_regions.size(); ++r) {
-        regions[r].voxels += tile_regions[r].voxels;
-        for (int k = 0; k < 3; ++k) regions[r].ge[k] += tile_regions[r].ge[k];
-        region_spills[2 * r]->Append(tile_regions[r].densities);
-        region_spills[2 * r + 1]->Append(tile_regions[r].sigmas);
-      }
-      if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
-      spills[1]->Append(st.sigma_max_mm);
-      spills[2]->Append(st.sigma_max_steady_mm);
-      std::vector<float>().swap(st.sigma_max_mm);  // spilled: not kept in memory
-      std::vector<float>().swap(st.sigma_max_steady_mm);
-      AddFieldStats(&total, st);
-      const Eigen::Vector3i lo = tiles[t].VoxelMin(), end = tiles[t].VoxelEnd(lattice);
-      std::map<std::string, std::string> tile_meta = meta;
-      tile_meta["tile"] = std::to_string(t) + " of " + std::to_string(tiles.size());
-      tile_meta["tile_voxel_min"] = Triple(lo);
-      tile_meta["tile_voxel_end"] = Triple(end);
-      tile_list.push_back({{"index", t},
-                           {"file", tile_files[t]},
-                           {"voxel_min", {lo.x(), lo.y(), lo.z()}},
-                           {"voxel_end", {end.x(), end.y(), end.z()}},
-                           {"region_voxels", st.active_set.region_voxels},
-                           {"seen_voxels", st.seen_voxels},
-                           {"seconds", st.seconds},
-                           {"rank", mpi.rank()}});
-      WriteFieldsVdb(std::move(f), tile_paths[t], tile_meta);  // then dropped: one tile at a time
+  for (auto& spill : spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
+  for (auto& spill : region_spills) spill = std::make_unique<ValueSpill>(spill_folder, "--out");
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    const std::size_t t = mine[i];
+    FieldOptions o = options;
+    o.tile = tiles[t];
+    o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
+    Fields f = EvaluateFields(scene, rig, study->caster(), o);
+    FieldStats& st = f.stats;
+    // DORI classes: the tile's grid, and its counts added up (the shares at the end).
+    if (scene.study.dori) {
+      const DoriSummary d = EvaluateDori(scene, f, &f);
+      dori.voxels += d.voxels;
+      for (int k = 0; k < 4; ++k) dori.reached[k] += d.reached[k];
     }
-  } catch (...) {
-    failure = std::current_exception();
+    const std::vector<RegionCounts> tile_regions = CountRegions(scene, f);
+    for (std::size_t r = 0; r < tile_regions.size(); ++r) {
+      regions[r].voxels += tile_regions[r].voxels;
+      for (int k = 0; k < 3; ++k) regions[r].ge[k] += tile_regions[r].ge[k];
+      region_spills[2 * r]->Append(tile_regions[r].densities);
+      region_spills[2 * r + 1]->Append(tile_regions[r].sigmas);
+    }
+    if (want_resolution) spills[0]->Append(GridActiveValues(f, "resolution"));
+    spills[1]->Append(st.sigma_max_mm);
+    spills[2]->Append(st.sigma_max_steady_mm);
+    std::vector<float>().swap(st.sigma_max_mm);  // spilled: not kept in memory
+    std::vector<float>().swap(st.sigma_max_steady_mm);
+    AddFieldStats(&total, st);
+    const Eigen::Vector3i lo = tiles[t].VoxelMin(), end = tiles[t].VoxelEnd(lattice);
+    std::map<std::string, std::string> tile_meta = meta;
+    tile_meta["tile"] = std::to_string(t) + " of " + std::to_string(tiles.size());
+    tile_meta["tile_voxel_min"] = Triple(lo);
+    tile_meta["tile_voxel_end"] = Triple(end);
+    tile_list.push_back({{"index", t},
+                         {"file", tile_files[t]},
+                         {"voxel_min", {lo.x(), lo.y(), lo.z()}},
+                         {"voxel_end", {end.x(), end.y(), end.z()}},
+                         {"region_voxels", st.active_set.region_voxels},
+                         {"seen_voxels", st.seen_voxels},
+                         {"seconds", st.seconds},
+                         {"rank", mpi.rank()}});
+    WriteFieldsVdb(std::move(f), tile_paths[t], tile_meta);  // then dropped: one tile at a time
   }
-  if (!mpi.AllOk(!failure)) {
-    if (failure && root) std::rethrow_exception(failure);
-    return 2;
-  }
-  bar.Finish();
+}
 
-  // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
-  // spilled values by two rounds of summed counts (only the counts travel).
-  const nlohmann::json part{
-      {"stats", StatsToJson(total)},
-      {"tiles", tile_list},
-      {"dori", {dori.voxels, dori.reached[0], dori.reached[1], dori.reached[2], dori.reached[3]}},
-      {"regions", RegionCountsToJson(regions)},
-      {"peak_rss_mib", PeakRssMiB()}};
-  const std::vector<std::string> parts = mpi.GatherToRoot(part.dump());
-  nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
-  if (root) {
-    total = FieldStats{};
-    dori = DoriSummary{};
-    regions.assign(region_count, RegionCounts{});
-    for (const std::string& p : parts) {
-      const nlohmann::json j = nlohmann::json::parse(p);
-      AddStats(&total, j.at("stats"));
-      const auto counts = j.at("dori").get<std::vector<std::int64_t>>();
-      dori.voxels += counts.at(0);
-      for (int k = 0; k < 4; ++k) dori.reached[k] += counts.at(1 + k);
-      const auto& rs = j.at("regions");
-      for (std::size_t r = 0; r < region_count; ++r) {
-        regions[r].voxels += rs.at(r).at(0).get<std::int64_t>();
-        for (int k = 0; k < 3; ++k) regions[r].ge[k] += rs.at(r).at(1 + k).get<std::int64_t>();
-      }
-      for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
-      peak_rss.push_back(j.at("peak_rss_mib"));
+// Rank 0 adds up every process's statistics into `totals` (from `parts`, its own included), with
+// every tile in `all_tiles` by index and each process's peak memory in `peak_rss`.
+void AddUpAtRoot(const std::vector<std::string>& parts, std::size_t region_count,
+                 StreamTotals& totals, nlohmann::json& all_tiles, nlohmann::json& peak_rss) {
+  FieldStats& total = totals.total;
+  DoriSummary& dori = totals.dori;
+  std::vector<RegionCounts>& regions = totals.regions;
+  total = FieldStats{};
+  dori = DoriSummary{};
+  regions.assign(region_count, RegionCounts{});
+  for (const std::string& p : parts) {
+    const nlohmann::json j = nlohmann::json::parse(p);
+    AddStats(&total, j.at("stats"));
+    const auto counts = j.at("dori").get<std::vector<std::int64_t>>();
+    dori.voxels += counts.at(0);
+    for (int k = 0; k < 4; ++k) dori.reached[k] += counts.at(1 + k);
+    const auto& rs = j.at("regions");
+    for (std::size_t r = 0; r < region_count; ++r) {
+      regions[r].voxels += rs.at(r).at(0).get<std::int64_t>();
+      for (int k = 0; k < 3; ++k) regions[r].ge[k] += rs.at(r).at(1 + k).get<std::int64_t>();
     }
-    std::sort(all_tiles.begin(), all_tiles.end(),
-              [](const auto& a, const auto& b) { return a.at("index") < b.at("index"); });
+    for (const auto& tile : j.at("tiles")) all_tiles.push_back(tile);
+    peak_rss.push_back(j.at("peak_rss_mib"));
   }
+  std::sort(all_tiles.begin(), all_tiles.end(),
+            [](const auto& a, const auto& b) { return a.at("index") < b.at("index"); });
+}
+
+// The summary's percentiles and target shares from every process's spilled values, and each named
+// region's summary (rank 0's; the other processes' are not used).
+struct StreamPercentiles {
+  std::vector<std::optional<double>> resolution_p, sigma_p, steady_p;
+  std::int64_t sigma_meets = 0, steady_meets = 0;
+  std::vector<RegionSummary> region_summaries;
+};
+
+// Selects the percentiles by two rounds of summed counts (a collective: every process calls it).
+StreamPercentiles SelectStreamPercentiles(const MpiSession& mpi, const Scene& scene,
+                                          const FieldOptions& options, const StreamTotals& totals,
+                                          bool want_resolution) {
+  const std::size_t region_count = scene.study.regions.size();
+  const auto& spills = totals.spills;
+  const auto& region_spills = totals.region_spills;
+  const std::vector<RegionCounts>& regions = totals.regions;
   const auto percentiles = [&](const ValueSpill& spill, const std::vector<double>& p) {
     // Rank 0 selects the bins from the summed upper counts; every process counts inside them.
     const PercentileBins selection =
@@ -641,40 +666,131 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
                                             want_resolution, has_sigma, sigma_count, p10[0],
                                             sigma_p[0], sigma_p[1]));
   }
-  if (!root) return 0;
+  return {resolution_p, sigma_p, steady_p, sigma_meets, steady_meets, std::move(region_summaries)};
+}
 
-  Fields merged;
-  merged.lattice = lattice;
-  merged.stats = std::move(total);
-  const int threads = static_cast<int>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  RigCheckOptions check;
-  check.visible_voxels = merged.stats.per_camera_seen;
-  const std::vector<Warning> warnings = CheckRig(scene, rig, study->caster(), check);
-  Summary typed = Summarize(scene, rig, merged, options.fields, threads, warnings);
-  // The percentiles and shares from the spilled values: the same nearest ranks over the same
-  // multisets as an in-memory run.
+// The percentiles and shares from the spilled values into `typed`: the same nearest ranks over the
+// same multisets as an in-memory run.
+void ApplyStreamPercentiles(const StreamPercentiles& p, bool want_resolution, const Fields& merged,
+                            Summary& typed) {
   if (want_resolution)
     typed.resolution_px_per_m =
-        ResolutionPercentiles{resolution_p[0], resolution_p[1], resolution_p[2]};
+        ResolutionPercentiles{p.resolution_p[0], p.resolution_p[1], p.resolution_p[2]};
   if (typed.uncertainty) {
     UncertaintySummary& u = *typed.uncertainty;
     const std::int64_t region = merged.stats.active_set.region_voxels;
     const auto share = [region](std::int64_t n) {
       return region > 0 ? double(n) / double(region) : 0.0;
     };
-    u.sigma_max_mm = SigmaPercentiles{sigma_p[0], sigma_p[1], sigma_p[2]};
-    if (u.max_sigma_mm) u.meets_max_sigma = share(sigma_meets);
+    u.sigma_max_mm = SigmaPercentiles{p.sigma_p[0], p.sigma_p[1], p.sigma_p[2]};
+    if (u.max_sigma_mm) u.meets_max_sigma = share(p.sigma_meets);
     if (u.motion) {
-      u.sigma_max_steady_mm = SigmaPercentiles{steady_p[0], steady_p[1], steady_p[2]};
-      if (u.max_sigma_mm) u.meets_max_sigma_steady = share(steady_meets);
+      u.sigma_max_steady_mm = SigmaPercentiles{p.steady_p[0], p.steady_p[1], p.steady_p[2]};
+      if (u.max_sigma_mm) u.meets_max_sigma_steady = share(p.steady_meets);
     }
   }
-  if (scene.study.dori) {
-    dori.SetShares();
-    typed.dori = dori;
+}
+
+// This process's totals as rank 0 adds them up, with its peak memory so far.
+nlohmann::json StreamPartJson(const StreamTotals& totals) {
+  const nlohmann::json part{{"stats", StatsToJson(totals.total)},
+                            {"tiles", totals.tile_list},
+                            {"dori",
+                             {totals.dori.voxels, totals.dori.reached[0], totals.dori.reached[1],
+                              totals.dori.reached[2], totals.dori.reached[3]}},
+                            {"regions", RegionCountsToJson(totals.regions)},
+                            {"peak_rss_mib", PeakRssMiB()}};
+  return part;
+}
+
+}  // namespace
+
+int RunStreamedAnalyze(const AnalyzeArgs& args) {
+  // Under mpirun every process evaluates its share of the tiles and writes them itself (into rank
+  // 0's staging folder: the processes share a file system); rank 0 adds up the statistics and
+  // writes the summary (docs/scale.md). Every process reads its own copy of the inputs, then rank
+  // 0 stages the outputs: one collective check after both, so an error on any process ends them
+  // all with its one line.
+  const MpiSession mpi(args.mpi);
+  const bool root = mpi.rank() == 0;
+  StreamSetup setup;
+  // Every tile and the summary appear together (summary.json last), or none does.
+  const std::filesystem::path out(args.out);
+  OutputTransaction output;
+  std::vector<std::string> tile_files, tile_paths;
+  std::string summary_path, staged;
+  std::exception_ptr failure;
+  try {
+    setup = PrepareStream(args);
+    tile_files = TileFileNames(setup.tiles.size());
+    if (root)
+      staged = StageStreamOutputs(output, setup.study->scene(), out, tile_files, tile_paths,
+                                  summary_path);
+  } catch (...) {
+    failure = std::current_exception();
   }
-  typed.regions = std::move(region_summaries);
+  mpi.ThrowIfAnyFailed(failure);
+  const auto& study = setup.study;
+  const Scene& scene = study->scene();
+  const Rig& rig = setup.rig;
+  const FieldOptions& options = setup.options;
+  const std::vector<BlockColumns>& tiles = setup.tiles;
+  const VoxelLattice& lattice = setup.lattice;
+  // The staged paths and the run id, from rank 0 to every process.
+  std::string run_id = output.run_id();
+  if (mpi.active()) {
+    std::istringstream lines(mpi.Broadcast(staged));
+    tile_paths.assign(tiles.size(), {});
+    for (std::string& path : tile_paths) std::getline(lines, path);
+    std::getline(lines, run_id);
+  }
+
+  const bool want_resolution =
+      std::find(options.fields.begin(), options.fields.end(), "resolution") != options.fields.end();
+  const std::map<std::string, std::string> meta = FieldsMetadata(scene, rig, run_id);
+  // This process's tiles (every size-th), their statistics added up, the values behind the
+  // summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
+  const std::string spill_folder = std::filesystem::path(tile_paths[0]).parent_path().string();
+  const std::size_t region_count = scene.study.regions.size();
+  StreamTotals totals(region_count);
+  ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
+                      (mpi.active() ? ", rank 0 of " + std::to_string(mpi.size()) : "") + ")",
+                  !(args.quiet || !root));
+  try {
+    EvaluateStreamTiles(setup, mpi, tile_files, tile_paths, meta, spill_folder, want_resolution,
+                        bar, totals);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  if (!mpi.AllOk(!failure)) {
+    if (failure && root) std::rethrow_exception(failure);
+    return 2;
+  }
+  bar.Finish();
+
+  // Rank 0 adds up every process's statistics; the percentiles are selected from every process's
+  // spilled values by two rounds of summed counts (only the counts travel).
+  const std::vector<std::string> parts = mpi.GatherToRoot(StreamPartJson(totals).dump());
+  nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
+  if (root) AddUpAtRoot(parts, region_count, totals, all_tiles, peak_rss);
+  StreamPercentiles p = SelectStreamPercentiles(mpi, scene, options, totals, want_resolution);
+  if (!root) return 0;
+
+  Fields merged;
+  merged.lattice = lattice;
+  merged.stats = std::move(totals.total);
+  const int threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  RigCheckOptions check;
+  check.visible_voxels = merged.stats.per_camera_seen;
+  const std::vector<Warning> warnings = CheckRig(scene, rig, study->caster(), check);
+  Summary typed = Summarize(scene, rig, merged, options.fields, threads, warnings);
+  ApplyStreamPercentiles(p, want_resolution, merged, typed);
+  if (scene.study.dori) {
+    totals.dori.SetShares();
+    typed.dori = totals.dori;
+  }
+  typed.regions = std::move(p.region_summaries);
   if (scene.study.targets)
     typed.targets =
         EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());

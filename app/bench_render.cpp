@@ -29,16 +29,131 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-}  // namespace
+// The best time of each measurement over the runs (seconds), the last run's hit and occluded
+// counts, and the ratios of the render to the raw Embree loops.
+struct RenderBenchTimes {
+  double best_render = std::numeric_limits<double>::infinity(), best_layers = best_render;
+  double best_primary = best_render, best_packet = best_render, best_single = best_render;
+  double best_primary_packet = best_render;
+  double best_prepared = best_render, best_with_bvh = best_render;
+  double best_hidden_once = best_render, best_hidden_prepared = best_render;
+  std::array<double, ProgressiveRender::kPasses> best_pass;
+  double best_progressive = best_render, best_first_fresh = best_render;
+  std::size_t hits = 0, occluded = 0;
+  double raw = 0, raw_single = 0, ratio = 0, ratio_single = 0;
+};
 
-int RunRenderBench(const BenchArgs& args) {
-  const auto [width, height] = ParseImageSize("--size", args.size);
-  const auto study = session::Study::Load(args.scene);
-  const Scene& scene = study->scene();
-  const Rig& rig = study->FindRig(args.rig, "--rig");
-  OutputTransaction output;
-  AddSceneInputs(output, scene);
-  const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
+// Times the renderers and the raw Embree loops over the recorded rays, `repeat` runs interleaved;
+// the best of each.
+RenderBenchTimes TimeRenders(const Scene& scene, const Rig& rig, const RayCaster* caster,
+                             const RenderView& view, const RenderOptions& options,
+                             const RenderOptions& with_layers, const std::vector<Ray>& primary,
+                             const std::vector<Ray>& shadow, int repeat) {
+  RenderBenchTimes t;
+  t.best_pass.fill(t.best_render);
+  // The prepared renderer against the one-shot form, and the progressive passes.
+  const PreparedScene prepared(scene, *caster);
+  RenderOptions hidden_line = options;
+  hidden_line.surface = Surface::kHiddenLine;
+  // Progressive: after Restart (a viewer's steady state: buffers reused) and freshly constructed.
+  ProgressiveRender restarted(prepared, rig, view, options);
+  restarted.RunAll();
+  for (int r = 0; r < repeat; ++r) {
+    RenderStats s;
+    RenderWithStats(scene, rig, *caster, view, options, nullptr, &s);
+    t.best_render = std::min(t.best_render, s.seconds);
+    RenderWithStats(scene, rig, *caster, view, with_layers, nullptr, &s);
+    t.best_layers = std::min(t.best_layers, s.seconds);
+    RenderWithStats(prepared, rig, view, options, nullptr, &s);
+    t.best_prepared = std::min(t.best_prepared, s.seconds);
+    {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::unique_ptr<RayCaster> own = MakeEmbreeRayCaster(scene.AllTriangles());
+      Render(scene, rig, *own, view, options);
+      t.best_with_bvh = std::min(t.best_with_bvh, Seconds(t0));
+    }
+    RenderWithStats(scene, rig, *caster, view, hidden_line, nullptr, &s);
+    t.best_hidden_once = std::min(t.best_hidden_once, s.seconds);
+    RenderWithStats(prepared, rig, view, hidden_line, nullptr, &s);
+    t.best_hidden_prepared = std::min(t.best_hidden_prepared, s.seconds);
+    {
+      // Each pass from the call to its image (the first includes starting the frame).
+      auto t0 = std::chrono::steady_clock::now();
+      const auto start = t0;
+      restarted.Restart(rig, view, options);
+      for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass) {
+        restarted.RunPass();
+        t.best_pass[pass] = std::min(t.best_pass[pass], Seconds(t0));
+        t0 = std::chrono::steady_clock::now();
+      }
+      t.best_progressive = std::min(t.best_progressive, Seconds(start));
+      t0 = std::chrono::steady_clock::now();
+      ProgressiveRender fresh(prepared, rig, view, options);
+      fresh.RunPass();
+      t.best_first_fresh = std::min(t.best_first_fresh, Seconds(t0));
+    }
+    const RawOcclusionResult p = RawEmbreeIntersection(*caster, primary);
+    t.best_primary = std::min(t.best_primary, p.seconds);
+    t.hits = p.occluded;
+    t.best_primary_packet = std::min(
+        t.best_primary_packet, RawEmbreeIntersection(*caster, primary, RawMode::kPacket).seconds);
+    const RawOcclusionResult sp = RawEmbreeOcclusion(*caster, shadow, RawMode::kPacket);
+    t.best_packet = std::min(t.best_packet, sp.seconds);
+    t.occluded = sp.occluded;
+    t.best_single = std::min(t.best_single, RawEmbreeOcclusion(*caster, shadow).seconds);
+  }
+  t.raw = t.best_primary_packet + t.best_packet;
+  t.raw_single = t.best_primary + t.best_single;
+  t.ratio = t.best_render / t.raw;
+  t.ratio_single = t.best_render / t.raw_single;
+  return t;
+}
+
+// The results as `--json` writes them.
+nlohmann::json RenderBenchJson(const BenchArgs& args, const Scene& scene, const Rig& rig,
+                               const RayCaster* caster, const RenderView& view, int threads,
+                               const std::vector<Ray>& primary, const std::vector<Ray>& shadow,
+                               const RenderBenchTimes& t) {
+  nlohmann::json j{
+      {"scene", scene.path},
+      {"rig", rig.name},
+      {"cameras", rig.enabled_count()},
+      {"triangles", caster->triangle_count()},
+      {"width", view.width},
+      {"height", view.height},
+      {"threads", threads},
+      {"repeat", args.repeat},
+      {"primary_rays", primary.size()},
+      {"shadow_rays", shadow.size()},
+      {"render_seconds", t.best_render},
+      {"raw_primary_seconds", t.best_primary},
+      {"raw_primary_packet_seconds", t.best_primary_packet},
+      {"raw_shadow_packet_seconds", t.best_packet},
+      {"packet_width", EmbreePacketWidth(*caster)},
+      {"raw_shadow_single_seconds", t.best_single},
+      {"ratio", t.ratio},
+      {"ratio_single", t.ratio_single},
+      {"render_with_layers_seconds", t.best_layers},
+      {"ratio_with_layers", t.best_layers / t.raw},
+      {"ratio_single_with_layers", t.best_layers / t.raw_single},
+      {"one_shot_seconds", t.best_render},
+      {"one_shot_with_bvh_seconds", t.best_with_bvh},
+      {"prepared_seconds", t.best_prepared},
+      {"hidden_line_one_shot_seconds", t.best_hidden_once},
+      {"hidden_line_prepared_seconds", t.best_hidden_prepared},
+      {"ratio_prepared_to_one_shot", t.best_prepared / t.best_render},
+      {"ratio_prepared_to_one_shot_with_bvh", t.best_prepared / t.best_with_bvh},
+      {"ratio_hidden_line_prepared_to_one_shot", t.best_hidden_prepared / t.best_hidden_once},
+      {"progressive_pass_seconds", t.best_pass},
+      {"progressive_first_pass_fresh_seconds", t.best_first_fresh},
+      {"ratio_first_pass_fresh_to_frame", t.best_first_fresh / t.best_prepared},
+      {"ratio_first_pass_to_frame", t.best_pass[0] / t.best_prepared},
+      {"ratio_all_passes_to_frame", t.best_progressive / t.best_prepared}};
+  return j;
+}
+
+// Where the bench looks from: --view, else the scene's first view, else a corner of its bounds.
+RenderView BenchView(const BenchArgs& args, const Scene& scene, int width, int height) {
   RenderView view;
   if (!args.view.empty()) {
     view = NamedView(scene, "--view", args.view, width, height);
@@ -52,6 +167,20 @@ int RunRenderBench(const BenchArgs& args) {
     view.width = width;
     view.height = height;
   }
+  return view;
+}
+
+}  // namespace
+
+int RunRenderBench(const BenchArgs& args) {
+  const auto [width, height] = ParseImageSize("--size", args.size);
+  const auto study = session::Study::Load(args.scene);
+  const Scene& scene = study->scene();
+  const Rig& rig = study->FindRig(args.rig, "--rig");
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  const std::string json_path = args.json_out.empty() ? "" : output.Stage(args.json_out, "--json");
+  const RenderView view = BenchView(args, scene, width, height);
   const std::string view_name =
       args.view.empty() && !scene.views.empty() ? scene.views.begin()->first : args.view;
   const RayCaster* caster = &study->caster();
@@ -68,70 +197,8 @@ int RunRenderBench(const BenchArgs& args) {
   RenderStats stats;
   RenderWithStats(scene, rig, *caster, view, options, nullptr, &stats, &primary, &shadow);
 
-  double best_render = std::numeric_limits<double>::infinity(), best_layers = best_render;
-  double best_primary = best_render, best_packet = best_render, best_single = best_render;
-  double best_primary_packet = best_render;
-  // The prepared renderer against the one-shot form, and the progressive passes.
-  const PreparedScene prepared(scene, *caster);
-  RenderOptions hidden_line = options;
-  hidden_line.surface = Surface::kHiddenLine;
-  double best_prepared = best_render, best_with_bvh = best_render;
-  double best_hidden_once = best_render, best_hidden_prepared = best_render;
-  // Progressive: after Restart (a viewer's steady state: buffers reused) and freshly constructed.
-  std::array<double, ProgressiveRender::kPasses> best_pass;
-  best_pass.fill(best_render);
-  double best_progressive = best_render, best_first_fresh = best_render;
-  ProgressiveRender restarted(prepared, rig, view, options);
-  restarted.RunAll();
-  std::size_t hits = 0, occluded = 0;
-  for (int r = 0; r < args.repeat; ++r) {
-    RenderStats s;
-    RenderWithStats(scene, rig, *caster, view, options, nullptr, &s);
-    best_render = std::min(best_render, s.seconds);
-    RenderWithStats(scene, rig, *caster, view, with_layers, nullptr, &s);
-    best_layers = std::min(best_layers, s.seconds);
-    RenderWithStats(prepared, rig, view, options, nullptr, &s);
-    best_prepared = std::min(best_prepared, s.seconds);
-    {
-      const auto t0 = std::chrono::steady_clock::now();
-      const std::unique_ptr<RayCaster> own = MakeEmbreeRayCaster(scene.AllTriangles());
-      Render(scene, rig, *own, view, options);
-      best_with_bvh = std::min(best_with_bvh, Seconds(t0));
-    }
-    RenderWithStats(scene, rig, *caster, view, hidden_line, nullptr, &s);
-    best_hidden_once = std::min(best_hidden_once, s.seconds);
-    RenderWithStats(prepared, rig, view, hidden_line, nullptr, &s);
-    best_hidden_prepared = std::min(best_hidden_prepared, s.seconds);
-    {
-      // Each pass from the call to its image (the first includes starting the frame).
-      auto t0 = std::chrono::steady_clock::now();
-      const auto start = t0;
-      restarted.Restart(rig, view, options);
-      for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass) {
-        restarted.RunPass();
-        best_pass[pass] = std::min(best_pass[pass], Seconds(t0));
-        t0 = std::chrono::steady_clock::now();
-      }
-      best_progressive = std::min(best_progressive, Seconds(start));
-      t0 = std::chrono::steady_clock::now();
-      ProgressiveRender fresh(prepared, rig, view, options);
-      fresh.RunPass();
-      best_first_fresh = std::min(best_first_fresh, Seconds(t0));
-    }
-    const RawOcclusionResult p = RawEmbreeIntersection(*caster, primary);
-    best_primary = std::min(best_primary, p.seconds);
-    hits = p.occluded;
-    best_primary_packet = std::min(
-        best_primary_packet, RawEmbreeIntersection(*caster, primary, RawMode::kPacket).seconds);
-    const RawOcclusionResult sp = RawEmbreeOcclusion(*caster, shadow, RawMode::kPacket);
-    best_packet = std::min(best_packet, sp.seconds);
-    occluded = sp.occluded;
-    best_single = std::min(best_single, RawEmbreeOcclusion(*caster, shadow).seconds);
-  }
-  const double raw = best_primary_packet + best_packet;
-  const double raw_single = best_primary + best_single;
-  const double ratio = best_render / raw;
-  const double ratio_single = best_render / raw_single;
+  const RenderBenchTimes t =
+      TimeRenders(scene, rig, caster, view, options, with_layers, primary, shadow, args.repeat);
   std::printf(
       "pandora bench --render: %s, rig %s (%d enabled cameras), %zu triangles, %dx%d, view %s, "
       "%d threads\n",
@@ -139,91 +206,58 @@ int RunRenderBench(const BenchArgs& args) {
       view.width, view.height, view_name.empty() ? "(from the bounds)" : view_name.c_str(),
       threads);
   std::printf("  primary rays %zu (%zu hit), shadow segments %zu (%zu occluded)\n", primary.size(),
-              hits, shadow.size(), occluded);
-  std::printf("  %-58s %9.4f s\n", "render, PNG defaults (best of runs)", best_render);
-  std::printf("  %-58s %9.4f s\n", "render with the EXR layers (best of runs)", best_layers);
+              t.hits, shadow.size(), t.occluded);
+  std::printf("  %-58s %9.4f s\n", "render, PNG defaults (best of runs)", t.best_render);
+  std::printf("  %-58s %9.4f s\n", "render with the EXR layers (best of runs)", t.best_layers);
   const int packet_width = EmbreePacketWidth(*caster);
   const std::string w = std::to_string(packet_width);
   std::printf("  %-58s %9.4f s\n", "raw Embree rtcIntersect1 loop, same primary rays",
-              best_primary);
+              t.best_primary);
   std::printf("  %-58s %9.4f s\n",
               ("raw Embree rtcIntersect" + w + " packets, same primary rays").c_str(),
-              best_primary_packet);
+              t.best_primary_packet);
   std::printf("  %-58s %9.4f s\n", "raw Embree rtcOccluded1 loop, same shadow segments",
-              best_single);
+              t.best_single);
   std::printf("  %-58s %9.4f s\n",
               ("raw Embree rtcOccluded" + w + " packets, same shadow segments").c_str(),
-              best_packet);
+              t.best_packet);
   std::printf(
       "  ratio render / raw single-ray loops (rtcIntersect1 + rtcOccluded1) = %.3f "
       "(target <= 1.5)\n",
-      ratio_single);
+      t.ratio_single);
   std::printf(
       "  ratio render / raw packet loops (rtcIntersect%d + rtcOccluded%d) = %.3f "
       "(our overhead over Embree itself)\n",
-      packet_width, packet_width, ratio);
+      packet_width, packet_width, t.ratio);
   std::printf(
       "  with the EXR layers: ratio to the single-ray loops = %.3f, to the packet loops = %.3f\n",
-      best_layers / raw_single, best_layers / raw);
+      t.best_layers / t.raw_single, t.best_layers / t.raw);
   std::printf("  %-58s %9.4f s\n", "one-shot Render, caster given (preparation per call)",
-              best_render);
+              t.best_render);
   std::printf("  %-58s %9.4f s\n", "one-shot with its BVH build (as `pandora render`)",
-              best_with_bvh);
-  std::printf("  %-58s %9.4f s\n", "prepared Render, per frame", best_prepared);
+              t.best_with_bvh);
+  std::printf("  %-58s %9.4f s\n", "prepared Render, per frame", t.best_prepared);
   std::printf("  %-58s %9.4f s\n", "hidden-line: one-shot (edges found per call)",
-              best_hidden_once);
-  std::printf("  %-58s %9.4f s\n", "hidden-line: prepared, per frame", best_hidden_prepared);
+              t.best_hidden_once);
+  std::printf("  %-58s %9.4f s\n", "hidden-line: prepared, per frame", t.best_hidden_prepared);
   std::printf(
       "  ratio prepared frame / one-shot = %.3f (with the BVH build: %.3f; hidden-line: %.3f)\n",
-      best_prepared / best_render, best_prepared / best_with_bvh,
-      best_hidden_prepared / best_hidden_once);
+      t.best_prepared / t.best_render, t.best_prepared / t.best_with_bvh,
+      t.best_hidden_prepared / t.best_hidden_once);
   std::printf("  progressive passes after Restart (1 pixel per 8x8, 4x4, 2x2 block, then all):");
   for (int pass = 0; pass < ProgressiveRender::kPasses; ++pass)
-    std::printf(" %.4f", best_pass[pass]);
+    std::printf(" %.4f", t.best_pass[pass]);
   std::printf(" s\n");
   std::printf("  %-58s %9.4f s\n", "first pass of a new ProgressiveRender (fresh buffers)",
-              best_first_fresh);
+              t.best_first_fresh);
   std::printf(
       "  ratio first pass / prepared full frame = %.3f (new ProgressiveRender: %.3f); "
       "all passes / prepared full frame = %.3f\n",
-      best_pass[0] / best_prepared, best_first_fresh / best_prepared,
-      best_progressive / best_prepared);
+      t.best_pass[0] / t.best_prepared, t.best_first_fresh / t.best_prepared,
+      t.best_progressive / t.best_prepared);
   if (!args.json_out.empty()) {
-    nlohmann::json j{
-        {"scene", scene.path},
-        {"rig", rig.name},
-        {"cameras", rig.enabled_count()},
-        {"triangles", caster->triangle_count()},
-        {"width", view.width},
-        {"height", view.height},
-        {"threads", threads},
-        {"repeat", args.repeat},
-        {"primary_rays", primary.size()},
-        {"shadow_rays", shadow.size()},
-        {"render_seconds", best_render},
-        {"raw_primary_seconds", best_primary},
-        {"raw_primary_packet_seconds", best_primary_packet},
-        {"raw_shadow_packet_seconds", best_packet},
-        {"packet_width", EmbreePacketWidth(*caster)},
-        {"raw_shadow_single_seconds", best_single},
-        {"ratio", ratio},
-        {"ratio_single", ratio_single},
-        {"render_with_layers_seconds", best_layers},
-        {"ratio_with_layers", best_layers / raw},
-        {"ratio_single_with_layers", best_layers / raw_single},
-        {"one_shot_seconds", best_render},
-        {"one_shot_with_bvh_seconds", best_with_bvh},
-        {"prepared_seconds", best_prepared},
-        {"hidden_line_one_shot_seconds", best_hidden_once},
-        {"hidden_line_prepared_seconds", best_hidden_prepared},
-        {"ratio_prepared_to_one_shot", best_prepared / best_render},
-        {"ratio_prepared_to_one_shot_with_bvh", best_prepared / best_with_bvh},
-        {"ratio_hidden_line_prepared_to_one_shot", best_hidden_prepared / best_hidden_once},
-        {"progressive_pass_seconds", best_pass},
-        {"progressive_first_pass_fresh_seconds", best_first_fresh},
-        {"ratio_first_pass_fresh_to_frame", best_first_fresh / best_prepared},
-        {"ratio_first_pass_to_frame", best_pass[0] / best_prepared},
-        {"ratio_all_passes_to_frame", best_progressive / best_prepared}};
+    const nlohmann::json j =
+        RenderBenchJson(args, scene, rig, caster, view, threads, primary, shadow, t);
     WriteFileAtomically(json_path, j.dump(2) + "\n");
     output.Commit();
   }

@@ -137,50 +137,38 @@ int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
   return 2;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // `pandora view`: the interactive viewer is its own program (the only one that links GL),
-  // pandora-view beside this one; it gets the remaining arguments.
-  // `pandora bench --viewer SCENE [--repeat N]` is `pandora-view SCENE --bench N` (frame rates).
-  bool viewer_bench = false;
-  if (argc >= 2 && std::string(argv[1]) == "bench")
-    for (int i = 2; i < argc; ++i) viewer_bench |= std::string(argv[i]) == "--viewer";
-  if (argc >= 2 && (std::string(argv[1]) == "view" || viewer_bench)) {
-    std::error_code ec;
-    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const std::string viewer = (self.parent_path() / "pandora-view").string();
-    std::vector<std::string> kept;
-    std::string frames = "20";
-    for (int i = 2; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (viewer_bench && arg == "--viewer") continue;
-      if (viewer_bench && arg == "--repeat" && i + 1 < argc) {
-        frames = argv[++i];
-        continue;
-      }
-      kept.push_back(arg);
+// Replaces this process with pandora-view (beside this program) for `pandora view` and
+// `pandora bench --viewer`; returns 2 when it cannot be started.
+int ExecViewer(int argc, char** argv, bool viewer_bench) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::string viewer = (self.parent_path() / "pandora-view").string();
+  std::vector<std::string> kept;
+  std::string frames = "20";
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (viewer_bench && arg == "--viewer") continue;
+    if (viewer_bench && arg == "--repeat" && i + 1 < argc) {
+      frames = argv[++i];
+      continue;
     }
-    if (viewer_bench) kept.insert(kept.end(), {"--bench", frames, "--no-autosave"});
-    std::vector<char*> args{const_cast<char*>(viewer.c_str())};
-    for (std::string& k : kept) args.push_back(k.data());
-    args.push_back(nullptr);
-    execv(viewer.c_str(), args.data());
-    std::fprintf(
-        stderr,
-        "pandora: error: cannot start the viewer %s: %s (hint: build the pandora-view target)\n",
-        viewer.c_str(), std::strerror(errno));
-    return 2;
+    kept.push_back(arg);
   }
-  using namespace pandora::app;
-  CLI::App app{"Pandora: design multi-camera setups (coverage, resolution and uncertainty fields)"};
-  app.set_version_flag("--version", PANDORA_VERSION);
-  app.require_subcommand(1);
-  int threads = 0;
-  const CLI::Validator kThreads = Number(0, 4096, "threads (0: all cores)", true);
-  app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  if (viewer_bench) kept.insert(kept.end(), {"--bench", frames, "--no-autosave"});
+  std::vector<char*> args{const_cast<char*>(viewer.c_str())};
+  for (std::string& k : kept) args.push_back(k.data());
+  args.push_back(nullptr);
+  execv(viewer.c_str(), args.data());
+  std::fprintf(
+      stderr,
+      "pandora: error: cannot start the viewer %s: %s (hint: build the pandora-view target)\n",
+      viewer.c_str(), std::strerror(errno));
+  return 2;
+}
 
-  AnalyzeArgs analyze;
+// Registers `pandora analyze` and its options.
+CLI::App* AddAnalyzeCommand(CLI::App& app, pandora::app::AnalyzeArgs& analyze, int& threads,
+                            const CLI::Validator& threads_check) {
   CLI::App* a = app.add_subcommand(
       "analyze", "Evaluate fields over the study region; write fields.vdb and summary.json");
   a->add_option("scene", analyze.scene, "Scene file (JSON)")->required();
@@ -197,7 +185,7 @@ int main(int argc, char** argv) {
   a->add_option("--memory-budget", analyze.memory_budget_mb,
                 "Memory budget in MiB (default: study.memory_budget_mb)")
       ->check(Number(0, HUGE_VAL, "MiB", false, true));
-  a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
   a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
   a->add_flag("--mpi", analyze.mpi,
               "Under mpirun: split the blocks over the processes; rank 0 writes (docs/scale.md)");
@@ -208,8 +196,12 @@ int main(int argc, char** argv) {
        "--tile-size", analyze.tile_size,
        "With --stream: the tiles' side in metres (default: as few tiles as the budget allows)")
       ->check(Number(0, HUGE_VAL, "metres", false, true));
+  return a;
+}
 
-  BenchArgs bench;
+// Registers `pandora bench` and its options (`viewer_flag`: --viewer, which main handles).
+CLI::App* AddBenchCommand(CLI::App& app, pandora::app::BenchArgs& bench, bool& viewer_flag,
+                          int& threads, const CLI::Validator& threads_check) {
   CLI::App* b = app.add_subcommand(
       "bench", "Time field evaluation against a raw Embree loop over the same rays");
   b->add_option("scene", bench.scene, "Scene file (JSON)")->required();
@@ -226,7 +218,6 @@ int main(int argc, char** argv) {
   b->add_option("--view", bench.view,
                 "With --render: the named view (default: the scene's first view)");
   b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
-  bool viewer_flag = false;  // handled above (pandora-view); listed for --help
   b->add_flag("--viewer", viewer_flag,
               "Frame rates of `pandora view` (navigating, all cameras moving) against the exact "
               "CPU renderer");
@@ -235,9 +226,13 @@ int main(int argc, char** argv) {
   b->add_option("--move", bench.move, "With --incremental: how far each camera moves, metres")
       ->check(Number(0, HUGE_VAL, "metres", false, true))
       ->capture_default_str();
-  b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  return b;
+}
 
-  AccuracyArgs accuracy;
+// Registers `pandora accuracy` and its options.
+CLI::App* AddAccuracyCommand(CLI::App& app, pandora::app::AccuracyArgs& accuracy, int& threads,
+                             const CLI::Validator& threads_check) {
   CLI::App* acc = app.add_subcommand("accuracy",
                                      "Error against run time: voxel size, Monte Carlo trials, "
                                      "steady-state solvers, coarse-to-fine");
@@ -253,9 +248,14 @@ int main(int argc, char** argv) {
   acc->add_flag("--gpu", accuracy.gpu,
                 "Also the GPU renderer of pandora view against the exact one per shadow-map size "
                 "(needs a display)");
-  acc->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  acc->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(threads_check);
+  return acc;
+}
 
-  RenderArgs render;
+// Registers `pandora render` and its options.
+CLI::App* AddRenderCommand(CLI::App& app, pandora::app::RenderArgs& render, int& threads,
+                           const CLI::Validator& threads_check) {
   CLI::App* rn = app.add_subcommand(
       "render",
       "Render the scene lit by every enabled camera as a projector of its own colour (PNG or EXR)");
@@ -324,10 +324,14 @@ int main(int argc, char** argv) {
   rn->add_option("--iso", render.iso, "Draw the isosurface of this field");
   rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)")
       ->check(Number(-HUGE_VAL, HUGE_VAL, "the field's unit"));
-  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
   rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
+  return rn;
+}
 
-  ExportSurfaceArgs surface;
+// Registers `pandora export-surface` and its options.
+CLI::App* AddExportSurfaceCommand(CLI::App& app, pandora::app::ExportSurfaceArgs& surface,
+                                  int& threads, const CLI::Validator& threads_check) {
   CLI::App* es = app.add_subcommand(
       "export-surface",
       "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
@@ -347,10 +351,13 @@ int main(int argc, char** argv) {
   es->add_flag(
       "--all-surfaces", surface.all_surfaces,
       "Sample every surface, also those facing away from the study region and every camera");
-  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
   es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
+  return es;
+}
 
-  ExportRigArgs export_rig;
+// Registers `pandora export-rig` and its options.
+CLI::App* AddExportRigCommand(CLI::App& app, pandora::app::ExportRigArgs& export_rig) {
   CLI::App* er = app.add_subcommand("export-rig",
                                     "Write the rig as OpenCV YAML, a COLMAP text model, glTF "
                                     "(meshes + cameras) or an installation sheet (CSV)");
@@ -359,9 +366,12 @@ int main(int argc, char** argv) {
   er->add_option("--format", export_rig.format, "opencv | colmap | gltf | sheet")->required();
   er->add_option("--out", export_rig.out, "Output file (a folder for colmap)")->required();
   er->add_flag("--quiet,-q", export_rig.quiet, "Print nothing but errors");
+  return er;
+}
 
-  ImportRigArgs import_rig;
-  std::vector<std::string> import_from;
+// Registers `pandora import-rig` and its options (`import_from`: the two values of --from).
+CLI::App* AddImportRigCommand(CLI::App& app, pandora::app::ImportRigArgs& import_rig,
+                              std::vector<std::string>& import_from) {
   CLI::App* ir =
       app.add_subcommand("import-rig",
                          "Write a calibrated rig (OpenCV YAML or COLMAP text model) into the scene "
@@ -375,8 +385,12 @@ int main(int argc, char** argv) {
       ->required();
   ir->add_option("--as", import_rig.as, "Write a new rig of this name instead");
   ir->add_flag("--quiet,-q", import_rig.quiet, "Print nothing but errors");
+  return ir;
+}
 
-  ReportArgs report;
+// Registers `pandora report` and its options.
+CLI::App* AddReportCommand(CLI::App& app, pandora::app::ReportArgs& report, int& threads,
+                           const CLI::Validator& threads_check) {
   CLI::App* rep = app.add_subcommand("report",
                                      "One self-contained HTML report: renders, field slices, "
                                      "histograms, cameras, rigs side by side");
@@ -403,9 +417,14 @@ int main(int argc, char** argv) {
          "--brightness", report.brightness,
          "Scale of every camera's light in the renders (default min(1, 3 / enabled cameras))")
       ->check(Number(0, 1e6, "times one camera's light", false, true));
-  rep->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  rep->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(threads_check);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
-  RigArgs rig_args;
+  return rep;
+}
+
+// Registers `pandora rig` and its options.
+CLI::App* AddRigCommand(CLI::App& app, pandora::app::RigArgs& rig_args) {
   CLI::App* rg = app.add_subcommand("rig",
                                     "Generate a rig (ring, ceiling or wall grid, cameras along "
                                     "walls) and write it into the scene file (keeps a backup)");
@@ -443,8 +462,12 @@ int main(int argc, char** argv) {
   rg->add_option("--prefix", rig_args.prefix, "Camera id prefix (default: the rig's name and _)");
   rg->add_flag("--dry-run", rig_args.dry_run, "Print the new scene file instead of writing it");
   rg->add_flag("-q,--quiet", rig_args.quiet, "Print nothing on success");
+  return rg;
+}
 
-  SuggestArgs suggest;
+// Registers `pandora suggest` and its options.
+CLI::App* AddSuggestCommand(CLI::App& app, pandora::app::SuggestArgs& suggest, int& threads,
+                            const CLI::Validator& threads_check) {
   CLI::App* sg = app.add_subcommand(
       "suggest",
       "Nudge the selected cameras within limits to improve an objective; write a suggestion");
@@ -528,10 +551,13 @@ int main(int argc, char** argv) {
   sg->add_option("--seed", suggest.seed, "Seed for target points and perturbations")
       ->capture_default_str()
       ->check(Number(0, 9.2e18, "(any whole number)", true));
-  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
   sg->add_flag("--quiet,-q", suggest.quiet, "Print nothing but errors");
+  return sg;
+}
 
-  AcceptArgs accept;
+// Registers `pandora accept` and its options.
+CLI::App* AddAcceptCommand(CLI::App& app, pandora::app::AcceptArgs& accept) {
   CLI::App* ac = app.add_subcommand(
       "accept", "Write a suggestion's poses into the scene file (keeps a backup)");
   ac->add_option("suggestion", accept.suggestion, "Suggestion file from pandora suggest")
@@ -539,6 +565,52 @@ int main(int argc, char** argv) {
   ac->add_option("--cameras", accept.cameras, "Comma-separated ids to accept (default: all)");
   ac->add_flag("--force", accept.force, "Accept even if the scene file changed since");
   ac->add_flag("--quiet,-q", accept.quiet, "Print nothing but errors");
+  return ac;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // `pandora view`: the interactive viewer is its own program (the only one that links GL),
+  // pandora-view beside this one; it gets the remaining arguments.
+  // `pandora bench --viewer SCENE [--repeat N]` is `pandora-view SCENE --bench N` (frame rates).
+  bool viewer_bench = false;
+  if (argc >= 2 && std::string(argv[1]) == "bench")
+    for (int i = 2; i < argc; ++i) viewer_bench |= std::string(argv[i]) == "--viewer";
+  if (argc >= 2 && (std::string(argv[1]) == "view" || viewer_bench))
+    return ExecViewer(argc, argv, viewer_bench);
+  using namespace pandora::app;
+  CLI::App app{"Pandora: design multi-camera setups (coverage, resolution and uncertainty fields)"};
+  app.set_version_flag("--version", PANDORA_VERSION);
+  app.require_subcommand(1);
+  int threads = 0;
+  const CLI::Validator kThreads = Number(0, 4096, "threads (0: all cores)", true);
+  app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(kThreads);
+
+  AnalyzeArgs analyze;
+  CLI::App* a = AddAnalyzeCommand(app, analyze, threads, kThreads);
+  BenchArgs bench;
+  bool viewer_flag = false;  // handled above (pandora-view); listed for --help
+  CLI::App* b = AddBenchCommand(app, bench, viewer_flag, threads, kThreads);
+  AccuracyArgs accuracy;
+  CLI::App* acc = AddAccuracyCommand(app, accuracy, threads, kThreads);
+  RenderArgs render;
+  CLI::App* rn = AddRenderCommand(app, render, threads, kThreads);
+  ExportSurfaceArgs surface;
+  CLI::App* es = AddExportSurfaceCommand(app, surface, threads, kThreads);
+  ExportRigArgs export_rig;
+  CLI::App* er = AddExportRigCommand(app, export_rig);
+  ImportRigArgs import_rig;
+  std::vector<std::string> import_from;
+  CLI::App* ir = AddImportRigCommand(app, import_rig, import_from);
+  ReportArgs report;
+  CLI::App* rep = AddReportCommand(app, report, threads, kThreads);
+  RigArgs rig_args;
+  CLI::App* rg = AddRigCommand(app, rig_args);
+  SuggestArgs suggest;
+  CLI::App* sg = AddSuggestCommand(app, suggest, threads, kThreads);
+  AcceptArgs accept;
+  CLI::App* ac = AddAcceptCommand(app, accept);
 
   RefuseEmptyValues(&app);
 

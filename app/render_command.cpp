@@ -18,13 +18,10 @@
 #include "volume/vdb_io.h"
 
 namespace pandora::app {
+namespace {
 
-int RunRender(const RenderArgs& args) {
-  // Options that need no scene first, so typos fail fast.
-  const std::string ext = Lower(std::filesystem::path(args.out).extension().string());
-  if (ext != ".png" && ext != ".exr")
-    throw InputError("--out", "", "unsupported image type '" + ext + "'",
-                     "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
+// Checks that the options name exactly one viewpoint, and only the options that go with it.
+void CheckViewpoint(const RenderArgs& args) {
   const bool have_from = !args.from.empty() || !args.at.empty();
   const int viewpoints = int(!args.view.empty()) + int(have_from) + int(!args.camera.empty()) +
                          int(!args.plan.empty());
@@ -44,6 +41,10 @@ int RunRender(const RenderArgs& args) {
     throw InputError(args.from.empty() ? "--from" : "--at", "", "--from and --at go together");
   if (!std::isnan(args.fov) && !(args.fov > 0 && args.fov < 180))
     throw InputError("--fov", "", "must be in (0, 180) degrees");
+}
+
+// The render options from the command line (pattern, surface, overlays), each checked.
+RenderOptions ParseRenderOptions(const RenderArgs& args) {
   RenderOptions options;
   if (!std::isnan(args.brightness))
     options.brightness =
@@ -99,12 +100,11 @@ int RunRender(const RenderArgs& args) {
     if (!std::isfinite(args.iso_value)) throw InputError("--iso-value", "", "must be finite");
     options.overlays.iso_value = args.iso_value;
   }
+  return options;
+}
 
-  // The study (scene, ray caster and prepared scene, built once) through the session layer.
-  session::SessionOptions session_options;
-  session_options.rig = args.rig;
-  session_options.rig_option = "--rig";
-  session_options.disable = args.disable;
+// The study of --scene, moved to --time-sample when that is given.
+std::shared_ptr<const session::Study> LoadRenderStudy(const RenderArgs& args) {
   std::shared_ptr<const session::Study> study = session::Study::Load(args.scene);
   if (!args.time_sample.empty()) {
     // The scene moved to one time sample: by number, pose name or label.
@@ -128,17 +128,14 @@ int RunRender(const RenderArgs& args) {
     }
     study = session::Study::FromScene(SceneAtSample(placed, samples[pick]), study->text());
   }
-  const session::Session session(study, session_options);
-  const Scene& scene = session.study().scene();
-  const Rig& rig = session.rig().rig();
-  OutputTransaction output;
-  AddSceneInputs(output, scene);
-  output.AddInput(args.fields, "fields file");
-  const std::string staged = output.Stage(args.out, "--out");
-  options.pixel_sigma = scene.study.pixel_sigma;
+  return study;
+}
 
+// The viewpoint: --camera, --view, --plan / --elevation (setting `plan_scale` and the plan's
+// overlays) or --from / --at; then --fov and --size.
+RenderView ChooseView(const RenderArgs& args, const Scene& scene, const Rig& rig,
+                      RenderOptions& options, double& plan_scale) {
   RenderView view;
-  double plan_scale = 0;  // metres per pixel of a plan or elevation
   if (!args.camera.empty()) {
     view.camera = CameraOption(rig, "--camera", args.camera);
     view.width = rig.cameras[view.camera].model.width();
@@ -173,7 +170,12 @@ int RunRender(const RenderArgs& args) {
   }
   if (!std::isnan(args.fov)) view.fov_deg = args.fov;
   if (!args.size.empty()) std::tie(view.width, view.height) = ParseImageSize("--size", args.size);
+  return view;
+}
 
+// The fields of --fields for the overlays (null without it), their provenance checked.
+std::unique_ptr<Fields> ReadOverlayFields(const RenderArgs& args, const Scene& scene,
+                                          const Rig& rig) {
   std::unique_ptr<Fields> fields;
   if (!args.fields.empty()) {
     // A run killed while committing its outputs is finished before they are read.
@@ -184,6 +186,39 @@ int RunRender(const RenderArgs& args) {
          CheckFieldsProvenance(provenance, fields->lattice, scene, rig, args.fields))
       std::fprintf(stderr, "pandora: warning: %s\n", w.c_str());
   }
+  return fields;
+}
+
+}  // namespace
+
+int RunRender(const RenderArgs& args) {
+  // Options that need no scene first, so typos fail fast.
+  const std::string ext = Lower(std::filesystem::path(args.out).extension().string());
+  if (ext != ".png" && ext != ".exr")
+    throw InputError("--out", "", "unsupported image type '" + ext + "'",
+                     "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
+  CheckViewpoint(args);
+  RenderOptions options = ParseRenderOptions(args);
+
+  // The study (scene, ray caster and prepared scene, built once) through the session layer.
+  session::SessionOptions session_options;
+  session_options.rig = args.rig;
+  session_options.rig_option = "--rig";
+  session_options.disable = args.disable;
+  std::shared_ptr<const session::Study> study = LoadRenderStudy(args);
+  const session::Session session(study, session_options);
+  const Scene& scene = session.study().scene();
+  const Rig& rig = session.rig().rig();
+  OutputTransaction output;
+  AddSceneInputs(output, scene);
+  output.AddInput(args.fields, "fields file");
+  const std::string staged = output.Stage(args.out, "--out");
+  options.pixel_sigma = scene.study.pixel_sigma;
+
+  double plan_scale = 0;  // metres per pixel of a plan or elevation
+  RenderView view = ChooseView(args, scene, rig, options, plan_scale);
+
+  const std::unique_ptr<Fields> fields = ReadOverlayFields(args, scene, rig);
 
   // One BVH for the image and the rig checks: the study's, under its prepared scene.
   std::unique_ptr<PreparedOverlays> overlays;

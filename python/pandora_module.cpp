@@ -104,9 +104,8 @@ double SigmaOf(const Scene& scene, const Camera& c) {
   return c.pixel_sigma > 0 ? c.pixel_sigma : scene.study.pixel_sigma;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(pandora, m) {
+// The module docstring and pandora.InputError with its file/path/reason/hint attributes.
+void BindInputError(py::module_& m) {
   m.doc() = "Pandora: multi-camera setup design (coverage, resolution and uncertainty fields)";
   static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -124,7 +123,10 @@ PYBIND11_MODULE(pandora, m) {
       PyErr_SetObject(input_error.ptr(), err.ptr());
     }
   });
+}
 
+// pandora.Scene and load_scene().
+void BindScene(py::module_& m) {
   py::class_<PyScene>(m, "Scene", "A scene file, loaded and checked, with its ray caster.")
       .def_property_readonly("path", [](const PyScene& s) { return s.scene().path; })
       .def_property_readonly("rigs",
@@ -163,7 +165,10 @@ PYBIND11_MODULE(pandora, m) {
       "load_scene", [](const std::string& path) { return PyScene{session::Study::Load(path)}; },
       py::arg("path"),
       "Reads and checks a scene file (meshes, rigs, study); raises pandora.InputError.");
+}
 
+// pandora.Rig: the editable rig (returned for the suggestion bindings that extend it).
+py::class_<PyRig> BindRig(py::module_& m) {
   py::class_<PyRig> rig(m, "Rig",
                         "A rig of cameras being edited (undo, redo, save with a backup).");
   rig.def_property_readonly("name", [](const PyRig& r) { return r.rig().name; })
@@ -263,7 +268,11 @@ PYBIND11_MODULE(pandora, m) {
             return ids;
           },
           "Ids of the cameras that differ from the scene file.");
+  return rig;
+}
 
+// pandora.Fields: evaluated grids as sparse or dense arrays, and write().
+void BindFields(py::module_& m) {
   py::class_<PyFields>(m, "Fields",
                        "Evaluated fields over the study region (sparse OpenVDB grids).")
       .def_property_readonly("names", [](const PyFields& f) { return f.names; })
@@ -358,7 +367,10 @@ PYBIND11_MODULE(pandora, m) {
           py::arg("path"),
           "Writes the grids as `pandora analyze` writes fields.vdb (atomically; never over an "
           "input).");
+}
 
+// evaluate(): the fields for a rig.
+void BindEvaluate(py::module_& m) {
   m.def(
       "evaluate",
       [](const PyScene& s, const PyRig& r, std::vector<std::string> fields) {
@@ -391,7 +403,10 @@ PYBIND11_MODULE(pandora, m) {
       "Evaluates the fields (default: the study's) for the rig's enabled cameras; with PTZ cameras "
       "also "
       "their reach-time and tour fields.");
+}
 
+// visibility() and covariance() at given points.
+void BindPointQueries(py::module_& m) {
   m.def(
       "visibility",
       [](const PyScene& s, const PyRig& r,
@@ -441,7 +456,10 @@ PYBIND11_MODULE(pandora, m) {
       py::arg("scene"), py::arg("rig"), py::arg("points"),
       "(N, 3, 3) triangulation covariance (m^2) from the cameras that see each point; NaN where "
       "not triangulable.");
+}
 
+// render(): the projective-light render as a numpy array.
+void BindRender(py::module_& m) {
   m.def(
       "render",
       [](const PyScene& s, const PyRig& r, const std::string& view, int width, int height,
@@ -480,6 +498,18 @@ PYBIND11_MODULE(pandora, m) {
       py::arg("scene"), py::arg("rig"), py::arg("view") = "", py::arg("width") = 640,
       py::arg("height") = 400, py::arg("plan") = "",
       "The projective-light render as an (H, W, 3) float32 linear RGB array.");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(pandora, m) {
+  BindInputError(m);
+  BindScene(m);
+  py::class_<PyRig> rig = BindRig(m);
+  BindFields(m);
+  BindEvaluate(m);
+  BindPointQueries(m);
+  BindRender(m);
 
   BindSuggest(m, rig);
 }

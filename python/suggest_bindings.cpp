@@ -214,10 +214,9 @@ AcceptResult AcceptText(const std::string& text, const AcceptOptions& options) {
   }
 }
 
-}  // namespace
-
-void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
-  // ---- PTZ settings of a rig camera, and save ---------------------------------------------------
+// ---- PTZ settings of a rig camera, and save ---------------------------------------------------
+// Rig.ptz(), Rig.set_ptz() and Rig.save().
+void BindPtzSettings(py::class_<PyRig>& rig) {
   rig.def(
          "ptz",
          [](const PyRig& r, const std::string& id) {
@@ -307,8 +306,11 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
           "keeping "
           "the previous file as a backup; refuses when the file changed since it was loaded "
           "(unless force).");
+}
 
-  // ---- Suggestions -----------------------------------------------------------------------------
+// ---- Suggestions -----------------------------------------------------------------------------
+// pandora.Suggestion: its measures, save(), apply() and accept().
+void BindSuggestion(py::module_& m) {
   py::class_<PySuggestion>(m, "Suggestion",
                            "A suggestion: look at it, apply it to the rig, save it, or accept it.")
       .def_property_readonly("kind", [](const PySuggestion& s) { return s.kind; })
@@ -414,7 +416,10 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
           "Writes the suggestion into the scene file as `pandora accept` does (backup, read-back "
           "check) and "
           "applies it to the rig; `cameras`: only these ids (camera nudges).");
+}
 
+// suggest(): camera nudges, as `pandora suggest`.
+void BindSuggestCameras(py::module_& m) {
   m.def(
       "suggest",
       [](const PyScene& sc, PyRig& r, std::vector<std::string> cameras,
@@ -489,7 +494,10 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
       "`pandora suggest` does (docs/suggest.md). Per-camera limits: a value for all, a list in "
       "`cameras` "
       "order, or for hfov_range / rail / plane / mount_box a dict {id: value}.");
+}
 
+// suggest_ptz_preset() and suggest_ptz_tour().
+void BindSuggestPtz(py::module_& m) {
   auto ptz_common = [](const PyScene& sc, PyRig& r, const char* option, const std::string& id,
                        int points, const std::string& target_region,
                        const std::vector<std::string>& surfaces, bool with_region,
@@ -596,7 +604,10 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
       py::arg("seed") = 1,
       "The order of a PTZ camera's tour stops that minimises the mean (or max) longest unwatched "
       "gap.");
+}
 
+// accept(): a saved suggestion file into its scene file.
+void BindAccept(py::module_& m) {
   m.def(
       "accept",
       [](const std::string& path, std::vector<std::string> cameras, bool force) {
@@ -607,6 +618,16 @@ void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
       },
       py::arg("path"), py::arg("cameras") = std::vector<std::string>{}, py::arg("force") = false,
       "`pandora accept PATH`: writes a saved suggestion file into its scene file (backup kept).");
+}
+
+}  // namespace
+
+void BindSuggest(py::module_& m, py::class_<PyRig>& rig) {
+  BindPtzSettings(rig);
+  BindSuggestion(m);
+  BindSuggestCameras(m);
+  BindSuggestPtz(m);
+  BindAccept(m);
 }
 
 }  // namespace pandora::python

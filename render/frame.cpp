@@ -499,6 +499,17 @@ struct FrameRenderer::Impl {
   std::vector<double> reach_budget;
   const std::vector<int>* object_texture = nullptr;
   const std::vector<uint8_t>* drawn_edges = nullptr;
+
+  // The steps of RenderGroup (frame.h).
+  int GroupSamples(int level, int x0, int y0, int x1, int y1, GroupScratch* scratch) const;
+  void TracePrimary(GroupScratch* scratch, TileRecord* record, bool record_rays) const;
+  void CameraSegments(int c, const PtzReach* reach, GroupScratch* scratch) const;
+  void ApplyCameraLight(int c, const PtzReach* reach, GroupScratch* scratch) const;
+  Vec3 SurfaceColor(const Sample& smp, Vec3 color) const;
+  Vec3 OverlayColor(const Sample& smp, const FieldSlice* slice, double slice_plane,
+                    Vec3 color) const;
+  void StoreLayers(const Sample& smp, std::size_t p, const GroupScratch& scratch,
+                   FrameBuffers* out) const;
 };
 
 FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, const RenderView& view,
@@ -608,18 +619,11 @@ void FrameRenderer::Reset(FrameBuffers* b) const {
     b->normal.clear();
 }
 
-void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch,
-                                TileRecord* record, bool record_rays) const {
-  const Impl& m = *impl_;
-  const RenderOptions& options = m.options;
-  const Rig& rig = m.rig;
-  const ViewRays& rays = m.rays;
-  const PreparedSceneData& scene = m.scene;
-  const RayCaster& caster = *scene.caster;
-  const int W = width_;
-  const int samples = m.samples;
-  const int x0 = (tile % tiles_x_) * kTile, y0 = (tile / tiles_x_) * kTile;
-  const int x1 = std::min(W, x0 + kTile), y1 = std::min(height_, y0 + kTile);
+// The samples of group `level` of the tile with pixels [x0, x1) x [y0, y1), in tile order, into
+// scratch->s; returns the number of centre samples.
+int FrameRenderer::Impl::GroupSamples(int level, int x0, int y0, int x1, int y1,
+                                      GroupScratch* scratch) const {
+  const Impl& m = *this;
   const int tw = x1 - x0;
   // At the last level with several samples per pixel, the stratified colour samples of every
   // pixel of the tile are traced; the coarser levels' centre samples give a preview colour.
@@ -658,13 +662,14 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
           s.push_back(e);
         }
   }
-  if (s.empty()) return;
-  std::vector<double>& resolution = scratch->resolution;
-  std::vector<InformationBuilder>& info = scratch->info;
-  if (options.layers) {
-    resolution.assign(centres, 0.0);
-    info.assign(centres, InformationBuilder());
-  }
+  return centres;
+}
+
+// Traces the group's primary rays and sets the samples' hits.
+void FrameRenderer::Impl::TracePrimary(GroupScratch* scratch, TileRecord* record,
+                                       bool record_rays) const {
+  std::vector<Sample>& s = scratch->s;
+  const RayCaster& caster = *scene.caster;
   // Primary rays, in sample order (Morton order: compact clusters per packet).
   std::vector<Ray>& primary = scratch->primary;
   std::vector<int>& primary_owner = scratch->primary_owner;
@@ -694,6 +699,239 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       h.t += rays.NearT(s[primary_owner[k]].d);  // from the eye
       SetHit(rays.eye(), h, scene.mesh, &s[primary_owner[k]]);
     }
+}
+
+// Camera c's occlusion segments to the group's hit points that pass its geometric tests, with
+// their samples (owner), projection Jacobians and light factors (shade).
+void FrameRenderer::Impl::CameraSegments(int c, const PtzReach* reach,
+                                         GroupScratch* scratch) const {
+  const Impl& m = *this;
+  std::vector<Sample>& s = scratch->s;
+  std::vector<Ray>& segments = scratch->segments;
+  std::vector<int>& owner = scratch->owner;
+  std::vector<Mat23>& jacobians = scratch->jacobians;
+  std::vector<double>& shade = scratch->shade;
+  const Cull& cull = m.culls[c];
+  segments.clear();
+  owner.clear();
+  jacobians.clear();
+  shade.clear();
+  for (int i = 0; i < int(s.size()); ++i) {
+    if (!s[i].hit) continue;
+    const Vec3 X = s[i].X + m.lift * s[i].n;
+    Ray seg;
+    Mat23 J;
+    if (reach) {
+      // The first whole second (0 = from home) from which a reachable setting sees X.
+      const double budget = m.reach_budget[c];
+      const int seconds = std::max(1, static_cast<int>(std::ceil(budget - 1e-9)));
+      int k = 0;
+      while (k <= seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg)) ++k;
+      if (k > seconds) continue;  // not reachable within the budget
+      const double tol = m.tester.Tolerance(c, seg.t_far);
+      seg.t_near = tol;
+      seg.t_far = std::max(tol, seg.t_far - tol);
+      if (m.need_jacobian) {
+        const std::optional<PtzState> pose = reach->BestPose(X, std::min<double>(k, budget));
+        const Camera at = rig.cameras[c].ptz->CameraAt(rig.cameras[c], *pose);
+        if (!at.Project(X, &J)) J.setZero();
+      }
+      shade.push_back(1.0 - 0.6 * k / seconds);
+    } else {
+      if (!cull.MaySee(X, s[i].n)) continue;
+      if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) !=
+          ViewResult::kSeen)
+        continue;
+      shade.push_back(1.0);
+    }
+    if (seg.t_far <= seg.t_near) seg.t_far = seg.t_near;  // at the centre: nothing between
+    segments.push_back(seg);
+    owner.push_back(i);
+    jacobians.push_back(J);
+  }
+}
+
+// Camera c's light rule term (and layers) for each sample whose segment is not occluded.
+void FrameRenderer::Impl::ApplyCameraLight(int c, const PtzReach* reach,
+                                           GroupScratch* scratch) const {
+  const Impl& m = *this;
+  std::vector<Sample>& s = scratch->s;
+  const std::vector<Ray>& segments = scratch->segments;
+  const std::vector<int>& owner = scratch->owner;
+  const std::vector<Mat23>& jacobians = scratch->jacobians;
+  const std::vector<uint8_t>& occluded = scratch->occluded;
+  const std::vector<double>& shade = scratch->shade;
+  std::vector<double>& resolution = scratch->resolution;
+  std::vector<InformationBuilder>& info = scratch->info;
+  const Camera& cam = rig.cameras[c];
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    if (occluded[k] && segments[k].t_far > segments[k].t_near) continue;
+    Sample& smp = s[owner[k]];
+    const Mat23& J = jacobians[k];
+    if (smp.layers) {
+      ++smp.seen;
+      if (m.mask) smp.mask |= uint64_t(1) << c;
+      if (options.layers) {
+        resolution[smp.slot] = std::max(resolution[smp.slot], PixelDensity(J));
+        info[smp.slot].Add(J, m.sigma_px[c]);
+      }
+    }
+    if (smp.weight == 0) continue;
+    CameraAtPoint at;
+    at.sees = true;
+    at.color = shade[k] * cam.color;
+    if (options.pattern == Pattern::kGrid && !reach) {
+      const auto pixel = cam.Project(smp.X);
+      // Derivative of the hit point per output pixel on the hit plane (ray differentials), and
+      // of the camera's pixel coordinates through the projection Jacobian.
+      const double nd = smp.n.dot(smp.d);
+      const Vec3 dXdx = smp.t * (smp.ddx - (smp.n.dot(smp.ddx) / nd) * smp.d);
+      const Vec3 dXdy = smp.t * (smp.ddy - (smp.n.dot(smp.ddy) / nd) * smp.d);
+      at.du = Eigen::Vector2d(J.row(0).dot(dXdx), J.row(0).dot(dXdy)).norm();
+      at.dv = Eigen::Vector2d(J.row(1).dot(dXdx), J.row(1).dot(dXdy)).norm();
+      at.projects = pixel.has_value();
+      if (pixel) {
+        at.u = pixel->x();
+        at.v = pixel->y();
+      }
+    }
+    smp.light += CameraLight(m.rule, at);
+  }
+}
+
+// The colour of a sample's hit surface (`color`: the background), with the drawn edges of
+// Surface::kHiddenLine over it.
+Vec3 FrameRenderer::Impl::SurfaceColor(const Sample& smp, Vec3 color) const {
+  const Impl& m = *this;
+  const int object = scene.triangle_object[smp.triangle];
+  switch (options.surface) {
+    case Surface::kMaterial: {
+      Vec3 albedo = scene.object_color[object];
+      const std::vector<int>& object_texture = *m.object_texture;
+      if (object_texture[object] >= 0)  // colour times texture (OBJ Kd x map_Kd, glTF)
+        albedo =
+            albedo.cwiseProduct(SampleTexture(scene.textures[object_texture[object]],
+                                              TextureCoordinate(scene.mesh, smp.triangle, smp.X)));
+      color = MaterialColor(albedo, smp.light, options.ambient, smp.n.dot(smp.d));
+      break;
+    }
+    default:
+      color = smp.light;
+      break;
+  }
+  if (m.drawn_edges && (*m.drawn_edges)[smp.triangle]) {
+    const uint8_t drawn = (*m.drawn_edges)[smp.triangle];
+    const auto& tri = scene.mesh.triangles[smp.triangle];
+    const Vec3 A = scene.mesh.vertices[tri[0]], B = scene.mesh.vertices[tri[1]],
+               C = scene.mesh.vertices[tri[2]];
+    const Vec3 cr = (B - A).cross(C - A);
+    const double area2 = cr.norm();
+    if (area2 > 0) {
+      const Vec3 nt = cr / area2;
+      const double nd = smp.n.dot(smp.d);
+      const Vec3 dXdx = smp.t * (smp.ddx - (smp.n.dot(smp.ddx) / nd) * smp.d);
+      const Vec3 dXdy = smp.t * (smp.ddy - (smp.n.dot(smp.ddy) / nd) * smp.d);
+      const Vec3 P[3] = {A, B, C};
+      double a = 0;
+      for (int i = 0; i < 3; ++i) {
+        if (!(drawn & (1u << i))) continue;
+        const Vec3& E0 = P[(i + 1) % 3];
+        const Vec3& E1 = P[(i + 2) % 3];
+        const Vec3 grad = nt.cross(E1 - E0) / area2;  // gradient of barycentric i
+        const double lambda = grad.dot(smp.X - E0);
+        const double g = Eigen::Vector2d(grad.dot(dXdx), grad.dot(dXdy)).norm();
+        if (g > 0) a = std::max(a, LineCoverage(std::abs(lambda) / g, options.line_width_px));
+      }
+      color = (1.0 - a) * color + a * Vec3::Constant(options.line_grey);
+    }
+  }
+  return color;
+}
+
+// `color` with the slice plane and isosurface in front of the surface, alpha-composited back to
+// front.
+Vec3 FrameRenderer::Impl::OverlayColor(const Sample& smp, const FieldSlice* slice,
+                                       double slice_plane, Vec3 color) const {
+  const Impl& m = *this;
+  const OverlayOptions& ov = options.overlays;
+  const double t_surface = smp.hit ? smp.t : kInf;
+  if (smp.d.squaredNorm() > 0) {
+    struct Layer {
+      double t;
+      Vec3 color;
+      double alpha;
+    };
+    Layer layers[2];
+    int nl = 0;
+    if (slice && smp.d[slice->axis] != 0) {
+      const double tp = (slice_plane - rays.eye()[slice->axis]) / smp.d[slice->axis];
+      if (tp > 0 && tp < t_surface) {
+        const double v = slice->Sample(rays.eye() + tp * smp.d);
+        if (std::isfinite(v)) {
+          const double range = m.slice_max - m.slice_min;
+          const double u = range > 0 ? (v - m.slice_min) / range : 0.5;
+          layers[nl++] = {tp, ViridisLinear(u), ov.slice_opacity};
+        }
+      }
+    }
+    if (m.iso_caster) {
+      const auto ih = m.iso_caster->Intersect(Ray{rays.eye(), smp.d, 0.0, t_surface});
+      if (ih) {
+        const double shade = 0.35 + 0.65 * std::abs(ih->normal.dot(smp.d));
+        layers[nl++] = {ih->t, shade * ov.iso_color, ov.iso_opacity};
+      }
+    }
+    if (nl == 2 && layers[0].t < layers[1].t) std::swap(layers[0], layers[1]);
+    for (int i = 0; i < nl; ++i)
+      color = (1.0 - layers[i].alpha) * color + layers[i].alpha * layers[i].color;
+  }
+  return color;
+}
+
+// Every layer of a centre sample's pixel `p`, also where nothing is hit.
+void FrameRenderer::Impl::StoreLayers(const Sample& smp, std::size_t p, const GroupScratch& scratch,
+                                      FrameBuffers* out) const {
+  const Impl& m = *this;
+  Image& image = out->image;
+  const std::vector<double>& resolution = scratch.resolution;
+  const std::vector<InformationBuilder>& info = scratch.info;
+  image.depth[p] = smp.hit ? float(smp.t) : std::numeric_limits<float>::infinity();
+  image.object[p] = smp.hit ? scene.triangle_object[smp.triangle] : -1;
+  if (m.mask) image.cameras[p] = smp.mask;
+  image.coverage[p] = float(smp.seen);
+  image.resolution[p] = options.layers ? float(resolution[smp.slot]) : 0.0f;
+  float sigma = std::numeric_limits<float>::infinity();
+  if (options.layers && info[smp.slot].cameras() >= 2) {
+    const InformationBuilder& b = info[smp.slot];
+    const StaticUncertainty u = StaticFromInformation(b.Decompose(), b.cameras());
+    if (u.triangulable) sigma = float(1e3 * u.sigma_max);
+  }
+  image.sigma_max[p] = sigma;
+  if (!out->normal.empty()) out->normal[p] = smp.hit ? smp.n : Vec3::Zero();
+}
+
+void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScratch* scratch,
+                                TileRecord* record, bool record_rays) const {
+  const Impl& m = *impl_;
+  const RenderOptions& options = m.options;
+  const Rig& rig = m.rig;
+  const PreparedSceneData& scene = m.scene;
+  const RayCaster& caster = *scene.caster;
+  const int W = width_;
+  const int x0 = (tile % tiles_x_) * kTile, y0 = (tile / tiles_x_) * kTile;
+  const int x1 = std::min(W, x0 + kTile), y1 = std::min(height_, y0 + kTile);
+  const int tw = x1 - x0;
+  const int centres = m.GroupSamples(level, x0, y0, x1, y1, scratch);
+  std::vector<Sample>& s = scratch->s;
+  if (s.empty()) return;
+  std::vector<double>& resolution = scratch->resolution;
+  std::vector<InformationBuilder>& info = scratch->info;
+  if (options.layers) {
+    resolution.assign(centres, 0.0);
+    info.assign(centres, InformationBuilder());
+  }
+  // Primary rays, in sample order (Morton order: compact clusters per packet).
+  m.TracePrimary(scratch, record, record_rays);
   // Cameras that cannot see any of the group's hit points skip it (FrustumCuller is conservative).
   Aabb box;
   for (const Sample& smp : s)
@@ -705,54 +943,13 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
   // Per camera, in rig order: the geometric tests, then the occlusion segments of the whole group
   // as packets, then the light rule's term for each sample that camera sees.
   std::vector<Ray>& segments = scratch->segments;
-  std::vector<int>& owner = scratch->owner;
-  std::vector<Mat23>& jacobians = scratch->jacobians;
   std::vector<uint8_t>& occluded = scratch->occluded;
   const int camera_count = int(rig.cameras.size());
-  std::vector<double>& shade = scratch->shade;
   for (int c = 0; c < camera_count && !box.empty(); ++c) {
     if (!rig.cameras[c].enabled) continue;
     const PtzReach* reach = m.reach[c].get();
     if (!reach && !m.culler.MayIntersect(c, box)) continue;
-    const Cull& cull = m.culls[c];
-    segments.clear();
-    owner.clear();
-    jacobians.clear();
-    shade.clear();
-    for (int i = 0; i < int(s.size()); ++i) {
-      if (!s[i].hit) continue;
-      const Vec3 X = s[i].X + m.lift * s[i].n;
-      Ray seg;
-      Mat23 J;
-      if (reach) {
-        // The first whole second (0 = from home) from which a reachable setting sees X.
-        const double budget = m.reach_budget[c];
-        const int seconds = std::max(1, static_cast<int>(std::ceil(budget - 1e-9)));
-        int k = 0;
-        while (k <= seconds && !reach->Reachable(X, std::min<double>(k, budget), &s[i].n, &seg))
-          ++k;
-        if (k > seconds) continue;  // not reachable within the budget
-        const double tol = m.tester.Tolerance(c, seg.t_far);
-        seg.t_near = tol;
-        seg.t_far = std::max(tol, seg.t_far - tol);
-        if (m.need_jacobian) {
-          const std::optional<PtzState> pose = reach->BestPose(X, std::min<double>(k, budget));
-          const Camera at = rig.cameras[c].ptz->CameraAt(rig.cameras[c], *pose);
-          if (!at.Project(X, &J)) J.setZero();
-        }
-        shade.push_back(1.0 - 0.6 * k / seconds);
-      } else {
-        if (!cull.MaySee(X, s[i].n)) continue;
-        if (m.tester.TestGeometry(c, X, &s[i].n, &seg, m.need_jacobian ? &J : nullptr) !=
-            ViewResult::kSeen)
-          continue;
-        shade.push_back(1.0);
-      }
-      if (seg.t_far <= seg.t_near) seg.t_far = seg.t_near;  // at the centre: nothing between
-      segments.push_back(seg);
-      owner.push_back(i);
-      jacobians.push_back(J);
-    }
+    m.CameraSegments(c, reach, scratch);
     if (segments.empty()) continue;
     occluded.resize(segments.size());
     caster.OccludedPacket(segments.data(), segments.size(), occluded.data());
@@ -761,40 +958,7 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       if (record_rays)
         record->shadow_rays.insert(record->shadow_rays.end(), segments.begin(), segments.end());
     }
-    const Camera& cam = rig.cameras[c];
-    for (std::size_t k = 0; k < segments.size(); ++k) {
-      if (occluded[k] && segments[k].t_far > segments[k].t_near) continue;
-      Sample& smp = s[owner[k]];
-      const Mat23& J = jacobians[k];
-      if (smp.layers) {
-        ++smp.seen;
-        if (m.mask) smp.mask |= uint64_t(1) << c;
-        if (options.layers) {
-          resolution[smp.slot] = std::max(resolution[smp.slot], PixelDensity(J));
-          info[smp.slot].Add(J, m.sigma_px[c]);
-        }
-      }
-      if (smp.weight == 0) continue;
-      CameraAtPoint at;
-      at.sees = true;
-      at.color = shade[k] * cam.color;
-      if (options.pattern == Pattern::kGrid && !reach) {
-        const auto pixel = cam.Project(smp.X);
-        // Derivative of the hit point per output pixel on the hit plane (ray differentials), and
-        // of the camera's pixel coordinates through the projection Jacobian.
-        const double nd = smp.n.dot(smp.d);
-        const Vec3 dXdx = smp.t * (smp.ddx - (smp.n.dot(smp.ddx) / nd) * smp.d);
-        const Vec3 dXdy = smp.t * (smp.ddy - (smp.n.dot(smp.ddy) / nd) * smp.d);
-        at.du = Eigen::Vector2d(J.row(0).dot(dXdx), J.row(0).dot(dXdy)).norm();
-        at.dv = Eigen::Vector2d(J.row(1).dot(dXdx), J.row(1).dot(dXdy)).norm();
-        at.projects = pixel.has_value();
-        if (pixel) {
-          at.u = pixel->x();
-          at.v = pixel->y();
-        }
-      }
-      smp.light += CameraLight(m.rule, at);
-    }
+    m.ApplyCameraLight(c, reach, scratch);
   }
   // Shading, overlays in front of the surface, and the layers.
   // A pixel's samples are consecutive: its colour is summed in `sum` and stored when the next
@@ -807,89 +971,15 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
     const std::size_t q = std::size_t(y0 + summing / tw) * W + (x0 + summing % tw);
     for (int k = 0; k < 3; ++k) image.rgb[3 * q + k] = sum[k];
   };
-  const OverlayOptions& ov = options.overlays;
   const FieldSlice* slice = m.have_slice ? &m.overlays->slice : nullptr;
   const double slice_plane = m.have_slice ? m.overlays->slice_plane : 0.0;
   for (Sample& smp : s) {
     const int x = x0 + smp.pixel % tw, y = y0 + smp.pixel / tw;
     const std::size_t p = std::size_t(y) * W + x;
     Vec3 color = smp.d.squaredNorm() == 0 ? Vec3::Zero() : options.background;
-    if (smp.hit) {
-      const int object = scene.triangle_object[smp.triangle];
-      switch (options.surface) {
-        case Surface::kMaterial: {
-          Vec3 albedo = scene.object_color[object];
-          const std::vector<int>& object_texture = *m.object_texture;
-          if (object_texture[object] >= 0)  // colour times texture (OBJ Kd x map_Kd, glTF)
-            albedo = albedo.cwiseProduct(
-                SampleTexture(scene.textures[object_texture[object]],
-                              TextureCoordinate(scene.mesh, smp.triangle, smp.X)));
-          color = MaterialColor(albedo, smp.light, options.ambient, smp.n.dot(smp.d));
-          break;
-        }
-        default:
-          color = smp.light;
-          break;
-      }
-      if (m.drawn_edges && (*m.drawn_edges)[smp.triangle]) {
-        const uint8_t drawn = (*m.drawn_edges)[smp.triangle];
-        const auto& tri = scene.mesh.triangles[smp.triangle];
-        const Vec3 A = scene.mesh.vertices[tri[0]], B = scene.mesh.vertices[tri[1]],
-                   C = scene.mesh.vertices[tri[2]];
-        const Vec3 cr = (B - A).cross(C - A);
-        const double area2 = cr.norm();
-        if (area2 > 0) {
-          const Vec3 nt = cr / area2;
-          const double nd = smp.n.dot(smp.d);
-          const Vec3 dXdx = smp.t * (smp.ddx - (smp.n.dot(smp.ddx) / nd) * smp.d);
-          const Vec3 dXdy = smp.t * (smp.ddy - (smp.n.dot(smp.ddy) / nd) * smp.d);
-          const Vec3 P[3] = {A, B, C};
-          double a = 0;
-          for (int i = 0; i < 3; ++i) {
-            if (!(drawn & (1u << i))) continue;
-            const Vec3& E0 = P[(i + 1) % 3];
-            const Vec3& E1 = P[(i + 2) % 3];
-            const Vec3 grad = nt.cross(E1 - E0) / area2;  // gradient of barycentric i
-            const double lambda = grad.dot(smp.X - E0);
-            const double g = Eigen::Vector2d(grad.dot(dXdx), grad.dot(dXdy)).norm();
-            if (g > 0) a = std::max(a, LineCoverage(std::abs(lambda) / g, options.line_width_px));
-          }
-          color = (1.0 - a) * color + a * Vec3::Constant(options.line_grey);
-        }
-      }
-    }
+    if (smp.hit) color = m.SurfaceColor(smp, color);
     // Slice plane and isosurface in front of the surface, alpha-composited back to front.
-    const double t_surface = smp.hit ? smp.t : kInf;
-    if (smp.d.squaredNorm() > 0) {
-      struct Layer {
-        double t;
-        Vec3 color;
-        double alpha;
-      };
-      Layer layers[2];
-      int nl = 0;
-      if (slice && smp.d[slice->axis] != 0) {
-        const double tp = (slice_plane - rays.eye()[slice->axis]) / smp.d[slice->axis];
-        if (tp > 0 && tp < t_surface) {
-          const double v = slice->Sample(rays.eye() + tp * smp.d);
-          if (std::isfinite(v)) {
-            const double range = m.slice_max - m.slice_min;
-            const double u = range > 0 ? (v - m.slice_min) / range : 0.5;
-            layers[nl++] = {tp, ViridisLinear(u), ov.slice_opacity};
-          }
-        }
-      }
-      if (m.iso_caster) {
-        const auto ih = m.iso_caster->Intersect(Ray{rays.eye(), smp.d, 0.0, t_surface});
-        if (ih) {
-          const double shade = 0.35 + 0.65 * std::abs(ih->normal.dot(smp.d));
-          layers[nl++] = {ih->t, shade * ov.iso_color, ov.iso_opacity};
-        }
-      }
-      if (nl == 2 && layers[0].t < layers[1].t) std::swap(layers[0], layers[1]);
-      for (int i = 0; i < nl; ++i)
-        color = (1.0 - layers[i].alpha) * color + layers[i].alpha * layers[i].color;
-    }
+    color = m.OverlayColor(smp, slice, slice_plane, color);
     if (smp.weight > 0) {
       if (smp.pixel != summing) {
         store();
@@ -898,21 +988,8 @@ void FrameRenderer::RenderGroup(int tile, int level, FrameBuffers* out, GroupScr
       }
       for (int k = 0; k < 3; ++k) sum[k] += float(smp.weight * color[k]);
     }
-    if (smp.layers) {  // every layer of the pixel, also where nothing is hit
-      image.depth[p] = smp.hit ? float(smp.t) : std::numeric_limits<float>::infinity();
-      image.object[p] = smp.hit ? scene.triangle_object[smp.triangle] : -1;
-      if (m.mask) image.cameras[p] = smp.mask;
-      image.coverage[p] = float(smp.seen);
-      image.resolution[p] = options.layers ? float(resolution[smp.slot]) : 0.0f;
-      float sigma = std::numeric_limits<float>::infinity();
-      if (options.layers && info[smp.slot].cameras() >= 2) {
-        const InformationBuilder& b = info[smp.slot];
-        const StaticUncertainty u = StaticFromInformation(b.Decompose(), b.cameras());
-        if (u.triangulable) sigma = float(1e3 * u.sigma_max);
-      }
-      image.sigma_max[p] = sigma;
-      if (!out->normal.empty()) out->normal[p] = smp.hit ? smp.n : Vec3::Zero();
-    }
+    // Every layer of the pixel, also where nothing is hit.
+    if (smp.layers) m.StoreLayers(smp, p, *scratch, out);
   }
   store();
 }

@@ -5,15 +5,10 @@
                                          writes it (clang-format --dry-run -Werror); lists the
                                          files that differ and exits 1.
   scripts/check_style.py function-size   no function longer than LIMIT lines (signature to closing
-                                         brace, comments and blank lines included), GoogleTest
-                                         bodies (TEST, TEST_F, TEST_P) included. Functions found by
-                                         universal-ctags. The functions listed in
-                                         scripts/function_size_allowlist.txt were over the limit
-                                         when the check came in: each may shrink, never grow, and
-                                         must leave the list once it is within the limit, so the
-                                         list only gets shorter.
-  scripts/check_style.py function-size --write-allowlist
-                                         rewrites the allowlist from the tree (only to shorten it).
+                                         brace, comments and blank lines included), lambdas counted
+                                         in their function and on their own, GoogleTest bodies
+                                         (TEST, TEST_F, TEST_P) included. Functions found by
+                                         universal-ctags.
 Run from anywhere; it reads the git checkout it lives in.
 """
 import os
@@ -23,7 +18,6 @@ import sys
 
 LIMIT = 150
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ALLOWLIST = os.path.join(ROOT, 'scripts', 'function_size_allowlist.txt')
 
 
 def tracked_cpp():
@@ -142,57 +136,13 @@ def functions():
     return long
 
 
-def read_allowlist():
-    allowed = {}
-    if os.path.exists(ALLOWLIST):
-        with open(ALLOWLIST, encoding='utf-8') as f:
-            for line in f:
-                line = line.strip()
-                if not line or line.startswith('#'):
-                    continue
-                lines, path, name = line.split(None, 2)
-                allowed[(path, name)] = int(lines)
-    return allowed
-
-
-def check_function_size(write):
+def check_function_size():
     long = functions()
-    if write:
-        allowed = read_allowlist()
-        grown = [k for k in long if k not in allowed or long[k] > allowed[k]]
-        if grown and os.path.exists(ALLOWLIST):
-            print('refusing to write: the allowlist may only shrink; over the limit and new or grown: '
-                  + ', '.join('%s %s (%d)' % (k[0], k[1], long[k]) for k in grown))
-            return 1
-        with open(ALLOWLIST, 'w', encoding='utf-8') as f:
-            f.write('# Functions over %d lines when scripts/check_style.py came in (issue 28): lines, file,\n'
-                    '# function. Each may shrink, never grow; split one and take its line out. Never add one.\n'
-                    % LIMIT)
-            for (path, name), n in sorted(long.items(), key=lambda kv: (-kv[1], kv[0])):
-                f.write('%d %s %s\n' % (n, path, name))
-        print('wrote %s: %d functions' % (ALLOWLIST, len(long)))
-        return 0
-    allowed = read_allowlist()
-    errors = []
     for (path, name), n in sorted(long.items()):
-        if (path, name) not in allowed:
-            errors.append('%s: %s is %d lines, over the limit of %d: split it' % (path, name, n, LIMIT))
-        elif n > allowed[(path, name)]:
-            errors.append('%s: %s grew to %d lines (listed at %d, over the limit of %d): split it'
-                          % (path, name, n, allowed[(path, name)], LIMIT))
-    for (path, name), n in sorted(allowed.items()):
-        if (path, name) not in long:
-            errors.append('%s: %s is within %d lines now (or gone): take its line out of %s'
-                          % (path, name, LIMIT, os.path.relpath(ALLOWLIST, ROOT)))
-        elif long[(path, name)] < n:
-            errors.append('%s: %s shrank to %d lines: lower its line in %s to %d'
-                          % (path, name, long[(path, name)], os.path.relpath(ALLOWLIST, ROOT),
-                             long[(path, name)]))
-    if errors:
-        print('\n'.join(errors))
+        print('%s: %s is %d lines, over the limit of %d: split it' % (path, name, n, LIMIT))
+    if long:
         return 1
-    print('style.function_size: no function over %d lines but the %d listed, none grown'
-          % (LIMIT, len(allowed)))
+    print('style.function_size: no function over %d lines' % LIMIT)
     return 0
 
 
@@ -200,7 +150,7 @@ def main(argv):
     if len(argv) >= 2 and argv[1] == 'format':
         return check_format()
     if len(argv) >= 2 and argv[1] == 'function-size':
-        return check_function_size('--write-allowlist' in argv[2:])
+        return check_function_size()
     print(__doc__)
     return 2
 

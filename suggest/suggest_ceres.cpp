@@ -26,8 +26,11 @@
 namespace pandora {
 namespace {
 
+using suggest_detail::CameraView;
 using suggest_detail::ExactEvaluator;
+using suggest_detail::Placement;
 using suggest_detail::PoseChart;
+using suggest_detail::RotationAngleDeg;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPenalty = 10.0;    // weight of the limit and keep-out penalties (cost ~ 1)
@@ -386,6 +389,430 @@ class SurrogateCost final : public ceres::CostFunction {
   std::vector<Contribution>* frozen_;
 };
 
+// Seconds on the steady clock since `t0`.
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Judges every successful Ceres step with the exact evaluation; keeps the best.
+class ExactJudge final : public ceres::IterationCallback {
+ public:
+  std::function<void()> on_step;
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration > 0 && summary.step_is_successful) on_step();
+    return ceres::SOLVER_CONTINUE;
+  }
+};
+
+// Scales the surrogate's terms at `poses`: the frozen cameras' contributions and the active ones'.
+void NormaliseAt(Surrogate& surrogate, const std::vector<int>& active,
+                 const std::vector<Contribution>& frozen,
+                 const std::vector<Eigen::Isometry3d>& poses, const std::vector<double>& scales) {
+  std::vector<Contribution> current(active.size());
+  std::vector<const Contribution*> ptrs;
+  for (const Contribution& f : frozen) ptrs.push_back(&f);
+  for (std::size_t a = 0; a < active.size(); ++a) {
+    surrogate.Contribute(active[a], poses[active[a]], scales[active[a]], &current[a]);
+    ptrs.push_back(&current[a]);
+  }
+  surrogate.Normalise(ptrs);
+}
+
+// What the stages of one Suggest call share: the inputs, the exact evaluator, the surrogate, the
+// parameters and the best pose so far (Suggest's own), the suggestion being filled, and what the
+// screening and the polish keep between their steps.
+struct SuggestRun {
+  SuggestRun(const SuggestOptions& options, const ExactEvaluator& ev, const Placement& placement,
+             const std::vector<PoseChart>& charts, const std::vector<Eigen::Isometry3d>& start,
+             Suggestion& s, Surrogate& surrogate, std::chrono::steady_clock::time_point t0,
+             double start_score, std::vector<std::vector<double>>& x,
+             std::vector<std::vector<double>>& best_x, Metrics& best_m, double& best_score)
+      : options(options),
+        ev(ev),
+        placement(placement),
+        charts(charts),
+        start(start),
+        s(s),
+        surrogate(surrogate),
+        t0(t0),
+        nsel(options.cameras.size()),
+        start_score(start_score),
+        x(x),
+        best_x(best_x),
+        best_m(best_m),
+        best_score(best_score) {}
+
+  // Seconds since Suggest began.
+  double Elapsed() const { return SecondsSince(t0); }
+
+  // The suggestion with `message`, the evaluations and the time taken.
+  Suggestion Finish(const std::string& message) {
+    s.message = message;
+    s.evaluations = ev.evaluations() + surrogate.evaluations();
+    s.seconds = Elapsed();
+    return s;
+  }
+
+  // How far the occlusion slopes of selected camera c look (a fraction of its move limit).
+  double OcclusionDelta(std::size_t c) const { return kOcclusionDelta * charts[c].max_move; }
+
+  void FindActive();
+  std::vector<double> Sample(const PoseChart& chart, const std::vector<double>& centre,
+                             double radius);
+  void TryMove(const std::vector<int>& group, std::vector<std::vector<double>>& xs);
+  void ScreenChain(int candidates, int joint_candidates);
+  void Screen();
+  std::pair<std::vector<Eigen::Isometry3d>, bool> PosesOf(std::vector<std::vector<double>>& xs);
+  void JudgeStep();
+  bool OuterIteration(int o, const std::vector<int>& inactive, std::vector<Contribution>& frozen,
+                      ExactJudge& judge);
+  void Polish();
+  void LevelPoses(std::vector<Eigen::Isometry3d>& best_poses,
+                  const std::vector<double>& best_scales);
+
+  const SuggestOptions& options;
+  const ExactEvaluator& ev;
+  const Placement& placement;
+  const std::vector<PoseChart>& charts;
+  const std::vector<Eigen::Isometry3d>& start;
+  Suggestion& s;
+  Surrogate& surrogate;
+  const std::chrono::steady_clock::time_point t0;
+  const std::size_t nsel;
+  const double start_score;
+  std::vector<std::vector<double>>& x;
+  std::vector<std::vector<double>>& best_x;
+  Metrics& best_m;
+  double& best_score;
+
+  std::vector<int> movable;  // the selected cameras with limits that let them move
+  std::vector<int> active;   // the cameras the nudge moves
+  std::vector<std::vector<double>> screened_x;  // the screening's best, when it beat the start
+  double screened_score = -kInf;
+  // The screening's random draws (fixed seed), and one chain's current poses, views and score.
+  std::mt19937_64 rng{0x5eedULL};
+  std::uniform_real_distribution<double> uniform{-1.0, 1.0};
+  std::vector<std::vector<double>> cur_x;
+  std::vector<CameraView> cur_view;
+  std::vector<const CameraView*> ptrs;
+  double cur_score = -kInf;
+  // The focal scales of the poses PosesOf took last.
+  std::vector<double> scales;
+  // The polish's best pose so far (best_x is the best of all, the screening's included).
+  std::vector<std::vector<double>> run_x;
+  double run_score = -kInf;
+};
+
+// A camera whose smooth weight is zero at every target point (nothing in its image, its range, or
+// everything occluded) has no gradient: the nudge leaves it where it is and says so (the exact
+// screening still tries to move it).
+void SuggestRun::FindActive() {
+  std::vector<Contribution> start_weights(nsel);
+  for (std::size_t c = 0; c < nsel; ++c)
+    surrogate.UpdateOcclusion(static_cast<int>(c), start[c], OcclusionDelta(c));
+  surrogate.set_border_width(kBorderWidth);
+  for (int c : movable) {
+    surrogate.Contribute(c, start[c], 1.0, &start_weights[c]);
+    double wmax = 0;
+    for (double w : start_weights[c].w) wmax = std::max(wmax, w);
+    if (wmax > 1e-12) {
+      active.push_back(c);
+    } else {
+      s.cameras[c].note =
+          "sees none of the target points (outside its image or range, or occluded): "
+          "no gradient, left in place";
+    }
+  }
+}
+
+// Uniform in the ball of `radius` (in units of the limits) around `centre`, per part, projected
+// onto the limits.
+std::vector<double> SuggestRun::Sample(const PoseChart& chart, const std::vector<double>& centre,
+                                       double radius) {
+  std::vector<double> xs = centre;
+  auto ball = [&](int from, int n) {
+    if (n == 0) return;
+    std::vector<double> u(n);
+    double r2;
+    do {
+      r2 = 0;
+      for (int i = 0; i < n; ++i) {
+        u[i] = uniform(rng);
+        r2 += u[i] * u[i];
+      }
+    } while (r2 > 1.0);
+    for (int i = 0; i < n; ++i) xs[from + i] += radius * u[i];
+  };
+  ball(0, chart.dims_t);
+  ball(chart.dims_t, chart.dims_r);
+  if (chart.dims_f > 0) xs[chart.dims_t + chart.dims_r] += radius * uniform(rng);
+  chart.Project(xs.data());
+  return xs;
+}
+
+// Tries moving the cameras in `group` to `xs` (indexed by selected camera); keeps it if better.
+void SuggestRun::TryMove(const std::vector<int>& group, std::vector<std::vector<double>>& xs) {
+  for (int c : group)
+    if (!placement.Admissible(c, charts[c].Pose(xs[c].data()).translation())) return;  // free
+  std::vector<CameraView> v(nsel);
+  for (int c : group) {
+    v[c] = ev.View(c, charts[c].Pose(xs[c].data()), charts[c].FocalScale(xs[c].data()));
+    ptrs[c] = &v[c];
+  }
+  const Metrics m = ev.Combine(ptrs, /*objective_only=*/true);
+  for (int c : group) ptrs[c] = &cur_view[c];
+  const double score = ev.Score(m);
+  if (!(score > cur_score)) return;
+  cur_score = score;
+  for (int c : group) {
+    cur_x[c] = std::move(xs[c]);
+    cur_view[c] = std::move(v[c]);
+  }
+  if (score > best_score) {
+    best_score = score;
+    s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), m.objective});
+  }
+}
+
+// One screening chain from the current poses: single-camera moves within each radius, then joint
+// moves of all movable cameras.
+void SuggestRun::ScreenChain(int candidates, int joint_candidates) {
+  constexpr double kJointRadius = 0.15;
+  cur_x = x;  // the current poses
+  for (std::size_t c = 0; c < nsel; ++c) {
+    cur_view[c] = ev.View(static_cast<int>(c), start[c]);
+    ptrs[c] = &cur_view[c];
+  }
+  cur_score = start_score;
+  for (double radius : {1.0, 0.4, 0.15})
+    for (int c : movable)
+      for (int k = 0; k < candidates; ++k) {
+        std::vector<std::vector<double>> xs = cur_x;
+        xs[c] = Sample(charts[c], cur_x[c], radius);
+        TryMove({c}, xs);
+      }
+  for (int k = 0; k < joint_candidates; ++k) {
+    std::vector<std::vector<double>> xs = cur_x;
+    for (int c : movable) xs[c] = Sample(charts[c], cur_x[c], kJointRadius);
+    TryMove(movable, xs);
+  }
+}
+
+// Screening (exact), before the Ceres nudge: look across the whole limits for a better start. The
+// smooth surrogate sees occluders only through a local linearisation, so from the current poses
+// it cannot cross the medics' occlusion shadows; exact jumps can, and they are cheap. A chain
+// moves one active camera at a time: a candidate pose is tested once against the target points (a
+// CameraView, one visibility test per point) and combined with the other cameras' cached views,
+// which is one exact evaluation of the objective at a joint pose; a better one is kept at once.
+// Each camera gets `screening_candidates` candidates uniform in the ball of radius 1 (the whole
+// limits) around its best pose, then as many within 0.4 and within 0.15; last, joint moves of all
+// movable cameras within 0.15 (some points are gained only when two selected cameras move
+// together). Three independent chains from the current poses; the best end is polished below.
+// Deterministic (fixed seed).
+void SuggestRun::Screen() {
+  cur_view.resize(nsel);
+  ptrs.resize(nsel);
+  constexpr int kChains = 3;
+  // Coverage (and its N-1 form) is judged from counts alone; the other objectives need every
+  // point's covariance or density at each evaluation (about 2x the cost, and a slower polish), or
+  // for calibration a test of every calibration pose per candidate, so they get a quarter of the
+  // candidates (sigma-p90 on the trauma room: 3.2 s with all, 0.8 s with a quarter).
+  const int candidates = options.objective.kind == ObjectiveKind::kCoverage ||
+                                 options.objective.kind == ObjectiveKind::kCoverageN1
+                             ? options.screening_candidates
+                             : std::max(1, options.screening_candidates / 4);
+  // Every movable camera is screened, also one without a gradient at the start (it sees no target
+  // point, e.g. a camera turned away whose calibration links are what is asked): exact jumps
+  // need no gradient.
+  const int joint_candidates = movable.size() > 1 ? candidates * 3 / 4 : 0;
+  std::vector<CameraView> screened_view;
+  for (int chain = 0; chain < kChains; ++chain) {
+    ScreenChain(candidates, joint_candidates);
+    if (cur_score > screened_score && cur_score > start_score) {
+      screened_score = cur_score;
+      screened_x = cur_x;
+      screened_view = cur_view;
+    }
+  }
+  if (!screened_x.empty()) {
+    for (std::size_t c = 0; c < nsel; ++c) ptrs[c] = &screened_view[c];
+    best_m = ev.Summary(ptrs);  // the full metrics of the best pose found (already counted)
+    best_score = screened_score;
+    best_x = screened_x;
+  }
+  s.screened = static_cast<int>(ev.evaluations());
+  s.screened_objective = best_m.objective;
+  s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
+}
+
+// Projects `xs` onto the limits; the poses (the focal scales go to `scales`) and whether every
+// camera's centre is admissible.
+std::pair<std::vector<Eigen::Isometry3d>, bool> SuggestRun::PosesOf(
+    std::vector<std::vector<double>>& xs) {
+  std::vector<Eigen::Isometry3d> poses = start;
+  bool ok = true;
+  for (std::size_t c = 0; c < nsel; ++c) {
+    charts[c].Project(xs[c].data());
+    poses[c] = charts[c].Pose(xs[c].data());
+    scales[c] = charts[c].FocalScale(xs[c].data());
+    ok = ok && placement.Admissible(c, poses[c].translation());
+  }
+  return std::make_pair(poses, ok);
+}
+
+// The exact judge of a Ceres step: evaluates the current parameters, keeps the polish's best and
+// the best of all.
+void SuggestRun::JudgeStep() {
+  std::vector<std::vector<double>> xs = x;
+  auto [poses, ok] = PosesOf(xs);
+  if (!ok) return;
+  const Metrics m = ev.Evaluate(poses, scales);
+  const double score = ev.Score(m);
+  if (score > run_score) {
+    run_score = score;
+    run_x = xs;
+  }
+  if (score > best_score) {
+    best_score = score;
+    best_m = m;
+    best_x = xs;
+  }
+  s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
+}
+
+// Outer iteration `o` of the polish: occlusion, frozen contributions and term scales at the
+// polish's best pose, then one Ceres solve from there; true when it converged (stop).
+bool SuggestRun::OuterIteration(int o, const std::vector<int>& inactive,
+                                std::vector<Contribution>& frozen, ExactJudge& judge) {
+  // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
+  surrogate.set_border_width(o == 0 ? kBorderWidth
+                                    : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
+  x = run_x;
+  auto [poses, ok] = PosesOf(x);
+  (void)ok;
+  for (int c : active) surrogate.UpdateOcclusion(c, poses[c], OcclusionDelta(c));
+  for (std::size_t f = 0; f < inactive.size(); ++f)
+    surrogate.Contribute(inactive[f], poses[inactive[f]], scales[inactive[f]], &frozen[f]);
+  NormaliseAt(surrogate, active, frozen, poses, scales);
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  SurrogateCost cost(surrogate, charts, active, placement, &frozen);
+  std::vector<double*> blocks;
+  for (int c : active) blocks.push_back(x[c].data());
+  problem.AddResidualBlock(&cost, nullptr, blocks);
+  for (int c : active)
+    for (int i = 0; i < charts[c].dims(); ++i) {
+      // A flat mount box gives lower == upper on one axis, which Ceres rejects as infeasible
+      // (and then does not iterate at all); the projection onto the limits before every exact
+      // evaluation holds that axis anyway.
+      if (!(charts[c].lower[i] < charts[c].upper[i])) continue;
+      problem.SetParameterLowerBound(x[c].data(), i, charts[c].lower[i]);
+      problem.SetParameterUpperBound(x[c].data(), i, charts[c].upper[i]);
+    }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = std::max(1, options.max_inner_iterations);
+  so.update_state_every_iteration = true;
+  so.callbacks.push_back(&judge);
+  so.logging_type =
+      std::getenv("PANDORA_SUGGEST_DEBUG") ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  so.minimizer_progress_to_stdout = std::getenv("PANDORA_SUGGEST_DEBUG") != nullptr;
+  so.num_threads = 1;
+  so.function_tolerance = 1e-7;
+  so.parameter_tolerance = 1e-7;
+  so.initial_trust_region_radius = 1.0;
+  ceres::Solver::Summary summary;
+  const double score_before_outer = run_score;
+  ceres::Solve(so, &problem, &summary);
+  s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+  s.outer_iterations = o + 1;
+  // The final state too (the callback saw every successful step already; this is cheap
+  // insurance).
+  judge.on_step();
+  return o >= 2 && !(run_score > score_before_outer);  // converged at the final width
+}
+
+// The Ceres nudge: outer iterations of the surrogate's minimisation from the best start, every
+// successful step judged exactly.
+void SuggestRun::Polish() {
+  ExactJudge judge;
+  scales.assign(nsel, 1.0);
+  judge.on_step = [&]() { JudgeStep(); };
+
+  // Polish the best start with the Ceres nudge: the screening's best pose when it beat the current
+  // poses, else the current poses. (Polishing the current poses as well, as a second start, never
+  // ended best on the trauma-room benchmark and doubled the time.)
+  run_x = screened_x.empty() ? x : screened_x;
+  run_score = screened_x.empty() ? start_score : screened_score;
+  // The polish moves the cameras with a gradient where it starts (a camera the screening turned
+  // towards the target points gains one); the others contribute where they are.
+  if (!screened_x.empty()) {
+    std::vector<std::vector<double>> xs = run_x;
+    auto [poses, ok] = PosesOf(xs);
+    (void)ok;
+    active.clear();
+    for (int c : movable) {
+      surrogate.UpdateOcclusion(c, poses[c], OcclusionDelta(c));
+      Contribution w;
+      surrogate.Contribute(c, poses[c], scales[c], &w);
+      double wmax = 0;
+      for (double v : w.w) wmax = std::max(wmax, v);
+      if (wmax > 1e-12) active.push_back(c);
+    }
+  }
+  std::vector<int> inactive;
+  for (std::size_t c = 0; c < nsel; ++c)
+    if (std::find(active.begin(), active.end(), static_cast<int>(c)) == active.end())
+      inactive.push_back(static_cast<int>(c));
+  std::vector<Contribution> frozen(inactive.size());
+  const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
+  for (int o = 0; o < outer; ++o)
+    if (OuterIteration(o, inactive, frozen, judge)) break;
+}
+
+// A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
+// costs nothing: the screening's random turns leave a roll about the optical axis that coverage
+// rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
+// orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25,
+// judged exactly); the best is taken when it is no worse than the rolled pose.
+void SuggestRun::LevelPoses(std::vector<Eigen::Isometry3d>& best_poses,
+                            const std::vector<double>& best_scales) {
+  for (std::size_t c = 0; c < nsel; ++c) {
+    const Mat3& R0 = start[c].linear();
+    const Mat3 R = best_poses[c].linear();
+    if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
+    const Vec3 ypr = YawPitchRollDeg(R);
+    if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
+    const double limit = charts[c].max_rotate * 180.0 / kPi * (1 + 1e-9);
+    // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
+    const Vec3 axis = R.col(2);
+    const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / kPi;
+    const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / kPi;
+    std::vector<Eigen::Isometry3d> best_trial;
+    Metrics best_level;
+    double best_level_score = -kInf;
+    for (double dy : {0.0, -0.5, 0.5, -1.0, 1.0})
+      for (double dp : {0.0, -0.5, 0.5, -1.0, 1.0}) {
+        const Mat3 L = RotationFromYawPitchRollDeg(Vec3(yaw + dy, pitch + dp, 0.0));
+        if (RotationAngleDeg(R0, L) > limit) continue;
+        std::vector<Eigen::Isometry3d> trial = best_poses;
+        trial[c].linear() = L;
+        const Metrics m = ev.Evaluate(trial, best_scales);
+        if (ev.Score(m) > best_level_score) {
+          best_level_score = ev.Score(m);
+          best_level = m;
+          best_trial = trial;
+        }
+      }
+    if (!best_trial.empty() && best_level_score >= best_score) {
+      best_poses = best_trial;
+      best_m = best_level;
+      best_score = best_level_score;
+    }
+  }
+}
+
 }  // namespace
 
 Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
@@ -393,9 +820,6 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   using namespace suggest_detail;
   CheckOptions(scene, rig, options);
   const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&]() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
   const std::size_t nsel = options.cameras.size();
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras,
                     options.sample_casters);
@@ -415,296 +839,30 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
   best_x = x;
   Metrics best_m = s.before;
   double best_score = start_score;
-  s.trace.push_back({elapsed(), ev.evaluations(), best_m.objective});
+  s.trace.push_back({SecondsSince(t0), ev.evaluations(), best_m.objective});
 
   const bool need_info = options.objective.kind == ObjectiveKind::kSigmaMean ||
                          options.objective.kind == ObjectiveKind::kSigmaPercentile ||
                          options.objective.kind == ObjectiveKind::kMix;
   Surrogate surrogate(ev, need_info);
-  auto finish = [&](const std::string& message) {
-    s.message = message;
-    s.evaluations = ev.evaluations() + surrogate.evaluations();
-    s.seconds = elapsed();
-    return s;
-  };
+  SuggestRun run(options, ev, placement, charts, start, s, surrogate, t0, start_score, x, best_x,
+                 best_m, best_score);
 
-  std::vector<int> movable;
   for (std::size_t c = 0; c < nsel; ++c)
-    if (charts[c].dims() > 0) movable.push_back(static_cast<int>(c));
-  if (movable.empty())
-    return finish("the limits are zero: every selected camera keeps its pose; nothing to suggest");
+    if (charts[c].dims() > 0) run.movable.push_back(static_cast<int>(c));
+  if (run.movable.empty())
+    return run.Finish(
+        "the limits are zero: every selected camera keeps its pose; nothing to suggest");
 
-  // A camera whose smooth weight is zero at every target point (nothing in its image, its range, or
-  // everything occluded) has no gradient: the nudge leaves it where it is and says so (the exact
-  // screening still tries to move it).
-  std::vector<int> active;
-  std::vector<Contribution> start_weights(nsel);
-  auto occlusion_delta = [&](std::size_t c) { return kOcclusionDelta * charts[c].max_move; };
-  for (std::size_t c = 0; c < nsel; ++c)
-    surrogate.UpdateOcclusion(static_cast<int>(c), start[c], occlusion_delta(c));
-  surrogate.set_border_width(kBorderWidth);
-  for (int c : movable) {
-    surrogate.Contribute(c, start[c], 1.0, &start_weights[c]);
-    double wmax = 0;
-    for (double w : start_weights[c].w) wmax = std::max(wmax, w);
-    if (wmax > 1e-12) {
-      active.push_back(c);
-    } else {
-      s.cameras[c].note =
-          "sees none of the target points (outside its image or range, or occluded): "
-          "no gradient, left in place";
-    }
-  }
+  run.FindActive();
   const std::string no_gradient =
       "no improvement found: no selected camera sees any target point, so the smooth objective has "
       "no gradient; aim the cameras at the region first";
-  if (active.empty() && options.screening_candidates <= 0) return finish(no_gradient);
-  const bool start_without_gradient = active.empty();
+  if (run.active.empty() && options.screening_candidates <= 0) return run.Finish(no_gradient);
+  const bool start_without_gradient = run.active.empty();
 
-  // Screening (exact), before the Ceres nudge: look across the whole limits for a better start. The
-  // smooth surrogate sees occluders only through a local linearisation, so from the current poses
-  // it cannot cross the medics' occlusion shadows; exact jumps can, and they are cheap. A chain
-  // moves one active camera at a time: a candidate pose is tested once against the target points (a
-  // CameraView, one visibility test per point) and combined with the other cameras' cached views,
-  // which is one exact evaluation of the objective at a joint pose; a better one is kept at once.
-  // Each camera gets `screening_candidates` candidates uniform in the ball of radius 1 (the whole
-  // limits) around its best pose, then as many within 0.4 and within 0.15; last, joint moves of all
-  // movable cameras within 0.15 (some points are gained only when two selected cameras move
-  // together). Three independent chains from the current poses; the best end is polished below.
-  // Deterministic (fixed seed).
-  std::vector<std::vector<double>> screened_x;  // the screening's best, when it beat the start
-  double screened_score = -kInf;
-  if (options.screening_candidates > 0) {
-    std::mt19937_64 rng(0x5eedULL);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    // Uniform in the ball of `radius` (in units of the limits) around `centre`, per part, projected
-    // onto the limits.
-    auto sample = [&](const PoseChart& chart, const std::vector<double>& centre, double radius) {
-      std::vector<double> xs = centre;
-      auto ball = [&](int from, int n) {
-        if (n == 0) return;
-        std::vector<double> u(n);
-        double r2;
-        do {
-          r2 = 0;
-          for (int i = 0; i < n; ++i) {
-            u[i] = uniform(rng);
-            r2 += u[i] * u[i];
-          }
-        } while (r2 > 1.0);
-        for (int i = 0; i < n; ++i) xs[from + i] += radius * u[i];
-      };
-      ball(0, chart.dims_t);
-      ball(chart.dims_t, chart.dims_r);
-      if (chart.dims_f > 0) xs[chart.dims_t + chart.dims_r] += radius * uniform(rng);
-      chart.Project(xs.data());
-      return xs;
-    };
-    std::vector<std::vector<double>> cur_x;
-    std::vector<CameraView> cur_view(nsel);
-    std::vector<const CameraView*> ptrs(nsel);
-    double cur_score = -kInf;
-    // Tries moving the cameras in `group` to `xs` (indexed by selected camera); keeps it if better.
-    auto try_move = [&](const std::vector<int>& group, std::vector<std::vector<double>>& xs) {
-      for (int c : group)
-        if (!placement.Admissible(c, charts[c].Pose(xs[c].data()).translation())) return;  // free
-      std::vector<CameraView> v(nsel);
-      for (int c : group) {
-        v[c] = ev.View(c, charts[c].Pose(xs[c].data()), charts[c].FocalScale(xs[c].data()));
-        ptrs[c] = &v[c];
-      }
-      const Metrics m = ev.Combine(ptrs, /*objective_only=*/true);
-      for (int c : group) ptrs[c] = &cur_view[c];
-      const double score = ev.Score(m);
-      if (!(score > cur_score)) return;
-      cur_score = score;
-      for (int c : group) {
-        cur_x[c] = std::move(xs[c]);
-        cur_view[c] = std::move(v[c]);
-      }
-      if (score > best_score) {
-        best_score = score;
-        s.trace.push_back({elapsed(), ev.evaluations() + surrogate.evaluations(), m.objective});
-      }
-    };
-    constexpr int kChains = 3;
-    constexpr double kJointRadius = 0.15;
-    // Coverage (and its N-1 form) is judged from counts alone; the other objectives need every
-    // point's covariance or density at each evaluation (about 2x the cost, and a slower polish), or
-    // for calibration a test of every calibration pose per candidate, so they get a quarter of the
-    // candidates (sigma-p90 on the trauma room: 3.2 s with all, 0.8 s with a quarter).
-    const int candidates = options.objective.kind == ObjectiveKind::kCoverage ||
-                                   options.objective.kind == ObjectiveKind::kCoverageN1
-                               ? options.screening_candidates
-                               : std::max(1, options.screening_candidates / 4);
-    // Every movable camera is screened, also one without a gradient at the start (it sees no target
-    // point, e.g. a camera turned away whose calibration links are what is asked): exact jumps
-    // need no gradient.
-    const int joint_candidates = movable.size() > 1 ? candidates * 3 / 4 : 0;
-    std::vector<CameraView> screened_view;
-    for (int chain = 0; chain < kChains; ++chain) {
-      cur_x = x;  // the current poses
-      for (std::size_t c = 0; c < nsel; ++c) {
-        cur_view[c] = ev.View(static_cast<int>(c), start[c]);
-        ptrs[c] = &cur_view[c];
-      }
-      cur_score = start_score;
-      for (double radius : {1.0, 0.4, 0.15})
-        for (int c : movable)
-          for (int k = 0; k < candidates; ++k) {
-            std::vector<std::vector<double>> xs = cur_x;
-            xs[c] = sample(charts[c], cur_x[c], radius);
-            try_move({c}, xs);
-          }
-      for (int k = 0; k < joint_candidates; ++k) {
-        std::vector<std::vector<double>> xs = cur_x;
-        for (int c : movable) xs[c] = sample(charts[c], cur_x[c], kJointRadius);
-        try_move(movable, xs);
-      }
-      if (cur_score > screened_score && cur_score > start_score) {
-        screened_score = cur_score;
-        screened_x = cur_x;
-        screened_view = cur_view;
-      }
-    }
-    if (!screened_x.empty()) {
-      for (std::size_t c = 0; c < nsel; ++c) ptrs[c] = &screened_view[c];
-      best_m = ev.Summary(ptrs);  // the full metrics of the best pose found (already counted)
-      best_score = screened_score;
-      best_x = screened_x;
-    }
-    s.screened = static_cast<int>(ev.evaluations());
-    s.screened_objective = best_m.objective;
-    s.trace.push_back({elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
-  }
-
-  // Judges every successful Ceres step with the exact evaluation; keeps the best.
-  class ExactJudge final : public ceres::IterationCallback {
-   public:
-    std::function<void()> on_step;
-    ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-      if (summary.iteration > 0 && summary.step_is_successful) on_step();
-      return ceres::SOLVER_CONTINUE;
-    }
-  } judge;
-  std::vector<double> scales(nsel, 1.0);
-  auto poses_of = [&](std::vector<std::vector<double>>& xs) {
-    std::vector<Eigen::Isometry3d> poses = start;
-    bool ok = true;
-    for (std::size_t c = 0; c < nsel; ++c) {
-      charts[c].Project(xs[c].data());
-      poses[c] = charts[c].Pose(xs[c].data());
-      scales[c] = charts[c].FocalScale(xs[c].data());
-      ok = ok && placement.Admissible(c, poses[c].translation());
-    }
-    return std::make_pair(poses, ok);
-  };
-  // The polish's best pose so far (best_x is the best of all, the screening's included).
-  std::vector<std::vector<double>> run_x;
-  double run_score = -kInf;
-  judge.on_step = [&]() {
-    std::vector<std::vector<double>> xs = x;
-    auto [poses, ok] = poses_of(xs);
-    if (!ok) return;
-    const Metrics m = ev.Evaluate(poses, scales);
-    const double score = ev.Score(m);
-    if (score > run_score) {
-      run_score = score;
-      run_x = xs;
-    }
-    if (score > best_score) {
-      best_score = score;
-      best_m = m;
-      best_x = xs;
-    }
-    s.trace.push_back({elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
-  };
-
-  // Polish the best start with the Ceres nudge: the screening's best pose when it beat the current
-  // poses, else the current poses. (Polishing the current poses as well, as a second start, never
-  // ended best on the trauma-room benchmark and doubled the time.)
-  run_x = screened_x.empty() ? x : screened_x;
-  run_score = screened_x.empty() ? start_score : screened_score;
-  // The polish moves the cameras with a gradient where it starts (a camera the screening turned
-  // towards the target points gains one); the others contribute where they are.
-  if (!screened_x.empty()) {
-    std::vector<std::vector<double>> xs = run_x;
-    auto [poses, ok] = poses_of(xs);
-    (void)ok;
-    active.clear();
-    for (int c : movable) {
-      surrogate.UpdateOcclusion(c, poses[c], occlusion_delta(c));
-      Contribution w;
-      surrogate.Contribute(c, poses[c], scales[c], &w);
-      double wmax = 0;
-      for (double v : w.w) wmax = std::max(wmax, v);
-      if (wmax > 1e-12) active.push_back(c);
-    }
-  }
-  std::vector<int> inactive;
-  for (std::size_t c = 0; c < nsel; ++c)
-    if (std::find(active.begin(), active.end(), static_cast<int>(c)) == active.end())
-      inactive.push_back(static_cast<int>(c));
-  std::vector<Contribution> frozen(inactive.size());
-  const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
-  for (int o = 0; o < outer; ++o) {
-    // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
-    surrogate.set_border_width(o == 0 ? kBorderWidth
-                                      : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
-    x = run_x;
-    auto [poses, ok] = poses_of(x);
-    (void)ok;
-    for (int c : active) surrogate.UpdateOcclusion(c, poses[c], occlusion_delta(c));
-    for (std::size_t f = 0; f < inactive.size(); ++f)
-      surrogate.Contribute(inactive[f], poses[inactive[f]], scales[inactive[f]], &frozen[f]);
-    {
-      std::vector<Contribution> current(active.size());
-      std::vector<const Contribution*> ptrs;
-      for (const Contribution& f : frozen) ptrs.push_back(&f);
-      for (std::size_t a = 0; a < active.size(); ++a) {
-        surrogate.Contribute(active[a], poses[active[a]], scales[active[a]], &current[a]);
-        ptrs.push_back(&current[a]);
-      }
-      surrogate.Normalise(ptrs);
-    }
-    ceres::Problem::Options problem_options;
-    problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    SurrogateCost cost(surrogate, charts, active, placement, &frozen);
-    std::vector<double*> blocks;
-    for (int c : active) blocks.push_back(x[c].data());
-    problem.AddResidualBlock(&cost, nullptr, blocks);
-    for (int c : active)
-      for (int i = 0; i < charts[c].dims(); ++i) {
-        // A flat mount box gives lower == upper on one axis, which Ceres rejects as infeasible
-        // (and then does not iterate at all); the projection onto the limits before every exact
-        // evaluation holds that axis anyway.
-        if (!(charts[c].lower[i] < charts[c].upper[i])) continue;
-        problem.SetParameterLowerBound(x[c].data(), i, charts[c].lower[i]);
-        problem.SetParameterUpperBound(x[c].data(), i, charts[c].upper[i]);
-      }
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.max_num_iterations = std::max(1, options.max_inner_iterations);
-    so.update_state_every_iteration = true;
-    so.callbacks.push_back(&judge);
-    so.logging_type =
-        std::getenv("PANDORA_SUGGEST_DEBUG") ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-    so.minimizer_progress_to_stdout = std::getenv("PANDORA_SUGGEST_DEBUG") != nullptr;
-    so.num_threads = 1;
-    so.function_tolerance = 1e-7;
-    so.parameter_tolerance = 1e-7;
-    so.initial_trust_region_radius = 1.0;
-    ceres::Solver::Summary summary;
-    const double score_before_outer = run_score;
-    ceres::Solve(so, &problem, &summary);
-    s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-    s.outer_iterations = o + 1;
-    // The final state too (the callback saw every successful step already; this is cheap
-    // insurance).
-    judge.on_step();
-    if (o >= 2 && !(run_score > score_before_outer)) break;  // converged at the final width
-  }
+  if (options.screening_candidates > 0) run.Screen();
+  run.Polish();
 
   std::vector<Eigen::Isometry3d> best_poses = start;
   std::vector<double> best_scales(nsel, 1.0);
@@ -712,46 +870,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     best_poses[c] = charts[c].Pose(best_x[c].data());
     best_scales[c] = charts[c].FocalScale(best_x[c].data());
   }
-  // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
-  // costs nothing: the screening's random turns leave a roll about the optical axis that coverage
-  // rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
-  // orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25,
-  // judged exactly); the best is taken when it is no worse than the rolled pose.
-  if (best_score > start_score) {
-    for (std::size_t c = 0; c < nsel; ++c) {
-      const Mat3& R0 = start[c].linear();
-      const Mat3 R = best_poses[c].linear();
-      if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
-      const Vec3 ypr = YawPitchRollDeg(R);
-      if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
-      const double limit = charts[c].max_rotate * 180.0 / kPi * (1 + 1e-9);
-      // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
-      const Vec3 axis = R.col(2);
-      const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / kPi;
-      const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / kPi;
-      std::vector<Eigen::Isometry3d> best_trial;
-      Metrics best_level;
-      double best_level_score = -kInf;
-      for (double dy : {0.0, -0.5, 0.5, -1.0, 1.0})
-        for (double dp : {0.0, -0.5, 0.5, -1.0, 1.0}) {
-          const Mat3 L = RotationFromYawPitchRollDeg(Vec3(yaw + dy, pitch + dp, 0.0));
-          if (RotationAngleDeg(R0, L) > limit) continue;
-          std::vector<Eigen::Isometry3d> trial = best_poses;
-          trial[c].linear() = L;
-          const Metrics m = ev.Evaluate(trial, best_scales);
-          if (ev.Score(m) > best_level_score) {
-            best_level_score = ev.Score(m);
-            best_level = m;
-            best_trial = trial;
-          }
-        }
-      if (!best_trial.empty() && best_level_score >= best_score) {
-        best_poses = best_trial;
-        best_m = best_level;
-        best_score = best_level_score;
-      }
-    }
-  }
+  if (best_score > start_score) run.LevelPoses(best_poses, best_scales);
   if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
     if (best_score > start_score) {
       s.unsnapped = best_m;
@@ -771,18 +890,18 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     if (std::isinf(s.after.objective))
       extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
               Num("%.4g", s.before.untriangulable) + " to " + Num("%.4g", s.after.untriangulable);
-    return finish(name + " improved from " + Num("%.6g", s.before.objective) + " to " +
-                  Num("%.6g", s.after.objective) +
-                  (higher ? " (higher is better)" : " (lower is better)") + extra);
+    return run.Finish(name + " improved from " + Num("%.6g", s.before.objective) + " to " +
+                      Num("%.6g", s.after.objective) +
+                      (higher ? " (higher is better)" : " (lower is better)") + extra);
   }
   if (s.unsnapped)
-    return finish("no improvement found: the optimum improved " + name + " to " +
-                  Num("%.6g", s.unsnapped->objective) +
-                  " but the snapped poses do not; use finer snap steps");
-  if (start_without_gradient) return finish(no_gradient);
-  return finish("no improvement found: the exact " + name +
-                " did not improve within the limits (it stays " + Num("%.6g", s.before.objective) +
-                ")");
+    return run.Finish("no improvement found: the optimum improved " + name + " to " +
+                      Num("%.6g", s.unsnapped->objective) +
+                      " but the snapped poses do not; use finer snap steps");
+  if (start_without_gradient) return run.Finish(no_gradient);
+  return run.Finish("no improvement found: the exact " + name +
+                    " did not improve within the limits (it stays " +
+                    Num("%.6g", s.before.objective) + ")");
 }
 
 }  // namespace pandora

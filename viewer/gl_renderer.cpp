@@ -557,6 +557,48 @@ constexpr int kMaxBatch = 64;
 
 bool IsCube(const Camera& cam) { return cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle; }
 
+// Batches of enabled cameras in rig order, each within the map memory budget and the uniform
+// block; each batch is one light pass over the G-buffer with all its maps bound.
+struct Batch {
+  std::vector<int> cameras;
+  int perspective = 0, cube = 0;
+};
+
+// The rig's enabled cameras in light batches (GlRenderer::Render).
+std::vector<Batch> LightBatches(const Rig& rig, const GlRenderOptions& options, int max_layers) {
+  const int camera_count = int(rig.cameras.size());
+  std::vector<Batch> batches;
+  const double map_bytes = 4.0 * options.shadow_map_size * options.shadow_map_size;
+  const double budget = std::max(options.map_memory_mib, 1.0) * 1024.0 * 1024.0;
+  double bytes = 0;
+  for (int c = 0; c < camera_count; ++c) {
+    const Camera& cam = rig.cameras[c];
+    if (!cam.enabled) continue;
+    const bool cube = IsCube(cam);
+    const double need = cube ? 1.5 * map_bytes : map_bytes;
+    // A new batch when this one is full: the uniform block, the map budget, or the layers a
+    // texture array may have (GL_MAX_ARRAY_TEXTURE_LAYERS, at least 256 in GL 3.3).
+    if (batches.empty() || int(batches.back().cameras.size()) == kMaxBatch ||
+        (bytes + need > budget && !batches.back().cameras.empty()) ||
+        (cube ? 6 * (batches.back().cube + 1) : batches.back().perspective + 1) > max_layers) {
+      batches.emplace_back();
+      bytes = 0;
+    }
+    batches.back().cameras.push_back(c);
+    (cube ? batches.back().cube : batches.back().perspective) += 1;
+    bytes += need;
+  }
+  return batches;
+}
+
+// The eye of a frame as its passes take it (GlRenderer::Render).
+struct FrameEye {
+  int W = 0, H = 0;                                        // the image size
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world_from_camera
+  double f = 0;                                            // focal length, pixels
+  Vec3 rel = Vec3::Zero();                                 // relative to the scene's centre
+};
+
 // (sx, sy, ox, oy) with ndc = (sx x / z - ox, sy y / z - oy) mapping `bounds` onto [-1, 1]^2.
 Eigen::Vector4d MapCoefficients(const Eigen::Vector4d& b) {
   return Eigen::Vector4d(2 / (b(1) - b(0)), 2 / (b(3) - b(2)), (b(0) + b(1)) / (b(1) - b(0)),
@@ -861,6 +903,214 @@ struct GlRenderer::Impl {
     }
     return drawn;
   }
+
+  // The G-buffer pass: surface point, normal and albedo of every pixel seen from the eye.
+  void DrawGBuffer(const RenderView& view, const FrameEye& eye, const GlRenderOptions& options) {
+    const int W = eye.W, H = eye.H;
+    const double f = eye.f;
+    const Mat3 eye_R = eye.pose.linear().transpose();  // camera_from_world
+    const Eigen::Isometry3d cfw = eye.pose.inverse();
+    const Eigen::Vector4d bounds(-0.5 * W / f, 0.5 * W / f, -0.5 * H / f, 0.5 * H / f);
+    auto range = DepthRangeInPyramid(mesh, cfw, bounds);
+    if (!(range.first <= range.second)) range = {1.0, 2.0};  // nothing in view: any range
+    // The depth range spans the content in view (an eye 500 scene sizes away: far / near ~ 1.002).
+    // Depths are taken relative to the near plane in the shaders and the depth test's value is
+    // linear in them, so its resolution is (far - near) / 2^24 however far the eye stands. The
+    // cut (RenderView::clip_near, a plan's) is a discard at that depth, as the CPU starts its rays
+    // on the cut plane.
+    const auto [near, far] = PadRange(range);
+    const double cut_rel = view.clip_near > 0 ? view.clip_near - near : -1.0;
+    const Eigen::Vector2d ab = DepthCoefficients(near, far);
+    glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+    const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, buffers);
+    glViewport(0, 0, W, H);
+    const float no_hit[4] = {0, 0, 0, -1}, zero[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, no_hit);
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(gbuffer_program);
+    SetMat3(gbuffer_program, "view_R", eye_R);
+    SetVec3(gbuffer_program, "view_t", eye_R * (origin - view.from) - Vec3(0, 0, near));
+    glUniform1f(Loc(gbuffer_program, "view_d0"), float(near));
+    glUniform4f(Loc(gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
+                float(ab(0) * near + ab(1)));
+    glUniform2f(Loc(gbuffer_program, "depth_map"), float(cut_rel), float(1.0 / (far - near)));
+    SetVec3(gbuffer_program, "eye", eye.rel);
+    glUniform1i(Loc(gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
+    glUniform1f(Loc(gbuffer_program, "line_width"), float(options.line_width_px));
+    glUniform1i(Loc(gbuffer_program, "albedo_tex"), 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindVertexArray(vao);
+    for (const Draw& d : draws) {
+      glUniform1i(Loc(gbuffer_program, "textured"),
+                  d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
+      glBindTexture(GL_TEXTURE_2D, d.texture);
+      glDrawArrays(GL_TRIANGLES, d.first, d.count);
+    }
+  }
+
+  // Draws the distance maps of a batch's cameras not kept from the last frame and sets each
+  // camera's layer. Returns the maps drawn.
+  int DrawBatchMaps(const Rig& rig, const Batch& batch, bool keep, const GlRenderOptions& options,
+                    std::vector<int>& layer) {
+    int maps_drawn = 0;
+    int next_map = 0, next_cube = 0;
+    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
+      const Camera& cam = rig.cameras[batch.cameras[i]];
+      const bool cube = IsCube(cam);
+      layer[i] = cube ? next_cube++ : next_map++;
+      std::optional<Camera>& held = cube ? cube_camera[layer[i]] : map_camera[layer[i]];
+      if (held && SameCameraGeometry(*held, cam)) continue;
+      maps_drawn += DrawMaps(cam, cube, layer[i]);
+      if (keep && options.reuse_maps)
+        held = cam;
+      else
+        held.reset();
+    }
+    return maps_drawn;
+  }
+
+  // A batch's light pass over the G-buffer: adds its cameras' light into the accumulation target
+  // and their bits from mask `src` into the other mask. Returns that mask.
+  int DrawBatchLight(const Rig& rig, const Batch& batch, const std::vector<int>& layer,
+                     const FrameEye& eye, const GlRenderOptions& options, double brightness,
+                     int src, std::vector<float>& block) {
+    const double lift = 0.1 * 1e-5 * scene_scale;  // as the CPU renderer: a tenth of epsilon
+    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
+      const int c = batch.cameras[i];
+      PackCamera(rig.cameras[c], c, IsCube(rig.cameras[c]), layer[i], origin, brightness,
+                 &block[4 * kCameraVec4 * i]);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, camera_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0,
+                    GLsizeiptr(4 * kCameraVec4 * batch.cameras.size() * sizeof(float)),
+                    block.data());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, camera_ubo);
+    const int dst = 1 - src;
+    glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[dst]);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    glViewport(0, 0, eye.W, eye.H);
+    glDisable(GL_DEPTH_TEST);
+    glEnablei(GL_BLEND, 0);
+    glDisablei(GL_BLEND, 1);  // integer: the shader ORs the previous mask in
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    int variant = options.pattern == Pattern::kGrid ? 1 : 0;
+    for (int c : batch.cameras) {
+      const LensModel lens = rig.cameras[c].model.intrinsics().model;
+      variant |= lens == LensModel::kFisheye ? 2 : lens == LensModel::kBrownConrady ? 4 : 0;
+      variant |= IsCube(rig.cameras[c]) ? 8 : 0;
+    }
+    const GLuint p = LightProgram(variant);
+    glUseProgram(p);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g_position);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, g_normal);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, mask[src]);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, maps);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, cubes);
+    glUniform1i(Loc(p, "g_position_tex"), 0);
+    glUniform1i(Loc(p, "g_normal_tex"), 1);
+    glUniform1i(Loc(p, "mask_in"), 2);
+    glUniform1i(Loc(p, "maps"), 3);
+    glUniform1i(Loc(p, "cubes"), 4);
+    glUniform1i(Loc(p, "camera_count"), int(batch.cameras.size()));
+    glUniform1i(Loc(p, "map_size"), map_size);
+    glUniform1i(Loc(p, "cube_size"), cube_size);
+    static const std::array<Mat3, 6> kCube = CubeFaces();
+    for (int i = 0; i < 6; ++i) SetMat3(p, ("face_R[" + std::to_string(i) + "]").c_str(), kCube[i]);
+    glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
+    glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
+    glUniform1f(Loc(p, "lift"), float(lift));
+    glUniform1f(Loc(p, "grid_n"), float(std::max(1, options.grid_pixels)));
+    glUniform1f(Loc(p, "grid_fill"), float(options.grid_fill));
+    glUniform1f(Loc(p, "line_width"), float(options.line_width_px));
+    SetVec3(p, "eye", eye.rel);
+    SetMat3(p, "view_Rt", eye.pose.linear());
+    glUniform3f(Loc(p, "view_f"), float(eye.f), float(0.5 * eye.W - 0.5), float(0.5 * eye.H - 0.5));
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisablei(GL_BLEND, 0);
+    return dst;
+  }
+
+  // The compose pass: material colour (or the light alone) and the background.
+  void Compose(const FrameEye& eye, const GlRenderOptions& options) {
+    glBindFramebuffer(GL_FRAMEBUFFER, compose_fbo);
+    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer0);
+    glViewport(0, 0, eye.W, eye.H);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    const GLuint p = compose_program;
+    glUseProgram(p);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g_position);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, g_normal);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, g_albedo);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, light_accum);
+    glUniform1i(Loc(p, "g_position_tex"), 0);
+    glUniform1i(Loc(p, "g_normal_tex"), 1);
+    glUniform1i(Loc(p, "g_albedo_tex"), 2);
+    glUniform1i(Loc(p, "light_tex"), 3);
+    const int surface = options.surface == Surface::kMaterial     ? 0
+                        : options.surface == Surface::kHiddenLine ? 2
+                        : options.surface == Surface::kContours   ? 3
+                                                                  : 1;
+    glUniform1i(Loc(p, "surface"), surface);
+    glUniform1f(Loc(p, "line_grey"), float(options.line_grey));
+    glUniform1f(Loc(p, "ambient"), float(options.ambient));
+    SetVec3(p, "background", options.background);
+    SetVec3(p, "eye", eye.rel);
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+
+  // Reads the composed colour, the surface hits and (up to 64 cameras) mask `src` back.
+  GlImage ReadBack(int W, int H, int src, int camera_count) {
+    const std::size_t pixels = std::size_t(W) * H;
+    // GL's row r is the image's row r: no flip.
+    GlImage image;
+    image.width = W;
+    image.height = H;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    std::vector<float> rgba(4 * pixels);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+    image.rgb.resize(3 * pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      for (int ch = 0; ch < 3; ++ch) image.rgb[3 * i + ch] = rgba[4 * i + ch];
+    glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
+    image.hit.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) image.hit[i] = rgba[4 * i + 3] >= 0;
+    if (camera_count <= 64) {
+      std::vector<GLuint> bits(2 * pixels);
+      glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[src]);
+      glReadBuffer(GL_COLOR_ATTACHMENT1);
+      glReadPixels(0, 0, W, H, GL_RG_INTEGER, GL_UNSIGNED_INT, bits.data());
+      image.cameras.resize(pixels);
+      for (std::size_t i = 0; i < pixels; ++i)
+        image.cameras[i] = uint64_t(bits[2 * i]) | (uint64_t(bits[2 * i + 1]) << 32);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return image;
+  }
 };
 
 GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
@@ -1001,38 +1251,9 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   GLint max_layers = 0;
   glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   const int W = view.width, H = view.height;
-  const std::size_t pixels = std::size_t(W) * H;
   const int camera_count = int(rig.cameras.size());
 
-  // Batches of enabled cameras in rig order, each within the map memory budget and the uniform
-  // block; each batch is one light pass over the G-buffer with all its maps bound.
-  struct Batch {
-    std::vector<int> cameras;
-    int perspective = 0, cube = 0;
-  };
-  std::vector<Batch> batches;
-  {
-    const double map_bytes = 4.0 * options.shadow_map_size * options.shadow_map_size;
-    const double budget = std::max(options.map_memory_mib, 1.0) * 1024.0 * 1024.0;
-    double bytes = 0;
-    for (int c = 0; c < camera_count; ++c) {
-      const Camera& cam = rig.cameras[c];
-      if (!cam.enabled) continue;
-      const bool cube = IsCube(cam);
-      const double need = cube ? 1.5 * map_bytes : map_bytes;
-      // A new batch when this one is full: the uniform block, the map budget, or the layers a
-      // texture array may have (GL_MAX_ARRAY_TEXTURE_LAYERS, at least 256 in GL 3.3).
-      if (batches.empty() || int(batches.back().cameras.size()) == kMaxBatch ||
-          (bytes + need > budget && !batches.back().cameras.empty()) ||
-          (cube ? 6 * (batches.back().cube + 1) : batches.back().perspective + 1) > max_layers) {
-        batches.emplace_back();
-        bytes = 0;
-      }
-      batches.back().cameras.push_back(c);
-      (cube ? batches.back().cube : batches.back().perspective) += 1;
-      bytes += need;
-    }
-  }
+  const std::vector<Batch> batches = LightBatches(rig, options, max_layers);
   int perspective_layers = 0, cube_count = 0;
   for (const Batch& b : batches) {
     perspective_layers = std::max(perspective_layers, b.perspective);
@@ -1049,55 +1270,10 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
 
   // 1. G-buffer. The eye: OpenCV frame (x right, y down, z forward); GL's window row r is the
   // image's row r.
-  const Mat3 eye_R = pose->linear().transpose();  // camera_from_world
   const double f = 0.5 * W / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   const Vec3 eye_rel = view.from - m.origin;
-  {
-    const Eigen::Isometry3d cfw = pose->inverse();
-    const Eigen::Vector4d bounds(-0.5 * W / f, 0.5 * W / f, -0.5 * H / f, 0.5 * H / f);
-    auto range = DepthRangeInPyramid(m.mesh, cfw, bounds);
-    if (!(range.first <= range.second)) range = {1.0, 2.0};  // nothing in view: any range
-    // The depth range spans the content in view (an eye 500 scene sizes away: far / near ~ 1.002).
-    // Depths are taken relative to the near plane in the shaders and the depth test's value is
-    // linear in them, so its resolution is (far - near) / 2^24 however far the eye stands. The
-    // cut (RenderView::clip_near, a plan's) is a discard at that depth, as the CPU starts its rays
-    // on the cut plane.
-    const auto [near, far] = PadRange(range);
-    const double cut_rel = view.clip_near > 0 ? view.clip_near - near : -1.0;
-    const Eigen::Vector2d ab = DepthCoefficients(near, far);
-    glBindFramebuffer(GL_FRAMEBUFFER, m.g_fbo);
-    const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    glDrawBuffers(3, buffers);
-    glViewport(0, 0, W, H);
-    const float no_hit[4] = {0, 0, 0, -1}, zero[4] = {0, 0, 0, 0};
-    glClearBufferfv(GL_COLOR, 0, no_hit);
-    glClearBufferfv(GL_COLOR, 1, zero);
-    glClearBufferfv(GL_COLOR, 2, zero);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glUseProgram(m.gbuffer_program);
-    SetMat3(m.gbuffer_program, "view_R", eye_R);
-    SetVec3(m.gbuffer_program, "view_t", eye_R * (m.origin - view.from) - Vec3(0, 0, near));
-    glUniform1f(Loc(m.gbuffer_program, "view_d0"), float(near));
-    glUniform4f(Loc(m.gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
-                float(ab(0) * near + ab(1)));
-    glUniform2f(Loc(m.gbuffer_program, "depth_map"), float(cut_rel), float(1.0 / (far - near)));
-    SetVec3(m.gbuffer_program, "eye", eye_rel);
-    glUniform1i(Loc(m.gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
-    glUniform1f(Loc(m.gbuffer_program, "line_width"), float(options.line_width_px));
-    glUniform1i(Loc(m.gbuffer_program, "albedo_tex"), 0);
-    glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(m.vao);
-    for (const Impl::Draw& d : m.draws) {
-      glUniform1i(Loc(m.gbuffer_program, "textured"),
-                  d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
-      glBindTexture(GL_TEXTURE_2D, d.texture);
-      glDrawArrays(GL_TRIANGLES, d.first, d.count);
-    }
-  }
+  const FrameEye eye{W, H, *pose, f, eye_rel};
+  m.DrawGBuffer(view, eye, options);
 
   // Clear the light and the first mask.
   glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[0]);
@@ -1112,7 +1288,6 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
 
   const double brightness =
       std::isnan(options.brightness) ? DefaultBrightness(rig.enabled_count()) : options.brightness;
-  const double lift = 0.1 * 1e-5 * m.scene_scale;  // as the CPU renderer: a tenth of epsilon
   int src = 0;
   double shadow_seconds = 0, light_seconds = 0;
   int maps_drawn = 0;
@@ -1121,20 +1296,8 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     // 2. The batch's distance maps (those not kept from the last frame).
     if (stats) glFinish();
     const auto shadow_start = Clock::now();
-    int next_map = 0, next_cube = 0;
     std::vector<int> layer(batch.cameras.size());
-    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
-      const Camera& cam = rig.cameras[batch.cameras[i]];
-      const bool cube = IsCube(cam);
-      layer[i] = cube ? next_cube++ : next_map++;
-      std::optional<Camera>& held = cube ? m.cube_camera[layer[i]] : m.map_camera[layer[i]];
-      if (held && SameCameraGeometry(*held, cam)) continue;
-      maps_drawn += m.DrawMaps(cam, cube, layer[i]);
-      if (keep && options.reuse_maps)
-        held = cam;
-      else
-        held.reset();
-    }
+    maps_drawn += m.DrawBatchMaps(rig, batch, keep, options, layer);
     if (stats) {
       glFinish();
       shadow_seconds += std::chrono::duration<double>(Clock::now() - shadow_start).count();
@@ -1142,67 +1305,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
 
     // 3. The batch's light over the G-buffer, in one pass.
     const auto light_start = Clock::now();
-    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
-      const int c = batch.cameras[i];
-      PackCamera(rig.cameras[c], c, IsCube(rig.cameras[c]), layer[i], m.origin, brightness,
-                 &block[4 * kCameraVec4 * i]);
-    }
-    glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
-    glBufferSubData(GL_UNIFORM_BUFFER, 0,
-                    GLsizeiptr(4 * kCameraVec4 * batch.cameras.size() * sizeof(float)),
-                    block.data());
-    glBindBufferBase(GL_UNIFORM_BUFFER, 0, m.camera_ubo);
-    const int dst = 1 - src;
-    glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[dst]);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    glViewport(0, 0, W, H);
-    glDisable(GL_DEPTH_TEST);
-    glEnablei(GL_BLEND, 0);
-    glDisablei(GL_BLEND, 1);  // integer: the shader ORs the previous mask in
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
-    int variant = options.pattern == Pattern::kGrid ? 1 : 0;
-    for (int c : batch.cameras) {
-      const LensModel lens = rig.cameras[c].model.intrinsics().model;
-      variant |= lens == LensModel::kFisheye ? 2 : lens == LensModel::kBrownConrady ? 4 : 0;
-      variant |= IsCube(rig.cameras[c]) ? 8 : 0;
-    }
-    const GLuint p = m.LightProgram(variant);
-    glUseProgram(p);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, m.g_position);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, m.g_normal);
-    glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D, m.mask[src]);
-    glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, m.maps);
-    glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, m.cubes);
-    glUniform1i(Loc(p, "g_position_tex"), 0);
-    glUniform1i(Loc(p, "g_normal_tex"), 1);
-    glUniform1i(Loc(p, "mask_in"), 2);
-    glUniform1i(Loc(p, "maps"), 3);
-    glUniform1i(Loc(p, "cubes"), 4);
-    glUniform1i(Loc(p, "camera_count"), int(batch.cameras.size()));
-    glUniform1i(Loc(p, "map_size"), m.map_size);
-    glUniform1i(Loc(p, "cube_size"), m.cube_size);
-    static const std::array<Mat3, 6> kCube = CubeFaces();
-    for (int i = 0; i < 6; ++i) SetMat3(p, ("face_R[" + std::to_string(i) + "]").c_str(), kCube[i]);
-    glUniform1f(Loc(p, "bias_scale"), float(options.shadow_bias_scale));
-    glUniform1i(Loc(p, "shadow_mode"), int(options.shadow_test));
-    glUniform1f(Loc(p, "lift"), float(lift));
-    glUniform1f(Loc(p, "grid_n"), float(std::max(1, options.grid_pixels)));
-    glUniform1f(Loc(p, "grid_fill"), float(options.grid_fill));
-    glUniform1f(Loc(p, "line_width"), float(options.line_width_px));
-    SetVec3(p, "eye", eye_rel);
-    SetMat3(p, "view_Rt", pose->linear());
-    glUniform3f(Loc(p, "view_f"), float(f), float(0.5 * W - 0.5), float(0.5 * H - 0.5));
-    glBindVertexArray(m.empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDisablei(GL_BLEND, 0);
-    src = dst;
+    src = m.DrawBatchLight(rig, batch, layer, eye, options, brightness, src, block);
     if (stats) {
       glFinish();
       light_seconds += std::chrono::duration<double>(Clock::now() - light_start).count();
@@ -1210,66 +1313,12 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   }
 
   // 4. Compose.
-  glBindFramebuffer(GL_FRAMEBUFFER, m.compose_fbo);
-  const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &buffer0);
-  glViewport(0, 0, W, H);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  const GLuint p = m.compose_program;
-  glUseProgram(p);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, m.g_position);
-  glActiveTexture(GL_TEXTURE1);
-  glBindTexture(GL_TEXTURE_2D, m.g_normal);
-  glActiveTexture(GL_TEXTURE2);
-  glBindTexture(GL_TEXTURE_2D, m.g_albedo);
-  glActiveTexture(GL_TEXTURE3);
-  glBindTexture(GL_TEXTURE_2D, m.light_accum);
-  glUniform1i(Loc(p, "g_position_tex"), 0);
-  glUniform1i(Loc(p, "g_normal_tex"), 1);
-  glUniform1i(Loc(p, "g_albedo_tex"), 2);
-  glUniform1i(Loc(p, "light_tex"), 3);
-  const int surface = options.surface == Surface::kMaterial     ? 0
-                      : options.surface == Surface::kHiddenLine ? 2
-                      : options.surface == Surface::kContours   ? 3
-                                                                : 1;
-  glUniform1i(Loc(p, "surface"), surface);
-  glUniform1f(Loc(p, "line_grey"), float(options.line_grey));
-  glUniform1f(Loc(p, "ambient"), float(options.ambient));
-  SetVec3(p, "background", options.background);
-  SetVec3(p, "eye", eye_rel);
-  glBindVertexArray(m.empty_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  m.Compose(eye, options);
   if (stats) glFinish();
   const auto drawn = Clock::now();
 
-  // 5. Read back (GL's row r is the image's row r: no flip).
-  GlImage image;
-  image.width = W;
-  image.height = H;
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  std::vector<float> rgba(4 * pixels);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
-  image.rgb.resize(3 * pixels);
-  for (std::size_t i = 0; i < pixels; ++i)
-    for (int ch = 0; ch < 3; ++ch) image.rgb[3 * i + ch] = rgba[4 * i + ch];
-  glBindFramebuffer(GL_FRAMEBUFFER, m.g_fbo);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
-  image.hit.resize(pixels);
-  for (std::size_t i = 0; i < pixels; ++i) image.hit[i] = rgba[4 * i + 3] >= 0;
-  if (camera_count <= 64) {
-    std::vector<GLuint> bits(2 * pixels);
-    glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[src]);
-    glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glReadPixels(0, 0, W, H, GL_RG_INTEGER, GL_UNSIGNED_INT, bits.data());
-    image.cameras.resize(pixels);
-    for (std::size_t i = 0; i < pixels; ++i)
-      image.cameras[i] = uint64_t(bits[2 * i]) | (uint64_t(bits[2 * i + 1]) << 32);
-  }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  // 5. Read back.
+  GlImage image = m.ReadBack(W, H, src, camera_count);
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR)
     throw std::runtime_error("GlRenderer: GL error " + std::to_string(error) + " in a frame");

@@ -368,6 +368,26 @@ struct BlockLeaves {
   }
 };
 
+// The working arrays of one FieldEvaluator::State::Derive: the dirty voxels' coverage, the voxels
+// to re-sum, and the triangulation candidates with their information and statistics.
+struct DeriveScratch {
+  // Per dirty voxel: coverage, density, information in rig order.
+  std::array<std::array<double, 512>, 6> upper;
+  std::array<std::array<double, 512>, 3> eigenvalue;
+  std::array<unsigned char, 512> converged;
+  std::array<std::int16_t, 512> candidate;
+  std::array<double, 512> cand_x, cand_y, cand_z;
+  std::array<float, 512> angle_deg;
+  std::array<std::array<double, 512>, kStatRows> stats;
+  int candidate_count = 0;
+  std::array<std::int32_t, 512> cover;
+  Bits rescan_density{}, rescan_info{};
+  // Voxels summed in double (rig order), by offset; rarely any.
+  Bits in_double{};
+  std::vector<std::array<double, 6>> double_sum;
+  std::array<std::int16_t, 512> double_index;
+};
+
 }  // namespace
 
 struct FieldEvaluator::State {
@@ -412,6 +432,26 @@ struct FieldEvaluator::State {
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
               const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
               bool in_place);
+  // Derive's steps, in its order.
+  void PrepareCaches(const BlockState& old, bool fresh, bool in_place, BlockState* next) const;
+  void PrepareLeaves(const openvdb::Coord& origin, bool in_place, BlockLeaves* leaves);
+  void SumChangedCameras(const BlockState& old, const std::vector<const CameraEntry*>& view,
+                         const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
+                         BlockState* next, DeriveScratch* scratch) const;
+  void Rescan(const std::vector<const CameraEntry*>& view, const Bits& dirty, bool fresh,
+              BlockState* next, DeriveScratch* scratch) const;
+  void WriteDirtyVoxels(const Block& block, const Bits& dirty, BlockState* next,
+                        BlockLeaves* leaves, DeriveScratch* scratch) const;
+  void CandidateStatistics(const std::vector<const CameraEntry*>& view,
+                           const std::vector<std::uint8_t>& is_changed,
+                           const std::vector<Vec3>& centres, bool fresh, BlockState* next,
+                           DeriveScratch* scratch) const;
+  void CandidateAngles(const std::vector<const CameraEntry*>& view,
+                       const std::vector<std::uint8_t>& is_changed,
+                       const std::vector<Vec3>& centres, bool fresh, BlockState* next,
+                       DeriveScratch* scratch) const;
+  void PutStatistics(BlockState* next, BlockLeaves* leaves, const DeriveScratch& scratch) const;
+  void SummariseBlock(const Block& block, BlockState* next) const;
   void Totals(FieldStats* stats, int camera_count, int enabled) const;
   void ResetGrids(int camera_count);
 };
@@ -527,28 +567,10 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
   }
 }
 
-// Recomputes the voxels in `dirty` from the block's camera entries (`view`, ascending camera:
-// the kept ones and the re-cast ones) and the kept caches, and makes the block's new leaves:
-// copies of the current ones with the dirty voxels rewritten, or (`in_place`, an update that can
-// no longer be cancelled; `next` is then `old`) the grids' own leaves rewritten in place, new
-// leaves only where the grid has none. The same arithmetic for a full evaluation (every voxel
-// dirty) and an update, so both give the same bits.
-void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
-                                   std::vector<const CameraEntry*> view, const Bits& dirty,
-                                   const std::vector<std::uint8_t>& is_changed,
-                                   const std::vector<Vec3>& centres, BlockState* next,
-                                   BlockLeaves* leaves, bool in_place) {
-  // Entries that see nothing take no part.
-  view.erase(
-      std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
-      view.end());
-  Fields::Impl& g = fields.impl();
-  const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
-  const VoxelLattice& lattice = fields.lattice;
-
-  // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
-  const bool fresh = old.coverage.empty();
-  if (in_place && next != &old) throw std::logic_error("Derive in place: next must be old");
+// Resets the block's caches (a full evaluation writes every voxel) or copies the old ones (an
+// update not in place; in place they stay where they are).
+void FieldEvaluator::State::PrepareCaches(const BlockState& old, bool fresh, bool in_place,
+                                          BlockState* next) const {
   if (fresh) {
     next->coverage.assign(512, 0);
     next->status.assign(512, kUnseen);
@@ -585,7 +607,12 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     next->sum_band = old.sum_band;
     next->band_count = old.band_count;
   }
+}
 
+// The block's leaves to rewrite: the grids' own ones (`in_place`), copies of them, or new ones.
+void FieldEvaluator::State::PrepareLeaves(const openvdb::Coord& origin, bool in_place,
+                                          BlockLeaves* leaves) {
+  Fields::Impl& g = fields.impl();
   // Leaves to rewrite: copies of the grids' current ones, or new ones.
   // (probeLeaf changes no tree structure, and every block has leaves of its own: the threads
   // never write the same leaf.)
@@ -613,30 +640,18 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       leaves->float_owned[f] = true;
     }
   }
+}
 
-  // Per dirty voxel: coverage, density, information in rig order.
-  std::array<std::array<double, 512>, 6> upper;
-  std::array<std::array<double, 512>, 3> eigenvalue;
-  std::array<unsigned char, 512> converged;
-  std::array<std::int16_t, 512> candidate;
-  std::array<double, 512> cand_x, cand_y, cand_z;
-  std::array<float, 512> angle_deg;
-  std::array<std::array<double, 512>, kStatRows> stats;
-  double* stats_ptr[kStatRows];
-  for (int k = 0; k < kStatRows; ++k) stats_ptr[k] = stats[k].data();
-  const double* upper_ptr[6];
-  for (int k = 0; k < 6; ++k) upper_ptr[k] = upper[k].data();
-  double* eigen_ptr[3] = {eigenvalue[0].data(), eigenvalue[1].data(), eigenvalue[2].data()};
-  FloatLeaf* resolution = leaves->floats[kResolution];
-
-  // Coverage, best density and information of the dirty voxels. A full evaluation sums every
-  // camera of every voxel. An update starts from the cached values and takes out the changed
-  // cameras' old contributions and puts in their new ones: coverage is a count, the density a
-  // maximum and the information an exact fixed-point sum (see Sum6), so the result has the bits of
-  // a full evaluation. A voxel whose best density came from a changed camera, or whose sum's band
-  // changes (or that is summed in double), is re-summed from every camera ("rescan").
-  std::array<std::int32_t, 512> cover;
-  Bits rescan_density{}, rescan_info{};
+// An update's coverage, best density and information sums from the cached ones: the changed
+// cameras' new views in, their old ones out; marks the voxels to re-sum from every camera.
+void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
+                                              const std::vector<const CameraEntry*>& view,
+                                              const Bits& dirty,
+                                              const std::vector<std::uint8_t>& is_changed,
+                                              BlockState* next, DeriveScratch* scratch) const {
+  std::array<std::int32_t, 512>& cover = scratch->cover;
+  Bits& rescan_density = scratch->rescan_density;
+  Bits& rescan_info = scratch->rescan_info;
   const std::array<BandScale, 64>& scales = BandScales();
   const auto walk = [](const CameraEntry& e, auto&& f)
       __attribute__((always_inline)) {  // every seen voxel, with its index
@@ -645,56 +660,62 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
         f(64 * w + __builtin_ctzll(bits), index++);
   };
-  if (fresh) {
-    cover.fill(0);
-    if (want_resolution) rescan_density = dirty;
-    if (want_information) rescan_info = dirty;
-  } else {
-    for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
-    for (const CameraEntry* e : view) {
-      if (!is_changed[e->camera]) continue;
-      walk(
-          *e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
-            ++cover[o];
-            if (want_resolution && e->density[index] > next->best_density[o]) {
-              next->best_density[o] = e->density[index];
-              next->best_camera[o] = e->camera;
+  for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
+  for (const CameraEntry* e : view) {
+    if (!is_changed[e->camera]) continue;
+    walk(
+        *e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
+          ++cover[o];
+          if (want_resolution && e->density[index] > next->best_density[o]) {
+            next->best_density[o] = e->density[index];
+            next->best_camera[o] = e->camera;
+          }
+          if (want_information && !TestBit(rescan_info, o)) {
+            const std::uint8_t b = e->band[index], k = next->sum_band[o];
+            if (k == kNotExact || b > k) {
+              SetBit(rescan_info, o);
+            } else {
+              if (b == k) ++next->band_count[o];
+              Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
             }
-            if (want_information && !TestBit(rescan_info, o)) {
-              const std::uint8_t b = e->band[index], k = next->sum_band[o];
-              if (k == kNotExact || b > k) {
-                SetBit(rescan_info, o);
-              } else {
-                if (b == k) ++next->band_count[o];
-                Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
-              }
-            }
-          });
-    }
-    for (const CameraEntry& e : old.entries) {
-      if (!is_changed[e.camera] || e.seen == 0) continue;
-      walk(
-          e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
-            --cover[o];
-            if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
-            if (want_information && !TestBit(rescan_info, o)) {
-              const std::uint8_t b = e.band[index], k = next->sum_band[o];
-              if (k == kNotExact || b > k) {
-                SetBit(rescan_info, o);
-              } else {
-                if (b == k) --next->band_count[o];
-                Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
-              }
-            }
-          });
-    }
-    if (want_information)
-      for (int w = 0; w < kWords; ++w)
-        for (std::uint64_t bits = dirty[w] & ~rescan_info[w]; bits; bits &= bits - 1) {
-          const int o = 64 * w + __builtin_ctzll(bits);
-          if (next->band_count[o] <= 0 || cover[o] > kMaxExactCameras) SetBit(rescan_info, o);
-        }
+          }
+        });
   }
+  for (const CameraEntry& e : old.entries) {
+    if (!is_changed[e.camera] || e.seen == 0) continue;
+    walk(
+        e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
+          --cover[o];
+          if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
+          if (want_information && !TestBit(rescan_info, o)) {
+            const std::uint8_t b = e.band[index], k = next->sum_band[o];
+            if (k == kNotExact || b > k) {
+              SetBit(rescan_info, o);
+            } else {
+              if (b == k) --next->band_count[o];
+              Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
+            }
+          }
+        });
+  }
+  if (want_information)
+    for (int w = 0; w < kWords; ++w)
+      for (std::uint64_t bits = dirty[w] & ~rescan_info[w]; bits; bits &= bits - 1) {
+        const int o = 64 * w + __builtin_ctzll(bits);
+        if (next->band_count[o] <= 0 || cover[o] > kMaxExactCameras) SetBit(rescan_info, o);
+      }
+}
+
+// Re-sums the voxels to rescan (every dirty voxel of a full evaluation) from every camera.
+void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, const Bits& dirty,
+                                   bool fresh, BlockState* next, DeriveScratch* scratch) const {
+  std::array<std::int32_t, 512>& cover = scratch->cover;
+  const Bits& rescan_density = scratch->rescan_density;
+  const Bits& rescan_info = scratch->rescan_info;
+  Bits& in_double = scratch->in_double;
+  std::vector<std::array<double, 6>>& double_sum = scratch->double_sum;
+  std::array<std::int16_t, 512>& double_index = scratch->double_index;
+  const std::array<BandScale, 64>& scales = BandScales();
   // Rescans, camera by camera in rig order: coverage (a full evaluation), best density, the band
   // of the information sum and its count.
   Bits rescan = rescan_density;
@@ -719,10 +740,6 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   };
   bool any_rescan = false;
   for (std::uint64_t word : rescan) any_rescan |= word != 0;
-  // Voxels summed in double (rig order), by offset; rarely any.
-  Bits in_double{};
-  std::vector<std::array<double, 6>> double_sum;
-  std::array<std::int16_t, 512> double_index;
   if (any_rescan) {
     for (int w = 0; w < kWords; ++w) {
       for (std::uint64_t bits = rescan_density[w]; bits; bits &= bits - 1) {
@@ -784,8 +801,26 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
               }
             });
   }
+}
 
-  int candidate_count = 0;
+// Writes the dirty voxels' coverage and best density into the caches and the leaves, clears their
+// other fields, and collects the triangulation candidates with their information and centres.
+void FieldEvaluator::State::WriteDirtyVoxels(const Block& block, const Bits& dirty,
+                                             BlockState* next, BlockLeaves* leaves,
+                                             DeriveScratch* scratch) const {
+  const VoxelLattice& lattice = fields.lattice;
+  const std::array<BandScale, 64>& scales = BandScales();
+  FloatLeaf* resolution = leaves->floats[kResolution];
+  const std::array<std::int32_t, 512>& cover = scratch->cover;
+  const Bits& in_double = scratch->in_double;
+  const std::vector<std::array<double, 6>>& double_sum = scratch->double_sum;
+  const std::array<std::int16_t, 512>& double_index = scratch->double_index;
+  std::array<std::array<double, 512>, 6>& upper = scratch->upper;
+  std::array<double, 512>& cand_x = scratch->cand_x;
+  std::array<double, 512>& cand_y = scratch->cand_y;
+  std::array<double, 512>& cand_z = scratch->cand_z;
+  std::array<std::int16_t, 512>& candidate = scratch->candidate;
+  int& candidate_count = scratch->candidate_count;
   for (int w = 0; w < kWords; ++w) {
     for (std::uint64_t bits = dirty[w]; bits; bits &= bits - 1) {
       const int o = 64 * w + __builtin_ctzll(bits);
@@ -824,75 +859,110 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       candidate[candidate_count++] = static_cast<std::int16_t>(o);
     }
   }
-  if (candidate_count > 0) {
-    SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), candidate_count);
-    StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
-    if (want_angle) {
-      std::vector<const std::uint64_t*> sees;
-      std::vector<Vec3> entry_centres;
-      std::vector<unsigned char> entry_changed;
-      sees.reserve(view.size());
-      entry_centres.reserve(view.size());
-      for (const CameraEntry* e : view) {
-        sees.push_back(e->bits.data());
-        entry_centres.push_back(centres[e->camera]);
-        entry_changed.push_back(is_changed[e->camera]);
-      }
-      const auto entry_of = [&](std::int32_t camera) {
-        const auto it = std::lower_bound(view.begin(), view.end(), camera,
-                                         [](const CameraEntry* e, int c) { return e->camera < c; });
-        return static_cast<std::int32_t>(it - view.begin());
-      };
-      // Two groups: voxels whose cached best pair involves no changed camera try only the pairs
-      // with a changed one; the others (new candidates, a changed camera in the pair) try all.
-      std::array<int, 512> group_of;  // candidate -> index within its group
-      std::array<std::int16_t, 512> offsets[2];
-      std::array<double, 512> gx[2], gy[2], gz[2], dot[2];
-      std::array<std::int32_t, 512> pa[2], pb[2];
-      std::array<float, 512> degrees[2];
-      int size[2] = {0, 0};
-      std::array<unsigned char, 512> which;
-      for (int m = 0; m < candidate_count; ++m) {
-        const int o = candidate[m];
-        const std::int32_t ca = next->pair_a[o], cb = next->pair_b[o];
-        const int g = (!fresh && ca >= 0 && !is_changed[ca] && !is_changed[cb]) ? 1 : 0;
-        const int k = size[g]++;
-        which[m] = static_cast<unsigned char>(g);
-        group_of[m] = k;
-        offsets[g][k] = static_cast<std::int16_t>(o);
-        gx[g][k] = cand_x[m];
-        gy[g][k] = cand_y[m];
-        gz[g][k] = cand_z[m];
-        if (g == 1) {
-          dot[g][k] = next->pair_dot[o];
-          pa[g][k] = entry_of(ca);
-          pb[g][k] = entry_of(cb);
-        }
-      }
-      // Scratch, every entry written before it is read: no zero fill (36 KiB for 24 cameras).
-      const std::unique_ptr<double[]> directions(new double[3 * 64 * view.size()]);
-      for (int g = 0; g < 2; ++g)
-        if (size[g] > 0)
-          TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
-                              static_cast<int>(view.size()), sees.data(), entry_centres.data(),
-                              g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
-                              pb[g].data(), directions.get(), degrees[g].data());
-      for (int m = 0; m < candidate_count; ++m) {
-        const int g = which[m], k = group_of[m], o = candidate[m];
-        angle_deg[m] = degrees[g][k];
-        next->pair_dot[o] = dot[g][k];
-        next->pair_a[o] = view[pa[g][k]]->camera;
-        next->pair_b[o] = view[pb[g][k]]->camera;
-      }
-    }
-    if (want_steady) {
-      const double frame = frame_period;
-      for (int k = 0; k < 3; ++k)
-        SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(), stats[kVar0 + k].data(),
-                                candidate_count, scene.study.steady_prior);
-      SteadyStatistics(candidate_count, stats_ptr);
+}
+
+// The candidates' static statistics (eigenvalues of the information), triangulation angles and
+// steady-state statistics.
+void FieldEvaluator::State::CandidateStatistics(const std::vector<const CameraEntry*>& view,
+                                                const std::vector<std::uint8_t>& is_changed,
+                                                const std::vector<Vec3>& centres, bool fresh,
+                                                BlockState* next, DeriveScratch* scratch) const {
+  const int candidate_count = scratch->candidate_count;
+  std::array<std::array<double, 512>, kStatRows>& stats = scratch->stats;
+  double* stats_ptr[kStatRows];
+  for (int k = 0; k < kStatRows; ++k) stats_ptr[k] = stats[k].data();
+  const double* upper_ptr[6];
+  for (int k = 0; k < 6; ++k) upper_ptr[k] = scratch->upper[k].data();
+  double* eigen_ptr[3] = {scratch->eigenvalue[0].data(), scratch->eigenvalue[1].data(),
+                          scratch->eigenvalue[2].data()};
+  SymmetricEigenvalues3(upper_ptr, eigen_ptr, scratch->converged.data(), candidate_count);
+  StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
+  if (want_angle) CandidateAngles(view, is_changed, centres, fresh, next, scratch);
+  if (want_steady) {
+    const double frame = frame_period;
+    for (int k = 0; k < 3; ++k)
+      SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(), stats[kVar0 + k].data(),
+                              candidate_count, scene.study.steady_prior);
+    SteadyStatistics(candidate_count, stats_ptr);
+  }
+}
+
+// The candidates' triangulation angles and best camera pairs (into the pair caches).
+void FieldEvaluator::State::CandidateAngles(const std::vector<const CameraEntry*>& view,
+                                            const std::vector<std::uint8_t>& is_changed,
+                                            const std::vector<Vec3>& centres, bool fresh,
+                                            BlockState* next, DeriveScratch* scratch) const {
+  const int candidate_count = scratch->candidate_count;
+  const std::array<std::int16_t, 512>& candidate = scratch->candidate;
+  const std::array<double, 512>& cand_x = scratch->cand_x;
+  const std::array<double, 512>& cand_y = scratch->cand_y;
+  const std::array<double, 512>& cand_z = scratch->cand_z;
+  std::array<float, 512>& angle_deg = scratch->angle_deg;
+  std::vector<const std::uint64_t*> sees;
+  std::vector<Vec3> entry_centres;
+  std::vector<unsigned char> entry_changed;
+  sees.reserve(view.size());
+  entry_centres.reserve(view.size());
+  for (const CameraEntry* e : view) {
+    sees.push_back(e->bits.data());
+    entry_centres.push_back(centres[e->camera]);
+    entry_changed.push_back(is_changed[e->camera]);
+  }
+  const auto entry_of = [&](std::int32_t camera) {
+    const auto it = std::lower_bound(view.begin(), view.end(), camera,
+                                     [](const CameraEntry* e, int c) { return e->camera < c; });
+    return static_cast<std::int32_t>(it - view.begin());
+  };
+  // Two groups: voxels whose cached best pair involves no changed camera try only the pairs
+  // with a changed one; the others (new candidates, a changed camera in the pair) try all.
+  std::array<int, 512> group_of;  // candidate -> index within its group
+  std::array<std::int16_t, 512> offsets[2];
+  std::array<double, 512> gx[2], gy[2], gz[2], dot[2];
+  std::array<std::int32_t, 512> pa[2], pb[2];
+  std::array<float, 512> degrees[2];
+  int size[2] = {0, 0};
+  std::array<unsigned char, 512> which;
+  for (int m = 0; m < candidate_count; ++m) {
+    const int o = candidate[m];
+    const std::int32_t ca = next->pair_a[o], cb = next->pair_b[o];
+    const int g = (!fresh && ca >= 0 && !is_changed[ca] && !is_changed[cb]) ? 1 : 0;
+    const int k = size[g]++;
+    which[m] = static_cast<unsigned char>(g);
+    group_of[m] = k;
+    offsets[g][k] = static_cast<std::int16_t>(o);
+    gx[g][k] = cand_x[m];
+    gy[g][k] = cand_y[m];
+    gz[g][k] = cand_z[m];
+    if (g == 1) {
+      dot[g][k] = next->pair_dot[o];
+      pa[g][k] = entry_of(ca);
+      pb[g][k] = entry_of(cb);
     }
   }
+  // Scratch, every entry written before it is read: no zero fill (36 KiB for 24 cameras).
+  const std::unique_ptr<double[]> directions(new double[3 * 64 * view.size()]);
+  for (int g = 0; g < 2; ++g)
+    if (size[g] > 0)
+      TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
+                          static_cast<int>(view.size()), sees.data(), entry_centres.data(),
+                          g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
+                          pb[g].data(), directions.get(), degrees[g].data());
+  for (int m = 0; m < candidate_count; ++m) {
+    const int g = which[m], k = group_of[m], o = candidate[m];
+    angle_deg[m] = degrees[g][k];
+    next->pair_dot[o] = dot[g][k];
+    next->pair_a[o] = view[pa[g][k]]->camera;
+    next->pair_b[o] = view[pb[g][k]]->camera;
+  }
+}
+
+// Puts the candidates' statistics into the caches and the float leaves.
+void FieldEvaluator::State::PutStatistics(BlockState* next, BlockLeaves* leaves,
+                                          const DeriveScratch& scratch) const {
+  const int candidate_count = scratch.candidate_count;
+  const std::array<std::int16_t, 512>& candidate = scratch.candidate;
+  const std::array<std::array<double, 512>, kStatRows>& stats = scratch.stats;
+  const std::array<float, 512>& angle_deg = scratch.angle_deg;
   const auto put = [&](int field, int offset, float value) {
     if (leaves->floats[field]) leaves->floats[field]->setValueOn(offset, value);
   };
@@ -916,8 +986,10 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
       put(kSigmaMeanSteady, o, static_cast<float>(stats[kSteadyMeanMm][m]));
     }
   }
+}
 
-  // The block's summary from its caches (every free voxel, ascending offset).
+// The block's summary from its caches (every free voxel, ascending offset).
+void FieldEvaluator::State::SummariseBlock(const Block& block, BlockState* next) const {
   next->histogram.clear();
   next->seen = next->triangulable = next->unobservable = 0;
   next->sigma_list.clear();
@@ -943,6 +1015,52 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
         next->sigma_list.push_back(next->sigma_max[o]);
         if (want_steady) next->steady_list.push_back(next->sigma_steady[o]);
       }
+}
+
+// Recomputes the voxels in `dirty` from the block's camera entries (`view`, ascending camera:
+// the kept ones and the re-cast ones) and the kept caches, and makes the block's new leaves:
+// copies of the current ones with the dirty voxels rewritten, or (`in_place`, an update that can
+// no longer be cancelled; `next` is then `old`) the grids' own leaves rewritten in place, new
+// leaves only where the grid has none. The same arithmetic for a full evaluation (every voxel
+// dirty) and an update, so both give the same bits.
+void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
+                                   std::vector<const CameraEntry*> view, const Bits& dirty,
+                                   const std::vector<std::uint8_t>& is_changed,
+                                   const std::vector<Vec3>& centres, BlockState* next,
+                                   BlockLeaves* leaves, bool in_place) {
+  // Entries that see nothing take no part.
+  view.erase(
+      std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
+      view.end());
+  const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+
+  // Caches: the old ones (an update) or fresh ones (a full evaluation writes every voxel).
+  const bool fresh = old.coverage.empty();
+  if (in_place && next != &old) throw std::logic_error("Derive in place: next must be old");
+  PrepareCaches(old, fresh, in_place, next);
+  PrepareLeaves(origin, in_place, leaves);
+
+  DeriveScratch scratch;
+  // Coverage, best density and information of the dirty voxels. A full evaluation sums every
+  // camera of every voxel. An update starts from the cached values and takes out the changed
+  // cameras' old contributions and puts in their new ones: coverage is a count, the density a
+  // maximum and the information an exact fixed-point sum (see Sum6), so the result has the bits of
+  // a full evaluation. A voxel whose best density came from a changed camera, or whose sum's band
+  // changes (or that is summed in double), is re-summed from every camera ("rescan").
+  if (fresh) {
+    scratch.cover.fill(0);
+    if (want_resolution) scratch.rescan_density = dirty;
+    if (want_information) scratch.rescan_info = dirty;
+  } else {
+    SumChangedCameras(old, view, dirty, is_changed, next, &scratch);
+  }
+  Rescan(view, dirty, fresh, next, &scratch);
+  WriteDirtyVoxels(block, dirty, next, leaves, &scratch);
+  if (scratch.candidate_count > 0)
+    CandidateStatistics(view, is_changed, centres, fresh, next, &scratch);
+  PutStatistics(next, leaves, scratch);
+
+  SummariseBlock(block, next);
 
   // Leaves: a full block nobody sees keeps its coverage as a tile; empty float leaves go.
   if (leaves->coverage && block.full && next->seen == 0) {
@@ -1169,78 +1287,77 @@ double FieldEvaluator::state_bytes() const {
   return bytes;
 }
 
-FieldUpdate FieldEvaluator::Update(const Rig& rig) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t cpu0 = std::clock();
-  State& S = *state_;
-  const FieldOptions& opt = S.options;
-  FieldUpdate update;
-  if (S.evaluated && !S.keep) TakeFields();  // nothing kept: evaluate again in full
+namespace {
 
-  // Which cameras changed (by index; cameras added or removed at the end count as changed).
-  const int new_count = static_cast<int>(rig.cameras.size());
-  const int old_count = S.evaluated ? static_cast<int>(S.rig.cameras.size()) : 0;
+using State = FieldEvaluator::State;
+
+// The working data of one FieldEvaluator::Update: the changed cameras, the blocks to visit and
+// what the parallel phase makes for each of them (by index into `dirty`).
+struct UpdatePass {
   std::vector<int> changed;
-  for (int c = 0; c < std::max(new_count, old_count); ++c)
-    if (!S.evaluated || c >= old_count || c >= new_count ||
-        !SameCameraGeometry(S.rig.cameras[c], rig.cameras[c]))
-      changed.push_back(c);
-  update.full = !S.evaluated;
-  update.changed_cameras = static_cast<int>(changed.size());
-  if (S.evaluated && changed.empty()) {
-    S.rig = rig;  // names, colours and ids may differ
-    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return update;
-  }
+  std::vector<std::uint8_t> is_changed;  // by rig index, 1 for a changed camera
+  std::vector<std::vector<std::int32_t>> candidates;
+  std::vector<std::size_t> dirty;
+  bool in_place = false;
+  std::vector<BlockState> next;
+  std::vector<std::vector<CameraEntry>> cast;
+  std::vector<BlockLeaves> leaves;
+  std::atomic<std::size_t> done{0};
+  std::atomic<std::int64_t> dirty_voxels{0};
+  std::atomic<bool> cancelled{false};
+};
+
+// Throws InputError when the fields with `new_count` cameras and the scene's structures exceed the
+// memory budget.
+void CheckCameraBudget(const State& S, int new_count) {
+  const FieldOptions& opt = S.options;
   // The memory budget with the cameras counted (the evaluator learns them only now): each camera's
   // own grid for "cameras" (an OpenVDB tree's internal nodes, ~300 kB per camera even over a few
   // blocks) and its per-block counts. 2,000 cameras over 4,096
   // voxels peaked at 675 MB under a 256 MiB budget before (issue 27).
-  if (!S.evaluated || new_count > old_count) {
-    const double blocks = double(S.blocks.size());
-    // The budget bounds the process's data: the evaluation, every camera's share, and the scene's
-    // structures held for the run (its meshes, the Embree BVH and the solids' search trees:
-    // SceneStructureBytes). The program itself (code and libraries, about 45 MiB resident before
-    // any input) comes on top; summary.json's timing.peak_rss_mib shows the whole.
-    const double scene_bytes = SceneStructureBytes(S.scene);
-    const double need =
-        S.fields.stats.estimated_bytes + scene_bytes +
-        double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
-    if (need > opt.memory_budget_bytes) {
-      std::ostringstream reason;
-      reason << "the run needs about " << std::llround(need / 1048576.0)
-             << " MiB (the region's fields with the rig's " << new_count << " cameras";
-      if (scene_bytes >= 1048576.0)
-        reason << ", the scene's meshes and BVH " << std::llround(scene_bytes / 1048576.0)
-               << " MiB of it";
-      reason << "), over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
-             << " MiB";
-      const std::string hint =
-          Wants(opt.fields, "cameras")
-              ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
-              : "raise the budget ({memory_budget_mb} or study.memory_budget_mb), or use fewer "
-                "cameras";
-      if (!opt.memory_budget_option.empty())
-        throw InputError(opt.memory_budget_option, "", reason.str(), hint);
-      throw InputError(S.file, "$.study.memory_budget_mb", reason.str(), hint);
-    }
+  const double blocks = double(S.blocks.size());
+  // The budget bounds the process's data: the evaluation, every camera's share, and the scene's
+  // structures held for the run (its meshes, the Embree BVH and the solids' search trees:
+  // SceneStructureBytes). The program itself (code and libraries, about 45 MiB resident before
+  // any input) comes on top; summary.json's timing.peak_rss_mib shows the whole.
+  const double scene_bytes = SceneStructureBytes(S.scene);
+  const double need =
+      S.fields.stats.estimated_bytes + scene_bytes +
+      double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
+  if (need > opt.memory_budget_bytes) {
+    std::ostringstream reason;
+    reason << "the run needs about " << std::llround(need / 1048576.0)
+           << " MiB (the region's fields with the rig's " << new_count << " cameras";
+    if (scene_bytes >= 1048576.0)
+      reason << ", the scene's meshes and BVH " << std::llround(scene_bytes / 1048576.0)
+             << " MiB of it";
+    reason << "), over the budget of " << std::llround(opt.memory_budget_bytes / 1048576.0)
+           << " MiB";
+    const std::string hint =
+        Wants(opt.fields, "cameras")
+            ? "leave the per-camera 'cameras' field out, raise the budget, or use fewer cameras"
+            : "raise the budget ({memory_budget_mb} or study.memory_budget_mb), or use fewer "
+              "cameras";
+    if (!opt.memory_budget_option.empty())
+      throw InputError(opt.memory_budget_option, "", reason.str(), hint);
+    throw InputError(S.file, "$.study.memory_budget_mb", reason.str(), hint);
   }
-  const RigData rd = S.Prepare(rig);
+}
 
-  // New candidate lists; the blocks to visit are those a changed camera's old or new frustum
-  // meets (all of them the first time).
-  if (!S.evaluated) {
-    S.states.assign(S.blocks.size(), BlockState{});
-    S.ResetGrids(new_count);
-    S.fields.stats.active_set = S.active_stats;
-  }
-  std::vector<std::vector<std::int32_t>> candidates(S.blocks.size());
+// The blocks' new candidate lists and the blocks to visit (into `u`): those a changed camera's old
+// or new frustum meets (all of them the first time), of this process's partition.
+void VisitBlocks(State& S, const RigData& rd, int new_count, int old_count, UpdatePass* u) {
+  const FieldOptions& opt = S.options;
+  const std::vector<int>& changed = u->changed;
+  std::vector<std::vector<std::int32_t>>& candidates = u->candidates;
+  candidates.resize(S.blocks.size());
   std::vector<std::uint8_t> dirty_block(S.blocks.size(), 0);
-  const std::vector<std::uint8_t> is_changed = [&] {
+  u->is_changed = [&] {
     std::vector<std::uint8_t> v(std::max(new_count, old_count) + 1, 0);
     for (int c : changed) v[c] = 1;
     return v;
   }();
+  const std::vector<std::uint8_t>& is_changed = u->is_changed;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16),
                     [&](const auto& range) {
                       for (std::size_t b = range.begin(); b != range.end(); ++b) {
@@ -1271,119 +1388,145 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     S.owned = PartitionBlocks(S.blocks, candidates, opt.partition_count, opt.partition_rank);
     for (std::size_t b = 0; b < S.blocks.size(); ++b) dirty_block[b] &= S.owned[b];
   }
-  std::vector<std::size_t> dirty;
+  std::vector<std::size_t>& dirty = u->dirty;
   for (std::size_t b = 0; b < S.blocks.size(); ++b)
     if (dirty_block[b]) dirty.push_back(b);
-  update.dirty_blocks = static_cast<std::int64_t>(dirty.size());
+}
 
-  // Kept state: an upper bound (every candidate camera sees every free voxel) against the budget.
-  if (S.keep) {
-    const double per_pair = (S.want_information ? 49.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
-    // Per voxel caches: coverage, status, sigmas, best pair, best density, exact sums.
-    const double per_voxel = 13 + (S.want_angle ? 16 : 0) + (S.want_resolution ? 8 : 0) +
-                             (S.want_information ? sizeof(Sum6) + 5 : 0);
-    double bytes = 0;
-    for (std::size_t b = 0; b < S.blocks.size(); ++b)
-      bytes += 512.0 * per_voxel + double(candidates[b].size()) *
-                                       (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
-    const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(S.scene);
-    if (total > opt.memory_budget_bytes) {
-      std::ostringstream reason;
-      reason << "incremental updates of rig '" << rig.name << "' need up to "
-             << std::llround(total / 1048576.0) << " MiB, over the budget of "
-             << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
-      throw InputError(opt.memory_budget_option.empty() ? S.file : opt.memory_budget_option,
-                       opt.memory_budget_option.empty() ? "$.study.memory_budget_mb" : "",
-                       reason.str(),
-                       "use a coarser voxel_size, a smaller region, or raise the budget");
-    }
+// Throws InputError when the kept state's upper bound (every candidate camera sees every free
+// voxel) exceeds the memory budget.
+void CheckKeptBudget(const State& S, const Rig& rig,
+                     const std::vector<std::vector<std::int32_t>>& candidates) {
+  const FieldOptions& opt = S.options;
+  const double per_pair = (S.want_information ? 49.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
+  // Per voxel caches: coverage, status, sigmas, best pair, best density, exact sums.
+  const double per_voxel = 13 + (S.want_angle ? 16 : 0) + (S.want_resolution ? 8 : 0) +
+                           (S.want_information ? sizeof(Sum6) + 5 : 0);
+  double bytes = 0;
+  for (std::size_t b = 0; b < S.blocks.size(); ++b)
+    bytes += 512.0 * per_voxel + double(candidates[b].size()) *
+                                     (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
+  const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(S.scene);
+  if (total > opt.memory_budget_bytes) {
+    std::ostringstream reason;
+    reason << "incremental updates of rig '" << rig.name << "' need up to "
+           << std::llround(total / 1048576.0) << " MiB, over the budget of "
+           << std::llround(opt.memory_budget_bytes / 1048576.0) << " MiB";
+    throw InputError(opt.memory_budget_option.empty() ? S.file : opt.memory_budget_option,
+                     opt.memory_budget_option.empty() ? "$.study.memory_budget_mb" : "",
+                     reason.str(),
+                     "use a coarser voxel_size, a smaller region, or raise the budget");
   }
+}
 
-  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves. A full
-  // evaluation does both per block (the per-pair data is dropped block by block without kept
-  // state). An update casts every changed camera first, where it can still be cancelled, then
-  // derives in place: into the kept caches and the grids' own leaves, no copies.
-  const bool in_place = S.evaluated;
-  std::vector<BlockState> next(dirty.size());
-  std::vector<std::vector<CameraEntry>> cast(dirty.size());
-  std::vector<BlockLeaves> leaves(dirty.size());
-  std::atomic<std::size_t> done{0};
-  std::atomic<std::int64_t> dirty_voxels{0};
-  std::atomic<bool> cancelled{false};
+// A leaf per re-cast camera of `cast` that sees part of the block, for the camera grids.
+void CameraLeaves(const Block& block, const std::vector<CameraEntry>& cast, BlockLeaves* leaves) {
+  for (const CameraEntry& e : cast) {
+    if (e.seen == 0) continue;
+    const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+    auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
+    // Word by word: the leaf's value mask and its values are both these bits (OpenVDB's
+    // 512-bit masks number voxels as Block::Offset does).
+    openvdb::BoolTree::LeafNodeType::NodeMaskType& mask = leaf->getValueMask();
+    auto* values = leaf->buffer().data();
+    for (int w = 0; w < kWords; ++w) {
+      mask.getWord<openvdb::Index64>(w) = e.bits[w];
+      values[w] = e.bits[w];
+    }
+    leaves->visible.emplace_back(e.camera, leaf);
+  }
+}
+
+// Without kept state: drops block i's entries, per-pair data and caches (see there).
+void DropPairData(BlockState& old, UpdatePass* u, std::size_t i) {
+  const bool in_place = u->in_place;
+  std::vector<std::vector<CameraEntry>>& cast = u->cast;
+  std::vector<BlockState>& next = u->next;
+  // One evaluation only: keep the summary (the per-camera counts), drop the entries, the
+  // per-pair data and the caches now, block by block, so that they never add up.
+  BlockState& n = in_place ? old : next[i];
+  n.counts.clear();
+  for (const CameraEntry& e : cast[i]) n.counts.push_back({e.camera, e.rays, e.seen});
+  std::sort(n.counts.begin(), n.counts.end(),
+            [](const BlockState::CameraCount& a, const BlockState::CameraCount& b) {
+              return a.camera < b.camera;
+            });
+  std::vector<CameraEntry>().swap(cast[i]);
+  std::vector<std::int32_t>().swap(next[i].coverage);
+  std::vector<std::uint8_t>().swap(next[i].status);
+  std::vector<float>().swap(next[i].sigma_max);
+  std::vector<float>().swap(next[i].sigma_steady);
+  std::vector<double>().swap(next[i].pair_dot);
+  std::vector<std::int32_t>().swap(next[i].pair_a);
+  std::vector<std::int32_t>().swap(next[i].pair_b);
+  std::vector<float>().swap(next[i].best_density);
+  std::vector<std::int32_t>().swap(next[i].best_camera);
+  std::vector<Sum6>().swap(next[i].sums);
+  std::vector<std::uint8_t>().swap(next[i].sum_band);
+  std::vector<std::int32_t>().swap(next[i].band_count);
+}
+
+// Derives block i of `dirty` from its kept and re-cast entries, and makes its camera leaves.
+void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
+  const std::vector<std::uint8_t>& is_changed = u->is_changed;
+  std::vector<std::vector<CameraEntry>>& cast = u->cast;
+  std::vector<BlockState>& next = u->next;
+  std::vector<BlockLeaves>& leaves = u->leaves;
+  const bool in_place = u->in_place;
+  const std::size_t b = u->dirty[i];
+  const Block& block = S.blocks[b];
+  BlockState& old = S.states[b];
+  // Dirty voxels: where a changed camera saw or sees.
+  Bits voxels{};
+  if (old.coverage.empty()) {
+    for (int x = 0; x < block.extent.x(); ++x)
+      for (int y = 0; y < block.extent.y(); ++y)
+        for (int z = 0; z < block.extent.z(); ++z)
+          if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
+  } else {
+    for (const CameraEntry& e : old.entries)
+      if (is_changed[e.camera])
+        for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+    for (const CameraEntry& e : cast[i])
+      for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
+  }
+  std::int64_t count = 0;
+  for (std::uint64_t w : voxels) count += PopcountInline(w);
+  u->dirty_voxels += count;
+  std::vector<const CameraEntry*> view;
+  view.reserve(old.entries.size() + cast[i].size());
+  for (const CameraEntry& e : old.entries)
+    if (!is_changed[e.camera]) view.push_back(&e);
+  for (const CameraEntry& e : cast[i]) view.push_back(&e);
+  std::sort(view.begin(), view.end(),
+            [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
+  if (count > 0 || old.coverage.empty())
+    S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
+             in_place ? &old : &next[i], &leaves[i], in_place);
+  // Camera grids: a leaf per re-cast camera that sees part of the block.
+  if (S.want_cameras) CameraLeaves(block, cast[i], &leaves[i]);
+  if (!S.keep) DropPairData(old, u, i);
+}
+
+// The parallel phase: casts the changed cameras and derives the dirty blocks (`u->dirty`).
+// Returns false, with nothing derived in place, when cancelled.
+bool CastAndDerive(State& S, const RigData& rd, UpdatePass* u) {
+  const FieldOptions& opt = S.options;
+  const std::vector<int>& changed = u->changed;
+  const std::vector<std::vector<std::int32_t>>& candidates = u->candidates;
+  const std::vector<std::size_t>& dirty = u->dirty;
+  u->in_place = S.evaluated;
+  const bool in_place = u->in_place;
+  u->next.resize(dirty.size());
+  u->cast.resize(dirty.size());
+  u->leaves.resize(dirty.size());
+  std::vector<BlockState>& next = u->next;
+  std::vector<std::vector<CameraEntry>>& cast = u->cast;
+  std::atomic<std::size_t>& done = u->done;
+  std::atomic<bool>& cancelled = u->cancelled;
   const std::size_t report_every = std::max<std::size_t>(1, dirty.size() / 200);
   const double phases = in_place ? 2.0 : 1.0;
-  const auto derive = [&](std::size_t i) {
-    const std::size_t b = dirty[i];
-    const Block& block = S.blocks[b];
-    BlockState& old = S.states[b];
-    // Dirty voxels: where a changed camera saw or sees.
-    Bits voxels{};
-    if (old.coverage.empty()) {
-      for (int x = 0; x < block.extent.x(); ++x)
-        for (int y = 0; y < block.extent.y(); ++y)
-          for (int z = 0; z < block.extent.z(); ++z)
-            if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
-    } else {
-      for (const CameraEntry& e : old.entries)
-        if (is_changed[e.camera])
-          for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-      for (const CameraEntry& e : cast[i])
-        for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w];
-    }
-    std::int64_t count = 0;
-    for (std::uint64_t w : voxels) count += PopcountInline(w);
-    dirty_voxels += count;
-    std::vector<const CameraEntry*> view;
-    view.reserve(old.entries.size() + cast[i].size());
-    for (const CameraEntry& e : old.entries)
-      if (!is_changed[e.camera]) view.push_back(&e);
-    for (const CameraEntry& e : cast[i]) view.push_back(&e);
-    std::sort(view.begin(), view.end(),
-              [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
-    if (count > 0 || old.coverage.empty())
-      S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
-               in_place ? &old : &next[i], &leaves[i], in_place);
-    // Camera grids: a leaf per re-cast camera that sees part of the block.
-    if (S.want_cameras)
-      for (const CameraEntry& e : cast[i]) {
-        if (e.seen == 0) continue;
-        const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
-        auto* leaf = new openvdb::BoolTree::LeafNodeType(origin, false, false);
-        // Word by word: the leaf's value mask and its values are both these bits (OpenVDB's
-        // 512-bit masks number voxels as Block::Offset does).
-        openvdb::BoolTree::LeafNodeType::NodeMaskType& mask = leaf->getValueMask();
-        auto* values = leaf->buffer().data();
-        for (int w = 0; w < kWords; ++w) {
-          mask.getWord<openvdb::Index64>(w) = e.bits[w];
-          values[w] = e.bits[w];
-        }
-        leaves[i].visible.emplace_back(e.camera, leaf);
-      }
-    if (!S.keep) {
-      // One evaluation only: keep the summary (the per-camera counts), drop the entries, the
-      // per-pair data and the caches now, block by block, so that they never add up.
-      BlockState& n = in_place ? old : next[i];
-      n.counts.clear();
-      for (const CameraEntry& e : cast[i]) n.counts.push_back({e.camera, e.rays, e.seen});
-      std::sort(n.counts.begin(), n.counts.end(),
-                [](const BlockState::CameraCount& a, const BlockState::CameraCount& b) {
-                  return a.camera < b.camera;
-                });
-      std::vector<CameraEntry>().swap(cast[i]);
-      std::vector<std::int32_t>().swap(next[i].coverage);
-      std::vector<std::uint8_t>().swap(next[i].status);
-      std::vector<float>().swap(next[i].sigma_max);
-      std::vector<float>().swap(next[i].sigma_steady);
-      std::vector<double>().swap(next[i].pair_dot);
-      std::vector<std::int32_t>().swap(next[i].pair_a);
-      std::vector<std::int32_t>().swap(next[i].pair_b);
-      std::vector<float>().swap(next[i].best_density);
-      std::vector<std::int32_t>().swap(next[i].best_camera);
-      std::vector<Sum6>().swap(next[i].sums);
-      std::vector<std::uint8_t>().swap(next[i].sum_band);
-      std::vector<std::int32_t>().swap(next[i].band_count);
-    }
-  };
+  const auto derive = [&](std::size_t i) { DeriveBlock(S, rd, u, i); };
   const auto report = [&](double base) {
     const std::size_t n = done.fetch_add(1) + 1;
     if (opt.progress && (n % report_every == 0 || n == dirty.size()))
@@ -1410,16 +1553,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       report(0.0);
     }
   });
-  if (cancelled) {
-    for (BlockLeaves& l : leaves) l.Free();
-    if (!S.evaluated) {
-      S.states.clear();
-      S.fields.impl() = Fields::Impl();
-    }
-    update.cancelled = true;
-    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return update;
-  }
+  if (cancelled) return false;
   if (in_place) {
     done = 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 1), [&](const auto& range) {
@@ -1429,8 +1563,14 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       }
     });
   }
+  return true;
+}
 
-  // The serial phase: the new leaves into the grids, the new entries and caches into the state.
+// Puts the new leaves into the grids, a task per grid (the trees are independent).
+void InsertLeaves(State& S, int new_count, UpdatePass* u) {
+  const std::vector<std::uint8_t>& is_changed = u->is_changed;
+  const std::vector<std::size_t>& dirty = u->dirty;
+  std::vector<BlockLeaves>& leaves = u->leaves;
   Fields::Impl& g = S.fields.impl();
   if (S.want_cameras && new_count != static_cast<int>(g.visible.size())) {
     const std::size_t had = g.visible.size();
@@ -1486,6 +1626,15 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
         });
   }
   tbb::parallel_for(std::size_t(0), grid_tasks.size(), [&](std::size_t t) { grid_tasks[t](); });
+}
+
+// Puts the new candidate lists, entries and caches into the state.
+void StoreStates(State& S, UpdatePass* u) {
+  const std::vector<std::uint8_t>& is_changed = u->is_changed;
+  const std::vector<std::size_t>& dirty = u->dirty;
+  std::vector<std::vector<std::int32_t>>& candidates = u->candidates;
+  std::vector<std::vector<CameraEntry>>& cast = u->cast;
+  std::vector<BlockState>& next = u->next;
   for (std::size_t b = 0; b < S.blocks.size(); ++b)
     S.states[b].candidates = std::move(candidates[b]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirty.size(), 16), [&](const auto& range) {
@@ -1510,6 +1659,69 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
       }
     }
   });
+}
+
+}  // namespace
+
+FieldUpdate FieldEvaluator::Update(const Rig& rig) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  State& S = *state_;
+  const FieldOptions& opt = S.options;
+  FieldUpdate update;
+  if (S.evaluated && !S.keep) TakeFields();  // nothing kept: evaluate again in full
+
+  // Which cameras changed (by index; cameras added or removed at the end count as changed).
+  UpdatePass u;
+  const int new_count = static_cast<int>(rig.cameras.size());
+  const int old_count = S.evaluated ? static_cast<int>(S.rig.cameras.size()) : 0;
+  std::vector<int>& changed = u.changed;
+  for (int c = 0; c < std::max(new_count, old_count); ++c)
+    if (!S.evaluated || c >= old_count || c >= new_count ||
+        !SameCameraGeometry(S.rig.cameras[c], rig.cameras[c]))
+      changed.push_back(c);
+  update.full = !S.evaluated;
+  update.changed_cameras = static_cast<int>(changed.size());
+  if (S.evaluated && changed.empty()) {
+    S.rig = rig;  // names, colours and ids may differ
+    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return update;
+  }
+  if (!S.evaluated || new_count > old_count) CheckCameraBudget(S, new_count);
+  const RigData rd = S.Prepare(rig);
+
+  // New candidate lists; the blocks to visit are those a changed camera's old or new frustum
+  // meets (all of them the first time).
+  if (!S.evaluated) {
+    S.states.assign(S.blocks.size(), BlockState{});
+    S.ResetGrids(new_count);
+    S.fields.stats.active_set = S.active_stats;
+  }
+  VisitBlocks(S, rd, new_count, old_count, &u);
+  update.dirty_blocks = static_cast<std::int64_t>(u.dirty.size());
+
+  // Kept state: an upper bound (every candidate camera sees every free voxel) against the budget.
+  if (S.keep) CheckKeptBudget(S, rig, u.candidates);
+
+  // The parallel phase: cast the changed cameras, derive the dirty voxels, make leaves. A full
+  // evaluation does both per block (the per-pair data is dropped block by block without kept
+  // state). An update casts every changed camera first, where it can still be cancelled, then
+  // derives in place: into the kept caches and the grids' own leaves, no copies.
+  if (!CastAndDerive(S, rd, &u)) {
+    for (BlockLeaves& l : u.leaves) l.Free();
+    if (!S.evaluated) {
+      S.states.clear();
+      S.fields.impl() = Fields::Impl();
+    }
+    update.cancelled = true;
+    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return update;
+  }
+
+  // The serial phase: the new leaves into the grids, the new entries and caches into the state.
+  InsertLeaves(S, new_count, &u);
+  StoreStates(S, &u);
+  Fields::Impl& g = S.fields.impl();
   if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
   if (S.evaluated) {
     for (auto& [name, grid] : g.floats) openvdb::tools::pruneInactive(grid->tree());
@@ -1518,11 +1730,11 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
 
   S.rig = rig;
   S.evaluated = true;
-  update.dirty_voxels = dirty_voxels;
-  for (const auto& c : cast)
+  update.dirty_voxels = u.dirty_voxels;
+  for (const auto& c : u.cast)
     for (const CameraEntry& e : c) update.rays += e.rays;
   if (!S.keep)  // the entries went block by block; their counts stayed
-    for (std::size_t b : dirty)
+    for (std::size_t b : u.dirty)
       for (const BlockState::CameraCount& e : S.states[b].counts) update.rays += e.rays;
   FieldStats& st = S.fields.stats;
   const double estimated = st.estimated_bytes;

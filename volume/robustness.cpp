@@ -70,25 +70,11 @@ std::vector<int> CriticalityTable::MostCritical() const {
   return order;
 }
 
-CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
-                                    const RayCaster& caster, int k) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const Fields::Impl& g = fields.impl();
-  if (!HasCameraSets(fields))
-    throw std::invalid_argument("ComputeCriticality: the fields hold no per-camera sets");
-  if (g.visible.size() != rig.cameras.size())
-    throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
-  if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
+namespace {
+
+// The leaves seen by some enabled camera, ascending.
+std::vector<openvdb::Coord> SeenLeafOrigins(const Rig& rig, const Fields::Impl& g) {
   const std::size_t camera_count = rig.cameras.size();
-  const Thresholds th{{1, 2, 3, k}};
-
-  CriticalityTable table;
-  table.k = k;
-  table.region_voxels = fields.stats.active_set.region_voxels;
-  const openvdb::FloatGrid::Ptr sigma_grid = g.Float("sigma_max");
-  table.uncertainty = sigma_grid != nullptr;
-
-  // Leaves seen by some enabled camera.
   std::vector<openvdb::Coord> origins;
   for (std::size_t c = 0; c < camera_count; ++c) {
     if (!rig.cameras[c].enabled || !g.visible[c]) continue;
@@ -96,204 +82,256 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   }
   std::sort(origins.begin(), origins.end());
   origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+  return origins;
+}
 
-  // As the field evaluation prepares its rig (FieldEvaluator::State::Prepare): the Jacobian in the
-  // camera frame and the whitened rotation.
-  std::unique_ptr<VisibilityTester> tester;
-  std::vector<std::array<double, 9>> whitened(camera_count);
-  if (table.uncertainty) {
-    tester =
-        std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
-    for (std::size_t c = 0; c < camera_count; ++c) {
-      const Camera& cam = rig.cameras[c];
-      const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene.study.pixel_sigma;
-      WhitenedRotation(tester->camera_rotation(int(c)), sigma, whitened[c].data());
+// Sizes `base` and `intact` for the triangulable voxels' sigma_max (the leaves fill the values);
+// refuses a sigma_max field outside the camera sets.
+void SizeIntactSigmas(const openvdb::FloatGrid& sigma_grid,
+                      const std::vector<openvdb::Coord>& origins, std::vector<std::int64_t>* base,
+                      std::vector<float>* intact) {
+  for (std::size_t i = 0; i < origins.size(); ++i) {
+    const auto* leaf = sigma_grid.tree().probeConstLeaf(origins[i]);
+    (*base)[i + 1] = (*base)[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
+  }
+  // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
+  if (base->back() != static_cast<std::int64_t>(sigma_grid.activeVoxelCount()))
+    throw std::invalid_argument(
+        "ComputeCriticality: the sigma_max field does not match the camera sets");
+  intact->resize(static_cast<std::size_t>(base->back()));
+}
+
+// What every leaf's work reads (the rig, its fields, the thresholds, the prepared cameras) and
+// where it puts the intact sigma_max values.
+struct CriticalityInputs {
+  const Rig& rig;
+  const Fields& fields;
+  const Fields::Impl& g;
+  Thresholds th;
+  bool uncertainty;
+  const openvdb::FloatGrid* sigma_grid;
+  const VisibilityTester* tester;
+  const std::vector<std::array<double, 9>>& whitened;
+  const std::array<BandScale, 64>& scales;
+  const std::vector<std::int64_t>& base;
+  std::vector<float>& intact;
+};
+
+// One thread's work over its leaves: its scratch buffers and the steps on each leaf.
+struct LeafWorker {
+  const CriticalityInputs& in;
+  Partial& part;
+  std::vector<std::int32_t> cams;
+  std::vector<Bits> bits;
+  std::array<std::int32_t, 512> count{};
+  std::vector<double> contribution;  // 6 per camera of a voxel
+  std::vector<std::uint8_t> band;
+  std::vector<std::array<double, 6>> upper_rows;
+  std::vector<std::int32_t> failed, seeing;
+  std::vector<Int128> fixed;
+  std::array<std::vector<double>, 6> upper;
+  std::array<std::vector<double>, 3> eigen;
+  std::array<std::vector<double>, kStatRows> stats;
+  std::vector<unsigned char> converged;
+
+  LeafWorker(const CriticalityInputs& inputs, Partial& partial) : in(inputs), part(partial) {}
+  void Leaf(std::size_t i, const openvdb::Coord& origin);
+  void GatherCameras(const openvdb::Coord& origin);
+  void CountCoverage();
+  void Uncertainty(std::size_t i, const openvdb::Coord& origin);
+  void Contributions(int o, const openvdb::Coord& origin);
+  void WithoutEachCamera();
+  void FailedStatistics();
+};
+
+// Adds leaf i (at `origin`) to the thread's partial sums.
+void LeafWorker::Leaf(std::size_t i, const openvdb::Coord& origin) {
+  GatherCameras(origin);
+  if (cams.empty()) return;
+  CountCoverage();
+  if (!in.uncertainty) return;
+  Uncertainty(i, origin);
+}
+
+// The enabled cameras that see part of the leaf (ascending) and the voxels each sees.
+void LeafWorker::GatherCameras(const openvdb::Coord& origin) {
+  const Rig& rig = in.rig;
+  const Fields::Impl& g = in.g;
+  const std::size_t camera_count = rig.cameras.size();
+  cams.clear();
+  bits.clear();
+  for (std::size_t c = 0; c < camera_count; ++c) {
+    if (!rig.cameras[c].enabled || !g.visible[c]) continue;
+    const auto* leaf = g.visible[c]->tree().probeConstLeaf(origin);
+    if (!leaf) continue;
+    Bits b{};
+    bool any = false;
+    for (auto it = leaf->cbeginValueOn(); it; ++it)
+      if (*it) {
+        const int o = static_cast<int>(it.pos());
+        b[o >> 6] |= std::uint64_t{1} << (o & 63);
+        any = true;
+      }
+    if (!any) continue;
+    cams.push_back(static_cast<std::int32_t>(c));
+    bits.push_back(b);
+  }
+}
+
+// The leaf's coverage counts: voxels seen by >= j[t] cameras, and per camera the voxels it sees
+// with exactly j[t].
+void LeafWorker::CountCoverage() {
+  const Thresholds& th = in.th;
+  const std::size_t n_cams = cams.size();
+  count.fill(0);
+  for (const Bits& b : bits)
+    for (int w = 0; w < kWords; ++w)
+      for (std::uint64_t x = b[w]; x; x &= x - 1) ++count[64 * w + __builtin_ctzll(x)];
+  for (int o = 0; o < 512; ++o)
+    for (int t = 0; t < 4; ++t) part.at_least[t] += count[o] >= th.j[t] ? 1 : 0;
+  for (std::size_t e = 0; e < n_cams; ++e) {
+    auto& ex = part.exactly[cams[e]];
+    for (int w = 0; w < kWords; ++w)
+      for (std::uint64_t x = bits[e][w]; x; x &= x - 1) {
+        const int o = 64 * w + __builtin_ctzll(x);
+        ++part.seen[cams[e]];
+        for (int t = 0; t < 4; ++t) ex[t] += count[o] == th.j[t] ? 1 : 0;
+      }
+  }
+}
+
+// The leaf's uncertainty: the intact sigma_max values, the voxels each camera's failure removes,
+// and the sigma_max after each failure where >= 3 cameras see a voxel.
+void LeafWorker::Uncertainty(std::size_t i, const openvdb::Coord& origin) {
+  const std::size_t n_cams = cams.size();
+  // The uncertainty: at every voxel, the intact sigma_max leaves with each camera that sees it;
+  // where >= 3 see it, the information without each of them is re-derived.
+  const auto* sigma_leaf = in.sigma_grid->tree().probeConstLeaf(origin);
+  upper_rows.clear();
+  failed.clear();
+  std::int64_t index = in.base[i];
+  for (int o = 0; o < 512; ++o) {
+    if (sigma_leaf && sigma_leaf->isValueOn(o)) {  // triangulable intact
+      in.intact[static_cast<std::size_t>(index)] = sigma_leaf->getValue(o);
+      for (std::size_t e = 0; e < n_cams; ++e)
+        if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(index);
+      ++index;
+    }
+    if (count[o] < 3) continue;
+    Contributions(o, origin);
+    WithoutEachCamera();
+  }
+  FailedStatistics();
+}
+
+// The information contributions of the cameras that see voxel `o`, with their bands.
+void LeafWorker::Contributions(int o, const openvdb::Coord& origin) {
+  const std::size_t n_cams = cams.size();
+  // The seeing cameras' contributions, ascending camera (the evaluator's view order).
+  const int x = origin.x() + (o >> 6), y = origin.y() + ((o >> 3) & 7), z = origin.z() + (o & 7);
+  const Vec3 p = in.fields.lattice.Center(x, y, z);
+  contribution.clear();
+  band.clear();
+  seeing.clear();
+  for (std::size_t e = 0; e < n_cams; ++e) {
+    if (!(bits[e][o >> 6] >> (o & 63) & 1)) continue;
+    Ray segment;
+    Mat23 jacobian;
+    if (in.tester->TestGeometryCameraFrame(cams[e], p, nullptr, &segment, &jacobian) !=
+        ViewResult::kSeen)
+      throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
+    double c6[6] = {0, 0, 0, 0, 0, 0};
+    AddCameraInformation(jacobian, in.whitened[cams[e]].data(), c6);
+    contribution.insert(contribution.end(), c6, c6 + 6);
+    band.push_back(Band(c6));
+    seeing.push_back(cams[e]);
+  }
+}
+
+// Per seeing camera, the voxel's information without it (as Derive sums it) into upper_rows.
+void LeafWorker::WithoutEachCamera() {
+  const std::array<BandScale, 64>& scales = in.scales;
+  const int m = static_cast<int>(seeing.size());
+  // The whole set's band and how many contributions lie in it, and its exact sum there.
+  std::uint8_t top = 0;
+  int top_count = 0;
+  for (int a = 0; a < m; ++a) {
+    if (band[a] > top) {
+      top = band[a];
+      top_count = 1;
+    } else if (band[a] == top) {
+      ++top_count;
     }
   }
-  const std::array<BandScale, 64>& scales = BandScales();
-  // Every triangulable voxel's sigma_max, leaf by leaf in `origins` order (ascending offset within
-  // a leaf): base[i] is where leaf i's values start.
-  std::vector<std::int64_t> base(origins.size() + 1, 0);
-  std::vector<float> intact;
-  if (table.uncertainty) {
-    for (std::size_t i = 0; i < origins.size(); ++i) {
-      const auto* leaf = sigma_grid->tree().probeConstLeaf(origins[i]);
-      base[i + 1] = base[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
-    }
-    // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
-    if (base.back() != static_cast<std::int64_t>(sigma_grid->activeVoxelCount()))
-      throw std::invalid_argument(
-          "ComputeCriticality: the sigma_max field does not match the camera sets");
-    intact.resize(static_cast<std::size_t>(base.back()));
-  }
-
-  tbb::enumerable_thread_specific<Partial> partials([&] { return Partial(camera_count); });
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4), [&](const auto& range) {
-    Partial& part = partials.local();
-    std::vector<std::int32_t> cams;
-    std::vector<Bits> bits;
-    std::vector<double> contribution;  // 6 per camera of a voxel
-    std::vector<std::uint8_t> band;
-    std::vector<std::array<double, 6>> upper_rows;
-    std::vector<std::int32_t> failed, seeing;
-    std::vector<Int128> fixed;
-    std::array<std::vector<double>, 6> upper;
-    std::array<std::vector<double>, 3> eigen;
-    std::array<std::vector<double>, kStatRows> stats;
-    std::vector<unsigned char> converged;
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const openvdb::Coord origin = origins[i];
-      cams.clear();
-      bits.clear();
-      for (std::size_t c = 0; c < camera_count; ++c) {
-        if (!rig.cameras[c].enabled || !g.visible[c]) continue;
-        const auto* leaf = g.visible[c]->tree().probeConstLeaf(origin);
-        if (!leaf) continue;
-        Bits b{};
-        bool any = false;
-        for (auto it = leaf->cbeginValueOn(); it; ++it)
-          if (*it) {
-            const int o = static_cast<int>(it.pos());
-            b[o >> 6] |= std::uint64_t{1} << (o & 63);
-            any = true;
-          }
-        if (!any) continue;
-        cams.push_back(static_cast<std::int32_t>(c));
-        bits.push_back(b);
-      }
-      if (cams.empty()) continue;
-      const std::size_t n_cams = cams.size();
-      std::array<std::int32_t, 512> count{};
-      for (const Bits& b : bits)
-        for (int w = 0; w < kWords; ++w)
-          for (std::uint64_t x = b[w]; x; x &= x - 1) ++count[64 * w + __builtin_ctzll(x)];
-      for (int o = 0; o < 512; ++o)
-        for (int t = 0; t < 4; ++t) part.at_least[t] += count[o] >= th.j[t] ? 1 : 0;
-      for (std::size_t e = 0; e < n_cams; ++e) {
-        auto& ex = part.exactly[cams[e]];
-        for (int w = 0; w < kWords; ++w)
-          for (std::uint64_t x = bits[e][w]; x; x &= x - 1) {
-            const int o = 64 * w + __builtin_ctzll(x);
-            ++part.seen[cams[e]];
-            for (int t = 0; t < 4; ++t) ex[t] += count[o] == th.j[t] ? 1 : 0;
-          }
-      }
-      if (!table.uncertainty) continue;
-
-      // The uncertainty: at every voxel, the intact sigma_max leaves with each camera that sees it;
-      // where >= 3 see it, the information without each of them is re-derived.
-      const auto* sigma_leaf = sigma_grid->tree().probeConstLeaf(origin);
-      upper_rows.clear();
-      failed.clear();
-      std::int64_t index = base[i];
-      for (int o = 0; o < 512; ++o) {
-        if (sigma_leaf && sigma_leaf->isValueOn(o)) {  // triangulable intact
-          intact[static_cast<std::size_t>(index)] = sigma_leaf->getValue(o);
-          for (std::size_t e = 0; e < n_cams; ++e)
-            if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(index);
-          ++index;
-        }
-        if (count[o] < 3) continue;
-        // The seeing cameras' contributions, ascending camera (the evaluator's view order).
-        const int x = origin.x() + (o >> 6), y = origin.y() + ((o >> 3) & 7),
-                  z = origin.z() + (o & 7);
-        const Vec3 p = fields.lattice.Center(x, y, z);
-        contribution.clear();
-        band.clear();
-        seeing.clear();
-        for (std::size_t e = 0; e < n_cams; ++e) {
-          if (!(bits[e][o >> 6] >> (o & 63) & 1)) continue;
-          Ray segment;
-          Mat23 jacobian;
-          if (tester->TestGeometryCameraFrame(cams[e], p, nullptr, &segment, &jacobian) !=
-              ViewResult::kSeen)
-            throw std::invalid_argument(
-                "ComputeCriticality: the fields were evaluated for another rig");
-          double c6[6] = {0, 0, 0, 0, 0, 0};
-          AddCameraInformation(jacobian, whitened[cams[e]].data(), c6);
-          contribution.insert(contribution.end(), c6, c6 + 6);
-          band.push_back(Band(c6));
-          seeing.push_back(cams[e]);
-        }
-        const int m = static_cast<int>(seeing.size());
-        // The whole set's band and how many contributions lie in it, and its exact sum there.
-        std::uint8_t top = 0;
-        int top_count = 0;
-        for (int a = 0; a < m; ++a) {
-          if (band[a] > top) {
-            top = band[a];
-            top_count = 1;
-          } else if (band[a] == top) {
-            ++top_count;
-          }
-        }
-        Sum6 full{};
-        const bool full_exact = top != kNotExact && m - 1 <= kMaxExactCameras;
-        if (full_exact) {
-          fixed.resize(6 * m);
-          for (int a = 0; a < m; ++a)
-            for (int q = 0; q < 6; ++q) {
-              fixed[6 * a + q] = ToFixed(contribution[6 * a + q], scales[top].q);
-              full.v[q] += fixed[6 * a + q];
-            }
-        }
-        for (int f = 0; f < m; ++f) {
-          std::array<double, 6> row;
-          if (full_exact && (band[f] < top || top_count > 1)) {
-            // The others' band is still `top`: the exact sum less f's rounded contribution.
-            for (int q = 0; q < 6; ++q)
-              row[q] =
-                  ToDouble(full.v[q] - fixed[6 * f + q]) * scales[top].up[0] * scales[top].up[1];
-          } else {
-            // As Derive re-sums a voxel: the others' largest band, or in double in rig order.
-            std::uint8_t b = 0;
-            for (int a = 0; a < m; ++a)
-              if (a != f) b = std::max(b, band[a]);
-            if (b == kNotExact || m - 1 > kMaxExactCameras) {
-              row.fill(0.0);
-              for (int a = 0; a < m; ++a)
-                if (a != f)
-                  for (int q = 0; q < 6; ++q) row[q] += contribution[6 * a + q];
-            } else {
-              Sum6 s{};
-              for (int a = 0; a < m; ++a)
-                if (a != f) Accumulate(s, &contribution[6 * a], scales[b], true);
-              for (int q = 0; q < 6; ++q)
-                row[q] = ToDouble(s.v[q]) * scales[b].up[0] * scales[b].up[1];
-            }
-          }
-          upper_rows.push_back(row);
-          failed.push_back(seeing[f]);
-        }
-      }
-      const std::size_t n = upper_rows.size();
-      if (n == 0) continue;
+  Sum6 full{};
+  const bool full_exact = top != kNotExact && m - 1 <= kMaxExactCameras;
+  if (full_exact) {
+    fixed.resize(6 * m);
+    for (int a = 0; a < m; ++a)
       for (int q = 0; q < 6; ++q) {
-        upper[q].resize(n);
-        for (std::size_t r = 0; r < n; ++r) upper[q][r] = upper_rows[r][q];
+        fixed[6 * a + q] = ToFixed(contribution[6 * a + q], scales[top].q);
+        full.v[q] += fixed[6 * a + q];
       }
-      for (auto& v : eigen) v.resize(n);
-      for (auto& v : stats) v.resize(n);
-      converged.resize(n);
-      const double* upper_ptr[6];
-      for (int q = 0; q < 6; ++q) upper_ptr[q] = upper[q].data();
-      double* eigen_ptr[3] = {eigen[0].data(), eigen[1].data(), eigen[2].data()};
-      double* stats_ptr[kStatRows];
-      for (int r = 0; r < kStatRows; ++r) stats_ptr[r] = stats[r].data();
-      SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), n);
-      StaticStatistics(static_cast<int>(n), eigen_ptr, stats_ptr);
-      for (std::size_t r = 0; r < n; ++r)
-        if (stats[kObservable][r] != 0.0)
-          part.added[failed[r]].push_back(static_cast<float>(stats[kSigmaMaxMm][r]));
+  }
+  for (int f = 0; f < m; ++f) {
+    std::array<double, 6> row;
+    if (full_exact && (band[f] < top || top_count > 1)) {
+      // The others' band is still `top`: the exact sum less f's rounded contribution.
+      for (int q = 0; q < 6; ++q)
+        row[q] = ToDouble(full.v[q] - fixed[6 * f + q]) * scales[top].up[0] * scales[top].up[1];
+    } else {
+      // As Derive re-sums a voxel: the others' largest band, or in double in rig order.
+      std::uint8_t b = 0;
+      for (int a = 0; a < m; ++a)
+        if (a != f) b = std::max(b, band[a]);
+      if (b == kNotExact || m - 1 > kMaxExactCameras) {
+        row.fill(0.0);
+        for (int a = 0; a < m; ++a)
+          if (a != f)
+            for (int q = 0; q < 6; ++q) row[q] += contribution[6 * a + q];
+      } else {
+        Sum6 s{};
+        for (int a = 0; a < m; ++a)
+          if (a != f) Accumulate(s, &contribution[6 * a], scales[b], true);
+        for (int q = 0; q < 6; ++q) row[q] = ToDouble(s.v[q]) * scales[b].up[0] * scales[b].up[1];
+      }
     }
-  });
+    upper_rows.push_back(row);
+    failed.push_back(seeing[f]);
+  }
+}
 
-  // Totals.
-  std::array<std::int64_t, 4> at_least{};
-  std::vector<std::array<std::int64_t, 4>> exactly(camera_count);
-  std::vector<std::int64_t> seen(camera_count, 0);
-  std::vector<std::vector<std::int64_t>> removed(camera_count);
-  std::vector<std::vector<float>> added(camera_count);
+// The sigma_max of every row of upper_rows, added to its failed camera's list where observable.
+void LeafWorker::FailedStatistics() {
+  const std::size_t n = upper_rows.size();
+  if (n == 0) return;
+  for (int q = 0; q < 6; ++q) {
+    upper[q].resize(n);
+    for (std::size_t r = 0; r < n; ++r) upper[q][r] = upper_rows[r][q];
+  }
+  for (auto& v : eigen) v.resize(n);
+  for (auto& v : stats) v.resize(n);
+  converged.resize(n);
+  const double* upper_ptr[6];
+  for (int q = 0; q < 6; ++q) upper_ptr[q] = upper[q].data();
+  double* eigen_ptr[3] = {eigen[0].data(), eigen[1].data(), eigen[2].data()};
+  double* stats_ptr[kStatRows];
+  for (int r = 0; r < kStatRows; ++r) stats_ptr[r] = stats[r].data();
+  SymmetricEigenvalues3(upper_ptr, eigen_ptr, converged.data(), n);
+  StaticStatistics(static_cast<int>(n), eigen_ptr, stats_ptr);
+  for (std::size_t r = 0; r < n; ++r)
+    if (stats[kObservable][r] != 0.0)
+      part.added[failed[r]].push_back(static_cast<float>(stats[kSigmaMaxMm][r]));
+}
+
+// The threads' partial sums joined (in a Partial of the totals).
+Partial JoinPartials(tbb::enumerable_thread_specific<Partial>& partials, std::size_t camera_count) {
+  Partial total(camera_count);
+  std::array<std::int64_t, 4>& at_least = total.at_least;
+  std::vector<std::array<std::int64_t, 4>>& exactly = total.exactly;
+  std::vector<std::int64_t>& seen = total.seen;
+  std::vector<std::vector<std::int64_t>>& removed = total.removed;
+  std::vector<std::vector<float>>& added = total.added;
   for (Partial& p : partials) {
     for (int t = 0; t < 4; ++t) at_least[t] += p.at_least[t];
     for (std::size_t c = 0; c < camera_count; ++c) {
@@ -317,6 +355,94 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
       std::vector<float>().swap(p.added[c]);
     }
   }
+  return total;
+}
+
+// Each row's triangulable share and sigma_max percentiles without its camera.
+void FailedUncertainty(const Partial& total, const std::vector<float>& intact, std::int64_t region,
+                       CriticalityTable* table) {
+  const std::vector<std::vector<std::int64_t>>& removed = total.removed;
+  const std::vector<std::vector<float>>& added = total.added;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table->rows.size(), 1),
+                    [&](const auto& range) {
+                      for (std::size_t r = range.begin(); r != range.end(); ++r) {
+                        CriticalityRow& row = table->rows[r];
+                        const std::vector<std::int64_t>& out = removed[row.camera];
+                        const std::vector<float>& in = added[row.camera];
+                        // The multiset intact - out + in: the sigma_max list of the rig without
+                        // this camera.
+                        std::vector<unsigned char> gone(intact.size(), 0);
+                        for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
+                        std::vector<float> after;
+                        after.reserve(intact.size() - out.size() + in.size());
+                        for (std::size_t v = 0; v < intact.size(); ++v)
+                          if (!gone[v]) after.push_back(intact[v]);
+                        after.insert(after.end(), in.begin(), in.end());
+                        row.triangulable_voxels = static_cast<std::int64_t>(after.size());
+                        row.triangulable = Fraction(row.triangulable_voxels, region);
+                        row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
+                        row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
+                      }
+                    });
+}
+
+}  // namespace
+
+CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
+                                    const RayCaster& caster, int k) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Fields::Impl& g = fields.impl();
+  if (!HasCameraSets(fields))
+    throw std::invalid_argument("ComputeCriticality: the fields hold no per-camera sets");
+  if (g.visible.size() != rig.cameras.size())
+    throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
+  if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
+  const std::size_t camera_count = rig.cameras.size();
+  const Thresholds th{{1, 2, 3, k}};
+
+  CriticalityTable table;
+  table.k = k;
+  table.region_voxels = fields.stats.active_set.region_voxels;
+  const openvdb::FloatGrid::Ptr sigma_grid = g.Float("sigma_max");
+  table.uncertainty = sigma_grid != nullptr;
+
+  // Leaves seen by some enabled camera.
+  const std::vector<openvdb::Coord> origins = SeenLeafOrigins(rig, g);
+
+  // As the field evaluation prepares its rig (FieldEvaluator::State::Prepare): the Jacobian in the
+  // camera frame and the whitened rotation.
+  std::unique_ptr<VisibilityTester> tester;
+  std::vector<std::array<double, 9>> whitened(camera_count);
+  if (table.uncertainty) {
+    tester =
+        std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
+    for (std::size_t c = 0; c < camera_count; ++c) {
+      const Camera& cam = rig.cameras[c];
+      const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene.study.pixel_sigma;
+      WhitenedRotation(tester->camera_rotation(int(c)), sigma, whitened[c].data());
+    }
+  }
+  const std::array<BandScale, 64>& scales = BandScales();
+  // Every triangulable voxel's sigma_max, leaf by leaf in `origins` order (ascending offset within
+  // a leaf): base[i] is where leaf i's values start.
+  std::vector<std::int64_t> base(origins.size() + 1, 0);
+  std::vector<float> intact;
+  if (table.uncertainty) SizeIntactSigmas(*sigma_grid, origins, &base, &intact);
+
+  const CriticalityInputs in{
+      rig,      fields, g,    th,    table.uncertainty, sigma_grid.get(), tester.get(),
+      whitened, scales, base, intact};
+  tbb::enumerable_thread_specific<Partial> partials([&] { return Partial(camera_count); });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4), [&](const auto& range) {
+    LeafWorker worker(in, partials.local());
+    for (std::size_t i = range.begin(); i != range.end(); ++i) worker.Leaf(i, origins[i]);
+  });
+
+  // Totals.
+  const Partial total = JoinPartials(partials, camera_count);
+  const std::array<std::int64_t, 4>& at_least = total.at_least;
+  const std::vector<std::array<std::int64_t, 4>>& exactly = total.exactly;
+  const std::vector<std::int64_t>& seen = total.seen;
   const std::int64_t region = table.region_voxels;
   table.ge_k = Fraction(at_least[3], region);
   for (std::size_t c = 0; c < camera_count; ++c) {
@@ -331,29 +457,7 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
     row.ge_k = Fraction(at_least[3] - exactly[c][3], region);
     table.rows.push_back(row);
   }
-  if (table.uncertainty) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table.rows.size(), 1),
-                      [&](const auto& range) {
-                        for (std::size_t r = range.begin(); r != range.end(); ++r) {
-                          CriticalityRow& row = table.rows[r];
-                          const std::vector<std::int64_t>& out = removed[row.camera];
-                          const std::vector<float>& in = added[row.camera];
-                          // The multiset intact - out + in: the sigma_max list of the rig without
-                          // this camera.
-                          std::vector<unsigned char> gone(intact.size(), 0);
-                          for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
-                          std::vector<float> after;
-                          after.reserve(intact.size() - out.size() + in.size());
-                          for (std::size_t v = 0; v < intact.size(); ++v)
-                            if (!gone[v]) after.push_back(intact[v]);
-                          after.insert(after.end(), in.begin(), in.end());
-                          row.triangulable_voxels = static_cast<std::int64_t>(after.size());
-                          row.triangulable = Fraction(row.triangulable_voxels, region);
-                          row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
-                          row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
-                        }
-                      });
-  }
+  if (table.uncertainty) FailedUncertainty(total, intact, region, &table);
   double sum = 0;
   for (const CriticalityRow& row : table.rows) sum += row.ge_k;
   table.mean_ge_k = table.rows.empty() ? table.ge_k : sum / static_cast<double>(table.rows.size());

@@ -213,6 +213,151 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
   return s;
 }
 
+namespace {
+
+// An optional value as JSON, null when absent.
+nlohmann::json OptionalJson(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json();
+}
+
+// summary.json's "per_camera": each camera's visibility and lens coverage.
+nlohmann::json PerCameraJson(const std::vector<CameraSummary>& cameras) {
+  nlohmann::json per_camera = nlohmann::json::array();
+  for (const CameraSummary& c : cameras)
+    per_camera.push_back({{"id", c.id},
+                          {"name", c.name},
+                          {"enabled", c.enabled},
+                          {"visible_voxels", c.visible_voxels},
+                          {"visible_fraction", c.visible_fraction},
+                          {"fov_deg",
+                           {{"nominal", {c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg}},
+                            {"effective", {c.lens.hfov_deg, c.lens.vfov_deg}}}},
+                          {"unreachable_pixels", c.lens.unreachable_fraction}});
+  return per_camera;
+}
+
+// summary.json's "uncertainty".
+nlohmann::json UncertaintyJson(const UncertaintySummary& u) {
+  nlohmann::json uj{{"triangulable", u.triangulable},
+                    {"triangulable_voxels", u.triangulable_voxels},
+                    {"unobservable_voxels", u.unobservable_voxels},
+                    {"pixel_sigma", u.pixel_sigma},
+                    {"sigma_max_mm", Json(u.sigma_max_mm)}};
+  if (u.max_sigma_mm) uj["max_sigma_mm"] = *u.max_sigma_mm;
+  if (u.meets_max_sigma) uj["meets_max_sigma"] = *u.meets_max_sigma;
+  if (u.motion) {
+    uj["motion"] = {{"q", u.motion->q},
+                    {"rate_hz", u.motion->rate_hz},
+                    {"covariance", u.steady_prior ? "prior" : "posterior"}};
+    uj["sigma_max_steady_mm"] = Json(u.sigma_max_steady_mm);
+    if (u.meets_max_sigma_steady) uj["meets_max_sigma_steady"] = *u.meets_max_sigma_steady;
+  }
+  return uj;
+}
+
+// summary.json's "warnings".
+nlohmann::json WarningsJson(const std::vector<Warning>& warnings) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Warning& w : warnings)
+    list.push_back({{"kind", WarningKindName(w.kind)},
+                    {"camera", w.camera},
+                    {"path", w.json_path},
+                    {"message", w.reason}});
+  return list;
+}
+
+// summary.json's "time": the time samples and their totals.
+nlohmann::json TimeJson(const TimeSummary& t) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const TimeSampleSummary& r : t.samples)
+    rows.push_back({{"label", r.label},
+                    {"time", r.time},
+                    {"region_voxels", r.region_voxels},
+                    {"ge1", r.ge1},
+                    {"ge2", r.ge2},
+                    {"ge3", r.ge3},
+                    {"ge_k", r.ge_k},
+                    {"sigma_max_p50_mm", OptionalJson(r.sigma_max_p50)},
+                    {"sigma_max_p90_mm", OptionalJson(r.sigma_max_p90)},
+                    {"seconds", r.seconds}});
+  return {{"min_cameras", t.min_cameras},
+          {"samples", rows},
+          {"voxels", t.voxels},
+          {"always", t.always},
+          {"mean", t.mean},
+          {"worst_sample",
+           t.samples.empty() ? nlohmann::json() : nlohmann::json(t.samples[t.worst_sample].label)},
+          {"sigma_max_mm",
+           {{"p50", OptionalJson(t.sigma_max_p50)},
+            {"p90", OptionalJson(t.sigma_max_p90)},
+            {"p99", OptionalJson(t.sigma_max_p99)}}},
+          {"seconds", t.seconds},
+          {"parts_seconds", t.parts_seconds}};
+}
+
+// summary.json's "targets": each surface target's shares per sample and per camera.
+nlohmann::json TargetsJson(const Summary& s) {
+  nlohmann::json targets = nlohmann::json::array();
+  for (const SurfaceTargetResult& r : s.targets) {
+    nlohmann::json per_sample = nlohmann::json::array();
+    for (std::size_t k = 0; k < r.sample_share.size(); ++k)
+      per_sample.push_back(
+          {{"label", k < s.sample_labels.size() ? s.sample_labels[k] : "as placed"},
+           {"share", r.sample_share[k]}});
+    nlohmann::json per_camera = nlohmann::json::array();
+    for (std::size_t c = 0; c < r.per_camera.size() && c < s.per_camera.size(); ++c)
+      per_camera.push_back({{"id", s.per_camera[c].id}, {"share", r.per_camera[c]}});
+    targets.push_back(
+        {{"name", r.name},
+         {"points", r.points},
+         {"samples", r.samples},
+         {"share_ge", r.share_ge},
+         {"always", r.always},
+         {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
+         {"per_sample", per_sample},
+         {"per_camera", per_camera},
+         {"seconds", r.seconds}});
+    if (!r.pixel_share.empty()) {
+      nlohmann::json pixel = nlohmann::json::object();
+      for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
+        pixel[s.pixel_targets[p].target.name] = r.pixel_share[p];
+      targets.back()["pixel_share"] = pixel;
+    }
+  }
+  return targets;
+}
+
+// summary.json's "pixel_targets".
+nlohmann::json PixelTargetsJson(const std::vector<PixelTargetSummary>& pixel_targets) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const PixelTargetSummary& p : pixel_targets)
+    list.push_back({{"name", p.target.name},
+                    {"size_m", p.target.size_m},
+                    {"min_px", p.target.min_px},
+                    {"px_per_m", p.target.px_per_m()},
+                    {"share_ge", p.share_ge},
+                    {"seconds", p.seconds}});
+  return list;
+}
+
+// summary.json's "regions": the named regions' coverage and uncertainty.
+nlohmann::json RegionsJson(const std::vector<RegionSummary>& regions) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const RegionSummary& r : regions)
+    list.push_back({{"name", r.name},
+                    {"voxels", r.voxels},
+                    {"ge1", r.ge1},
+                    {"ge2", r.ge2},
+                    {"ge3", r.ge3},
+                    {"resolution_p10_px_per_m", OptionalJson(r.resolution_p10)},
+                    {"triangulable", r.triangulable},
+                    {"sigma_max_p50_mm", OptionalJson(r.sigma_max_p50)},
+                    {"sigma_max_p90_mm", OptionalJson(r.sigma_max_p90)}});
+  return list;
+}
+
+}  // namespace
+
 void to_json(nlohmann::json& j, const Summary& s) {
   j = nlohmann::json::object();
   j["scene"] = s.scene;
@@ -237,136 +382,19 @@ void to_json(nlohmann::json& j, const Summary& s) {
     j["resolution_px_per_m"] = {{"p10", Value(s.resolution_px_per_m->p10)},
                                 {"p50", Value(s.resolution_px_per_m->p50)},
                                 {"p90", Value(s.resolution_px_per_m->p90)}};
-  nlohmann::json per_camera = nlohmann::json::array();
-  for (const CameraSummary& c : s.per_camera)
-    per_camera.push_back({{"id", c.id},
-                          {"name", c.name},
-                          {"enabled", c.enabled},
-                          {"visible_voxels", c.visible_voxels},
-                          {"visible_fraction", c.visible_fraction},
-                          {"fov_deg",
-                           {{"nominal", {c.lens.nominal_hfov_deg, c.lens.nominal_vfov_deg}},
-                            {"effective", {c.lens.hfov_deg, c.lens.vfov_deg}}}},
-                          {"unreachable_pixels", c.lens.unreachable_fraction}});
-  j["per_camera"] = per_camera;
-  if (s.uncertainty) {
-    const UncertaintySummary& u = *s.uncertainty;
-    nlohmann::json uj{{"triangulable", u.triangulable},
-                      {"triangulable_voxels", u.triangulable_voxels},
-                      {"unobservable_voxels", u.unobservable_voxels},
-                      {"pixel_sigma", u.pixel_sigma},
-                      {"sigma_max_mm", Json(u.sigma_max_mm)}};
-    if (u.max_sigma_mm) uj["max_sigma_mm"] = *u.max_sigma_mm;
-    if (u.meets_max_sigma) uj["meets_max_sigma"] = *u.meets_max_sigma;
-    if (u.motion) {
-      uj["motion"] = {{"q", u.motion->q},
-                      {"rate_hz", u.motion->rate_hz},
-                      {"covariance", u.steady_prior ? "prior" : "posterior"}};
-      uj["sigma_max_steady_mm"] = Json(u.sigma_max_steady_mm);
-      if (u.meets_max_sigma_steady) uj["meets_max_sigma_steady"] = *u.meets_max_sigma_steady;
-    }
-    j["uncertainty"] = uj;
-  }
-  nlohmann::json list = nlohmann::json::array();
-  for (const Warning& w : s.warnings)
-    list.push_back({{"kind", WarningKindName(w.kind)},
-                    {"camera", w.camera},
-                    {"path", w.json_path},
-                    {"message", w.reason}});
-  j["warnings"] = list;
-  auto opt = [](const std::optional<double>& v) {
-    return v ? nlohmann::json(*v) : nlohmann::json();
-  };
-  if (s.time) {
-    const TimeSummary& t = *s.time;
-    nlohmann::json rows = nlohmann::json::array();
-    for (const TimeSampleSummary& r : t.samples)
-      rows.push_back({{"label", r.label},
-                      {"time", r.time},
-                      {"region_voxels", r.region_voxels},
-                      {"ge1", r.ge1},
-                      {"ge2", r.ge2},
-                      {"ge3", r.ge3},
-                      {"ge_k", r.ge_k},
-                      {"sigma_max_p50_mm", opt(r.sigma_max_p50)},
-                      {"sigma_max_p90_mm", opt(r.sigma_max_p90)},
-                      {"seconds", r.seconds}});
-    j["time"] = {
-        {"min_cameras", t.min_cameras},
-        {"samples", rows},
-        {"voxels", t.voxels},
-        {"always", t.always},
-        {"mean", t.mean},
-        {"worst_sample",
-         t.samples.empty() ? nlohmann::json() : nlohmann::json(t.samples[t.worst_sample].label)},
-        {"sigma_max_mm",
-         {{"p50", opt(t.sigma_max_p50)},
-          {"p90", opt(t.sigma_max_p90)},
-          {"p99", opt(t.sigma_max_p99)}}},
-        {"seconds", t.seconds},
-        {"parts_seconds", t.parts_seconds}};
-  }
-  if (!s.targets.empty()) {
-    nlohmann::json targets = nlohmann::json::array();
-    for (const SurfaceTargetResult& r : s.targets) {
-      nlohmann::json per_sample = nlohmann::json::array();
-      for (std::size_t k = 0; k < r.sample_share.size(); ++k)
-        per_sample.push_back(
-            {{"label", k < s.sample_labels.size() ? s.sample_labels[k] : "as placed"},
-             {"share", r.sample_share[k]}});
-      nlohmann::json per_camera = nlohmann::json::array();
-      for (std::size_t c = 0; c < r.per_camera.size() && c < s.per_camera.size(); ++c)
-        per_camera.push_back({{"id", s.per_camera[c].id}, {"share", r.per_camera[c]}});
-      targets.push_back(
-          {{"name", r.name},
-           {"points", r.points},
-           {"samples", r.samples},
-           {"share_ge", r.share_ge},
-           {"always", r.always},
-           {"worst_sample", per_sample.empty() ? nlohmann::json() : per_sample[r.worst_sample]},
-           {"per_sample", per_sample},
-           {"per_camera", per_camera},
-           {"seconds", r.seconds}});
-      if (!r.pixel_share.empty()) {
-        nlohmann::json pixel = nlohmann::json::object();
-        for (std::size_t p = 0; p < r.pixel_share.size() && p < s.pixel_targets.size(); ++p)
-          pixel[s.pixel_targets[p].target.name] = r.pixel_share[p];
-        targets.back()["pixel_share"] = pixel;
-      }
-    }
-    j["targets"] = targets;
-  }
-  if (!s.pixel_targets.empty()) {
-    nlohmann::json list = nlohmann::json::array();
-    for (const PixelTargetSummary& p : s.pixel_targets)
-      list.push_back({{"name", p.target.name},
-                      {"size_m", p.target.size_m},
-                      {"min_px", p.target.min_px},
-                      {"px_per_m", p.target.px_per_m()},
-                      {"share_ge", p.share_ge},
-                      {"seconds", p.seconds}});
-    j["pixel_targets"] = list;
-  }
+  j["per_camera"] = PerCameraJson(s.per_camera);
+  if (s.uncertainty) j["uncertainty"] = UncertaintyJson(*s.uncertainty);
+  j["warnings"] = WarningsJson(s.warnings);
+  if (s.time) j["time"] = TimeJson(*s.time);
+  if (!s.targets.empty()) j["targets"] = TargetsJson(s);
+  if (!s.pixel_targets.empty()) j["pixel_targets"] = PixelTargetsJson(s.pixel_targets);
   if (s.dori)
     j["dori"] = {{"detection", s.dori->detection},
                  {"observation", s.dori->observation},
                  {"recognition", s.dori->recognition},
                  {"identification", s.dori->identification},
                  {"px_per_m", {kDoriPxPerM[0], kDoriPxPerM[1], kDoriPxPerM[2], kDoriPxPerM[3]}}};
-  if (!s.regions.empty()) {
-    nlohmann::json list = nlohmann::json::array();
-    for (const RegionSummary& r : s.regions)
-      list.push_back({{"name", r.name},
-                      {"voxels", r.voxels},
-                      {"ge1", r.ge1},
-                      {"ge2", r.ge2},
-                      {"ge3", r.ge3},
-                      {"resolution_p10_px_per_m", opt(r.resolution_p10)},
-                      {"triangulable", r.triangulable},
-                      {"sigma_max_p50_mm", opt(r.sigma_max_p50)},
-                      {"sigma_max_p90_mm", opt(r.sigma_max_p90)}});
-    j["regions"] = list;
-  }
+  if (!s.regions.empty()) j["regions"] = RegionsJson(s.regions);
   j["timing"] = {{"seconds", s.timing.seconds},
                  {"active_set_seconds", s.timing.active_set_seconds},
                  {"rays", s.timing.rays},

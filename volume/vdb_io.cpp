@@ -327,16 +327,22 @@ Fields ReadFieldsVdb(const std::string& path, FieldsProvenance* provenance) {
   return ReadFieldsVdbBytes(ReadVdbFileBytes(path), path, provenance);
 }
 
-Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
-                          FieldsProvenance* provenance) {
-  const VdbFileInfo info = CheckVdbBytes(bytes, path);
-  InitializeOpenVdb();
+namespace {
 
-  // Which grids to keep, by what the validator saw (names are unique, types known).
+// The grids to keep, by what the validator saw (names are unique, types known).
+struct KeptGrids {
   std::map<std::string, const VdbGridInfo*> by_name;
   std::vector<const VdbGridInfo*> cameras_info;
-  std::set<std::int64_t> indices;
   const VdbGridInfo* first = nullptr;
+};
+
+// Chooses the grids to keep from the validator's report; refuses wrong types and transforms.
+KeptGrids SelectGrids(const VdbFileInfo& info, const std::string& path) {
+  KeptGrids kept;
+  std::map<std::string, const VdbGridInfo*>& by_name = kept.by_name;
+  std::vector<const VdbGridInfo*>& cameras_info = kept.cameras_info;
+  std::set<std::int64_t> indices;
+  const VdbGridInfo*& first = kept.first;
   int known =
       0;  // grids of FieldNames(), coverage and cameras (a file of derived grids alone is not ours)
   for (const VdbGridInfo& grid : info.grids) {
@@ -385,7 +391,12 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     Refuse(path, "the VDB file holds none of Pandora's field grids");
   if (by_name.count(kCamerasGrid) && !cameras_info.empty())
     Refuse(path, "the file holds both a 'cameras' grid and per-camera 'visible/' grids");
+  return kept;
+}
 
+// Parses every grid of the file from memory; refuses a count other than the validator's.
+openvdb::GridPtrVecPtr ParseGrids(const std::string& bytes, const std::string& path,
+                                  const VdbFileInfo& info) {
   openvdb::GridPtrVecPtr grids;
   try {
     MemoryBuffer buffer(bytes.data(), bytes.size());
@@ -397,12 +408,40 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
   }
   if (!grids || grids->size() != info.grids.size())
     Refuse(path, "OpenVDB read a different number of grids than the file holds");
+  return grids;
+}
 
-  Fields fields;
-  Fields::Impl& g = fields.impl();
+// The earlier layout: one Int64 bitmask of up to 64 cameras, into one BoolGrid per camera.
+void ExpandCameraBitmask(const openvdb::Int64Grid& bitmask, const std::string& path,
+                         Fields::Impl& g) {
+  int count = 0;
+  for (auto it = bitmask.cbeginValueOn(); it; ++it) {
+    if (!it.isVoxelValue()) Refuse(path, "grid 'cameras' holds active tiles; it holds voxels only");
+    if (*it) count = std::max(count, 64 - __builtin_clzll(std::uint64_t(*it)));
+  }
+  for (int c = 0; c < count; ++c) {
+    auto grid = openvdb::BoolGrid::create(false);
+    grid->setTransform(g.transform);
+    g.visible.push_back(grid);
+  }
+  std::vector<openvdb::BoolGrid::Accessor> acc;
+  for (auto& grid : g.visible) acc.push_back(grid->getAccessor());
+  for (auto it = bitmask.cbeginValueOn(); it; ++it) {
+    const std::uint64_t mask = static_cast<std::uint64_t>(*it);
+    const openvdb::CoordBBox box = it.getBoundingBox();
+    for (auto xyz = box.begin(); xyz; ++xyz)
+      for (int c = 0; c < count; ++c)
+        if (mask >> c & 1) acc[c].setValueOn(*xyz, true);
+  }
+}
+
+// Puts the kept grids of `grids` into `g`: coverage, float fields, derived grids, camera grids.
+void TakeGrids(const openvdb::GridPtrVec& grids, KeptGrids& kept, const std::string& path,
+               Fields::Impl& g) {
+  std::map<std::string, const VdbGridInfo*>& by_name = kept.by_name;
   std::map<std::int64_t, openvdb::BoolGrid::Ptr> visible;
   openvdb::Int64Grid::Ptr bitmask;
-  for (const openvdb::GridBase::Ptr& base : *grids) {
+  for (const openvdb::GridBase::Ptr& base : grids) {
     const std::string name = base->getName();
     if (!by_name.count(name)) continue;
     if (name == kCoverageGrid) {
@@ -427,7 +466,7 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
     if (!g.transform) g.transform = base->transformPtr();
   }
   if ((by_name.count(kCoverageGrid) && !g.coverage) || (by_name.count(kCamerasGrid) && !bitmask) ||
-      visible.size() != cameras_info.size())
+      visible.size() != kept.cameras_info.size())
     Refuse(path, "OpenVDB read a grid of another type than the file declares");
   if (!visible.empty()) {
     // Indices 0..n-1 each once: a rig's cameras.
@@ -436,54 +475,52 @@ Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
                        std::to_string(visible.size() - 1));
     for (const auto& [index, grid] : visible) g.visible.push_back(grid);
   }
-  if (bitmask) {
-    // The earlier layout: one Int64 bitmask of up to 64 cameras.
-    int count = 0;
-    for (auto it = bitmask->cbeginValueOn(); it; ++it) {
-      if (!it.isVoxelValue())
-        Refuse(path, "grid 'cameras' holds active tiles; it holds voxels only");
-      if (*it) count = std::max(count, 64 - __builtin_clzll(std::uint64_t(*it)));
-    }
-    for (int c = 0; c < count; ++c) {
-      auto grid = openvdb::BoolGrid::create(false);
-      grid->setTransform(g.transform);
-      g.visible.push_back(grid);
-    }
-    std::vector<openvdb::BoolGrid::Accessor> acc;
-    for (auto& grid : g.visible) acc.push_back(grid->getAccessor());
-    for (auto it = bitmask->cbeginValueOn(); it; ++it) {
-      const std::uint64_t mask = static_cast<std::uint64_t>(*it);
-      const openvdb::CoordBBox box = it.getBoundingBox();
-      for (auto xyz = box.begin(); xyz; ++xyz)
-        for (int c = 0; c < count; ++c)
-          if (mask >> c & 1) acc[c].setValueOn(*xyz, true);
-    }
-  }
+  if (bitmask) ExpandCameraBitmask(*bitmask, path, g);
+}
+
+// The provenance strings of the file's metadata.
+FieldsProvenance ReadProvenance(const VdbFileInfo& info) {
+  FieldsProvenance p;
+  p.metadata = info.strings;
+  auto get = [&](const char* key) {
+    auto it = info.strings.find(key);
+    return it == info.strings.end() ? std::string() : it->second;
+  };
+  p.scene_file = get("scene_file");
+  p.scene_sha256 = get("scene_sha256");
+  p.rig_name = get("rig_name");
+  p.rig_json = get("rig");
+  p.tool = get("tool");
+  p.tool_version = get("tool_version");
+  return p;
+}
+
+}  // namespace
+
+Fields ReadFieldsVdbBytes(const std::string& bytes, const std::string& path,
+                          FieldsProvenance* provenance) {
+  const VdbFileInfo info = CheckVdbBytes(bytes, path);
+  InitializeOpenVdb();
+
+  // Which grids to keep, by what the validator saw (names are unique, types known).
+  KeptGrids kept = SelectGrids(info, path);
+  const VdbGridInfo* first = kept.first;
+
+  const openvdb::GridPtrVecPtr grids = ParseGrids(bytes, path, info);
+
+  Fields fields;
+  TakeGrids(*grids, kept, path, fields.impl());
 
   // The lattice: voxel (0, 0, 0) at the transform's origin, extent from the active voxels.
   fields.lattice.voxel_size = first->voxel_size;
   fields.lattice.origin = Vec3(first->translation[0], first->translation[1], first->translation[2]);
-  for (const auto& [name, grid] : by_name)
+  for (const auto& [name, grid] : kept.by_name)
     if (!grid->empty)
       for (int a = 0; a < 3; ++a)
         fields.lattice.dims[a] =
             std::max<int>(fields.lattice.dims[a], int(grid->active_max[a] + 1));
 
-  if (provenance) {
-    FieldsProvenance p;
-    p.metadata = info.strings;
-    auto get = [&](const char* key) {
-      auto it = info.strings.find(key);
-      return it == info.strings.end() ? std::string() : it->second;
-    };
-    p.scene_file = get("scene_file");
-    p.scene_sha256 = get("scene_sha256");
-    p.rig_name = get("rig_name");
-    p.rig_json = get("rig");
-    p.tool = get("tool");
-    p.tool_version = get("tool_version");
-    *provenance = std::move(p);
-  }
+  if (provenance) *provenance = ReadProvenance(info);
   return fields;
 }
 

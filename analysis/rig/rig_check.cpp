@@ -325,50 +325,29 @@ LensCoverage ComputeLensCoverage(const CameraModel& model) {
   return c;
 }
 
-std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                              const RigCheckOptions& options) {
-  std::vector<Warning> out;
-  const int rig_index = RigIndex(scene, rig);
-  auto camera_path = [&](std::size_t c) {
-    return "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
-  };
-  CheckPlausibleValues(scene, rig, camera_path, &out);
-  std::vector<int> triangle_object;
-  const TriangleMesh all = scene.AllTriangles(&triangle_object);
-  const Aabb geometry = all.Bounds();
-  const double pad = 1e-9 * std::max(1.0, geometry.diagonal());
-  Solids solids(scene);
-  const std::vector<Vec3> samples =
-      RegionSamples(scene, std::max(1, options.region_samples_per_axis), &solids);
-  const double scale = std::max(scene.Bounds().diagonal(), 1e-9);
-  const VisibilityTester tester(rig.cameras, caster, scale);
-  const double eps = tester.epsilon();
-  // The reference point: the free region sample nearest the region's centre. The region is
-  // enclosed (a room) when every horizontal ray from it meets geometry.
-  Vec3 reference = scene.study.region.box.center();
-  bool enclosed = false;
-  if (!samples.empty()) {
-    reference =
-        *std::min_element(samples.begin(), samples.end(), [&](const Vec3& a, const Vec3& b) {
-          return (a - scene.study.region.box.center()).squaredNorm() <
-                 (b - scene.study.region.box.center()).squaredNorm();
-        });
-    enclosed = true;
-    for (int k = 0; k < 16 && enclosed; ++k) {
-      const double a = 2 * kPi * k / 16;
-      enclosed =
-          caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
-    }
-  }
+namespace {
 
-  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
-    const Camera& cam = rig.cameras[c];
-    if (!cam.enabled) continue;
-    const Vec3 centre = cam.center();
-    auto add = [&](Warning::Kind kind, const std::string& key, const std::string& reason) {
-      out.push_back({kind, cam.id, camera_path(c) + key, reason});
-    };
+// The per-camera checks of CheckRig, and what they share: the scene's geometry, the region's
+// sample points and the reference point inside the region.
+struct CameraChecks {
+  const Scene& scene;
+  const RayCaster& caster;
+  const RigCheckOptions& options;
+  const std::vector<int>& triangle_object;
+  const Aabb& geometry;
+  double pad;
+  Solids& solids;
+  const std::vector<Vec3>& samples;
+  double scale;
+  const VisibilityTester& tester;
+  double eps;
+  const Vec3& reference;
+  bool enclosed;
 
+  // Where camera `cam` is (inside a solid, on a surface, outside the room); false when it is not
+  // placed where it could see the region.
+  template <class Add>
+  bool Placement(const Camera& cam, const Vec3& centre, const Add& add) const {
     // Where the camera is.
     bool placed = true;
     const int solid = solids.Containing(centre, /*strict=*/true, 1e-6 * scale);
@@ -424,7 +403,13 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
         }
       }
     }
+    return placed;
+  }
 
+  // What camera `c` sees of the region's sample points, and why not: a warning when it sees none.
+  template <class Add>
+  void RegionView(std::size_t c, const Camera& cam, const Vec3& centre, bool placed,
+                  const Add& add) const {
     // What it sees of the region's sample points, and why not.
     std::map<ViewResult, int> why;
     std::map<int, int> occluders;  // object -> lines of sight it blocks where the point is in view
@@ -483,6 +468,59 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
           "camera '" + cam.id + "' sees " + basis + " (mostly: " + cause +
               "); aim it at the region or disable it");
     }
+  }
+};
+
+}  // namespace
+
+std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                              const RigCheckOptions& options) {
+  std::vector<Warning> out;
+  const int rig_index = RigIndex(scene, rig);
+  auto camera_path = [&](std::size_t c) {
+    return "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
+  };
+  CheckPlausibleValues(scene, rig, camera_path, &out);
+  std::vector<int> triangle_object;
+  const TriangleMesh all = scene.AllTriangles(&triangle_object);
+  const Aabb geometry = all.Bounds();
+  const double pad = 1e-9 * std::max(1.0, geometry.diagonal());
+  Solids solids(scene);
+  const std::vector<Vec3> samples =
+      RegionSamples(scene, std::max(1, options.region_samples_per_axis), &solids);
+  const double scale = std::max(scene.Bounds().diagonal(), 1e-9);
+  const VisibilityTester tester(rig.cameras, caster, scale);
+  const double eps = tester.epsilon();
+  // The reference point: the free region sample nearest the region's centre. The region is
+  // enclosed (a room) when every horizontal ray from it meets geometry.
+  Vec3 reference = scene.study.region.box.center();
+  bool enclosed = false;
+  if (!samples.empty()) {
+    reference =
+        *std::min_element(samples.begin(), samples.end(), [&](const Vec3& a, const Vec3& b) {
+          return (a - scene.study.region.box.center()).squaredNorm() <
+                 (b - scene.study.region.box.center()).squaredNorm();
+        });
+    enclosed = true;
+    for (int k = 0; k < 16 && enclosed; ++k) {
+      const double a = 2 * kPi * k / 16;
+      enclosed =
+          caster.Occluded(Ray{reference, Vec3(std::cos(a), std::sin(a), 0), eps, 1e3 * scale});
+    }
+  }
+
+  const CameraChecks checks{scene, caster, options, triangle_object, geometry, pad, solids, samples,
+                            scale, tester, eps,     reference,       enclosed};
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    const Camera& cam = rig.cameras[c];
+    if (!cam.enabled) continue;
+    const Vec3 centre = cam.center();
+    auto add = [&](Warning::Kind kind, const std::string& key, const std::string& reason) {
+      out.push_back({kind, cam.id, camera_path(c) + key, reason});
+    };
+
+    const bool placed = checks.Placement(cam, centre, add);
+    checks.RegionView(c, cam, centre, placed, add);
 
     // The lens.
     const LensCoverage lens = ComputeLensCoverage(cam.model);

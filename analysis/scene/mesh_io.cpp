@@ -1186,6 +1186,167 @@ void ReadNodes(const aiNode* root, Skeleton* skeleton, std::map<const aiNode*, i
   }
 }
 
+// A material's vertices of a skinned mesh file: its mesh, its binding to the skeleton, and the
+// welding of vertices with equal positions and influences.
+struct SkinnedPart {
+  MeshPart part;
+  SkinBinding binding;
+  std::map<std::vector<double>, int> weld;
+};
+
+// Animation `a` of a skinned mesh file as a clip: key times in seconds, quaternions normalised in
+// double.
+template <class Corrupt, class FindNode>
+SkinClip ReadSkinClip(const aiAnimation* anim, unsigned a, const Corrupt& corrupt,
+                      const FindNode& find_node) {
+  if (anim == nullptr) corrupt("animation " + std::to_string(a) + " is missing");
+  const std::string clip_name = "animation " + std::to_string(a);
+  const double ticks = anim->mTicksPerSecond > 0 && std::isfinite(anim->mTicksPerSecond)
+                           ? anim->mTicksPerSecond
+                           : 25.0;
+  SkinClip clip;
+  clip.name = anim->mName.C_Str();
+  if (!std::isfinite(anim->mDuration) || anim->mDuration < 0)
+    corrupt(clip_name + " has a duration that is not finite");
+  clip.duration_s = anim->mDuration / ticks;
+  if (anim->mNumChannels > 0 && anim->mChannels == nullptr)
+    corrupt(clip_name + " has no channel list");
+  double last_key = 0;
+  for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+    const aiNodeAnim* ch = anim->mChannels[c];
+    if (ch == nullptr) corrupt(clip_name + ": channel " + std::to_string(c) + " is missing");
+    NodeChannel channel;
+    channel.node = find_node(ch->mNodeName);
+    if (channel.node < 0) continue;  // keys for a node the file does not have: nothing moves
+    if ((ch->mNumPositionKeys > 0 && !ch->mPositionKeys) ||
+        (ch->mNumRotationKeys > 0 && !ch->mRotationKeys) ||
+        (ch->mNumScalingKeys > 0 && !ch->mScalingKeys))
+      corrupt(clip_name + ": channel of node '" + Printable(ch->mNodeName.C_Str()) +
+              "' has no keys");
+    auto time_of = [&](double ticks_value) {
+      if (!std::isfinite(ticks_value)) corrupt(clip_name + " has a key time that is not finite");
+      last_key = std::max(last_key, ticks_value / ticks);
+      return ticks_value / ticks;
+    };
+    auto vec = [&](const aiVector3D& v) {
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        corrupt(clip_name + " has a key value that is not finite");
+      return Vec3(v.x, v.y, v.z);
+    };
+    for (unsigned k = 0; k < ch->mNumPositionKeys; ++k)
+      channel.position.emplace_back(time_of(ch->mPositionKeys[k].mTime),
+                                    vec(ch->mPositionKeys[k].mValue));
+    for (unsigned k = 0; k < ch->mNumScalingKeys; ++k)
+      channel.scaling.emplace_back(time_of(ch->mScalingKeys[k].mTime),
+                                   vec(ch->mScalingKeys[k].mValue));
+    for (unsigned k = 0; k < ch->mNumRotationKeys; ++k) {
+      const aiQuaternion& q = ch->mRotationKeys[k].mValue;
+      Eigen::Quaterniond e(q.w, q.x, q.y, q.z);
+      if (!e.coeffs().allFinite() || !(e.norm() > 1e-6))
+        corrupt(clip_name + " has a rotation key that is not a rotation");
+      channel.rotation.emplace_back(time_of(ch->mRotationKeys[k].mTime), e.normalized());
+    }
+    auto by_time = [](const auto& x, const auto& y) { return x.first < y.first; };
+    std::stable_sort(channel.position.begin(), channel.position.end(), by_time);
+    std::stable_sort(channel.rotation.begin(), channel.rotation.end(), by_time);
+    std::stable_sort(channel.scaling.begin(), channel.scaling.end(), by_time);
+    clip.channels.push_back(std::move(channel));
+  }
+  if (!(clip.duration_s > 0)) clip.duration_s = last_key;
+  return clip;
+}
+
+// The influences of each vertex of `mesh`, as bone indices of the part; adds the mesh's bones to
+// the part's binding.
+template <class Corrupt, class FindNode>
+std::vector<std::vector<std::pair<int, double>>> MeshInfluences(const aiMesh& mesh,
+                                                                const Corrupt& corrupt,
+                                                                const FindNode& find_node,
+                                                                SkinnedPart* part) {
+  SkinnedPart& p = *part;
+  std::vector<std::vector<std::pair<int, double>>> infl(mesh.mNumVertices);
+  for (unsigned b = 0; b < mesh.mNumBones; ++b) {
+    const aiBone& bone = *mesh.mBones[b];
+    const int bone_node = find_node(bone.mName);
+    if (bone_node < 0)
+      corrupt("bone '" + Printable(bone.mName.C_Str()) + "' names no node of the file");
+    const Eigen::Matrix4d offset = ToEigen(bone.mOffsetMatrix);
+    if (!Finite(offset))
+      corrupt("bone '" + Printable(bone.mName.C_Str()) +
+              "' has an offset matrix that is not finite");
+    const int index = int(p.binding.bones.size());
+    p.binding.bones.emplace_back(bone_node, offset);
+    if (bone.mNumWeights > 0 && bone.mWeights == nullptr)
+      corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has no weights");
+    for (unsigned w = 0; w < bone.mNumWeights; ++w) {
+      // Checked before post-processing, and again: assimp's steps keep damaged weights.
+      const aiVertexWeight& vw = bone.mWeights[w];
+      if (vw.mVertexId >= mesh.mNumVertices || !std::isfinite(vw.mWeight) || vw.mWeight < 0)
+        corrupt("bone '" + Printable(bone.mName.C_Str()) +
+                "' weighs a vertex past the end of its mesh, or by a "
+                "negative or non-finite weight");
+      if (vw.mWeight > 0) infl[vw.mVertexId].emplace_back(index, vw.mWeight);
+    }
+  }
+  return infl;
+}
+
+// Adds the vertices (welded) and triangles of `mesh`, placed by node `mesh_node`, to a part.
+template <class Corrupt, class FindNode>
+void AddSkinnedMesh(const aiMesh& mesh, int mesh_node, const std::string& path,
+                    const Corrupt& corrupt, const FindNode& find_node, SkinnedPart* part) {
+  SkinnedPart& p = *part;
+  // Influences of each vertex of this mesh, as bone indices of the part.
+  std::vector<std::vector<std::pair<int, double>>> infl =
+      MeshInfluences(mesh, corrupt, find_node, &p);
+  std::vector<int> remap(mesh.mNumVertices);
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    const aiVector3D& x = mesh.mVertices[v];
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
+      throw InputError(path, "", "cannot read mesh file: a vertex has non-finite coordinates");
+    auto& list = infl[v];
+    double sum = 0;
+    for (const auto& [b, w] : list) sum += w;
+    if (!(sum > 0)) {
+      // No weight: the vertex hangs rigidly on its mesh's node.
+      list.clear();
+      int bone = -1;
+      for (std::size_t b = 0; b < p.binding.bones.size(); ++b)
+        if (p.binding.bones[b].first == mesh_node &&
+            p.binding.bones[b].second == Eigen::Matrix4d::Identity())
+          bone = int(b);
+      if (bone < 0) {
+        bone = int(p.binding.bones.size());
+        p.binding.bones.emplace_back(mesh_node, Eigen::Matrix4d::Identity());
+      }
+      list.emplace_back(bone, 1.0);
+    } else {
+      for (auto& bw : list) bw.second /= sum;
+    }
+    std::sort(list.begin(), list.end());
+    std::vector<double> key{double(x.x), double(x.y), double(x.z)};
+    for (const auto& [b, w] : list) {
+      // Bones are keyed by node and offset, so equal influences from two meshes weld.
+      key.push_back(double(p.binding.bones[b].first));
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) key.push_back(p.binding.bones[b].second(r, c));
+      key.push_back(w);
+    }
+    auto [it, added] = p.weld.emplace(std::move(key), int(p.binding.mesh_vertices.size()));
+    if (added) {
+      p.binding.mesh_vertices.emplace_back(x.x, x.y, x.z);
+      if (p.binding.first.empty()) p.binding.first.push_back(0);
+      p.binding.influences.insert(p.binding.influences.end(), list.begin(), list.end());
+      p.binding.first.push_back(int(p.binding.influences.size()));
+    }
+    remap[v] = it->second;
+  }
+  TriangleMesh& out = p.part.mesh;
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f)
+    AppendTriangle(
+        mesh, mesh.mFaces[f], path, [&remap](unsigned v) { return remap[v]; }, &out);
+}
+
 }  // namespace
 
 SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
@@ -1217,74 +1378,13 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
               "and keyframes); remove \"animation\" for a still object");
         for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
           const aiAnimation* anim = scene.mAnimations[a];
-          if (anim == nullptr) corrupt("animation " + std::to_string(a) + " is missing");
-          const std::string clip_name = "animation " + std::to_string(a);
-          const double ticks = anim->mTicksPerSecond > 0 && std::isfinite(anim->mTicksPerSecond)
-                                   ? anim->mTicksPerSecond
-                                   : 25.0;
-          SkinClip clip;
-          clip.name = anim->mName.C_Str();
-          if (!std::isfinite(anim->mDuration) || anim->mDuration < 0)
-            corrupt(clip_name + " has a duration that is not finite");
-          clip.duration_s = anim->mDuration / ticks;
-          if (anim->mNumChannels > 0 && anim->mChannels == nullptr)
-            corrupt(clip_name + " has no channel list");
-          double last_key = 0;
-          for (unsigned c = 0; c < anim->mNumChannels; ++c) {
-            const aiNodeAnim* ch = anim->mChannels[c];
-            if (ch == nullptr)
-              corrupt(clip_name + ": channel " + std::to_string(c) + " is missing");
-            NodeChannel channel;
-            channel.node = find_node(ch->mNodeName);
-            if (channel.node < 0)
-              continue;  // keys for a node the file does not have: nothing moves
-            if ((ch->mNumPositionKeys > 0 && !ch->mPositionKeys) ||
-                (ch->mNumRotationKeys > 0 && !ch->mRotationKeys) ||
-                (ch->mNumScalingKeys > 0 && !ch->mScalingKeys))
-              corrupt(clip_name + ": channel of node '" + Printable(ch->mNodeName.C_Str()) +
-                      "' has no keys");
-            auto time_of = [&](double ticks_value) {
-              if (!std::isfinite(ticks_value))
-                corrupt(clip_name + " has a key time that is not finite");
-              last_key = std::max(last_key, ticks_value / ticks);
-              return ticks_value / ticks;
-            };
-            auto vec = [&](const aiVector3D& v) {
-              if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
-                corrupt(clip_name + " has a key value that is not finite");
-              return Vec3(v.x, v.y, v.z);
-            };
-            for (unsigned k = 0; k < ch->mNumPositionKeys; ++k)
-              channel.position.emplace_back(time_of(ch->mPositionKeys[k].mTime),
-                                            vec(ch->mPositionKeys[k].mValue));
-            for (unsigned k = 0; k < ch->mNumScalingKeys; ++k)
-              channel.scaling.emplace_back(time_of(ch->mScalingKeys[k].mTime),
-                                           vec(ch->mScalingKeys[k].mValue));
-            for (unsigned k = 0; k < ch->mNumRotationKeys; ++k) {
-              const aiQuaternion& q = ch->mRotationKeys[k].mValue;
-              Eigen::Quaterniond e(q.w, q.x, q.y, q.z);
-              if (!e.coeffs().allFinite() || !(e.norm() > 1e-6))
-                corrupt(clip_name + " has a rotation key that is not a rotation");
-              channel.rotation.emplace_back(time_of(ch->mRotationKeys[k].mTime), e.normalized());
-            }
-            auto by_time = [](const auto& x, const auto& y) { return x.first < y.first; };
-            std::stable_sort(channel.position.begin(), channel.position.end(), by_time);
-            std::stable_sort(channel.rotation.begin(), channel.rotation.end(), by_time);
-            std::stable_sort(channel.scaling.begin(), channel.scaling.end(), by_time);
-            clip.channels.push_back(std::move(channel));
-          }
-          if (!(clip.duration_s > 0)) clip.duration_s = last_key;
+          SkinClip clip = ReadSkinClip(anim, a, corrupt, find_node);
           skeleton->clips.push_back(std::move(clip));
         }
 
         // Vertices per material: the file's mesh-space positions and their influences; welded where
         // both the position and the influences are equal.
-        struct Part {
-          MeshPart part;
-          SkinBinding binding;
-          std::map<std::vector<double>, int> weld;
-        };
-        std::map<unsigned, Part> parts;
+        std::map<unsigned, SkinnedPart> parts;
         const fs::path folder = fs::path(path).parent_path();
         // Nodes in the skeleton's order (depth first, file order), each mesh where a node places
         // it.
@@ -1301,81 +1401,8 @@ SkinnedMeshFile LoadSkinnedMeshFile(const std::string& path) {
             if (mesh.mNumBones > 0 && mesh.mBones == nullptr) corrupt("a mesh has no bone list");
             for (unsigned b = 0; b < mesh.mNumBones; ++b)
               if (mesh.mBones[b] == nullptr) corrupt("a mesh has a missing bone");
-            Part& p = parts[mesh.mMaterialIndex];
-            // Influences of each vertex of this mesh, as bone indices of the part.
-            std::vector<std::vector<std::pair<int, double>>> infl(mesh.mNumVertices);
-            for (unsigned b = 0; b < mesh.mNumBones; ++b) {
-              const aiBone& bone = *mesh.mBones[b];
-              const int bone_node = find_node(bone.mName);
-              if (bone_node < 0)
-                corrupt("bone '" + Printable(bone.mName.C_Str()) + "' names no node of the file");
-              const Eigen::Matrix4d offset = ToEigen(bone.mOffsetMatrix);
-              if (!Finite(offset))
-                corrupt("bone '" + Printable(bone.mName.C_Str()) +
-                        "' has an offset matrix that is not finite");
-              const int index = int(p.binding.bones.size());
-              p.binding.bones.emplace_back(bone_node, offset);
-              if (bone.mNumWeights > 0 && bone.mWeights == nullptr)
-                corrupt("bone '" + Printable(bone.mName.C_Str()) + "' has no weights");
-              for (unsigned w = 0; w < bone.mNumWeights; ++w) {
-                // Checked before post-processing, and again: assimp's steps keep damaged weights.
-                const aiVertexWeight& vw = bone.mWeights[w];
-                if (vw.mVertexId >= mesh.mNumVertices || !std::isfinite(vw.mWeight) ||
-                    vw.mWeight < 0)
-                  corrupt("bone '" + Printable(bone.mName.C_Str()) +
-                          "' weighs a vertex past the end of its mesh, or by a "
-                          "negative or non-finite weight");
-                if (vw.mWeight > 0) infl[vw.mVertexId].emplace_back(index, vw.mWeight);
-              }
-            }
-            std::vector<int> remap(mesh.mNumVertices);
-            for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-              const aiVector3D& x = mesh.mVertices[v];
-              if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
-                throw InputError(path, "",
-                                 "cannot read mesh file: a vertex has non-finite coordinates");
-              auto& list = infl[v];
-              double sum = 0;
-              for (const auto& [b, w] : list) sum += w;
-              if (!(sum > 0)) {
-                // No weight: the vertex hangs rigidly on its mesh's node.
-                list.clear();
-                int bone = -1;
-                for (std::size_t b = 0; b < p.binding.bones.size(); ++b)
-                  if (p.binding.bones[b].first == mesh_node &&
-                      p.binding.bones[b].second == Eigen::Matrix4d::Identity())
-                    bone = int(b);
-                if (bone < 0) {
-                  bone = int(p.binding.bones.size());
-                  p.binding.bones.emplace_back(mesh_node, Eigen::Matrix4d::Identity());
-                }
-                list.emplace_back(bone, 1.0);
-              } else {
-                for (auto& bw : list) bw.second /= sum;
-              }
-              std::sort(list.begin(), list.end());
-              std::vector<double> key{double(x.x), double(x.y), double(x.z)};
-              for (const auto& [b, w] : list) {
-                // Bones are keyed by node and offset, so equal influences from two meshes weld.
-                key.push_back(double(p.binding.bones[b].first));
-                for (int r = 0; r < 3; ++r)
-                  for (int c = 0; c < 4; ++c) key.push_back(p.binding.bones[b].second(r, c));
-                key.push_back(w);
-              }
-              auto [it, added] =
-                  p.weld.emplace(std::move(key), int(p.binding.mesh_vertices.size()));
-              if (added) {
-                p.binding.mesh_vertices.emplace_back(x.x, x.y, x.z);
-                if (p.binding.first.empty()) p.binding.first.push_back(0);
-                p.binding.influences.insert(p.binding.influences.end(), list.begin(), list.end());
-                p.binding.first.push_back(int(p.binding.influences.size()));
-              }
-              remap[v] = it->second;
-            }
-            TriangleMesh& out = p.part.mesh;
-            for (unsigned f = 0; f < mesh.mNumFaces; ++f)
-              AppendTriangle(
-                  mesh, mesh.mFaces[f], path, [&remap](unsigned v) { return remap[v]; }, &out);
+            SkinnedPart& p = parts[mesh.mMaterialIndex];
+            AddSkinnedMesh(mesh, mesh_node, path, corrupt, find_node, &p);
           }
         }
 

@@ -627,6 +627,152 @@ void CheckObjectBounds(const TriangleMesh& mesh, const Node& node) {
               "check its scale, its unit_scale and the file's \"units\"");
 }
 
+// An object's instance transform: translate * rotate * scale, in metres.
+Eigen::Affine3d ReadObjectTransform(const Node& node) {
+  Vec3 position = Vec3::Zero();
+  if (auto n = node.Find("position")) position = n->Point();
+  Mat3 rotation = Mat3::Identity();
+  if (node.Has("rotation_deg") && node.Has("quaternion")) {
+    node.Get("quaternion")
+        .Fail("both 'rotation_deg' and 'quaternion' are given", "give one rotation form");
+  }
+  if (auto n = node.Find("rotation_deg")) rotation = RotationXyzDegrees(n->Vector3());
+  if (auto n = node.Find("quaternion")) rotation = ReadQuaternion(*n);
+  Vec3 scale = Vec3::Ones();
+  if (auto n = node.Find("scale")) {
+    scale = n->value().is_number() ? Vec3::Constant(n->Positive()) : n->PositiveVector3();
+  }
+  Eigen::Affine3d world_from_object = Eigen::Affine3d::Identity();
+  world_from_object.translation() = position;
+  world_from_object.linear() = rotation * scale.asDiagonal();
+  return world_from_object;
+}
+
+// An object's material index: a named one, a colour shortcut, or -1 (meshes: the file's own).
+int ReadObjectMaterial(const Node& node, const std::map<std::string, int>& material_index,
+                       const std::string& name, Scene* scene) {
+  int material = -1;
+  if (node.Has("material") && node.Has("color")) {
+    node.Get("color").Fail("both 'material' and 'color' are given", "give one of them");
+  }
+  if (auto n = node.Find("material")) {
+    const std::string material_name = n->NonEmptyString();
+    const auto it = material_index.find(material_name);
+    if (it == material_index.end()) {
+      std::vector<std::string> known;
+      for (const auto& [k, v] : material_index) known.push_back(k);
+      n->Fail("unknown material " + Quoted(material_name),
+              known.empty() ? "define it under \"materials\""
+                            : SuggestionHint(material_name, known, "defined materials"));
+    }
+    material = it->second;
+  }
+  if (auto n = node.Find("color")) {
+    Material m;
+    m.name = name;
+    m.color = n->Color();
+    material = AddMaterial(scene, m);
+  }
+  return material;
+}
+
+// Adds the objects of a "mesh" entry (one per part of the file), skinned when animated.
+void AddMeshObjects(const Node& node, const Node& geometry, const std::optional<Node>& animation,
+                    const std::string& name, const Eigen::Affine3d& world_from_object, int material,
+                    bool solid, const Context& context, Scene* scene) {
+  const MeshReference reference = ReadMeshReference(geometry);
+  const Eigen::Affine3d transform = world_from_object * reference.file_to_object;
+  std::optional<SkinnedObject> skin;
+  if (animation) skin = ReadAnimation(*animation);
+  if (!context.options.load_meshes) {
+    scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid, {}, -1});
+    if (skin) {  // no skeleton: the object stays as placed
+      skin->object = int(scene->objects.size()) - 1;
+      scene->objects.back().skin = int(scene->skins.size());
+      scene->skins.push_back(*skin);
+    }
+    return;
+  }
+  std::vector<MeshPart> parts;
+  SkinnedMeshFile skinned;
+  if (skin) {
+    skinned = LoadSkinnedParts(reference);
+    skin->skeleton = skinned.skeleton;
+    skin->world_from_file = transform;
+    skin->clip = ResolveClip(*animation, *skinned.skeleton);
+    parts = skinned.parts;
+  } else {
+    parts = LoadMeshParts(reference);
+  }
+  TriangleMesh all;
+  std::set<std::string> part_names;
+  for (MeshPart& part : parts) {
+    SceneObject object;
+    object.name = name;
+    if (parts.size() > 1) {
+      object.name = name + "/" + part.material_name;
+      for (int k = 2; !part_names.insert(object.name).second; ++k) {
+        object.name = name + "/" + part.material_name + "#" + std::to_string(k);
+      }
+    }
+    object.source = reference.file;
+    object.mesh = Transformed(part.mesh, transform);
+    CheckObjectBounds(object.mesh, node);
+    object.solid = solid;
+    object.material = material;
+    if (material < 0 && part.has_material) {
+      object.material =
+          AddMaterial(scene, Material{name + "/" + part.material_name, part.color, part.texture});
+    }
+    if (solid) all.Append(object.mesh);
+    if (skin) {
+      SkinnedObject part_skin = *skin;
+      part_skin.object = int(scene->objects.size());
+      part_skin.binding = skinned.bindings[std::size_t(&part - parts.data())];
+      object.skin = int(scene->skins.size());
+      scene->skins.push_back(std::move(part_skin));
+    }
+    scene->objects.push_back(std::move(object));
+  }
+  if (solid) {
+    CheckSolid(all, node, "solid object " + Quoted(name),
+               "repair the mesh, or set \"solid\": false");
+  }
+}
+
+// The mesh of a primitive object ("box", "sphere", "cylinder", "capsule", "plane"), unplaced.
+TriangleMesh MakePrimitive(const std::string& kind, const Node& geometry, double unit) {
+  auto segments = [&geometry]() {
+    auto n = geometry.Find("segments");
+    return n ? n->Integer(kMinSegments, kMaxSegments) : kDefaultSegments;
+  };
+  TriangleMesh mesh;
+  if (kind == "box") {
+    geometry.CheckKeys({"size"});
+    mesh = MakeBox(geometry.Get("size").PositiveVector3() * unit);
+  } else if (kind == "sphere") {
+    geometry.CheckKeys({"radius", "segments"});
+    mesh = MakeSphere(geometry.Get("radius").PositiveLength(), segments());
+  } else if (kind == "cylinder") {
+    geometry.CheckKeys({"radius", "height", "segments"});
+    mesh = MakeCylinder(geometry.Get("radius").PositiveLength(),
+                        geometry.Get("height").PositiveLength(), segments());
+  } else if (kind == "capsule") {
+    geometry.CheckKeys({"radius", "length", "segments"});
+    mesh = MakeCapsule(geometry.Get("radius").PositiveLength(),
+                       geometry.Get("length").NonNegativeLength(), segments());
+  } else {  // plane
+    geometry.CheckKeys({"size"});
+    const Node size_node = geometry.Get("size");
+    const Vec2 size = size_node.Vector2();
+    for (int i = 0; i < 2; ++i) {
+      if (!(size[i] > 0)) size_node.At(i).Fail("must be positive, got " + FormatNumber(size[i]));
+    }
+    mesh = MakePlane(size * unit);
+  }
+  return mesh;
+}
+
 void ReadObject(const Node& node, const std::map<std::string, int>& material_index,
                 std::set<std::string>* names, Scene* scene) {
   const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
@@ -657,23 +803,7 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     }
   } assign{scene, first_object, group};
 
-  // Instance transform: translate * rotate * scale, in metres.
-  Vec3 position = Vec3::Zero();
-  if (auto n = node.Find("position")) position = n->Point();
-  Mat3 rotation = Mat3::Identity();
-  if (node.Has("rotation_deg") && node.Has("quaternion")) {
-    node.Get("quaternion")
-        .Fail("both 'rotation_deg' and 'quaternion' are given", "give one rotation form");
-  }
-  if (auto n = node.Find("rotation_deg")) rotation = RotationXyzDegrees(n->Vector3());
-  if (auto n = node.Find("quaternion")) rotation = ReadQuaternion(*n);
-  Vec3 scale = Vec3::Ones();
-  if (auto n = node.Find("scale")) {
-    scale = n->value().is_number() ? Vec3::Constant(n->Positive()) : n->PositiveVector3();
-  }
-  Eigen::Affine3d world_from_object = Eigen::Affine3d::Identity();
-  world_from_object.translation() = position;
-  world_from_object.linear() = rotation * scale.asDiagonal();
+  const Eigen::Affine3d world_from_object = ReadObjectTransform(node);
 
   bool solid = false;
   if (auto n = node.Find("solid")) {
@@ -681,36 +811,10 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     if (solid && kind == "plane") n->Fail("a plane is an open sheet and cannot be solid");
   }
 
-  // Material: a named one, a colour shortcut, or (meshes) the file's own.
-  int material = -1;
-  if (node.Has("material") && node.Has("color")) {
-    node.Get("color").Fail("both 'material' and 'color' are given", "give one of them");
-  }
-  if (auto n = node.Find("material")) {
-    const std::string material_name = n->NonEmptyString();
-    const auto it = material_index.find(material_name);
-    if (it == material_index.end()) {
-      std::vector<std::string> known;
-      for (const auto& [k, v] : material_index) known.push_back(k);
-      n->Fail("unknown material " + Quoted(material_name),
-              known.empty() ? "define it under \"materials\""
-                            : SuggestionHint(material_name, known, "defined materials"));
-    }
-    material = it->second;
-  }
-  if (auto n = node.Find("color")) {
-    Material m;
-    m.name = name;
-    m.color = n->Color();
-    material = AddMaterial(scene, m);
-  }
+  const int material = ReadObjectMaterial(node, material_index, name, scene);
 
   const Context& context = node.context();
   const double unit = context.metres_per_unit;
-  auto segments = [&geometry]() {
-    auto n = geometry.Find("segments");
-    return n ? n->Integer(kMinSegments, kMaxSegments) : kDefaultSegments;
-  };
 
   const std::optional<Node> animation = node.Find("animation");
   if (animation && kind != "mesh")
@@ -718,91 +822,12 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
         "\"animation\" needs a mesh file with bones and an animation clip, not a " + kind,
         "give \"mesh\": {\"file\": ...} with a glTF, FBX or COLLADA file, or remove \"animation\"");
   if (kind == "mesh") {
-    const MeshReference reference = ReadMeshReference(geometry);
-    const Eigen::Affine3d transform = world_from_object * reference.file_to_object;
-    std::optional<SkinnedObject> skin;
-    if (animation) skin = ReadAnimation(*animation);
-    if (!context.options.load_meshes) {
-      scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid, {}, -1});
-      if (skin) {  // no skeleton: the object stays as placed
-        skin->object = int(scene->objects.size()) - 1;
-        scene->objects.back().skin = int(scene->skins.size());
-        scene->skins.push_back(*skin);
-      }
-      return;
-    }
-    std::vector<MeshPart> parts;
-    SkinnedMeshFile skinned;
-    if (skin) {
-      skinned = LoadSkinnedParts(reference);
-      skin->skeleton = skinned.skeleton;
-      skin->world_from_file = transform;
-      skin->clip = ResolveClip(*animation, *skinned.skeleton);
-      parts = skinned.parts;
-    } else {
-      parts = LoadMeshParts(reference);
-    }
-    TriangleMesh all;
-    std::set<std::string> part_names;
-    for (MeshPart& part : parts) {
-      SceneObject object;
-      object.name = name;
-      if (parts.size() > 1) {
-        object.name = name + "/" + part.material_name;
-        for (int k = 2; !part_names.insert(object.name).second; ++k) {
-          object.name = name + "/" + part.material_name + "#" + std::to_string(k);
-        }
-      }
-      object.source = reference.file;
-      object.mesh = Transformed(part.mesh, transform);
-      CheckObjectBounds(object.mesh, node);
-      object.solid = solid;
-      object.material = material;
-      if (material < 0 && part.has_material) {
-        object.material =
-            AddMaterial(scene, Material{name + "/" + part.material_name, part.color, part.texture});
-      }
-      if (solid) all.Append(object.mesh);
-      if (skin) {
-        SkinnedObject part_skin = *skin;
-        part_skin.object = int(scene->objects.size());
-        part_skin.binding = skinned.bindings[std::size_t(&part - parts.data())];
-        object.skin = int(scene->skins.size());
-        scene->skins.push_back(std::move(part_skin));
-      }
-      scene->objects.push_back(std::move(object));
-    }
-    if (solid) {
-      CheckSolid(all, node, "solid object " + Quoted(name),
-                 "repair the mesh, or set \"solid\": false");
-    }
+    AddMeshObjects(node, geometry, animation, name, world_from_object, material, solid, context,
+                   scene);
     return;
   }
 
-  TriangleMesh mesh;
-  if (kind == "box") {
-    geometry.CheckKeys({"size"});
-    mesh = MakeBox(geometry.Get("size").PositiveVector3() * unit);
-  } else if (kind == "sphere") {
-    geometry.CheckKeys({"radius", "segments"});
-    mesh = MakeSphere(geometry.Get("radius").PositiveLength(), segments());
-  } else if (kind == "cylinder") {
-    geometry.CheckKeys({"radius", "height", "segments"});
-    mesh = MakeCylinder(geometry.Get("radius").PositiveLength(),
-                        geometry.Get("height").PositiveLength(), segments());
-  } else if (kind == "capsule") {
-    geometry.CheckKeys({"radius", "length", "segments"});
-    mesh = MakeCapsule(geometry.Get("radius").PositiveLength(),
-                       geometry.Get("length").NonNegativeLength(), segments());
-  } else {  // plane
-    geometry.CheckKeys({"size"});
-    const Node size_node = geometry.Get("size");
-    const Vec2 size = size_node.Vector2();
-    for (int i = 0; i < 2; ++i) {
-      if (!(size[i] > 0)) size_node.At(i).Fail("must be positive, got " + FormatNumber(size[i]));
-    }
-    mesh = MakePlane(size * unit);
-  }
+  const TriangleMesh mesh = MakePrimitive(kind, geometry, unit);
   scene->objects.push_back(
       {name, kind, Transformed(mesh, world_from_object), material, solid, {}, -1});
   CheckObjectBounds(scene->objects.back().mesh, node);
@@ -937,28 +962,9 @@ Intrinsics ReadIntrinsics(const Node& node) {
   return k;
 }
 
-// A PTZ camera's head ("ptz", docs/ptz.md): its file pose is the home pose at the pivot; the
-// camera becomes the head's current setting.
-void ReadPtz(const Node& node, Camera* camera) {
-  node.CheckKeys({"pan_deg", "tilt_deg", "hfov_deg", "pan_range_deg", "tilt_range_deg",
-                  "pan_speed_deg_s", "tilt_speed_deg_s", "zoom_hfov_deg", "zoom_speed_pct_s",
-                  "home_hfov_deg", "pan_axis", "offset_m", "trace_s", "presets", "tour"});
-  auto head = std::make_shared<PtzHead>();
+// The pan and tilt ranges of a PTZ head ("pan_range_deg", "tilt_range_deg").
+void ReadPtzRanges(const Node& node, PtzHead* head) {
   PtzHead& h = *head;
-  h.home = camera->world_from_camera;
-  const Vec3 x_home = h.home.linear().col(0);
-  if (auto n = node.Find("pan_axis")) {
-    const Vec3 a = n->Vector3();
-    if (!(a.norm() > 0)) n->Fail("the pan axis must not be the zero vector");
-    h.pan_axis = a.normalized();
-    if (std::abs(h.pan_axis.dot(x_home)) > 1e-6)
-      n->Fail(
-          "the home view's image x axis is not perpendicular to the pan axis (the head is not "
-          "level)",
-          "aim the camera with \"look_at\" and an \"up\" along the pan axis");
-  } else {
-    h.pan_axis = std::abs(x_home.z()) <= 1e-9 ? Vec3::UnitZ() : Vec3(-h.home.linear().col(1));
-  }
   const double el0 = h.HomeElevationDeg();
   auto range = [&](const char* key, double lo, double hi, double* out_lo, double* out_hi) {
     *out_lo = lo;
@@ -993,6 +999,11 @@ void ReadPtz(const Node& node, Camera* camera) {
         .Fail("a pan range spans at most 360 degrees",
               "a head that turns without end: [-180, 180]");
   range("tilt_range_deg", -90 - el0, 90 - el0, &h.tilt_min_deg, &h.tilt_max_deg);
+}
+
+// The pan, tilt and zoom speeds and the trace time of a PTZ head.
+void ReadPtzSpeeds(const Node& node, PtzHead* head) {
+  PtzHead& h = *head;
   // Bounded so that every accepted head's reach and tour work is bounded (a head of 1e-12 deg/s
   // once ran analyze for minutes): the slowest 0.1 deg/s (a full turn in an hour), a trace of an
   // hour.
@@ -1011,61 +1022,41 @@ void ReadPtz(const Node& node, Camera* camera) {
         "a zoom speed in percent of the range per second");
   h.zoom_speed = zoom_pct / 100.0;
   speed("trace_s", &h.trace_s, 1e-3, 3600, "a trace time in seconds");
-  const Intrinsics k = camera->model.intrinsics();
-  auto focal = [&](const Node& n) {
-    const double hfov = n.Positive();
-    const double max = k.model == LensModel::kFisheye ? 360.0 : 180.0;
-    if (!(hfov < max)) n.Fail("a field of view must be below " + FormatNumber(max) + " degrees");
-    return FocalFromHfov(hfov * kRadPerDeg, k.width, k.model);
-  };
-  h.focal_min = h.focal_max = k.fx;
-  if (auto n = node.Find("zoom_hfov_deg")) {
-    if (!n->value().is_array() || n->value().size() != 2)
-      n->Fail("expected [widest, narrowest] degrees");
-    const double a = focal(n->At(0)), b = focal(n->At(1));
-    h.focal_min = std::min(a, b);
-    h.focal_max = std::max(a, b);
-    if (k.fx < h.focal_min * (1 - 1e-9) || k.fx > h.focal_max * (1 + 1e-9))
-      n->Fail("the camera's own field of view (its current zoom) lies outside the zoom range",
-              "give the camera's hfov_deg within zoom_hfov_deg");
+}
+
+// The focal length (pixels) of a field of view node (degrees) for the lens `k`.
+double PtzFocal(const Node& n, const Intrinsics& k) {
+  const double hfov = n.Positive();
+  const double max = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+  if (!(hfov < max)) n.Fail("a field of view must be below " + FormatNumber(max) + " degrees");
+  return FocalFromHfov(hfov * kRadPerDeg, k.width, k.model);
+}
+
+// A PTZ setting's pan, tilt and zoom, each checked against the head's ranges.
+void ReadPtzState(const Node& n, const PtzHead& h, const Intrinsics& k, PtzState* s) {
+  if (auto p = n.Find("pan_deg")) {
+    s->pan_deg = p->Number();
+    if (s->pan_deg < h.pan_min_deg - 1e-9 || s->pan_deg > h.pan_max_deg + 1e-9)
+      p->Fail("outside the pan range [" + FormatNumber(h.pan_min_deg) + ", " +
+              FormatNumber(h.pan_max_deg) + "]");
   }
-  auto state = [&](const Node& n, PtzState* s) {
-    if (auto p = n.Find("pan_deg")) {
-      s->pan_deg = p->Number();
-      if (s->pan_deg < h.pan_min_deg - 1e-9 || s->pan_deg > h.pan_max_deg + 1e-9)
-        p->Fail("outside the pan range [" + FormatNumber(h.pan_min_deg) + ", " +
-                FormatNumber(h.pan_max_deg) + "]");
-    }
-    if (auto p = n.Find("tilt_deg")) {
-      s->tilt_deg = p->Number();
-      if (s->tilt_deg < h.tilt_min_deg - 1e-9 || s->tilt_deg > h.tilt_max_deg + 1e-9)
-        p->Fail("outside the tilt range [" + FormatNumber(h.tilt_min_deg) + ", " +
-                FormatNumber(h.tilt_max_deg) + "]");
-    }
-    if (auto p = n.Find("hfov_deg")) {
-      s->focal = focal(*p);
-      if (s->focal < h.focal_min * (1 - 1e-9) || s->focal > h.focal_max * (1 + 1e-9))
-        p->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
-      s->focal = std::clamp(s->focal, h.focal_min, h.focal_max);
-    }
-  };
-  h.home_focal = h.focal_min;
-  if (auto n = node.Find("home_hfov_deg")) {
-    h.home_focal = focal(*n);
-    if (h.home_focal < h.focal_min * (1 - 1e-9) || h.home_focal > h.focal_max * (1 + 1e-9))
-      n->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
-    h.home_focal = std::clamp(h.home_focal, h.focal_min, h.focal_max);
+  if (auto p = n.Find("tilt_deg")) {
+    s->tilt_deg = p->Number();
+    if (s->tilt_deg < h.tilt_min_deg - 1e-9 || s->tilt_deg > h.tilt_max_deg + 1e-9)
+      p->Fail("outside the tilt range [" + FormatNumber(h.tilt_min_deg) + ", " +
+              FormatNumber(h.tilt_max_deg) + "]");
   }
-  h.current.focal = k.fx;
-  state(node, &h.current);
-  if (node.Has("hfov_deg"))
-    node.Get("hfov_deg")
-        .Fail("the current zoom is the camera's own \"hfov_deg\" (or focal)",
-              "remove ptz.hfov_deg");
-  if (auto n = node.Find("offset_m")) {
-    n->Vector3();  // three numbers
-    for (int i = 0; i < 3; ++i) h.offset[i] = n->At(i).Length();
+  if (auto p = n.Find("hfov_deg")) {
+    s->focal = PtzFocal(*p, k);
+    if (s->focal < h.focal_min * (1 - 1e-9) || s->focal > h.focal_max * (1 + 1e-9))
+      p->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
+    s->focal = std::clamp(s->focal, h.focal_min, h.focal_max);
   }
+}
+
+// The named presets of a PTZ head.
+void ReadPtzPresets(const Node& node, const Intrinsics& k, PtzHead* head) {
+  PtzHead& h = *head;
   if (auto n = node.Find("presets")) {
     const size_t count = n->ArraySize("an array of presets");
     std::set<std::string> names;
@@ -1077,10 +1068,15 @@ void ReadPtz(const Node& node, Camera* camera) {
       if (!names.insert(preset.name).second)
         p.Get("name").Fail("duplicate preset name " + Quoted(preset.name));
       preset.state.focal = h.current.focal;
-      state(p, &preset.state);
+      ReadPtzState(p, h, k, &preset.state);
       h.presets.push_back(preset);
     }
   }
+}
+
+// The tour of a PTZ head: stops at its presets, with dwell times.
+void ReadPtzTour(const Node& node, PtzHead* head) {
+  PtzHead& h = *head;
   if (auto n = node.Find("tour")) {
     const size_t count = n->ArraySize("an array of tour stops");
     if (count == 0) n->Fail("a tour needs at least one stop");
@@ -1103,6 +1099,63 @@ void ReadPtz(const Node& node, Camera* camera) {
       h.tour.push_back(t);
     }
   }
+}
+
+// A PTZ camera's head ("ptz", docs/ptz.md): its file pose is the home pose at the pivot; the
+// camera becomes the head's current setting.
+void ReadPtz(const Node& node, Camera* camera) {
+  node.CheckKeys({"pan_deg", "tilt_deg", "hfov_deg", "pan_range_deg", "tilt_range_deg",
+                  "pan_speed_deg_s", "tilt_speed_deg_s", "zoom_hfov_deg", "zoom_speed_pct_s",
+                  "home_hfov_deg", "pan_axis", "offset_m", "trace_s", "presets", "tour"});
+  auto head = std::make_shared<PtzHead>();
+  PtzHead& h = *head;
+  h.home = camera->world_from_camera;
+  const Vec3 x_home = h.home.linear().col(0);
+  if (auto n = node.Find("pan_axis")) {
+    const Vec3 a = n->Vector3();
+    if (!(a.norm() > 0)) n->Fail("the pan axis must not be the zero vector");
+    h.pan_axis = a.normalized();
+    if (std::abs(h.pan_axis.dot(x_home)) > 1e-6)
+      n->Fail(
+          "the home view's image x axis is not perpendicular to the pan axis (the head is not "
+          "level)",
+          "aim the camera with \"look_at\" and an \"up\" along the pan axis");
+  } else {
+    h.pan_axis = std::abs(x_home.z()) <= 1e-9 ? Vec3::UnitZ() : Vec3(-h.home.linear().col(1));
+  }
+  ReadPtzRanges(node, &h);
+  ReadPtzSpeeds(node, &h);
+  const Intrinsics k = camera->model.intrinsics();
+  h.focal_min = h.focal_max = k.fx;
+  if (auto n = node.Find("zoom_hfov_deg")) {
+    if (!n->value().is_array() || n->value().size() != 2)
+      n->Fail("expected [widest, narrowest] degrees");
+    const double a = PtzFocal(n->At(0), k), b = PtzFocal(n->At(1), k);
+    h.focal_min = std::min(a, b);
+    h.focal_max = std::max(a, b);
+    if (k.fx < h.focal_min * (1 - 1e-9) || k.fx > h.focal_max * (1 + 1e-9))
+      n->Fail("the camera's own field of view (its current zoom) lies outside the zoom range",
+              "give the camera's hfov_deg within zoom_hfov_deg");
+  }
+  h.home_focal = h.focal_min;
+  if (auto n = node.Find("home_hfov_deg")) {
+    h.home_focal = PtzFocal(*n, k);
+    if (h.home_focal < h.focal_min * (1 - 1e-9) || h.home_focal > h.focal_max * (1 + 1e-9))
+      n->Fail("outside the zoom range", "zoom_hfov_deg gives the range");
+    h.home_focal = std::clamp(h.home_focal, h.focal_min, h.focal_max);
+  }
+  h.current.focal = k.fx;
+  ReadPtzState(node, h, k, &h.current);
+  if (node.Has("hfov_deg"))
+    node.Get("hfov_deg")
+        .Fail("the current zoom is the camera's own \"hfov_deg\" (or focal)",
+              "remove ptz.hfov_deg");
+  if (auto n = node.Find("offset_m")) {
+    n->Vector3();  // three numbers
+    for (int i = 0; i < 3; ++i) h.offset[i] = n->At(i).Length();
+  }
+  ReadPtzPresets(node, k, &h);
+  ReadPtzTour(node, &h);
   *camera = h.CameraAt(*camera, h.current);
   camera->ptz = head;
 }

@@ -91,6 +91,186 @@ void Marker(std::ostringstream& o, int shape, double x, double y, const char* co
   }
 }
 
+// A log-log plot being drawn: the plot, its frame in pixels, its whole decades, the SVG so far, and
+// the colour and marker shape of each series.
+struct LogLogCanvas {
+  LogLogCanvas(const LogLogPlot& plot, double left, double right, double top, double bottom,
+               int xlo, int xhi, int ylo, int yhi)
+      : plot(plot),
+        left(left),
+        right(right),
+        top(top),
+        bottom(bottom),
+        xlo(xlo),
+        xhi(xhi),
+        ylo(ylo),
+        yhi(yhi) {}
+
+  // The x pixel of data value x.
+  double Px(double x) const { return left + (std::log10(x) - xlo) / (xhi - xlo) * (right - left); }
+  // The y pixel of data value y.
+  double Py(double y) const {
+    return bottom - (std::log10(y) - ylo) / (yhi - ylo) * (bottom - top);
+  }
+
+  void GridAndTicks();
+  void FrameAndLabels(bool has_data);
+  void VerticalMarkers();
+  void Series();
+  void Legend();
+
+  const LogLogPlot& plot;
+  const double left, right, top, bottom;
+  const int xlo, xhi, ylo, yhi;
+  std::ostringstream o;
+  std::vector<std::string> colors;
+  std::vector<int> shapes;
+};
+
+// Grid and ticks. Label every decade, or every 2nd/3rd when there are many.
+void LogLogCanvas::GridAndTicks() {
+  auto step_for = [](int decades) { return decades <= 9 ? 1 : decades <= 18 ? 2 : 3; };
+  const int xstep = step_for(xhi - xlo), ystep = step_for(yhi - ylo);
+  o << "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
+  for (int k = xlo; k <= xhi; ++k) {
+    const double x = left + double(k - xlo) / (xhi - xlo) * (right - left);
+    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(x) << "\" y2=\""
+      << Num(bottom) << "\"/>\n";
+  }
+  for (int k = ylo; k <= yhi; ++k) {
+    const double y = bottom - double(k - ylo) / (yhi - ylo) * (bottom - top);
+    o << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(right)
+      << "\" y2=\"" << Num(y) << "\"/>\n";
+  }
+  o << "</g>\n<g stroke=\"black\" stroke-width=\"1\">\n";
+  const bool x_minor = xhi - xlo <= 6, y_minor = yhi - ylo <= 6;
+  for (int k = xlo; k <= xhi; ++k) {
+    const double x = Px(std::pow(10.0, k));
+    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(bottom) << "\" x2=\"" << Num(x) << "\" y2=\""
+      << Num(bottom + 6) << "\"/>\n";
+    if (x_minor && k < xhi)
+      for (int m = 2; m <= 9; ++m) {
+        const double xm = Px(m * std::pow(10.0, k));
+        o << "<line x1=\"" << Num(xm) << "\" y1=\"" << Num(bottom) << "\" x2=\"" << Num(xm)
+          << "\" y2=\"" << Num(bottom + 3) << "\"/>\n";
+      }
+  }
+  for (int k = ylo; k <= yhi; ++k) {
+    const double y = Py(std::pow(10.0, k));
+    o << "<line x1=\"" << Num(left - 6) << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(left)
+      << "\" y2=\"" << Num(y) << "\"/>\n";
+    if (y_minor && k < yhi)
+      for (int m = 2; m <= 9; ++m) {
+        const double ym = Py(m * std::pow(10.0, k));
+        o << "<line x1=\"" << Num(left - 3) << "\" y1=\"" << Num(ym) << "\" x2=\"" << Num(left)
+          << "\" y2=\"" << Num(ym) << "\"/>\n";
+      }
+  }
+  o << "</g>\n";
+  for (int k = xlo; k <= xhi; k += xstep)
+    o << "<text x=\"" << Num(Px(std::pow(10.0, k))) << "\" y=\"" << Num(bottom + 22)
+      << "\" text-anchor=\"middle\">" << DecadeLabel(k) << "</text>\n";
+  for (int k = ylo; k <= yhi; k += ystep)
+    o << "<text x=\"" << Num(left - 10) << "\" y=\"" << Num(Py(std::pow(10.0, k)) + 4)
+      << "\" text-anchor=\"end\">" << DecadeLabel(k) << "</text>\n";
+}
+
+// The frame, the axis labels, the note, and "no data" when nothing is plottable.
+void LogLogCanvas::FrameAndLabels(bool has_data) {
+  o << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(right - left)
+    << "\" height=\"" << Num(bottom - top) << "\" fill=\"none\" stroke=\"black\"/>\n";
+  o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(bottom + 42)
+    << "\" text-anchor=\"middle\" font-size=\"13\">" << Escape(plot.x_label) << "</text>\n";
+  const double ymid = (top + bottom) / 2;
+  o << "<text x=\"18\" y=\"" << Num(ymid) << "\" text-anchor=\"middle\" font-size=\"13\" "
+    << "transform=\"rotate(-90 18 " << Num(ymid) << ")\">" << Escape(plot.y_label) << "</text>\n";
+  if (!plot.note.empty())
+    o << "<text x=\"" << Num(left) << "\" y=\"" << Num(bottom + 62)
+      << "\" font-size=\"11\" fill=\"#555\">" << Escape(plot.note) << "</text>\n";
+  if (!has_data)
+    o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(ymid)
+      << "\" text-anchor=\"middle\" fill=\"#888\">no data</text>\n";
+}
+
+// Vertical markers.
+void LogLogCanvas::VerticalMarkers() {
+  for (const PlotMarker& m : plot.vertical_lines) {
+    if (!Plottable(m.x)) continue;
+    const double x = Px(m.x);
+    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(x) << "\" y2=\""
+      << Num(bottom) << "\" stroke=\"#444\" stroke-width=\"1.5\" stroke-dasharray=\"2,3\"/>\n";
+    o << "<text x=\"" << Num(x + 4) << "\" y=\"" << Num(top + 14) << "\" font-size=\"11\" "
+      << "fill=\"#444\">" << Escape(m.label) << "</text>\n";
+  }
+}
+
+// Series, clipped to the frame; their point labels after them, unclipped.
+void LogLogCanvas::Series() {
+  o << "<clipPath id=\"frame\"><rect x=\"" << Num(left - 6) << "\" y=\"" << Num(top - 6)
+    << "\" width=\"" << Num(right - left + 12) << "\" height=\"" << Num(bottom - top + 12)
+    << "\"/></clipPath>\n<g clip-path=\"url(#frame)\">\n";
+  // Colour and marker shape of each series.
+  int next_shape = 0;
+  for (std::size_t si = 0; si < plot.series.size(); ++si) {
+    const PlotSeries& s = plot.series[si];
+    colors.push_back(s.color.empty() ? kColors[si % kColorCount] : s.color);
+    shapes.push_back(s.shape >= 0 ? s.shape : s.markers ? next_shape++ : 0);
+  }
+  std::ostringstream labels;  // point labels, drawn unclipped after the series
+  for (std::size_t si = 0; si < plot.series.size(); ++si) {
+    const PlotSeries& s = plot.series[si];
+    const char* color = colors[si].c_str();
+    const std::size_t n = std::min(s.x.size(), s.y.size());
+    if (s.line) {
+      std::string d;
+      bool pen_down = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!Plottable(s.x[i]) || !Plottable(s.y[i])) {
+          pen_down = false;
+          continue;
+        }
+        d += (pen_down ? " L" : " M") + Num(Px(s.x[i])) + "," + Num(Py(s.y[i]));
+        pen_down = true;
+      }
+      if (!d.empty())
+        o << "<path d=\"" << d.substr(1) << "\" fill=\"none\" stroke=\"" << color
+          << "\" stroke-width=\"1.8\"" << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!Plottable(s.x[i]) || !Plottable(s.y[i])) continue;
+      const double x = Px(s.x[i]), y = Py(s.y[i]);
+      if (s.markers) Marker(o, shapes[si], x, y, color);
+      if (i < s.point_labels.size() && !s.point_labels[i].empty()) {
+        const bool near_right = x > right - 70;  // keep the label inside the frame
+        labels << "<text x=\"" << Num(near_right ? x - 6 : x + 6) << "\" y=\""
+               << Num(s.labels_below ? y + 15 : y - 6) << "\" font-size=\"10\" fill=\"" << color
+               << "\"" << (near_right ? " text-anchor=\"end\"" : "") << ">"
+               << Escape(s.point_labels[i]) << "</text>\n";
+      }
+    }
+  }
+  o << "</g>\n" << labels.str();
+}
+
+// Legend, in its own column right of the frame (after Series, which picks the colours and shapes).
+void LogLogCanvas::Legend() {
+  double ly = top + 8;
+  for (std::size_t si = 0; si < plot.series.size(); ++si) {
+    const PlotSeries& s = plot.series[si];
+    if (!s.in_legend) continue;
+    const char* color = colors[si].c_str();
+    const double lx = right + 18;
+    if (s.line)
+      o << "<line x1=\"" << Num(lx) << "\" y1=\"" << Num(ly) << "\" x2=\"" << Num(lx + 26)
+        << "\" y2=\"" << Num(ly) << "\" stroke=\"" << color << "\" stroke-width=\"1.8\""
+        << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
+    if (s.markers) Marker(o, shapes[si], lx + 13, ly, color);
+    o << "<text x=\"" << Num(lx + 34) << "\" y=\"" << Num(ly + 4) << "\">" << Escape(s.label)
+      << "</text>\n";
+    ly += 20;
+  }
+}
+
 }  // namespace
 
 std::string RenderLogLogSvg(const LogLogPlot& plot) {
@@ -116,10 +296,9 @@ std::string RenderLogLogSvg(const LogLogPlot& plot) {
 
   const double W = plot.width, H = plot.height;
   const double left = 78, right = W - 240, top = 42, bottom = H - (plot.note.empty() ? 62 : 80);
-  auto px = [&](double x) { return left + (std::log10(x) - xlo) / (xhi - xlo) * (right - left); };
-  auto py = [&](double y) { return bottom - (std::log10(y) - ylo) / (yhi - ylo) * (bottom - top); };
+  LogLogCanvas canvas(plot, left, right, top, bottom, xlo, xhi, ylo, yhi);
 
-  std::ostringstream o;
+  std::ostringstream& o = canvas.o;
   o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
     << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << plot.width
     << "\" height=\"" << plot.height << "\" viewBox=\"0 0 " << plot.width << " " << plot.height
@@ -128,139 +307,11 @@ std::string RenderLogLogSvg(const LogLogPlot& plot) {
   o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"24\" text-anchor=\"middle\" "
     << "font-size=\"15\" font-weight=\"bold\">" << Escape(plot.title) << "</text>\n";
 
-  // Grid and ticks. Label every decade, or every 2nd/3rd when there are many.
-  auto step_for = [](int decades) { return decades <= 9 ? 1 : decades <= 18 ? 2 : 3; };
-  const int xstep = step_for(xhi - xlo), ystep = step_for(yhi - ylo);
-  o << "<g stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
-  for (int k = xlo; k <= xhi; ++k) {
-    const double x = left + double(k - xlo) / (xhi - xlo) * (right - left);
-    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(x) << "\" y2=\""
-      << Num(bottom) << "\"/>\n";
-  }
-  for (int k = ylo; k <= yhi; ++k) {
-    const double y = bottom - double(k - ylo) / (yhi - ylo) * (bottom - top);
-    o << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(right)
-      << "\" y2=\"" << Num(y) << "\"/>\n";
-  }
-  o << "</g>\n<g stroke=\"black\" stroke-width=\"1\">\n";
-  const bool x_minor = xhi - xlo <= 6, y_minor = yhi - ylo <= 6;
-  for (int k = xlo; k <= xhi; ++k) {
-    const double x = px(std::pow(10.0, k));
-    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(bottom) << "\" x2=\"" << Num(x) << "\" y2=\""
-      << Num(bottom + 6) << "\"/>\n";
-    if (x_minor && k < xhi)
-      for (int m = 2; m <= 9; ++m) {
-        const double xm = px(m * std::pow(10.0, k));
-        o << "<line x1=\"" << Num(xm) << "\" y1=\"" << Num(bottom) << "\" x2=\"" << Num(xm)
-          << "\" y2=\"" << Num(bottom + 3) << "\"/>\n";
-      }
-  }
-  for (int k = ylo; k <= yhi; ++k) {
-    const double y = py(std::pow(10.0, k));
-    o << "<line x1=\"" << Num(left - 6) << "\" y1=\"" << Num(y) << "\" x2=\"" << Num(left)
-      << "\" y2=\"" << Num(y) << "\"/>\n";
-    if (y_minor && k < yhi)
-      for (int m = 2; m <= 9; ++m) {
-        const double ym = py(m * std::pow(10.0, k));
-        o << "<line x1=\"" << Num(left - 3) << "\" y1=\"" << Num(ym) << "\" x2=\"" << Num(left)
-          << "\" y2=\"" << Num(ym) << "\"/>\n";
-      }
-  }
-  o << "</g>\n";
-  for (int k = xlo; k <= xhi; k += xstep)
-    o << "<text x=\"" << Num(px(std::pow(10.0, k))) << "\" y=\"" << Num(bottom + 22)
-      << "\" text-anchor=\"middle\">" << DecadeLabel(k) << "</text>\n";
-  for (int k = ylo; k <= yhi; k += ystep)
-    o << "<text x=\"" << Num(left - 10) << "\" y=\"" << Num(py(std::pow(10.0, k)) + 4)
-      << "\" text-anchor=\"end\">" << DecadeLabel(k) << "</text>\n";
-  o << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(right - left)
-    << "\" height=\"" << Num(bottom - top) << "\" fill=\"none\" stroke=\"black\"/>\n";
-  o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(bottom + 42)
-    << "\" text-anchor=\"middle\" font-size=\"13\">" << Escape(plot.x_label) << "</text>\n";
-  const double ymid = (top + bottom) / 2;
-  o << "<text x=\"18\" y=\"" << Num(ymid) << "\" text-anchor=\"middle\" font-size=\"13\" "
-    << "transform=\"rotate(-90 18 " << Num(ymid) << ")\">" << Escape(plot.y_label) << "</text>\n";
-  if (!plot.note.empty())
-    o << "<text x=\"" << Num(left) << "\" y=\"" << Num(bottom + 62)
-      << "\" font-size=\"11\" fill=\"#555\">" << Escape(plot.note) << "</text>\n";
-  if (!has_data)
-    o << "<text x=\"" << Num((left + right) / 2) << "\" y=\"" << Num(ymid)
-      << "\" text-anchor=\"middle\" fill=\"#888\">no data</text>\n";
-
-  // Vertical markers.
-  for (const PlotMarker& m : plot.vertical_lines) {
-    if (!Plottable(m.x)) continue;
-    const double x = px(m.x);
-    o << "<line x1=\"" << Num(x) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(x) << "\" y2=\""
-      << Num(bottom) << "\" stroke=\"#444\" stroke-width=\"1.5\" stroke-dasharray=\"2,3\"/>\n";
-    o << "<text x=\"" << Num(x + 4) << "\" y=\"" << Num(top + 14) << "\" font-size=\"11\" "
-      << "fill=\"#444\">" << Escape(m.label) << "</text>\n";
-  }
-
-  // Series, clipped to the frame.
-  o << "<clipPath id=\"frame\"><rect x=\"" << Num(left - 6) << "\" y=\"" << Num(top - 6)
-    << "\" width=\"" << Num(right - left + 12) << "\" height=\"" << Num(bottom - top + 12)
-    << "\"/></clipPath>\n<g clip-path=\"url(#frame)\">\n";
-  // Colour and marker shape of each series.
-  std::vector<std::string> colors;
-  std::vector<int> shapes;
-  int next_shape = 0;
-  for (std::size_t si = 0; si < plot.series.size(); ++si) {
-    const PlotSeries& s = plot.series[si];
-    colors.push_back(s.color.empty() ? kColors[si % kColorCount] : s.color);
-    shapes.push_back(s.shape >= 0 ? s.shape : s.markers ? next_shape++ : 0);
-  }
-  std::ostringstream labels;  // point labels, drawn unclipped after the series
-  for (std::size_t si = 0; si < plot.series.size(); ++si) {
-    const PlotSeries& s = plot.series[si];
-    const char* color = colors[si].c_str();
-    const std::size_t n = std::min(s.x.size(), s.y.size());
-    if (s.line) {
-      std::string d;
-      bool pen_down = false;
-      for (std::size_t i = 0; i < n; ++i) {
-        if (!Plottable(s.x[i]) || !Plottable(s.y[i])) {
-          pen_down = false;
-          continue;
-        }
-        d += (pen_down ? " L" : " M") + Num(px(s.x[i])) + "," + Num(py(s.y[i]));
-        pen_down = true;
-      }
-      if (!d.empty())
-        o << "<path d=\"" << d.substr(1) << "\" fill=\"none\" stroke=\"" << color
-          << "\" stroke-width=\"1.8\"" << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!Plottable(s.x[i]) || !Plottable(s.y[i])) continue;
-      const double x = px(s.x[i]), y = py(s.y[i]);
-      if (s.markers) Marker(o, shapes[si], x, y, color);
-      if (i < s.point_labels.size() && !s.point_labels[i].empty()) {
-        const bool near_right = x > right - 70;  // keep the label inside the frame
-        labels << "<text x=\"" << Num(near_right ? x - 6 : x + 6) << "\" y=\""
-               << Num(s.labels_below ? y + 15 : y - 6) << "\" font-size=\"10\" fill=\"" << color
-               << "\"" << (near_right ? " text-anchor=\"end\"" : "") << ">"
-               << Escape(s.point_labels[i]) << "</text>\n";
-      }
-    }
-  }
-  o << "</g>\n" << labels.str();
-
-  // Legend, in its own column right of the frame.
-  double ly = top + 8;
-  for (std::size_t si = 0; si < plot.series.size(); ++si) {
-    const PlotSeries& s = plot.series[si];
-    if (!s.in_legend) continue;
-    const char* color = colors[si].c_str();
-    const double lx = right + 18;
-    if (s.line)
-      o << "<line x1=\"" << Num(lx) << "\" y1=\"" << Num(ly) << "\" x2=\"" << Num(lx + 26)
-        << "\" y2=\"" << Num(ly) << "\" stroke=\"" << color << "\" stroke-width=\"1.8\""
-        << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
-    if (s.markers) Marker(o, shapes[si], lx + 13, ly, color);
-    o << "<text x=\"" << Num(lx + 34) << "\" y=\"" << Num(ly + 4) << "\">" << Escape(s.label)
-      << "</text>\n";
-    ly += 20;
-  }
+  canvas.GridAndTicks();
+  canvas.FrameAndLabels(has_data);
+  canvas.VerticalMarkers();
+  canvas.Series();
+  canvas.Legend();
   o << "</svg>\n";
   return o.str();
 }

@@ -375,14 +375,86 @@ ReportTarget StageReport(OutputTransaction& output, const std::string& dir,
   return t;
 }
 
-ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const ReportData& data,
-                       const ReportOptions& options, const ReportTarget& target) {
-  const std::vector<RigReport>& reports = data.rigs;
-  const Study& study = data.study;
-  const std::size_t n = reports.size();
-  const int view_width = options.view_width;
+namespace {
+
+// The page being written: its inputs, the rig headers of the column layout, the figures it
+// embeds and the body so far; a member per section, each appending to the body in page order.
+struct ReportPage {
+  ReportPage(const Scene& scene, const RayCaster& caster, const ReportData& data,
+             const ReportOptions& options)
+      : scene(scene),
+        caster(caster),
+        data(data),
+        options(options),
+        reports(data.rigs),
+        study(data.study),
+        n(reports.size()),
+        view_width(options.view_width) {}
+
+  void Intro();
+  void Numbers();
+  void RigHeads();
+  void Warnings();
+  void Plan();
+  void Views();
+  void CameraViews();
+  void Slices();
+  void Histograms();
+  void Cameras();
+  void Sheet();
+  void Calibration();
+  void OverTime();
+  void Robustness();
+  std::string Html() const;
+
+  const Scene& scene;
+  const RayCaster& caster;
+  const ReportData& data;
+  const ReportOptions& options;
+  const std::vector<RigReport>& reports;
+  const Study& study;
+  const std::size_t n;
+  const int view_width;
   Figures fig;
   std::ostringstream body;
+  std::vector<std::string> heads;
+};
+
+// The CSV's rows as a table (fields may be quoted: "a, b" and "" inside quotes).
+std::string SheetTable(const std::string& csv) {
+  std::string table = "<table class=\"sheet\">";
+  std::size_t line = 0;
+  for (std::size_t at = 0; at < csv.size();) {
+    const std::size_t end = csv.find('\n', at);
+    const std::string row = csv.substr(at, end - at);
+    at = end == std::string::npos ? csv.size() : end + 1;
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      const char ch = row[i];
+      if (quoted && ch == '"' && i + 1 < row.size() && row[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (ch == '"') {
+        quoted = !quoted;
+      } else if (ch == ',' && !quoted) {
+        fields.emplace_back();
+      } else {
+        fields.back() += ch;
+      }
+    }
+    const char* cell = line++ == 0 ? "th" : "td";
+    table += "<tr>";
+    for (const std::string& f : fields)
+      table += std::string("<") + cell + ">" + HtmlEscape(f) + "</" + cell + ">";
+    table += "</tr>";
+  }
+  table += "</table>";
+  return table;
+}
+
+// The title, the scene and study line, and the image check.
+void ReportPage::Intro() {
   body << "<h1>Pandora report: "
        << HtmlEscape(std::filesystem::path(scene.path).filename().string())
        << "</h1>\n<p class=\"meta\">Scene <code>" << HtmlEscape(scene.path)
@@ -405,7 +477,10 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
   for (std::size_t i = 0; i < n; ++i)
     body << (i ? ", " : "") << "<b>" << HtmlEscape(reports[i].rig.name) << "</b>";
   body << ".</p>\n<p id=\"image-check\" class=\"pending\">checking images&hellip;</p>\n";
+}
 
+// The headline numbers, compared when there are several rigs.
+void ReportPage::Numbers() {
   body << "<h2 id=\"numbers\">" << (n > 1 ? "Rigs compared" : "Summary") << "</h2>\n"
        << "<p class=\"note\">Fractions are of the free region voxels (inside the region, outside "
           "solids); &sigma;<sub>max</sub> percentiles are over the triangulable voxels."
@@ -414,59 +489,63 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
                  : "")
        << "</p>\n"
        << HeadlineTable(data);
+}
 
-  // Rig headers for the column layout.
-  std::vector<std::string> heads;
+// Rig headers for the column layout.
+void ReportPage::RigHeads() {
   for (const RigReport& r : reports)
     heads.push_back("<h3 class=\"rig\">" + HtmlEscape(r.rig.name) + " &mdash; " +
                     std::to_string(r.rig.enabled_count()) + " cameras</h3>");
+}
 
-  // Warnings (as `pandora analyze` prints them): nonsense placements and lenses.
-  {
-    std::size_t total = 0;
-    for (const RigReport& r : reports) total += r.warnings.size();
-    body << "<h2 id=\"warnings\">Warnings</h2>\n<p class=\"note\">Checks of each enabled camera: "
-            "inside a solid object, outside the modelled room, seeing none of the region, a lens "
-            "model that folds back inside the image (docs/user-guide.md, "
-            "&ldquo;Warnings&rdquo;).</p>\n";
-    if (total == 0) {
-      body << "<p>No warnings.</p>\n";
-    } else {
-      std::vector<std::string> cells;
-      for (const RigReport& r : reports) cells.push_back(WarningList(r, scene.path));
-      body << RigRow(heads) << RigRow(cells);
-    }
-  }
-
-  // The plan: the proposal's first picture (orthographic, cut at the region's top, ids labelled).
-  {
-    const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
-    double mpp = 0;
-    const std::optional<RenderView> plan =
-        PlanView(scene.ContentBounds(), "plan", view_width, height, study.region.box.max.z(), &mpp);
-    char note[256];
-    std::snprintf(
-        note, sizeof note,
-        "From above, north up, orthographic (to %.1f %%), cut at the study region's top (%.2f m): "
-        "1 px = %.3g cm. Each camera is drawn with its id.",
-        100.0 / kPlanDistance, study.region.box.max.z(), 100.0 * mpp);
-    body << "<h2 id=\"plan\">Plan</h2>\n<p class=\"note\">" << note << "</p>\n" << RigRow(heads);
+// Warnings (as `pandora analyze` prints them): nonsense placements and lenses.
+void ReportPage::Warnings() {
+  std::size_t total = 0;
+  for (const RigReport& r : reports) total += r.warnings.size();
+  body << "<h2 id=\"warnings\">Warnings</h2>\n<p class=\"note\">Checks of each enabled camera: "
+          "inside a solid object, outside the modelled room, seeing none of the region, a lens "
+          "model that folds back inside the image (docs/user-guide.md, "
+          "&ldquo;Warnings&rdquo;).</p>\n";
+  if (total == 0) {
+    body << "<p>No warnings.</p>\n";
+  } else {
     std::vector<std::string> cells;
-    for (const RigReport& r : reports) {
-      RenderOptions render;
-      render.pixel_sigma = study.pixel_sigma;
-      render.brightness = options.brightness;
-      render.layers = false;
-      render.overlays.labels = true;
-      render.overlays.frustum_length = 0.04 * mpp * view_width;
-      const Image image = Render(scene, r.rig, caster, *plan, render);
-      cells.push_back("<figure>" +
-                      fig.Img("image/png", PngBytes(image), r.rig.name + " plan", "render") +
-                      "<figcaption>plan</figcaption></figure>");
-    }
-    body << RigRow(cells);
+    for (const RigReport& r : reports) cells.push_back(WarningList(r, scene.path));
+    body << RigRow(heads) << RigRow(cells);
   }
-  // Renders: the named views, then each camera's own view, per rig.
+}
+
+// The plan: the proposal's first picture (orthographic, cut at the region's top, ids labelled).
+void ReportPage::Plan() {
+  const int height = std::max(1, static_cast<int>(std::lround(view_width * 10.0 / 16.0)));
+  double mpp = 0;
+  const std::optional<RenderView> plan =
+      PlanView(scene.ContentBounds(), "plan", view_width, height, study.region.box.max.z(), &mpp);
+  char note[256];
+  std::snprintf(
+      note, sizeof note,
+      "From above, north up, orthographic (to %.1f %%), cut at the study region's top (%.2f m): "
+      "1 px = %.3g cm. Each camera is drawn with its id.",
+      100.0 / kPlanDistance, study.region.box.max.z(), 100.0 * mpp);
+  body << "<h2 id=\"plan\">Plan</h2>\n<p class=\"note\">" << note << "</p>\n" << RigRow(heads);
+  std::vector<std::string> cells;
+  for (const RigReport& r : reports) {
+    RenderOptions render;
+    render.pixel_sigma = study.pixel_sigma;
+    render.brightness = options.brightness;
+    render.layers = false;
+    render.overlays.labels = true;
+    render.overlays.frustum_length = 0.04 * mpp * view_width;
+    const Image image = Render(scene, r.rig, caster, *plan, render);
+    cells.push_back("<figure>" +
+                    fig.Img("image/png", PngBytes(image), r.rig.name + " plan", "render") +
+                    "<figcaption>plan</figcaption></figure>");
+  }
+  body << RigRow(cells);
+}
+
+// Renders: the named views (here), then each camera's own view (CameraViews), per rig.
+void ReportPage::Views() {
   if (!scene.views.empty()) {
     body << "<h2 id=\"views\">Views</h2>\n<p class=\"note\">Each enabled camera projects light of "
             "its own colour; where several see a surface their colours add, and surfaces no camera "
@@ -498,41 +577,45 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
       body << RigRow(cells);
     }
   }
+}
+
+// Each camera's own view, per rig.
+void ReportPage::CameraViews() {
   body << "<h2 id=\"camera-views\">What each camera sees</h2>\n<p class=\"note\">Each camera's "
           "own image (its lens model, distortion included), lit by every camera of its rig.</p>\n"
        << RigRow(heads);
-  {
-    std::vector<std::string> cells;
-    for (const RigReport& r : reports) {
-      std::string cell = ColourKey(r.rig) + "<div class=\"thumbs\">";
-      for (std::size_t c = 0; c < r.rig.cameras.size(); ++c) {
-        const Camera& cam = r.rig.cameras[c];
-        if (!cam.enabled) continue;
-        RenderView view;
-        view.camera = static_cast<int>(c);
-        view.width = options.camera_width;
-        view.height =
-            std::max(1, static_cast<int>(std::lround(double(options.camera_width) *
-                                                     cam.model.height() / cam.model.width())));
-        RenderOptions render;
-        render.pixel_sigma = study.pixel_sigma;
-        render.brightness = options.brightness;
-        render.layers = false;  // PNG only: no resolution / sigma_max per pixel
-        render.overlays.cameras = false;
-        render.overlays.key = false;  // the key is above the views, once per rig
-        const Image image = Render(scene, r.rig, caster, view, render);
-        cell += "<figure>" +
-                fig.Img("image/png", PngBytes(image), r.rig.name + " camera " + cam.id, "thumb") +
-                "<figcaption>" + HtmlEscape(cam.id) +
-                (cam.name != cam.id ? " (" + HtmlEscape(cam.name) + ")" : "") +
-                "</figcaption></figure>";
-      }
-      cells.push_back(cell + "</div>");
+  std::vector<std::string> cells;
+  for (const RigReport& r : reports) {
+    std::string cell = ColourKey(r.rig) + "<div class=\"thumbs\">";
+    for (std::size_t c = 0; c < r.rig.cameras.size(); ++c) {
+      const Camera& cam = r.rig.cameras[c];
+      if (!cam.enabled) continue;
+      RenderView view;
+      view.camera = static_cast<int>(c);
+      view.width = options.camera_width;
+      view.height =
+          std::max(1, static_cast<int>(std::lround(double(options.camera_width) *
+                                                   cam.model.height() / cam.model.width())));
+      RenderOptions render;
+      render.pixel_sigma = study.pixel_sigma;
+      render.brightness = options.brightness;
+      render.layers = false;  // PNG only: no resolution / sigma_max per pixel
+      render.overlays.cameras = false;
+      render.overlays.key = false;  // the key is above the views, once per rig
+      const Image image = Render(scene, r.rig, caster, view, render);
+      cell += "<figure>" +
+              fig.Img("image/png", PngBytes(image), r.rig.name + " camera " + cam.id, "thumb") +
+              "<figcaption>" + HtmlEscape(cam.id) +
+              (cam.name != cam.id ? " (" + HtmlEscape(cam.name) + ")" : "") +
+              "</figcaption></figure>";
     }
-    body << RigRow(cells);
+    cells.push_back(cell + "</div>");
   }
+  body << RigRow(cells);
+}
 
-  // Field slices on shared scales.
+// Field slices on shared scales.
+void ReportPage::Slices() {
   body << "<h2 id=\"slices\">Field slices</h2>\n<p class=\"note\">Voxel planes through the centre "
           "of "
           "the region, one pixel block per voxel. Light grey: not a free region voxel (inside a "
@@ -575,8 +658,10 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     }
     body << RigRow(cells);
   }
+}
 
-  // Histograms on shared axes.
+// Histograms on shared axes.
+void ReportPage::Histograms() {
   body << "<h2 id=\"histograms\">Histograms</h2>\n" << RigRow(heads);
   {
     const CoverageHistogram& h = data.coverage_histogram;
@@ -628,8 +713,10 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     }
     body << RigRow(cells);
   }
+}
 
-  // Cameras.
+// Cameras.
+void ReportPage::Cameras() {
   body
       << "<h2 id=\"cameras\">Cameras</h2>\n<p class=\"note\">The swatch is the colour of the "
          "camera's light in the renders. FOV: edge to edge of the image along the rows and columns "
@@ -639,62 +726,34 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
          "model's valid domain; region seen: share of the free region voxels the camera sees "
          "(visibility rules, occlusion included).</p>\n"
       << RigRow(heads);
-  {
-    std::vector<std::string> cells;
-    for (const RigReport& r : reports)
-      cells.push_back("<div class=\"scroll\">" + CameraTable(r, study) + "</div>");
-    body << RigRow(cells);
-  }
+  std::vector<std::string> cells;
+  for (const RigReport& r : reports)
+    cells.push_back("<div class=\"scroll\">" + CameraTable(r, study) + "</div>");
+  body << RigRow(cells);
+}
 
-  // The installation sheet: what an installer needs per camera, with the CSV to download
-  // (analysis/rig/rig_formats.h RigToSheetCsv, the same as `pandora export-rig --format sheet`).
+// The installation sheet: what an installer needs per camera, with the CSV to download
+// (analysis/rig/rig_formats.h RigToSheetCsv, the same as `pandora export-rig --format sheet`).
+void ReportPage::Sheet() {
   body << "<h2 id=\"sheet\">Installation sheet</h2>\n<p class=\"note\">Mount point (the centre of "
           "projection) in centimetres, pan, tilt and roll in degrees (the scene file's euler_deg: "
           "pan "
           "about +z from +x, tilt up from horizontal, roll about the optical axis), lens and "
           "resolution. The link holds the whole sheet as CSV.</p>\n"
        << RigRow(heads);
-  {
-    std::vector<std::string> cells;
-    for (const RigReport& r : reports) {
-      const std::string csv = RigToSheetCsv(r.rig);
-      // The CSV's rows as a table (fields may be quoted: "a, b" and "" inside quotes).
-      std::string table = "<table class=\"sheet\">";
-      std::size_t line = 0;
-      for (std::size_t at = 0; at < csv.size();) {
-        const std::size_t end = csv.find('\n', at);
-        const std::string row = csv.substr(at, end - at);
-        at = end == std::string::npos ? csv.size() : end + 1;
-        std::vector<std::string> fields(1);
-        bool quoted = false;
-        for (std::size_t i = 0; i < row.size(); ++i) {
-          const char ch = row[i];
-          if (quoted && ch == '"' && i + 1 < row.size() && row[i + 1] == '"') {
-            fields.back() += '"';
-            ++i;
-          } else if (ch == '"') {
-            quoted = !quoted;
-          } else if (ch == ',' && !quoted) {
-            fields.emplace_back();
-          } else {
-            fields.back() += ch;
-          }
-        }
-        const char* cell = line++ == 0 ? "th" : "td";
-        table += "<tr>";
-        for (const std::string& f : fields)
-          table += std::string("<") + cell + ">" + HtmlEscape(f) + "</" + cell + ">";
-        table += "</tr>";
-      }
-      table += "</table>";
-      cells.push_back("<div class=\"scroll\">" + table + "</div><p><a download=\"" +
-                      HtmlEscape(r.rig.name) + "_sheet.csv\" href=\"" + DataUri("text/csv", csv) +
-                      "\">" + HtmlEscape(r.rig.name) + "_sheet.csv</a></p>");
-    }
-    body << RigRow(cells);
+  std::vector<std::string> cells;
+  for (const RigReport& r : reports) {
+    const std::string csv = RigToSheetCsv(r.rig);
+    const std::string table = SheetTable(csv);
+    cells.push_back("<div class=\"scroll\">" + table + "</div><p><a download=\"" +
+                    HtmlEscape(r.rig.name) + "_sheet.csv\" href=\"" + DataUri("text/csv", csv) +
+                    "\">" + HtmlEscape(r.rig.name) + "_sheet.csv</a></p>");
   }
+  body << RigRow(cells);
+}
 
-  // Calibration feasibility (app/report/calibration_section.h), when the study asks for it.
+// Calibration feasibility (app/report/calibration_section.h), when the study asks for it.
+void ReportPage::Calibration() {
   if (study.calibration) {
     body << "<h2 id=\"calibration\">Calibration</h2>\n"
          << CalibrationIntroHtml(*study.calibration) << RigRow(heads);
@@ -706,19 +765,21 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
       cells.push_back(CalibrationCellHtml(*r.summary.calibration, r.rig.name, svg_image));
     body << RigRow(cells);
   }
+}
 
-  // Over time and on bodies (app/report/time_section.h), with moving objects or targets.
-  {
-    std::vector<const Summary*> summaries;
-    std::vector<std::string> names;
-    for (const RigReport& r : reports) {
-      summaries.push_back(&r.summary);
-      names.push_back(r.rig.name);
-    }
-    body << TimeSectionHtml(summaries, names);
+// Over time and on bodies (app/report/time_section.h), with moving objects or targets.
+void ReportPage::OverTime() {
+  std::vector<const Summary*> summaries;
+  std::vector<std::string> names;
+  for (const RigReport& r : reports) {
+    summaries.push_back(&r.summary);
+    names.push_back(r.rig.name);
   }
+  body << TimeSectionHtml(summaries, names);
+}
 
-  // N-1 robustness (app/report/robustness_section.h): the most critical cameras of each rig.
+// N-1 robustness (app/report/robustness_section.h): the most critical cameras of each rig.
+void ReportPage::Robustness() {
   if (std::all_of(reports.begin(), reports.end(),
                   [](const RigReport& r) { return r.summary.robustness; })) {
     body << "<h2 id=\"robustness\">Robustness</h2>\n"
@@ -727,7 +788,10 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
     for (const RigReport& r : reports) cells.push_back(RobustnessCellHtml(*r.summary.robustness));
     body << RigRow(cells);
   }
+}
 
+// The whole page: head and style, the body, each rig's summary.json and the image check.
+std::string ReportPage::Html() const {
   // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.
   std::string summaries;
   for (const RigReport& r : reports) {
@@ -796,11 +860,33 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
          "    status.className = 'bad';\n"
          "  }\n"
          "});\n</script>\n</body>\n</html>\n";
-  const std::string html = page.str();
+  return page.str();
+}
+
+}  // namespace
+
+ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const ReportData& data,
+                       const ReportOptions& options, const ReportTarget& target) {
+  ReportPage page(scene, caster, data, options);
+  page.Intro();
+  page.Numbers();
+  page.RigHeads();
+  page.Warnings();
+  page.Plan();
+  page.Views();
+  page.CameraViews();
+  page.Slices();
+  page.Histograms();
+  page.Cameras();
+  page.Sheet();
+  page.Calibration();
+  page.OverTime();
+  page.Robustness();
+  const std::string html = page.Html();
   WriteFileAtomically(target.staged, html);
   ReportFile file;
   file.path = target.path;
-  file.images = fig.count();
+  file.images = page.fig.count();
   file.bytes = html.size();
   return file;
 }

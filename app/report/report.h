@@ -24,8 +24,8 @@
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/output_transaction.h"
-#include "volume/rig_comparison.h"
 #include "volume/fields.h"
+#include "volume/rig_comparison.h"
 #include "volume/slice.h"
 #include "volume/summary.h"
 

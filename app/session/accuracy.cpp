@@ -287,11 +287,11 @@ MonteCarloStudy RunMonteCarloStudy(const Scene& scene, const Rig& rig, const Ray
 // ---------------------------------------------------------------------------------------------
 // (c) Steady-state solvers.
 
-SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& mc,
-                           const AccuracyOptions& options) {
-  options.Check();
-  SteadyStudy study;
-  // A representative information matrix: the sample point with the median predicted sigma_max.
+namespace {
+
+// The representative information matrix (the sample point with the median predicted sigma_max)
+// into study->J, and where it comes from into study->J_source.
+void ChooseSteadyJ(const MonteCarloStudy& mc, SteadyStudy* study) {
   if (!mc.points.empty()) {
     std::vector<const SamplePoint*> sorted;
     for (const SamplePoint& p : mc.points) sorted.push_back(&p);
@@ -299,14 +299,205 @@ SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& mc,
       return a->sigma_max < b->sigma_max;
     });
     const SamplePoint& p = *sorted[sorted.size() / 2];
-    study.J = p.info.J;
-    study.J_source =
+    study->J = p.info.J;
+    study->J_source =
         Format("J of sample point (%.3f, %.3f, %.3f) m, %zu cameras, sigma_max %.3g mm", p.X.x(),
                p.X.y(), p.X.z(), p.cameras.size(), 1e3 * p.sigma_max);
   } else {
-    study.J = 1e6 * Mat3::Identity();
-    study.J_source = "no triangulable sample point: isotropic J for sigma = 1 mm";
+    study->J = 1e6 * Mat3::Identity();
+    study->J_source = "no triangulable sample point: isotropic J for sigma = 1 mm";
   }
+}
+
+// One steady-state case: its motion, the per-axis measurement variance r and eigen-directions V of
+// J, the long-double reference variance per axis, and the row every solver's row starts from.
+struct SteadyCaseRun {
+  double q, T;
+  Vec3 r;
+  Mat3 V;
+  double min_seconds;
+  Vec3 reference;
+  SteadyRow base;
+
+  // The largest relative error of `variance` over the axes (NaN when one is not finite).
+  double AxisError(const Vec3& variance) const {
+    double e = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double ek = RelativeError(variance[k], reference[k]);
+      e = std::isfinite(ek) ? std::max(e, ek) : kNaN;
+      if (std::isnan(e)) break;
+    }
+    return e;
+  }
+};
+
+// Long-double doubling: how far the reference itself can be trusted.
+SteadyRow ReferenceCheckRow(const SteadyCaseRun& sc, double reference_check,
+                            int reference_iterations) {
+  const double q = sc.q, T = sc.T;
+  const Vec3& r = sc.r;
+  SteadyRow row = sc.base;
+  row.method = "doubling 2x2 in long double (reference check)";
+  row.label = "long-double doubling (check)";
+  row.iterations = reference_iterations;
+  row.error = reference_check;
+  row.seconds =
+      3 * SecondsPerCall(
+              [&] {
+                int its;
+                return static_cast<double>(SteadyPositionVarianceDoublingLong(q, T, r[0], &its));
+              },
+              sc.min_seconds);
+  return row;
+}
+
+// Closed form, three axes.
+SteadyRow ClosedFormRow(const SteadyCaseRun& sc) {
+  const double q = sc.q, T = sc.T;
+  const Vec3& r = sc.r;
+  SteadyRow row = sc.base;
+  row.method = "closed form (ScalarSteadyState x 3)";
+  row.label = "closed form";
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = ScalarSteadyState(q, T, r[k])(0, 0);
+  row.error = sc.AxisError(v);
+  row.seconds = SecondsPerCall(
+      [&] {
+        return ScalarSteadyState(q, T, r[0])(0, 0) + ScalarSteadyState(q, T, r[1])(0, 0) +
+               ScalarSteadyState(q, T, r[2])(0, 0);
+      },
+      sc.min_seconds);
+  return row;
+}
+
+// Doubling on the three 2x2 axis problems.
+SteadyRow Doubling2x2Row(const SteadyCaseRun& sc) {
+  const double q = sc.q, T = sc.T;
+  const Vec3& r = sc.r;
+  Eigen::Matrix2d F2, Q2;
+  F2 << 1, T, 0, 1;
+  Q2 << T * T * T / 3, T * T / 2, T * T / 2, T;
+  Q2 *= q;
+  std::vector<Eigen::MatrixXd> G2(3, Eigen::MatrixXd::Zero(2, 2));
+  for (int k = 0; k < 3; ++k) G2[k](0, 0) = 1.0 / r[k];
+  SteadyRow row = sc.base;
+  row.method = "doubling 2x2 x 3 (tol 1e-15)";
+  row.label = "doubling 2x2";
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) {
+    int its = 0;
+    const std::optional<Eigen::MatrixXd> M = SolveDareDoubling(F2, G2[k], Q2, 1e-15, 100, &its);
+    row.iterations = std::max(row.iterations, its);
+    row.converged = row.converged && M.has_value();
+    v[k] = M ? PosteriorFromPrior(*M, G2[k])(0, 0) : kNaN;
+  }
+  row.error = sc.AxisError(v);
+  row.seconds = SecondsPerCall(
+      [&] {
+        double sum = 0;
+        for (int k = 0; k < 3; ++k) {
+          const auto M = SolveDareDoubling(F2, G2[k], Q2);
+          if (M) sum += PosteriorFromPrior(*M, G2[k])(0, 0);
+        }
+        return sum;
+      },
+      sc.min_seconds);
+  return row;
+}
+
+// The rows of the full 6x6 problem of the case: doubling, then plain Riccati iteration to each
+// tolerance (the last, 0, runs `run_on_iterations` steps with no early stop).
+void AddSixBySixRows(const SteadyCaseRun& sc, const Mat3& J, const MotionModel& motion,
+                     int run_on_iterations, std::vector<SteadyRow>* rows) {
+  const Mat3& V = sc.V;
+  const double min_seconds = sc.min_seconds;
+  const int kMaxIterations = 1000000;
+  const int kRunOnIterations = run_on_iterations;  // the "tol 0" row: no early stop
+  const ConstantVelocity6 m6 = MakeConstantVelocity6(J, motion);
+  const Eigen::MatrixXd F6 = m6.F, G6 = m6.G, Q6 = m6.Q;
+  // Position variance of a 6x6 prior along each eigen-direction of J.
+  auto project = [&](const Eigen::MatrixXd& M) {
+    const Eigen::MatrixXd P = PosteriorFromPrior(M, G6);
+    const Mat3 pos = P.topLeftCorner(3, 3);
+    Vec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = V.col(k).dot(pos * V.col(k));
+    return v;
+  };
+  {  // Doubling on the full 6x6 problem.
+    SteadyRow row = sc.base;
+    row.method = "doubling 6x6 (tol 1e-15)";
+    row.label = "doubling 6x6";
+    const std::optional<Eigen::MatrixXd> M =
+        SolveDareDoubling(F6, G6, Q6, 1e-15, 100, &row.iterations);
+    row.converged = M.has_value();
+    row.error = M ? sc.AxisError(project(*M)) : kNaN;
+    row.seconds = SecondsPerCall(
+        [&] {
+          const auto M = SolveDareDoubling(F6, G6, Q6);
+          return M ? PosteriorFromPrior(*M, G6)(0, 0) : 0.0;
+        },
+        min_seconds);
+    rows->push_back(row);
+  }
+  for (double tolerance : {1e-4, 1e-8, 1e-12, 0.0}) {  // Plain Riccati iteration on the 6x6.
+    SteadyRow row = sc.base;
+    row.method = tolerance > 0 ? Format("iteration 6x6 (tol %.0e)", tolerance)
+                               : Format("iteration 6x6 (tol 0: %d steps)", kRunOnIterations);
+    row.label = tolerance > 0 ? Format("iteration, tol %.0e", tolerance)
+                              : Format("iteration, %.0e steps", double(kRunOnIterations));
+    const int max_iterations = tolerance > 0 ? kMaxIterations : kRunOnIterations;
+    row.run_on = tolerance == 0;
+    const Eigen::MatrixXd M =
+        SolveDareIteration(F6, G6, Q6, tolerance, max_iterations, &row.converged, &row.iterations);
+    row.error = sc.AxisError(project(M));
+    row.seconds = SecondsPerCall(
+        [&] {
+          const Eigen::MatrixXd Mi = SolveDareIteration(F6, G6, Q6, tolerance, max_iterations);
+          return PosteriorFromPrior(Mi, G6)(0, 0);
+        },
+        min_seconds);
+    rows->push_back(row);
+  }
+}
+
+// The rows of case `c`: the reference check, then every solver, into `rows`.
+void AddSteadyCaseRows(const SteadyCase& c, const Mat3& J, const Vec3& r, const Mat3& V,
+                       double min_seconds, int run_on_iterations, std::vector<SteadyRow>* rows) {
+  const double q = c.motion.q, T = 1.0 / c.motion.rate_hz;
+  Vec3 reference;
+  double reference_check = 0;
+  int reference_iterations = 0;
+  for (int k = 0; k < 3; ++k) {
+    reference[k] = static_cast<double>(SteadyPositionVarianceLong(q, T, r[k]));
+    int its = 0;
+    const long double check = SteadyPositionVarianceDoublingLong(q, T, r[k], &its);
+    reference_check =
+        std::max(reference_check,
+                 static_cast<double>(std::fabs(check - SteadyPositionVarianceLong(q, T, r[k])) /
+                                     SteadyPositionVarianceLong(q, T, r[k])));
+    reference_iterations = std::max(reference_iterations, its);
+  }
+  SteadyRow base;
+  base.case_name = c.name;
+  base.motion = c.motion;
+  base.lambda_min = std::sqrt(q * T * T * T / r.maxCoeff());
+  base.lambda_max = std::sqrt(q * T * T * T / r.minCoeff());
+  const SteadyCaseRun sc{q, T, r, V, min_seconds, reference, base};
+
+  rows->push_back(ReferenceCheckRow(sc, reference_check, reference_iterations));
+  rows->push_back(ClosedFormRow(sc));
+  rows->push_back(Doubling2x2Row(sc));
+  AddSixBySixRows(sc, J, c.motion, run_on_iterations, rows);
+}
+
+}  // namespace
+
+SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& mc,
+                           const AccuracyOptions& options) {
+  options.Check();
+  SteadyStudy study;
+  // A representative information matrix: the sample point with the median predicted sigma_max.
+  ChooseSteadyJ(mc, &study);
   const Information info = DecomposeInformation(study.J);
   const Vec3 r = info.eigenvalues.cwiseInverse();  // per-axis measurement variance, m^2
   const Mat3 V = info.eigenvectors;
@@ -319,145 +510,9 @@ SteadyStudy RunSteadyStudy(const Scene& scene, const MonteCarloStudy& mc,
   study.cases.push_back({"1 MHz", MotionModel{1.0, 1e6}});
 
   const double min_seconds = options.min_timing_seconds;
-  const int kMaxIterations = 1000000;
   const int kRunOnIterations = options.run_on_iterations;  // the "tol 0" row: no early stop
-  for (const SteadyCase& c : study.cases) {
-    const double q = c.motion.q, T = 1.0 / c.motion.rate_hz;
-    Vec3 reference;
-    double reference_check = 0;
-    int reference_iterations = 0;
-    for (int k = 0; k < 3; ++k) {
-      reference[k] = static_cast<double>(SteadyPositionVarianceLong(q, T, r[k]));
-      int its = 0;
-      const long double check = SteadyPositionVarianceDoublingLong(q, T, r[k], &its);
-      reference_check =
-          std::max(reference_check,
-                   static_cast<double>(std::fabs(check - SteadyPositionVarianceLong(q, T, r[k])) /
-                                       SteadyPositionVarianceLong(q, T, r[k])));
-      reference_iterations = std::max(reference_iterations, its);
-    }
-    auto axis_error = [&](const Vec3& variance) {
-      double e = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double ek = RelativeError(variance[k], reference[k]);
-        e = std::isfinite(ek) ? std::max(e, ek) : kNaN;
-        if (std::isnan(e)) break;
-      }
-      return e;
-    };
-    SteadyRow base;
-    base.case_name = c.name;
-    base.motion = c.motion;
-    base.lambda_min = std::sqrt(q * T * T * T / r.maxCoeff());
-    base.lambda_max = std::sqrt(q * T * T * T / r.minCoeff());
-
-    {  // Long-double doubling: how far the reference itself can be trusted.
-      SteadyRow row = base;
-      row.method = "doubling 2x2 in long double (reference check)";
-      row.label = "long-double doubling (check)";
-      row.iterations = reference_iterations;
-      row.error = reference_check;
-      row.seconds = 3 * SecondsPerCall(
-                            [&] {
-                              int its;
-                              return static_cast<double>(
-                                  SteadyPositionVarianceDoublingLong(q, T, r[0], &its));
-                            },
-                            min_seconds);
-      study.rows.push_back(row);
-    }
-    {  // Closed form, three axes.
-      SteadyRow row = base;
-      row.method = "closed form (ScalarSteadyState x 3)";
-      row.label = "closed form";
-      Vec3 v;
-      for (int k = 0; k < 3; ++k) v[k] = ScalarSteadyState(q, T, r[k])(0, 0);
-      row.error = axis_error(v);
-      row.seconds = SecondsPerCall(
-          [&] {
-            return ScalarSteadyState(q, T, r[0])(0, 0) + ScalarSteadyState(q, T, r[1])(0, 0) +
-                   ScalarSteadyState(q, T, r[2])(0, 0);
-          },
-          min_seconds);
-      study.rows.push_back(row);
-    }
-    Eigen::Matrix2d F2, Q2;
-    F2 << 1, T, 0, 1;
-    Q2 << T * T * T / 3, T * T / 2, T * T / 2, T;
-    Q2 *= q;
-    std::vector<Eigen::MatrixXd> G2(3, Eigen::MatrixXd::Zero(2, 2));
-    for (int k = 0; k < 3; ++k) G2[k](0, 0) = 1.0 / r[k];
-    {  // Doubling on the three 2x2 axis problems.
-      SteadyRow row = base;
-      row.method = "doubling 2x2 x 3 (tol 1e-15)";
-      row.label = "doubling 2x2";
-      Vec3 v;
-      for (int k = 0; k < 3; ++k) {
-        int its = 0;
-        const std::optional<Eigen::MatrixXd> M = SolveDareDoubling(F2, G2[k], Q2, 1e-15, 100, &its);
-        row.iterations = std::max(row.iterations, its);
-        row.converged = row.converged && M.has_value();
-        v[k] = M ? PosteriorFromPrior(*M, G2[k])(0, 0) : kNaN;
-      }
-      row.error = axis_error(v);
-      row.seconds = SecondsPerCall(
-          [&] {
-            double sum = 0;
-            for (int k = 0; k < 3; ++k) {
-              const auto M = SolveDareDoubling(F2, G2[k], Q2);
-              if (M) sum += PosteriorFromPrior(*M, G2[k])(0, 0);
-            }
-            return sum;
-          },
-          min_seconds);
-      study.rows.push_back(row);
-    }
-    const ConstantVelocity6 m6 = MakeConstantVelocity6(study.J, c.motion);
-    const Eigen::MatrixXd F6 = m6.F, G6 = m6.G, Q6 = m6.Q;
-    // Position variance of a 6x6 prior along each eigen-direction of J.
-    auto project = [&](const Eigen::MatrixXd& M) {
-      const Eigen::MatrixXd P = PosteriorFromPrior(M, G6);
-      const Mat3 pos = P.topLeftCorner(3, 3);
-      Vec3 v;
-      for (int k = 0; k < 3; ++k) v[k] = V.col(k).dot(pos * V.col(k));
-      return v;
-    };
-    {  // Doubling on the full 6x6 problem.
-      SteadyRow row = base;
-      row.method = "doubling 6x6 (tol 1e-15)";
-      row.label = "doubling 6x6";
-      const std::optional<Eigen::MatrixXd> M =
-          SolveDareDoubling(F6, G6, Q6, 1e-15, 100, &row.iterations);
-      row.converged = M.has_value();
-      row.error = M ? axis_error(project(*M)) : kNaN;
-      row.seconds = SecondsPerCall(
-          [&] {
-            const auto M = SolveDareDoubling(F6, G6, Q6);
-            return M ? PosteriorFromPrior(*M, G6)(0, 0) : 0.0;
-          },
-          min_seconds);
-      study.rows.push_back(row);
-    }
-    for (double tolerance : {1e-4, 1e-8, 1e-12, 0.0}) {  // Plain Riccati iteration on the 6x6.
-      SteadyRow row = base;
-      row.method = tolerance > 0 ? Format("iteration 6x6 (tol %.0e)", tolerance)
-                                 : Format("iteration 6x6 (tol 0: %d steps)", kRunOnIterations);
-      row.label = tolerance > 0 ? Format("iteration, tol %.0e", tolerance)
-                                : Format("iteration, %.0e steps", double(kRunOnIterations));
-      const int max_iterations = tolerance > 0 ? kMaxIterations : kRunOnIterations;
-      row.run_on = tolerance == 0;
-      const Eigen::MatrixXd M = SolveDareIteration(F6, G6, Q6, tolerance, max_iterations,
-                                                   &row.converged, &row.iterations);
-      row.error = axis_error(project(M));
-      row.seconds = SecondsPerCall(
-          [&] {
-            const Eigen::MatrixXd Mi = SolveDareIteration(F6, G6, Q6, tolerance, max_iterations);
-            return PosteriorFromPrior(Mi, G6)(0, 0);
-          },
-          min_seconds);
-      study.rows.push_back(row);
-    }
-  }
+  for (const SteadyCase& c : study.cases)
+    AddSteadyCaseRows(c, study.J, r, V, min_seconds, kRunOnIterations, &study.rows);
   return study;
 }
 

@@ -374,200 +374,514 @@ void ViewerModel::Run(const std::vector<Action>& script, Frontend* frontend) {
   for (const Action& a : script) Do(a, frontend);
 }
 
+// Applies camera changes as one undo step (a drag's later steps amend its first).
+void ViewerModel::ApplyEdit(const Action& a, EditStep& step, const std::vector<int>& cams,
+                            const std::string& label, const std::function<void(Camera&)>& change) {
+  session::EditableRig& edit = session_->rig();
+  session::Edit e;
+  e.label = label;
+  for (int c : cams) {
+    session::CameraEdit ce{c, rig().cameras[c], rig().cameras[c]};
+    change(ce.after);
+    // A PTZ camera's base stays level and its head turns: a pose or zoom asked of it moves the
+    // pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md, "In the viewer").
+    if (ce.before.ptz && ce.after.ptz == ce.before.ptz &&
+        (ce.after.world_from_camera.matrix() != ce.before.world_from_camera.matrix() ||
+         ce.after.model.intrinsics().fx != ce.before.model.intrinsics().fx)) {
+      bool clamped = false;
+      ce.after = session::PtzFollow(ce.before, ce.after, &clamped);
+      step.ptz_status = PtzStatus(ce.after, clamped);
+    }
+    e.changes.push_back(std::move(ce));
+  }
+  if (a.drag && step.drag == label && edit.CanAmend(cams))
+    edit.Amend(e);
+  else
+    edit.Apply(std::move(e));
+  if (a.drag) drag_label_ = label;
+  Edited();
+}
+
+// An edit's undo label: the verb and the camera's id, or the number of cameras.
+std::string ViewerModel::EditLabel(const char* verb, const std::vector<int>& cams) const {
+  return std::string(verb) + " " +
+         (cams.size() == 1 ? rig().cameras[cams[0]].id : std::to_string(cams.size()) + " cameras");
+}
+
+// "move": the cameras by an offset, or one camera to a position.
+void ViewerModel::DoMove(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  for (int c : cams) {
+    const Vec3 target = a.flag ? a.a : rig().cameras[c].center() + a.a;
+    scene().CheckReach(target, a.where, "the camera position");
+  }
+  ApplyEdit(a, step, cams, EditLabel("move", cams), [&](Camera& cam) {
+    cam.world_from_camera.translation() =
+        a.flag ? a.a : Vec3(cam.world_from_camera.translation() + a.a);
+  });
+}
+
+// "rotate": the cameras rigidly about their mean centre.
+void ViewerModel::DoRotate(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  Vec3 pivot = Vec3::Zero();
+  std::vector<Eigen::Isometry3d> poses;
+  for (int c : cams) {
+    pivot += rig().cameras[c].center() / double(cams.size());
+    poses.push_back(rig().cameras[c].world_from_camera);
+  }
+  const Mat3 R = Eigen::AngleAxisd(a.number * kRadPerDeg, a.a.normalized()).toRotationMatrix();
+  const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, pivot, Vec3::Zero(), R);
+  std::size_t i = 0;
+  ApplyEdit(a, step, cams, EditLabel("rotate", cams),
+            [&](Camera& cam) { cam.world_from_camera = moved[i++]; });
+}
+
+// "aim": a camera turned to look at a point.
+void ViewerModel::DoAim(const Action& a, EditStep& step) {
+  const int c = CameraIndex(a.cameras[0], a);
+  const Vec3 from = rig().cameras[c].center();
+  const auto pose = LookAt(from, a.a, UpFor(from, a.a));
+  if (!pose) throw InputError(a.where, "", "the camera cannot aim at its own position");
+  ApplyEdit(a, step, {c}, EditLabel("aim", {c}),
+            [&](Camera& cam) { cam.world_from_camera = *pose; });
+}
+
+// "orient": a camera turned to a yaw, pitch and roll.
+void ViewerModel::DoOrient(const Action& a, EditStep& step) {
+  const int c = CameraIndex(a.cameras[0], a);
+  const Mat3 R = RotationFromYawPitchRollDeg(a.a);
+  ApplyEdit(a, step, {c}, EditLabel("turn", {c}),
+            [&](Camera& cam) { cam.world_from_camera.linear() = R; });
+}
+
+// "enable" and "disable": the cameras switched on or off.
+void ViewerModel::DoEnable(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  const bool on = a.kind == Action::Kind::kEnable;
+  ApplyEdit(a, step, cams, EditLabel(on ? "enable" : "disable", cams),
+            [&](Camera& cam) { cam.enabled = on; });
+}
+
+// "hfov": the cameras zoomed to a horizontal field of view.
+void ViewerModel::DoHfov(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  ApplyEdit(a, step, cams, EditLabel("zoom", cams), [&](Camera& cam) {
+    Intrinsics k = cam.model.intrinsics();
+    const double fx = FocalFromHfov(a.number * kRadPerDeg, k.width, k.model);
+    if (k.model != LensModel::kFisheye && a.number >= 180)
+      throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+    k.fy *= fx / k.fx;
+    k.fx = fx;
+    cam.model = CameraModel(k);
+  });
+}
+
+// "intrinsics": the cameras' resolution, lens model and distortion coefficients.
+void ViewerModel::DoIntrinsics(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  const bool lens_changed =
+      !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
+                                     [](double v) { return !std::isnan(v); });
+  ApplyEdit(a, step, cams, EditLabel("lens", cams), [&](Camera& cam) {
+    Intrinsics k = cam.model.intrinsics();
+    if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
+      throw InputError(a.where, "",
+                       "camera '" + cam.id +
+                           "' is a PTZ camera: its zoom range is in pixels of its "
+                           "resolution and lens, which the viewer does not convert",
+                       "change its resolution or lens model in the scene file");
+    if (a.width > 0) {
+      // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
+      const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;
+      k.fx *= sx;
+      k.fy *= sy;
+      k.cx = (k.cx + 0.5) * sx - 0.5;
+      k.cy = (k.cy + 0.5) * sy - 0.5;
+      k.width = a.width;
+      k.height = a.height;
+    }
+    if (!a.lens.empty()) {
+      const LensModel to = LensFromName(a.lens);
+      if ((to == LensModel::kFisheye) != (k.model == LensModel::kFisheye)) {
+        // Keep the nominal field of view across the projection's change.
+        const double hfov = HfovFromFocal(k.fx, k.width, k.model);
+        if (to != LensModel::kFisheye && !(hfov < kPi))
+          throw InputError(a.where, "",
+                           "camera '" + cam.id + "' sees " +
+                               std::to_string(int(std::lround(hfov / kRadPerDeg))) +
+                               " degrees; a " + a.lens + " lens sees less than 180",
+                           "narrow its field of view (hfov) first");
+        const double fx = FocalFromHfov(hfov, k.width, to);
+        k.fy *= fx / k.fx;
+        k.fx = fx;
+      }
+      k.model = to;
+      k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = k.k4 = 0;
+    }
+    const std::string model = LensModelName(k.model);
+    double* c[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
+    for (int i = 0; i < 6; ++i) {
+      if (std::isnan(a.coefficients[i])) continue;
+      if (!LensHasCoefficient(model, i))
+        throw InputError(a.where, "",
+                         "camera '" + cam.id + "' has a " + model +
+                             " lens, which has no coefficient " + kCoefficientNames[i],
+                         model == "pinhole"
+                             ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
+                             : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
+      *c[i] = a.coefficients[i];
+    }
+    cam.model = CameraModel(k);
+    if (lens_changed && k.model != LensModel::kPinhole) {
+      // A lens that folds back inside the image: part of it no ray reaches.
+      const LensCoverage lc = ComputeLensCoverage(cam.model);
+      if (lc.domain_ends_inside_image) {
+        char share[32];
+        std::snprintf(share, sizeof share, "%.1f", 100 * lc.unreachable_fraction);
+        throw InputError(
+            a.where, "",
+            "camera '" + cam.id + "': this " + model +
+                " distortion folds back inside the image (its valid domain ends there; " + share +
+                " % of the pixels would see nothing)",
+            "use smaller coefficients");
+      }
+    }
+  });
+}
+
+// "range": the cameras' working range (near and / or far).
+void ViewerModel::DoRange(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  ApplyEdit(a, step, cams, EditLabel("range", cams), [&](Camera& cam) {
+    const double near = std::isnan(a.near) ? cam.near : a.near;
+    const double far = std::isnan(a.far) ? cam.far : a.far;
+    if (!(far > near))
+      throw InputError(a.where, "",
+                       "camera '" + cam.id + "': far (" + std::to_string(far) +
+                           " m) must be greater than near (" + std::to_string(near) + " m)");
+    cam.near = near;
+    cam.far = far;
+  });
+}
+
+// "color": the cameras' colour.
+void ViewerModel::DoColor(const Action& a, EditStep& step) {
+  const std::vector<int> cams = CameraIndices(a.cameras, a);
+  ApplyEdit(a, step, cams, EditLabel("colour", cams), [&](Camera& cam) { cam.color = a.a; });
+}
+
+// "slice" and "iso": the slice plane or the isosurface of a live field (or none).
+void ViewerModel::DoSliceIso(const Action& a) {
+  const bool slice = a.kind == Action::Kind::kSlice;
+  if (!a.flag) {
+    const std::vector<std::string> live =
+        options_.fields.empty() ? DefaultFields() : options_.fields;
+    if (std::find(live.begin(), live.end(), a.text) == live.end()) {
+      std::string list;
+      for (const std::string& f : live) list += (list.empty() ? "" : ", ") + f;
+      throw InputError(a.where, "", "'" + a.text + "' is not a live field of this session",
+                       "live: " + list);
+    }
+  }
+  if (slice) {
+    display.overlays.slice_field = a.text;
+    display.overlays.slice_axis = a.text2 == "x" ? 0 : a.text2 == "y" ? 1 : 2;
+    display.overlays.slice_position = a.number;
+  } else {
+    display.overlays.iso_field = a.text;
+    if (!a.flag) display.overlays.iso_value = a.number;
+  }
+}
+
+// "view": a plan, an elevation or one of the scene's views.
+void ViewerModel::DoView(const Action& a) {
+  const std::string& file = scene().path;
+  if (a.text == "plan" || a.text == "elevation") {
+    SetPlan(a.text == "plan" ? "plan" : a.text2);
+    return;
+  }
+  const auto it = scene().views.find(a.text);
+  if (it == scene().views.end()) {
+    std::string names;
+    for (const auto& [name, v] : scene().views) names += (names.empty() ? "" : ", ") + name;
+    throw InputError(a.where, "", "no view '" + a.text + "' in " + file,
+                     names.empty() ? "the scene defines no views" : "views: " + names);
+  }
+  const RenderView v = ViewFromScene(it->second, width, height, 50.0);
+  plan.clear();
+  view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
+}
+
+// "light": the pattern, grid size, brightness and surface of the display.
+void ViewerModel::DoLight(const Action& a) {
+  display.pattern = a.text == "grid" ? Pattern::kGrid : Pattern::kUniform;
+  display.grid_pixels = int(a.number);
+  display.brightness = a.number2;
+  display.surface = a.text2 == "black"         ? Surface::kBlack
+                    : a.text2 == "hidden-line" ? Surface::kHiddenLine
+                    : a.text2 == "contours"    ? Surface::kContours
+                                               : Surface::kMaterial;
+}
+
+// "wait": for the fields, the suggestion or the render job.
+void ViewerModel::DoWait(const Action& a) {
+  if (a.text == "fields") {
+    for (const char* kind : {"fields", "time"}) {
+      const session::JobStatus s = session_->jobs().Wait(kind);
+      if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+    }
+  } else if (a.text == "suggest") {
+    session::JobStatus s;
+    suggestion = session_->WaitSuggestion(&s);
+    if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
+    if (suggestion) status = suggestion->message;
+  } else {
+    session_->jobs().Wait("render");
+  }
+}
+
+// "suggest": starts a suggestion in the background.
+void ViewerModel::DoSuggest(const Action& a) {
+  std::shared_ptr<app::SuggestProblem> problem;
+  try {
+    problem = app::PrepareSuggest(SuggestArgsOf(a, scene().path), scene(), rig());
+  } catch (const InputError& e) {
+    RethrowAsAction(e, a.where);
+  }
+  problem->options.scene_path = a.where;  // the library's checks name the action
+  suggestion.reset();
+  suggestion_over_time = a.over_time;
+  suggestion_targets =
+      std::to_string(problem->targets.size()) + " points " +
+      (a.over_time ? "on the study's targets at " + std::to_string(problem->sample_casters.size()) +
+                         " time samples"
+       : a.target_surfaces.empty()
+           ? std::string("of the study region")
+           : std::string("on the target surfaces") + (a.with_region ? " and in the region" : ""));
+  session_->SuggestInBackground(problem->targets, problem->options, problem);
+  status = "suggesting";
+}
+
+// "accept": the suggestion's poses of all or the named cameras; the rest stays suggested.
+void ViewerModel::DoAccept(const Action& a) {
+  if (!suggestion)
+    throw InputError(a.where, "", "there is no suggestion to accept",
+                     "suggest first, then wait for it");
+  // As `pandora accept`: a suggestion that does not improve its objective is not offered.
+  if (!suggestion->improved)
+    throw InputError(a.where, "", "the suggestion offers no improvement; nothing to accept",
+                     "suggest again with other limits or cameras, or reject it");
+  Suggestion take = *suggestion, keep = *suggestion;
+  take.cameras.clear();
+  keep.cameras.clear();
+  for (const CameraChange& c : suggestion->cameras)
+    (a.cameras.empty() || std::count(a.cameras.begin(), a.cameras.end(), c.id) ? take : keep)
+        .cameras.push_back(c);
+  for (const std::string& id : a.cameras)
+    if (std::none_of(take.cameras.begin(), take.cameras.end(),
+                     [&](const CameraChange& c) { return c.id == id; }))
+      throw InputError(a.where, "", "camera '" + id + "' is not in the suggestion");
+  session_->ApplySuggestion(take);
+  Edited();
+  if (keep.cameras.empty())
+    suggestion.reset();
+  else
+    suggestion = keep;
+  status = "accepted " + std::to_string(take.cameras.size()) + " cameras (not saved yet)";
+}
+
+// "save": the edited poses, focal lengths and moved viewing stations into the scene file.
+void ViewerModel::DoSave(const Action& a) {
+  session::EditableRig& edit = session_->rig();
+  const std::string& file = scene().path;
+  // Saving writes poses and focal lengths only: name what else changed, camera by camera.
+  std::string unsavable;
+  for (int c : edit.Unsaved()) {
+    const std::string what = UnsavableChanges(edit.saved().cameras[c], rig().cameras[c]);
+    if (!what.empty())
+      unsavable += (unsavable.empty() ? "" : "; ") + rig().cameras[c].id + "'s " + what;
+  }
+  if (!unsavable.empty())
+    throw InputError(file, "",
+                     "not saved: saving writes poses and focal lengths only, not " + unsavable,
+                     "undo them, or copy them into the scene file by hand");
+  std::vector<StationMove> moved;
+  for (const auto& [name, st] : stations) {
+    const ViewingStation& before = saved_stations.at(name);
+    if (st.eye != before.eye || st.display_center != before.display_center)
+      moved.push_back({name, st.eye, st.display_center});
+  }
+  const session::SaveResult r = session_->Save(a.flag, moved);
+  saved_stations = stations;
+  if (!options_.autosave_path.empty()) session::WriteAutosave(*session_, options_.autosave_path);
+  std::string what;
+  auto count = [](std::size_t n, const std::string& what) {
+    return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+  };
+  if (!r.saved.empty()) what = count(r.saved.size(), "camera");
+  if (!r.saved_stations.empty())
+    what += (what.empty() ? "" : " and ") + count(r.saved_stations.size(), "viewing station");
+  status = what.empty() ? "nothing to save"
+                        : "saved " + what + " into " + r.scene_path + " (previous file kept as " +
+                              r.backup_path + ")";
+}
+
+// "screenshot": the main view or a camera's view through the front end.
+void ViewerModel::DoScreenshot(const Action& a, Frontend* frontend) {
+  if (!frontend) throw InputError(a.where, "", "screenshots need a front end");
+  const int camera = a.text2.empty() ? -1 : CameraIndex(a.text2, a);
+  // As every command's outputs: never onto an input, written whole or not at all.
+  OutputTransaction output;
+  for (const auto& [path, what] : scene().InputFiles()) output.AddInput(path, what);
+  frontend->Screenshot(*this, output.Stage(a.text, a.where), camera);
+  output.Commit();
+}
+
+// "gamepad": a camera flown by stick positions held for some seconds.
+void ViewerModel::DoGamepad(const Action& a, EditStep& step) {
+  const int c = CameraIndex(a.cameras[0], a);
+  GamepadAxes axes;
+  axes.left_x = a.a.x();
+  axes.left_y = a.a.y();
+  axes.right_x = a.b.x();
+  axes.right_y = a.b.y();
+  Eigen::Isometry3d pose = rig().cameras[c].world_from_camera;
+  const int steps = int(std::lround(a.number * 60.0));  // 60 Hz, as the window polls
+  for (int i = 0; i < steps; ++i) pose = GamepadMove(pose, axes, 1.0 / 60.0, 0.5, 45.0);
+  ApplyEdit(a, step, {c}, EditLabel("gamepad", {c}),
+            [&](Camera& cam) { cam.world_from_camera = pose; });
+}
+
+// "station": a viewing station's eye or display centre moved.
+void ViewerModel::DoStation(const Action& a) {
+  const std::string& file = scene().path;
+  auto it = stations.find(a.text);
+  if (it == stations.end()) {
+    std::string names;
+    for (const auto& [name, st] : stations) names += (names.empty() ? "" : ", ") + name;
+    throw InputError(a.where, "", "no viewing station '" + a.text + "' in " + file,
+                     names.empty() ? "the scene defines no stations" : "stations: " + names);
+  }
+  ViewingStation moved = it->second;
+  scene().CheckReach(a.a, a.where, a.flag ? "the display" : "the eye");
+  if (a.flag)
+    moved.display_center = a.a;
+  else
+    moved.eye = a.a;
+  if (!((moved.eye - moved.display_center).dot(moved.display_normal) > 0))
+    throw InputError(a.where, "", "the eye would be behind the display or in its plane");
+  it->second = moved;
+  ++stations_version;
+}
+
+// "ptz": a PTZ camera's pan, tilt and zoom, or one of its presets.
+void ViewerModel::DoPtz(const Action& a, EditStep& step) {
+  const int c = CameraIndex(a.cameras[0], a);
+  const Camera& cam = rig().cameras[c];
+  if (!cam.ptz)
+    throw InputError(a.where, "", "camera '" + cam.id + "' has no pan-tilt-zoom head",
+                     "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
+  PtzState s = cam.ptz->current;
+  if (!a.preset.empty()) {
+    std::string names;
+    const PtzPreset* found = nullptr;
+    for (const PtzPreset& p : cam.ptz->presets) {
+      if (p.name == a.preset) found = &p;
+      names += (names.empty() ? "" : ", ") + p.name;
+    }
+    if (!found)
+      throw InputError(a.where, "", "camera '" + cam.id + "' has no preset '" + a.preset + "'",
+                       names.empty() ? "it has no presets" : "presets: " + names);
+    s = found->state;
+  } else {
+    if (!std::isnan(a.pan_deg)) s.pan_deg = a.pan_deg;
+    if (!std::isnan(a.tilt_deg)) s.tilt_deg = a.tilt_deg;
+    if (!std::isnan(a.hfov_deg)) {
+      const Intrinsics& k = cam.model.intrinsics();
+      if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
+        throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
+      s.focal = FocalFromHfov(a.hfov_deg * kRadPerDeg, k.width, k.model);
+    }
+  }
+  const PtzState want = s;
+  const PtzState got = session::ClampPtzState(*cam.ptz, want);
+  ApplyEdit(a, step, {c}, EditLabel("pan/tilt/zoom", {c}),
+            [&](Camera& x) { x = session::WithPtzState(x, want); });
+  const bool clamped = std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
+                       std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
+                       (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
+  status = PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
+}
+
+// "recentre": a PTZ camera's home made its current view.
+void ViewerModel::DoRecentre(const Action& a, EditStep& step) {
+  const std::string& file = scene().path;
+  const int c = CameraIndex(a.cameras[0], a);
+  const std::string where = session_->CameraJsonPath(c);
+  ApplyEdit(a, step, {c}, EditLabel("re-centre", {c}),
+            [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
+  const PtzHead& h = *rig().cameras[c].ptz;
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "%s: home is now the current view (pan [%.1f, %.1f], tilt [%.1f, %.1f] deg)",
+                rig().cameras[c].id.c_str(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg,
+                h.tilt_max_deg);
+  status = line;
+}
+
+// "trace": the PTZ traces the main view shows.
+void ViewerModel::DoTrace(const Action& a) {
+  bool any = false;
+  session::PtzTracedRig(rig(), a.text, a.number, nullptr, &any);
+  if (!any && a.text != "single")
+    throw InputError(a.where, "", "rig '" + rig().name + "' has no enabled PTZ camera",
+                     "add a \"ptz\" block to a camera (docs/ptz.md)");
+  ptz_trace = a.text;
+  ptz_trace_s = a.number;
+  status = "PTZ trace: " + a.text;
+}
+
 void ViewerModel::Do(const Action& a, Frontend* frontend) {
   using Kind = Action::Kind;
   session::EditableRig& edit = session_->rig();
-  const std::string& file = scene().path;
-  // Applies camera changes as one undo step (a drag's later steps amend its first).
-  const std::string drag = a.drag ? drag_label_ : std::string();
-  std::string ptz_status;  // a PTZ camera's setting after a pose edit
+  // The drag this action may continue: its camera edit then amends the drag's first (ApplyEdit).
+  EditStep step;
+  step.drag = a.drag ? drag_label_ : std::string();
   drag_label_.clear();
-  auto apply = [&](const std::vector<int>& cams, const std::string& label, const auto& change) {
-    session::Edit e;
-    e.label = label;
-    for (int c : cams) {
-      session::CameraEdit ce{c, rig().cameras[c], rig().cameras[c]};
-      change(ce.after);
-      // A PTZ camera's base stays level and its head turns: a pose or zoom asked of it moves the
-      // pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md, "In the viewer").
-      if (ce.before.ptz && ce.after.ptz == ce.before.ptz &&
-          (ce.after.world_from_camera.matrix() != ce.before.world_from_camera.matrix() ||
-           ce.after.model.intrinsics().fx != ce.before.model.intrinsics().fx)) {
-        bool clamped = false;
-        ce.after = session::PtzFollow(ce.before, ce.after, &clamped);
-        ptz_status = PtzStatus(ce.after, clamped);
-      }
-      e.changes.push_back(std::move(ce));
-    }
-    if (a.drag && drag == label && edit.CanAmend(cams))
-      edit.Amend(e);
-    else
-      edit.Apply(std::move(e));
-    if (a.drag) drag_label_ = label;
-    Edited();
-  };
-  auto label = [&](const char* verb, const std::vector<int>& cams) {
-    return std::string(verb) + " " +
-           (cams.size() == 1 ? rig().cameras[cams[0]].id
-                             : std::to_string(cams.size()) + " cameras");
-  };
   status.clear();
   switch (a.kind) {
     case Kind::kSelect:
       selection = CameraIndices(a.cameras, a);
       break;
-    case Kind::kMove: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      for (int c : cams) {
-        const Vec3 target = a.flag ? a.a : rig().cameras[c].center() + a.a;
-        scene().CheckReach(target, a.where, "the camera position");
-      }
-      apply(cams, label("move", cams), [&](Camera& cam) {
-        cam.world_from_camera.translation() =
-            a.flag ? a.a : Vec3(cam.world_from_camera.translation() + a.a);
-      });
+    case Kind::kMove:
+      DoMove(a, step);
       break;
-    }
-    case Kind::kRotate: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      Vec3 pivot = Vec3::Zero();
-      std::vector<Eigen::Isometry3d> poses;
-      for (int c : cams) {
-        pivot += rig().cameras[c].center() / double(cams.size());
-        poses.push_back(rig().cameras[c].world_from_camera);
-      }
-      const Mat3 R = Eigen::AngleAxisd(a.number * kRadPerDeg, a.a.normalized()).toRotationMatrix();
-      const std::vector<Eigen::Isometry3d> moved = MoveRigidly(poses, pivot, Vec3::Zero(), R);
-      std::size_t i = 0;
-      apply(cams, label("rotate", cams), [&](Camera& cam) { cam.world_from_camera = moved[i++]; });
+    case Kind::kRotate:
+      DoRotate(a, step);
       break;
-    }
-    case Kind::kAim: {
-      const int c = CameraIndex(a.cameras[0], a);
-      const Vec3 from = rig().cameras[c].center();
-      const auto pose = LookAt(from, a.a, UpFor(from, a.a));
-      if (!pose) throw InputError(a.where, "", "the camera cannot aim at its own position");
-      apply({c}, label("aim", {c}), [&](Camera& cam) { cam.world_from_camera = *pose; });
+    case Kind::kAim:
+      DoAim(a, step);
       break;
-    }
-    case Kind::kOrient: {
-      const int c = CameraIndex(a.cameras[0], a);
-      const Mat3 R = RotationFromYawPitchRollDeg(a.a);
-      apply({c}, label("turn", {c}), [&](Camera& cam) { cam.world_from_camera.linear() = R; });
+    case Kind::kOrient:
+      DoOrient(a, step);
       break;
-    }
     case Kind::kEnable:
-    case Kind::kDisable: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      const bool on = a.kind == Kind::kEnable;
-      apply(cams, label(on ? "enable" : "disable", cams), [&](Camera& cam) { cam.enabled = on; });
+    case Kind::kDisable:
+      DoEnable(a, step);
       break;
-    }
-    case Kind::kHfov: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      apply(cams, label("zoom", cams), [&](Camera& cam) {
-        Intrinsics k = cam.model.intrinsics();
-        const double fx = FocalFromHfov(a.number * kRadPerDeg, k.width, k.model);
-        if (k.model != LensModel::kFisheye && a.number >= 180)
-          throw InputError(a.where, "",
-                           "a pinhole or Brown-Conrady lens sees less than 180 degrees");
-        k.fy *= fx / k.fx;
-        k.fx = fx;
-        cam.model = CameraModel(k);
-      });
+    case Kind::kHfov:
+      DoHfov(a, step);
       break;
-    }
-    case Kind::kIntrinsics: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      const bool lens_changed =
-          !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
-                                         [](double v) { return !std::isnan(v); });
-      apply(cams, label("lens", cams), [&](Camera& cam) {
-        Intrinsics k = cam.model.intrinsics();
-        if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
-          throw InputError(a.where, "",
-                           "camera '" + cam.id +
-                               "' is a PTZ camera: its zoom range is in pixels of its "
-                               "resolution and lens, which the viewer does not convert",
-                           "change its resolution or lens model in the scene file");
-        if (a.width > 0) {
-          // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
-          const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;
-          k.fx *= sx;
-          k.fy *= sy;
-          k.cx = (k.cx + 0.5) * sx - 0.5;
-          k.cy = (k.cy + 0.5) * sy - 0.5;
-          k.width = a.width;
-          k.height = a.height;
-        }
-        if (!a.lens.empty()) {
-          const LensModel to = LensFromName(a.lens);
-          if ((to == LensModel::kFisheye) != (k.model == LensModel::kFisheye)) {
-            // Keep the nominal field of view across the projection's change.
-            const double hfov = HfovFromFocal(k.fx, k.width, k.model);
-            if (to != LensModel::kFisheye && !(hfov < kPi))
-              throw InputError(a.where, "",
-                               "camera '" + cam.id + "' sees " +
-                                   std::to_string(int(std::lround(hfov / kRadPerDeg))) +
-                                   " degrees; a " + a.lens + " lens sees less than 180",
-                               "narrow its field of view (hfov) first");
-            const double fx = FocalFromHfov(hfov, k.width, to);
-            k.fy *= fx / k.fx;
-            k.fx = fx;
-          }
-          k.model = to;
-          k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = k.k4 = 0;
-        }
-        const std::string model = LensModelName(k.model);
-        double* c[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
-        for (int i = 0; i < 6; ++i) {
-          if (std::isnan(a.coefficients[i])) continue;
-          if (!LensHasCoefficient(model, i))
-            throw InputError(a.where, "",
-                             "camera '" + cam.id + "' has a " + model +
-                                 " lens, which has no coefficient " + kCoefficientNames[i],
-                             model == "pinhole"
-                                 ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
-                                 : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
-          *c[i] = a.coefficients[i];
-        }
-        cam.model = CameraModel(k);
-        if (lens_changed && k.model != LensModel::kPinhole) {
-          // A lens that folds back inside the image: part of it no ray reaches.
-          const LensCoverage lc = ComputeLensCoverage(cam.model);
-          if (lc.domain_ends_inside_image) {
-            char share[32];
-            std::snprintf(share, sizeof share, "%.1f", 100 * lc.unreachable_fraction);
-            throw InputError(
-                a.where, "",
-                "camera '" + cam.id + "': this " + model +
-                    " distortion folds back inside the image (its valid domain ends there; " +
-                    share + " % of the pixels would see nothing)",
-                "use smaller coefficients");
-          }
-        }
-      });
+    case Kind::kIntrinsics:
+      DoIntrinsics(a, step);
       break;
-    }
-    case Kind::kRange: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      apply(cams, label("range", cams), [&](Camera& cam) {
-        const double near = std::isnan(a.near) ? cam.near : a.near;
-        const double far = std::isnan(a.far) ? cam.far : a.far;
-        if (!(far > near))
-          throw InputError(a.where, "",
-                           "camera '" + cam.id + "': far (" + std::to_string(far) +
-                               " m) must be greater than near (" + std::to_string(near) + " m)");
-        cam.near = near;
-        cam.far = far;
-      });
+    case Kind::kRange:
+      DoRange(a, step);
       break;
-    }
-    case Kind::kColor: {
-      const std::vector<int> cams = CameraIndices(a.cameras, a);
-      apply(cams, label("colour", cams), [&](Camera& cam) { cam.color = a.a; });
+    case Kind::kColor:
+      DoColor(a, step);
       break;
-    }
     case Kind::kCompare:
       Compare(a);
       break;
@@ -580,45 +894,12 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (edit.Redo()) Edited();
       break;
     case Kind::kSlice:
-    case Kind::kIso: {
-      const bool slice = a.kind == Kind::kSlice;
-      if (!a.flag) {
-        const std::vector<std::string> live =
-            options_.fields.empty() ? DefaultFields() : options_.fields;
-        if (std::find(live.begin(), live.end(), a.text) == live.end()) {
-          std::string list;
-          for (const std::string& f : live) list += (list.empty() ? "" : ", ") + f;
-          throw InputError(a.where, "", "'" + a.text + "' is not a live field of this session",
-                           "live: " + list);
-        }
-      }
-      if (slice) {
-        display.overlays.slice_field = a.text;
-        display.overlays.slice_axis = a.text2 == "x" ? 0 : a.text2 == "y" ? 1 : 2;
-        display.overlays.slice_position = a.number;
-      } else {
-        display.overlays.iso_field = a.text;
-        if (!a.flag) display.overlays.iso_value = a.number;
-      }
+    case Kind::kIso:
+      DoSliceIso(a);
       break;
-    }
-    case Kind::kView: {
-      if (a.text == "plan" || a.text == "elevation") {
-        SetPlan(a.text == "plan" ? "plan" : a.text2);
-        break;
-      }
-      const auto it = scene().views.find(a.text);
-      if (it == scene().views.end()) {
-        std::string names;
-        for (const auto& [name, v] : scene().views) names += (names.empty() ? "" : ", ") + name;
-        throw InputError(a.where, "", "no view '" + a.text + "' in " + file,
-                         names.empty() ? "the scene defines no views" : "views: " + names);
-      }
-      const RenderView v = ViewFromScene(it->second, width, height, 50.0);
-      plan.clear();
-      view = OrbitView::FromLookAt(v.from, v.at, v.fov_deg);
+    case Kind::kView:
+      DoView(a);
       break;
-    }
     case Kind::kOrbit:
       Orbit(a.a.x(), a.a.y());
       break;
@@ -633,229 +914,45 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       view = OrbitView::FromLookAt(a.a, a.b, a.number);
       break;
     case Kind::kLight:
-      display.pattern = a.text == "grid" ? Pattern::kGrid : Pattern::kUniform;
-      display.grid_pixels = int(a.number);
-      display.brightness = a.number2;
-      display.surface = a.text2 == "black"         ? Surface::kBlack
-                        : a.text2 == "hidden-line" ? Surface::kHiddenLine
-                        : a.text2 == "contours"    ? Surface::kContours
-                                                   : Surface::kMaterial;
+      DoLight(a);
       break;
     case Kind::kWait:
-      if (a.text == "fields") {
-        for (const char* kind : {"fields", "time"}) {
-          const session::JobStatus s = session_->jobs().Wait(kind);
-          if (s.state == session::JobState::kFailed && s.exception)
-            std::rethrow_exception(s.exception);
-        }
-      } else if (a.text == "suggest") {
-        session::JobStatus s;
-        suggestion = session_->WaitSuggestion(&s);
-        if (s.state == session::JobState::kFailed && s.exception)
-          std::rethrow_exception(s.exception);
-        if (suggestion) status = suggestion->message;
-      } else {
-        session_->jobs().Wait("render");
-      }
+      DoWait(a);
       break;
-    case Kind::kSuggest: {
-      std::shared_ptr<app::SuggestProblem> problem;
-      try {
-        problem = app::PrepareSuggest(SuggestArgsOf(a, scene().path), scene(), rig());
-      } catch (const InputError& e) {
-        RethrowAsAction(e, a.where);
-      }
-      problem->options.scene_path = a.where;  // the library's checks name the action
-      suggestion.reset();
-      suggestion_over_time = a.over_time;
-      suggestion_targets =
-          std::to_string(problem->targets.size()) + " points " +
-          (a.over_time ? "on the study's targets at " +
-                             std::to_string(problem->sample_casters.size()) + " time samples"
-           : a.target_surfaces.empty() ? std::string("of the study region")
-                                       : std::string("on the target surfaces") +
-                                             (a.with_region ? " and in the region" : ""));
-      session_->SuggestInBackground(problem->targets, problem->options, problem);
-      status = "suggesting";
+    case Kind::kSuggest:
+      DoSuggest(a);
       break;
-    }
-    case Kind::kAccept: {
-      if (!suggestion)
-        throw InputError(a.where, "", "there is no suggestion to accept",
-                         "suggest first, then wait for it");
-      // As `pandora accept`: a suggestion that does not improve its objective is not offered.
-      if (!suggestion->improved)
-        throw InputError(a.where, "", "the suggestion offers no improvement; nothing to accept",
-                         "suggest again with other limits or cameras, or reject it");
-      Suggestion take = *suggestion, keep = *suggestion;
-      take.cameras.clear();
-      keep.cameras.clear();
-      for (const CameraChange& c : suggestion->cameras)
-        (a.cameras.empty() || std::count(a.cameras.begin(), a.cameras.end(), c.id) ? take : keep)
-            .cameras.push_back(c);
-      for (const std::string& id : a.cameras)
-        if (std::none_of(take.cameras.begin(), take.cameras.end(),
-                         [&](const CameraChange& c) { return c.id == id; }))
-          throw InputError(a.where, "", "camera '" + id + "' is not in the suggestion");
-      session_->ApplySuggestion(take);
-      Edited();
-      if (keep.cameras.empty())
-        suggestion.reset();
-      else
-        suggestion = keep;
-      status = "accepted " + std::to_string(take.cameras.size()) + " cameras (not saved yet)";
+    case Kind::kAccept:
+      DoAccept(a);
       break;
-    }
     case Kind::kReject:
       suggestion.reset();
       break;
-    case Kind::kSave: {
-      // Saving writes poses and focal lengths only: name what else changed, camera by camera.
-      std::string unsavable;
-      for (int c : edit.Unsaved()) {
-        const std::string what = UnsavableChanges(edit.saved().cameras[c], rig().cameras[c]);
-        if (!what.empty())
-          unsavable += (unsavable.empty() ? "" : "; ") + rig().cameras[c].id + "'s " + what;
-      }
-      if (!unsavable.empty())
-        throw InputError(file, "",
-                         "not saved: saving writes poses and focal lengths only, not " + unsavable,
-                         "undo them, or copy them into the scene file by hand");
-      std::vector<StationMove> moved;
-      for (const auto& [name, st] : stations) {
-        const ViewingStation& before = saved_stations.at(name);
-        if (st.eye != before.eye || st.display_center != before.display_center)
-          moved.push_back({name, st.eye, st.display_center});
-      }
-      const session::SaveResult r = session_->Save(a.flag, moved);
-      saved_stations = stations;
-      if (!options_.autosave_path.empty())
-        session::WriteAutosave(*session_, options_.autosave_path);
-      std::string what;
-      auto count = [](std::size_t n, const std::string& what) {
-        return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-      };
-      if (!r.saved.empty()) what = count(r.saved.size(), "camera");
-      if (!r.saved_stations.empty())
-        what += (what.empty() ? "" : " and ") + count(r.saved_stations.size(), "viewing station");
-      status = what.empty() ? "nothing to save"
-                            : "saved " + what + " into " + r.scene_path +
-                                  " (previous file kept as " + r.backup_path + ")";
+    case Kind::kSave:
+      DoSave(a);
       break;
-    }
-    case Kind::kScreenshot: {
-      if (!frontend) throw InputError(a.where, "", "screenshots need a front end");
-      const int camera = a.text2.empty() ? -1 : CameraIndex(a.text2, a);
-      // As every command's outputs: never onto an input, written whole or not at all.
-      OutputTransaction output;
-      for (const auto& [path, what] : scene().InputFiles()) output.AddInput(path, what);
-      frontend->Screenshot(*this, output.Stage(a.text, a.where), camera);
-      output.Commit();
+    case Kind::kScreenshot:
+      DoScreenshot(a, frontend);
       break;
-    }
     case Kind::kSize:
       width = int(a.a.x());
       height = int(a.a.y());
       break;
-    case Kind::kGamepad: {
-      const int c = CameraIndex(a.cameras[0], a);
-      GamepadAxes axes;
-      axes.left_x = a.a.x();
-      axes.left_y = a.a.y();
-      axes.right_x = a.b.x();
-      axes.right_y = a.b.y();
-      Eigen::Isometry3d pose = rig().cameras[c].world_from_camera;
-      const int steps = int(std::lround(a.number * 60.0));  // 60 Hz, as the window polls
-      for (int i = 0; i < steps; ++i) pose = GamepadMove(pose, axes, 1.0 / 60.0, 0.5, 45.0);
-      apply({c}, label("gamepad", {c}), [&](Camera& cam) { cam.world_from_camera = pose; });
+    case Kind::kGamepad:
+      DoGamepad(a, step);
       break;
-    }
-    case Kind::kStation: {
-      auto it = stations.find(a.text);
-      if (it == stations.end()) {
-        std::string names;
-        for (const auto& [name, st] : stations) names += (names.empty() ? "" : ", ") + name;
-        throw InputError(a.where, "", "no viewing station '" + a.text + "' in " + file,
-                         names.empty() ? "the scene defines no stations" : "stations: " + names);
-      }
-      ViewingStation moved = it->second;
-      scene().CheckReach(a.a, a.where, a.flag ? "the display" : "the eye");
-      if (a.flag)
-        moved.display_center = a.a;
-      else
-        moved.eye = a.a;
-      if (!((moved.eye - moved.display_center).dot(moved.display_normal) > 0))
-        throw InputError(a.where, "", "the eye would be behind the display or in its plane");
-      it->second = moved;
-      ++stations_version;
+    case Kind::kStation:
+      DoStation(a);
       break;
-    }
-    case Kind::kPtz: {
-      const int c = CameraIndex(a.cameras[0], a);
-      const Camera& cam = rig().cameras[c];
-      if (!cam.ptz)
-        throw InputError(a.where, "", "camera '" + cam.id + "' has no pan-tilt-zoom head",
-                         "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
-      PtzState s = cam.ptz->current;
-      if (!a.preset.empty()) {
-        std::string names;
-        const PtzPreset* found = nullptr;
-        for (const PtzPreset& p : cam.ptz->presets) {
-          if (p.name == a.preset) found = &p;
-          names += (names.empty() ? "" : ", ") + p.name;
-        }
-        if (!found)
-          throw InputError(a.where, "", "camera '" + cam.id + "' has no preset '" + a.preset + "'",
-                           names.empty() ? "it has no presets" : "presets: " + names);
-        s = found->state;
-      } else {
-        if (!std::isnan(a.pan_deg)) s.pan_deg = a.pan_deg;
-        if (!std::isnan(a.tilt_deg)) s.tilt_deg = a.tilt_deg;
-        if (!std::isnan(a.hfov_deg)) {
-          const Intrinsics& k = cam.model.intrinsics();
-          if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
-            throw InputError(a.where, "",
-                             "a pinhole or Brown-Conrady lens sees less than 180 degrees");
-          s.focal = FocalFromHfov(a.hfov_deg * kRadPerDeg, k.width, k.model);
-        }
-      }
-      const PtzState want = s;
-      const PtzState got = session::ClampPtzState(*cam.ptz, want);
-      apply({c}, label("pan/tilt/zoom", {c}),
-            [&](Camera& x) { x = session::WithPtzState(x, want); });
-      const bool clamped =
-          std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
-          std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
-          (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
-      status =
-          PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
+    case Kind::kPtz:
+      DoPtz(a, step);
       break;
-    }
-    case Kind::kRecentre: {
-      const int c = CameraIndex(a.cameras[0], a);
-      const std::string where = session_->CameraJsonPath(c);
-      apply({c}, label("re-centre", {c}),
-            [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
-      const PtzHead& h = *rig().cameras[c].ptz;
-      char line[200];
-      std::snprintf(line, sizeof line,
-                    "%s: home is now the current view (pan [%.1f, %.1f], tilt [%.1f, %.1f] deg)",
-                    rig().cameras[c].id.c_str(), h.pan_min_deg, h.pan_max_deg, h.tilt_min_deg,
-                    h.tilt_max_deg);
-      status = line;
+    case Kind::kRecentre:
+      DoRecentre(a, step);
       break;
-    }
-    case Kind::kTrace: {
-      bool any = false;
-      session::PtzTracedRig(rig(), a.text, a.number, nullptr, &any);
-      if (!any && a.text != "single")
-        throw InputError(a.where, "", "rig '" + rig().name + "' has no enabled PTZ camera",
-                         "add a \"ptz\" block to a camera (docs/ptz.md)");
-      ptz_trace = a.text;
-      ptz_trace_s = a.number;
-      status = "PTZ trace: " + a.text;
+    case Kind::kTrace:
+      DoTrace(a);
       break;
-    }
     case Kind::kMouse:
     case Kind::kKey:
     case Kind::kScroll:
@@ -863,7 +960,7 @@ void ViewerModel::Do(const Action& a, Frontend* frontend) {
       if (frontend) frontend->Input(*this, a);
       break;
   }
-  if (status.empty() && !ptz_status.empty()) status = ptz_status;
+  if (status.empty() && !step.ptz_status.empty()) status = step.ptz_status;
 }
 
 nlohmann::json ViewerModel::StateJson() const {

@@ -149,6 +149,37 @@ class ViewerModel {
   std::vector<int> CameraIndices(const std::vector<std::string>& ids, const Action& action) const;
   void Edited();  // fields in the background, autosave, on_edit
   void Compare(const Action& action);
+  // What the camera edits of one Do share.
+  struct EditStep {
+    std::string drag;        // the label of the drag the action may amend, empty: none
+    std::string ptz_status;  // a PTZ camera's setting after a pose edit
+  };
+  void ApplyEdit(const Action& a, EditStep& step, const std::vector<int>& cams,
+                 const std::string& label, const std::function<void(Camera&)>& change);
+  std::string EditLabel(const char* verb, const std::vector<int>& cams) const;
+  // Do's actions, one per kind or group (model.cpp).
+  void DoMove(const Action& a, EditStep& step);
+  void DoRotate(const Action& a, EditStep& step);
+  void DoAim(const Action& a, EditStep& step);
+  void DoOrient(const Action& a, EditStep& step);
+  void DoEnable(const Action& a, EditStep& step);
+  void DoHfov(const Action& a, EditStep& step);
+  void DoIntrinsics(const Action& a, EditStep& step);
+  void DoRange(const Action& a, EditStep& step);
+  void DoColor(const Action& a, EditStep& step);
+  void DoSliceIso(const Action& a);
+  void DoView(const Action& a);
+  void DoLight(const Action& a);
+  void DoWait(const Action& a);
+  void DoSuggest(const Action& a);
+  void DoAccept(const Action& a);
+  void DoSave(const Action& a);
+  void DoScreenshot(const Action& a, Frontend* frontend);
+  void DoGamepad(const Action& a, EditStep& step);
+  void DoStation(const Action& a);
+  void DoPtz(const Action& a, EditStep& step);
+  void DoRecentre(const Action& a, EditStep& step);
+  void DoTrace(const Action& a);
   std::vector<std::string> LiveFields() const;
   // Summaries of rigs other than the edited one, evaluated once (Compare).
   struct CachedSummary {

@@ -175,7 +175,8 @@ const std::map<std::string, Kind>& Kinds() {
   return kinds;
 }
 
-Action ParseAction(const json& j, const std::string& where, const std::string& file) {
+// The action an object names: its one known key.
+std::string ActionName(const json& j, const std::string& where, const std::string& file) {
   if (!j.is_object() || j.empty())
     throw InputError(file, where, "expected an object naming one action, e.g. {\"undo\": 1}");
   // The action is the first known key present (objects keep their keys sorted; exactly one action).
@@ -193,45 +194,392 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
     for (const auto& [k, v] : Kinds()) list += (list.empty() ? "" : ", ") + k;
     throw InputError(file, where, "no known action in this object", "actions: " + list);
   }
+  return name;
+}
+
+// "select": the cameras to select (none: clear the selection).
+void ParseSelect(const Entry& e, Action& a) {
+  e.Keys({"select"});
+  a.cameras = e.Ids("select", true);
+}
+
+// "move": cameras, and 'by' (a move) or 'to' (a position of one camera).
+void ParseMove(const Entry& e, const json& j, Action& a) {
+  e.Keys({"move", "by", "to", "drag"});
+  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.cameras = e.Ids("move", false);
+  if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
+  a.flag = e.Has("to");
+  if (a.flag && a.cameras.size() != 1) e.Fail("to", "'to' places one camera; use 'by' for a group");
+  a.a = e.Vector(a.flag ? "to" : "by");
+  a.has_a = true;
+}
+
+// "rotate": cameras, an axis and an angle.
+void ParseRotate(const Entry& e, const json& j, Action& a) {
+  e.Keys({"rotate", "axis", "deg", "drag"});
+  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.cameras = e.Ids("rotate", false);
+  a.a = e.Vector("axis");
+  if (!(a.a.norm() > 0)) e.Fail("axis", "the axis must be a non-zero vector");
+  a.number = e.Number("deg", -360, 360);
+}
+
+// "aim": a camera and the point it looks at.
+void ParseAim(const Entry& e, Action& a) {
+  e.Keys({"aim", "at"});
+  a.cameras = {e.String("aim")};
+  a.a = e.Vector("at");
+}
+
+// "orient": a camera and its yaw, pitch and roll.
+void ParseOrient(const Entry& e, const json& j, Action& a) {
+  e.Keys({"orient", "ypr_deg", "drag"});
+  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.cameras = {e.String("orient")};
+  a.a = e.Vector("ypr_deg");
+  if (std::abs(a.a.y()) > 90) e.Fail("ypr_deg[1]", "the pitch lies in [-90, 90] degrees");
+}
+
+// "hfov": cameras and a horizontal field of view.
+void ParseHfov(const Entry& e, Action& a) {
+  e.Keys({"hfov", "deg"});
+  a.cameras = e.Ids("hfov", false);
+  a.number = e.Number("deg", 1, 359);
+}
+
+// "intrinsics": cameras and a resolution, a lens model and / or distortion coefficients.
+void ParseIntrinsics(const Entry& e, Action& a) {
+  e.Keys({"intrinsics", "resolution", "model", "k1", "k2", "p1", "p2", "k3", "k4"});
+  a.cameras = e.Ids("intrinsics", false);
+  if (e.Has("resolution")) {
+    const Vec3 v = e.Vector("resolution", 2);
+    if (v.x() < 1 || v.y() < 1 || v.x() > 65536 || v.y() > 65536 || v.x() != std::floor(v.x()) ||
+        v.y() != std::floor(v.y()))
+      e.Fail("resolution", "expected [width, height], whole numbers of pixels from 1 to 65536");
+    a.width = int(v.x());
+    a.height = int(v.y());
+  }
+  if (e.Has("model")) a.lens = e.OneOf("model", {"pinhole", "brown_conrady", "fisheye"});
+  bool any = a.width > 0 || !a.lens.empty();
+  for (int i = 0; i < 6; ++i) {
+    const char* key = kCoefficientNames[i];
+    if (!e.Has(key)) continue;
+    if (!a.lens.empty() && !LensHasCoefficient(a.lens, i))
+      e.Fail(key, "a " + a.lens + " lens has no coefficient " + key,
+             a.lens == "pinhole"   ? "pinhole: no distortion"
+             : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4"
+                                   : "brown_conrady: k1 k2 p1 p2 k3");
+    a.coefficients[i] = e.Number(key, -1000, 1000);
+    any = true;
+  }
+  if (!any)
+    e.Fail("", "nothing to change", "give resolution, model or coefficients (k1 k2 p1 p2 k3 k4)");
+}
+
+// "range": cameras and a near and / or far distance (far null: unbounded).
+void ParseRange(const Entry& e, const json& j, Action& a) {
+  e.Keys({"range", "near", "far"});
+  a.cameras = e.Ids("range", false);
+  if (!e.Has("near") && !e.Has("far"))
+    e.Fail("", "nothing to change", "give near, far or both (metres)");
+  if (e.Has("near")) a.near = e.Number("near", 0, 1e7);
+  if (e.Has("far")) {
+    if (j.at("far").is_null())
+      a.far = INFINITY;
+    else
+      a.far = e.Number("far", 1e-9, 1e7);
+    if (a.far <= a.near) e.Fail("far", "far must be greater than near");
+  }
+}
+
+// "color": cameras and a linear RGB colour.
+void ParseColor(const Entry& e, Action& a) {
+  e.Keys({"color", "rgb"});
+  a.cameras = e.Ids("color", false);
+  a.a = e.Vector("rgb");
+  for (int i = 0; i < 3; ++i)
+    if (a.a[i] < 0 || a.a[i] > 1)
+      e.Fail("rgb[" + std::to_string(i) + "]", "colour components are linear RGB in [0, 1]");
+}
+
+// "compare": up to 8 different rigs.
+void ParseCompare(const Entry& e, Action& a) {
+  e.Keys({"compare"});
+  a.cameras = e.Ids("compare", false);
+  if (a.cameras.size() > 8) e.Fail("compare", "compare with at most 8 rigs");
+  for (std::size_t i = 0; i < a.cameras.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (a.cameras[i] == a.cameras[k])
+        e.Fail("compare[" + std::to_string(i) + "]", "'" + a.cameras[i] + "' is named twice");
+}
+
+// "slice": a field (empty: none), an axis and a position.
+void ParseSlice(const Entry& e, Action& a) {
+  e.Keys({"slice", "axis", "at"});
+  a.text = e.String("slice", true);
+  a.flag = a.text.empty();
+  a.text2 = e.Has("axis") ? e.OneOf("axis", {"x", "y", "z"}) : "z";
+  a.number = e.Has("at") ? e.Number("at", -1e7, 1e7) : NAN;
+}
+
+// "iso": a field (empty: none) and its value.
+void ParseIso(const Entry& e, Action& a) {
+  e.Keys({"iso", "value"});
+  a.text = e.String("iso", true);
+  a.flag = a.text.empty();
+  if (!a.flag) a.number = e.Number("value", -1e30, 1e30);
+}
+
+// "view": a plan, an elevation (with its side) or a view of the scene.
+void ParseView(const Entry& e, Action& a) {
+  // "plan" and "elevation" (with "side") are the orthographic proposal views; any other name
+  // is one of the scene's views.
+  e.Keys({"view", "side"});
+  a.text = e.String("view");
+  if (a.text == "elevation")
+    a.text2 = e.OneOf("side", {"north", "south", "east", "west"});
+  else if (e.Has("side"))
+    e.Fail("side", "only with \"view\": \"elevation\"");
+}
+
+// "dolly": the steps towards the point looked at.
+void ParseDolly(const Entry& e, Action& a) {
+  e.Keys({"dolly"});
+  a.number = e.Number("dolly", -100, 100);
+}
+
+// "eye": the eye, the point it looks at and the field of view.
+void ParseEye(const Entry& e, Action& a) {
+  e.Keys({"eye", "at", "fov"});
+  a.a = e.Vector("eye");
+  a.b = e.Vector("at");
+  if ((a.a - a.b).norm() == 0) e.Fail("at", "the eye and the point looked at coincide");
+  a.number = e.Number("fov", 1, 170, 50);
+}
+
+// "light": the pattern, grid size, brightness and surface.
+void ParseLight(const Entry& e, Action& a) {
+  e.Keys({"light", "grid", "brightness", "surface"});
+  a.text = e.OneOf("light", {"uniform", "grid"});
+  a.number = e.Number("grid", 1, 100000, 32);
+  a.number2 = e.Has("brightness") ? e.Number("brightness", 1e-6, 1e6) : NAN;
+  a.text2 = e.Has("surface") ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"})
+                             : "material";
+}
+
+// "wait": the job waited for.
+void ParseWait(const Entry& e, Action& a) {
+  e.Keys({"wait"});
+  a.text = e.OneOf("wait", {"fields", "suggest", "render"});
+}
+
+// "suggest": cameras, the objective, limits, mounts, keep-out boxes and targets.
+void ParseSuggest(const Entry& e, const json& j, const std::string& where, const std::string& file,
+                  Action& a) {
+  e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane",
+          "box", "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate",
+          "outer", "target_surface", "with_region", "over_time"});
+  a.cameras = e.Ids("suggest", false);
+  a.text = e.Has("objective") ? e.String("objective") : "coverage2";
+  a.number = e.Number("max_move", 0, 1e4, 0.3);
+  a.number2 = e.Number("max_rotate", 0, 179.999, 10);
+  a.number3 = e.Number("points", 1, 1e6, 1500);  // pandora suggest's --points
+  if (e.Has("weights")) {
+    a.weights = e.Vector("weights");
+    if ((a.weights.array() < 0).any() || a.weights.sum() <= 0)
+      e.Fail("weights", "the weights must be >= 0 and not all zero");
+  }
+  a.snap_move = e.Number("snap_move", 0, 1e4, 0);
+  a.snap_rotate = e.Number("snap_rotate", 0, 180, 0);
+  a.outer_iterations = int(e.Number("outer", 1, 100, 4));
+  if (e.Has("target_surface")) a.target_surfaces = e.Ids("target_surface", false, "surface");
+  for (const char* key : {"with_region", "over_time"})
+    if (e.Has(key) && !j.at(key).is_boolean()) e.Fail(key, "expected true or false");
+  a.with_region = e.Has("with_region") && j.at("with_region").get<bool>();
+  a.over_time = e.Has("over_time") && j.at("over_time").get<bool>();
+  if (a.over_time && !a.target_surfaces.empty())
+    e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene",
+           "give one of them");
+  a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
+  if (int(e.Has("rail")) + int(e.Has("plane")) + int(e.Has("box")) > 1)
+    e.Fail("", "give at most one mount: 'rail', 'plane' or 'box'");
+  for (const char* mount : {"rail", "plane"})
+    if (e.Has(mount)) {
+      a.mount = mount;
+      a.a = e.Vector(mount);
+      if (!(a.a.norm() > 0)) e.Fail(mount, "the direction must be a non-zero vector");
+    }
+  if (e.Has("box")) {
+    a.mount = "box";
+    a.mount_box = e.Box("box");
+  }
+  if (e.Has("keep_out")) {
+    const json& boxes = j.at("keep_out");
+    if (!boxes.is_array() || boxes.size() > 1000)
+      e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      const Entry box(boxes, where + ".keep_out", file);
+      a.keep_out.push_back(box.Box(i));
+    }
+  }
+  if (e.Has("clearance")) a.clearance = e.Number("clearance", 0, 1e4);
+  if (e.Has("hfov_range")) {
+    const Vec3 r = e.Vector("hfov_range", 2);
+    if (!(r.x() > 0 && r.x() <= r.y() && r.y() < 360))
+      e.Fail("hfov_range", "expected [min, max] degrees, 0 < min <= max < 360");
+    a.min_hfov = r.x();
+    a.max_hfov = r.y();
+  }
+}
+
+// "accept": "all" or the cameras to take.
+void ParseAccept(const Entry& e, const json& j, Action& a) {
+  e.Keys({"accept"});
+  if (j.at("accept").is_string() && j.at("accept") == "all") return;  // every suggested camera
+  a.cameras = e.Ids("accept", false);
+}
+
+// "save": forced ("force") or not.
+void ParseSave(const Entry& e, const json& j, Action& a) {
+  e.Keys({"save"});
+  a.flag = j.at("save").is_string() && j.at("save") == "force";
+}
+
+// "screenshot": the file and, optionally, the camera whose view it shows.
+void ParseScreenshot(const Entry& e, Action& a) {
+  e.Keys({"screenshot", "camera"});
+  a.text = e.String("screenshot");
+  if (e.Has("camera")) a.text2 = e.String("camera");
+}
+
+// "size": the main view's width and height.
+void ParseSize(const Entry& e, Action& a) {
+  e.Keys({"size"});
+  const Vec3 v = e.Vector("size", 2);
+  if (v.x() < 16 || v.y() < 16 || v.x() > 8192 || v.y() > 8192 || v.x() != std::floor(v.x()) ||
+      v.y() != std::floor(v.y()))
+    e.Fail("size", "expected [width, height], whole numbers of pixels from 16 to 8192");
+  a.a = v;
+}
+
+// "mouse": press, release or move, a button, and the pointer (pixels, a world point or a handle).
+void ParseMouse(const Entry& e, Action& a) {
+  e.Keys({"mouse", "button", "x", "y", "at", "gizmo", "by"});
+  a.text = e.OneOf("mouse", {"press", "release", "move"});
+  a.text2 = e.Has("button") ? e.OneOf("button", {"left", "right", "middle"}) : "left";
+  if (int(e.Has("x") || e.Has("y")) + int(e.Has("at")) + int(e.Has("gizmo")) != 1)
+    e.Fail("",
+           "give the pointer as one of 'x' and 'y' (pixels), 'at' (a world point) or 'gizmo' "
+           "(a handle)");
+  if (e.Has("at")) {
+    a.a = e.Vector("at");
+    a.has_a = true;
+  } else if (e.Has("gizmo")) {
+    const std::string h = e.OneOf("gizmo", {"x", "y", "z", "rx", "ry", "rz"});
+    a.gizmo = (h[0] == 'r' ? 3 : 0) + (h.back() - 'x');
+    a.number = e.Number("by", -1e4, 1e4, 0);
+  } else {
+    a.number3 = e.Number("x", -1e5, 1e5);
+    a.number2 = e.Number("y", -1e5, 1e5);
+  }
+  if (e.Has("by") && !e.Has("gizmo")) e.Fail("by", "'by' goes with 'gizmo'");
+}
+
+// "key": the key pressed.
+void ParseKey(const Entry& e, Action& a) {
+  e.Keys({"key"});
+  a.text = e.String("key");
+}
+
+// "scroll": the steps and the pointer.
+void ParseScroll(const Entry& e, Action& a) {
+  e.Keys({"scroll", "x", "y"});
+  a.number = e.Number("scroll", -100, 100);
+  a.number3 = e.Number("x", -1e5, 1e5, 0);
+  a.number2 = e.Number("y", -1e5, 1e5, 0);
+}
+
+// "gamepad": a camera, the sticks' positions and how long they are held.
+void ParseGamepad(const Entry& e, const json& j, Action& a) {
+  e.Keys({"gamepad", "left", "right", "seconds", "drag"});
+  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.cameras = {e.String("gamepad")};
+  a.a = e.Has("left") ? e.Vector("left", 2) : Vec3::Zero();
+  a.b = e.Has("right") ? e.Vector("right", 2) : Vec3::Zero();
+  if (a.a.cwiseAbs().maxCoeff() > 1 || a.b.cwiseAbs().maxCoeff() > 1)
+    e.Fail(a.a.cwiseAbs().maxCoeff() > 1 ? "left" : "right", "stick positions lie in [-1, 1]");
+  a.number = e.Number("seconds", 0, 60);
+}
+
+// "station": a viewing station and its eye's or display's new position.
+void ParseStation(const Entry& e, Action& a) {
+  e.Keys({"station", "eye_at", "display_at"});
+  a.text = e.String("station");
+  if (e.Has("eye_at") == e.Has("display_at"))
+    e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
+  a.flag = e.Has("display_at");
+  a.a = e.Vector(a.flag ? "display_at" : "eye_at");
+}
+
+// "ptz": a camera and a preset, or its pan, tilt and / or field of view.
+void ParsePtz(const Entry& e, const json& j, Action& a) {
+  e.Keys({"ptz", "pan_deg", "tilt_deg", "hfov_deg", "preset", "drag"});
+  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.cameras = {e.String("ptz")};
+  if (e.Has("preset")) {
+    if (e.Has("pan_deg") || e.Has("tilt_deg") || e.Has("hfov_deg"))
+      e.Fail("preset", "give a preset or angles, not both");
+    a.preset = e.String("preset");
+    return;
+  }
+  if (!e.Has("pan_deg") && !e.Has("tilt_deg") && !e.Has("hfov_deg"))
+    e.Fail("", "nothing to change", "give pan_deg, tilt_deg, hfov_deg or a preset");
+  a.pan_deg = e.Number("pan_deg", -360, 360, NAN);
+  a.tilt_deg = e.Number("tilt_deg", -180, 180, NAN);
+  a.hfov_deg = e.Number("hfov_deg", 0.01, 359, NAN);
+}
+
+// "recentre": the PTZ camera.
+void ParseRecentre(const Entry& e, Action& a) {
+  e.Keys({"recentre"});
+  a.cameras = {e.String("recentre")};
+}
+
+// "trace": the kind of PTZ trace and its time budget.
+void ParseTrace(const Entry& e, Action& a) {
+  e.Keys({"trace", "seconds"});
+  a.text = e.OneOf("trace", {"single", "path", "all"});
+  a.number = e.Number("seconds", 0, 3600, NAN);
+}
+
+// "frames": how many frames to run.
+void ParseFrames(const Entry& e, Action& a) {
+  e.Keys({"frames"});
+  a.number = e.Number("frames", 0, 10000);
+}
+
+Action ParseAction(const json& j, const std::string& where, const std::string& file) {
+  const std::string name = ActionName(j, where, file);
   const Entry e(j, where, file);
   Action a;
   a.kind = Kinds().at(name);
   a.where = where;
   switch (a.kind) {
     case Kind::kSelect:
-      e.Keys({"select"});
-      a.cameras = e.Ids("select", true);
+      ParseSelect(e, a);
       break;
     case Kind::kMove:
-      e.Keys({"move", "by", "to", "drag"});
-      a.drag = e.Has("drag") && j.at("drag") == true;
-      a.cameras = e.Ids("move", false);
-      if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
-      a.flag = e.Has("to");
-      if (a.flag && a.cameras.size() != 1)
-        e.Fail("to", "'to' places one camera; use 'by' for a group");
-      a.a = e.Vector(a.flag ? "to" : "by");
-      a.has_a = true;
+      ParseMove(e, j, a);
       break;
     case Kind::kRotate:
-      e.Keys({"rotate", "axis", "deg", "drag"});
-      a.drag = e.Has("drag") && j.at("drag") == true;
-      a.cameras = e.Ids("rotate", false);
-      a.a = e.Vector("axis");
-      if (!(a.a.norm() > 0)) e.Fail("axis", "the axis must be a non-zero vector");
-      a.number = e.Number("deg", -360, 360);
+      ParseRotate(e, j, a);
       break;
     case Kind::kAim:
-      e.Keys({"aim", "at"});
-      a.cameras = {e.String("aim")};
-      a.a = e.Vector("at");
+      ParseAim(e, a);
       break;
     case Kind::kOrient:
-      e.Keys({"orient", "ypr_deg", "drag"});
-      a.drag = e.Has("drag") && j.at("drag") == true;
-      a.cameras = {e.String("orient")};
-      a.a = e.Vector("ypr_deg");
-      if (std::abs(a.a.y()) > 90) e.Fail("ypr_deg[1]", "the pitch lies in [-90, 90] degrees");
+      ParseOrient(e, j, a);
       break;
     case Kind::kEnable:
     case Kind::kDisable:
@@ -239,100 +587,33 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.cameras = e.Ids(name, false);
       break;
     case Kind::kHfov:
-      e.Keys({"hfov", "deg"});
-      a.cameras = e.Ids("hfov", false);
-      a.number = e.Number("deg", 1, 359);
+      ParseHfov(e, a);
       break;
-    case Kind::kIntrinsics: {
-      e.Keys({"intrinsics", "resolution", "model", "k1", "k2", "p1", "p2", "k3", "k4"});
-      a.cameras = e.Ids("intrinsics", false);
-      if (e.Has("resolution")) {
-        const Vec3 v = e.Vector("resolution", 2);
-        if (v.x() < 1 || v.y() < 1 || v.x() > 65536 || v.y() > 65536 ||
-            v.x() != std::floor(v.x()) || v.y() != std::floor(v.y()))
-          e.Fail("resolution", "expected [width, height], whole numbers of pixels from 1 to 65536");
-        a.width = int(v.x());
-        a.height = int(v.y());
-      }
-      if (e.Has("model")) a.lens = e.OneOf("model", {"pinhole", "brown_conrady", "fisheye"});
-      bool any = a.width > 0 || !a.lens.empty();
-      for (int i = 0; i < 6; ++i) {
-        const char* key = kCoefficientNames[i];
-        if (!e.Has(key)) continue;
-        if (!a.lens.empty() && !LensHasCoefficient(a.lens, i))
-          e.Fail(key, "a " + a.lens + " lens has no coefficient " + key,
-                 a.lens == "pinhole"   ? "pinhole: no distortion"
-                 : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4"
-                                       : "brown_conrady: k1 k2 p1 p2 k3");
-        a.coefficients[i] = e.Number(key, -1000, 1000);
-        any = true;
-      }
-      if (!any)
-        e.Fail("", "nothing to change",
-               "give resolution, model or coefficients (k1 k2 p1 p2 k3 k4)");
+    case Kind::kIntrinsics:
+      ParseIntrinsics(e, a);
       break;
-    }
-    case Kind::kRange: {
-      e.Keys({"range", "near", "far"});
-      a.cameras = e.Ids("range", false);
-      if (!e.Has("near") && !e.Has("far"))
-        e.Fail("", "nothing to change", "give near, far or both (metres)");
-      if (e.Has("near")) a.near = e.Number("near", 0, 1e7);
-      if (e.Has("far")) {
-        if (j.at("far").is_null())
-          a.far = INFINITY;
-        else
-          a.far = e.Number("far", 1e-9, 1e7);
-        if (a.far <= a.near) e.Fail("far", "far must be greater than near");
-      }
+    case Kind::kRange:
+      ParseRange(e, j, a);
       break;
-    }
-    case Kind::kColor: {
-      e.Keys({"color", "rgb"});
-      a.cameras = e.Ids("color", false);
-      a.a = e.Vector("rgb");
-      for (int i = 0; i < 3; ++i)
-        if (a.a[i] < 0 || a.a[i] > 1)
-          e.Fail("rgb[" + std::to_string(i) + "]", "colour components are linear RGB in [0, 1]");
+    case Kind::kColor:
+      ParseColor(e, a);
       break;
-    }
-    case Kind::kCompare: {
-      e.Keys({"compare"});
-      a.cameras = e.Ids("compare", false);
-      if (a.cameras.size() > 8) e.Fail("compare", "compare with at most 8 rigs");
-      for (std::size_t i = 0; i < a.cameras.size(); ++i)
-        for (std::size_t k = 0; k < i; ++k)
-          if (a.cameras[i] == a.cameras[k])
-            e.Fail("compare[" + std::to_string(i) + "]", "'" + a.cameras[i] + "' is named twice");
+    case Kind::kCompare:
+      ParseCompare(e, a);
       break;
-    }
     case Kind::kUndo:
     case Kind::kRedo:
     case Kind::kReject:
       e.Keys({name.c_str()});
       break;
     case Kind::kSlice:
-      e.Keys({"slice", "axis", "at"});
-      a.text = e.String("slice", true);
-      a.flag = a.text.empty();
-      a.text2 = e.Has("axis") ? e.OneOf("axis", {"x", "y", "z"}) : "z";
-      a.number = e.Has("at") ? e.Number("at", -1e7, 1e7) : NAN;
+      ParseSlice(e, a);
       break;
     case Kind::kIso:
-      e.Keys({"iso", "value"});
-      a.text = e.String("iso", true);
-      a.flag = a.text.empty();
-      if (!a.flag) a.number = e.Number("value", -1e30, 1e30);
+      ParseIso(e, a);
       break;
     case Kind::kView:
-      // "plan" and "elevation" (with "side") are the orthographic proposal views; any other name
-      // is one of the scene's views.
-      e.Keys({"view", "side"});
-      a.text = e.String("view");
-      if (a.text == "elevation")
-        a.text2 = e.OneOf("side", {"north", "south", "east", "west"});
-      else if (e.Has("side"))
-        e.Fail("side", "only with \"view\": \"elevation\"");
+      ParseView(e, a);
       break;
     case Kind::kOrbit:
     case Kind::kPan:
@@ -340,185 +621,58 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       a.a = e.Vector(name, 2);
       break;
     case Kind::kDolly:
-      e.Keys({"dolly"});
-      a.number = e.Number("dolly", -100, 100);
+      ParseDolly(e, a);
       break;
     case Kind::kEye:
-      e.Keys({"eye", "at", "fov"});
-      a.a = e.Vector("eye");
-      a.b = e.Vector("at");
-      if ((a.a - a.b).norm() == 0) e.Fail("at", "the eye and the point looked at coincide");
-      a.number = e.Number("fov", 1, 170, 50);
+      ParseEye(e, a);
       break;
     case Kind::kLight:
-      e.Keys({"light", "grid", "brightness", "surface"});
-      a.text = e.OneOf("light", {"uniform", "grid"});
-      a.number = e.Number("grid", 1, 100000, 32);
-      a.number2 = e.Has("brightness") ? e.Number("brightness", 1e-6, 1e6) : NAN;
-      a.text2 = e.Has("surface")
-                    ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"})
-                    : "material";
+      ParseLight(e, a);
       break;
     case Kind::kWait:
-      e.Keys({"wait"});
-      a.text = e.OneOf("wait", {"fields", "suggest", "render"});
+      ParseWait(e, a);
       break;
     case Kind::kSuggest:
-      e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane",
-              "box", "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate",
-              "outer", "target_surface", "with_region", "over_time"});
-      a.cameras = e.Ids("suggest", false);
-      a.text = e.Has("objective") ? e.String("objective") : "coverage2";
-      a.number = e.Number("max_move", 0, 1e4, 0.3);
-      a.number2 = e.Number("max_rotate", 0, 179.999, 10);
-      a.number3 = e.Number("points", 1, 1e6, 1500);  // pandora suggest's --points
-      if (e.Has("weights")) {
-        a.weights = e.Vector("weights");
-        if ((a.weights.array() < 0).any() || a.weights.sum() <= 0)
-          e.Fail("weights", "the weights must be >= 0 and not all zero");
-      }
-      a.snap_move = e.Number("snap_move", 0, 1e4, 0);
-      a.snap_rotate = e.Number("snap_rotate", 0, 180, 0);
-      a.outer_iterations = int(e.Number("outer", 1, 100, 4));
-      if (e.Has("target_surface")) a.target_surfaces = e.Ids("target_surface", false, "surface");
-      for (const char* key : {"with_region", "over_time"})
-        if (e.Has(key) && !j.at(key).is_boolean()) e.Fail(key, "expected true or false");
-      a.with_region = e.Has("with_region") && j.at("with_region").get<bool>();
-      a.over_time = e.Has("over_time") && j.at("over_time").get<bool>();
-      if (a.over_time && !a.target_surfaces.empty())
-        e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene",
-               "give one of them");
-      a.seed = static_cast<unsigned long long>(e.Number("seed", 0, 9e15, 1));
-      if (int(e.Has("rail")) + int(e.Has("plane")) + int(e.Has("box")) > 1)
-        e.Fail("", "give at most one mount: 'rail', 'plane' or 'box'");
-      for (const char* mount : {"rail", "plane"})
-        if (e.Has(mount)) {
-          a.mount = mount;
-          a.a = e.Vector(mount);
-          if (!(a.a.norm() > 0)) e.Fail(mount, "the direction must be a non-zero vector");
-        }
-      if (e.Has("box")) {
-        a.mount = "box";
-        a.mount_box = e.Box("box");
-      }
-      if (e.Has("keep_out")) {
-        const json& boxes = j.at("keep_out");
-        if (!boxes.is_array() || boxes.size() > 1000)
-          e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
-        for (std::size_t i = 0; i < boxes.size(); ++i) {
-          const Entry box(boxes, where + ".keep_out", file);
-          a.keep_out.push_back(box.Box(i));
-        }
-      }
-      if (e.Has("clearance")) a.clearance = e.Number("clearance", 0, 1e4);
-      if (e.Has("hfov_range")) {
-        const Vec3 r = e.Vector("hfov_range", 2);
-        if (!(r.x() > 0 && r.x() <= r.y() && r.y() < 360))
-          e.Fail("hfov_range", "expected [min, max] degrees, 0 < min <= max < 360");
-        a.min_hfov = r.x();
-        a.max_hfov = r.y();
-      }
+      ParseSuggest(e, j, where, file, a);
       break;
     case Kind::kAccept:
-      e.Keys({"accept"});
-      if (j.at("accept").is_string() && j.at("accept") == "all") break;  // every suggested camera
-      a.cameras = e.Ids("accept", false);
+      ParseAccept(e, j, a);
       break;
     case Kind::kSave:
-      e.Keys({"save"});
-      a.flag = j.at("save").is_string() && j.at("save") == "force";
+      ParseSave(e, j, a);
       break;
     case Kind::kScreenshot:
-      e.Keys({"screenshot", "camera"});
-      a.text = e.String("screenshot");
-      if (e.Has("camera")) a.text2 = e.String("camera");
+      ParseScreenshot(e, a);
       break;
-    case Kind::kSize: {
-      e.Keys({"size"});
-      const Vec3 v = e.Vector("size", 2);
-      if (v.x() < 16 || v.y() < 16 || v.x() > 8192 || v.y() > 8192 || v.x() != std::floor(v.x()) ||
-          v.y() != std::floor(v.y()))
-        e.Fail("size", "expected [width, height], whole numbers of pixels from 16 to 8192");
-      a.a = v;
+    case Kind::kSize:
+      ParseSize(e, a);
       break;
-    }
     case Kind::kMouse:
-      e.Keys({"mouse", "button", "x", "y", "at", "gizmo", "by"});
-      a.text = e.OneOf("mouse", {"press", "release", "move"});
-      a.text2 = e.Has("button") ? e.OneOf("button", {"left", "right", "middle"}) : "left";
-      if (int(e.Has("x") || e.Has("y")) + int(e.Has("at")) + int(e.Has("gizmo")) != 1)
-        e.Fail("",
-               "give the pointer as one of 'x' and 'y' (pixels), 'at' (a world point) or 'gizmo' "
-               "(a handle)");
-      if (e.Has("at")) {
-        a.a = e.Vector("at");
-        a.has_a = true;
-      } else if (e.Has("gizmo")) {
-        const std::string h = e.OneOf("gizmo", {"x", "y", "z", "rx", "ry", "rz"});
-        a.gizmo = (h[0] == 'r' ? 3 : 0) + (h.back() - 'x');
-        a.number = e.Number("by", -1e4, 1e4, 0);
-      } else {
-        a.number3 = e.Number("x", -1e5, 1e5);
-        a.number2 = e.Number("y", -1e5, 1e5);
-      }
-      if (e.Has("by") && !e.Has("gizmo")) e.Fail("by", "'by' goes with 'gizmo'");
+      ParseMouse(e, a);
       break;
     case Kind::kKey:
-      e.Keys({"key"});
-      a.text = e.String("key");
+      ParseKey(e, a);
       break;
     case Kind::kScroll:
-      e.Keys({"scroll", "x", "y"});
-      a.number = e.Number("scroll", -100, 100);
-      a.number3 = e.Number("x", -1e5, 1e5, 0);
-      a.number2 = e.Number("y", -1e5, 1e5, 0);
+      ParseScroll(e, a);
       break;
     case Kind::kGamepad:
-      e.Keys({"gamepad", "left", "right", "seconds", "drag"});
-      a.drag = e.Has("drag") && j.at("drag") == true;
-      a.cameras = {e.String("gamepad")};
-      a.a = e.Has("left") ? e.Vector("left", 2) : Vec3::Zero();
-      a.b = e.Has("right") ? e.Vector("right", 2) : Vec3::Zero();
-      if (a.a.cwiseAbs().maxCoeff() > 1 || a.b.cwiseAbs().maxCoeff() > 1)
-        e.Fail(a.a.cwiseAbs().maxCoeff() > 1 ? "left" : "right", "stick positions lie in [-1, 1]");
-      a.number = e.Number("seconds", 0, 60);
+      ParseGamepad(e, j, a);
       break;
     case Kind::kStation:
-      e.Keys({"station", "eye_at", "display_at"});
-      a.text = e.String("station");
-      if (e.Has("eye_at") == e.Has("display_at"))
-        e.Fail("", "give one of 'eye_at' or 'display_at' (a position)");
-      a.flag = e.Has("display_at");
-      a.a = e.Vector(a.flag ? "display_at" : "eye_at");
+      ParseStation(e, a);
       break;
     case Kind::kPtz:
-      e.Keys({"ptz", "pan_deg", "tilt_deg", "hfov_deg", "preset", "drag"});
-      a.drag = e.Has("drag") && j.at("drag") == true;
-      a.cameras = {e.String("ptz")};
-      if (e.Has("preset")) {
-        if (e.Has("pan_deg") || e.Has("tilt_deg") || e.Has("hfov_deg"))
-          e.Fail("preset", "give a preset or angles, not both");
-        a.preset = e.String("preset");
-        break;
-      }
-      if (!e.Has("pan_deg") && !e.Has("tilt_deg") && !e.Has("hfov_deg"))
-        e.Fail("", "nothing to change", "give pan_deg, tilt_deg, hfov_deg or a preset");
-      a.pan_deg = e.Number("pan_deg", -360, 360, NAN);
-      a.tilt_deg = e.Number("tilt_deg", -180, 180, NAN);
-      a.hfov_deg = e.Number("hfov_deg", 0.01, 359, NAN);
+      ParsePtz(e, j, a);
       break;
     case Kind::kRecentre:
-      e.Keys({"recentre"});
-      a.cameras = {e.String("recentre")};
+      ParseRecentre(e, a);
       break;
     case Kind::kTrace:
-      e.Keys({"trace", "seconds"});
-      a.text = e.OneOf("trace", {"single", "path", "all"});
-      a.number = e.Number("seconds", 0, 3600, NAN);
+      ParseTrace(e, a);
       break;
     case Kind::kFrames:
-      e.Keys({"frames"});
-      a.number = e.Number("frames", 0, 10000);
+      ParseFrames(e, a);
       break;
   }
   return a;
