@@ -21,6 +21,7 @@
 #include "app/commands.h"
 #include "app/mpi_session.h"
 #include "app/output.h"
+#include "app/session/analyze.h"
 #include "app/session/session.h"
 #include "volume/fields.h"
 #include "volume/fields_transfer.h"
@@ -179,32 +180,6 @@ bool MergeAtRoot(const MpiSession& mpi, Fields& fields, nlohmann::json& mpi_summ
   return true;
 }
 
-// The fields at every time sample (their grids added to `fields`, their summary in `time`), the
-// surface targets at each, and the samples' labels.
-void EvaluateOverTime(const AnalyzeArgs& args, const Scene& scene, const Rig& rig,
-                      const FieldOptions& options, Fields& fields, std::optional<TimeSummary>& time,
-                      std::vector<SurfaceTargetResult>& targets,
-                      std::vector<std::string>& sample_labels) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto parts = MakeSceneParts(scene);
-  const double parts_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::vector<TimeSample> samples = scene.TimeSamples();
-  for (const TimeSample& s : samples) sample_labels.push_back(s.label);
-  if (!samples.empty()) {
-    FieldOptions over_time = OverTimeOptions(options);
-    ProgressBar time_bar("over " + std::to_string(samples.size()) + " time samples", !args.quiet);
-    over_time.progress = [&time_bar](double f) { time_bar.Update(f); };
-    TimeFieldsResult result =
-        EvaluateFieldsOverTime(scene, rig, *parts, samples, over_time, scene.TimeMinCameras());
-    time_bar.Finish();
-    result.summary.parts_seconds = parts_seconds;
-    time = result.summary;
-    AddTimeGrids(&fields, &result);
-  }
-  targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
-}
-
 }  // namespace
 
 double CheckPositiveOption(const char* option, double value, const char* unit) {
@@ -270,41 +245,22 @@ int RunAnalyze(const AnalyzeArgs& args) {
   // The partitions meet at rank 0: grids merged, statistics added (volume/fields_transfer.h).
   nlohmann::json mpi_summary;
   if (mpi.active() && !MergeAtRoot(mpi, fields, mpi_summary)) return 0;
-  // Moving objects: the fields at every time sample; surface targets at each (docs/time.md).
-  std::optional<TimeSummary> time;
-  std::vector<SurfaceTargetResult> targets;
-  std::vector<std::string> sample_labels;
-  if (scene.Animated() || scene.study.targets)
-    EvaluateOverTime(args, scene, rig, options, fields, time, targets, sample_labels);
-  // Pixel-size targets and DORI classes, from the fields without casting again.
-  std::vector<PixelTargetSummary> pixel_targets =
-      EvaluatePixelTargets(scene, rig, fields, scene.TimeMinCameras(), &fields);
-  std::optional<DoriSummary> dori;
-  if (scene.study.dori) dori = EvaluateDori(scene, fields, &fields);
-  const RayCaster& caster = study->caster();
-
-  const int threads = static_cast<int>(
+  // Everything beside the fields, as every front end computes it (app/session/analyze.h): time
+  // samples and surface targets, pixel targets and DORI, warnings, calibration, N-1, PTZ.
+  session::AnalyzeOptions analysis;
+  analysis.fields = options;
+  analysis.threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  // Plausibility warnings, after every input check (they are printed only when the run succeeds).
-  RigCheckOptions check;
-  check.visible_voxels = fields.stats.per_camera_seen;
-  const std::vector<Warning> warnings = CheckRig(scene, rig, caster, check);
-  Summary typed = Summarize(scene, rig, fields, options.fields, threads, warnings);
-  typed.time = time;
-  typed.targets = std::move(targets);
-  typed.sample_labels = sample_labels;
-  typed.pixel_targets = std::move(pixel_targets);
-  typed.dori = dori;
-  if (scene.study.calibration)
-    typed.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
-  // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets
-  // (docs/failures.md).
-  if (HasCameraSets(fields)) {
-    typed.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
-    AddCoverageN1Grid(&fields);
-  }
-  // PTZ cameras: reach times, reachable shares, tours (docs/ptz.md).
-  if (RigHasPtz(rig)) typed.ptz = EvaluatePtzFields(scene, rig, caster, fields, &fields);
+  std::optional<ProgressBar> time_bar;
+  analysis.time_stage = [&](std::size_t samples) -> std::function<void(double)> {
+    time_bar.emplace("over " + std::to_string(samples) + " time samples", !args.quiet);
+    return [&time_bar](double f) { time_bar->Update(f); };
+  };
+  session::RigAnalysis result =
+      session::CompleteAnalysis(scene, study->caster(), rig, fields, analysis);
+  if (time_bar) time_bar->Finish();
+  const Summary& typed = result.summary;
+  const std::vector<Warning>& warnings = result.warnings;
   nlohmann::json summary = typed;
   summary["run_id"] = output.run_id();
   if (mpi.active()) summary["mpi"] = mpi_summary;

@@ -21,6 +21,7 @@
 #include "analysis/geometry/visibility.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "app/session/analyze.h"
 #include "app/session/study.h"
 #include "python/bindings.h"
 #include "python/keywords.h"
@@ -376,33 +377,33 @@ void BindEvaluate(py::module_& m) {
       [](const PyScene& s, const PyRig& r, std::vector<std::string> fields) {
         const Scene& scene = s.scene();
         const Rig rig = r.rig();  // a copy: the evaluation runs without the GIL
-        FieldOptions o;
-        o.solid_trees = &s.study->solid_trees();
+        // What `pandora analyze` computes (app/session/analyze.h): the fields, then the time
+        // samples, surface targets, pixel targets, DORI, warnings, calibration, N-1 and PTZ.
+        session::AnalyzeOptions analysis;
+        FieldOptions& o = analysis.fields;
         o.fields = fields.empty() ? scene.study.fields : fields;
         o.scene_path = scene.path;
         o.memory_budget_bytes = scene.study.memory_budget_bytes;
         PyFields out;
         out.study = s.study;
-        std::optional<PtzFieldsSummary> ptz;
+        session::RigAnalysis result;
         {
           py::gil_scoped_release release;
-          out.fields = std::make_shared<Fields>(EvaluateFields(scene, rig, s.study->caster(), o));
-          // PTZ cameras: reach times and tours over the region (docs/ptz.md), as `pandora analyze`.
-          if (RigHasPtz(rig) && out.fields->impl().coverage)
-            ptz = EvaluatePtzFields(scene, rig, s.study->caster(), *out.fields, out.fields.get());
+          session::RigFieldsAnalysis a = session::AnalyzeRig(*s.study, rig, analysis);
+          out.fields = std::make_shared<Fields>(std::move(a.fields));
+          result = std::move(a.analysis);
         }
         out.names = o.fields;
         for (const auto& [name, grid] : out.fields->impl().extra) out.names.push_back(name);
-        out.summary = MakeSummary(scene, rig, *out.fields, o.fields, 0);
-        if (ptz) out.summary["ptz"] = *ptz;
+        out.summary = result.summary;
         out.rig_name = rig.name;
         out.rig_json = RigToJson(rig).dump();
         return out;
       },
       py::arg("scene"), py::arg("rig"), py::arg("fields") = std::vector<std::string>{},
-      "Evaluates the fields (default: the study's) for the rig's enabled cameras; with PTZ cameras "
-      "also "
-      "their reach-time and tour fields.");
+      "Evaluates the fields (default: the study's) for the rig's enabled cameras, and what "
+      "`pandora analyze` computes beside them (time samples, surface targets, pixel targets, DORI, "
+      "warnings, calibration, N-1, PTZ reach and tours): the same summary and the same grids.");
 }
 
 // visibility() and covariance() at given points.

@@ -26,6 +26,7 @@
 #include "app/report/robustness_section.h"
 #include "app/report/table.h"
 #include "app/report/time_section.h"
+#include "app/session/analyze.h"
 #include "render/render.h"
 #include "volume/time_fields.h"
 
@@ -261,50 +262,34 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
     for (const std::string& f : FieldNames())
       if (wanted.count(f)) data.field_names.push_back(f);
   }
-  const int threads = static_cast<int>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  // Moving objects and surface targets (docs/time.md): the scene's rigid parts, built once.
+  // Moving objects and surface targets (docs/time.md): the scene's rigid parts, built once for
+  // every rig.
   std::unique_ptr<RigidPartsRayCaster> parts;
-  std::vector<TimeSample> samples;
-  std::vector<std::string> sample_labels;
-  if (scene.Animated() || scene.study.targets) {
-    parts = MakeSceneParts(scene);
-    samples = scene.TimeSamples();
-    for (const TimeSample& s : samples) sample_labels.push_back(s.label);
-  }
+  if (scene.Animated() || scene.study.targets) parts = MakeSceneParts(scene);
   for (const Rig* rig : rigs) {
-    FieldOptions field_options;
+    // The analysis every front end runs (app/session/analyze.h), without the parts the report has
+    // no section for yet (pixel targets, DORI, PTZ) and without derived grids.
+    session::AnalyzeOptions analysis;
+    FieldOptions& field_options = analysis.fields;
     field_options.scene_path = scene.path;
     field_options.fields = data.field_names;
     field_options.memory_budget_bytes = scene.study.memory_budget_bytes;
     if (adjusted) field_options.voxel_size_option = "{voxel_size}";
     field_options.progress = options.progress;
+    analysis.threads = static_cast<int>(
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    analysis.time_stage = [&](std::size_t) { return options.progress; };
+    analysis.parts = parts.get();
+    analysis.add_grids = false;
+    analysis.pixel_targets = analysis.dori = analysis.ptz = false;
     if (options.rig_started) options.rig_started(rig->name);
     RigReport r;
     r.rig = *rig;
     r.fields = EvaluateFields(scene, *rig, caster, field_options);
-    RigCheckOptions check;
-    check.visible_voxels = r.fields.stats.per_camera_seen;
-    r.warnings = CheckRig(scene, *rig, caster, check);
-    r.summary = Summarize(scene, *rig, r.fields, data.field_names, threads, r.warnings);
-    if (scene.study.calibration)
-      r.summary.calibration = SimulateCalibration(scene, *rig, caster, *scene.study.calibration);
-    if (parts) {
-      if (!samples.empty()) {
-        FieldOptions over_time = field_options;
-        over_time.fields.erase(
-            std::remove(over_time.fields.begin(), over_time.fields.end(), "cameras"),
-            over_time.fields.end());
-        r.summary.time =
-            EvaluateFieldsOverTime(scene, *rig, *parts, samples, over_time, scene.TimeMinCameras())
-                .summary;
-      }
-      r.summary.targets =
-          EvaluateSurfaceTargets(scene, *rig, *parts, samples, scene.TimeMinCameras());
-      r.summary.sample_labels = sample_labels;
-    }
-    r.summary.robustness =
-        ComputeCriticality(scene, *rig, r.fields, caster, scene.TimeMinCameras());
+    session::RigAnalysis result =
+        session::CompleteAnalysis(scene, caster, *rig, r.fields, analysis);
+    r.summary = std::move(result.summary);
+    r.warnings = std::move(result.warnings);
     data.rigs.push_back(std::move(r));
   }
 
