@@ -22,6 +22,7 @@
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
 #include "app/session/analyze.h"
+#include "app/session/camera_edits.h"
 #include "app/session/study.h"
 #include "python/bindings.h"
 #include "python/keywords.h"
@@ -210,44 +211,25 @@ py::class_<PyRig> BindRig(py::module_& m) {
           "move",
           [](PyRig& r, const std::string& id, const Vec3& position, const Vec3& look_at,
              const Vec3& up) {
-            const int index = r.Index(id);
-            if (r.rig().cameras[index].ptz)
-              throw InputError(
-                  "move", "", "camera '" + id + "' is a PTZ camera: its pose is its head's setting",
-                  "use set_ptz");
-            if (!position.allFinite() || !look_at.allFinite())
-              throw InputError("move", "", "not a finite position");
-            const auto pose = LookAt(position, look_at, up);
-            if (!pose)
-              throw InputError("move", "",
-                               "look_at equals the position, or up is parallel to the view");
-            r.session->rig().SetPose(index, *pose);
+            // The session's edit, PTZ rule inside (app/session/camera_edits.h), as the viewer's.
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::AimEdit{r.Index(id), position, look_at, up})
+                    .edit);
           },
           py::arg("id"), py::arg("position"), py::arg("look_at"), py::arg("up") = Vec3(0, 0, 1),
           "Places camera `id` at `position` looking at `look_at` (metres, world frame). One undo "
-          "step.")
+          "step. A PTZ camera's head follows: its pivot moves with the centre, pan and tilt face "
+          "`look_at` within the head's ranges (as in the viewer).")
       .def(
           "set_pose",
           [](PyRig& r, const std::string& id, const Vec3& position, const Mat3& rotation) {
-            const int index = r.Index(id);
-            if (r.rig().cameras[index].ptz)
-              throw InputError(
-                  "set_pose", "",
-                  "camera '" + id + "' is a PTZ camera: its pose is its head's setting",
-                  "use set_ptz");
-            if (!position.allFinite() || !rotation.allFinite())
-              throw InputError("set_pose", "", "not finite");
-            if ((rotation.transpose() * rotation - Mat3::Identity()).norm() > 1e-9 ||
-                rotation.determinant() < 0)
-              throw InputError("set_pose", "rotation",
-                               "not a rotation matrix (orthonormal to 1e-9, determinant +1)");
-            Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-            pose.linear() = rotation;
-            pose.translation() = position;
-            r.session->rig().SetPose(index, pose);
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::PoseEdit{r.Index(id), position, rotation})
+                    .edit);
           },
           py::arg("id"), py::arg("position"), py::arg("rotation"),
-          "Sets camera `id`'s centre (metres) and world_from_camera rotation (3x3). One undo step.")
+          "Sets camera `id`'s centre (metres) and world_from_camera rotation (3x3). One undo step. "
+          "A PTZ camera's head follows, as with move().")
       .def(
           "set_enabled",
           [](PyRig& r, const std::string& id, bool on) {

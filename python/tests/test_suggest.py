@@ -156,8 +156,13 @@ def test_ptz_settings_save_and_fields(tmp_path):
     assert [q["name"] for q in p["presets"]] == ["window", "west_door", "east_door"]
     assert [t["preset"] for t in p["tour"]] == ["window", "west_door", "window", "east_door"]
     assert p["hfov_deg"] == pytest.approx(30)
-    with pytest.raises(pandora.InputError):
-        rig.move("dome", [0, 0, 2], [0, 1, 1])
+    # A PTZ camera's head follows a move, as in the viewer (app/session/camera_edits.h): the pivot
+    # moves with the centre (this head has no offset) and pan and tilt face the target.
+    rig.move("dome", [0, 0, 2], [0, 1, 1])
+    assert rig.position("dome") == pytest.approx([0, 0, 2], abs=1e-9)
+    assert rig.rotation("dome")[:, 2] == pytest.approx(np.array([0, 1, -1]) / np.sqrt(2), abs=1e-9)
+    assert rig.unsaved == ["dome"]
+    assert rig.undo()
     rig.set_ptz("dome", preset="west_door")
     q = rig.ptz("dome")
     assert (q["pan_deg"], q["tilt_deg"]) == pytest.approx((63, -3))

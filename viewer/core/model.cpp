@@ -12,6 +12,7 @@
 #include "analysis/util/output_transaction.h"
 #include "analysis/util/units.h"
 #include "app/session/autosave.h"
+#include "app/session/camera_edits.h"
 #include "app/session/ptz_edit.h"
 #include "app/suggest_options.h"
 #include "render/prepared_scene.h"
@@ -378,22 +379,12 @@ void ViewerModel::Run(const std::vector<Action>& script, Frontend* frontend) {
 void ViewerModel::ApplyEdit(const Action& a, EditStep& step, const std::vector<int>& cams,
                             const std::string& label, const std::function<void(Camera&)>& change) {
   session::EditableRig& edit = session_->rig();
-  session::Edit e;
-  e.label = label;
-  for (int c : cams) {
-    session::CameraEdit ce{c, rig().cameras[c], rig().cameras[c]};
-    change(ce.after);
-    // A PTZ camera's base stays level and its head turns: a pose or zoom asked of it moves the
-    // pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md, "In the viewer").
-    if (ce.before.ptz && ce.after.ptz == ce.before.ptz &&
-        (ce.after.world_from_camera.matrix() != ce.before.world_from_camera.matrix() ||
-         ce.after.model.intrinsics().fx != ce.before.model.intrinsics().fx)) {
-      bool clamped = false;
-      ce.after = session::PtzFollow(ce.before, ce.after, &clamped);
-      step.ptz_status = PtzStatus(ce.after, clamped);
-    }
-    e.changes.push_back(std::move(ce));
-  }
+  // The session's rule: a PTZ camera's base stays level and its head turns, so a pose or zoom
+  // asked of it moves the pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md).
+  session::CameraEditResult made = session::MakeCameraEdit(rig(), cams, label, change);
+  session::Edit& e = made.edit;
+  for (const session::CameraEdit& ce : e.changes)
+    if (ce.index == made.ptz_camera) step.ptz_status = PtzStatus(ce.after, made.clamped);
   if (a.drag && step.drag == label && edit.CanAmend(cams))
     edit.Amend(e);
   else
