@@ -1,5 +1,5 @@
-// A hidden GLFW window holding a GL 3.3 core context (viewer/gl_context.h).
-#include "viewer/gl_context.h"
+// A hidden GLFW window holding a GL 3.3 core context (viewer/gl/context.h).
+#include "viewer/gl/context.h"
 
 #include <epoxy/gl.h>
 // GLFW after epoxy: epoxy provides the GL declarations, GLFW must not include its own.

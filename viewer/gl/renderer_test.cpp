@@ -2,7 +2,7 @@
 // `xvfb-run -a` with Mesa's llvmpipe (ctest sets LIBGL_ALWAYS_SOFTWARE=1); each case renders the
 // same rig, view and size on both and compares the per-pixel camera sets away from the one-pixel
 // band around the CPU image's edges (footprint and shadow edges, silhouettes), and the colours.
-#include "viewer/gl_renderer.h"
+#include "viewer/gl/renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -19,9 +19,9 @@
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "tests/fixtures.h"
-#include "viewer/gl_compare.h"
-#include "viewer/gl_context.h"
-#include "viewer/gl_test_scenes.h"
+#include "viewer/gl/compare.h"
+#include "viewer/gl/context.h"
+#include "viewer/gl/test_scenes.h"
 
 namespace pandora {
 namespace {

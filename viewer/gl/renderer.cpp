@@ -1,4 +1,4 @@
-// The GPU projective-light renderer (viewer/gl_renderer.h). A frame is deferred:
+// The GPU projective-light renderer (viewer/gl/renderer.h). A frame is deferred:
 //  1. G-buffer: the scene from the view; per pixel the surface point (relative to the scene's
 //     centre, float), the normal turned towards the eye and the albedo.
 //  2. Per enabled camera, in rig order: its distance map (one perspective map over the camera's
@@ -12,7 +12,7 @@
 //     (render/frame.cpp's rule, from the screen derivatives of the barycentric coordinates), so
 //     only edges of visible surface are drawn; contour mode: the compose pass finds object, depth
 //     and crease discontinuities between neighbouring pixels of the G-buffer (Finish's rules).
-#include "viewer/gl_renderer.h"
+#include "viewer/gl/renderer.h"
 
 #include <epoxy/gl.h>
 

@@ -1,6 +1,6 @@
 #pragma once
-/// \file gl_compare.h
-/// How far a GPU frame (viewer/gl_renderer.h) is from the exact CPU renderer's (render/render.h)
+/// \file compare.h
+/// How far a GPU frame (viewer/gl/renderer.h) is from the exact CPU renderer's (render/render.h)
 /// for the same rig, view and size: the per-pixel camera sets and the colours, away from the
 /// edges where a shadow map or a rasterised silhouette cannot agree with a ray to the pixel centre.
 /// Used by the viewer's test and by pandora_gl_bench (docs/viewer.md).
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "render/render.h"
-#include "viewer/gl_renderer.h"
+#include "viewer/gl/renderer.h"
 
 namespace pandora {
 

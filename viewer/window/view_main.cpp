@@ -15,9 +15,9 @@
 #include "app/flags.h"
 #include "app/session/autosave.h"
 #include "app/session/study.h"
-#include "viewer/app/viewer_app.h"
 #include "viewer/core/model.h"
 #include "viewer/core/script.h"
+#include "viewer/window/viewer_app.h"
 
 namespace {
 

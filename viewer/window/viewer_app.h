@@ -1,7 +1,7 @@
 #pragma once
 /// \file viewer_app.h
 /// The window of `pandora view`: GLFW + OpenGL 3.3 core + Dear ImGui over a ViewerModel
-/// (viewer/core/model.h). It draws the model (the GPU projective light of viewer/gl_renderer.h,
+/// (viewer/core/model.h). It draws the model (the GPU projective light of viewer/gl/renderer.h,
 /// camera bodies and frusta, the gizmo, the slice, the suggestion's ghosts, the panels) and turns
 /// mouse, keyboard and gamepad input into the model's actions; scripted input goes through the same
 /// handlers. Light header: no GL, GLFW or ImGui in it.

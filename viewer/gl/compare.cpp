@@ -1,5 +1,5 @@
-// Agreement of a GPU frame with the CPU renderer's (viewer/gl_compare.h).
-#include "viewer/gl_compare.h"
+// Agreement of a GPU frame with the CPU renderer's (viewer/gl/compare.h).
+#include "viewer/gl/compare.h"
 
 #include <algorithm>
 #include <cmath>

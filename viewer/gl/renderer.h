@@ -1,5 +1,5 @@
 #pragma once
-/// \file gl_renderer.h
+/// \file renderer.h
 /// The GPU projective-light renderer of the viewer: the same picture as the exact CPU renderer
 /// (render/render.h) drawn with OpenGL 3.3 core into offscreen framebuffers, with shadow maps in
 /// place of the occlusion rays. Every enabled camera is a projector of its colour; lights add in
@@ -10,7 +10,7 @@
 /// test, fisheye k1..k4: the formulas of analysis/geometry/camera.cpp), the image bounds, facing,
 /// and, in place of the occlusion segment, one distance map per camera (docs/viewer.md).
 ///
-/// Light header: no GL. Every call needs a current GL 3.3 context (viewer/gl_context.h) on the
+/// Light header: no GL. Every call needs a current GL 3.3 context (viewer/gl/context.h) on the
 /// calling thread, the one the renderer was created on.
 
 #include <cstdint>

@@ -14,10 +14,10 @@
 #include "analysis/util/error.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
-#include "viewer/gl_compare.h"
-#include "viewer/gl_context.h"
-#include "viewer/gl_renderer.h"
-#include "viewer/gl_test_scenes.h"
+#include "viewer/gl/compare.h"
+#include "viewer/gl/context.h"
+#include "viewer/gl/renderer.h"
+#include "viewer/gl/test_scenes.h"
 
 using namespace pandora;
 

@@ -1,8 +1,8 @@
-// The window of `pandora view` (viewer/app/viewer_app.h). Input from GLFW and from scripts lands in
-// one InputState; each frame feeds it to Dear ImGui (no platform backend: the state is ours, so a
-// script drives the panels exactly as a mouse does), then to the 3D handlers (orbit, pan, dolly,
+// The window of `pandora view` (viewer/window/viewer_app.h). Input from GLFW and from scripts lands
+// in one InputState; each frame feeds it to Dear ImGui (no platform backend: the state is ours, so
+// a script drives the panels exactly as a mouse does), then to the 3D handlers (orbit, pan, dolly,
 // pick, gizmo), which turn it into the model's actions.
-#include "viewer/app/viewer_app.h"
+#include "viewer/window/viewer_app.h"
 
 #include <epoxy/gl.h>
 #define GLFW_INCLUDE_NONE
@@ -30,7 +30,7 @@
 #include "render/prepared_scene.h"
 #include "viewer/core/manipulate.h"
 #include "viewer/core/station.h"
-#include "viewer/gl_renderer.h"
+#include "viewer/gl/renderer.h"
 #include "volume/fields.h"
 #include "volume/slice.h"
 #include "volume/summary.h"

@@ -1,7 +1,7 @@
 #pragma once
-/// \file gl_context.h
+/// \file context.h
 /// An OpenGL 3.3 core context without a visible window: a hidden GLFW window whose context the
-/// GPU renderer (viewer/gl_renderer.h) draws into offscreen framebuffers. Needs an X display; in
+/// GPU renderer (viewer/gl/renderer.h) draws into offscreen framebuffers. Needs an X display; in
 /// tests and CI that is Xvfb (`xvfb-run -a`) with Mesa's llvmpipe (software GL 4.5). Light header:
 /// no GL or GLFW in it.
 
