@@ -798,17 +798,17 @@ SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int targe
   return b;
 }
 
-void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options) {
-  const std::string& file = options.scene_path.empty() ? scene.path : options.scene_path;
-  if (options.cameras.empty())
+void SuggestOptions::Check(const Scene& scene, const Rig& rig) const {
+  const std::string& file = scene_path.empty() ? scene.path : scene_path;
+  if (cameras.empty())
     throw InputError(file, "{cameras}", "no camera selected",
                      "name the cameras to move, e.g. {cameras} 3,5");
-  if (options.limits.size() != 1 && options.limits.size() != options.cameras.size())
+  if (limits.size() != 1 && limits.size() != cameras.size())
     throw InputError(file, "{max_move}",
                      "one set of limits, or one per selected camera, is needed");
   std::set<int> seen;
-  for (std::size_t i = 0; i < options.cameras.size(); ++i) {
-    const int idx = options.cameras[i];
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const int idx = cameras[i];
     if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
       throw InputError(file, "{cameras}",
                        "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
@@ -822,7 +822,7 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
     if (!cam.enabled)
       throw InputError(file, "{cameras}", "camera '" + cam.id + "' is disabled",
                        "enable it in the scene file to move it");
-    const CameraLimits& l = LimitsOf(options, i);
+    const CameraLimits& l = LimitsOf(*this, i);
     if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
       throw InputError(
           file, "{max_move}",
@@ -853,17 +853,17 @@ void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& opti
     if (m.kind == MountConstraint::Kind::kBox && !m.box.Contains(cam.center()))
       throw InputError(file, "{mount_box}", "camera '" + cam.id + "' is outside its mounting box",
                        "the box must hold the camera's current centre");
-    if (InKeepOut(options.keep_out, cam.center()))
+    if (InKeepOut(keep_out, cam.center()))
       throw InputError(file, "{keep_out}", "camera '" + cam.id + "' is inside a keep-out box",
                        "a keep-out box must not hold a selected camera's current centre");
   }
-  if (!(options.clearance >= 0) || !std::isfinite(options.clearance))
+  if (!(clearance >= 0) || !std::isfinite(clearance))
     throw InputError(file, "{clearance}", "must be a finite length >= 0 (metres)");
-  if (!(options.snap_move >= 0) || !std::isfinite(options.snap_move))
+  if (!(snap_move >= 0) || !std::isfinite(snap_move))
     throw InputError(file, "{snap_move}", "must be a finite length >= 0");
-  if (!(options.snap_rotate_deg >= 0) || !std::isfinite(options.snap_rotate_deg))
+  if (!(snap_rotate_deg >= 0) || !std::isfinite(snap_rotate_deg))
     throw InputError(file, "{snap_rotate_deg}", "must be a finite angle >= 0");
-  if (options.objective.k < 1 || options.objective.k > 64)
+  if (objective.k < 1 || objective.k > 64)
     throw InputError(file, "{objective}", "k must be in 1..64");
 }
 
@@ -999,7 +999,7 @@ Suggestion BaselineSearch(const Scene& scene, const Rig& rig, const RayCaster& c
                           const std::vector<TargetPoint>& targets, const SuggestOptions& options,
                           std::int64_t evaluation_budget, std::uint64_t seed, bool adaptive_step) {
   using namespace suggest_detail;
-  CheckOptions(scene, rig, options);
+  options.Check(scene, rig);
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&]() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

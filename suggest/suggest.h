@@ -190,6 +190,13 @@ struct SuggestOptions {
   double snap_move = 0, snap_rotate_deg = 0;
   /// Used in error messages (the option or JSON path that set the selection and limits).
   std::string scene_path;
+
+  /// Checks the options against `rig` (of `scene`): a selection of distinct, enabled, fixed
+  /// cameras, limits (one set or one per camera) that hold each camera's current pose and field of
+  /// view, mounts with a direction, boxes that hold the cameras, finite non-negative clearance and
+  /// snap steps, k in 1..64. InputError naming the field at fault as `{field}` ({cameras},
+  /// {max_move}, {hfov_range}, ...), which each front end writes its own way.
+  void Check(const Scene& scene, const Rig& rig) const;
 };
 
 struct Suggestion {

@@ -818,7 +818,7 @@ void SuggestRun::LevelPoses(std::vector<Eigen::Isometry3d>& best_poses,
 Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
                    const std::vector<TargetPoint>& targets, const SuggestOptions& options) {
   using namespace suggest_detail;
-  CheckOptions(scene, rig, options);
+  options.Check(scene, rig);
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t nsel = options.cameras.size();
   ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras,

@@ -182,9 +182,6 @@ class Placement {
   std::vector<double> required_;  // per selected camera, metres
 };
 
-/// Checks the selection and the limits; throws InputError naming the option.
-void CheckOptions(const Scene& scene, const Rig& rig, const SuggestOptions& options);
-
 /// The limits of selected camera i.
 const CameraLimits& LimitsOf(const SuggestOptions& options, std::size_t i);
 
