@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "analysis/util/color.h"
+#include "app/report/table.h"
 
 namespace pandora::report {
 namespace {
@@ -18,28 +19,8 @@ constexpr int kColorCount = sizeof(kColors) / sizeof(kColors[0]);
 
 bool Plottable(double v) { return std::isfinite(v) && v > 0; }
 
-std::string Escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+// Text in the SVG, escaped as the report's HTML is.
+std::string Escape(const std::string& s) { return HtmlEscape(s); }
 
 std::string Num(double v) {
   char b[32];
