@@ -798,75 +798,6 @@ SearchStart BeginSearch(const Rig& rig, const SuggestOptions& options, int targe
   return b;
 }
 
-void SuggestOptions::Check(const Scene& scene, const Rig& rig) const {
-  const std::string& file = scene_path.empty() ? scene.path : scene_path;
-  if (cameras.empty())
-    throw InputError(file, "{cameras}", "no camera selected",
-                     "name the cameras to move, e.g. {cameras} 3,5");
-  if (limits.size() != 1 && limits.size() != cameras.size())
-    throw InputError(file, "{max_move}",
-                     "one set of limits, or one per selected camera, is needed");
-  std::set<int> seen;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    const int idx = cameras[i];
-    if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
-      throw InputError(file, "{cameras}",
-                       "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
-    const Camera& cam = rig.cameras[idx];
-    if (!seen.insert(idx).second)
-      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is selected twice");
-    if (cam.ptz)  // its file pose is its home, not its current setting (docs/ptz.md)
-      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is a PTZ camera",
-                       "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its "
-                       "\"ptz\" block");
-    if (!cam.enabled)
-      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is disabled",
-                       "enable it in the scene file to move it");
-    const CameraLimits& l = LimitsOf(*this, i);
-    if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
-      throw InputError(
-          file, "{max_move}",
-          "the largest move must be a finite length >= 0 (got " + Format("%g", l.max_move) + ")");
-    if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
-      throw InputError(file, "{max_rotate_deg}",
-                       "the largest rotation must be in [0, 180) degrees (got " +
-                           Format("%g", l.max_rotate_deg) + ")");
-    if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
-      const Intrinsics& k = cam.model.intrinsics();
-      const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
-      if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
-        throw InputError(file, "{hfov_range}",
-                         "the field-of-view range must satisfy 0 < MIN <= MAX < " +
-                             Format("%g", limit) + " degrees");
-      const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
-      if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
-        throw InputError(file, "{hfov_range}",
-                         "camera '" + cam.id + "' has a field of view of " + Format("%.6g", hfov) +
-                             " degrees, outside the range",
-                         "the range must hold the current field of view");
-    }
-    const MountConstraint& m = l.mount;
-    if ((m.kind == MountConstraint::Kind::kLine || m.kind == MountConstraint::Kind::kPlane) &&
-        !(m.axis.norm() > 0 && m.axis.allFinite()))
-      throw InputError(file, m.kind == MountConstraint::Kind::kLine ? "{rail}" : "{plane}",
-                       "the direction must be a non-zero vector");
-    if (m.kind == MountConstraint::Kind::kBox && !m.box.Contains(cam.center()))
-      throw InputError(file, "{mount_box}", "camera '" + cam.id + "' is outside its mounting box",
-                       "the box must hold the camera's current centre");
-    if (InKeepOut(keep_out, cam.center()))
-      throw InputError(file, "{keep_out}", "camera '" + cam.id + "' is inside a keep-out box",
-                       "a keep-out box must not hold a selected camera's current centre");
-  }
-  if (!(clearance >= 0) || !std::isfinite(clearance))
-    throw InputError(file, "{clearance}", "must be a finite length >= 0 (metres)");
-  if (!(snap_move >= 0) || !std::isfinite(snap_move))
-    throw InputError(file, "{snap_move}", "must be a finite length >= 0");
-  if (!(snap_rotate_deg >= 0) || !std::isfinite(snap_rotate_deg))
-    throw InputError(file, "{snap_rotate_deg}", "must be a finite angle >= 0");
-  if (objective.k < 1 || objective.k > 64)
-    throw InputError(file, "{objective}", "k must be in 1..64");
-}
-
 // ---------------------------------------------------------------------------------------------
 // Snapping
 
@@ -979,6 +910,75 @@ void FillChanges(const Rig& rig, const SuggestOptions& options,
 }
 
 }  // namespace suggest_detail
+
+void SuggestOptions::Check(const Scene& scene, const Rig& rig) const {
+  const std::string& file = scene_path.empty() ? scene.path : scene_path;
+  if (cameras.empty())
+    throw InputError(file, "{cameras}", "no camera selected",
+                     "name the cameras to move, e.g. {cameras} 3,5");
+  if (limits.size() != 1 && limits.size() != cameras.size())
+    throw InputError(file, "{max_move}",
+                     "one set of limits, or one per selected camera, is needed");
+  std::set<int> seen;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const int idx = cameras[i];
+    if (idx < 0 || idx >= static_cast<int>(rig.cameras.size()))
+      throw InputError(file, "{cameras}",
+                       "camera index " + std::to_string(idx) + " is not in rig '" + rig.name + "'");
+    const Camera& cam = rig.cameras[idx];
+    if (!seen.insert(idx).second)
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is selected twice");
+    if (cam.ptz)  // its file pose is its home, not its current setting (docs/ptz.md)
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is a PTZ camera",
+                       "suggest moves fixed cameras; set a PTZ camera's pan, tilt and zoom in its "
+                       "\"ptz\" block");
+    if (!cam.enabled)
+      throw InputError(file, "{cameras}", "camera '" + cam.id + "' is disabled",
+                       "enable it in the scene file to move it");
+    const CameraLimits& l = suggest_detail::LimitsOf(*this, i);
+    if (!(l.max_move >= 0) || !std::isfinite(l.max_move))
+      throw InputError(
+          file, "{max_move}",
+          "the largest move must be a finite length >= 0 (got " + Format("%g", l.max_move) + ")");
+    if (!(l.max_rotate_deg >= 0) || !(l.max_rotate_deg < 180))
+      throw InputError(file, "{max_rotate_deg}",
+                       "the largest rotation must be in [0, 180) degrees (got " +
+                           Format("%g", l.max_rotate_deg) + ")");
+    if (l.min_hfov_deg != 0 || l.max_hfov_deg != 0) {
+      const Intrinsics& k = cam.model.intrinsics();
+      const double limit = k.model == LensModel::kFisheye ? 360.0 : 180.0;
+      if (!(l.min_hfov_deg > 0) || !(l.max_hfov_deg >= l.min_hfov_deg) || !(l.max_hfov_deg < limit))
+        throw InputError(file, "{hfov_range}",
+                         "the field-of-view range must satisfy 0 < MIN <= MAX < " +
+                             Format("%g", limit) + " degrees");
+      const double hfov = Deg(HfovFromFocal(k.fx, k.width, k.model));
+      if (hfov < l.min_hfov_deg - 1e-9 || hfov > l.max_hfov_deg + 1e-9)
+        throw InputError(file, "{hfov_range}",
+                         "camera '" + cam.id + "' has a field of view of " + Format("%.6g", hfov) +
+                             " degrees, outside the range",
+                         "the range must hold the current field of view");
+    }
+    const MountConstraint& m = l.mount;
+    if ((m.kind == MountConstraint::Kind::kLine || m.kind == MountConstraint::Kind::kPlane) &&
+        !(m.axis.norm() > 0 && m.axis.allFinite()))
+      throw InputError(file, m.kind == MountConstraint::Kind::kLine ? "{rail}" : "{plane}",
+                       "the direction must be a non-zero vector");
+    if (m.kind == MountConstraint::Kind::kBox && !m.box.Contains(cam.center()))
+      throw InputError(file, "{mount_box}", "camera '" + cam.id + "' is outside its mounting box",
+                       "the box must hold the camera's current centre");
+    if (suggest_detail::InKeepOut(keep_out, cam.center()))
+      throw InputError(file, "{keep_out}", "camera '" + cam.id + "' is inside a keep-out box",
+                       "a keep-out box must not hold a selected camera's current centre");
+  }
+  if (!(clearance >= 0) || !std::isfinite(clearance))
+    throw InputError(file, "{clearance}", "must be a finite length >= 0 (metres)");
+  if (!(snap_move >= 0) || !std::isfinite(snap_move))
+    throw InputError(file, "{snap_move}", "must be a finite length >= 0");
+  if (!(snap_rotate_deg >= 0) || !std::isfinite(snap_rotate_deg))
+    throw InputError(file, "{snap_rotate_deg}", "must be a finite angle >= 0");
+  if (objective.k < 1 || objective.k > 64)
+    throw InputError(file, "{objective}", "k must be in 1..64");
+}
 
 // ---------------------------------------------------------------------------------------------
 // Exact evaluation of a whole rig, and the baseline

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "analysis/geometry/camera.h"
+#include "analysis/scene/ptz.h"
 #include "analysis/util/error.h"
 #include "app/session/study.h"
 
