@@ -53,12 +53,26 @@ const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
   return kFlags;
 }
 
+const std::vector<std::string>& FieldsWithoutFlag() {
+  // The typed camera edits' values (app/session/camera_edits.h): Python and the viewer set them.
+  static const std::vector<std::string> kFields{"position", "look_at", "rotation"};
+  return kFields;
+}
+
 std::string CommandLineFlag(const std::string& field) {
   for (const auto& [name, flag] : CommandLineFlags())
     if (name == field) return flag;
   return {};
 }
 
-InputError ForCommandLine(const InputError& e) { return RenameOptions(e, CommandLineFlag); }
+InputError ForCommandLine(const InputError& e) {
+  return RenameOptions(e, [](const std::string& field) {
+    const std::string flag = CommandLineFlag(field);
+    if (!flag.empty()) return flag;
+    for (const std::string& f : FieldsWithoutFlag())
+      if (f == field) return field;
+    return std::string();
+  });
+}
 
 }  // namespace pandora::app

@@ -15,10 +15,14 @@ namespace pandora::app {
 /// Every (field, flag) pair, in no particular order.
 const std::vector<std::pair<std::string, std::string>>& CommandLineFlags();
 
+/// The fields no command sets (a library names them for Python and the viewer): the command line
+/// writes them as their names.
+const std::vector<std::string>& FieldsWithoutFlag();
+
 /// The flag of `field` ("max_move" -> "--max-move"); empty when the table has none.
 std::string CommandLineFlag(const std::string& field);
 
-/// `e` with its `{field}` names written as flags.
+/// `e` with its `{field}` names written as flags (FieldsWithoutFlag as their names).
 InputError ForCommandLine(const InputError& e);
 
 }  // namespace pandora::app
