@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -161,6 +162,15 @@ void BindEvaluate(py::module_& m) {
         o.fields = fields.empty() ? scene.study.fields : fields;
         o.scene_path = scene.path;
         o.memory_budget_bytes = scene.study.memory_budget_bytes;
+        // A script names the fields it wants: pixel targets and DORI where those fields hold what
+        // they need (analyze, which evaluates the study's fields or --fields, refuses instead).
+        auto has = [&o](const char* f) {
+          return std::find(o.fields.begin(), o.fields.end(), f) != o.fields.end();
+        };
+        if (!fields.empty()) {
+          analysis.pixel_targets = has("coverage") && has("cameras");
+          analysis.dori = has("coverage") && has("resolution");
+        }
         PyFields out;
         out.study = s.study;
         session::RigAnalysis result;
