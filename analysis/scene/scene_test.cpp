@@ -38,11 +38,12 @@ using json = nlohmann::json;
 // -------------------------------------------------------------------------------------------------
 // Helpers.
 
-// The repository root: two levels above this source file, or the working directory (ctest runs the
-// tests from the root).
+// The repository root: the first folder above this source file that holds tests/data, or the
+// working directory (ctest runs the tests from the root).
 fs::path SourceRoot() {
-  const fs::path from_file = fs::path(__FILE__).parent_path().parent_path();
-  if (fs::exists(from_file / "tests" / "data")) return from_file;
+  for (fs::path p = fs::path(__FILE__).parent_path(); !p.empty() && p != p.parent_path();
+       p = p.parent_path())
+    if (fs::exists(p / "tests" / "data")) return p;
   return fs::current_path();
 }
 
