@@ -125,3 +125,33 @@ def test_render_is_a_finite_image():
     assert np.isfinite(img).all() and img.max() > 0
     plan = pandora.render(scene, rig, width=160, height=100, plan="plan")
     assert plan.shape == (100, 160, 3) and not np.array_equal(plan, img)
+
+
+def test_evaluate_returns_what_analyze_returns(tmp_path):
+    """One conductor (app/session/analyze.h): evaluate's summary equals `pandora analyze`'s
+    summary.json but for timings, on the mocap lab (people over six poses, body targets, pixel
+    targets, N-1), and its grids include analyze's derived ones."""
+    import subprocess
+
+    binary = pathlib.Path(pandora.__file__).resolve().parent.parent / "pandora"
+    scene_path = str(SOURCE / "examples" / "mocap_lab" / "scene.json")
+    subprocess.run([str(binary), "analyze", scene_path, "--rig", "ring", "--out",
+                    str(tmp_path / "out"), "--quiet"], check=True)
+    analyzed = json.loads((tmp_path / "out" / "summary.json").read_text())
+    scene = pandora.load_scene(scene_path)
+    fields = pandora.evaluate(scene, scene.rig("ring"))
+
+    def without_timings(d):
+        if isinstance(d, dict):
+            return {k: without_timings(v) for k, v in d.items()
+                    if k not in ("timing", "run_id", "seconds", "parts_seconds")}
+        if isinstance(d, list):
+            return [without_timings(x) for x in d]
+        return d
+
+    expected, got = without_timings(analyzed), without_timings(fields.summary)
+    for key in ("time", "targets", "pixel_targets", "robustness", "warnings"):
+        assert key in got, key
+    assert got == expected
+    for grid in ("coverage_min", "coverage_time_share", "coverage_n1", "pixels_marker"):
+        assert grid in fields.names, grid
