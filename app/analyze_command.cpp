@@ -257,7 +257,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
     return [&time_bar](double f) { time_bar->Update(f); };
   };
   session::RigAnalysis result =
-      session::CompleteAnalysis(scene, study->caster(), rig, fields, analysis);
+      session::CompleteAnalysis(scene, study->caster(), rig, fields, &fields, analysis);
   if (time_bar) time_bar->Finish();
   const Summary& typed = result.summary;
   const std::vector<Warning>& warnings = result.warnings;

@@ -280,14 +280,13 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     analysis.time_stage = [&](std::size_t) { return options.progress; };
     analysis.parts = parts.get();
-    analysis.add_grids = false;
     analysis.pixel_targets = analysis.dori = analysis.ptz = false;
     if (options.rig_started) options.rig_started(rig->name);
     RigReport r;
     r.rig = *rig;
     r.fields = EvaluateFields(scene, *rig, caster, field_options);
     session::RigAnalysis result =
-        session::CompleteAnalysis(scene, caster, *rig, r.fields, analysis);
+        session::CompleteAnalysis(scene, caster, *rig, r.fields, nullptr, analysis);
     r.summary = std::move(result.summary);
     r.warnings = std::move(result.warnings);
     data.rigs.push_back(std::move(r));

@@ -14,9 +14,9 @@
 namespace pandora::session {
 namespace {
 
-// The moving objects' part: the fields at every time sample (summary.time, and their grids with
-// add_grids), the surface targets at each, and the samples' labels.
-void AnalyzeOverTime(const Scene& scene, const Rig& rig, Fields& fields,
+// The moving objects' part: the fields at every time sample (summary.time, and their grids into
+// `grids` when given), the surface targets at each, and the samples' labels.
+void AnalyzeOverTime(const Scene& scene, const Rig& rig, Fields* grids,
                      const AnalyzeOptions& options, Summary& summary) {
   std::unique_ptr<RigidPartsRayCaster> built;
   double parts_seconds = 0;
@@ -36,7 +36,7 @@ void AnalyzeOverTime(const Scene& scene, const Rig& rig, Fields& fields,
         EvaluateFieldsOverTime(scene, rig, *parts, samples, over_time, scene.TimeMinCameras());
     result.summary.parts_seconds = parts_seconds;
     summary.time = result.summary;
-    if (options.add_grids) AddTimeGrids(&fields, &result);
+    if (grids) AddTimeGrids(grids, &result);
   }
   summary.targets = EvaluateSurfaceTargets(scene, rig, *parts, samples, scene.TimeMinCameras());
 }
@@ -44,11 +44,10 @@ void AnalyzeOverTime(const Scene& scene, const Rig& rig, Fields& fields,
 }  // namespace
 
 RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const Rig& rig,
-                             Fields& fields, const AnalyzeOptions& options) {
-  Fields* grids = options.add_grids ? &fields : nullptr;
+                             const Fields& fields, Fields* grids, const AnalyzeOptions& options) {
   Summary over_time;  // the parts computed before the summary, moved into it below
   if (scene.Animated() || scene.study.targets)
-    AnalyzeOverTime(scene, rig, fields, options, over_time);
+    AnalyzeOverTime(scene, rig, grids, options, over_time);
   // Pixel-size targets and DORI classes, from the fields without casting again.
   std::vector<PixelTargetSummary> pixel_targets;
   if (options.pixel_targets)
@@ -67,13 +66,13 @@ RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const 
   s.sample_labels = std::move(over_time.sample_labels);
   s.pixel_targets = std::move(pixel_targets);
   s.dori = dori;
-  if (scene.study.calibration)
+  if (options.calibration && scene.study.calibration)
     s.calibration = SimulateCalibration(scene, rig, caster, *scene.study.calibration);
   // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets
   // (docs/failures.md).
-  if (HasCameraSets(fields)) {
+  if (options.robustness && HasCameraSets(fields)) {
     s.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
-    if (options.add_grids) AddCoverageN1Grid(&fields);
+    if (grids) AddCoverageN1Grid(grids);
   }
   // PTZ cameras: reach times, reachable shares, tours (docs/ptz.md).
   if (options.ptz && RigHasPtz(rig)) s.ptz = EvaluatePtzFields(scene, rig, caster, fields, grids);
@@ -84,7 +83,8 @@ RigFieldsAnalysis AnalyzeRig(const Study& study, const Rig& rig, const AnalyzeOp
   FieldOptions field_options = options.fields;
   if (!field_options.solid_trees) field_options.solid_trees = &study.solid_trees();
   RigFieldsAnalysis out{EvaluateFields(study.scene(), rig, study.caster(), field_options), {}};
-  out.analysis = CompleteAnalysis(study.scene(), study.caster(), rig, out.fields, options);
+  out.analysis =
+      CompleteAnalysis(study.scene(), study.caster(), rig, out.fields, &out.fields, options);
   return out;
 }
 

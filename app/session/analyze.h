@@ -37,10 +37,9 @@ struct AnalyzeOptions {
   /// The scene's rigid parts (MakeSceneParts), when the caller keeps them for several rigs; null:
   /// built here when needed, and their build time recorded (time.parts_seconds).
   const RigidPartsRayCaster* parts = nullptr;
-  /// Add the derived grids (time, pixels_*, dori, coverage_n1, ptz_*) to the fields.
-  bool add_grids = true;
-  /// The steps the report has no section for yet; every other front end runs them.
-  bool pixel_targets = true, dori = true, ptz = true;
+  /// The steps a front end may leave out: the report has no section for pixel targets, DORI and
+  /// PTZ yet; the viewer's Compare shows the headline numbers only.
+  bool pixel_targets = true, dori = true, ptz = true, calibration = true, robustness = true;
 };
 
 /// What CompleteAnalysis adds: the full typed summary and its warnings (also in summary.warnings).
@@ -49,11 +48,12 @@ struct RigAnalysis {
   std::vector<Warning> warnings;
 };
 
-/// Everything after the fields of `rig` (see the file comment); with options.add_grids the derived
-/// grids go into `fields`. Throws InputError as the steps do (pixel targets need the "cameras"
-/// field, DORI the "resolution" field).
+/// Everything after the fields of `rig` (see the file comment). With `grids` (usually &fields) the
+/// derived grids (time, pixels_*, dori, coverage_n1, ptz_*) go into it; null: `fields` is only
+/// read. Throws InputError as the steps do (pixel targets need the "cameras" field, DORI the
+/// "resolution" field).
 RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const Rig& rig,
-                             Fields& fields, const AnalyzeOptions& options);
+                             const Fields& fields, Fields* grids, const AnalyzeOptions& options);
 
 /// EvaluateFields(study, rig, options.fields) and then CompleteAnalysis: one rig's whole analysis.
 struct RigFieldsAnalysis {

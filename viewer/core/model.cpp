@@ -11,6 +11,7 @@
 #include "analysis/util/error.h"
 #include "analysis/util/output_transaction.h"
 #include "analysis/util/units.h"
+#include "app/session/analyze.h"
 #include "app/session/autosave.h"
 #include "app/session/camera_edits.h"
 #include "app/session/ptz_edit.h"
@@ -325,16 +326,24 @@ void ViewerModel::Compare(const Action& a) {
   // The edited rig: its live fields once they have caught up.
   const session::JobStatus s = session_->WaitFields();
   if (s.state == session::JobState::kFailed && s.exception) std::rethrow_exception(s.exception);
-  // Moving objects: the numbers over the time samples too, as `pandora analyze` gives them (the
-  // live fields are the static scene's: the volume without the people).
-  auto over_time = [&](const Rig& r, Summary* summary) {
-    summary->time = session_->EvaluateOverTime(r);
+  // Each rig's numbers as `pandora analyze` gives them, through the same conductor
+  // (app/session/analyze.h): the warnings and, with moving objects, the numbers over the time
+  // samples (the live fields are the static scene's: the volume without the people). The headline
+  // rows only: no calibration, N-1, pixel targets, DORI or PTZ.
+  session::AnalyzeOptions analysis;
+  analysis.fields.fields = names;
+  analysis.fields.scene_path = scene().path;
+  analysis.threads = 1;
+  analysis.pixel_targets = analysis.dori = analysis.ptz = false;
+  analysis.calibration = analysis.robustness = false;
+  auto summarize = [&](const Rig& r, const Fields& f) {
+    return session::CompleteAnalysis(scene(), session_->study().caster(), r, f, nullptr, analysis)
+        .summary;
   };
   std::vector<Summary> summaries;
-  session_->ReadFields([&](const Fields& f, std::int64_t) {
-    summaries.push_back(Summarize(scene(), rig(), f, names, 1));
-  });
-  over_time(rig(), &summaries.back());
+  // The fields have caught up (WaitFields): no update waits on this read meanwhile.
+  session_->ReadFields(
+      [&](const Fields& f, std::int64_t) { summaries.push_back(summarize(rig(), f)); });
   summaries.back().rig = rig().name + " (edited)";
   for (std::size_t i = 0; i < others.size(); ++i) {
     const Rig& other = *others[i];
@@ -353,12 +362,9 @@ void ViewerModel::Compare(const Action& a) {
       if (hit != compare_cache_.end()) {
         summary = hit->summary;
       } else {
-        FieldOptions fo;
-        fo.fields = names;
-        fo.scene_path = scene().path;
-        const Fields f = EvaluateFields(scene(), other, session_->study().caster(), fo);
-        summary = Summarize(scene(), other, f, names, 1);
-        over_time(other, &summary);
+        const Fields f =
+            EvaluateFields(scene(), other, session_->study().caster(), analysis.fields);
+        summary = summarize(other, f);
         compare_cache_.push_back({other, summary});
         if (compare_cache_.size() > 8) compare_cache_.erase(compare_cache_.begin());
       }
