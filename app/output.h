@@ -32,24 +32,6 @@ void AddSceneInputs(OutputTransaction& transaction, const Scene& scene);
 /// own view and contours). Throws InputError naming the option otherwise.
 std::pair<int, int> ParseImageSize(const std::string& option, const std::string& text);
 
-/// Library option names and the command-line flags that set them, e.g. {"view_width", "--width"}.
-using FlagNames = std::vector<std::pair<std::string, std::string>>;
-
-/// Runs `fn` and returns its result; an InputError about a library option (its file() is one of
-/// the names in `flags`, its JSON path empty) is thrown again naming the flag instead, so the
-/// one-line message names what the user typed. Other errors pass unchanged.
-template <class Fn>
-auto WithFlagNames(const FlagNames& flags, Fn&& fn) -> decltype(fn()) {
-  try {
-    return fn();
-  } catch (const InputError& e) {
-    if (e.json_path().empty())
-      for (const auto& [name, flag] : flags)
-        if (e.file() == name) throw InputError(flag, "", e.reason(), e.hint());
-    throw;
-  }
-}
-
 /// A one-line progress bar on stderr, drawn only when stderr is a terminal. Thread-safe; redraws at
 /// most ten times a second.
 class ProgressBar {

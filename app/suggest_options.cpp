@@ -1,6 +1,5 @@
 #include "app/suggest_options.h"
 
-#include <cctype>
 #include <cmath>
 
 #include "analysis/scene/motion.h"

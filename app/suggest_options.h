@@ -5,7 +5,6 @@
 /// prefixes), keep-out boxes, the objective. Every error names the option as its field
 /// (`{max_move}`), which each front end writes its own way (analysis/util/error.h).
 
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>

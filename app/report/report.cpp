@@ -266,6 +266,8 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
   // every rig.
   std::unique_ptr<RigidPartsRayCaster> parts;
   if (scene.Animated() || scene.study.targets) parts = MakeSceneParts(scene);
+  const int threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   for (const Rig* rig : rigs) {
     // The analysis every front end runs (app/session/analyze.h), without the parts the report has
     // no section for yet (pixel targets, DORI, PTZ) and without derived grids.
@@ -276,8 +278,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
     field_options.memory_budget_bytes = scene.study.memory_budget_bytes;
     if (adjusted) field_options.voxel_size_option = "{voxel_size}";
     field_options.progress = options.progress;
-    analysis.threads = static_cast<int>(
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    analysis.threads = threads;
     analysis.time_stage = [&](std::size_t) { return options.progress; };
     analysis.parts = parts.get();
     analysis.pixel_targets = analysis.dori = analysis.ptz = false;
