@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "analysis/util/error.h"
+#include "analysis/util/text.h"
 #include "app/commands.h"
 #include "app/flags.h"
 #include "app/mpi_session.h"
@@ -82,21 +83,6 @@ void RefuseEmptyValues(CLI::App* app) {
   for (CLI::App* sub : app->get_subcommands({})) RefuseEmptyValues(sub);
 }
 
-std::size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 // A parse error in Pandora's one-line format: what the parser found, and where to read more.
 int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
   std::string message = e.what();
@@ -118,7 +104,7 @@ int ReportParseError(const CLI::App& app, const CLI::ParseError& e) {
     std::size_t best = 3;  // suggest a command at most two edits away
     for (const std::string& n : names) {
       list += (list.empty() ? "" : ", ") + n;
-      const std::size_t d = EditDistance(word, n);
+      const std::size_t d = pandora::EditDistance(word, n);
       if (d < best) best = d, closest = n;
     }
     const std::string hint = closest.empty()

@@ -12,6 +12,7 @@
 #include "analysis/geometry/camera.h"
 #include "analysis/scene/scene_text.h"
 #include "analysis/util/error.h"
+#include "analysis/util/json_reader.h"
 #include "analysis/util/sha256.h"
 #include "analysis/util/units.h"
 #include "suggest/suggestion_file.h"
@@ -423,42 +424,26 @@ std::string ReplacePtzTour(const std::string& text, const std::string& path, con
   return scene_text::DumpLike(root, text);
 }
 
-std::string AcceptPtzSuggestion(const std::string& suggestion_text,
-                                const std::string& suggestion_path, bool force,
-                                std::string* scene_path, std::string* what) {
-  json j;
-  try {
-    j = json::parse(suggestion_text);
-  } catch (const std::exception& e) {
-    throw InputError(suggestion_path, "$", std::string("malformed JSON: ") + e.what());
-  }
-  auto fail = [&](const std::string& at, const std::string& why) {
-    throw InputError(suggestion_path, at, why, "is this a file written by pandora suggest?");
-  };
-  if (!j.is_object() || !j.contains("kind") || !j["kind"].is_string())
-    fail("$.kind", "missing or not a string");
-  const std::string kind = j["kind"].get<std::string>();
-  if (kind != "ptz_preset" && kind != "ptz_tour") fail("$.kind", "unknown kind '" + kind + "'");
-  if (!j.contains("scene") || !j["scene"].is_object() || !j["scene"].contains("path") ||
-      !j["scene"]["path"].is_string() || !j["scene"].contains("sha256") ||
-      !j["scene"]["sha256"].is_string())
-    fail("$.scene", "expected {\"path\", \"sha256\"}");
-  if (!j.contains("rig") || !j["rig"].is_string()) fail("$.rig", "missing or not a string");
-  if (!j.contains("improved") || !j["improved"].is_boolean())
-    fail("$.improved", "missing or not true/false");
-  if (!j.contains("ptz") || !j["ptz"].is_object()) fail("$.ptz", "missing or not an object");
-  const json& p = j["ptz"];
-  if (!p.contains("camera") || !p["camera"].is_string())
-    fail("$.ptz.camera", "missing or not a string");
-  if (!j["improved"].get<bool>())
+std::string AcceptPtzSuggestion(const JsonNode& root, bool force, std::string* scene_path,
+                                std::string* what) {
+  const std::string& suggestion_path = root.file();
+  root.ExpectObject();
+  const std::string kind = root.Get("kind").Enum({"ptz_preset", "ptz_tour"});
+  const JsonNode scene = root.Get("scene");
+  scene.ExpectObject("a scene {\"path\", \"sha256\"}");
+  *scene_path = scene.Get("path").String();
+  const std::string sha256 = scene.Get("sha256").String();
+  const std::string rig = root.Get("rig").String();
+  const bool improved = root.Get("improved").Bool();
+  const JsonNode p = root.Get("ptz");
+  p.ExpectObject();
+  const std::string camera = p.Get("camera").String();
+  if (!improved)
     throw InputError(suggestion_path, "$.improved",
                      "the suggestion offers no improvement; nothing to accept",
                      "run pandora suggest with another target");
-  const std::string rig = j["rig"].get<std::string>();
-  const std::string camera = p["camera"].get<std::string>();
-  *scene_path = j["scene"]["path"].get<std::string>();
   const std::string scene_text = scene_text::ReadJsonText(*scene_path, "scene file");
-  if (Sha256Hex(scene_text) != j["scene"]["sha256"].get<std::string>() && !force)
+  if (Sha256Hex(scene_text) != sha256 && !force)
     throw InputError(*scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with {force}");
@@ -479,42 +464,35 @@ std::string AcceptPtzSuggestion(const std::string& suggestion_text,
   int preset_index = -1;
   std::vector<int> order;
   if (kind == "ptz_preset") {
-    if (!p.contains("preset") || !p["preset"].is_string())
-      fail("$.ptz.preset", "missing or not a string");
-    const std::string preset = p["preset"].get<std::string>();
+    const std::string preset = p.Get("preset").String();
     for (std::size_t i = 0; i < head.presets.size(); ++i)
       if (head.presets[i].name == preset) preset_index = static_cast<int>(i);
     if (preset_index < 0)
       throw InputError(*scene_path, "", "camera '" + camera + "' has no preset '" + preset + "'",
                        "the scene file no longer matches the suggestion");
-    const json& a = p.value("after", json());
-    for (const char* key : {"pan_deg", "tilt_deg", "hfov_deg"})
-      if (!a.is_object() || !a.contains(key) || !a[key].is_number() ||
-          !std::isfinite(a[key].get<double>()))
-        fail(std::string("$.ptz.after.") + key, "missing or not a finite number");
+    const JsonNode after = p.Get("after");
+    const double pan = after.Get("pan_deg").Number(), tilt = after.Get("tilt_deg").Number(),
+                 hfov = after.Get("hfov_deg").Number();
     const Intrinsics& k = cam->model.intrinsics();
     const bool zooms = head.focal_max > head.focal_min;
-    const double hfov = a["hfov_deg"].get<double>();
-    expected_state = {a["pan_deg"].get<double>(), a["tilt_deg"].get<double>(),
+    expected_state = {pan, tilt,
                       zooms ? FocalFromHfov(hfov * kPi / 180.0, k.width, k.model)
                             : head.presets[preset_index].state.focal};
     new_text = ReplacePtzPreset(scene_text, *scene_path, rig, camera, preset, expected_state,
                                 zooms ? hfov : 0.0);
     *what = camera + " preset " + preset;
   } else {
-    if (!p.contains("tour_after") || !p["tour_after"].is_array())
-      fail("$.ptz.tour_after", "missing or not an array");
+    const JsonNode tour_after = p.Get("tour_after");
+    const std::size_t n = tour_after.ArraySize("an array of the tour's stops");
     std::vector<char> used(head.tour.size(), 0);
-    for (const json& v : p["tour_after"]) {
-      if (!v.is_number_integer() || v.get<long long>() < 0 ||
-          v.get<long long>() >= static_cast<long long>(head.tour.size()) ||
-          used[v.get<std::size_t>()])
-        fail("$.ptz.tour_after", "not an order of the tour's stops");
-      used[v.get<std::size_t>()] = 1;
-      order.push_back(v.get<int>());
+    for (std::size_t i = 0; i < n; ++i) {
+      const int stop = tour_after.At(i).Integer(0, static_cast<int>(head.tour.size()) - 1);
+      if (used[static_cast<std::size_t>(stop)]) tour_after.At(i).Fail("a stop is named twice");
+      used[static_cast<std::size_t>(stop)] = 1;
+      order.push_back(stop);
     }
     if (order.size() != head.tour.size())
-      fail("$.ptz.tour_after", "not an order of the tour's stops");
+      tour_after.Fail("not an order of the tour's " + std::to_string(head.tour.size()) + " stops");
     new_text = ReplacePtzTour(scene_text, *scene_path, rig, camera, order);
     *what = camera + " tour";
   }

@@ -17,6 +17,8 @@
 
 namespace pandora {
 
+class JsonNode;
+
 /// Which target points a setting of a PTZ camera sees: PtzSees at `min_px_per_m` and, when it does,
 /// the occlusion segment from the setting's centre (cast once per point when the offset is zero:
 /// the pivot is every setting's centre).
@@ -133,12 +135,11 @@ std::string ReplacePtzTour(const std::string& scene_text, const std::string& sce
                            const std::string& rig, const std::string& camera,
                            const std::vector<int>& tour_order);
 
-/// `pandora accept` of a PTZ suggestion file (its JSON text already read): checks it as
+/// `pandora accept` of a PTZ suggestion file (already parsed, `suggestion` its root): checks it as
 /// AcceptSuggestion does (improved, scene unchanged unless `force`), rewrites the preset or the
 /// tour, parses the result back and checks that exactly that changed, then replaces the scene file
 /// with a backup. Returns the backup path; `what` receives e.g. "dome preset window".
-std::string AcceptPtzSuggestion(const std::string& suggestion_text,
-                                const std::string& suggestion_path, bool force,
-                                std::string* scene_path, std::string* what);
+std::string AcceptPtzSuggestion(const JsonNode& suggestion, bool force, std::string* scene_path,
+                                std::string* what);
 
 }  // namespace pandora

@@ -19,6 +19,7 @@
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "analysis/util/json_reader.h"
 #include "analysis/util/output_transaction.h"
 #include "analysis/util/sha256.h"
 #include "analysis/util/units.h"
@@ -66,30 +67,14 @@ json PoseJson(const Eigen::Isometry3d& pose) {
   return json{{"position", {p.x(), p.y(), p.z()}}, {"quaternion", {q.w(), q.x(), q.y(), q.z()}}};
 }
 
-// A JSON file's text: a regular file of bounded size, nesting checked before any parser sees it.
-
-Vec3 ReadVec3(const json& j, const std::string& file, const std::string& path) {
-  if (!j.is_array() || j.size() != 3) throw InputError(file, path, "expected [x, y, z]");
-  Vec3 v;
-  for (int i = 0; i < 3; ++i) {
-    if (!j[i].is_number()) throw InputError(file, path, "expected numbers");
-    v[i] = j[i].get<double>();
-  }
-  return v;
-}
-
-Eigen::Isometry3d ReadPose(const json& j, const std::string& file, const std::string& path) {
-  if (!j.is_object() || !j.contains("position") || !j.contains("quaternion"))
-    throw InputError(file, path, "expected {\"position\", \"quaternion\"}");
-  const Vec3 p = ReadVec3(j["position"], file, path + ".position");
-  const json& q = j["quaternion"];
-  if (!q.is_array() || q.size() != 4)
-    throw InputError(file, path + ".quaternion", "expected [w, x, y, z]");
-  for (int i = 0; i < 4; ++i)
-    if (!q[i].is_number()) throw InputError(file, path + ".quaternion", "expected numbers");
-  Eigen::Quaterniond quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(),
-                          q[3].get<double>());
-  if (!(quat.norm() > 0.5)) throw InputError(file, path + ".quaternion", "not a unit quaternion");
+// A pose {"position": [x, y, z], "quaternion": [w, x, y, z]} (normalised).
+Eigen::Isometry3d ReadPose(const JsonNode& node) {
+  node.ExpectObject("a pose {\"position\", \"quaternion\"}");
+  const Vec3 p = node.Get("position").Numbers(3);
+  const JsonNode q = node.Get("quaternion");
+  const Eigen::VectorXd w = q.Numbers(4);
+  Eigen::Quaterniond quat(w[0], w[1], w[2], w[3]);
+  if (!(quat.norm() > 0.5)) q.Fail("not a unit quaternion");
   quat.normalize();
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = quat.toRotationMatrix();
@@ -416,22 +401,14 @@ std::string ReplaceStations(const std::string& text, const std::string& scene_pa
 }
 
 AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOptions& options) {
-  const std::string text = ReadJsonText(suggestion_path, "suggestion file");
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(suggestion_path, "$", std::string("malformed JSON: ") + e.what());
-  }
-  auto need = [&](const char* key, bool (json::*is)() const noexcept) -> const json& {
-    if (!j.is_object() || !j.contains(key) || !(j[key].*is)())
-      throw InputError(suggestion_path, std::string("$.") + key, "missing or of the wrong type",
-                       "is this a file written by pandora suggest?");
-    return j[key];
-  };
-  need("pandora_suggestion", &json::is_number);
+  const json j = ReadJsonFile(suggestion_path, "suggestion file");
+  const JsonNode root = JsonNode::Root(j, suggestion_path);
+  if (!j.is_object() || !j.contains("pandora_suggestion"))
+    root.Fail("not a suggestion file: no \"pandora_suggestion\" key",
+              "is this a file written by pandora suggest?");
+  root.Get("pandora_suggestion").Number();
   // A PTZ controller suggestion (a preset's setting or a tour's order; suggest/ptz_suggest.h).
-  if (j.is_object() && j.contains("kind") && j["kind"].is_string() &&
+  if (j.contains("kind") && j["kind"].is_string() &&
       j["kind"].get<std::string>().rfind("ptz_", 0) == 0) {
     if (!options.cameras.empty())
       throw InputError("{cameras}", "",
@@ -439,55 +416,54 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
                        "leave out {cameras}");
     AcceptResult result;
     std::string what;
-    result.backup_path =
-        AcceptPtzSuggestion(text, suggestion_path, options.force, &result.scene_path, &what);
+    result.backup_path = AcceptPtzSuggestion(root, options.force, &result.scene_path, &what);
     result.accepted.push_back(what);
     return result;
   }
-  const json& scene_j = need("scene", &json::is_object);
-  const std::string rig = need("rig", &json::is_string).get<std::string>();
-  const bool improved = need("improved", &json::is_boolean).get<bool>();
-  const json& cams = need("cameras", &json::is_array);
-  if (!scene_j.contains("path") || !scene_j["path"].is_string() || !scene_j.contains("sha256") ||
-      !scene_j["sha256"].is_string())
-    throw InputError(suggestion_path, "$.scene", "expected {\"path\", \"sha256\"}");
+  const JsonNode scene = root.Get("scene");
+  scene.ExpectObject("a scene {\"path\", \"sha256\"}");
+  const std::string rig = root.Get("rig").String();
+  const bool improved = root.Get("improved").Bool();
+  const JsonNode cams = root.Get("cameras");
+  const std::size_t camera_count = cams.ArraySize("an array of cameras");
+  AcceptResult result;
+  result.scene_path = scene.Get("path").String();
+  const std::string scene_sha256 = scene.Get("sha256").String();
   if (!improved)
     throw InputError(suggestion_path, "$.improved",
                      "the suggestion offers no improvement; nothing to accept",
                      "run pandora suggest with other limits or cameras");
-  if (j.contains("perturbed_for_benchmark") && j["perturbed_for_benchmark"] == true)
+  if (root.Has("perturbed_for_benchmark") && root.Get("perturbed_for_benchmark").Bool())
     throw InputError(
         suggestion_path, "$.perturbed_for_benchmark",
         "this suggestion was made from perturbed poses ({perturb}), not the scene file's",
         "run pandora suggest without {perturb}");
-  AcceptResult result;
-  result.scene_path = scene_j["path"].get<std::string>();
   double snap_move = 0;
-  if (j.contains("snap") && j["snap"].is_object() && j["snap"].contains("move_m") &&
-      j["snap"]["move_m"].is_number())
-    snap_move = std::max(0.0, j["snap"]["move_m"].get<double>());
+  if (const auto snap = root.Find("snap"))
+    if (const auto move = snap->Find("move_m")) snap_move = move->NonNegative();
 
   std::vector<PoseUpdate> updates;
   std::map<std::string, PoseUpdate> offered;
   std::vector<std::string> order;
-  for (std::size_t c = 0; c < cams.size(); ++c) {
-    const std::string where = "$.cameras[" + std::to_string(c) + "]";
-    if (!cams[c].is_object() || !cams[c].contains("id") || !cams[c]["id"].is_string())
-      throw InputError(suggestion_path, where + ".id", "missing camera id");
-    const std::string id = cams[c]["id"].get<std::string>();
-    const json after = cams[c].value("after", json());
-    PoseUpdate u{id, ReadPose(after, suggestion_path, where + ".after"), std::nullopt, snap_move};
-    if (after.is_object() && after.contains("focal_px")) {
-      const json& f = after["focal_px"];
-      if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_number() ||
-          !(f[0].get<double>() > 0) || !(f[1].get<double>() > 0))
-        throw InputError(suggestion_path, where + ".after.focal_px", "expected [fx, fy], positive");
-      u.focal_px = Vec2(f[0].get<double>(), f[1].get<double>());
+  for (std::size_t c = 0; c < camera_count; ++c) {
+    const JsonNode cam = cams.At(c);
+    cam.ExpectObject();
+    const std::string id = cam.Get("id").NonEmptyString();
+    const JsonNode after = cam.Get("after");
+    PoseUpdate u{id, ReadPose(after), std::nullopt, snap_move};
+    if (const auto f = after.Find("focal_px")) {
+      const Eigen::VectorXd focal = f->Numbers(2);
+      if (!(focal[0] > 0) || !(focal[1] > 0)) f->Fail("expected [fx, fy], positive");
+      u.focal_px = Vec2(focal[0], focal[1]);
     }
     offered[id] = u;
-    // Accepting everything leaves the cameras the search did not move as the user wrote them.
-    const bool moved = !(cams[c].value("move_m", 1.0) == 0.0 &&
-                         cams[c].value("rotate_deg", 1.0) == 0.0 && !u.focal_px);
+    // Accepting everything leaves the cameras the search did not move as the user wrote them
+    // (a move written as null, not finite, counts as a move).
+    const auto unmoved = [&cam](const char* key) {
+      const auto n = cam.Find(key);
+      return n && n->value().is_number() && n->value().get<double>() == 0.0;
+    };
+    const bool moved = !(unmoved("move_m") && unmoved("rotate_deg") && !u.focal_px);
     if (moved || !options.cameras.empty()) order.push_back(id);
   }
   std::vector<std::string> chosen = options.cameras.empty() ? order : options.cameras;
@@ -504,7 +480,7 @@ AcceptResult AcceptSuggestion(const std::string& suggestion_path, const AcceptOp
   }
 
   const std::string scene_text = ReadJsonText(result.scene_path, "scene file");
-  if (Sha256Hex(scene_text) != scene_j["sha256"].get<std::string>() && !options.force)
+  if (Sha256Hex(scene_text) != scene_sha256 && !options.force)
     throw InputError(result.scene_path, "",
                      "the scene file changed since the suggestion was made (SHA-256 differs)",
                      "run pandora suggest again, or accept with {force}");

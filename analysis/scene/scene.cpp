@@ -21,8 +21,10 @@
 #include "analysis/util/allocation_budget.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "analysis/util/json_reader.h"
 #include "analysis/util/palette.h"
 #include "analysis/util/sha256.h"
+#include "analysis/util/text.h"
 #include "analysis/util/units.h"
 
 namespace pandora {
@@ -53,67 +55,6 @@ std::string Short(double v) {
   return text;
 }
 
-std::string Quoted(const std::string& s) { return "'" + s + "'"; }
-
-std::string JoinQuoted(const std::vector<std::string>& items) {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + Quoted(items[i]);
-  return out;
-}
-
-size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// "did you mean 'X'? " when a candidate is close to `word` (by edit distance, or as a prefix), then
-// the list of candidates.
-std::string SuggestionHint(const std::string& word, const std::vector<std::string>& candidates,
-                           const std::string& what) {
-  std::string best;
-  size_t best_distance = std::string::npos;
-  for (const std::string& c : candidates) {
-    size_t d = EditDistance(word, c);
-    const bool prefix = word.size() >= 3 && (c.rfind(word, 0) == 0 || word.rfind(c, 0) == 0);
-    const size_t limit = std::max<size_t>(2, c.size() / 3);
-    if (d > limit && !prefix) continue;
-    if (prefix) d = std::min(d, limit);
-    if (d < best_distance) {
-      best_distance = d;
-      best = c;
-    }
-  }
-  std::string hint;
-  if (!best.empty()) hint = "did you mean " + Quoted(best) + "? ";
-  return hint + what + ": " + JoinQuoted(candidates);
-}
-
-bool IsIdentifier(const std::string& key) {
-  if (key.empty() || std::isdigit(static_cast<unsigned char>(key[0]))) return false;
-  return std::all_of(key.begin(), key.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  });
-}
-
-// JSON path of member `key` of the value at `path`: $.a.b, or $.a["odd key"].
-std::string MemberPath(const std::string& path, const std::string& key) {
-  return IsIdentifier(key) ? path + "." + key : path + "[" + json(key).dump() + "]";
-}
-
-std::string ElementPath(const std::string& path, size_t index) {
-  return path + "[" + std::to_string(index) + "]";
-}
-
 // -------------------------------------------------------------------------------------------------
 // Reading JSON with paths.
 
@@ -125,90 +66,23 @@ struct Context {
   LoadOptions options;
 };
 
-// A JSON value with its path. Every accessor validates and throws an InputError naming the path.
-class Node {
+// A scene file's JSON value with its path (analysis/util/json_reader.h), plus what a scene adds:
+// lengths in the file's unit, the coordinate limit, colours and pixel noise.
+class Node : public JsonNode {
  public:
   Node(const json* value, std::string path, const Context* context)
-      : value_(value), path_(std::move(path)), context_(context) {}
+      : JsonNode(value, std::move(path), &context->file), context_(context) {}
+  Node(const JsonNode& node, const Context* context) : JsonNode(node), context_(context) {}
 
-  const json& value() const { return *value_; }
-  const std::string& path() const { return path_; }
   const Context& context() const { return *context_; }
 
-  [[noreturn]] void Fail(const std::string& reason, const std::string& hint = {}) const {
-    throw InputError(context_->file, path_, reason, hint);
-  }
-
-  // Objects.
-
-  void ExpectObject(const char* what = "an object") const {
-    if (!value_->is_object()) Fail(std::string("expected ") + what + ", got " + TypeName());
-  }
-
-  // Fails on the first key not in `allowed`, suggesting the closest allowed one.
-  void CheckKeys(const std::vector<std::string>& allowed) const {
-    ExpectObject();
-    for (const auto& item : value_->items()) {
-      if (std::find(allowed.begin(), allowed.end(), item.key()) != allowed.end()) continue;
-      throw InputError(context_->file, MemberPath(path_, item.key()),
-                       "unknown key " + Quoted(item.key()),
-                       SuggestionHint(item.key(), allowed, "allowed keys here"));
-    }
-  }
-
-  bool Has(const std::string& key) const { return value_->contains(key); }
-
   std::optional<Node> Find(const std::string& key) const {
-    const auto it = value_->find(key);
-    if (it == value_->end()) return std::nullopt;
-    return Node(&*it, MemberPath(path_, key), context_);
+    std::optional<JsonNode> child = JsonNode::Find(key);
+    if (!child) return std::nullopt;
+    return Node(*child, context_);
   }
-
-  Node Get(const std::string& key) const {
-    std::optional<Node> child = Find(key);
-    if (!child) Fail("missing required key " + Quoted(key));
-    return *child;
-  }
-
-  // The one key of `keys` present; fails when none or several are.
-  std::string OneOf(const std::vector<std::string>& keys, const std::string& what) const {
-    std::string found;
-    for (const std::string& key : keys) {
-      if (!Has(key)) continue;
-      if (!found.empty()) {
-        throw InputError(context_->file, MemberPath(path_, key),
-                         "both " + Quoted(found) + " and " + Quoted(key) + " are given",
-                         "give exactly one " + what + ": " + JoinQuoted(keys));
-      }
-      found = key;
-    }
-    if (found.empty()) Fail("missing " + what, "give exactly one of " + JoinQuoted(keys));
-    return found;
-  }
-
-  // Arrays.
-
-  size_t ArraySize(const char* what = "an array") const {
-    if (!value_->is_array()) Fail(std::string("expected ") + what + ", got " + TypeName());
-    return value_->size();
-  }
-
-  Node At(size_t i) const { return Node(&(*value_)[i], ElementPath(path_, i), context_); }
-
-  // Scalars.
-
-  double Number() const {
-    if (!value_->is_number()) Fail("expected a number, got " + TypeName());
-    const double v = value_->get<double>();
-    if (!std::isfinite(v)) Fail("number is not finite");
-    return v;
-  }
-
-  double Positive() const {
-    const double v = Number();
-    if (!(v > 0)) Fail("must be positive, got " + FormatNumber(v));
-    return v;
-  }
+  Node Get(const std::string& key) const { return Node(JsonNode::Get(key), context_); }
+  Node At(size_t i) const { return Node(JsonNode::At(i), context_); }
 
   // A pixel noise sigma: positive and within [1e-6, 1e6] pixels, so 1 / sigma^2 stays a normal
   // double in any information matrix.
@@ -216,12 +90,6 @@ class Node {
     const double v = Positive();
     if (v < 1e-6 || v > 1e6)
       Fail("pixel noise must be between 1e-6 and 1e6 pixels, got " + FormatNumber(v));
-    return v;
-  }
-
-  double NonNegative() const {
-    const double v = Number();
-    if (!(v >= 0)) Fail("must be zero or positive, got " + FormatNumber(v));
     return v;
   }
 
@@ -238,44 +106,6 @@ class Node {
                " m on coordinates and lengths",
            "check the number and the file's \"units\"");
     return metres;
-  }
-
-  int Integer(int min, int max) const {
-    const double v = Number();
-    if (v != std::floor(v)) Fail("expected an integer, got " + FormatNumber(v));
-    if (v < min || v > max) {
-      Fail("must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got " +
-           FormatNumber(v));
-    }
-    return static_cast<int>(v);
-  }
-
-  std::string String() const {
-    if (!value_->is_string()) Fail("expected a string, got " + TypeName());
-    return value_->get<std::string>();
-  }
-
-  std::string NonEmptyString() const {
-    std::string s = String();
-    if (s.empty()) Fail("must not be empty");
-    return s;
-  }
-
-  bool Bool() const {
-    if (!value_->is_boolean()) Fail("expected true or false, got " + TypeName());
-    return value_->get<bool>();
-  }
-
-  // An array of exactly `n` numbers.
-  Eigen::VectorXd Numbers(size_t n) const {
-    const std::string expected = "expected an array of " + std::to_string(n) + " numbers";
-    if (!value_->is_array()) Fail(expected + ", got " + TypeName());
-    if (value_->size() != n) {
-      Fail(expected + ", got an array of " + std::to_string(value_->size()));
-    }
-    Eigen::VectorXd v(n);
-    for (size_t i = 0; i < n; ++i) v[i] = At(i).Number();
-    return v;
   }
 
   Vec3 Vector3() const { return Numbers(3); }
@@ -296,8 +126,8 @@ class Node {
 
   // [r, g, b] linear in [0, 1], or "#rrggbb" in sRGB (converted to linear).
   Vec3 Color() const {
-    if (value_->is_string()) {
-      const std::string s = value_->get<std::string>();
+    if (value().is_string()) {
+      const std::string s = value().get<std::string>();
       const bool ok =
           s.size() == 7 && s[0] == '#' && std::all_of(s.begin() + 1, s.end(), [](char c) {
             return std::isxdigit(static_cast<unsigned char>(c));
@@ -308,7 +138,7 @@ class Node {
         color[i] = LinearFromSrgb(std::stoi(s.substr(1 + 2 * i, 2), nullptr, 16) / 255.0);
       return color;
     }
-    if (!value_->is_array()) {
+    if (!value().is_array()) {
       Fail("expected a colour: [r, g, b] with components in 0..1 or \"#rrggbb\", got " +
            TypeName());
     }
@@ -321,113 +151,9 @@ class Node {
     return color;
   }
 
-  std::string TypeName() const {
-    if (value_->is_number()) return "a number";
-    if (value_->is_string()) return "a string";
-    if (value_->is_boolean()) return "a boolean";
-    if (value_->is_array()) return "an array";
-    if (value_->is_object()) return "an object";
-    return "null";
-  }
-
  private:
-  const json* value_;
-  std::string path_;
   const Context* context_;
 };
-
-// -------------------------------------------------------------------------------------------------
-// Parsing the text, with the path of the value being read kept for error messages.
-
-// Follows the parser's position as a JSON path, and rejects duplicate keys.
-class PathTracker {
- public:
-  explicit PathTracker(const std::string& file) : file_(file) {}
-
-  // The path of the value the parser is reading now.
-  std::string CurrentPath() const {
-    if (stack_.empty()) return "$";
-    const Frame& top = stack_.back();
-    if (top.is_array) return ElementPath(top.path, top.count);
-    return top.key.empty() && top.keys.empty() ? top.path : MemberPath(top.path, top.key);
-  }
-
-  bool OnEvent(json::parse_event_t event, const json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start: {
-        Frame frame;
-        frame.is_array = event == json::parse_event_t::array_start;
-        frame.path = CurrentPath();
-        stack_.push_back(std::move(frame));
-        break;
-      }
-      case json::parse_event_t::key: {
-        Frame& top = stack_.back();
-        top.key = parsed.get<std::string>();
-        if (!top.keys.insert(top.key).second) {
-          throw InputError(file_, MemberPath(top.path, top.key), "duplicate key " + Quoted(top.key),
-                           "a key may appear once per object; the later value would replace the "
-                           "earlier one");
-        }
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        stack_.pop_back();
-        EndValue();
-        break;
-      case json::parse_event_t::value:
-        EndValue();
-        break;
-    }
-    return true;
-  }
-
- private:
-  struct Frame {
-    bool is_array = false;
-    size_t count = 0;  // Elements read so far (arrays).
-    std::string key;   // The current key (objects).
-    std::set<std::string> keys;
-    std::string path;
-  };
-
-  void EndValue() {
-    if (!stack_.empty() && stack_.back().is_array) ++stack_.back().count;
-  }
-
-  std::string file_;
-  std::vector<Frame> stack_;
-};
-
-json ParseJson(const std::string& text, const std::string& file) {
-  CheckJsonLimits(text, file);
-  PathTracker tracker(file);
-  try {
-    return json::parse(text, [&tracker](int, json::parse_event_t event, json& parsed) {
-      return tracker.OnEvent(event, parsed);
-    });
-  } catch (const json::parse_error& e) {
-    std::string message = e.what();
-    const size_t bracket = message.find("] ");
-    if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos) {
-      message = message.substr(bracket + 2);
-    }
-    const std::string where = tracker.CurrentPath();
-    throw InputError(file, "$", "malformed JSON: " + message,
-                     where == "$" ? "check the brackets, commas and quotes there"
-                                  : "the error is inside " + where +
-                                        "; check the brackets, commas and quotes there");
-  } catch (const json::exception& e) {
-    // Numbers too large for a double (1e400) end up here.
-    std::string message = e.what();
-    const size_t bracket = message.find("] ");
-    if (bracket != std::string::npos) message = message.substr(bracket + 2);
-    throw InputError(file, tracker.CurrentPath(), message,
-                     "numbers must be finite and within the range of a double");
-  }
-}
 
 // -------------------------------------------------------------------------------------------------
 // Scene parts.
@@ -565,7 +291,7 @@ int ResolveClip(const Node& node, const Skeleton& skeleton) {
     if (!skeleton.clips[i].name.empty()) names.push_back(skeleton.clips[i].name);
   }
   n->Fail("no clip " + Quoted(name) + " in the mesh file",
-          names.size() == std::size_t(count) ? SuggestionHint(name, names, "clips in this file")
+          names.size() == std::size_t(count) ? DidYouMean(name, names, "clips in this file")
                                              : "the clips: " + skeleton.ClipList());
 }
 
@@ -663,7 +389,7 @@ int ReadObjectMaterial(const Node& node, const std::map<std::string, int>& mater
       for (const auto& [k, v] : material_index) known.push_back(k);
       n->Fail("unknown material " + Quoted(material_name),
               known.empty() ? "define it under \"materials\""
-                            : SuggestionHint(material_name, known, "defined materials"));
+                            : DidYouMean(material_name, known, "defined materials"));
     }
     material = it->second;
   }
@@ -902,7 +628,7 @@ Intrinsics ReadIntrinsics(const Node& node) {
       d->CheckKeys({"model", "k1", "k2", "k3", "k4"});
     } else {
       model_node.Fail("unknown distortion model " + json(model).dump(),
-                      SuggestionHint(model, {"brown_conrady", "fisheye"}, "models"));
+                      DidYouMean(model, {"brown_conrady", "fisheye"}, "models"));
     }
     auto coefficient = [&d](const char* key, double* value) {
       if (auto n = d->Find(key)) *value = n->Number();
@@ -1090,7 +816,7 @@ void ReadPtzTour(const Node& node, PtzHead* head) {
       const std::string preset = name.NonEmptyString();
       const auto it = std::find(names.begin(), names.end(), preset);
       if (it == names.end())
-        name.Fail("no preset " + Quoted(preset), SuggestionHint(preset, names, "presets"));
+        name.Fail("no preset " + Quoted(preset), DidYouMean(preset, names, "presets"));
       PtzTourStop t;
       t.preset = static_cast<int>(it - names.begin());
       t.dwell_s = stop.Get("dwell_s").NonNegative();
@@ -1429,7 +1155,7 @@ Study ReadStudy(const Node& node) {
       for (const PixelTarget& t : study.pixel_targets) names.push_back(t.name);
       const auto it = std::find(names.begin(), names.end(), name);
       if (it == names.end())
-        n->Fail("no pixel target " + Quoted(name), SuggestionHint(name, names, "pixel_targets"));
+        n->Fail("no pixel target " + Quoted(name), DidYouMean(name, names, "pixel_targets"));
       study.ptz.pixel_target = name;
       study.ptz.min_px_per_m = study.pixel_targets[it - names.begin()].px_per_m();
     }
@@ -1453,7 +1179,7 @@ Study ReadStudy(const Node& node) {
     regions->ExpectObject("an object of named regions {\"box\": ...} or {\"mesh\": ...}");
     if (regions->value().size() > 64) regions->Fail("at most 64 named regions");
     for (const auto& item : regions->value().items()) {
-      const Node r(&item.value(), MemberPath(regions->path(), item.key()), &node.context());
+      const Node r(&item.value(), JsonMemberPath(regions->path(), item.key()), &node.context());
       if (item.key().empty()) r.Fail("region names must not be empty");
       study.regions.emplace_back(item.key(), ReadRegion(r, node));
     }
@@ -1680,7 +1406,7 @@ const Rig& Scene::FindRig(const std::string& name) const {
   for (const Rig& rig : rigs) names.push_back(rig.name);
   if (names.empty()) throw InputError(path, "$.rigs", "the scene has no rigs");
   throw InputError(path, "$.rigs", "no rig named " + Quoted(name),
-                   SuggestionHint(name, names, "rigs in this scene"));
+                   DidYouMean(name, names, "rigs in this scene"));
 }
 
 // "motions": {"GROUP": {"keyframes": [{"t", "move", "yaw_deg"}, ...]} | {"poses": {"NAME": {"move",
@@ -1714,7 +1440,7 @@ void ReadMotions(const Node& motions, Scene* scene) {
   motions.ExpectObject("an object of motions by group or object name");
   std::vector<int> owner(scene->objects.size(), -1);
   for (const auto& item : motions.value().items()) {
-    const Node m(&item.value(), MemberPath(motions.path(), item.key()), &motions.context());
+    const Node m(&item.value(), JsonMemberPath(motions.path(), item.key()), &motions.context());
     ObjectMotion motion;
     motion.name = item.key();
     Aabb bounds;
@@ -1731,7 +1457,7 @@ void ReadMotions(const Node& motions, Scene* scene) {
     }
     if (motion.objects.empty())
       m.Fail("no object or group named " + Quoted(motion.name),
-             SuggestionHint(motion.name, GroupNames(*scene), "objects and groups"));
+             DidYouMean(motion.name, GroupNames(*scene), "objects and groups"));
     if (!bounds.empty())
       motion.anchor = Vec3(bounds.center().x(), bounds.center().y(), bounds.min.z());
     m.CheckKeys({"keyframes", "poses", "random"});
@@ -1756,7 +1482,7 @@ void ReadMotions(const Node& motions, Scene* scene) {
       p.ExpectObject("an object of named poses {\"move\", \"yaw_deg\"}");
       if (p.value().empty()) p.Fail("at least one pose is needed");
       for (const auto& pose : p.value().items()) {
-        const Node n(&pose.value(), MemberPath(p.path(), pose.key()), &motions.context());
+        const Node n(&pose.value(), JsonMemberPath(p.path(), pose.key()), &motions.context());
         if (pose.key().empty()) n.Fail("pose names must not be empty");
         if (n.Has("t"))
           n.Get("t").Fail("a named pose has no time", "use \"keyframes\" for timed poses");
@@ -1837,7 +1563,7 @@ void CheckTimeAxis(const Node& root, const Scene& scene) {
           for (const auto& [pose, value] : m.poses) have.push_back(pose);
           node.Get("poses").Fail(
               "no pose " + Quoted(name) + " (asked for by the study's time axis)",
-              SuggestionHint(name, have, "poses of this group"));
+              DidYouMean(name, have, "poses of this group"));
         }
       }
     }
@@ -1871,7 +1597,7 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto materials = root.Find("materials")) {
     materials->ExpectObject("an object of named materials");
     for (const auto& item : materials->value().items()) {
-      const Node m(&item.value(), MemberPath(materials->path(), item.key()), &context);
+      const Node m(&item.value(), JsonMemberPath(materials->path(), item.key()), &context);
       if (item.key().empty()) m.Fail("material names must not be empty");
       material_index[item.key()] = AddMaterial(&scene, ReadMaterial(m, item.key()));
     }
@@ -1909,7 +1635,7 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
       const std::string& name = scene.study.targets->names[i];
       if (!std::binary_search(known.begin(), known.end(), name))
         names.At(i).Fail("no object or group named " + Quoted(name),
-                         SuggestionHint(name, known, "objects and groups"));
+                         DidYouMean(name, known, "objects and groups"));
     }
   }
   if (root.Has("motions") || scene.study.time) CheckTimeAxis(root, scene);
@@ -1917,7 +1643,7 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto views = root.Find("views")) {
     views->ExpectObject("an object of named views");
     for (const auto& item : views->value().items()) {
-      const Node v(&item.value(), MemberPath(views->path(), item.key()), &context);
+      const Node v(&item.value(), JsonMemberPath(views->path(), item.key()), &context);
       if (item.key().empty()) v.Fail("view names must not be empty");
       scene.views[item.key()] = ReadView(v);
     }
@@ -1925,7 +1651,7 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   if (auto stations = root.Find("stations")) {
     stations->ExpectObject("an object of named viewing stations");
     for (const auto& item : stations->value().items()) {
-      const Node v(&item.value(), MemberPath(stations->path(), item.key()), &context);
+      const Node v(&item.value(), JsonMemberPath(stations->path(), item.key()), &context);
       if (item.key().empty()) v.Fail("station names must not be empty");
       scene.stations[item.key()] = ReadStation(v);
     }
@@ -1991,7 +1717,7 @@ std::optional<FieldListProblem> CheckFieldList(const std::vector<std::string>& f
     const std::string& name = fields[i];
     if (std::find(known.begin(), known.end(), name) == known.end())
       return FieldListProblem{i, "unknown field " + Quoted(name),
-                              SuggestionHint(name, known, "known fields")};
+                              DidYouMean(name, known, "known fields")};
     if (std::find(fields.begin(), fields.begin() + i, name) != fields.begin() + i)
       return FieldListProblem{i, "field " + Quoted(name) + " is listed twice", ""};
     if (!has_motion && name.size() > 7 && name.compare(name.size() - 7, 7, "_steady") == 0)

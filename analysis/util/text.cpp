@@ -1,5 +1,6 @@
 #include "analysis/util/text.h"
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <vector>
@@ -81,6 +82,49 @@ std::string CheckPrintableUtf8(const std::string& s) {
     i += len;
   }
   return "";
+}
+
+std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+std::string JoinQuoted(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + Quoted(items[i]);
+  return out;
+}
+
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string DidYouMean(const std::string& word, const std::vector<std::string>& candidates,
+                       const std::string& what) {
+  std::string best;
+  std::size_t best_distance = std::string::npos;
+  for (const std::string& c : candidates) {
+    std::size_t d = EditDistance(word, c);
+    const bool prefix = word.size() >= 3 && (c.rfind(word, 0) == 0 || word.rfind(c, 0) == 0);
+    const std::size_t limit = std::max<std::size_t>(2, c.size() / 3);
+    if (d > limit && !prefix) continue;
+    if (prefix) d = std::min(d, limit);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  std::string hint;
+  if (!best.empty()) hint = "did you mean " + Quoted(best) + "? ";
+  return hint + what + ": " + JoinQuoted(candidates);
 }
 
 }  // namespace pandora

@@ -7,6 +7,7 @@
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "analysis/util/json_reader.h"
 
 namespace pandora::session {
 
@@ -36,26 +37,17 @@ void WriteAutosave(const Session& session, const std::string& path) {
 std::optional<Autosave> ReadAutosave(const std::string& path, const Study& study) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::nullopt;
-  const std::string text = ReadInputFile(path, InputLimits::kJsonBytes, "autosave file");
-  CheckJsonLimits(text, path);
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(path, "$", std::string("malformed JSON: ") + e.what(),
-                     "delete the autosave file to start from the scene file");
-  }
-  if (!j.is_object()) throw InputError(path, "$", "expected an object");
+  const json j = ReadJsonFile(path, "autosave file");
+  const JsonNode root = JsonNode::Root(j, path);
+  root.ExpectObject();
   if (!j.contains("pandora_autosave") || j["pandora_autosave"] != 1)
-    throw InputError(path, "$.pandora_autosave", "not a Pandora autosave file (version 1)");
-  for (const char* key : {"scene_sha256", "rig"})
-    if (!j.contains(key) || !j[key].is_string())
-      throw InputError(path, std::string("$.") + key, "expected a string");
-  if (!j.contains("cameras") || !j["cameras"].is_array())
-    throw InputError(path, "$.cameras", "expected an array of cameras");
+    throw InputError(path, "$.pandora_autosave", "not a Pandora autosave file (version 1)",
+                     "delete the autosave file to start from the scene file");
   Autosave a;
-  a.rig = j["rig"].get<std::string>();
-  a.stale = j["scene_sha256"].get<std::string>() != study.scene().sha256;
+  const std::string sha256 = root.Get("scene_sha256").String();
+  a.rig = root.Get("rig").String();
+  root.Get("cameras").ArraySize("an array of cameras");
+  a.stale = sha256 != study.scene().sha256;
   const Rig* found = nullptr;
   for (const Rig& r : study.scene().rigs)
     if (r.name == a.rig) found = &r;

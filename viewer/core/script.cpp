@@ -7,6 +7,8 @@
 
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "analysis/util/json_reader.h"
+#include "analysis/util/text.h"
 
 namespace pandora::viewer {
 namespace {
@@ -14,123 +16,86 @@ namespace {
 using nlohmann::json;
 using Kind = Action::Kind;
 
-// One action object: typed reads of its keys, each failing with the file and the JSON path.
+// One action object: typed reads of its keys through the one JSON reader
+// (analysis/util/json_reader.h), each failing with the file and the JSON path.
 class Entry {
  public:
-  Entry(const json& j, std::string path, const std::string& file)
-      : j_(j), path_(std::move(path)), file_(file) {}
+  explicit Entry(JsonNode node) : node_(std::move(node)) {}
 
+  const JsonNode& node() const { return node_; }
+  // Member `key` (fails when it is missing).
+  JsonNode Get(const std::string& key) const { return node_.Get(key); }
+
+  // Fails at `key` (at the action itself when empty).
   [[noreturn]] void Fail(const std::string& key, const std::string& reason,
                          const std::string& hint = "") const {
-    throw InputError(file_, key.empty() ? path_ : path_ + "." + key, reason, hint);
+    if (key.empty() || !Has(key)) node_.Fail(reason, hint);
+    Get(key).Fail(reason, hint);
   }
-  bool Has(const std::string& key) const { return j_.contains(key); }
+  bool Has(const std::string& key) const { return node_.Has(key); }
+  // Whether `key` is given as true ("drag": true).
+  bool Flag(const std::string& key) const { return Has(key) && node_.value().at(key) == true; }
   void Keys(std::initializer_list<const char*> allowed) const {
-    std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& item : j_.items())
-      if (!ok.count(item.key())) {
-        std::string list;
-        for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);
-        Fail(item.key(), "unknown key for this action", "keys: " + list);
-      }
+    node_.CheckKeys(std::vector<std::string>(allowed.begin(), allowed.end()));
   }
   double Number(const std::string& key, double lo, double hi) const {
-    if (!Has(key)) Fail(key, "missing");
-    const json& v = j_.at(key);
-    if (!v.is_number()) Fail(key, "expected a number");
-    const double x = v.get<double>();
-    if (!std::isfinite(x) || x < lo || x > hi)
-      Fail(key, "expected a number in [" + Short(lo) + ", " + Short(hi) + "], got " + v.dump());
-    return x;
+    return Get(key).Number(lo, hi);
   }
   double Number(const std::string& key, double lo, double hi, double fallback) const {
     return Has(key) ? Number(key, lo, hi) : fallback;
   }
   std::string String(const std::string& key, bool allow_empty = false) const {
-    if (!Has(key)) Fail(key, "missing");
-    const json& v = j_.at(key);
-    if (!v.is_string()) Fail(key, "expected a string");
-    std::string s = v.get<std::string>();
-    if (s.empty() && !allow_empty) Fail(key, "must not be empty");
-    if (s.size() > 4096) Fail(key, "longer than 4096 characters");
-    return s;
+    return Text(Get(key), allow_empty);
   }
   std::string OneOf(const std::string& key, std::initializer_list<const char*> values) const {
-    const std::string s = String(key);
-    for (const char* v : values)
-      if (s == v) return s;
-    std::string list;
-    for (const char* v : values) list += (list.empty() ? "" : ", ") + std::string(v);
-    Fail(key, "unknown value '" + s + "'", "use one of " + list);
+    return Get(key).Enum(std::vector<std::string>(values.begin(), values.end()));
   }
+  // `n` (2 or 3) numbers of at most 1e7 in size.
   Vec3 Vector(const std::string& key, int n = 3) const {
-    if (!Has(key)) Fail(key, "missing");
-    const json& v = j_.at(key);
-    if (!v.is_array() || int(v.size()) != n)
-      Fail(key, "expected an array of " + std::to_string(n) + " numbers");
+    const JsonNode v = Get(key);
+    v.Numbers(n);
     Vec3 out = Vec3::Zero();
-    for (int i = 0; i < n; ++i) {
-      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) ||
-          std::abs(v[i].get<double>()) > 1e7)
-        Fail(key + "[" + std::to_string(i) + "]",
-             "expected a finite number of at most 1e7 in size");
-      out[i] = v[i].get<double>();
-    }
+    for (int i = 0; i < n; ++i) out[i] = v.At(i).Number(-kMaxCoordinate, kMaxCoordinate);
     return out;
   }
-  // [x0, y0, z0, x1, y1, z1] under `key`, or at index `i` of this (array) value.
-  Aabb Box(const std::string& key) const {
-    if (!Has(key)) Fail(key, "missing");
-    return BoxOf(j_.at(key), key);
+  // [x0, y0, z0, x1, y1, z1].
+  static Aabb Box(const JsonNode& v) {
+    if (!v.value().is_array() || v.value().size() != 6)
+      v.Fail("expected a box [x0, y0, z0, x1, y1, z1], got " + v.TypeName());
+    Aabb b;
+    for (int i = 0; i < 6; ++i)
+      (i < 3 ? b.min : b.max)[i % 3] = v.At(i).Number(-kMaxCoordinate, kMaxCoordinate);
+    if ((b.min.array() > b.max.array()).any()) v.Fail("the box's min exceeds its max");
+    return b;
   }
-  Aabb Box(std::size_t i) const { return BoxOf(j_.at(i), "[" + std::to_string(i) + "]"); }
   // A camera id or a list of them.
   std::vector<std::string> Ids(const std::string& key, bool allow_empty,
                                const std::string& what = "camera") const {
-    const json& v = j_.at(key);
+    const JsonNode v = Get(key);
     std::vector<std::string> out;
-    if (v.is_string()) {
-      out.push_back(String(key));
-    } else if (v.is_array()) {
-      if (v.size() > 10000) Fail(key, "more than 10000 " + what + "s");
-      for (std::size_t i = 0; i < v.size(); ++i) {
-        if (!v[i].is_string() || v[i].get<std::string>().empty())
-          Fail(key + "[" + std::to_string(i) + "]",
-               "expected a " + what + " id (a non-empty string)");
-        out.push_back(v[i].get<std::string>());
-      }
+    if (v.value().is_string()) {
+      out.push_back(Text(v, false));
+    } else if (v.value().is_array()) {
+      const std::size_t n = v.ArraySize(10000, what + "s");
+      for (std::size_t i = 0; i < n; ++i) out.push_back(Text(v.At(i), false));
     } else {
-      Fail(key, "expected a " + what + " id or an array of ids");
+      v.Fail("expected a " + what + " id or an array of ids, got " + v.TypeName());
     }
-    if (out.empty() && !allow_empty) Fail(key, "name at least one " + what);
+    if (out.empty() && !allow_empty) v.Fail("name at least one " + what);
     return out;
   }
 
  private:
-  Aabb BoxOf(const json& v, const std::string& key) const {
-    // key: a member name ("box": "$[0].box") or an element ("[1]": "$[0].keep_out[1]").
-    auto fail = [&](const std::string& sub, const std::string& reason) {
-      throw InputError(file_, path_ + (key.rfind("[", 0) == 0 ? "" : ".") + key + sub, reason);
-    };
-    if (!v.is_array() || v.size() != 6) fail("", "expected a box [x0, y0, z0, x1, y1, z1]");
-    Aabb b;
-    for (int i = 0; i < 6; ++i) {
-      if (!v[i].is_number() || !std::isfinite(v[i].get<double>()) ||
-          std::abs(v[i].get<double>()) > 1e7)
-        fail("[" + std::to_string(i) + "]", "expected a finite number of at most 1e7 in size");
-      (i < 3 ? b.min : b.max)[i % 3] = v[i].get<double>();
-    }
-    if ((b.min.array() > b.max.array()).any()) fail("", "the box's min exceeds its max");
-    return b;
+  // Coordinates, lengths and steps in a script are within 1e7.
+  static constexpr double kMaxCoordinate = 1e7;
+
+  static std::string Text(const JsonNode& v, bool allow_empty) {
+    std::string s = allow_empty ? v.String() : v.NonEmptyString();
+    if (s.size() > 4096) v.Fail("longer than 4096 characters");
+    return s;
   }
-  static std::string Short(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return b;
-  }
-  const json& j_;
-  std::string path_;
-  const std::string& file_;
+
+  JsonNode node_;
 };
 
 const std::map<std::string, Kind>& Kinds() {
@@ -176,23 +141,25 @@ const std::map<std::string, Kind>& Kinds() {
 }
 
 // The action an object names: its one known key.
-std::string ActionName(const json& j, const std::string& where, const std::string& file) {
+std::string ActionName(const JsonNode& node) {
+  const json& j = node.value();
   if (!j.is_object() || j.empty())
-    throw InputError(file, where, "expected an object naming one action, e.g. {\"undo\": 1}");
+    node.Fail("expected an object naming one action, e.g. {\"undo\": 1}");
   // The action is the first known key present (objects keep their keys sorted; exactly one action).
   std::string name;
   for (const auto& item : j.items())
     if (Kinds().count(item.key())) {
       if (!name.empty())
-        throw InputError(file, where,
-                         "two actions in one object ('" + name + "' and '" + item.key() + "')",
-                         "give each action its own object");
+        node.Fail("two actions in one object ('" + name + "' and '" + item.key() + "')",
+                  "give each action its own object");
       name = item.key();
     }
   if (name.empty()) {
-    std::string list;
-    for (const auto& [k, v] : Kinds()) list += (list.empty() ? "" : ", ") + k;
-    throw InputError(file, where, "no known action in this object", "actions: " + list);
+    std::vector<std::string> names;
+    for (const auto& [k, v] : Kinds()) names.push_back(k);
+    std::string nearest;
+    for (const auto& item : j.items()) nearest = item.key();
+    node.Fail("no known action in this object", DidYouMean(nearest, names, "actions"));
   }
   return name;
 }
@@ -204,9 +171,9 @@ void ParseSelect(const Entry& e, Action& a) {
 }
 
 // "move": cameras, and 'by' (a move) or 'to' (a position of one camera).
-void ParseMove(const Entry& e, const json& j, Action& a) {
+void ParseMove(const Entry& e, Action& a) {
   e.Keys({"move", "by", "to", "drag"});
-  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.drag = e.Flag("drag");
   a.cameras = e.Ids("move", false);
   if (e.Has("by") == e.Has("to")) e.Fail("", "give one of 'by' (a move) or 'to' (a position)");
   a.flag = e.Has("to");
@@ -216,9 +183,9 @@ void ParseMove(const Entry& e, const json& j, Action& a) {
 }
 
 // "rotate": cameras, an axis and an angle.
-void ParseRotate(const Entry& e, const json& j, Action& a) {
+void ParseRotate(const Entry& e, Action& a) {
   e.Keys({"rotate", "axis", "deg", "drag"});
-  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.drag = e.Flag("drag");
   a.cameras = e.Ids("rotate", false);
   a.a = e.Vector("axis");
   if (!(a.a.norm() > 0)) e.Fail("axis", "the axis must be a non-zero vector");
@@ -233,12 +200,12 @@ void ParseAim(const Entry& e, Action& a) {
 }
 
 // "orient": a camera and its yaw, pitch and roll.
-void ParseOrient(const Entry& e, const json& j, Action& a) {
+void ParseOrient(const Entry& e, Action& a) {
   e.Keys({"orient", "ypr_deg", "drag"});
-  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.drag = e.Flag("drag");
   a.cameras = {e.String("orient")};
   a.a = e.Vector("ypr_deg");
-  if (std::abs(a.a.y()) > 90) e.Fail("ypr_deg[1]", "the pitch lies in [-90, 90] degrees");
+  if (std::abs(a.a.y()) > 90) e.Get("ypr_deg").At(1).Fail("the pitch lies in [-90, 90] degrees");
 }
 
 // "hfov": cameras and a horizontal field of view.
@@ -278,14 +245,14 @@ void ParseIntrinsics(const Entry& e, Action& a) {
 }
 
 // "range": cameras and a near and / or far distance (far null: unbounded).
-void ParseRange(const Entry& e, const json& j, Action& a) {
+void ParseRange(const Entry& e, Action& a) {
   e.Keys({"range", "near", "far"});
   a.cameras = e.Ids("range", false);
   if (!e.Has("near") && !e.Has("far"))
     e.Fail("", "nothing to change", "give near, far or both (metres)");
   if (e.Has("near")) a.near = e.Number("near", 0, 1e7);
   if (e.Has("far")) {
-    if (j.at("far").is_null())
+    if (e.Get("far").IsNull())
       a.far = INFINITY;
     else
       a.far = e.Number("far", 1e-9, 1e7);
@@ -300,7 +267,7 @@ void ParseColor(const Entry& e, Action& a) {
   a.a = e.Vector("rgb");
   for (int i = 0; i < 3; ++i)
     if (a.a[i] < 0 || a.a[i] > 1)
-      e.Fail("rgb[" + std::to_string(i) + "]", "colour components are linear RGB in [0, 1]");
+      e.Get("rgb").At(i).Fail("colour components are linear RGB in [0, 1]");
 }
 
 // "compare": up to 8 different rigs.
@@ -311,7 +278,7 @@ void ParseCompare(const Entry& e, Action& a) {
   for (std::size_t i = 0; i < a.cameras.size(); ++i)
     for (std::size_t k = 0; k < i; ++k)
       if (a.cameras[i] == a.cameras[k])
-        e.Fail("compare[" + std::to_string(i) + "]", "'" + a.cameras[i] + "' is named twice");
+        e.Get("compare").At(i).Fail("'" + a.cameras[i] + "' is named twice");
 }
 
 // "slice": a field (empty: none), an axis and a position.
@@ -375,8 +342,7 @@ void ParseWait(const Entry& e, Action& a) {
 }
 
 // "suggest": cameras, the objective, limits, mounts, keep-out boxes and targets.
-void ParseSuggest(const Entry& e, const json& j, const std::string& where, const std::string& file,
-                  Action& a) {
+void ParseSuggest(const Entry& e, Action& a) {
   e.Keys({"suggest", "objective", "max_move", "max_rotate", "points", "seed", "rail", "plane",
           "box", "keep_out", "clearance", "hfov_range", "weights", "snap_move", "snap_rotate",
           "outer", "target_surface", "with_region", "over_time"});
@@ -394,10 +360,8 @@ void ParseSuggest(const Entry& e, const json& j, const std::string& where, const
   a.snap_rotate = e.Number("snap_rotate", 0, 180, 0);
   a.outer_iterations = int(e.Number("outer", 1, 100, 4));
   if (e.Has("target_surface")) a.target_surfaces = e.Ids("target_surface", false, "surface");
-  for (const char* key : {"with_region", "over_time"})
-    if (e.Has(key) && !j.at(key).is_boolean()) e.Fail(key, "expected true or false");
-  a.with_region = e.Has("with_region") && j.at("with_region").get<bool>();
-  a.over_time = e.Has("over_time") && j.at("over_time").get<bool>();
+  a.with_region = e.Has("with_region") && e.Get("with_region").Bool();
+  a.over_time = e.Has("over_time") && e.Get("over_time").Bool();
   if (a.over_time && !a.target_surfaces.empty())
     e.Fail("over_time", "takes the study's targets; 'target_surface' is for a static scene",
            "give one of them");
@@ -412,16 +376,12 @@ void ParseSuggest(const Entry& e, const json& j, const std::string& where, const
     }
   if (e.Has("box")) {
     a.mount = "box";
-    a.mount_box = e.Box("box");
+    a.mount_box = Entry::Box(e.Get("box"));
   }
   if (e.Has("keep_out")) {
-    const json& boxes = j.at("keep_out");
-    if (!boxes.is_array() || boxes.size() > 1000)
-      e.Fail("keep_out", "expected an array of boxes [x0, y0, z0, x1, y1, z1]");
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      const Entry box(boxes, where + ".keep_out", file);
-      a.keep_out.push_back(box.Box(i));
-    }
+    const JsonNode boxes = e.Get("keep_out");
+    const std::size_t n = boxes.ArraySize(1000, "boxes [x0, y0, z0, x1, y1, z1]");
+    for (std::size_t i = 0; i < n; ++i) a.keep_out.push_back(Entry::Box(boxes.At(i)));
   }
   if (e.Has("clearance")) a.clearance = e.Number("clearance", 0, 1e4);
   if (e.Has("hfov_range")) {
@@ -434,16 +394,16 @@ void ParseSuggest(const Entry& e, const json& j, const std::string& where, const
 }
 
 // "accept": "all" or the cameras to take.
-void ParseAccept(const Entry& e, const json& j, Action& a) {
+void ParseAccept(const Entry& e, Action& a) {
   e.Keys({"accept"});
-  if (j.at("accept").is_string() && j.at("accept") == "all") return;  // every suggested camera
+  if (e.Get("accept").value() == "all") return;  // every suggested camera
   a.cameras = e.Ids("accept", false);
 }
 
 // "save": forced ("force") or not.
-void ParseSave(const Entry& e, const json& j, Action& a) {
+void ParseSave(const Entry& e, Action& a) {
   e.Keys({"save"});
-  a.flag = j.at("save").is_string() && j.at("save") == "force";
+  a.flag = e.Get("save").value() == "force";
 }
 
 // "screenshot": the file and, optionally, the camera whose view it shows.
@@ -501,9 +461,9 @@ void ParseScroll(const Entry& e, Action& a) {
 }
 
 // "gamepad": a camera, the sticks' positions and how long they are held.
-void ParseGamepad(const Entry& e, const json& j, Action& a) {
+void ParseGamepad(const Entry& e, Action& a) {
   e.Keys({"gamepad", "left", "right", "seconds", "drag"});
-  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.drag = e.Flag("drag");
   a.cameras = {e.String("gamepad")};
   a.a = e.Has("left") ? e.Vector("left", 2) : Vec3::Zero();
   a.b = e.Has("right") ? e.Vector("right", 2) : Vec3::Zero();
@@ -523,9 +483,9 @@ void ParseStation(const Entry& e, Action& a) {
 }
 
 // "ptz": a camera and a preset, or its pan, tilt and / or field of view.
-void ParsePtz(const Entry& e, const json& j, Action& a) {
+void ParsePtz(const Entry& e, Action& a) {
   e.Keys({"ptz", "pan_deg", "tilt_deg", "hfov_deg", "preset", "drag"});
-  a.drag = e.Has("drag") && j.at("drag") == true;
+  a.drag = e.Flag("drag");
   a.cameras = {e.String("ptz")};
   if (e.Has("preset")) {
     if (e.Has("pan_deg") || e.Has("tilt_deg") || e.Has("hfov_deg"))
@@ -559,27 +519,27 @@ void ParseFrames(const Entry& e, Action& a) {
   a.number = e.Number("frames", 0, 10000);
 }
 
-Action ParseAction(const json& j, const std::string& where, const std::string& file) {
-  const std::string name = ActionName(j, where, file);
-  const Entry e(j, where, file);
+Action ParseAction(const JsonNode& node) {
+  const std::string name = ActionName(node);
+  const Entry e(node);
   Action a;
   a.kind = Kinds().at(name);
-  a.where = where;
+  a.where = node.path();
   switch (a.kind) {
     case Kind::kSelect:
       ParseSelect(e, a);
       break;
     case Kind::kMove:
-      ParseMove(e, j, a);
+      ParseMove(e, a);
       break;
     case Kind::kRotate:
-      ParseRotate(e, j, a);
+      ParseRotate(e, a);
       break;
     case Kind::kAim:
       ParseAim(e, a);
       break;
     case Kind::kOrient:
-      ParseOrient(e, j, a);
+      ParseOrient(e, a);
       break;
     case Kind::kEnable:
     case Kind::kDisable:
@@ -593,7 +553,7 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       ParseIntrinsics(e, a);
       break;
     case Kind::kRange:
-      ParseRange(e, j, a);
+      ParseRange(e, a);
       break;
     case Kind::kColor:
       ParseColor(e, a);
@@ -633,13 +593,13 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       ParseWait(e, a);
       break;
     case Kind::kSuggest:
-      ParseSuggest(e, j, where, file, a);
+      ParseSuggest(e, a);
       break;
     case Kind::kAccept:
-      ParseAccept(e, j, a);
+      ParseAccept(e, a);
       break;
     case Kind::kSave:
-      ParseSave(e, j, a);
+      ParseSave(e, a);
       break;
     case Kind::kScreenshot:
       ParseScreenshot(e, a);
@@ -657,13 +617,13 @@ Action ParseAction(const json& j, const std::string& where, const std::string& f
       ParseScroll(e, a);
       break;
     case Kind::kGamepad:
-      ParseGamepad(e, j, a);
+      ParseGamepad(e, a);
       break;
     case Kind::kStation:
       ParseStation(e, a);
       break;
     case Kind::kPtz:
-      ParsePtz(e, j, a);
+      ParsePtz(e, a);
       break;
     case Kind::kRecentre:
       ParseRecentre(e, a);
@@ -689,20 +649,13 @@ bool LensHasCoefficient(const std::string& model, int i) {
 }
 
 std::vector<Action> ParseScript(const std::string& text, const std::string& path) {
-  CheckJsonLimits(text, path);
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const std::exception& e) {
-    throw InputError(path, "$", std::string("malformed JSON: ") + e.what());
-  }
-  if (!j.is_array())
-    throw InputError(path, "$", "a script is an array of actions", "e.g. [{\"undo\": 1}]");
-  if (j.size() > 100000) throw InputError(path, "$", "more than 100000 actions");
+  const json j = ParseJson(text, path);
+  const JsonNode root = JsonNode::Root(j, path);
+  if (!j.is_array()) root.Fail("a script is an array of actions", "e.g. [{\"undo\": 1}]");
+  const std::size_t n = root.ArraySize(100000, "actions");
   std::vector<Action> out;
-  out.reserve(j.size());
-  for (std::size_t i = 0; i < j.size(); ++i)
-    out.push_back(ParseAction(j[i], "$[" + std::to_string(i) + "]", path));
+  out.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) out.push_back(ParseAction(root.At(i)));
   return out;
 }
 

@@ -373,7 +373,7 @@ TEST(Script, CameraPanelActionsParseAndRefuseBadValuesWithTheirPath) {
   ExpectScriptError(R"([{"range": "a", "near": 2, "far": 1}])", "$[0].far");
   ExpectScriptError(R"([{"range": "a", "far": "inf"}])", "$[0].far");
   ExpectScriptError(R"([{"range": "a", "far": 0}])", "$[0].far");
-  ExpectScriptError(R"([{"color": "a"}])", "$[0].rgb");
+  ExpectScriptError(R"([{"color": "a"}])", "$[0]");
   ExpectScriptError(R"([{"color": "a", "rgb": [1.5, 0, 0]}])", "$[0].rgb[0]");
   ExpectScriptError(R"([{"color": "a", "rgb": "#ff0000"}])", "$[0].rgb");
   ExpectScriptError(R"([{"color": "a", "rgb": [1, 0, 0], "alpha": 1}])", "$[0].alpha");
@@ -1020,7 +1020,7 @@ namespace {
 // `pandora render --plan`'s PlanView with the same default cut; pan and dolly stay in it, orbit
 // leaves it.
 TEST(ViewerModel, PlanAndElevationViewsAreRenderPlansAndPanWithinThem) {
-  ExpectScriptError(R"([{"view": "elevation"}])", "$[0].side");
+  ExpectScriptError(R"([{"view": "elevation"}])", "$[0]");
   ExpectScriptError(R"([{"view": "elevation", "side": "up"}])", "$[0].side");
   ExpectScriptError(R"([{"view": "plan", "side": "north"}])", "$[0].side");
   ViewerOptions options;
