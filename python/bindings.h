@@ -49,6 +49,12 @@ struct PyRig {
                        "no camera '" + id + "' in rig '" + rig().name + "'");
     return c;
   }
+  std::vector<int> Indices(const std::vector<std::string>& ids) const {
+    if (ids.empty()) throw InputError("{ids}", "", "name at least one camera");
+    std::vector<int> out;
+    for (const std::string& id : ids) out.push_back(Index(id));
+    return out;
+  }
 };
 
 // Evaluated fields (evaluate()) with what write() records beside the grids.

@@ -6,10 +6,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -102,6 +105,79 @@ void BindScene(py::module_& m) {
       "Reads and checks a scene file (meshes, rigs, study); raises pandora.InputError.");
 }
 
+// The session's typed edits beyond the pose (app/session/camera_edits.h), as the viewer makes them.
+void BindTypedEdits(py::class_<PyRig>& rig) {
+  rig.def(
+         "orient",
+         [](PyRig& r, const std::string& id, double yaw_deg, double pitch_deg, double roll_deg) {
+           r.session->rig().Apply(
+               session::MakeEdit(
+                   r.rig(), session::OrientEdit{r.Index(id), Vec3(yaw_deg, pitch_deg, roll_deg)})
+                   .edit);
+         },
+         py::arg("id"), py::arg("yaw_deg"), py::arg("pitch_deg"), py::arg("roll_deg") = 0.0,
+         "Turns camera `id` to a yaw, pitch and roll in degrees (the scene file's euler_deg). One "
+         "undo step; a PTZ camera's head follows.")
+      .def(
+          "zoom",
+          [](PyRig& r, const std::vector<std::string>& ids, double hfov_deg) {
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::ZoomEdit{r.Indices(ids), hfov_deg}).edit);
+          },
+          py::arg("ids"), py::arg("hfov_deg"),
+          "Zooms cameras `ids` to a horizontal field of view in degrees (fy / fx kept). One undo "
+          "step; a PTZ camera zooms within its head's range.")
+      .def(
+          "set_lens",
+          [](PyRig& r, const std::vector<std::string>& ids,
+             std::optional<std::pair<int, int>> resolution, std::optional<std::string> model,
+             std::optional<double> k1, std::optional<double> k2, std::optional<double> p1,
+             std::optional<double> p2, std::optional<double> k3, std::optional<double> k4) {
+            session::LensEdit edit;
+            edit.cameras = r.Indices(ids);
+            if (resolution) std::tie(edit.width, edit.height) = *resolution;
+            if (resolution && (edit.width == 0 || edit.height == 0))
+              throw InputError("{resolution}", "",
+                               "expected whole numbers of pixels from 1 to 65536");
+            if (model) {
+              edit.model = LensModelFromName(*model);
+              if (!edit.model)
+                throw InputError("{model}", "", "unknown lens model '" + *model + "'",
+                                 "pinhole, brown_conrady or fisheye");
+            }
+            const std::optional<double>* c[6] = {&k1, &k2, &p1, &p2, &k3, &k4};
+            for (int i = 0; i < 6; ++i)
+              if (*c[i]) edit.coefficients[i] = **c[i];
+            r.session->rig().Apply(session::MakeEdit(r.rig(), edit).edit);
+          },
+          py::arg("ids"), py::arg("resolution") = py::none(), py::arg("model") = py::none(),
+          py::arg("k1") = py::none(), py::arg("k2") = py::none(), py::arg("p1") = py::none(),
+          py::arg("p2") = py::none(), py::arg("k3") = py::none(), py::arg("k4") = py::none(),
+          "Sets cameras `ids`' resolution (width, height: the same rays through the image's "
+          "edges), lens model (pinhole, brown_conrady, fisheye: the field of view kept, the "
+          "coefficients reset) and distortion coefficients, as the viewer's lens panel. One undo "
+          "step.")
+      .def(
+          "set_range",
+          [](PyRig& r, const std::vector<std::string>& ids, std::optional<double> near,
+             std::optional<double> far) {
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::RangeEdit{r.Indices(ids), near.value_or(NAN),
+                                                              far.value_or(NAN)})
+                    .edit);
+          },
+          py::arg("ids"), py::arg("near") = py::none(), py::arg("far") = py::none(),
+          "Sets cameras `ids`' working range in metres (far may be math.inf). One undo step.")
+      .def(
+          "set_color",
+          [](PyRig& r, const std::vector<std::string>& ids, const Vec3& color) {
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::ColorEdit{r.Indices(ids), color}).edit);
+          },
+          py::arg("ids"), py::arg("color"),
+          "Sets cameras `ids`' colour (linear RGB in [0, 1]). One undo step.");
+}
+
 // pandora.Rig: the editable rig (returned for the suggestion bindings that extend it).
 py::class_<PyRig> BindRig(py::module_& m) {
   py::class_<PyRig> rig(m, "Rig",
@@ -137,6 +213,9 @@ py::class_<PyRig> BindRig(py::module_& m) {
              d["model"] = LensModelName(k.model);
              d["k"] = std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
              d["enabled"] = c.enabled;
+             d["near"] = c.near;
+             d["far"] = c.far;
+             d["color"] = Vec3Array(c.color);
              d["ptz"] = bool(c.ptz);
              return d;
            })
@@ -184,6 +263,7 @@ py::class_<PyRig> BindRig(py::module_& m) {
             return ids;
           },
           "Ids of the cameras that differ from the scene file.");
+  BindTypedEdits(rig);
   return rig;
 }
 

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +24,7 @@
 #include "analysis/util/input_file.h"
 #include "analysis/util/units.h"
 #include "app/commands.h"
+#include "app/session/camera_edits.h"
 #include "app/suggest_options.h"
 #include "python/bindings.h"
 #include "suggest/ptz_suggest.h"
@@ -258,37 +260,27 @@ void BindPtzSettings(py::class_<PyRig>& rig) {
           [](PyRig& r, const std::string& id, std::optional<double> pan_deg,
              std::optional<double> tilt_deg, std::optional<double> hfov_deg,
              const std::string& preset) {
-            const int index = r.Index(id);
-            const Camera& c = r.rig().cameras[index];
-            if (!c.ptz)
-              throw InputError("set_ptz", "", "camera '" + id + "' has no PTZ head",
-                               "move() places a fixed camera");
-            PtzState s = c.ptz->current;
-            if (!preset.empty()) {
-              bool found = false;
-              for (const PtzPreset& p : c.ptz->presets)
-                if (p.name == preset) s = p.state, found = true;
-              if (!found)
-                throw InputError("set_ptz", "preset",
-                                 "camera '" + id + "' has no preset '" + preset + "'");
-            }
-            for (const auto& [v, name] :
-                 {std::pair{pan_deg, "pan_deg"}, {tilt_deg, "tilt_deg"}, {hfov_deg, "hfov_deg"}})
-              if (v && !std::isfinite(*v)) throw InputError("set_ptz", name, "not a finite angle");
-            if (pan_deg) s.pan_deg = *pan_deg;
-            if (tilt_deg) s.tilt_deg = *tilt_deg;
-            if (hfov_deg) {
-              if (!(*hfov_deg > 0 && *hfov_deg < 360))
-                throw InputError("set_ptz", "hfov_deg", "must be in (0, 360) degrees");
-              const Intrinsics& k = c.model.intrinsics();
-              s.focal = FocalFromHfov(*hfov_deg * kPi / 180, k.width, k.model);
-            }
-            r.session->SetPtzState(index, s);  // clamped to the head's ranges
+            // The session's typed edit (app/session/camera_edits.h), as the viewer's "ptz".
+            session::PtzEdit edit{r.Index(id), preset, pan_deg.value_or(NAN),
+                                  tilt_deg.value_or(NAN), hfov_deg.value_or(NAN)};
+            r.session->rig().Apply(session::MakeEdit(r.rig(), edit).edit);
           },
           py::arg("id"), py::arg("pan_deg") = py::none(), py::arg("tilt_deg") = py::none(),
           py::arg("hfov_deg") = py::none(), py::arg("preset") = "",
           "Points PTZ camera `id` (a preset's setting, then the given angles; clamped to its "
           "ranges). One undo step.")
+      .def(
+          "recentre",
+          [](PyRig& r, const std::string& id) {
+            const int c = r.Index(id);
+            r.session->rig().Apply(
+                session::MakeEdit(r.rig(), session::RecentreEdit{c, r.study->scene().path,
+                                                                 r.session->CameraJsonPath(c)})
+                    .edit);
+          },
+          py::arg("id"),
+          "Makes PTZ camera `id`'s current view its home (pan and tilt 0; presets and ranges "
+          "shifted). One undo step.")
       .def(
           "save",
           [](PyRig& r, bool force) {

@@ -368,6 +368,14 @@ std::optional<LensModel> LensModelFromName(const std::string& name) {
   return std::nullopt;
 }
 
+const char* const kLensCoefficientNames[6] = {"k1", "k2", "p1", "p2", "k3", "k4"};
+
+bool LensHasCoefficient(LensModel model, int i) {
+  if (model == LensModel::kBrownConrady) return i >= 0 && i <= 4;
+  if (model == LensModel::kFisheye) return i == 0 || i == 1 || i == 4 || i == 5;
+  return false;
+}
+
 double FocalFromHfov(double hfov_rad, int width, LensModel model) {
   const double half_width = 0.5 * width;
   if (model == LensModel::kFisheye) return half_width / (0.5 * hfov_rad);

@@ -37,6 +37,11 @@ enum class LensModel { kPinhole, kBrownConrady, kFisheye };
 const char* LensModelName(LensModel model);
 /// The lens model LensModelName calls `name`; nullopt for any other text.
 std::optional<LensModel> LensModelFromName(const std::string& name);
+/// The distortion coefficients' names in Intrinsics' order: k1 k2 p1 p2 k3 k4.
+extern const char* const kLensCoefficientNames[6];
+/// Whether `model` uses coefficient `i` of kLensCoefficientNames (Brown-Conrady: k1 k2 p1 p2 k3;
+/// fisheye: k1 k2 k3 k4; pinhole: none).
+bool LensHasCoefficient(LensModel model, int i);
 
 /// Intrinsic parameters. Units: pixels for focal lengths and principal point.
 struct Intrinsics {

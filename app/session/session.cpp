@@ -7,6 +7,7 @@
 #include "analysis/scene/scene_text.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "app/session/camera_edits.h"
 #include "app/session/ptz_edit.h"
 #include "render/progressive.h"
 #include "suggest/suggestion_file.h"
@@ -203,9 +204,9 @@ void Session::SetPtzState(int index, const PtzState& state) {
 }
 
 void Session::RecentrePtz(int index) {
-  const Camera& before = rig_.rig().cameras.at(index);
-  Camera after = RecentredPtz(before, study_->scene().path, CameraJsonPath(index));
-  rig_.Apply({"re-centre " + before.id, {{index, before, std::move(after)}}});
+  rig_.rig().cameras.at(index);  // std::out_of_range for a wrong index, as before
+  rig_.Apply(
+      MakeEdit(rig_.rig(), RecentreEdit{index, study_->scene().path, CameraJsonPath(index)}).edit);
 }
 
 SaveResult Session::Save(bool force, const std::vector<StationMove>& stations) {

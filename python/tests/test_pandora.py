@@ -4,6 +4,7 @@ moved camera changes the fields of that rig copy only, the covariance equals a n
 from finite-difference projection Jacobians, renders are finite images, and bad input raises
 pandora.InputError with the file, JSON path and reason of the command line's message."""
 import json
+import math
 import os
 import pathlib
 
@@ -90,6 +91,36 @@ def test_moving_a_camera_changes_that_rig_only():
     assert after.max() == 1 and before.max() == 2
     again = pandora.evaluate(scene, scene.rig(), ["coverage"]).sparse("coverage")[2]
     np.testing.assert_array_equal(again, before)
+
+
+def test_typed_edits_as_the_viewer_makes_them():
+    scene = pandora.load_scene(MINIMAL)
+    rig = scene.rig()
+    k0 = rig.intrinsics("a")  # 640 x 480, hfov 60
+    rig.zoom(["a", "b"], 90)  # fx = (w / 2) / tan(45 deg)
+    assert rig.intrinsics("a")["fx"] == pytest.approx(320)
+    assert rig.intrinsics("b")["fy"] / rig.intrinsics("b")["fx"] == pytest.approx(k0["fy"] / k0["fx"])
+    rig.undo()
+    rig.set_lens(["a"], model="fisheye", k1=0.01)  # the field of view kept: fx = (w / 2) / (hfov / 2)
+    k = rig.intrinsics("a")
+    assert k["model"] == "fisheye" and k["k"][0] == 0.01
+    assert k["fx"] == pytest.approx(320 / (np.pi / 6))
+    rig.set_lens(["a"], resolution=(320, 240))
+    assert (rig.intrinsics("a")["width"], rig.intrinsics("a")["fx"]) == (320, pytest.approx(160 / (np.pi / 6)))
+    rig.set_range(["a"], near=0.5, far=math.inf)
+    assert (rig.intrinsics("a")["near"], rig.intrinsics("a")["far"]) == (0.5, math.inf)
+    rig.set_color(["b"], [1, 0.5, 0])
+    assert list(rig.intrinsics("b")["color"]) == [1, 0.5, 0]
+    rig.orient("b", 90, 0)  # yaw 90 turns the base (+x) left, to +y
+    assert rig.rotation("b")[:, 2] == pytest.approx([0, 1, 0], abs=1e-12)
+    for call, keyword in [(lambda: rig.zoom(["a"], 0), "hfov_deg"),
+                          (lambda: rig.set_range(["a"], near=2, far=1), "far"),
+                          (lambda: rig.set_lens(["a"], model="pinhole", k4=0.1), "k4"),
+                          (lambda: rig.set_color(["a"], [2, 0, 0]), "color"),
+                          (lambda: rig.orient("a", 0, 95), "ypr_deg")]:
+        with pytest.raises(pandora.InputError) as e:
+            call()
+        assert e.value.file == keyword, e.value
 
 
 def project(R, C, k, X):

@@ -175,6 +175,10 @@ def test_ptz_settings_save_and_fields(tmp_path):
     assert np.dot(axis0[:2], axis[:2]) == pytest.approx(0, abs=1e-12)
     rig.set_ptz("dome", tilt_deg=-500)  # clamped to the tilt range
     assert rig.ptz("dome")["tilt_deg"] == pytest.approx(-75)
+    # A pinhole dome cannot zoom out to 200 degrees: refused, naming the keyword.
+    with pytest.raises(pandora.InputError) as e:
+        rig.set_ptz("dome", hfov_deg=200)
+    assert e.value.file == "hfov_deg"
     rig.set_ptz("dome", pan_deg=20, tilt_deg=-10, hfov_deg=25)
     rig.save()
     again = pandora.load_scene(str(path)).rig().ptz("dome")

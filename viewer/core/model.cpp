@@ -120,16 +120,32 @@ app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
                    named.reason(), named.hint());
 }
 
+// A typed camera edit's error (app/session/camera_edits.h) as the action's: a value's field as the
+// action's key ("{hfov_deg}" -> "$[3].deg"), a camera's problem at the action ("$[3]").
+[[noreturn]] void RethrowEditError(const InputError& e, const Action& a) {
+  const std::string& f = e.file();
+  const bool field = f.size() >= 3 && f.front() == '{' && f.back() == '}';
+  if (!f.empty() && !field) throw e;  // a file's own (a PTZ head's ranges name the scene)
+  const auto key = [&a](const std::string& name) {
+    return a.kind == Action::Kind::kHfov && name == "hfov_deg" ? std::string("deg")
+                                                               : ActionKey(name);
+  };
+  const InputError named =
+      RenameOptions(e, [&key](const std::string& name) { return "'" + key(name) + "'"; });
+  throw InputError(field ? a.where + "." + key(f.substr(1, f.size() - 2)) : a.where,
+                   named.json_path(), named.reason(), named.hint());
+}
+
 }  // namespace
 
 std::string ActionKey(const std::string& field) {
   // Only where the key differs from the field.
-  static const std::pair<const char*, const char*> kKeys[] = {
-      {"cameras", "suggest"},
-      {"mount_box", "box"},
-      {"max_rotate_deg", "max_rotate"},
-      {"snap_rotate_deg", "snap_rotate"},
-      {"target_surfaces", "target_surface"}};
+  static const std::pair<const char*, const char*> kKeys[] = {{"cameras", "suggest"},
+                                                              {"mount_box", "box"},
+                                                              {"max_rotate_deg", "max_rotate"},
+                                                              {"snap_rotate_deg", "snap_rotate"},
+                                                              {"target_surfaces", "target_surface"},
+                                                              {"color", "rgb"}};
   for (const auto& [name, key] : kKeys)
     if (field == name) return key;
   return field;
@@ -384,11 +400,28 @@ void ViewerModel::Run(const std::vector<Action>& script, Frontend* frontend) {
 // Applies camera changes as one undo step (a drag's later steps amend its first).
 void ViewerModel::ApplyEdit(const Action& a, EditStep& step, const std::vector<int>& cams,
                             const std::string& label, const std::function<void(Camera&)>& change) {
-  session::EditableRig& edit = session_->rig();
   // The session's rule: a PTZ camera's base stays level and its head turns, so a pose or zoom
   // asked of it moves the pivot and becomes pan, tilt and zoom within its ranges (docs/ptz.md).
-  session::CameraEditResult made = session::MakeCameraEdit(rig(), cams, label, change);
+  Commit(a, step, cams, session::MakeCameraEdit(rig(), cams, label, change));
+}
+
+template <class TypedEdit>
+void ViewerModel::ApplyTyped(const Action& a, EditStep& step, const std::vector<int>& cams,
+                             const TypedEdit& edit) {
+  session::CameraEditResult made;
+  try {
+    made = session::MakeEdit(rig(), edit);
+  } catch (const InputError& e) {
+    RethrowEditError(e, a);
+  }
+  Commit(a, step, cams, std::move(made));
+}
+
+void ViewerModel::Commit(const Action& a, EditStep& step, const std::vector<int>& cams,
+                         session::CameraEditResult made) {
+  session::EditableRig& edit = session_->rig();
   session::Edit& e = made.edit;
+  const std::string label = e.label;
   for (const session::CameraEdit& ce : e.changes)
     if (ce.index == made.ptz_camera) step.ptz_status = PtzStatus(ce.after, made.clamped);
   if (a.drag && step.drag == label && edit.CanAmend(cams))
@@ -401,8 +434,7 @@ void ViewerModel::ApplyEdit(const Action& a, EditStep& step, const std::vector<i
 
 // An edit's undo label: the verb and the camera's id, or the number of cameras.
 std::string ViewerModel::EditLabel(const char* verb, const std::vector<int>& cams) const {
-  return std::string(verb) + " " +
-         (cams.size() == 1 ? rig().cameras[cams[0]].id : std::to_string(cams.size()) + " cameras");
+  return session::EditLabel(rig(), verb, cams);
 }
 
 // "move": the cameras by an offset, or one camera to a position.
@@ -447,125 +479,42 @@ void ViewerModel::DoAim(const Action& a, EditStep& step) {
 // "orient": a camera turned to a yaw, pitch and roll.
 void ViewerModel::DoOrient(const Action& a, EditStep& step) {
   const int c = CameraIndex(a.cameras[0], a);
-  const Mat3 R = RotationFromYawPitchRollDeg(a.a);
-  ApplyEdit(a, step, {c}, EditLabel("turn", {c}),
-            [&](Camera& cam) { cam.world_from_camera.linear() = R; });
+  ApplyTyped(a, step, {c}, session::OrientEdit{c, a.a});
 }
 
 // "enable" and "disable": the cameras switched on or off.
 void ViewerModel::DoEnable(const Action& a, EditStep& step) {
   const std::vector<int> cams = CameraIndices(a.cameras, a);
-  const bool on = a.kind == Action::Kind::kEnable;
-  ApplyEdit(a, step, cams, EditLabel(on ? "enable" : "disable", cams),
-            [&](Camera& cam) { cam.enabled = on; });
+  ApplyTyped(a, step, cams, session::EnableEdit{cams, a.kind == Action::Kind::kEnable});
 }
 
 // "hfov": the cameras zoomed to a horizontal field of view.
 void ViewerModel::DoHfov(const Action& a, EditStep& step) {
   const std::vector<int> cams = CameraIndices(a.cameras, a);
-  ApplyEdit(a, step, cams, EditLabel("zoom", cams), [&](Camera& cam) {
-    Intrinsics k = cam.model.intrinsics();
-    const double fx = FocalFromHfov(a.number * kRadPerDeg, k.width, k.model);
-    if (k.model != LensModel::kFisheye && a.number >= 180)
-      throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
-    k.fy *= fx / k.fx;
-    k.fx = fx;
-    cam.model = CameraModel(k);
-  });
+  ApplyTyped(a, step, cams, session::ZoomEdit{cams, a.number});
 }
 
 // "intrinsics": the cameras' resolution, lens model and distortion coefficients.
 void ViewerModel::DoIntrinsics(const Action& a, EditStep& step) {
-  const std::vector<int> cams = CameraIndices(a.cameras, a);
-  const bool lens_changed =
-      !a.lens.empty() || std::any_of(std::begin(a.coefficients), std::end(a.coefficients),
-                                     [](double v) { return !std::isnan(v); });
-  ApplyEdit(a, step, cams, EditLabel("lens", cams), [&](Camera& cam) {
-    Intrinsics k = cam.model.intrinsics();
-    if (cam.ptz && (a.width > 0 || (!a.lens.empty() && LensFromName(a.lens) != k.model)))
-      throw InputError(a.where, "",
-                       "camera '" + cam.id +
-                           "' is a PTZ camera: its zoom range is in pixels of its "
-                           "resolution and lens, which the viewer does not convert",
-                       "change its resolution or lens model in the scene file");
-    if (a.width > 0) {
-      // The same rays through the image's edges: pixel edges at -0.5 and width - 0.5 scale.
-      const double sx = double(a.width) / k.width, sy = double(a.height) / k.height;
-      k.fx *= sx;
-      k.fy *= sy;
-      k.cx = (k.cx + 0.5) * sx - 0.5;
-      k.cy = (k.cy + 0.5) * sy - 0.5;
-      k.width = a.width;
-      k.height = a.height;
-    }
-    if (!a.lens.empty()) {
-      const LensModel to = LensFromName(a.lens);
-      if ((to == LensModel::kFisheye) != (k.model == LensModel::kFisheye)) {
-        // Keep the nominal field of view across the projection's change.
-        const double hfov = HfovFromFocal(k.fx, k.width, k.model);
-        if (to != LensModel::kFisheye && !(hfov < kPi))
-          throw InputError(a.where, "",
-                           "camera '" + cam.id + "' sees " +
-                               std::to_string(int(std::lround(hfov / kRadPerDeg))) +
-                               " degrees; a " + a.lens + " lens sees less than 180",
-                           "narrow its field of view (hfov) first");
-        const double fx = FocalFromHfov(hfov, k.width, to);
-        k.fy *= fx / k.fx;
-        k.fx = fx;
-      }
-      k.model = to;
-      k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = k.k4 = 0;
-    }
-    const std::string model = LensModelName(k.model);
-    double* c[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
-    for (int i = 0; i < 6; ++i) {
-      if (std::isnan(a.coefficients[i])) continue;
-      if (!LensHasCoefficient(model, i))
-        throw InputError(a.where, "",
-                         "camera '" + cam.id + "' has a " + model +
-                             " lens, which has no coefficient " + kCoefficientNames[i],
-                         model == "pinhole"
-                             ? "give \"model\": \"brown_conrady\" or \"fisheye\" with it"
-                             : "fisheye: k1 k2 k3 k4; brown_conrady: k1 k2 p1 p2 k3");
-      *c[i] = a.coefficients[i];
-    }
-    cam.model = CameraModel(k);
-    if (lens_changed && k.model != LensModel::kPinhole) {
-      // A lens that folds back inside the image: part of it no ray reaches.
-      const LensCoverage lc = ComputeLensCoverage(cam.model);
-      if (lc.domain_ends_inside_image) {
-        char share[32];
-        std::snprintf(share, sizeof share, "%.1f", 100 * lc.unreachable_fraction);
-        throw InputError(
-            a.where, "",
-            "camera '" + cam.id + "': this " + model +
-                " distortion folds back inside the image (its valid domain ends there; " + share +
-                " % of the pixels would see nothing)",
-            "use smaller coefficients");
-      }
-    }
-  });
+  session::LensEdit edit;
+  edit.cameras = CameraIndices(a.cameras, a);
+  edit.width = a.width;
+  edit.height = a.height;
+  if (!a.lens.empty()) edit.model = LensFromName(a.lens);
+  std::copy(std::begin(a.coefficients), std::end(a.coefficients), edit.coefficients.begin());
+  ApplyTyped(a, step, edit.cameras, edit);
 }
 
 // "range": the cameras' working range (near and / or far).
 void ViewerModel::DoRange(const Action& a, EditStep& step) {
   const std::vector<int> cams = CameraIndices(a.cameras, a);
-  ApplyEdit(a, step, cams, EditLabel("range", cams), [&](Camera& cam) {
-    const double near = std::isnan(a.near) ? cam.near : a.near;
-    const double far = std::isnan(a.far) ? cam.far : a.far;
-    if (!(far > near))
-      throw InputError(a.where, "",
-                       "camera '" + cam.id + "': far (" + std::to_string(far) +
-                           " m) must be greater than near (" + std::to_string(near) + " m)");
-    cam.near = near;
-    cam.far = far;
-  });
+  ApplyTyped(a, step, cams, session::RangeEdit{cams, a.near, a.far});
 }
 
 // "color": the cameras' colour.
 void ViewerModel::DoColor(const Action& a, EditStep& step) {
   const std::vector<int> cams = CameraIndices(a.cameras, a);
-  ApplyEdit(a, step, cams, EditLabel("colour", cams), [&](Camera& cam) { cam.color = a.a; });
+  ApplyTyped(a, step, cams, session::ColorEdit{cams, a.a});
 }
 
 // "slice" and "iso": the slice plane or the isosurface of a live field (or none).
@@ -775,49 +724,14 @@ void ViewerModel::DoStation(const Action& a) {
 // "ptz": a PTZ camera's pan, tilt and zoom, or one of its presets.
 void ViewerModel::DoPtz(const Action& a, EditStep& step) {
   const int c = CameraIndex(a.cameras[0], a);
-  const Camera& cam = rig().cameras[c];
-  if (!cam.ptz)
-    throw InputError(a.where, "", "camera '" + cam.id + "' has no pan-tilt-zoom head",
-                     "pan, tilt and zoom apply to a camera with a \"ptz\" block (docs/ptz.md)");
-  PtzState s = cam.ptz->current;
-  if (!a.preset.empty()) {
-    std::string names;
-    const PtzPreset* found = nullptr;
-    for (const PtzPreset& p : cam.ptz->presets) {
-      if (p.name == a.preset) found = &p;
-      names += (names.empty() ? "" : ", ") + p.name;
-    }
-    if (!found)
-      throw InputError(a.where, "", "camera '" + cam.id + "' has no preset '" + a.preset + "'",
-                       names.empty() ? "it has no presets" : "presets: " + names);
-    s = found->state;
-  } else {
-    if (!std::isnan(a.pan_deg)) s.pan_deg = a.pan_deg;
-    if (!std::isnan(a.tilt_deg)) s.tilt_deg = a.tilt_deg;
-    if (!std::isnan(a.hfov_deg)) {
-      const Intrinsics& k = cam.model.intrinsics();
-      if (k.model != LensModel::kFisheye && a.hfov_deg >= 180)
-        throw InputError(a.where, "", "a pinhole or Brown-Conrady lens sees less than 180 degrees");
-      s.focal = FocalFromHfov(a.hfov_deg * kRadPerDeg, k.width, k.model);
-    }
-  }
-  const PtzState want = s;
-  const PtzState got = session::ClampPtzState(*cam.ptz, want);
-  ApplyEdit(a, step, {c}, EditLabel("pan/tilt/zoom", {c}),
-            [&](Camera& x) { x = session::WithPtzState(x, want); });
-  const bool clamped = std::abs(got.tilt_deg - want.tilt_deg) > 1e-9 ||
-                       std::abs(got.focal - want.focal) > 1e-9 * want.focal ||
-                       (!cam.ptz->ContinuousPan() && std::abs(got.pan_deg - want.pan_deg) > 1e-9);
-  status = PtzStatus(rig().cameras[c], clamped) + (a.preset.empty() ? "" : ", preset " + a.preset);
+  ApplyTyped(a, step, {c}, session::PtzEdit{c, a.preset, a.pan_deg, a.tilt_deg, a.hfov_deg});
+  status = step.ptz_status + (a.preset.empty() ? "" : ", preset " + a.preset);
 }
 
 // "recentre": a PTZ camera's home made its current view.
 void ViewerModel::DoRecentre(const Action& a, EditStep& step) {
-  const std::string& file = scene().path;
   const int c = CameraIndex(a.cameras[0], a);
-  const std::string where = session_->CameraJsonPath(c);
-  ApplyEdit(a, step, {c}, EditLabel("re-centre", {c}),
-            [&](Camera& x) { x = session::RecentredPtz(x, file, where); });
+  ApplyTyped(a, step, {c}, session::RecentreEdit{c, scene().path, session_->CameraJsonPath(c)});
   const PtzHead& h = *rig().cameras[c].ptz;
   char line[200];
   std::snprintf(line, sizeof line,
@@ -968,10 +882,9 @@ nlohmann::json ViewerModel::StateJson() const {
     const Vec3 p = c.center();
     const Intrinsics& k = c.model.intrinsics();
     json lens = {{"model", LensModelName(k.model)}};
-    const std::string model = LensModelName(k.model);
     const double* coefficients[6] = {&k.k1, &k.k2, &k.p1, &k.p2, &k.k3, &k.k4};
     for (int i = 0; i < 6; ++i)
-      if (LensHasCoefficient(model, i)) lens[kCoefficientNames[i]] = *coefficients[i];
+      if (LensHasCoefficient(k.model, i)) lens[kLensCoefficientNames[i]] = *coefficients[i];
     cameras.push_back({{"id", c.id},
                        {"enabled", c.enabled},
                        {"position", {p.x(), p.y(), p.z()}},

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "app/session/camera_edits.h"
 #include "app/session/session.h"
 #include "viewer/core/navigation.h"
 #include "viewer/core/script.h"
@@ -156,6 +157,12 @@ class ViewerModel {
   };
   void ApplyEdit(const Action& a, EditStep& step, const std::vector<int>& cams,
                  const std::string& label, const std::function<void(Camera&)>& change);
+  // A typed session edit (app/session/camera_edits.h): its errors as the action's keys.
+  template <class TypedEdit>
+  void ApplyTyped(const Action& a, EditStep& step, const std::vector<int>& cams,
+                  const TypedEdit& edit);
+  void Commit(const Action& a, EditStep& step, const std::vector<int>& cams,
+              session::CameraEditResult made);
   std::string EditLabel(const char* verb, const std::vector<int>& cams) const;
   // Do's actions, one per kind or group (model.cpp).
   void DoMove(const Action& a, EditStep& step);

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "analysis/geometry/camera.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
 #include "analysis/util/json_reader.h"
@@ -230,9 +231,9 @@ void ParseIntrinsics(const Entry& e, Action& a) {
   if (e.Has("model")) a.lens = e.OneOf("model", {"pinhole", "brown_conrady", "fisheye"});
   bool any = a.width > 0 || !a.lens.empty();
   for (int i = 0; i < 6; ++i) {
-    const char* key = kCoefficientNames[i];
+    const char* key = kLensCoefficientNames[i];
     if (!e.Has(key)) continue;
-    if (!a.lens.empty() && !LensHasCoefficient(a.lens, i))
+    if (!a.lens.empty() && !LensHasCoefficient(*LensModelFromName(a.lens), i))
       e.Fail(key, "a " + a.lens + " lens has no coefficient " + key,
              a.lens == "pinhole"   ? "pinhole: no distortion"
              : a.lens == "fisheye" ? "fisheye: k1 k2 k3 k4"
@@ -639,14 +640,6 @@ Action ParseAction(const JsonNode& node) {
 }
 
 }  // namespace
-
-const char* const kCoefficientNames[6] = {"k1", "k2", "p1", "p2", "k3", "k4"};
-
-bool LensHasCoefficient(const std::string& model, int i) {
-  if (model == "brown_conrady") return i <= 4;
-  if (model == "fisheye") return i == 0 || i == 1 || i == 4 || i == 5;
-  return false;
-}
 
 std::vector<Action> ParseScript(const std::string& text, const std::string& path) {
   const json j = ParseJson(text, path);

@@ -164,11 +164,6 @@ struct Action {
   std::string preset;
 };
 
-/// The names of Action::coefficients, in order: k1 k2 p1 p2 k3 k4.
-extern const char* const kCoefficientNames[6];
-/// Whether lens model `model` ("pinhole", "brown_conrady", "fisheye") has coefficient `i`.
-bool LensHasCoefficient(const std::string& model, int i);
-
 /// Parses a script (the text of `path`); throws InputError naming `path` and the JSON path.
 std::vector<Action> ParseScript(const std::string& text, const std::string& path);
 /// Reads and parses a script file (64 MiB and nesting limits as for scene files).

@@ -1288,12 +1288,11 @@ struct ViewerApp::Impl {
       Do(a);
     }
     const double values[6] = {k.k1, k.k2, k.p1, k.p2, k.k3, k.k4};
-    const std::string name = LensModelName(k.model);
     for (int i = 0; i < 6; ++i) {
-      if (!LensHasCoefficient(name, i)) continue;
+      if (!LensHasCoefficient(k.model, i)) continue;
       float v = float(values[i]);
-      if (ImGui::DragFloat(kCoefficientNames[i], &v, i == 2 || i == 3 ? 0.0001f : 0.001f, -10.0f,
-                           10.0f, "%.4f")) {
+      if (ImGui::DragFloat(kLensCoefficientNames[i], &v, i == 2 || i == 3 ? 0.0001f : 0.001f,
+                           -10.0f, 10.0f, "%.4f")) {
         Action a = Make(Action::Kind::kIntrinsics, {cam.id});
         a.coefficients[i] = v;
         a.drag = true;
