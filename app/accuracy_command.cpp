@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/output.h"
 #include "app/report/accuracy_tables.h"
@@ -136,6 +138,32 @@ int RunAccuracy(const AccuracyArgs& args) {
     std::printf(" %s", std::filesystem::path(path).filename().c_str());
   std::printf(" in %s\n", args.out.c_str());
   return 0;
+}
+
+// Registers `pandora accuracy` and its options.
+Command AddAccuracyCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<AccuracyArgs>();
+  AccuracyArgs& accuracy = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* acc = app.add_subcommand("accuracy",
+                                     "Error against run time: voxel size, Monte Carlo trials, "
+                                     "steady-state solvers, coarse-to-fine");
+  acc->add_option("scene", accuracy.scene, "Scene file (JSON)")->required();
+  acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
+  acc->add_option("--disable", accuracy.disable,
+                  "Camera ids to disable for this run, comma-separated or repeated (what the rig "
+                  "loses when they fail)")
+      ->delimiter(',');
+  acc->add_option("--out", accuracy.out, "Output folder")->capture_default_str();
+  acc->add_flag("--quick", accuracy.quick,
+                "Fewer voxel sizes, trials and sample points (for tests)");
+  acc->add_flag("--gpu", accuracy.gpu,
+                "Also the GPU renderer of pandora view against the exact one per shadow-map size "
+                "(needs a display)");
+  acc->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(threads_check);
+  return {acc, [args] { return RunAccuracy(*args); }};
 }
 
 }  // namespace pandora::app

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -18,6 +19,7 @@
 #include "analysis/scene/scene.h"
 #include "analysis/scene/surface_targets.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/mpi_session.h"
 #include "app/output.h"
@@ -772,6 +774,42 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   }
   return 0;
+}
+
+// Registers `pandora analyze` and its options.
+Command AddAnalyzeCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<AnalyzeArgs>();
+  AnalyzeArgs& analyze = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* a = app.add_subcommand(
+      "analyze", "Evaluate fields over the study region; write fields.vdb and summary.json");
+  a->add_option("scene", analyze.scene, "Scene file (JSON)")->required();
+  a->add_option("--rig", analyze.rig, "Rig name (default: the first rig)");
+  a->add_option("--disable", analyze.disable,
+                "Camera ids to disable for this run, comma-separated or repeated (what the rig "
+                "loses when they fail)")
+      ->delimiter(',');
+  a->add_option("--out", analyze.out, "Output folder")->capture_default_str();
+  a->add_option("--voxel-size", analyze.voxel_size,
+                "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  a->add_option("--fields", analyze.fields, "Comma-separated fields (default: study.fields)");
+  a->add_option("--memory-budget", analyze.memory_budget_mb,
+                "Memory budget in MiB (default: study.memory_budget_mb)")
+      ->check(Number(0, HUGE_VAL, "MiB", false, true));
+  a->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  a->add_flag("--quiet,-q", analyze.quiet, "Print nothing but errors");
+  a->add_flag("--mpi", analyze.mpi,
+              "Under mpirun: split the blocks over the processes; rank 0 writes (docs/scale.md)");
+  a->add_flag("--stream", analyze.stream,
+              "Evaluate and write the region tile by tile within the memory budget: "
+              "fields/tile_NNNN.vdb (docs/scale.md)");
+  a->add_option(
+       "--tile-size", analyze.tile_size,
+       "With --stream: the tiles' side in metres (default: as few tiles as the budget allows)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  return {a, [args] { return RunAnalyze(*args); }};
 }
 
 }  // namespace pandora::app

@@ -12,6 +12,7 @@
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/output.h"
 #include "app/session/study.h"
@@ -160,6 +161,42 @@ int RunBench(const BenchArgs& args) {
     output.Commit();
   }
   return 0;
+}
+
+// Registers `pandora bench` and its options (`viewer_flag`: --viewer, which main handles).
+Command AddBenchCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<BenchArgs>();
+  BenchArgs& bench = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  auto viewer_flag_value = std::make_shared<bool>(false);  // main runs pandora-view for it
+  bool& viewer_flag = *viewer_flag_value;
+  CLI::App* b = app.add_subcommand(
+      "bench", "Time field evaluation against a raw Embree loop over the same rays");
+  b->add_option("scene", bench.scene, "Scene file (JSON)")->required();
+  b->add_option("--rig", bench.rig, "Rig name (default: the first rig)");
+  b->add_option("--voxel-size", bench.voxel_size,
+                "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")
+      ->check(Number(1, 1000, "repetitions", true));
+  b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
+  b->add_flag("--render", bench.render,
+              "Time `pandora render` (1280x720) against raw Embree loops over the same primary and "
+              "shadow rays");
+  b->add_option("--view", bench.view,
+                "With --render: the named view (default: the scene's first view)");
+  b->add_option("--size", bench.size, "With --render: image size WxH")->capture_default_str();
+  b->add_flag("--viewer", viewer_flag,
+              "Frame rates of `pandora view` (navigating, all cameras moving) against the exact "
+              "CPU renderer");
+  b->add_flag("--incremental", bench.incremental,
+              "Time the field update after moving one camera against a full evaluation");
+  b->add_option("--move", bench.move, "With --incremental: how far each camera moves, metres")
+      ->check(Number(0, HUGE_VAL, "metres", false, true))
+      ->capture_default_str();
+  b->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  return {b, [args, viewer_flag_value] { return RunBench(*args); }};
 }
 
 }  // namespace pandora::app

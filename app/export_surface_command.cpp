@@ -3,11 +3,13 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/output.h"
 #include "app/session/study.h"
@@ -79,6 +81,36 @@ int RunExportSurface(const ExportSurfaceArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   }
   return 0;
+}
+
+// Registers `pandora export-surface` and its options.
+Command AddExportSurfaceCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<ExportSurfaceArgs>();
+  ExportSurfaceArgs& surface = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* es = app.add_subcommand(
+      "export-surface",
+      "Sample the scene's surfaces; write coverage, resolution and sigma_max per sample as PLY");
+  es->add_option("scene", surface.scene, "Scene file (JSON)")->required();
+  es->add_option("--rig", surface.rig, "Rig name (default: the first rig)");
+  es->add_option("--disable", surface.disable,
+                 "Camera ids to disable for this run, comma-separated or repeated (what the rig "
+                 "loses when they fail)")
+      ->delimiter(',');
+  es->add_option("--spacing", surface.spacing, "Distance between samples in metres")
+      ->capture_default_str()
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  es->add_option("--out", surface.out, "Output PLY file")->required();
+  es->add_option("--seed", surface.seed, "Seed of the sample positions")
+      ->capture_default_str()
+      ->check(Number(0, 9.2e18, "(any whole number)", true));
+  es->add_flag(
+      "--all-surfaces", surface.all_surfaces,
+      "Sample every surface, also those facing away from the study region and every camera");
+  es->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  es->add_flag("--quiet,-q", surface.quiet, "Print nothing but errors");
+  return {es, [args] { return RunExportSurface(*args); }};
 }
 
 }  // namespace pandora::app

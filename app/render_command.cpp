@@ -3,10 +3,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/ptz.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
@@ -265,6 +267,85 @@ int RunRender(const RenderArgs& args) {
       std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   }
   return 0;
+}
+
+// Registers `pandora render` and its options.
+Command AddRenderCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<RenderArgs>();
+  RenderArgs& render = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* rn = app.add_subcommand(
+      "render",
+      "Render the scene lit by every enabled camera as a projector of its own colour (PNG or EXR)");
+  rn->add_option("scene", render.scene, "Scene file (JSON)")->required();
+  rn->add_option("--rig", render.rig, "Rig name (default: the first rig)");
+  rn->add_option("--disable", render.disable,
+                 "Camera ids to disable for this run, comma-separated or repeated (what the rig "
+                 "loses when they fail)")
+      ->delimiter(',');
+  rn->add_option("--view", render.view, "Named view from the scene's \"views\"");
+  rn->add_flag_callback(
+      "--plan", [&render]() { render.plan = "plan"; },
+      "A plan of the scene from above (orthographic, north up, camera ids labelled)");
+  rn->add_option(
+      "--elevation", render.plan,
+      "An elevation from SIDE: north, south, east or west (orthographic, camera ids labelled)");
+  rn->add_option("--cut", render.cut,
+                 "With --plan: the cut height; with --elevation: the section's coordinate (metres; "
+                 "default: the study region's face on that side)");
+  rn->add_option("--from", render.from, "Eye position X,Y,Z (with --at)");
+  rn->add_option("--at", render.at, "Point looked at X,Y,Z (with --from)");
+  rn->add_option("--up", render.up, "Up direction X,Y,Z (default 0,0,1)");
+  rn->add_option("--camera", render.camera,
+                 "Render what this camera (id) images, distortion included");
+  rn->add_option("--time-sample", render.time_sample,
+                 "The scene at one of the study's time samples: its number, pose name or label "
+                 "(docs/time.md)");
+  rn->add_option(
+        "--ptz", render.ptz,
+        "PTZ traces: single (current setting), path (home to current, one per second), all "
+        "(reachable within --ptz-time)")
+      ->capture_default_str();
+  rn->add_option("--ptz-time", render.ptz_time,
+                 "Time budget of --ptz all, seconds (default: the head's trace_s)")
+      ->check(Number(0, 1e6, "seconds", false, true, true));
+  rn->add_option("--fov", render.fov,
+                 "Horizontal field of view in degrees (default: the view's, else 60)")
+      ->check(Number(0, 180, "degrees", false, true, true));
+  rn->add_option("--size", render.size,
+                 "Image size WxH (default 1280x720; the camera's with --camera)");
+  rn->add_option("--out", render.out, "Output image: FILE.png or FILE.exr")->capture_default_str();
+  rn->add_option("--pattern", render.pattern, "uniform | grid (each camera's pixel grid)")
+      ->capture_default_str();
+  rn->add_option("--grid", render.grid, "Grid pattern: a line every N camera pixels")
+      ->capture_default_str()
+      ->check(Number(1, 100000, "camera pixels", true));
+  rn->add_option("--surface", render.surface, "material | black | hidden-line | contours")
+      ->capture_default_str();
+  rn->add_option("--brightness", render.brightness,
+                 "Scale of every camera's light (default min(1, 3 / enabled cameras))")
+      ->check(Number(0, 1e6, "times one camera's light", false, true));
+  rn->add_option("--samples", render.samples, "Samples per pixel per axis (antialiasing)")
+      ->capture_default_str()
+      ->check(Number(1, 16, "samples per pixel per axis", true));
+  rn->add_flag("--no-cameras", render.no_cameras, "Do not draw the camera bodies and frusta");
+  rn->add_flag("--no-key", render.no_key, "Do not draw the colour key (camera id -> colour)");
+  rn->add_option("--fields", render.fields,
+                 "fields.vdb from `pandora analyze`, for --slice and --iso");
+  rn->add_option("--slice", render.slice,
+                 "Show this field on a slice plane (viridis, with a legend)");
+  rn->add_option("--slice-axis", render.slice_axis, "x | y | z: the slice plane's normal")
+      ->capture_default_str();
+  rn->add_option("--slice-at", render.slice_at,
+                 "Slice position along its axis in metres (default: the middle)")
+      ->check(Number(-HUGE_VAL, HUGE_VAL, "metres"));
+  rn->add_option("--iso", render.iso, "Draw the isosurface of this field");
+  rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)")
+      ->check(Number(-HUGE_VAL, HUGE_VAL, "the field's unit"));
+  rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
+  return {rn, [args] { return RunRender(*args); }};
 }
 
 }  // namespace pandora::app

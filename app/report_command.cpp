@@ -2,6 +2,7 @@
 // numbers are app/report/report.h; this parses the options, checks them, runs and prints.
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -9,6 +10,7 @@
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/output.h"
 #include "app/report/report.h"
@@ -97,6 +99,44 @@ int RunReport(const ReportArgs& args) {
         std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(scene.path, w).c_str());
   }
   return 0;
+}
+
+// Registers `pandora report` and its options.
+Command AddReportCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<ReportArgs>();
+  ReportArgs& report = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* rep = app.add_subcommand("report",
+                                     "One self-contained HTML report: renders, field slices, "
+                                     "histograms, cameras, rigs side by side");
+  rep->add_option("scene", report.scene, "Scene file (JSON)")->required();
+  rep->add_option("--rig", report.rigs,
+                  "Rig name(s), repeatable or comma-separated (default: every rig)");
+  rep->add_option("--disable", report.disable,
+                  "Camera ids to disable in every rig of the report that has them, comma-separated "
+                  "or repeated")
+      ->delimiter(',');
+  rep->add_option("--out", report.out, "Output folder (report.html is written there)")
+      ->capture_default_str();
+  rep->add_option("--voxel-size", report.voxel_size,
+                  "Voxel size in metres (default: study.voxel_size)")
+      ->check(Number(0, HUGE_VAL, "metres", false, true));
+  rep->add_option("--width", report.width, "Width in pixels of the renders from the named views")
+      ->capture_default_str()
+      ->check(Number(16, 8192, "pixels", true));
+  rep->add_option("--camera-width", report.camera_width,
+                  "Width in pixels of each camera's own view")
+      ->capture_default_str()
+      ->check(Number(16, 8192, "pixels", true));
+  rep->add_option(
+         "--brightness", report.brightness,
+         "Scale of every camera's light in the renders (default min(1, 3 / enabled cameras))")
+      ->check(Number(0, 1e6, "times one camera's light", false, true));
+  rep->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(threads_check);
+  rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
+  return {rep, [args] { return RunReport(*args); }};
 }
 
 }  // namespace pandora::app

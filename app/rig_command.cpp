@@ -2,6 +2,7 @@
 // the scene file, with a backup (docs/rig-generators.md).
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "analysis/scene/scene_text.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
@@ -222,6 +224,50 @@ int RunRig(const RigArgs& args) {
   for (const Warning& w : warnings)
     std::fprintf(stderr, "pandora: warning: %s\n", FormatWarning(args.scene, w).c_str());
   return 0;
+}
+
+// Registers `pandora rig` and its options.
+Command AddRigCommand(CLI::App& app, CommonOptions& /*common*/) {
+  auto args = std::make_shared<RigArgs>();
+  RigArgs& rig_args = *args;
+  CLI::App* rg = app.add_subcommand("rig",
+                                    "Generate a rig (ring, ceiling or wall grid, cameras along "
+                                    "walls) and write it into the scene file (keeps a backup)");
+  rg->add_option("scene", rig_args.scene, "Scene file (JSON)")->required();
+  rg->add_option("--name", rig_args.name, "Name of the new rig")->required();
+  rg->add_flag("--replace", rig_args.replace, "Overwrite the rig of that name");
+  rg->add_option(
+      "--ring", rig_args.ring,
+      "Layout: N cameras on a horizontal circle (--radius, --height, --center X,Y,Z, --start-deg)");
+  rg->add_option("--grid", rig_args.grid,
+                 "Layout: NX,NY cameras over a ceiling rectangle (--rect X0,Y0,X1,Y1, --height), "
+                 "looking down unless --aim");
+  rg->add_option(
+      "--wall-grid", rig_args.wall_grid,
+      "Layout: NU,NZ cameras over a wall (--wall X0,Y0,X1,Y1, --z-range Z0,Z1, --inset)");
+  rg->add_option(
+      "--along", rig_args.along,
+      "Layout: --count cameras evenly along walls X0,Y0,X1,Y1[,X2,Y2...] (--height, --inset)");
+  rg->add_option("--count", rig_args.count, "With --along: how many cameras");
+  rg->add_option("--radius", rig_args.radius, "Ring radius, metres");
+  rg->add_option("--height", rig_args.height, "Camera height, metres");
+  rg->add_option("--center", rig_args.center, "Ring centre X,Y (default: the region's centre)");
+  rg->add_option("--start-deg", rig_args.start_deg,
+                 "Ring: the first camera's angle from +x, degrees");
+  rg->add_option("--rect", rig_args.rect, "Ceiling grid rectangle X0,Y0,X1,Y1, metres");
+  rg->add_option("--wall", rig_args.wall, "Wall grid: the wall segment X0,Y0,X1,Y1, metres");
+  rg->add_option("--z-range", rig_args.z_range, "Wall grid: heights Z0,Z1, metres");
+  rg->add_option("--inset", rig_args.inset, "Distance in from the wall, metres")
+      ->capture_default_str();
+  rg->add_option("--aim", rig_args.aim,
+                 "Point every camera looks at X,Y,Z (default: the region's centre)");
+  rg->add_option("--resolution", rig_args.resolution, "Image size WxH")->capture_default_str();
+  rg->add_option("--hfov", rig_args.hfov_deg, "Horizontal field of view, degrees")
+      ->capture_default_str();
+  rg->add_option("--prefix", rig_args.prefix, "Camera id prefix (default: the rig's name and _)");
+  rg->add_flag("--dry-run", rig_args.dry_run, "Print the new scene file instead of writing it");
+  rg->add_flag("-q,--quiet", rig_args.quiet, "Print nothing on success");
+  return {rg, [args] { return RunRig(*args); }};
 }
 
 }  // namespace pandora::app

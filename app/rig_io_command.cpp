@@ -3,12 +3,14 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "analysis/rig/rig_check.h"
 #include "analysis/rig/rig_formats.h"
 #include "analysis/rig/rig_import.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/output.h"
 
@@ -118,6 +120,47 @@ int RunImportRig(const ImportRigArgs& args) {
     }
   }
   return 0;
+}
+
+// Registers `pandora export-rig` and its options.
+Command AddExportRigCommand(CLI::App& app, CommonOptions& /*common*/) {
+  auto args = std::make_shared<ExportRigArgs>();
+  ExportRigArgs& export_rig = *args;
+  CLI::App* er = app.add_subcommand("export-rig",
+                                    "Write the rig as OpenCV YAML, a COLMAP text model, glTF "
+                                    "(meshes + cameras) or an installation sheet (CSV)");
+  er->add_option("scene", export_rig.scene, "Scene file (JSON)")->required();
+  er->add_option("--rig", export_rig.rig, "Rig name (default: the first rig)");
+  er->add_option("--format", export_rig.format, "opencv | colmap | gltf | sheet")->required();
+  er->add_option("--out", export_rig.out, "Output file (a folder for colmap)")->required();
+  er->add_flag("--quiet,-q", export_rig.quiet, "Print nothing but errors");
+  return {er, [args] { return RunExportRig(*args); }};
+}
+
+// Registers `pandora import-rig` and its options (`import_from`: the two values of --from).
+Command AddImportRigCommand(CLI::App& app, CommonOptions& /*common*/) {
+  auto args = std::make_shared<ImportRigArgs>();
+  ImportRigArgs& import_rig = *args;
+  auto from = std::make_shared<std::vector<std::string>>();  // FORMAT PATH
+  std::vector<std::string>& import_from = *from;
+  CLI::App* ir =
+      app.add_subcommand("import-rig",
+                         "Write a calibrated rig (OpenCV YAML or COLMAP text model) into the scene "
+                         "file (keeps a backup) and compare it with the design");
+  ir->add_option("scene", import_rig.scene, "Scene file (JSON), rewritten")->required();
+  ir->add_option("--from", import_from, "FORMAT PATH: opencv FILE.yml or colmap FOLDER")
+      ->required()
+      ->expected(2);
+  ir->add_option("--rig", import_rig.rig,
+                 "The design rig: replaced by id, or compared with when --as is given")
+      ->required();
+  ir->add_option("--as", import_rig.as, "Write a new rig of this name instead");
+  ir->add_flag("--quiet,-q", import_rig.quiet, "Print nothing but errors");
+  return {ir, [args, from] {
+            args->format = from->at(0);
+            args->from = from->at(1);
+            return RunImportRig(*args);
+          }};
 }
 
 }  // namespace pandora::app

@@ -3,12 +3,14 @@
 // backup). docs/suggest.md describes both.
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/motion.h"
 #include "analysis/util/error.h"
+#include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
@@ -117,6 +119,114 @@ int RunAccept(const AcceptArgs& args) {
     for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
   }
   return 0;
+}
+
+// Registers `pandora suggest` and its options.
+Command AddSuggestCommand(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<SuggestArgs>();
+  SuggestArgs& suggest = *args;
+  int& threads = common.threads;
+  const CLI::Validator& threads_check = common.threads_check;
+  CLI::App* sg = app.add_subcommand(
+      "suggest",
+      "Nudge the selected cameras within limits to improve an objective; write a suggestion");
+  sg->add_option("scene", suggest.scene, "Scene file (JSON)")->required();
+  sg->add_option("--rig", suggest.rig, "Rig name (default: the first rig)");
+  sg->add_option("--disable", suggest.disable,
+                 "Camera ids to disable for this run, comma-separated or repeated (what the rig "
+                 "loses when they fail)")
+      ->delimiter(',');
+  sg->add_option("--cameras", suggest.cameras,
+                 "Comma-separated ids of the cameras that may move (or --ptz-preset / --ptz-tour)");
+  sg->add_option(
+      "--ptz-preset", suggest.ptz_preset,
+      "PTZ: ID:PRESET, the pan, tilt and zoom of that preset that best cover the targets");
+  sg->add_option("--ptz-tour", suggest.ptz_tour,
+                 "PTZ: ID, the order of its tour's stops with the shortest longest unwatched gap "
+                 "over the targets");
+  sg->add_option("--tour-objective", suggest.tour_objective,
+                 "With --ptz-tour: minimise the mean of the points' longest unwatched gaps (mean) "
+                 "or the longest of all (max)")
+      ->capture_default_str();
+  sg->add_option("--target-region", suggest.target_region,
+                 "Target points in this named region of the study (study.regions) instead of the "
+                 "whole region");
+  sg->add_option("--max-move", suggest.max_move,
+                 "Largest move, metres: one value, or one per camera in --cameras order")
+      ->capture_default_str();
+  sg->add_option("--max-rotate", suggest.max_rotate,
+                 "Largest rotation, degrees: one value, or one per camera")
+      ->capture_default_str();
+  sg->add_option("--objective", suggest.objective,
+                 "coverage2 (coverageK), sigma-mean, sigma-p90 (sigma-pNN), resolution, mix, "
+                 "coverage3-n1 (coverageK-n1, after the worst camera failure), calibration "
+                 "(study.calibration)")
+      ->capture_default_str();
+  sg->add_option("--weights", suggest.weights,
+                 "Mix weights WC,WS,WR (coverage, sigma, resolution)");
+  sg->add_option("--rail", suggest.rail,
+                 "Mount: stay on the line through the camera along [ID:]DX,DY,DZ (repeatable)");
+  sg->add_option(
+      "--plane", suggest.plane,
+      "Mount: stay on the plane through the camera with normal [ID:]NX,NY,NZ (repeatable)");
+  sg->add_option("--mount-box", suggest.mount_box,
+                 "Mount: stay inside [ID:]XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, metres in the world frame "
+                 "(repeatable)");
+  sg->add_option("--hfov-range", suggest.hfov_range,
+                 "Zoom: the horizontal FOV may change within [ID:]MIN,MAX degrees (repeatable)");
+  sg->add_option("--keep-out", suggest.keep_out,
+                 "Box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (metres, world frame) no camera centre may "
+                 "enter (repeatable)");
+  sg->add_option("--clearance", suggest.clearance,
+                 "Keep every suggested camera centre this far from every scene surface, metres (a "
+                 "camera already closer never moves closer)")
+      ->capture_default_str()
+      ->check(Number(0, HUGE_VAL, "metres"));
+  sg->add_option("--target-surface", suggest.target_surfaces,
+                 "Object whose surface is the target (repeatable)");
+  sg->add_flag("--with-region", suggest.with_region,
+               "With --target-surface: region points as well");
+  sg->add_flag("--over-time", suggest.over_time,
+               "Target the study's surface targets at every time sample (moving people; --points "
+               "per target)");
+  sg->add_option("--points", suggest.points, "Target points")
+      ->capture_default_str()
+      ->check(Number(1, 1000000, "target points", true));
+  sg->add_option("--snap-move", suggest.snap_move,
+                 "Round moves to multiples of this, metres (0: off)")
+      ->check(Number(0, HUGE_VAL, "metres (0: off)"));
+  sg->add_option("--snap-rotate", suggest.snap_rotate,
+                 "Round yaw/pitch/roll changes to multiples of this, degrees")
+      ->check(Number(0, 180, "degrees (0: off)"));
+  sg->add_option("--outer", suggest.outer_iterations,
+                 "Outer iterations (occlusion re-evaluated between)")
+      ->check(Number(1, 1000, "outer iterations", true));
+  sg->add_option("--out", suggest.out, "Suggestion file")->capture_default_str();
+  sg->add_option("--perturb", suggest.perturb,
+                 "Benchmark: first move and rotate the selected cameras by MOVE,DEG");
+  sg->add_option(
+      "--compare-baseline", suggest.compare_baseline,
+      "Also run random local search with the same budget; write CSV and SVG to this folder");
+  sg->add_option("--seed", suggest.seed, "Seed for target points and perturbations")
+      ->capture_default_str()
+      ->check(Number(0, 9.2e18, "(any whole number)", true));
+  sg->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  sg->add_flag("--quiet,-q", suggest.quiet, "Print nothing but errors");
+  return {sg, [args] { return RunSuggest(*args); }};
+}
+
+// Registers `pandora accept` and its options.
+Command AddAcceptCommand(CLI::App& app, CommonOptions& /*common*/) {
+  auto args = std::make_shared<AcceptArgs>();
+  AcceptArgs& accept = *args;
+  CLI::App* ac = app.add_subcommand(
+      "accept", "Write a suggestion's poses into the scene file (keeps a backup)");
+  ac->add_option("suggestion", accept.suggestion, "Suggestion file from pandora suggest")
+      ->required();
+  ac->add_option("--cameras", accept.cameras, "Comma-separated ids to accept (default: all)");
+  ac->add_flag("--force", accept.force, "Accept even if the scene file changed since");
+  ac->add_flag("--quiet,-q", accept.quiet, "Print nothing but errors");
+  return {ac, [args] { return RunAccept(*args); }};
 }
 
 }  // namespace pandora::app
