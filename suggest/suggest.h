@@ -9,7 +9,9 @@
 ///
 /// Units: metres and radians inside; the CLI and the suggestion file speak metres and degrees.
 
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -190,6 +192,13 @@ struct SuggestOptions {
   double snap_move = 0, snap_rotate_deg = 0;
   /// Used in error messages (the option or JSON path that set the selection and limits).
   std::string scene_path;
+  /// Called on the searching thread with the fraction done in [0, 1]: the screening's chains up
+  /// to 0.3, then the nudge's outer iterations. Empty: not called.
+  std::function<void(double fraction)> progress;
+  /// Polled between exact evaluations (a screening candidate, a Ceres step); once set, the search
+  /// stops and Suggest returns the best poses judged so far, snapped as asked, with
+  /// Suggestion::stopped (the viewer's Cancel). Null: never. Must outlive the call.
+  const std::atomic<bool>* cancel = nullptr;
 
   /// Checks the options against `rig` (of `scene`): a selection of distinct, enabled, fixed
   /// cameras, limits (one set or one per camera) that hold each camera's current pose and field of
@@ -202,6 +211,7 @@ struct SuggestOptions {
 struct Suggestion {
   bool improved = false;  ///< The exact objective improved: the poses are worth offering.
   std::string message;    ///< One line: what happened (always set).
+  bool stopped = false;   ///< SuggestOptions::cancel ended the search early.
   Objective objective;
   std::vector<CameraChange> cameras;
   Metrics before, after;  ///< Exact; `after` at the returned poses (the start when not improved).

@@ -42,6 +42,8 @@ constexpr double kIncidenceWidth = 0.1;
 constexpr double kBorderWidth = 0.04;
 // Occlusion slopes from centres moved by this fraction of the largest move.
 constexpr double kOcclusionDelta = 0.25;
+// The share of SuggestOptions::progress the screening reports (the nudge the rest).
+constexpr double kScreeningShare = 0.3;
 
 double Sigmoid(double z) {
   if (z >= 0) return 1.0 / (1.0 + std::exp(-z));
@@ -395,12 +397,14 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
 }
 
 // Judges every successful Ceres step with the exact evaluation; keeps the best.
+// Aborts the solve once `stop` says so (SuggestOptions::cancel).
 class ExactJudge final : public ceres::IterationCallback {
  public:
   std::function<void()> on_step;
+  std::function<bool()> stop;
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     if (summary.iteration > 0 && summary.step_is_successful) on_step();
-    return ceres::SOLVER_CONTINUE;
+    return stop() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
   }
 };
 
@@ -444,6 +448,13 @@ struct SuggestRun {
 
   // Seconds since Suggest began.
   double Elapsed() const { return SecondsSince(t0); }
+
+  // Whether the caller asked the search to stop (SuggestOptions::cancel).
+  bool Stopped() const { return options.cancel && options.cancel->load(std::memory_order_relaxed); }
+  // Reports the fraction done (SuggestOptions::progress).
+  void Progress(double fraction) const {
+    if (options.progress) options.progress(fraction);
+  }
 
   // The suggestion with `message`, the evaluations and the time taken.
   Suggestion Finish(const std::string& message) {
@@ -587,11 +598,13 @@ void SuggestRun::ScreenChain(int candidates, int joint_candidates) {
   for (double radius : {1.0, 0.4, 0.15})
     for (int c : movable)
       for (int k = 0; k < candidates; ++k) {
+        if (Stopped()) return;
         std::vector<std::vector<double>> xs = cur_x;
         xs[c] = Sample(charts[c], cur_x[c], radius);
         TryMove({c}, xs);
       }
   for (int k = 0; k < joint_candidates; ++k) {
+    if (Stopped()) return;
     std::vector<std::vector<double>> xs = cur_x;
     for (int c : movable) xs[c] = Sample(charts[c], cur_x[c], kJointRadius);
     TryMove(movable, xs);
@@ -626,13 +639,14 @@ void SuggestRun::Screen() {
   // need no gradient.
   const int joint_candidates = movable.size() > 1 ? candidates * 3 / 4 : 0;
   std::vector<CameraView> screened_view;
-  for (int chain = 0; chain < kChains; ++chain) {
+  for (int chain = 0; chain < kChains && !Stopped(); ++chain) {
     ScreenChain(candidates, joint_candidates);
     if (cur_score > screened_score && cur_score > start_score) {
       screened_score = cur_score;
       screened_x = cur_x;
       screened_view = cur_view;
     }
+    Progress(kScreeningShare * (chain + 1) / kChains);
   }
   if (!screened_x.empty()) {
     for (std::size_t c = 0; c < nsel; ++c) ptrs[c] = &screened_view[c];
@@ -739,6 +753,7 @@ void SuggestRun::Polish() {
   ExactJudge judge;
   scales.assign(nsel, 1.0);
   judge.on_step = [&]() { JudgeStep(); };
+  judge.stop = [&]() { return Stopped(); };
 
   // Polish the best start with the Ceres nudge: the screening's best pose when it beat the current
   // poses, else the current poses. (Polishing the current poses as well, as a second start, never
@@ -767,8 +782,11 @@ void SuggestRun::Polish() {
       inactive.push_back(static_cast<int>(c));
   std::vector<Contribution> frozen(inactive.size());
   const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
-  for (int o = 0; o < outer; ++o)
-    if (OuterIteration(o, inactive, frozen, judge)) break;
+  for (int o = 0; o < outer && !Stopped(); ++o) {
+    const bool converged = OuterIteration(o, inactive, frozen, judge);
+    Progress(kScreeningShare + (1 - kScreeningShare) * (o + 1) / outer);
+    if (converged) break;
+  }
 }
 
 // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
@@ -863,6 +881,7 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
 
   if (options.screening_candidates > 0) run.Screen();
   run.Polish();
+  run.Progress(1.0);
 
   std::vector<Eigen::Isometry3d> best_poses = start;
   std::vector<double> best_scales(nsel, 1.0);
@@ -870,7 +889,8 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     best_poses[c] = charts[c].Pose(best_x[c].data());
     best_scales[c] = charts[c].FocalScale(best_x[c].data());
   }
-  if (best_score > start_score) run.LevelPoses(best_poses, best_scales);
+  s.stopped = run.Stopped();
+  if (best_score > start_score && !s.stopped) run.LevelPoses(best_poses, best_scales);
   if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
     if (best_score > start_score) {
       s.unsnapped = best_m;
@@ -890,14 +910,15 @@ Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
     if (std::isinf(s.after.objective))
       extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
               Num("%.4g", s.before.untriangulable) + " to " + Num("%.4g", s.after.untriangulable);
-    return run.Finish(name + " improved from " + Num("%.6g", s.before.objective) + " to " +
-                      Num("%.6g", s.after.objective) +
+    return run.Finish(std::string(s.stopped ? "stopped early; " : "") + name + " improved from " +
+                      Num("%.6g", s.before.objective) + " to " + Num("%.6g", s.after.objective) +
                       (higher ? " (higher is better)" : " (lower is better)") + extra);
   }
   if (s.unsnapped)
     return run.Finish("no improvement found: the optimum improved " + name + " to " +
                       Num("%.6g", s.unsnapped->objective) +
                       " but the snapped poses do not; use finer snap steps");
+  if (s.stopped) return run.Finish("stopped early: no improvement found yet");
   if (start_without_gradient) return run.Finish(no_gradient);
   return run.Finish("no improvement found: the exact " + name +
                     " did not improve within the limits (it stays " +

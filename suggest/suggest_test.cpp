@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -336,6 +337,44 @@ TEST(Suggest, ScreeningThenPolishBeatsTheNudgeAlone) {
       EXPECT_GE(with.trace[i].objective, with.trace[i - 1].objective) << name;
   }
   EXPECT_GT(gain, 0.0);
+}
+
+// SuggestOptions::cancel stops the search where it is and returns the best judged so far (the
+// contract holds: `after` is the exact objective at the returned poses); progress rises to 1.
+TEST(Suggest, CancelStopsEarlyWithTheBestSoFarAndProgressRises) {
+  Fixture f(SceneText(1.0));
+  SuggestOptions o = Options({3}, 0.3, 30);
+  std::vector<double> fractions;
+  o.progress = [&fractions](double v) { fractions.push_back(v); };
+  const Suggestion full = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  ASSERT_FALSE(fractions.empty());
+  EXPECT_EQ(fractions.back(), 1.0);
+  for (std::size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1]);
+  EXPECT_FALSE(full.stopped);
+
+  // Cancelled before it starts: nothing searched, nothing offered.
+  std::atomic<bool> cancel{true};
+  o.progress = nullptr;
+  o.cancel = &cancel;
+  const Suggestion none = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  EXPECT_TRUE(none.stopped);
+  EXPECT_FALSE(none.improved);
+  EXPECT_EQ(none.iterations, 0);
+  EXPECT_LT(none.evaluations, full.evaluations / 10);
+  EXPECT_NE(none.message.find("stopped early"), std::string::npos) << none.message;
+
+  // Cancelled once the screening is done: the screening's best comes back, judged and within the
+  // limits, without the nudge.
+  cancel = false;
+  o.progress = [&cancel](double v) {
+    if (v >= 0.3) cancel = true;
+  };
+  const Suggestion screened = Suggest(f.scene, f.rig(), *f.caster, f.targets, o);
+  EXPECT_TRUE(screened.stopped);
+  EXPECT_EQ(screened.iterations, 0);
+  EXPECT_GT(screened.screened, 0);
+  EXPECT_LE(screened.after.objective, full.after.objective);
+  CheckContract(f, o, screened);
 }
 
 TEST(Suggest, ZeroLimitsReturnTheSamePoses) {

@@ -154,8 +154,12 @@ std::int64_t Session::SuggestInBackground(std::vector<TargetPoint> targets, Sugg
   }
   const std::int64_t job =
       jobs_.Submit("suggest", [this, rig, data, keep = std::move(keep)](JobContext& context) {
+        // Cancel stops the search itself (it returns its best so far, discarded here).
+        SuggestOptions options = data->second;
+        options.cancel = &context.cancel_flag();
+        options.progress = [&context](double fraction) { context.Progress(fraction); };
         Suggestion s =
-            pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, data->second);
+            pandora::Suggest(study_->scene(), *rig, study_->caster(), data->first, options);
         if (context.cancelled()) return;  // a newer suggestion was asked for
         std::lock_guard<std::mutex> lock(suggestion_mutex_);
         suggestion_ = std::move(s);

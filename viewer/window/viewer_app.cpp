@@ -1531,8 +1531,9 @@ struct ViewerApp::Impl {
     if (model.selection.empty()) {
       ImGui::TextDisabled("select the cameras that may move");
     } else if (running) {
-      ImGui::Text("suggesting...");
+      ImGui::Text("suggesting... %.0f %%", 100 * s.progress);
       ImGui::SameLine();
+      // Stops the search where it is (SuggestOptions::cancel); nothing is offered.
       if (ImGui::Button("Cancel")) model.session().jobs().Cancel("suggest");
     } else if (ImGui::Button(("Suggest for " + std::to_string(model.selection.size()) + " cameras")
                                  .c_str())) {
