@@ -8,6 +8,7 @@
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/ptz.h"
 #include "analysis/util/error.h"
+#include "analysis/util/text.h"
 #include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -52,25 +53,17 @@ RenderOptions ParseRenderOptions(const RenderArgs& args) {
     options.brightness =
         CheckPositiveOption("--brightness", args.brightness, "times one camera's light");
   const std::string pattern = Lower(args.pattern);
-  if (pattern == "uniform")
-    options.pattern = Pattern::kUniform;
-  else if (pattern == "grid")
-    options.pattern = Pattern::kGrid;
-  else
+  const std::optional<Pattern> p = PatternFromName(pattern);
+  if (!p)
     throw InputError("--pattern", "", "unknown pattern '" + args.pattern + "'",
-                     "use uniform or grid");
+                     DidYouMean(pattern, PatternNames(), "patterns"));
+  options.pattern = *p;
   const std::string surface = Lower(args.surface);
-  if (surface == "material")
-    options.surface = Surface::kMaterial;
-  else if (surface == "black")
-    options.surface = Surface::kBlack;
-  else if (surface == "hidden-line")
-    options.surface = Surface::kHiddenLine;
-  else if (surface == "contours")
-    options.surface = Surface::kContours;
-  else
+  const std::optional<Surface> mode = SurfaceFromName(surface);
+  if (!mode)
     throw InputError("--surface", "", "unknown surface mode '" + args.surface + "'",
-                     "use material, black, hidden-line or contours");
+                     DidYouMean(surface, SurfaceNames(), "surface modes"));
+  options.surface = *mode;
   if (args.grid < 1 || args.grid > 100000)
     throw InputError("--grid", "", "must be a whole number of camera pixels >= 1");
   options.grid_pixels = args.grid;

@@ -34,6 +34,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace pandora {
 
@@ -42,6 +45,22 @@ enum class Pattern {
   kUniform,  ///< Uniform light of the camera's colour over its whole footprint.
   kGrid,     ///< The camera's pixel grid: a line every `grid_pixels` of its pixels (Fig. 2 right).
 };
+
+/// Pattern's names in its order ("uniform", "grid"): `render --pattern`, a script's "light", the
+/// viewer's panel.
+inline const std::vector<std::string>& PatternNames() {
+  static const std::vector<std::string> kNames{"uniform", "grid"};
+  return kNames;
+}
+inline const std::string& PatternName(Pattern pattern) {
+  return PatternNames()[static_cast<std::size_t>(pattern)];
+}
+/// The pattern PatternName calls `name`; nullopt for any other text.
+inline std::optional<Pattern> PatternFromName(const std::string& name) {
+  for (std::size_t i = 0; i < PatternNames().size(); ++i)
+    if (PatternNames()[i] == name) return static_cast<Pattern>(i);
+  return std::nullopt;
+}
 
 /// The default light scale for `enabled_cameras` cameras: min(1, 3 / n). Where k cameras overlap
 /// their colours add, so with n cameras around a region the middle gets about n times one light;

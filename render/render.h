@@ -84,6 +84,22 @@ enum class Surface {
   kContours,  ///< Black with grey contours only: silhouette/crease/object boundaries in the image.
 };
 
+/// Surface's names in its order ("material", "black", "hidden-line", "contours"): `render
+/// --surface`, a script's "light", the viewer's panel.
+inline const std::vector<std::string>& SurfaceNames() {
+  static const std::vector<std::string> kNames{"material", "black", "hidden-line", "contours"};
+  return kNames;
+}
+inline const std::string& SurfaceName(Surface surface) {
+  return SurfaceNames()[static_cast<std::size_t>(surface)];
+}
+/// The surface mode SurfaceName calls `name`; nullopt for any other text.
+inline std::optional<Surface> SurfaceFromName(const std::string& name) {
+  for (std::size_t i = 0; i < SurfaceNames().size(); ++i)
+    if (SurfaceNames()[i] == name) return static_cast<Surface>(i);
+  return std::nullopt;
+}
+
 /// Overlays drawn in the main view.
 struct OverlayOptions {
   bool cameras = true;          ///< Each enabled camera as a small body plus its frustum wireframe.

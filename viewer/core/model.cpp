@@ -561,13 +561,10 @@ void ViewerModel::DoView(const Action& a) {
 
 // "light": the pattern, grid size, brightness and surface of the display.
 void ViewerModel::DoLight(const Action& a) {
-  display.pattern = a.text == "grid" ? Pattern::kGrid : Pattern::kUniform;
+  display.pattern = PatternFromName(a.text).value_or(Pattern::kUniform);
   display.grid_pixels = int(a.number);
   display.brightness = a.number2;
-  display.surface = a.text2 == "black"         ? Surface::kBlack
-                    : a.text2 == "hidden-line" ? Surface::kHiddenLine
-                    : a.text2 == "contours"    ? Surface::kContours
-                                               : Surface::kMaterial;
+  display.surface = SurfaceFromName(a.text2).value_or(Surface::kMaterial);
 }
 
 // "wait": for the fields, the suggestion or the render job.

@@ -10,6 +10,7 @@
 #include "analysis/util/input_file.h"
 #include "analysis/util/json_reader.h"
 #include "analysis/util/text.h"
+#include "render/render.h"
 
 namespace pandora::viewer {
 namespace {
@@ -228,7 +229,12 @@ void ParseIntrinsics(const Entry& e, Action& a) {
     a.width = int(v.x());
     a.height = int(v.y());
   }
-  if (e.Has("model")) a.lens = e.OneOf("model", {"pinhole", "brown_conrady", "fisheye"});
+  if (e.Has("model")) {
+    std::vector<std::string> models;
+    for (LensModel m : {LensModel::kPinhole, LensModel::kBrownConrady, LensModel::kFisheye})
+      models.push_back(LensModelName(m));
+    a.lens = e.Get("model").Enum(models);
+  }
   bool any = a.width > 0 || !a.lens.empty();
   for (int i = 0; i < 6; ++i) {
     const char* key = kLensCoefficientNames[i];
@@ -329,11 +335,11 @@ void ParseEye(const Entry& e, Action& a) {
 // "light": the pattern, grid size, brightness and surface.
 void ParseLight(const Entry& e, Action& a) {
   e.Keys({"light", "grid", "brightness", "surface"});
-  a.text = e.OneOf("light", {"uniform", "grid"});
+  a.text = e.Get("light").Enum(PatternNames());
   a.number = e.Number("grid", 1, 100000, 32);
   a.number2 = e.Has("brightness") ? e.Number("brightness", 1e-6, 1e6) : NAN;
-  a.text2 = e.Has("surface") ? e.OneOf("surface", {"material", "black", "hidden-line", "contours"})
-                             : "material";
+  a.text2 =
+      e.Has("surface") ? e.Get("surface").Enum(SurfaceNames()) : SurfaceName(Surface::kMaterial);
 }
 
 // "wait": the job waited for.

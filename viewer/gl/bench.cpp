@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
 
     RenderOptions cpu_options;
     cpu_options.surface = Surface::kMaterial;
-    cpu_options.pattern = pattern == "grid" ? Pattern::kGrid : Pattern::kUniform;
+    cpu_options.pattern = PatternFromName(pattern).value_or(Pattern::kUniform);
     cpu_options.layers = false;
     cpu_options.overlays.cameras = false;
     cpu_options.overlays.key = false;

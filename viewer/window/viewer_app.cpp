@@ -1648,11 +1648,10 @@ struct ViewerApp::Impl {
       shadow_map_size = 512 << map_index;
     if (changed) {
       Action a = Make(Action::Kind::kLight);
-      a.text = pattern ? "grid" : "uniform";
+      a.text = PatternName(pattern ? Pattern::kGrid : Pattern::kUniform);
       a.number = grid;
       a.number2 = automatic ? NAN : brightness;
-      const char* names[] = {"material", "black", "hidden-line", "contours"};
-      a.text2 = names[std::clamp(surface, 0, 3)];
+      a.text2 = SurfaceName(static_cast<Surface>(std::clamp(surface, 0, 3)));
       Do(a);
     }
     ImGui::End();
