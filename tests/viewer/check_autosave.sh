@@ -9,7 +9,7 @@ pandora=$1; out=$2
 src=$(cd "$(dirname "$0")/../.." && pwd)
 rm -rf "$out"; mkdir -p "$out"
 cp "$src"/examples/trauma_room/scene.json "$out"/scene.json
-view() { xvfb-run -a "$pandora" view "$out"/scene.json --hidden --size 640x360 "$@"; }
+view() { "$(dirname "$0")"/with_xvfb.sh "$pandora" view "$out"/scene.json --hidden --size 640x360 "$@"; }
 fail() { echo "FAIL: $*"; exit 1; }
 echo '[{"move": "o2", "by": [0, 0, 0.25]}, {"wait": "fields"}]' > "$out"/edit.json
 echo '[{"wait": "fields"}]' > "$out"/idle.json

@@ -11,8 +11,7 @@ src=$(cd "$(dirname "$0")/../.." && pwd)
 rm -rf "$out"; mkdir -p "$out"
 cp "$src"/examples/trauma_room/scene.json "$out"/scene.json
 sed "s|OUT/|$out/|g" "$src"/tests/viewer/plan_session.json > "$out"/script.json
-xvfb=(xvfb-run -a -s "-screen 0 1280x800x24")
-command -v xvfb-run >/dev/null || xvfb=()
+xvfb=("$(dirname "$0")"/with_xvfb.sh)
 "${xvfb[@]}" "$pandora" view "$out"/scene.json --rig octagon --script "$out"/script.json --hidden --size 960x540 \
   --log "$out"/log.json
 

@@ -14,9 +14,8 @@ rm -rf "$out"; mkdir -p "$out"
 cp "$src"/examples/mocap_lab/scene.json "$out"/scene.json
 fail() { echo "FAIL: $*"; exit 1; }
 view() {  # view SCRIPT LOG
-  local run=(xvfb-run -a -s "-screen 0 1280x800x24" "$pandora" view "$out"/scene.json --script "$1"
+  local run=("$(dirname "$0")"/with_xvfb.sh "$pandora" view "$out"/scene.json --script "$1"
              --hidden --size 320x240 --log "$2")
-  command -v xvfb-run >/dev/null || run=("${run[@]:4}")
   "${run[@]}"
 }
 

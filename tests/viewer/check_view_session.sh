@@ -13,9 +13,8 @@ refs=$src/tests/data/viewer
 rm -rf "$out"; mkdir -p "$out"
 cp "$src"/examples/trauma_room/scene.json "$out"/scene.json
 sed "s|OUT/|$out/|g" "$src"/tests/viewer/session.json > "$out"/script.json
-run=(xvfb-run -a -s "-screen 0 1280x800x24" "$pandora" view "$out"/scene.json --script "$out"/script.json
+run=("$(dirname "$0")"/with_xvfb.sh "$pandora" view "$out"/scene.json --script "$out"/script.json
      --hidden --size 960x540 --log "$out"/log.json)
-command -v xvfb-run >/dev/null || run=("${run[@]:4}")  # a display of one's own
 "${run[@]}"
 
 fail() { echo "FAIL: $*"; exit 1; }
