@@ -19,7 +19,7 @@ const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
       {"snap_rotate_deg", "--snap-rotate"},
       {"objective", "--objective"},
       {"weights", "--weights"},
-      {"outer_iterations", "--outer-iterations"},
+      {"outer_iterations", "--outer"},
       {"over_time", "--over-time"},
       {"target_surfaces", "--target-surface"},
       {"points", "--points"},

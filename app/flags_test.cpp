@@ -110,5 +110,23 @@ TEST(ErrorContract, CommandLineWritesFieldsAsFlags) {
   }
 }
 
+TEST(ErrorContract, EveryFlagInTheTableIsACommandLineOption) {
+  // The options the commands register: the first name of each add_option / add_flag literal
+  // ("--quiet,-q" registers --quiet) in app/*_command.cpp and app/cli.cpp.
+  std::set<std::string> registered;
+  for (const auto& entry : fs::directory_iterator("app")) {
+    const std::string name = entry.path().filename().string();
+    const bool command =
+        name.size() > 12 && name.compare(name.size() - 12, 12, "_command.cpp") == 0;
+    if (!command && name != "cli.cpp") continue;
+    for (const auto& [line, text] : StringLiterals(entry.path().string()))
+      if (text.rfind("--", 0) == 0) registered.insert(text.substr(0, text.find(',')));
+  }
+  ASSERT_GT(registered.size(), 50u);
+  for (const auto& [field, flag] : CommandLineFlags())
+    EXPECT_TRUE(registered.count(flag))
+        << "{" << field << "} -> " << flag << ": no command registers this flag";
+}
+
 }  // namespace
 }  // namespace pandora::app

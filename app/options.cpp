@@ -56,12 +56,18 @@ Aabb ParseBox(const Scene& scene, const std::string& option, const std::string& 
   Aabb b;
   b.min = Vec3(v[0], v[1], v[2]);
   b.max = Vec3(v[3], v[4], v[5]);
+  CheckBox(scene, option, b);
+  return b;
+}
+
+void CheckBox(const Scene& scene, const std::string& option, const Aabb& b) {
+  if (!b.min.allFinite() || !b.max.allFinite())
+    throw InputError(option, "", "the box's corners must be finite numbers");
   scene.CheckReach(b.min, option, "the box's min corner");
   scene.CheckReach(b.max, option, "the box's max corner");
   if ((b.min.array() > b.max.array()).any())
     throw InputError(option, "", "the box's min exceeds its max",
                      "give XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
-  return b;
 }
 
 int CameraOption(const Rig& rig, const std::string& option, const std::string& id) {

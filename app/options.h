@@ -25,6 +25,8 @@ Vec3 ParseVec3(const std::string& option, const std::string& text);
 
 /// A box "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" in metres, within the scene's reach, min <= max.
 Aabb ParseBox(const Scene& scene, const std::string& option, const std::string& text);
+/// The checks of ParseBox on a box given as values.
+void CheckBox(const Scene& scene, const std::string& option, const Aabb& box);
 
 /// The index of camera `id` in `rig`; an unknown id names the option and lists the rig's ids.
 int CameraOption(const Rig& rig, const std::string& option, const std::string& id);

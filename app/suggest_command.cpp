@@ -34,7 +34,8 @@ int RunSuggest(const SuggestArgs& args) {
   session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
   const Rig file_rig = session.rig().rig();
-  const std::shared_ptr<SuggestProblem> problem = PrepareSuggest(args, scene, file_rig);
+  const std::shared_ptr<SuggestProblem> problem =
+      PrepareSuggest(SuggestRequestFromArgs(args), scene, file_rig);
   const SuggestOptions& options = problem->options;
   const std::vector<TargetPoint>& targets = problem->targets;
   std::optional<std::vector<double>> perturbation;

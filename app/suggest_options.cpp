@@ -9,33 +9,61 @@
 namespace pandora::app {
 namespace {
 
-// One value for every selected camera, or one each in --cameras order.
-std::vector<double> PerCamera(const char* option, const std::string& value, std::size_t selected) {
-  const std::vector<std::string> items = SplitList(value);
-  if (items.size() != 1 && items.size() != selected)
+// One value for every selected camera, or one each in the selection's order.
+std::vector<double> PerCamera(const char* option, const std::vector<double>& values,
+                              std::size_t selected) {
+  if (values.size() != 1 && values.size() != selected)
     throw InputError(
         option, "",
         "give one value, or one per selected camera (" + std::to_string(selected) + ")");
-  std::vector<double> out;
-  for (const std::string& item : items) out.push_back(ParseNumbers(option, item, 1)[0]);
+  std::vector<double> out = values;
   out.resize(selected, out.back());
   return out;
 }
 
-// "ID:VALUE" or "VALUE": the positions in the selection it applies to; *value gets VALUE.
-std::vector<std::size_t> Targets(const char* option, const std::string& entry, const Rig& rig,
-                                 const std::vector<int>& selection, std::string* value) {
+// The positions in the selection that `camera` ("": all) names.
+std::vector<std::size_t> Targets(const char* option, const std::string& camera, const Rig& rig,
+                                 const std::vector<int>& selection) {
   std::vector<std::size_t> which;
-  const std::size_t colon = entry.find(':');
-  *value = colon == std::string::npos ? entry : entry.substr(colon + 1);
   for (std::size_t c = 0; c < selection.size(); ++c)
-    if (colon == std::string::npos || rig.cameras[selection[c]].id == entry.substr(0, colon))
-      which.push_back(c);
-  if (which.empty() && colon != std::string::npos)
-    throw InputError(
-        option, "",
-        "camera '" + entry.substr(0, colon) + "' is not among the selected cameras ({cameras})");
+    if (camera.empty() || rig.cameras[selection[c]].id == camera) which.push_back(c);
+  if (which.empty() && !camera.empty())
+    throw InputError(option, "",
+                     "camera '" + camera + "' is not among the selected cameras ({cameras})");
   return which;
+}
+
+// An "ID:VALUE" or "VALUE" option entry: the camera ("" for all) and VALUE parsed by `parse`.
+template <typename T, typename Parse>
+std::vector<ForCamera<T>> Entries(const std::vector<std::string>& entries, Parse parse) {
+  std::vector<ForCamera<T>> out;
+  for (const std::string& entry : entries) {
+    const std::size_t colon = entry.find(':');
+    ForCamera<T> e;
+    if (colon != std::string::npos) e.camera = entry.substr(0, colon);
+    e.value = parse(colon == std::string::npos ? entry : entry.substr(colon + 1));
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<double> NumberList(const char* option, const std::string& text) {
+  std::vector<double> out;
+  for (const std::string& item : SplitList(text)) out.push_back(ParseNumbers(option, item, 1)[0]);
+  return out;
+}
+
+Vec3 Vector(const char* option, const std::string& text) {
+  const std::vector<double> v = ParseNumbers(option, text, 3);
+  return Vec3(v[0], v[1], v[2]);
+}
+
+Aabb Box(const char* option, const std::string& text) {
+  const std::vector<double> v = ParseNumbers(option, text, 6);
+  Aabb b;
+  b.min = Vec3(v[0], v[1], v[2]);
+  b.max = Vec3(v[3], v[4], v[5]);
+  return b;
 }
 
 std::string Names(const std::vector<std::string>& names) {
@@ -87,94 +115,152 @@ session::SessionOptions SuggestSessionOptions(const SuggestArgs& args) {
   return o;
 }
 
-SuggestOptions SuggestOptionsFromArgs(const SuggestArgs& args, const Scene& scene, const Rig& rig) {
-  SuggestOptions options;
-  options.scene_path = scene.path;
-  for (const std::string& id : SplitList(args.cameras))
-    options.cameras.push_back(CameraOption(rig, "{cameras}", id));
-  const std::size_t n = options.cameras.size();
+SuggestRequest SuggestRequestFromArgs(const SuggestArgs& args) {
+  SuggestRequest r;
+  r.cameras = SplitList(args.cameras);
+  r.max_move = NumberList("{max_move}", args.max_move);
+  r.max_rotate_deg = NumberList("{max_rotate_deg}", args.max_rotate);
+  r.objective = args.objective;
+  if (!args.weights.empty()) {
+    const std::vector<double> w = ParseNumbers("{weights}", args.weights, 3);
+    r.weights = Vec3(w[0], w[1], w[2]);
+  }
+  const auto vector = [](const char* option) {
+    return [option](const std::string& text) { return Vector(option, text); };
+  };
+  r.rail = Entries<Vec3>(args.rail, vector("{rail}"));
+  r.plane = Entries<Vec3>(args.plane, vector("{plane}"));
+  r.mount_box = Entries<Aabb>(args.mount_box,
+                              [](const std::string& text) { return Box("{mount_box}", text); });
+  r.hfov_range = Entries<std::array<double, 2>>(args.hfov_range, [](const std::string& text) {
+    const std::vector<double> v = ParseNumbers("{hfov_range}", text, 2);
+    return std::array<double, 2>{v[0], v[1]};
+  });
+  for (const std::string& box : args.keep_out) r.keep_out.push_back(Box("{keep_out}", box));
+  r.target_surfaces = args.target_surfaces;
+  r.with_region = args.with_region;
+  r.over_time = args.over_time;
+  r.points = args.points;
+  r.snap_move = args.snap_move;
+  r.snap_rotate_deg = args.snap_rotate;
+  r.clearance = args.clearance;
+  r.outer_iterations = args.outer_iterations;
+  r.seed = args.seed;
+  return r;
+}
 
-  const std::vector<double> moves = PerCamera("{max_move}", args.max_move, n);
-  const std::vector<double> rotations = PerCamera("{max_rotate_deg}", args.max_rotate, n);
-  options.limits.assign(n, CameraLimits());
+namespace {
+
+// The selection's limits: moves and rotations, mounts, zoom ranges.
+std::vector<CameraLimits> LimitsOf(const SuggestRequest& r, const Scene& scene, const Rig& rig,
+                                   const std::vector<int>& selection) {
+  const std::size_t n = selection.size();
+  const std::vector<double> moves = PerCamera("{max_move}", r.max_move, n);
+  const std::vector<double> rotations = PerCamera("{max_rotate_deg}", r.max_rotate_deg, n);
+  std::vector<CameraLimits> limits(n);
   for (std::size_t c = 0; c < n; ++c) {
     if (!(moves[c] >= 0))
       throw InputError("{max_move}", "", "must be a finite length >= 0 in metres");
     scene.CheckLength(moves[c], "{max_move}", "the move");
     if (!(rotations[c] >= 0) || !(rotations[c] < 180))
       throw InputError("{max_rotate_deg}", "", "must be an angle in [0, 180) degrees");
-    options.limits[c].max_move = moves[c];
-    options.limits[c].max_rotate_deg = rotations[c];
+    limits[c].max_move = moves[c];
+    limits[c].max_rotate_deg = rotations[c];
   }
 
   std::vector<int> mounts(n, 0);
-  auto add_mount = [&](const char* option, const std::string& entry, MountConstraint::Kind kind) {
-    std::string value;
-    for (std::size_t c : Targets(option, entry, rig, options.cameras, &value)) {
-      MountConstraint& m = options.limits[c].mount;
+  const auto add_mount = [&](const char* option, const std::string& camera,
+                             MountConstraint::Kind kind, const Vec3& axis, const Aabb& box) {
+    for (std::size_t c : Targets(option, camera, rig, selection)) {
+      MountConstraint& m = limits[c].mount;
       m.kind = kind;
       if (kind == MountConstraint::Kind::kBox) {
-        m.box = ParseBox(scene, option, value);
+        CheckBox(scene, option, box);
+        m.box = box;
       } else {
-        const std::vector<double> v = ParseNumbers(option, value, 3);
-        m.axis = Vec3(v[0], v[1], v[2]);
-        if (!(m.axis.norm() > 0))
+        if (!(axis.norm() > 0) || !axis.allFinite())
           throw InputError(option, "", "the direction must be a non-zero vector");
+        m.axis = axis;
       }
       if (++mounts[c] > 1)
         throw InputError(option, "", "give at most one of {rail}, {plane}, {mount_box} per camera");
     }
   };
-  for (const std::string& e : args.rail) add_mount("{rail}", e, MountConstraint::Kind::kLine);
-  for (const std::string& e : args.plane) add_mount("{plane}", e, MountConstraint::Kind::kPlane);
-  for (const std::string& e : args.mount_box)
-    add_mount("{mount_box}", e, MountConstraint::Kind::kBox);
-  for (const std::string& e : args.hfov_range) {
-    std::string value;
-    for (std::size_t c : Targets("{hfov_range}", e, rig, options.cameras, &value)) {
-      const std::vector<double> v = ParseNumbers("{hfov_range}", value, 2);
-      if (!(v[0] > 0) || !(v[1] >= v[0]))
+  for (const ForCamera<Vec3>& e : r.rail)
+    add_mount("{rail}", e.camera, MountConstraint::Kind::kLine, e.value, Aabb());
+  for (const ForCamera<Vec3>& e : r.plane)
+    add_mount("{plane}", e.camera, MountConstraint::Kind::kPlane, e.value, Aabb());
+  for (const ForCamera<Aabb>& e : r.mount_box)
+    add_mount("{mount_box}", e.camera, MountConstraint::Kind::kBox, Vec3::Zero(), e.value);
+  for (const ForCamera<std::array<double, 2>>& e : r.hfov_range) {
+    for (std::size_t c : Targets("{hfov_range}", e.camera, rig, selection)) {
+      const auto& [lo, hi] = e.value;
+      if (!(lo > 0) || !(hi >= lo) || !std::isfinite(hi))
         throw InputError("{hfov_range}", "", "expected MIN,MAX degrees with 0 < MIN <= MAX");
-      options.limits[c].min_hfov_deg = v[0];
-      options.limits[c].max_hfov_deg = v[1];
+      limits[c].min_hfov_deg = lo;
+      limits[c].max_hfov_deg = hi;
     }
   }
-  for (const std::string& box : args.keep_out)
-    options.keep_out.push_back(ParseBox(scene, "{keep_out}", box));
+  return limits;
+}
 
-  const std::optional<Objective> objective = ParseObjective(args.objective);
+Objective ObjectiveOf(const SuggestRequest& r) {
+  std::optional<Objective> objective = ParseObjective(r.objective);
   if (!objective)
     throw InputError(
-        "{objective}", "", "unknown objective '" + args.objective + "'",
+        "{objective}", "", "unknown objective '" + r.objective + "'",
         "use coverage2 (or coverageK), sigma-mean, sigma-p90 (any percentile), resolution, mix, "
         "coverage3-n1 (coverageK-n1: after the worst camera failure) or calibration");
-  options.objective = *objective;
-  if (!args.weights.empty()) {
-    const std::vector<double> w = ParseNumbers("{weights}", args.weights, 3);
-    if (w[0] < 0 || w[1] < 0 || w[2] < 0 || w[0] + w[1] + w[2] <= 0)
+  if (r.weights) {
+    const Vec3& w = *r.weights;
+    if (!w.allFinite() || (w.array() < 0).any() || w.sum() <= 0)
       throw InputError("{weights}", "", "the weights must be >= 0 and not all zero");
-    options.objective.w_coverage = w[0];
-    options.objective.w_sigma = w[1];
-    options.objective.w_resolution = w[2];
+    objective->w_coverage = w[0];
+    objective->w_sigma = w[1];
+    objective->w_resolution = w[2];
   }
-  // The number options' ranges are checked as they are parsed (app/main.cpp); lengths against the
-  // scene's scale here.
-  options.snap_move = args.snap_move;
-  options.snap_rotate_deg = args.snap_rotate;
+  return *objective;
+}
+
+}  // namespace
+
+SuggestOptions SuggestOptionsOf(const SuggestRequest& r, const Scene& scene, const Rig& rig) {
+  SuggestOptions options;
+  options.scene_path = scene.path;
+  for (const std::string& id : r.cameras)
+    options.cameras.push_back(CameraOption(rig, "{cameras}", id));
+  options.limits = LimitsOf(r, scene, rig, options.cameras);
+  for (const Aabb& box : r.keep_out) {
+    CheckBox(scene, "{keep_out}", box);
+    options.keep_out.push_back(box);
+  }
+  options.objective = ObjectiveOf(r);
+  // The CLI checks the number options' ranges as it parses them (app/suggest_command.cpp); the
+  // same here for every front end, and lengths against the scene's scale.
+  if (!(r.points >= 1 && r.points <= 1000000))
+    throw InputError("{points}", "", "must be a whole number in [1, 1000000]");
+  if (!(r.snap_move >= 0)) throw InputError("{snap_move}", "", "must be >= 0 metres (0: off)");
+  if (!(r.snap_rotate_deg >= 0 && r.snap_rotate_deg <= 180))
+    throw InputError("{snap_rotate_deg}", "", "must be in [0, 180] degrees (0: off)");
+  if (!(r.clearance >= 0)) throw InputError("{clearance}", "", "must be >= 0 metres");
+  if (!(r.outer_iterations >= 1 && r.outer_iterations <= 1000))
+    throw InputError("{outer_iterations}", "", "must be a whole number in [1, 1000]");
+  options.snap_move = r.snap_move;
+  options.snap_rotate_deg = r.snap_rotate_deg;
   scene.CheckLength(options.snap_move, "{snap_move}", "the snap step");
-  options.outer_iterations = args.outer_iterations;
-  options.clearance = args.clearance;
+  options.outer_iterations = r.outer_iterations;
+  options.clearance = r.clearance;
   scene.CheckLength(options.clearance, "{clearance}", "the clearance");
   return options;
 }
 
-std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestArgs& args, const Scene& scene,
+std::shared_ptr<SuggestProblem> PrepareSuggest(const SuggestRequest& args, const Scene& scene,
                                                const Rig& rig) {
   if (args.cameras.empty())
     throw InputError("{cameras}", "", "which cameras may move?",
                      "give {cameras} ID,... (or {ptz_preset} / {ptz_tour})");
   auto problem = std::make_shared<SuggestProblem>();
-  problem->options = SuggestOptionsFromArgs(args, scene, rig);
+  problem->options = SuggestOptionsOf(args, scene, rig);
   if (args.over_time) {
     // The study's surface targets at every sample, each against its sample's caster.
     if (!args.target_surfaces.empty())

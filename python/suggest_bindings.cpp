@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -51,40 +52,27 @@ struct PySuggestion {
   int ptz_camera = -1, ptz_preset = -1;
 };
 
-std::string Num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
-std::string Join(const std::vector<double>& v) {
-  std::string out;
-  for (double x : v) out += (out.empty() ? "" : ",") + Num(x);
-  return out;
-}
-
-// A number, or a list of numbers (one per selected camera) -> "a" or "a,b,c".
-std::string NumberOrList(const py::handle& value, const char* name) {
+// A number for every selected camera, or a list of them in `cameras` order.
+std::vector<double> NumberOrList(const py::handle& value, const char* name) {
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value))
-    return Num(value.cast<double>());
+    return {value.cast<double>()};
   try {
-    return Join(value.cast<std::vector<double>>());
+    return value.cast<std::vector<double>>();
   } catch (const py::cast_error&) {
     throw InputError(name, "", "expected a number or a list of numbers (one per selected camera)");
   }
 }
 
-// A value for every selected camera, or {id: value}, as "ID:TEXT" entries; `format` turns one value
-// into the option's text.
-template <typename F>
-std::vector<std::string> PerCameraEntries(const py::object& value, F format) {
-  std::vector<std::string> out;
+// A value for every selected camera, or {id: value}; `convert` turns one Python value into T.
+template <typename T, typename F>
+std::vector<app::ForCamera<T>> PerCameraEntries(const py::object& value, F convert) {
+  std::vector<app::ForCamera<T>> out;
   if (value.is_none()) return out;
   if (py::isinstance<py::dict>(value)) {
     for (const auto& [id, v] : value.cast<py::dict>())
-      out.push_back(py::str(id).cast<std::string>() + ":" + format(v));
+      out.push_back({py::str(id).cast<std::string>(), convert(v)});
   } else {
-    out.push_back(format(value));
+    out.push_back({"", convert(value)});
   }
   return out;
 }
@@ -101,22 +89,26 @@ std::vector<double> Numbers(const py::handle& v, std::size_t n, const char* name
   return x;
 }
 
-std::string Vector3Text(const py::handle& v, const char* name) {
-  return Join(Numbers(v, 3, name, "expected three numbers (a direction, metres)"));
+Vec3 Vector3(const py::handle& v, const char* name) {
+  const std::vector<double> x = Numbers(v, 3, name, "expected three numbers (a direction, metres)");
+  return Vec3(x[0], x[1], x[2]);
 }
 
-std::string BoxText(const py::handle& v, const char* name) {
+Aabb Box(const py::handle& v, const char* name) {
   const char* reason = "expected a box as (min corner, max corner), metres";
   if (!py::isinstance<py::sequence>(v) || py::len(v) != 2) throw InputError(name, "", reason);
   const py::sequence corners = py::reinterpret_borrow<py::sequence>(v);
-  std::vector<double> box = Numbers(corners[0], 3, name, reason);
-  const std::vector<double> max = Numbers(corners[1], 3, name, reason);
-  box.insert(box.end(), max.begin(), max.end());
-  return Join(box);
+  const std::vector<double> lo = Numbers(corners[0], 3, name, reason);
+  const std::vector<double> hi = Numbers(corners[1], 3, name, reason);
+  Aabb box;
+  box.min = Vec3(lo[0], lo[1], lo[2]);
+  box.max = Vec3(hi[0], hi[1], hi[2]);
+  return box;
 }
 
-std::string RangeText(const py::handle& v, const char* name) {
-  return Join(Numbers(v, 2, name, "expected (min, max) degrees"));
+std::array<double, 2> Range(const py::handle& v, const char* name) {
+  const std::vector<double> x = Numbers(v, 2, name, "expected (min, max) degrees");
+  return {x[0], x[1]};
 }
 
 py::dict MetricsDict(const Metrics& m) {
@@ -424,9 +416,8 @@ void BindSuggestCameras(py::module_& m) {
         if (r.study != sc.study) throw InputError("rig", "", "the rig belongs to another scene");
         if (cameras.empty())
           throw InputError("cameras", "", "which cameras may move?", "give cameras=[ids]");
-        app::SuggestArgs a;
-        a.scene = scene.path;
-        for (const std::string& id : cameras) a.cameras += (a.cameras.empty() ? "" : ",") + id;
+        app::SuggestRequest a;
+        a.cameras = cameras;
         a.objective = objective;
         a.points = points;
         a.target_surfaces = target_surfaces;
@@ -434,29 +425,21 @@ void BindSuggestCameras(py::module_& m) {
         a.over_time = over_time;
         a.clearance = clearance;
         a.snap_move = snap_move;
-        a.snap_rotate = snap_rotate_deg;
+        a.snap_rotate_deg = snap_rotate_deg;
         a.outer_iterations = outer_iterations;
         a.seed = seed;
-        std::shared_ptr<app::SuggestProblem> problem;
-        {
-          a.max_move = NumberOrList(max_move, "{max_move}");
-          a.max_rotate = NumberOrList(max_rotate_deg, "{max_rotate_deg}");
-          a.hfov_range = PerCameraEntries(
-              hfov_range, [](const py::handle& v) { return RangeText(v, "{hfov_range}"); });
-          a.rail =
-              PerCameraEntries(rail, [](const py::handle& v) { return Vector3Text(v, "{rail}"); });
-          a.plane = PerCameraEntries(plane,
-                                     [](const py::handle& v) { return Vector3Text(v, "{plane}"); });
-          a.mount_box = PerCameraEntries(
-              mount_box, [](const py::handle& v) { return BoxText(v, "{mount_box}"); });
-          for (const py::object& box : keep_out) a.keep_out.push_back(BoxText(box, "{keep_out}"));
-          if (!(outer_iterations >= 1 && outer_iterations <= 100))
-            throw InputError("{outer_iterations}", "", "must be in [1, 100]");
-          if (!(snap_move >= 0) || !(snap_rotate_deg >= 0) || !(clearance >= 0))
-            throw InputError("{clearance}", "",
-                             "snap_move, snap_rotate_deg and clearance must be >= 0");
-          problem = app::PrepareSuggest(a, scene, r.rig());
-        }
+        a.max_move = NumberOrList(max_move, "{max_move}");
+        a.max_rotate_deg = NumberOrList(max_rotate_deg, "{max_rotate_deg}");
+        a.hfov_range = PerCameraEntries<std::array<double, 2>>(
+            hfov_range, [](const py::handle& v) { return Range(v, "{hfov_range}"); });
+        a.rail =
+            PerCameraEntries<Vec3>(rail, [](const py::handle& v) { return Vector3(v, "{rail}"); });
+        a.plane = PerCameraEntries<Vec3>(plane,
+                                         [](const py::handle& v) { return Vector3(v, "{plane}"); });
+        a.mount_box = PerCameraEntries<Aabb>(
+            mount_box, [](const py::handle& v) { return Box(v, "{mount_box}"); });
+        for (const py::object& box : keep_out) a.keep_out.push_back(Box(box, "{keep_out}"));
+        const std::shared_ptr<app::SuggestProblem> problem = app::PrepareSuggest(a, scene, r.rig());
         PySuggestion out;
         out.study = sc.study;
         out.session = r.session;

@@ -121,11 +121,33 @@ def test_suggest_bad_options_name_the_keyword():
         (dict(cameras=["c1"], keep_out=[((0, 0, 0),)]), "keep_out"),
         (dict(cameras=["c1"], rail=(0, 0, 0)), "rail"),
         (dict(cameras=[]), "cameras"),
+        (dict(cameras=["c1"], rail={"c2": (1, 0, 0)}), "rail"),  # c2 is not selected
+        (dict(cameras=["c1"], mount_box=((0, 0, float("nan")), (1, 1, 1))), "mount_box"),
+        (dict(cameras=["c1"], outer_iterations=0), "outer_iterations"),
+        (dict(cameras=["c1"], snap_rotate_deg=200), "snap_rotate_deg"),
+        (dict(cameras=["c1"], points=0), "points"),
     ]
     for kwargs, keyword in cases:
         with pytest.raises(pandora.InputError) as e:
-            pandora.suggest(scene, rig, points=50, **kwargs)
+            pandora.suggest(scene, rig, **{"points": 50, **kwargs})
         assert e.value.file == keyword, (kwargs, str(e.value))
+
+
+def test_suggest_per_camera_limits_hold():
+    # A list gives each selected camera its own limits, a dict mounts one camera: c2 may not move
+    # at all, c4 only along its vertical rail, 0.3 m at most.
+    scene = pandora.load_scene(str(RING))
+    rig = scene.rig()
+    start = {cid: pose(rig, cid) for cid in ["c2", "c4"]}
+    s = pandora.suggest(scene, rig, ["c2", "c4"], objective="coverage4", points=300,
+                        max_move=[0.0, 0.3], max_rotate_deg=[0, 30], rail={"c4": (0, 0, 1)})
+    assert s.improved
+    after = {c["id"]: c["after"] for c in s.cameras}
+    np.testing.assert_allclose(after["c2"][:3, 3], start["c2"][0], atol=1e-12)
+    np.testing.assert_allclose(after["c2"][:3, :3], start["c2"][1], atol=1e-12)
+    d = after["c4"][:3, 3] - start["c4"][0]
+    assert 0.01 < abs(d[2]) <= 0.3 + 1e-9
+    np.testing.assert_allclose(d[:2], 0, atol=1e-9)
 
 
 def test_suggestion_file_round_trip_through_accept(tmp_path):

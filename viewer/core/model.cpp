@@ -72,35 +72,25 @@ std::string PtzStatus(const Camera& cam, bool clamped) {
   return line;
 }
 
-// A number as `pandora suggest` would be given it on the command line (every bit kept).
-std::string Arg(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-std::string Arg(const Vec3& v) { return Arg(v.x()) + "," + Arg(v.y()) + "," + Arg(v.z()); }
-std::string Arg(const Aabb& b) { return Arg(b.min) + "," + Arg(b.max); }
-
-// A suggest action as `pandora suggest`'s options: the viewer's Suggest panel and scripts go
-// through the same door as the command (app::PrepareSuggest), so they optimise the same objective.
-app::SuggestArgs SuggestArgsOf(const Action& a, const std::string& scene_path) {
-  app::SuggestArgs s;
-  s.scene = scene_path;
-  for (const std::string& id : a.cameras) s.cameras += (s.cameras.empty() ? "" : ",") + id;
+// A suggest action as the request every front end makes (app::PrepareSuggest): the viewer's
+// Suggest panel and scripts optimise the same objective over the same points as the command.
+app::SuggestRequest SuggestRequestOf(const Action& a) {
+  app::SuggestRequest s;
+  s.cameras = a.cameras;
   s.objective = a.text;
-  s.max_move = Arg(a.number);
-  s.max_rotate = Arg(a.number2);
+  s.max_move = {a.number};
+  s.max_rotate_deg = {a.number2};
   s.points = int(a.number3);
   s.seed = a.seed;
-  if (a.mount == "rail") s.rail.push_back(Arg(a.a));
-  if (a.mount == "plane") s.plane.push_back(Arg(a.a));
-  if (a.mount == "box") s.mount_box.push_back(Arg(a.mount_box));
-  if (a.max_hfov > 0) s.hfov_range.push_back(Arg(a.min_hfov) + "," + Arg(a.max_hfov));
-  for (const Aabb& b : a.keep_out) s.keep_out.push_back(Arg(b));
+  if (a.mount == "rail") s.rail.push_back({"", a.a});
+  if (a.mount == "plane") s.plane.push_back({"", a.a});
+  if (a.mount == "box") s.mount_box.push_back({"", a.mount_box});
+  if (a.max_hfov > 0) s.hfov_range.push_back({"", {a.min_hfov, a.max_hfov}});
+  s.keep_out = a.keep_out;
   if (!std::isnan(a.clearance)) s.clearance = a.clearance;
-  if (!std::isnan(a.weights.x())) s.weights = Arg(a.weights);
+  if (!std::isnan(a.weights.x())) s.weights = a.weights;
   s.snap_move = a.snap_move;
-  s.snap_rotate = a.snap_rotate;
+  s.snap_rotate_deg = a.snap_rotate;
   s.outer_iterations = a.outer_iterations;
   s.target_surfaces = a.target_surfaces;
   s.with_region = a.with_region;
@@ -588,7 +578,7 @@ void ViewerModel::DoWait(const Action& a) {
 void ViewerModel::DoSuggest(const Action& a) {
   std::shared_ptr<app::SuggestProblem> problem;
   try {
-    problem = app::PrepareSuggest(SuggestArgsOf(a, scene().path), scene(), rig());
+    problem = app::PrepareSuggest(SuggestRequestOf(a), scene(), rig());
   } catch (const InputError& e) {
     RethrowAsAction(e, a.where);
   }
