@@ -56,9 +56,10 @@ const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
 const std::vector<std::string>& FieldsWithoutFlag() {
   // The typed camera edits' values (app/session/camera_edits.h): Python and the viewer set them.
   static const std::vector<std::string> kFields{
-      "position", "look_at", "rotation", "ypr_deg", "hfov_deg", "resolution",
-      "k1",       "k2",      "p1",       "p2",      "k3",       "k4",
-      "near",     "far",     "color",    "preset",  "pan_deg",  "tilt_deg"};
+      "position", "look_at", "rotation", "ypr_deg", "hfov_deg", "resolution", "k1", "k2", "p1",
+      "p2", "k3", "k4", "near", "far", "color", "preset", "pan_deg", "tilt_deg",
+      // Set by `pandora analyze --mpi` from the MPI world, never by hand.
+      "partition_count"};
   return kFields;
 }
 

@@ -160,6 +160,7 @@ void BindEvaluate(py::module_& m) {
         session::AnalyzeOptions analysis;
         FieldOptions& o = analysis.fields;
         o.fields = fields.empty() ? scene.study.fields : fields;
+        if (!fields.empty()) o.fields_option = "{fields}";
         o.scene_path = scene.path;
         o.memory_budget_bytes = scene.study.memory_budget_bytes;
         // A script names the fields it wants: pixel targets and DORI where those fields hold what

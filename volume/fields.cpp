@@ -1108,6 +1108,29 @@ void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled
   }
 }
 
+void FieldOptions::Check(const Scene& scene) const {
+  const std::string file = scene_path.empty() ? scene.path : scene_path;
+  // A list from an option is named by the option; the scene file's by its JSON path.
+  const auto fail = [&](const std::string& path, const std::string& reason,
+                        const std::string& hint) {
+    if (!fields_option.empty()) throw InputError(fields_option, "", reason, hint);
+    throw InputError(file, path, reason, hint);
+  };
+  if (auto problem = CheckFieldList(fields, scene.study.motion.has_value()))
+    fail("$.study.fields[" + std::to_string(problem->index) + "]", problem->reason, problem->hint);
+  if (fields.empty()) fail("$.study.fields", "no field requested", "ask for at least 'coverage'");
+  if (!(memory_budget_bytes > 0)) {
+    if (!memory_budget_option.empty())
+      throw InputError(memory_budget_option, "", "the memory budget must be > 0");
+    throw InputError(file, "$.study.memory_budget_mb", "the memory budget must be > 0");
+  }
+  if (partition_count < 1 || partition_rank < 0 || partition_rank >= partition_count)
+    throw InputError("{partition_count}", "",
+                     "partition " + std::to_string(partition_rank) + " of " +
+                         std::to_string(partition_count) + " does not exist",
+                     "ranks are 0 .. partition_count - 1");
+}
+
 FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, FieldOptions options,
                                bool keep_state)
     : state_(std::make_unique<State>(scene, caster)) {
@@ -1117,11 +1140,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   S.keep = keep_state;
   const FieldOptions& opt = S.options;
   S.file = opt.scene_path.empty() ? scene.path : opt.scene_path;
-  if (auto problem = CheckFieldList(opt.fields, scene.study.motion.has_value()))
-    throw InputError(S.file, "$.study.fields[" + std::to_string(problem->index) + "]",
-                     problem->reason, problem->hint);
-  if (opt.fields.empty())
-    throw InputError(S.file, "$.study.fields", "no field requested", "ask for at least 'coverage'");
+  opt.Check(scene);
 
   const Study& study = scene.study;
   // Errors about the voxel size name where it came from: the scene file or a command-line option.

@@ -48,6 +48,9 @@ struct FieldOptions {
   const std::atomic<bool>* cancel = nullptr;
   /// Used in error messages.
   std::string scene_path;
+  /// Where `fields` came from, for error messages: empty for the scene file's $.study.fields,
+  /// else the option's field ("{fields}": Python's evaluate(fields=...)).
+  std::string fields_option;
   /// Where the voxel size came from, for error messages: empty for the scene file's
   /// $.study.voxel_size, else the command-line option (e.g. "{voxel_size}").
   std::string voxel_size_option;
@@ -74,6 +77,13 @@ struct FieldOptions {
   /// The scene's solid and region-mesh search trees, kept between evaluations (a study's,
   /// volume/solid_trees.h); nullptr: the evaluation builds the ones it needs and drops them.
   const SolidTrees* solid_trees = nullptr;
+
+  /// Checks the options against `scene` (FieldEvaluator does before it evaluates): at least one
+  /// field, each known and listed once, steady-state ones only with a motion model; a memory
+  /// budget > 0; 1 <= partition_count and 0 <= partition_rank < partition_count. InputError naming
+  /// the scene file's JSON path ($.study.fields[i]) or the option's field (fields_option,
+  /// memory_budget_option; {partition_count}).
+  void Check(const Scene& scene) const;
 };
 
 /// Counts and timing of one evaluation.

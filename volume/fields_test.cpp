@@ -257,6 +257,36 @@ TEST(Fields, SteadyFieldsNeedAMotionModel) {
   }
 }
 
+TEST(Fields, OptionsCheckNamesWhereTheFieldsCameFrom) {
+  const Scene scene = TestScene();
+  const auto fault = [&scene](const FieldOptions& options) {
+    try {
+      options.Check(scene);
+    } catch (const InputError& e) {
+      return e.file() + " " + e.json_path() + " " + e.reason();
+    }
+    return std::string("no error");
+  };
+  FieldOptions options;
+  options.scene_path = "scene.json";
+  EXPECT_EQ(fault(options), "no error");
+  options.fields = {"coverage", "sigma_maxx"};
+  EXPECT_EQ(fault(options), "scene.json $.study.fields[1] unknown field 'sigma_maxx'");
+  options.fields_option = "{fields}";
+  EXPECT_EQ(fault(options), "{fields}  unknown field 'sigma_maxx'");
+  options.fields = {};
+  EXPECT_EQ(fault(options), "{fields}  no field requested");
+  options.fields = {"coverage"};
+  options.memory_budget_bytes = 0;
+  EXPECT_EQ(fault(options), "scene.json $.study.memory_budget_mb the memory budget must be > 0");
+  options.memory_budget_bytes = 1e9;
+  options.partition_count = 2;
+  options.partition_rank = 2;
+  EXPECT_EQ(fault(options), "{partition_count}  partition 2 of 2 does not exist");
+  options.partition_rank = 1;
+  EXPECT_EQ(fault(options), "no error");
+}
+
 TEST(Fields, SinglePinholeClosedForm) {
   // Camera 2 m above a small region, looking straight down; nothing in the way: every voxel is seen
   // once, and the resolution is f/Z (1 + r^2)^(1/4) with r the normalized image radius.

@@ -54,6 +54,11 @@ def test_bad_input_raises_input_error_with_its_parts(tmp_path):
         pandora.visibility(scene, scene.rig(), np.array([[0.0, 0.0, np.nan]]))
     with pytest.raises(pandora.InputError):
         scene.rig().move("a", [1, 1, 1], [1, 1, 1])
+    # Fields a script asks for are named as its keyword, not as the scene file's study.fields.
+    with pytest.raises(pandora.InputError) as e:
+        pandora.evaluate(scene, scene.rig(), ["coverage", "sigma_maxx"])
+    assert e.value.file == "fields" and e.value.path == ""
+    assert "sigma_maxx" in e.value.reason and "sigma_max" in e.value.hint
 
 
 def test_coverage_equals_per_point_visibility():
