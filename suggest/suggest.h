@@ -178,7 +178,7 @@ struct SuggestOptions {
   int outer_iterations = 4;       ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;  ///< Ceres iterations per outer iteration.
   /// Candidate poses per active camera at each of the three radii of the exact screening before the
-  /// Ceres nudge (three chains; see suggest_ceres.cpp), for coverage objectives (N-1 included); the
+  /// Ceres nudge (three chains; see suggest_search.cpp), for coverage objectives (N-1 included); the
   /// others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge starts
   /// from the current poses only.
   int screening_candidates = 200;

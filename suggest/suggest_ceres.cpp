@@ -22,17 +22,11 @@
 #include "analysis/util/units.h"
 #include "suggest/suggest.h"
 #include "suggest/suggest_internal.h"
+#include "suggest/suggest_run.h"
 
-namespace pandora {
+namespace pandora::suggest_detail {
 namespace {
 
-using suggest_detail::CameraView;
-using suggest_detail::ExactEvaluator;
-using suggest_detail::Placement;
-using suggest_detail::PoseChart;
-using suggest_detail::RotationAngleDeg;
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPenalty = 10.0;    // weight of the limit and keep-out penalties (cost ~ 1)
 constexpr double kStep = 1e-4;       // central-difference step, in units of the limits
 constexpr double kCountWidth = 0.4;  // soft ">= k": width of the sigmoid in cameras
@@ -42,8 +36,6 @@ constexpr double kIncidenceWidth = 0.1;
 constexpr double kBorderWidth = 0.04;
 // Occlusion slopes from centres moved by this fraction of the largest move.
 constexpr double kOcclusionDelta = 0.25;
-// The share of SuggestOptions::progress the screening reports (the nudge the rest).
-constexpr double kScreeningShare = 0.3;
 
 double Sigmoid(double z) {
   if (z >= 0) return 1.0 / (1.0 + std::exp(-z));
@@ -63,18 +55,14 @@ double SoftClamp01(double v) {
   return std::clamp(r, 0.0, 1.0);
 }
 
-std::string Num(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
 // Per selected camera and target point: the smooth visibility weight and what the camera adds.
 struct Contribution {
   std::vector<double> w;   // soft visibility in [0, 1] (times the occlusion indicator)
   std::vector<double> d;   // pixel density, px/m
   std::vector<Mat3> info;  // A^T A / sigma^2 (only for the sigma term)
 };
+
+}  // namespace
 
 // The surrogate objective: residuals over the target points for each active term, given the
 // selected cameras' contributions.
@@ -287,6 +275,8 @@ class Surrogate {
   mutable std::atomic<std::int64_t> evaluations_{0};
 };
 
+namespace {
+
 // Penalty rows of one camera: translation beyond the move limit, rotation beyond the rotation
 // limit, one row per keep-out box (depth of the centre inside it, relative to the move limit), and
 // the clearance (how much closer to a surface than required, relative to the move limit, with a
@@ -391,11 +381,6 @@ class SurrogateCost final : public ceres::CostFunction {
   std::vector<Contribution>* frozen_;
 };
 
-// Seconds on the steady clock since `t0`.
-double SecondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Judges every successful Ceres step with the exact evaluation; keeps the best.
 // Aborts the solve once `stop` says so (SuggestOptions::cancel).
 class ExactJudge final : public ceres::IterationCallback {
@@ -422,97 +407,20 @@ void NormaliseAt(Surrogate& surrogate, const std::vector<int>& active,
   surrogate.Normalise(ptrs);
 }
 
-// What the stages of one Suggest call share: the inputs, the exact evaluator, the surrogate, the
-// parameters and the best pose so far (Suggest's own), the suggestion being filled, and what the
-// screening and the polish keep between their steps.
-struct SuggestRun {
-  SuggestRun(const SuggestOptions& options, const ExactEvaluator& ev, const Placement& placement,
-             const std::vector<PoseChart>& charts, const std::vector<Eigen::Isometry3d>& start,
-             Suggestion& s, Surrogate& surrogate, std::chrono::steady_clock::time_point t0,
-             double start_score, std::vector<std::vector<double>>& x,
-             std::vector<std::vector<double>>& best_x, Metrics& best_m, double& best_score)
-      : options(options),
-        ev(ev),
-        placement(placement),
-        charts(charts),
-        start(start),
-        s(s),
-        surrogate(surrogate),
-        t0(t0),
-        nsel(options.cameras.size()),
-        start_score(start_score),
-        x(x),
-        best_x(best_x),
-        best_m(best_m),
-        best_score(best_score) {}
+}  // namespace
 
-  // Seconds since Suggest began.
-  double Elapsed() const { return SecondsSince(t0); }
+void SurrogateDeleter::operator()(Surrogate* surrogate) const { delete surrogate; }
 
-  // Whether the caller asked the search to stop (SuggestOptions::cancel).
-  bool Stopped() const { return options.cancel && options.cancel->load(std::memory_order_relaxed); }
-  // Reports the fraction done (SuggestOptions::progress).
-  void Progress(double fraction) const {
-    if (options.progress) options.progress(fraction);
-  }
+std::unique_ptr<Surrogate, SurrogateDeleter> MakeSurrogate(const ExactEvaluator& ev,
+                                                           bool need_info) {
+  return std::unique_ptr<Surrogate, SurrogateDeleter>(new Surrogate(ev, need_info));
+}
 
-  // The suggestion with `message`, the evaluations and the time taken.
-  Suggestion Finish(const std::string& message) {
-    s.message = message;
-    s.evaluations = ev.evaluations() + surrogate.evaluations();
-    s.seconds = Elapsed();
-    return s;
-  }
+std::int64_t SurrogateEvaluations(const Surrogate& surrogate) { return surrogate.evaluations(); }
 
-  // How far the occlusion slopes of selected camera c look (a fraction of its move limit).
-  double OcclusionDelta(std::size_t c) const { return kOcclusionDelta * charts[c].max_move; }
-
-  void FindActive();
-  std::vector<double> Sample(const PoseChart& chart, const std::vector<double>& centre,
-                             double radius);
-  void TryMove(const std::vector<int>& group, std::vector<std::vector<double>>& xs);
-  void ScreenChain(int candidates, int joint_candidates);
-  void Screen();
-  std::pair<std::vector<Eigen::Isometry3d>, bool> PosesOf(std::vector<std::vector<double>>& xs);
-  void JudgeStep();
-  bool OuterIteration(int o, const std::vector<int>& inactive, std::vector<Contribution>& frozen,
-                      ExactJudge& judge);
-  void Polish();
-  void LevelPoses(std::vector<Eigen::Isometry3d>& best_poses,
-                  const std::vector<double>& best_scales);
-
-  const SuggestOptions& options;
-  const ExactEvaluator& ev;
-  const Placement& placement;
-  const std::vector<PoseChart>& charts;
-  const std::vector<Eigen::Isometry3d>& start;
-  Suggestion& s;
-  Surrogate& surrogate;
-  const std::chrono::steady_clock::time_point t0;
-  const std::size_t nsel;
-  const double start_score;
-  std::vector<std::vector<double>>& x;
-  std::vector<std::vector<double>>& best_x;
-  Metrics& best_m;
-  double& best_score;
-
-  std::vector<int> movable;  // the selected cameras with limits that let them move
-  std::vector<int> active;   // the cameras the nudge moves
-  std::vector<std::vector<double>> screened_x;  // the screening's best, when it beat the start
-  double screened_score = -kInf;
-  // The screening's random draws (fixed seed), and one chain's current poses, views and score.
-  std::mt19937_64 rng{0x5eedULL};
-  std::uniform_real_distribution<double> uniform{-1.0, 1.0};
-  std::vector<std::vector<double>> cur_x;
-  std::vector<CameraView> cur_view;
-  std::vector<const CameraView*> ptrs;
-  double cur_score = -kInf;
-  // The focal scales of the poses PosesOf took last.
-  std::vector<double> scales;
-  // The polish's best pose so far (best_x is the best of all, the screening's included).
-  std::vector<std::vector<double>> run_x;
-  double run_score = -kInf;
-};
+double SuggestRun::OcclusionDelta(std::size_t c) const {
+  return kOcclusionDelta * charts[c].max_move;
+}
 
 // A camera whose smooth weight is zero at every target point (nothing in its image, its range, or
 // everything occluded) has no gradient: the nudge leaves it where it is and says so (the exact
@@ -536,130 +444,6 @@ void SuggestRun::FindActive() {
   }
 }
 
-// Uniform in the ball of `radius` (in units of the limits) around `centre`, per part, projected
-// onto the limits.
-std::vector<double> SuggestRun::Sample(const PoseChart& chart, const std::vector<double>& centre,
-                                       double radius) {
-  std::vector<double> xs = centre;
-  auto ball = [&](int from, int n) {
-    if (n == 0) return;
-    std::vector<double> u(n);
-    double r2;
-    do {
-      r2 = 0;
-      for (int i = 0; i < n; ++i) {
-        u[i] = uniform(rng);
-        r2 += u[i] * u[i];
-      }
-    } while (r2 > 1.0);
-    for (int i = 0; i < n; ++i) xs[from + i] += radius * u[i];
-  };
-  ball(0, chart.dims_t);
-  ball(chart.dims_t, chart.dims_r);
-  if (chart.dims_f > 0) xs[chart.dims_t + chart.dims_r] += radius * uniform(rng);
-  chart.Project(xs.data());
-  return xs;
-}
-
-// Tries moving the cameras in `group` to `xs` (indexed by selected camera); keeps it if better.
-void SuggestRun::TryMove(const std::vector<int>& group, std::vector<std::vector<double>>& xs) {
-  for (int c : group)
-    if (!placement.Admissible(c, charts[c].Pose(xs[c].data()).translation())) return;  // free
-  std::vector<CameraView> v(nsel);
-  for (int c : group) {
-    v[c] = ev.View(c, charts[c].Pose(xs[c].data()), charts[c].FocalScale(xs[c].data()));
-    ptrs[c] = &v[c];
-  }
-  const Metrics m = ev.Combine(ptrs, /*objective_only=*/true);
-  for (int c : group) ptrs[c] = &cur_view[c];
-  const double score = ev.Score(m);
-  if (!(score > cur_score)) return;
-  cur_score = score;
-  for (int c : group) {
-    cur_x[c] = std::move(xs[c]);
-    cur_view[c] = std::move(v[c]);
-  }
-  if (score > best_score) {
-    best_score = score;
-    s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), m.objective});
-  }
-}
-
-// One screening chain from the current poses: single-camera moves within each radius, then joint
-// moves of all movable cameras.
-void SuggestRun::ScreenChain(int candidates, int joint_candidates) {
-  constexpr double kJointRadius = 0.15;
-  cur_x = x;  // the current poses
-  for (std::size_t c = 0; c < nsel; ++c) {
-    cur_view[c] = ev.View(static_cast<int>(c), start[c]);
-    ptrs[c] = &cur_view[c];
-  }
-  cur_score = start_score;
-  for (double radius : {1.0, 0.4, 0.15})
-    for (int c : movable)
-      for (int k = 0; k < candidates; ++k) {
-        if (Stopped()) return;
-        std::vector<std::vector<double>> xs = cur_x;
-        xs[c] = Sample(charts[c], cur_x[c], radius);
-        TryMove({c}, xs);
-      }
-  for (int k = 0; k < joint_candidates; ++k) {
-    if (Stopped()) return;
-    std::vector<std::vector<double>> xs = cur_x;
-    for (int c : movable) xs[c] = Sample(charts[c], cur_x[c], kJointRadius);
-    TryMove(movable, xs);
-  }
-}
-
-// Screening (exact), before the Ceres nudge: look across the whole limits for a better start. The
-// smooth surrogate sees occluders only through a local linearisation, so from the current poses
-// it cannot cross the medics' occlusion shadows; exact jumps can, and they are cheap. A chain
-// moves one active camera at a time: a candidate pose is tested once against the target points (a
-// CameraView, one visibility test per point) and combined with the other cameras' cached views,
-// which is one exact evaluation of the objective at a joint pose; a better one is kept at once.
-// Each camera gets `screening_candidates` candidates uniform in the ball of radius 1 (the whole
-// limits) around its best pose, then as many within 0.4 and within 0.15; last, joint moves of all
-// movable cameras within 0.15 (some points are gained only when two selected cameras move
-// together). Three independent chains from the current poses; the best end is polished below.
-// Deterministic (fixed seed).
-void SuggestRun::Screen() {
-  cur_view.resize(nsel);
-  ptrs.resize(nsel);
-  constexpr int kChains = 3;
-  // Coverage (and its N-1 form) is judged from counts alone; the other objectives need every
-  // point's covariance or density at each evaluation (about 2x the cost, and a slower polish), or
-  // for calibration a test of every calibration pose per candidate, so they get a quarter of the
-  // candidates (sigma-p90 on the trauma room: 3.2 s with all, 0.8 s with a quarter).
-  const int candidates = options.objective.kind == ObjectiveKind::kCoverage ||
-                                 options.objective.kind == ObjectiveKind::kCoverageN1
-                             ? options.screening_candidates
-                             : std::max(1, options.screening_candidates / 4);
-  // Every movable camera is screened, also one without a gradient at the start (it sees no target
-  // point, e.g. a camera turned away whose calibration links are what is asked): exact jumps
-  // need no gradient.
-  const int joint_candidates = movable.size() > 1 ? candidates * 3 / 4 : 0;
-  std::vector<CameraView> screened_view;
-  for (int chain = 0; chain < kChains && !Stopped(); ++chain) {
-    ScreenChain(candidates, joint_candidates);
-    if (cur_score > screened_score && cur_score > start_score) {
-      screened_score = cur_score;
-      screened_x = cur_x;
-      screened_view = cur_view;
-    }
-    Progress(kScreeningShare * (chain + 1) / kChains);
-  }
-  if (!screened_x.empty()) {
-    for (std::size_t c = 0; c < nsel; ++c) ptrs[c] = &screened_view[c];
-    best_m = ev.Summary(ptrs);  // the full metrics of the best pose found (already counted)
-    best_score = screened_score;
-    best_x = screened_x;
-  }
-  s.screened = static_cast<int>(ev.evaluations());
-  s.screened_objective = best_m.objective;
-  s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
-}
-
-// Projects `xs` onto the limits; the poses (the focal scales go to `scales`) and whether every
 // camera's centre is admissible.
 std::pair<std::vector<Eigen::Isometry3d>, bool> SuggestRun::PosesOf(
     std::vector<std::vector<double>>& xs) {
@@ -674,7 +458,6 @@ std::pair<std::vector<Eigen::Isometry3d>, bool> SuggestRun::PosesOf(
   return std::make_pair(poses, ok);
 }
 
-// The exact judge of a Ceres step: evaluates the current parameters, keeps the polish's best and
 // the best of all.
 void SuggestRun::JudgeStep() {
   std::vector<std::vector<double>> xs = x;
@@ -694,39 +477,40 @@ void SuggestRun::JudgeStep() {
   s.trace.push_back({Elapsed(), ev.evaluations() + surrogate.evaluations(), best_m.objective});
 }
 
-// Outer iteration `o` of the polish: occlusion, frozen contributions and term scales at the
+namespace {
+
 // polish's best pose, then one Ceres solve from there; true when it converged (stop).
-bool SuggestRun::OuterIteration(int o, const std::vector<int>& inactive,
-                                std::vector<Contribution>& frozen, ExactJudge& judge) {
+bool OuterIteration(SuggestRun& run, int o, const std::vector<int>& inactive,
+                    std::vector<Contribution>& frozen, ExactJudge& judge) {
   // Soft border: wide first (a gradient from far outside the image), then a few % of the width.
-  surrogate.set_border_width(o == 0 ? kBorderWidth
-                                    : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
-  x = run_x;
-  auto [poses, ok] = PosesOf(x);
+  run.surrogate.set_border_width(o == 0 ? kBorderWidth
+                                        : (o == 1 ? kBorderWidth / 2 : kBorderWidth / 4));
+  run.x = run.run_x;
+  auto [poses, ok] = run.PosesOf(run.x);
   (void)ok;
-  for (int c : active) surrogate.UpdateOcclusion(c, poses[c], OcclusionDelta(c));
+  for (int c : run.active) run.surrogate.UpdateOcclusion(c, poses[c], run.OcclusionDelta(c));
   for (std::size_t f = 0; f < inactive.size(); ++f)
-    surrogate.Contribute(inactive[f], poses[inactive[f]], scales[inactive[f]], &frozen[f]);
-  NormaliseAt(surrogate, active, frozen, poses, scales);
+    run.surrogate.Contribute(inactive[f], poses[inactive[f]], run.scales[inactive[f]], &frozen[f]);
+  NormaliseAt(run.surrogate, run.active, frozen, poses, run.scales);
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  SurrogateCost cost(surrogate, charts, active, placement, &frozen);
+  SurrogateCost cost(run.surrogate, run.charts, run.active, run.placement, &frozen);
   std::vector<double*> blocks;
-  for (int c : active) blocks.push_back(x[c].data());
+  for (int c : run.active) blocks.push_back(run.x[c].data());
   problem.AddResidualBlock(&cost, nullptr, blocks);
-  for (int c : active)
-    for (int i = 0; i < charts[c].dims(); ++i) {
+  for (int c : run.active)
+    for (int i = 0; i < run.charts[c].dims(); ++i) {
       // A flat mount box gives lower == upper on one axis, which Ceres rejects as infeasible
       // (and then does not iterate at all); the projection onto the limits before every exact
       // evaluation holds that axis anyway.
-      if (!(charts[c].lower[i] < charts[c].upper[i])) continue;
-      problem.SetParameterLowerBound(x[c].data(), i, charts[c].lower[i]);
-      problem.SetParameterUpperBound(x[c].data(), i, charts[c].upper[i]);
+      if (!(run.charts[c].lower[i] < run.charts[c].upper[i])) continue;
+      problem.SetParameterLowerBound(run.x[c].data(), i, run.charts[c].lower[i]);
+      problem.SetParameterUpperBound(run.x[c].data(), i, run.charts[c].upper[i]);
     }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = std::max(1, options.max_inner_iterations);
+  so.max_num_iterations = std::max(1, run.options.max_inner_iterations);
   so.update_state_every_iteration = true;
   so.callbacks.push_back(&judge);
   so.logging_type =
@@ -737,18 +521,20 @@ bool SuggestRun::OuterIteration(int o, const std::vector<int>& inactive,
   so.parameter_tolerance = 1e-7;
   so.initial_trust_region_radius = 1.0;
   ceres::Solver::Summary summary;
-  const double score_before_outer = run_score;
+  const double score_before_outer = run.run_score;
   ceres::Solve(so, &problem, &summary);
-  s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
-  s.outer_iterations = o + 1;
+  run.s.iterations += std::max(0, static_cast<int>(summary.iterations.size()) - 1);
+  run.s.outer_iterations = o + 1;
   // The final state too (the callback saw every successful step already; this is cheap
   // insurance).
   judge.on_step();
-  return o >= 2 && !(run_score > score_before_outer);  // converged at the final width
+  return o >= 2 && !(run.run_score > score_before_outer);  // converged at the final width
 }
 
-// The Ceres nudge: outer iterations of the surrogate's minimisation from the best start, every
-// successful step judged exactly.
+// The Ceres nudge: outer iterations of the surrogate'run.s minimisation from the best start, every
+
+}  // namespace
+
 void SuggestRun::Polish() {
   ExactJudge judge;
   scales.assign(nsel, 1.0);
@@ -783,7 +569,7 @@ void SuggestRun::Polish() {
   std::vector<Contribution> frozen(inactive.size());
   const int outer = active.empty() ? 0 : std::max(1, options.outer_iterations);
   for (int o = 0; o < outer && !Stopped(); ++o) {
-    const bool converged = OuterIteration(o, inactive, frozen, judge);
+    const bool converged = OuterIteration(*this, o, inactive, frozen, judge);
     Progress(kScreeningShare + (1 - kScreeningShare) * (o + 1) / outer);
     if (converged) break;
   }
@@ -791,138 +577,5 @@ void SuggestRun::Polish() {
 
 // A level camera (image x axis horizontal, as look_at with up +z makes it) stays level when that
 // costs nothing: the screening's random turns leave a roll about the optical axis that coverage
-// rarely needs and that `accept` could only write as a tilted `up`. Per camera, the level
-// orientations with the same optical axis and within +-1 degree of it in yaw and pitch (25,
-// judged exactly); the best is taken when it is no worse than the rolled pose.
-void SuggestRun::LevelPoses(std::vector<Eigen::Isometry3d>& best_poses,
-                            const std::vector<double>& best_scales) {
-  for (std::size_t c = 0; c < nsel; ++c) {
-    const Mat3& R0 = start[c].linear();
-    const Mat3 R = best_poses[c].linear();
-    if (std::abs(R0(2, 0)) > 1e-9 || std::abs(R(2, 0)) <= 1e-12) continue;
-    const Vec3 ypr = YawPitchRollDeg(R);
-    if (std::abs(ypr.y()) > 89.0) continue;  // looking straight up or down: no horizon
-    const double limit = charts[c].max_rotate * 180.0 / kPi * (1 + 1e-9);
-    // Yaw and pitch of the optical axis (the Euler angles with the roll taken out).
-    const Vec3 axis = R.col(2);
-    const double yaw = std::atan2(axis.y(), axis.x()) * 180.0 / kPi;
-    const double pitch = std::asin(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / kPi;
-    std::vector<Eigen::Isometry3d> best_trial;
-    Metrics best_level;
-    double best_level_score = -kInf;
-    for (double dy : {0.0, -0.5, 0.5, -1.0, 1.0})
-      for (double dp : {0.0, -0.5, 0.5, -1.0, 1.0}) {
-        const Mat3 L = RotationFromYawPitchRollDeg(Vec3(yaw + dy, pitch + dp, 0.0));
-        if (RotationAngleDeg(R0, L) > limit) continue;
-        std::vector<Eigen::Isometry3d> trial = best_poses;
-        trial[c].linear() = L;
-        const Metrics m = ev.Evaluate(trial, best_scales);
-        if (ev.Score(m) > best_level_score) {
-          best_level_score = ev.Score(m);
-          best_level = m;
-          best_trial = trial;
-        }
-      }
-    if (!best_trial.empty() && best_level_score >= best_score) {
-      best_poses = best_trial;
-      best_m = best_level;
-      best_score = best_level_score;
-    }
-  }
-}
 
-}  // namespace
-
-Suggestion Suggest(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                   const std::vector<TargetPoint>& targets, const SuggestOptions& options) {
-  using namespace suggest_detail;
-  options.Check(scene, rig);
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t nsel = options.cameras.size();
-  ExactEvaluator ev(scene, rig, caster, targets, options.objective, options.cameras,
-                    options.sample_casters);
-  const Placement placement(scene, rig, options);
-  SearchStart begin = BeginSearch(rig, options, static_cast<int>(targets.size()), ev);
-  const std::vector<PoseChart>& charts = begin.charts;
-  const std::vector<Eigen::Isometry3d>& start = begin.start;
-  Suggestion& s = begin.suggestion;
-  s.after = s.before;
-  FillChanges(rig, options, start, {}, placement, &s);
-  const double start_score = ev.Score(s.before);
-  const std::string name = ObjectiveName(options.objective);
-
-  // Parameters (scaled so that +-1 is the limit), all starting at the start pose.
-  std::vector<std::vector<double>> x(nsel), best_x(nsel);
-  for (std::size_t c = 0; c < nsel; ++c) x[c].assign(charts[c].dims(), 0.0);
-  best_x = x;
-  Metrics best_m = s.before;
-  double best_score = start_score;
-  s.trace.push_back({SecondsSince(t0), ev.evaluations(), best_m.objective});
-
-  const bool need_info = options.objective.kind == ObjectiveKind::kSigmaMean ||
-                         options.objective.kind == ObjectiveKind::kSigmaPercentile ||
-                         options.objective.kind == ObjectiveKind::kMix;
-  Surrogate surrogate(ev, need_info);
-  SuggestRun run(options, ev, placement, charts, start, s, surrogate, t0, start_score, x, best_x,
-                 best_m, best_score);
-
-  for (std::size_t c = 0; c < nsel; ++c)
-    if (charts[c].dims() > 0) run.movable.push_back(static_cast<int>(c));
-  if (run.movable.empty())
-    return run.Finish(
-        "the limits are zero: every selected camera keeps its pose; nothing to suggest");
-
-  run.FindActive();
-  const std::string no_gradient =
-      "no improvement found: no selected camera sees any target point, so the smooth objective has "
-      "no gradient; aim the cameras at the region first";
-  if (run.active.empty() && options.screening_candidates <= 0) return run.Finish(no_gradient);
-  const bool start_without_gradient = run.active.empty();
-
-  if (options.screening_candidates > 0) run.Screen();
-  run.Polish();
-  run.Progress(1.0);
-
-  std::vector<Eigen::Isometry3d> best_poses = start;
-  std::vector<double> best_scales(nsel, 1.0);
-  for (std::size_t c = 0; c < nsel; ++c) {
-    best_poses[c] = charts[c].Pose(best_x[c].data());
-    best_scales[c] = charts[c].FocalScale(best_x[c].data());
-  }
-  s.stopped = run.Stopped();
-  if (best_score > start_score && !s.stopped) run.LevelPoses(best_poses, best_scales);
-  if (options.snap_move > 0 || options.snap_rotate_deg > 0) {
-    if (best_score > start_score) {
-      s.unsnapped = best_m;
-      best_poses = SnapPoses(charts, best_poses, options, placement);
-      best_m = ev.Evaluate(best_poses, best_scales);
-      best_score = ev.Score(best_m);
-    }
-  }
-  s.improved = best_score > start_score;
-  const bool higher = ObjectiveHigherIsBetter(options.objective);
-  if (s.improved) {
-    s.after = best_m;
-    FillChanges(rig, options, best_poses, best_scales, placement, &s);
-    for (CameraChange& c : s.cameras)
-      if (c.move_m > 0 || c.rotate_deg > 0 || c.focal_scale != 1.0) c.note.clear();
-    std::string extra;
-    if (std::isinf(s.after.objective))
-      extra = "; the percentile still falls on an untriangulable point, whose share fell from " +
-              Num("%.4g", s.before.untriangulable) + " to " + Num("%.4g", s.after.untriangulable);
-    return run.Finish(std::string(s.stopped ? "stopped early; " : "") + name + " improved from " +
-                      Num("%.6g", s.before.objective) + " to " + Num("%.6g", s.after.objective) +
-                      (higher ? " (higher is better)" : " (lower is better)") + extra);
-  }
-  if (s.unsnapped)
-    return run.Finish("no improvement found: the optimum improved " + name + " to " +
-                      Num("%.6g", s.unsnapped->objective) +
-                      " but the snapped poses do not; use finer snap steps");
-  if (s.stopped) return run.Finish("stopped early: no improvement found yet");
-  if (start_without_gradient) return run.Finish(no_gradient);
-  return run.Finish("no improvement found: the exact " + name +
-                    " did not improve within the limits (it stays " +
-                    Num("%.6g", s.before.objective) + ")");
-}
-
-}  // namespace pandora
+}  // namespace pandora::suggest_detail

@@ -1,6 +1,6 @@
 #pragma once
 /// \file suggest_internal.h
-/// Shared by suggest.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
+/// Shared by suggest.cpp, suggest_search.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
 /// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected
 /// camera.
 
