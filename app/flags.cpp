@@ -46,6 +46,11 @@ const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
       {"view_width", "--width"},
       {"camera_width", "--camera-width"},
       {"brightness", "--brightness"},
+      {"grid_pixels", "--grid"},
+      {"samples", "--samples"},
+      {"pattern", "--pattern"},
+      {"surface", "--surface"},
+      {"budget_s", "--ptz-time"},
       // Rig import (ImportRigOptions).
       {"from", "--from"},
       {"as", "--as"},
@@ -59,7 +64,9 @@ const std::vector<std::string>& FieldsWithoutFlag() {
       "position", "look_at", "rotation", "ypr_deg", "hfov_deg", "resolution", "k1", "k2", "p1",
       "p2", "k3", "k4", "near", "far", "color", "preset", "pan_deg", "tilt_deg",
       // Set by `pandora analyze --mpi` from the MPI world, never by hand.
-      "partition_count"};
+      "partition_count",
+      // The render options no command sets (RenderOptions::Check).
+      "ambient", "grid_fill", "line_width_px", "line_grey", "background", "pixel_sigma"};
   return kFields;
 }
 

@@ -47,11 +47,11 @@ int RunSuggestPtz(const SuggestArgs& args) {
                      "give one of them");
   if (args.over_time)
     throw InputError("--over-time", "", "is not available with --ptz-preset or --ptz-tour");
-  if (args.tour_objective != "mean" && args.tour_objective != "max")
+  const std::optional<TourObjective> tour = TourObjectiveFromName(args.tour_objective);
+  if (!tour)
     throw InputError("--tour-objective", "", "unknown objective '" + args.tour_objective + "'",
                      "use mean or max");
-  const TourObjective objective =
-      args.tour_objective == "max" ? TourObjective::kMax : TourObjective::kMean;
+  const TourObjective objective = *tour;
   session::Session session(session::Study::Load(args.scene), SuggestSessionOptions(args));
   const Scene& scene = session.study().scene();
   const Rig& rig = session.rig().rig();

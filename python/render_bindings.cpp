@@ -11,8 +11,10 @@
 
 #include "analysis/scene/scene.h"
 #include "analysis/util/error.h"
+#include "analysis/util/text.h"
 #include "app/session/study.h"
 #include "python/bindings.h"
+#include "render/light.h"
 #include "render/render.h"
 
 namespace pandora::python {
@@ -22,10 +24,25 @@ void BindRender(py::module_& m) {
   m.def(
       "render",
       [](const PyScene& s, const PyRig& r, const std::string& view, int width, int height,
-         const std::string& plan) {
+         const std::string& plan, const std::string& pattern, const std::string& surface,
+         const std::optional<double>& brightness, int grid_pixels, int samples) {
         const Scene& scene = s.scene();
         RenderView v;
         RenderOptions o;
+        const std::optional<Pattern> p = PatternFromName(pattern);
+        if (!p)
+          throw InputError("pattern", "", "unknown pattern '" + pattern + "'",
+                           DidYouMean(pattern, PatternNames(), "patterns"));
+        const std::optional<Surface> f = SurfaceFromName(surface);
+        if (!f)
+          throw InputError("surface", "", "unknown surface mode '" + surface + "'",
+                           DidYouMean(surface, SurfaceNames(), "surface modes"));
+        o.pattern = *p;
+        o.surface = *f;
+        if (brightness) o.brightness = *brightness;
+        o.grid_pixels = grid_pixels;
+        o.samples = samples;
+        o.Check();  // before the view: the options' own errors name their keyword
         if (!plan.empty()) {
           double mpp = 0;
           const std::optional<RenderView> p =
@@ -55,8 +72,13 @@ void BindRender(py::module_& m) {
         return out;
       },
       py::arg("scene"), py::arg("rig"), py::arg("view") = "", py::arg("width") = 640,
-      py::arg("height") = 400, py::arg("plan") = "",
-      "The projective-light render as an (H, W, 3) float32 linear RGB array.");
+      py::arg("height") = 400, py::arg("plan") = "", py::arg("pattern") = "uniform",
+      py::arg("surface") = "material", py::arg("brightness") = py::none(),
+      py::arg("grid_pixels") = 32, py::arg("samples") = 1,
+      "The projective-light render as an (H, W, 3) float32 linear RGB array, as `pandora render` "
+      "draws it: pattern uniform or grid (a line every grid_pixels camera pixels), surface "
+      "material, black, hidden-line or contours, brightness (default min(1, 3 / enabled "
+      "cameras)), samples per pixel per axis.");
 }
 
 }  // namespace pandora::python

@@ -536,7 +536,8 @@ void BindSuggestPtz(py::module_& m) {
       [ptz_common](const PyScene& sc, PyRig& r, const std::string& camera,
                    const std::string& objective, int points, const std::string& target_region,
                    std::vector<std::string> target_surfaces, bool with_region, std::uint64_t seed) {
-        if (objective != "mean" && objective != "max")
+        const std::optional<TourObjective> tour = TourObjectiveFromName(objective);
+        if (!tour)
           throw InputError("objective", "", "unknown tour objective '" + objective + "'",
                            "use mean or max");
         int c = -1;
@@ -558,9 +559,7 @@ void BindSuggestPtz(py::module_& m) {
           const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(sc.scene(), r.rig());
           const VisibilityTester tester(r.rig().cameras, sc.study->caster(),
                                         sc.scene().ContentBounds().diagonal(), surfaces.get());
-          out.tour =
-              SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m,
-                             objective == "max" ? TourObjective::kMax : TourObjective::kMean);
+          out.tour = SuggestPtzTour(tester, c, xyz, sc.scene().study.ptz.min_px_per_m, *tour);
         }
         out.improved = out.tour->improved();
         char line[256];

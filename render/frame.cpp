@@ -515,6 +515,7 @@ struct FrameRenderer::Impl {
 FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, const RenderView& view,
                              const RenderOptions& options, const PreparedOverlays* overlays) {
   CheckView(view, rig);
+  options.Check();
   const OverlayOptions& ov = options.overlays;
   const bool want_overlays = !ov.slice_field.empty() || !ov.iso_field.empty();
   if (want_overlays && !overlays)
@@ -1178,6 +1179,28 @@ std::vector<uint8_t> ComputeDrawnEdges(const TriangleMesh& mesh) {
       for (const auto& [t, i] : list) drawn[t] |= uint8_t(1u << i);
   }
   return drawn;
+}
+
+void RenderOptions::Check() const {
+  const auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };
+  if (!std::isnan(brightness) && !(brightness > 0 && brightness <= 1e6))
+    throw InputError("{brightness}", "", "must be in (0, 1e6] times one camera's light",
+                     "leave it unset for the default min(1, 3 / enabled cameras)");
+  if (!in(ambient, 0, 1)) throw InputError("{ambient}", "", "must be in [0, 1]");
+  if (!in(grid_pixels, 1, 100000))
+    throw InputError("{grid_pixels}", "", "must be a whole number of camera pixels in [1, 100000]");
+  if (!in(grid_fill, 0, 1)) throw InputError("{grid_fill}", "", "must be in [0, 1]");
+  if (!(line_width_px > 0 && line_width_px <= 1000))
+    throw InputError("{line_width_px}", "", "must be in (0, 1000] output pixels");
+  if (!in(line_grey, 0, 1)) throw InputError("{line_grey}", "", "must be in [0, 1]");
+  if (!in(samples, 1, 16)) throw InputError("{samples}", "", "must be 1 to 16 (per axis)");
+  if (!background.allFinite() || (background.array() < 0).any())
+    throw InputError("{background}", "", "must be a finite linear RGB colour >= 0");
+  if (!(pixel_sigma > 0 && std::isfinite(pixel_sigma)))
+    throw InputError("{pixel_sigma}", "", "must be a finite number of pixels > 0");
+  for (const PtzTrace& t : ptz_all)
+    if (!(t.budget_s >= 0 && std::isfinite(t.budget_s)))
+      throw InputError("{budget_s}", "", "must be a finite number of seconds >= 0");
 }
 
 }  // namespace pandora

@@ -165,6 +165,12 @@ struct RenderOptions {
     double budget_s = 3;
   };
   std::vector<PtzTrace> ptz_all;
+
+  /// Checks every value (Render does before it draws): brightness NaN or in (0, 1e6], ambient,
+  /// grid_fill and line_grey in [0, 1], grid_pixels in [1, 100000], line_width_px in (0, 1000],
+  /// samples in [1, 16], a finite background >= 0, pixel_sigma > 0, PTZ budgets >= 0. InputError
+  /// naming the field ({samples}), which each front end writes its own way.
+  void Check() const;
 };
 
 /// The rendered image and its per-pixel layers (row-major, y down, index y * width + x). The layers

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 
 #include "analysis/geometry/primitives.h"
@@ -108,6 +109,32 @@ OneCameraFloor MakeOneCameraFloor(int width, int height) {
   s.view.width = width;
   s.view.height = height;
   return s;
+}
+
+TEST(Render, OptionsCheckNamesTheFieldAtFault) {
+  const auto fault = [](const std::function<void(RenderOptions&)>& set) {
+    RenderOptions o;
+    set(o);
+    try {
+      o.Check();
+    } catch (const InputError& e) {
+      return e.file();
+    }
+    return std::string("ok");
+  };
+  EXPECT_EQ(fault([](RenderOptions&) {}), "ok");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.brightness = 1e6; }), "ok");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.brightness = 0; }), "{brightness}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.ambient = 1.5; }), "{ambient}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.grid_pixels = 0; }), "{grid_pixels}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.grid_fill = NAN; }), "{grid_fill}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.line_width_px = 0; }), "{line_width_px}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.line_grey = -0.1; }), "{line_grey}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.samples = 16; }), "ok");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.samples = 17; }), "{samples}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.background.x() = INFINITY; }), "{background}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.pixel_sigma = 0; }), "{pixel_sigma}");
+  EXPECT_EQ(fault([](RenderOptions& o) { o.ptz_all.push_back({0, -1}); }), "{budget_s}");
 }
 
 TEST(Render, SingleCameraLightsExactlyItsDistortedFootprint) {

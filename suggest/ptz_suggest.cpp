@@ -371,7 +371,7 @@ std::string PtzTourSuggestionToJson(const PtzTourSuggestion& s, const Scene& sce
   };
   json j = Header("ptz_tour", scene, rig, s.improved());
   j["ptz"] = {{"camera", s.camera},
-              {"objective", s.objective == TourObjective::kMax ? "max" : "mean"},
+              {"objective", TourObjectiveName(s.objective)},
               {"tour_before", s.before},
               {"tour_after", s.after},
               {"presets_before", names(s.before)},

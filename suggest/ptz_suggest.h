@@ -8,6 +8,7 @@
 /// with a backup). Light header (no JSON, no Ceres).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,21 @@ enum class TourObjective {
   kMean,  ///< The mean of each point's longest unwatched stretch (then the longest of all).
   kMax,   ///< The longest unwatched stretch of any point (then the mean).
 };
+/// The names of the tour objectives, in enum order ("mean", "max"): the command's
+/// --tour-objective, Python's objective=, the suggestion file's "objective".
+inline const std::vector<std::string>& TourObjectiveNames() {
+  static const std::vector<std::string> kNames{"mean", "max"};
+  return kNames;
+}
+inline const std::string& TourObjectiveName(TourObjective objective) {
+  return TourObjectiveNames()[static_cast<std::size_t>(objective)];
+}
+/// The objective TourObjectiveName calls `name`; nullopt for any other text.
+inline std::optional<TourObjective> TourObjectiveFromName(const std::string& name) {
+  for (std::size_t i = 0; i < TourObjectiveNames().size(); ++i)
+    if (TourObjectiveNames()[i] == name) return static_cast<TourObjective>(i);
+  return std::nullopt;
+}
 
 struct PtzTourSuggestion {
   std::string camera;

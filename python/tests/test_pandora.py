@@ -163,6 +163,30 @@ def test_render_is_a_finite_image():
     assert plan.shape == (100, 160, 3) and not np.array_equal(plan, img)
 
 
+def test_render_options_as_keywords():
+    """render() takes `pandora render`'s options: the grid pattern only takes light away (between
+    its lines), light is linear in brightness, and a bad value names its keyword
+    (RenderOptions::Check)."""
+    scene = pandora.load_scene(str(SOURCE / "examples" / "ptz_home" / "scene.json"))
+    rig = scene.rig("home")
+    size = dict(width=320, height=200)
+    uniform = pandora.render(scene, rig, **size)
+    grid = pandora.render(scene, rig, pattern="grid", grid_pixels=64, **size)
+    assert (grid <= uniform + 1e-6).all() and grid.sum() < 0.99 * uniform.sum()
+    a, b, c = (pandora.render(scene, rig, brightness=x, **size) for x in (0.5, 1.0, 1.5))
+    assert np.abs((c - b) - (b - a)).max() < 1e-5 * np.abs(c - b).max()
+    assert not np.array_equal(pandora.render(scene, rig, surface="black", **size), uniform)
+    for kwargs, keyword in [(dict(grid_pixels=0), "grid_pixels"), (dict(pattern="grd"), "pattern"),
+                            (dict(samples=17), "samples"), (dict(brightness=-1), "brightness"),
+                            (dict(surface="wire"), "surface")]:
+        with pytest.raises(pandora.InputError) as e:
+            pandora.render(scene, rig, width=16, height=10, **kwargs)
+        assert e.value.file == keyword, (kwargs, str(e.value))
+    with pytest.raises(pandora.InputError) as e:
+        pandora.render(scene, rig, pattern="grd")
+    assert "grid" in e.value.hint
+
+
 def test_evaluate_returns_what_analyze_returns(tmp_path):
     """One conductor (app/session/analyze.h): evaluate's summary equals `pandora analyze`'s
     summary.json but for timings, on the mocap lab (people over six poses, body targets, pixel

@@ -12,7 +12,7 @@ void ViewerApp::Impl::DisplayPanel() {
   int pattern = model.display.pattern == Pattern::kGrid ? 1 : 0;
   bool changed = ImGui::Combo("light", &pattern, "uniform\0grid\0");
   int grid = model.display.grid_pixels;
-  changed |= ImGui::DragInt("grid px", &grid, 1, 1, 1000);
+  changed |= ImGui::DragInt("grid px", &grid, 1, 1, 1000, "%d", ImGuiSliderFlags_AlwaysClamp);
   // The paper's display modes: material colours, black, hidden-line edges, contours.
   int surface = int(model.display.surface);
   changed |= ImGui::Combo("surfaces", &surface, "material\0black\0hidden-line\0contours\0");
@@ -21,7 +21,8 @@ void ViewerApp::Impl::DisplayPanel() {
                                : float(model.display.brightness);
   changed |= ImGui::Checkbox("auto brightness", &automatic);
   if (!automatic)
-    changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f");
+    changed |= ImGui::DragFloat("brightness", &brightness, 0.01f, 0.01f, 10.0f, "%.2f",
+                                ImGuiSliderFlags_AlwaysClamp);
   if (ImGui::Combo("shadow map", &map_index,
                    "512\0"
                    "1024\0"
