@@ -7,6 +7,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "analysis/util/atomic_file.h"
@@ -19,9 +20,11 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   const int W = image.width, H = image.height;
   const std::size_t pixels = std::size_t(W) * H;
   const bool mask = !image.cameras.empty();
-  if (W <= 0 || H <= 0 || image.rgb.size() != 3 * pixels || image.coverage.size() != pixels ||
-      (mask && image.cameras.size() != pixels) || image.resolution.size() != pixels ||
-      image.sigma_max.size() != pixels || image.depth.size() != pixels)
+  bool consistent =
+      W > 0 && H > 0 && image.rgb.size() == 3 * pixels && (!mask || image.cameras.size() == pixels);
+  for (const ImageLayer& layer : ImageFloatLayers())
+    consistent = consistent && (image.*layer.values).size() == pixels;
+  if (!consistent)
     throw std::invalid_argument(
         "WriteExr: empty or inconsistent image (every layer needs a value per pixel)");
   if (mask != (rig_cameras <= Image::kMaxMaskCameras))
@@ -46,12 +49,12 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
       mask ? "cameras: bitmask (bit c = rig camera c, bits 32-63 in cameras_hi)"
            : "cameras: not written, the rig has " + std::to_string(rig_cameras) +
                  " cameras (a bitmask holds 64; coverage counts them all)";
-  header.insert(
-      "pandora_layers",
-      Imf::StringAttribute("R,G,B: linear light; coverage: cameras seeing the surface point; " +
-                           cameras_meaning +
-                           "; resolution: px/m; sigma_max: mm, inf = not triangulable; depth: "
-                           "m along the eye ray, inf = no surface"));
+  std::string layers = "R,G,B: linear light";
+  for (const ImageLayer& layer : ImageFloatLayers()) {
+    layers += std::string("; ") + layer.name + ": " + layer.meaning;
+    if (layer.values == &Image::coverage) layers += "; " + cameras_meaning;
+  }
+  header.insert("pandora_layers", Imf::StringAttribute(layers));
   Imf::FrameBuffer fb;
   const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
   auto add_float = [&](const char* name, const float* data, std::size_t x_stride) {
@@ -61,10 +64,8 @@ void WriteExr(const Image& image, const std::string& path, int rig_cameras) {
   add_float("R", image.rgb.data() + 0, 3);
   add_float("G", image.rgb.data() + 1, 3);
   add_float("B", image.rgb.data() + 2, 3);
-  add_float("coverage", image.coverage.data(), 1);
-  add_float("resolution", image.resolution.data(), 1);
-  add_float("sigma_max", image.sigma_max.data(), 1);
-  add_float("depth", image.depth.data(), 1);
+  for (const ImageLayer& layer : ImageFloatLayers())
+    add_float(layer.name, (image.*layer.values).data(), 1);
   if (mask) {
     header.channels().insert("cameras", Imf::Channel(Imf::UINT));
     fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)lo.data(), us, us * W));
@@ -96,10 +97,7 @@ Image ReadExr(const std::string& path) {
     image.height = H;
     const std::size_t pixels = std::size_t(W) * H;
     image.rgb.assign(3 * pixels, 0.0f);
-    image.coverage.assign(pixels, 0.0f);
-    image.resolution.assign(pixels, 0.0f);
-    image.sigma_max.assign(pixels, 0.0f);
-    image.depth.assign(pixels, 0.0f);
+    for (const ImageLayer& layer : ImageFloatLayers()) (image.*layer.values).assign(pixels, 0.0f);
     std::vector<uint32_t> lo(pixels, 0), hi(pixels, 0);
     const std::size_t fs = sizeof(float), us = sizeof(uint32_t);
     // Slices are addressed from the data window's origin.
@@ -112,10 +110,8 @@ Image ReadExr(const std::string& path) {
     add_float("R", image.rgb.data() + 0, 3);
     add_float("G", image.rgb.data() + 1, 3);
     add_float("B", image.rgb.data() + 2, 3);
-    add_float("coverage", image.coverage.data(), 1);
-    add_float("resolution", image.resolution.data(), 1);
-    add_float("sigma_max", image.sigma_max.data(), 1);
-    add_float("depth", image.depth.data(), 1);
+    for (const ImageLayer& layer : ImageFloatLayers())
+      add_float(layer.name, (image.*layer.values).data(), 1);
     fb.insert("cameras", Imf::Slice(Imf::UINT, (char*)(lo.data() - origin), us, us * W));
     fb.insert("cameras_hi", Imf::Slice(Imf::UINT, (char*)(hi.data() - origin), us, us * W));
     file.setFrameBuffer(fb);

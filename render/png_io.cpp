@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "analysis/util/atomic_file.h"
@@ -14,10 +16,35 @@
 
 namespace pandora {
 
-void WritePng(const Image& image, const std::string& path) {
+std::string EncodePngSrgb8(int width, int height, const std::vector<std::uint8_t>& rgb) {
+  if (width <= 0 || height <= 0 || rgb.size() != 3 * std::size_t(width) * std::size_t(height))
+    throw std::invalid_argument("EncodePngSrgb8: empty image or wrong buffer size");
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = png_uint_32(width);
+  png.height = png_uint_32(height);
+  png.format = PNG_FORMAT_RGB;
+  // First the size, then the bytes (libpng's simplified API, in memory).
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, rgb.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw std::runtime_error("cannot encode the PNG: " + message);
+  }
+  std::string bytes(size, '\0');
+  if (!png_image_write_to_memory(&png, bytes.data(), &size, 0, rgb.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw std::runtime_error("cannot encode the PNG: " + message);
+  }
+  bytes.resize(size);
+  return bytes;
+}
+
+std::string EncodePng(const Image& image) {
   const std::size_t pixels = std::size_t(image.width) * image.height;
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() != 3 * pixels)
-    throw std::invalid_argument("WritePng: empty or inconsistent image");
+    throw std::invalid_argument("EncodePng: empty or inconsistent image");
   // sRGB encoding through a 65537-entry table of the transfer curve: the table's step (1/65536 in
   // linear light) moves the encoded value by at most 0.03 codes above 1/256, where it is used;
   // below, the curve is evaluated directly.
@@ -39,20 +66,19 @@ void WritePng(const Image& image, const std::string& path) {
     else
       bytes[i] = table[std::size_t(std::lround(double(v) * 65536.0))];
   }
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = png_uint_32(image.width);
-  png.height = png_uint_32(image.height);
-  png.format = PNG_FORMAT_RGB;
-  const std::string tmp = TemporaryPath(path);
-  if (!png_image_write_to_file(&png, tmp.c_str(), 0, bytes.data(), 0, nullptr)) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    std::remove(tmp.c_str());
-    throw InputError(path, "", "cannot write the PNG file: " + message,
+  return EncodePngSrgb8(image.width, image.height, bytes);
+}
+
+void WritePng(const Image& image, const std::string& path) {
+  const std::string bytes = EncodePng(image);
+  try {
+    WriteFileAtomically(path, bytes);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path, "", std::string("cannot write the PNG file: ") + e.what(),
                      "check that the output folder exists and is writable");
   }
-  CommitTemporary(path);
 }
 
 Image ReadPng(const std::string& path) {

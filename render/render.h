@@ -201,6 +201,25 @@ struct Image {
   }
 };
 
+/// A float layer of Image as files carry it: its name (the EXR channel), the member that holds
+/// it and what its values mean (the EXR header's pandora_layers).
+struct ImageLayer {
+  const char* name;
+  std::vector<float> Image::*values;
+  const char* meaning;
+};
+
+/// Image's float layers beside rgb, in file order: the one table WriteExr and ReadExr use.
+inline const std::vector<ImageLayer>& ImageFloatLayers() {
+  static const std::vector<ImageLayer> kLayers{
+      {"coverage", &Image::coverage, "cameras seeing the surface point"},
+      {"resolution", &Image::resolution, "px/m"},
+      {"sigma_max", &Image::sigma_max, "mm, inf = not triangulable"},
+      {"depth", &Image::depth, "m along the eye ray, inf = no surface"},
+  };
+  return kLayers;
+}
+
 /// Renders one frame of a prepared scene lit by the enabled cameras of `rig`: only per-frame work
 /// (the view's rays, the rig's visibility tests, shading, overlays). `overlays` (may be null) holds
 /// the prepared slice and isosurface that options.overlays asks for. Any number of cameras.
@@ -284,8 +303,14 @@ std::optional<Ray> PixelRay(const Rig& rig, const RenderView& view, double x, do
 std::optional<PixelPick> PickPixel(const PreparedScene& scene, const Rig& rig,
                                    const RenderView& view, int x, int y);
 
-/// 8-bit sRGB PNG of image.rgb (clamped to [0, 1], sRGB transfer curve). Written to a temporary
-/// name and renamed; throws InputError (file = path) when it cannot be written.
+/// 8-bit sRGB PNG of image.rgb (clamped to [0, 1], sRGB transfer curve), encoded in memory: the
+/// bytes of the file WritePng writes (the report embeds them).
+std::string EncodePng(const Image& image);
+/// A PNG of 8-bit sRGB triples (row-major, y down) as they are, encoded in memory.
+std::string EncodePngSrgb8(int width, int height, const std::vector<std::uint8_t>& rgb);
+
+/// EncodePng written to a temporary name and renamed; throws InputError (file = path) when it
+/// cannot be written.
 void WritePng(const Image& image, const std::string& path);
 
 /// Single-part, multi-layer scanline OpenEXR (ZIP): float R, G, B (linear) and float layers

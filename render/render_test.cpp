@@ -18,6 +18,7 @@
 #include "analysis/geometry/uncertainty.h"
 #include "analysis/geometry/visibility.h"
 #include "analysis/scene/scene.h"
+#include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "analysis/util/units.h"
 #include "render/colormap.h"
@@ -664,6 +665,21 @@ TEST(Render, ExrAndPngRoundTrip) {
         LinearFromSrgb(std::min(1.0, SrgbFromLinear(expected) + 0.5 / 255)) - expected;
     EXPECT_NEAR(p.rgb[i], expected, std::abs(step) + 1e-6) << i;
   }
+  // The file is the bytes EncodePng gives in memory.
+  std::ifstream in(png, std::ios::binary);
+  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(file, EncodePng(img));
+  // 8-bit sRGB codes are stored as they are: read back through the inverse curve, each code.
+  std::vector<std::uint8_t> codes(3 * n);
+  for (std::size_t i = 0; i < codes.size(); ++i) codes[i] = std::uint8_t((37 * i) % 256);
+  WriteFileAtomically(png, EncodePngSrgb8(7, 5, codes));
+  const Image q = ReadPng(png);
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    EXPECT_EQ(q.rgb[i], float(LinearFromSrgb(codes[i] / 255.0))) << i;
+  EXPECT_THROW(EncodePngSrgb8(7, 5, std::vector<std::uint8_t>(3)), std::invalid_argument);
+  // The EXR's channels are the layer table's (and R, G, B, cameras, cameras_hi).
+  EXPECT_EQ(ImageFloatLayers().size(), 4u);
+  for (const ImageLayer& layer : ImageFloatLayers()) EXPECT_EQ((back.*layer.values).size(), n);
 }
 
 }  // namespace

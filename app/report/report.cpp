@@ -522,9 +522,10 @@ void ReportPage::Plan() {
     render.overlays.labels = true;
     render.overlays.frustum_length = 0.04 * mpp * view_width;
     const Image image = Render(scene, r.rig, caster, *plan, render);
-    cells.push_back("<figure>" +
-                    fig.Img("image/png", PngBytes(image), r.rig.name + " plan", "render") +
-                    "<figcaption>plan</figcaption></figure>");
+    cells.push_back(
+        "<figure>" +
+        fig.Img("image/png", pandora::EncodePng(image), r.rig.name + " plan", "render") +
+        "<figcaption>plan</figcaption></figure>");
   }
   body << RigRow(cells);
 }
@@ -554,10 +555,10 @@ void ReportPage::Views() {
         render.layers = false;  // PNG only: no resolution / sigma_max per pixel
         const Image image =
             Render(scene, r.rig, caster, ViewFromScene(view, view_width, height), render);
-        cells.push_back(
-            "<figure>" +
-            fig.Img("image/png", PngBytes(image), r.rig.name + " view " + name, "render") +
-            "<figcaption>view <b>" + HtmlEscape(name) + "</b></figcaption></figure>");
+        cells.push_back("<figure>" +
+                        fig.Img("image/png", pandora::EncodePng(image),
+                                r.rig.name + " view " + name, "render") +
+                        "<figcaption>view <b>" + HtmlEscape(name) + "</b></figcaption></figure>");
       }
       body << RigRow(cells);
     }
@@ -589,7 +590,8 @@ void ReportPage::CameraViews() {
       render.overlays.key = false;  // the key is above the views, once per rig
       const Image image = Render(scene, r.rig, caster, view, render);
       cell += "<figure>" +
-              fig.Img("image/png", PngBytes(image), r.rig.name + " camera " + cam.id, "thumb") +
+              fig.Img("image/png", pandora::EncodePng(image), r.rig.name + " camera " + cam.id,
+                      "thumb") +
               "<figcaption>" + HtmlEscape(cam.id) +
               (cam.name != cam.id ? " (" + HtmlEscape(cam.name) + ")" : "") +
               "</figcaption></figure>";

@@ -35,12 +35,8 @@ inline constexpr Rgb8 kNoValueColor{64, 64, 64};           ///< Unseen, or not t
 /// kNoValueColor inside the region without a value, kOutsideRegionColor outside.
 Raster SliceRaster(const FieldSlice& slice, double min, double max, int scale);
 
-/// PNG bytes of a rendered image, through the renderer's WritePng (render/render.h) into a
-/// temporary file that is read back and removed.
-std::string PngBytes(const Image& image);
-
-/// PNG bytes of `raster` (8-bit sRGB): converted to linear RGB (the inverse sRGB curve, so
-/// WritePng's encoding gives the same 8-bit values back) and written by PngBytes.
+/// PNG bytes of `raster` (8-bit sRGB, encoded in memory as it is; a rendered image's are
+/// pandora::EncodePng's, render/render.h).
 std::string EncodePng(const Raster& raster);
 
 /// "data:MIME;base64,..." of `bytes`.
