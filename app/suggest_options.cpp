@@ -17,7 +17,7 @@ std::vector<double> PerCamera(const char* option, const std::vector<double>& val
         option, "",
         "give one value, or one per selected camera (" + std::to_string(selected) + ")");
   std::vector<double> out = values;
-  out.resize(selected, out.back());
+  if (!out.empty()) out.resize(selected, out.back());
   return out;
 }
 
@@ -49,7 +49,14 @@ std::vector<ForCamera<T>> Entries(const std::vector<std::string>& entries, Parse
 
 std::vector<double> NumberList(const char* option, const std::string& text) {
   std::vector<double> out;
-  for (const std::string& item : SplitList(text)) out.push_back(ParseNumbers(option, item, 1)[0]);
+  for (const std::string& item : SplitList(text)) {
+    try {
+      out.push_back(ParseNumbers(option, item, 1)[0]);
+    } catch (const InputError&) {
+      throw InputError(option, "", "'" + item + "' is not a number",
+                       "give one value, or one per selected camera, separated by commas");
+    }
+  }
   return out;
 }
 
