@@ -178,9 +178,9 @@ struct SuggestOptions {
   int outer_iterations = 4;       ///< Occlusion re-evaluated between them.
   int max_inner_iterations = 30;  ///< Ceres iterations per outer iteration.
   /// Candidate poses per active camera at each of the three radii of the exact screening before the
-  /// Ceres nudge (three chains; see suggest_search.cpp), for coverage objectives (N-1 included); the
-  /// others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge starts
-  /// from the current poses only.
+  /// Ceres nudge (three chains; see suggest_search.cpp), for coverage objectives (N-1 included);
+  /// the others, whose exact evaluation costs more, get a quarter. 0: no screening, the nudge
+  /// starts from the current poses only.
   int screening_candidates = 200;
   /// Installable steps (0: none): each camera's centre is rounded per axis of its mount: along a
   /// mount direction that is a world axis (free and box mounts, axis-aligned rails and planes) to a

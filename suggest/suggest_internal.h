@@ -1,8 +1,8 @@
 #pragma once
 /// \file suggest_internal.h
-/// Shared by suggest.cpp, suggest_search.cpp and suggest_ceres.cpp (not installed, no Ceres): the exact evaluator with
-/// the fixed cameras' contributions precomputed, and the pose parameterisation of a selected
-/// camera.
+/// Shared by suggest.cpp, suggest_search.cpp and suggest_ceres.cpp (not installed, no Ceres): the
+/// exact evaluator with the fixed cameras' contributions precomputed, and the pose parameterisation
+/// of a selected camera.
 
 #include <cmath>
 #include <cstdint>
