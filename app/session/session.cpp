@@ -62,6 +62,12 @@ bool Session::TryReadFields(const std::function<void(const Fields&, std::int64_t
   return true;
 }
 
+const RigidPartsRayCaster& Session::Parts() const {
+  std::lock_guard<std::mutex> lock(parts_mutex_);
+  if (!parts_) parts_ = MakeSceneParts(study_->scene());
+  return *parts_;
+}
+
 std::optional<TimeSummary> Session::EvaluateOverTime(
     const Rig& rig, const std::atomic<bool>* cancel,
     const std::function<void(double)>& progress) const {
@@ -69,13 +75,11 @@ std::optional<TimeSummary> Session::EvaluateOverTime(
   if (!scene.Animated() && !scene.study.targets) return std::nullopt;
   const std::vector<TimeSample> samples = scene.TimeSamples();
   if (samples.empty()) return std::nullopt;
-  std::lock_guard<std::mutex> lock(parts_mutex_);
-  if (!parts_) parts_ = MakeSceneParts(scene);
   FieldOptions options = OverTimeOptions(options_.fields);
   options.progress = progress;
   options.cancel = cancel;
   TimeFieldsResult r =
-      EvaluateFieldsOverTime(scene, rig, *parts_, samples, options, scene.TimeMinCameras());
+      EvaluateFieldsOverTime(scene, rig, Parts(), samples, options, scene.TimeMinCameras());
   if (cancel && cancel->load()) return std::nullopt;
   return std::move(r.summary);
 }

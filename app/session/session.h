@@ -79,9 +79,11 @@ class Session {
   std::int64_t UpdateTimeInBackground();
   /// The last summary over time and the rig version it reflects; nothing before the first.
   std::optional<std::pair<TimeSummary, std::int64_t>> TimeNumbers() const;
-  /// The same summary for any `rig`, on the calling thread (the viewer's Compare), over the
-  /// session's moving parts (built once); nothing for a study without time samples, or when
-  /// `cancel` was set.
+  /// The scene's moving parts (MakeSceneParts), built at the first call and kept: what every
+  /// evaluation over time of this session shares (the background numbers, the viewer's Compare).
+  const RigidPartsRayCaster& Parts() const;
+  /// The same summary for any `rig`, on the calling thread, over the session's moving parts
+  /// (Parts()); nothing for a study without time samples, or when `cancel` was set.
   std::optional<TimeSummary> EvaluateOverTime(
       const Rig& rig, const std::atomic<bool>* cancel = nullptr,
       const std::function<void(double)>& progress = {}) const;

@@ -342,6 +342,8 @@ void ViewerModel::Compare(const Action& a) {
   analysis.threads = 1;
   analysis.pixel_targets = analysis.dori = analysis.ptz = false;
   analysis.calibration = analysis.robustness = false;
+  // The moving parts once per session, not once per rig compared.
+  if (scene().Animated() || scene().study.targets) analysis.parts = &session_->Parts();
   auto summarize = [&](const Rig& r, const Fields& f) {
     return session::CompleteAnalysis(scene(), session_->study().caster(), r, f, nullptr, analysis)
         .summary;
