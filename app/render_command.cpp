@@ -64,11 +64,7 @@ RenderOptions ParseRenderOptions(const RenderArgs& args) {
     throw InputError("--surface", "", "unknown surface mode '" + args.surface + "'",
                      DidYouMean(surface, SurfaceNames(), "surface modes"));
   options.surface = *mode;
-  if (args.grid < 1 || args.grid > 100000)
-    throw InputError("--grid", "", "must be a whole number of camera pixels >= 1");
   options.grid_pixels = args.grid;
-  if (args.samples < 1 || args.samples > 16)
-    throw InputError("--samples", "", "must be 1 to 16 (per axis)");
   options.samples = args.samples;
   options.overlays.cameras = !args.no_cameras;
   options.overlays.key = !args.no_key;
@@ -95,6 +91,7 @@ RenderOptions ParseRenderOptions(const RenderArgs& args) {
     if (!std::isfinite(args.iso_value)) throw InputError("--iso-value", "", "must be finite");
     options.overlays.iso_value = args.iso_value;
   }
+  options.Check();  // the library's ranges ({grid_pixels} is --grid, {samples} --samples)
   return options;
 }
 

@@ -29,10 +29,7 @@ Raster SliceRaster(const FieldSlice& slice, double min, double max, int scale) {
 }
 
 std::string EncodePng(const Raster& raster) {
-  if (raster.width <= 0 || raster.height <= 0 ||
-      raster.rgb.size() != 3 * static_cast<std::size_t>(raster.width) * raster.height)
-    throw std::invalid_argument("EncodePng: empty raster or wrong buffer size");
-  return EncodePngSrgb8(raster.width, raster.height, raster.rgb);
+  return EncodePngSrgb8(raster.width, raster.height, raster.rgb);  // checks the size
 }
 
 std::string DataUri(const std::string& mime, const std::string& bytes) {
