@@ -16,6 +16,8 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "analysis/geometry/inside_mesh.h"
 #include "analysis/geometry/uncertainty.h"
@@ -170,36 +172,125 @@ inline double AtanNonNegative(double t) {
          x;
 }
 
+// The camera pairs of a group of voxels in the order TriangulationAngles tries them: by an upper
+// bound on the angle a pair can make at any of the voxels, largest first, with the cosine of that
+// bound. The voxels lie in a ball (centre, radius); camera a sees it within r_a = asin(radius /
+// |C_a - centre|) of the direction u_a to its centre (or anywhere, when the ball reaches the
+// camera), so the angle of pair (a, b) at any voxel is at most angle(u_a, u_b) + r_a + r_b (the
+// triangle inequality on the sphere). The cosine of that sum comes from the sines and cosines of
+// its terms by the angle-addition formulas (no trigonometric call), -1 where the sum reaches pi;
+// its rounding (a few 1e-16) is far inside the margin with which TriangulationAngles uses it.
+struct PairOrder {
+  std::vector<std::int32_t> a, b;
+  std::vector<double> cos_bound;  // ascending: the cosine of each pair's largest possible angle
+  bool sorted = false;            // false: (a, b) order, every bound -1 (nothing to prune)
+};
+
+PairOrder OrderPairs(int camera_count, const Vec3* centres, const Vec3& ball_centre,
+                     double ball_radius, const unsigned char* changed, bool exhaustive) {
+  PairOrder order;
+  // Up to 8 cameras (28 pairs) ordering costs more than it saves: every pair in (a, b) order.
+  if (camera_count <= 8 || exhaustive) {
+    for (int a = 0; a < camera_count; ++a)
+      for (int b = a + 1; b < camera_count; ++b) {
+        if (changed && !changed[a] && !changed[b]) continue;
+        order.a.push_back(a);
+        order.b.push_back(b);
+        order.cos_bound.push_back(-1.0);
+      }
+    return order;
+  }
+  order.sorted = true;
+  struct Cone {
+    Vec3 u;
+    double cos_r, sin_r;
+    bool everywhere;
+  };
+  std::vector<Cone> cones(camera_count);
+  for (int c = 0; c < camera_count; ++c) {
+    const Vec3 v = ball_centre - centres[c];
+    const double d = v.norm();
+    Cone& k = cones[c];
+    k.everywhere = !(d > ball_radius * (1 + 1e-9));
+    if (k.everywhere) continue;
+    k.u = v / d;
+    k.sin_r = ball_radius / d;
+    k.cos_r = std::sqrt(1 - k.sin_r * k.sin_r);
+  }
+  struct Entry {
+    double cos_bound;
+    std::int32_t a, b;
+  };
+  std::vector<Entry> pairs;
+  pairs.reserve(std::size_t(camera_count) * std::max(0, camera_count - 1) / 2);
+  for (int a = 0; a < camera_count; ++a)
+    for (int b = a + 1; b < camera_count; ++b) {
+      if (changed && !changed[a] && !changed[b]) continue;
+      const Cone &ka = cones[a], &kb = cones[b];
+      double bound = -1.0;
+      if (!ka.everywhere && !kb.everywhere) {
+        // beta = r_a + r_b (each below pi / 2), then theta + beta.
+        const double cos_beta = ka.cos_r * kb.cos_r - ka.sin_r * kb.sin_r;
+        const double sin_beta = ka.sin_r * kb.cos_r + ka.cos_r * kb.sin_r;
+        const double cos_theta = ka.u.dot(kb.u), sin_theta = ka.u.cross(kb.u).norm();
+        const double sin_sum = sin_theta * cos_beta + cos_theta * sin_beta;
+        const double cos_sum = cos_theta * cos_beta - sin_theta * sin_beta;
+        // The sum lies in [0, 2 pi): past pi where its sine is negative (or zero with cos < 0).
+        bound = (sin_sum > 0 || (sin_sum == 0 && cos_sum > 0)) ? cos_sum : -1.0;
+      }
+      pairs.push_back({bound, a, b});
+    }
+  std::sort(pairs.begin(), pairs.end(),
+            [](const Entry& x, const Entry& y) { return x.cos_bound < y.cos_bound; });
+  order.a.reserve(pairs.size());
+  order.b.reserve(pairs.size());
+  order.cos_bound.reserve(pairs.size());
+  for (const Entry& e : pairs) {
+    order.a.push_back(e.a);
+    order.b.push_back(e.b);
+    order.cos_bound.push_back(e.cos_bound);
+  }
+  return order;
+}
+
 // The triangulation angle of `count` voxels at (x, y, z) (block offsets `offset`): the largest
 // angle in degrees between two rays from camera centres that see the voxel. `sees[e]` is the
 // 512-bit mask of the voxels camera `centres[e]` sees (the block's cameras in rig order). The best
 // pair is the one with the smallest dot product of the unit directions, ties to the first pair in
-// (a, b) order; it is returned in best_dot / best_a / best_b (indices into `sees`). With `changed`
-// null every pair is tried. With `changed` (per camera, 1 for cameras that moved), best_* come in
-// as the best pair among the unchanged cameras (a previous result that involves no changed camera)
-// and only pairs with a changed camera are tried, keeping the lexicographically smallest (dot, a,
-// b): the same pair, so the same bits, as trying all pairs. Vectorised over voxels, in tiles of 64
-// that keep every camera's directions in L1: per camera the unit directions (into `dirs`, 3 * 64
-// per camera; NaN where the camera does not see the voxel, so every comparison with it fails), per
-// camera pair the dot product, then the angle as atan2(|cross|, dot) (both keep their relative
-// accuracy, so tiny and near-180 degree angles are as exact as at 90). The file is compiled without
-// floating-point contraction, so scalar and vector code give the same bits. No per-ray storage.
+// (a, b) order; it is returned in best_dot / best_a / best_b (indices into `sees`). best_* come in
+// as the best pair so far (dot 2 where there is none; with `changed`, the best pair among the
+// unchanged cameras), and the pairs of `order` are tried (with `changed`, those with a changed
+// camera), keeping the lexicographically smallest (dot, a, b): the same pair, so the same bits, as
+// trying all pairs. Pairs come largest bound first, and a tile stops at the first pair whose bound
+// cannot beat any of its voxels' best dot (its cosine, less 1e-12 for the dot products' rounding,
+// above their largest): every pair left has a dot above each voxel's best, so none would be taken.
+// Vectorised over voxels, in tiles of 64 that keep every camera's directions in L1: per camera the
+// unit directions (into `dirs`, 3 * 64 per camera, made when a pair first needs them; NaN where the
+// camera does not see the voxel, so every comparison with it fails), per camera pair the dot
+// product, then the angle as atan2(|cross|, dot) (both keep their relative accuracy, so tiny and
+// near-180 degree angles are as exact as at 90). The file is compiled without floating-point
+// contraction, so scalar and vector code give the same bits. No per-ray storage. Returns the
+// (voxel, pair) dot products computed.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
-void TriangulationAngles(int count, const double* x, const double* y, const double* z,
-                         const std::int16_t* offset, int camera_count,
-                         const std::uint64_t* const* sees, const Vec3* centres,
-                         const unsigned char* changed, double* best_dot_io,
-                         std::int32_t* best_a_io, std::int32_t* best_b_io, double* dirs,
-                         float* degrees) {
+std::int64_t
+TriangulationAngles(int count, const double* x, const double* y, const double* z,
+                    const std::int16_t* offset, int camera_count, const std::uint64_t* const* sees,
+                    const Vec3* centres, const PairOrder& order, bool from_cache,
+                    double* best_dot_io, std::int32_t* best_a_io, std::int32_t* best_b_io,
+                    double* dirs, unsigned char* have, float* degrees) {
   constexpr int kTile = 64;
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::size_t pair_count = order.a.size();
+  std::int64_t tried = 0;
   for (int start = 0; start < count; start += kTile) {
     const int n = std::min(kTile, count - start);
     const double *tx = x + start, *ty = y + start, *tz = z + start;
     const std::int16_t* to = offset + start;
-    for (int c = 0; c < camera_count; ++c) {
+    for (int c = 0; c < camera_count; ++c) have[c] = 0;
+    const auto directions = [&](int c) __attribute__((always_inline)) {
+      have[c] = 1;
       const double cx = centres[c].x(), cy = centres[c].y(), cz = centres[c].z();
       const std::uint64_t* mask = sees[c];
       double* d = dirs + 3 * kTile * c;
@@ -215,44 +306,56 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
         d[m + kTile] = vy * inv;
         d[m + 2 * kTile] = vz * inv;
       }
-    }
+    };
     double best_dot[kTile];
     std::int64_t best_a[kTile], best_b[kTile];  // camera indices of the best pair
-    if (changed) {
-      for (int m = 0; m < n; ++m)
-        best_dot[m] = best_dot_io[start + m], best_a[m] = best_a_io[start + m],
-        best_b[m] = best_b_io[start + m];
-    } else {
-      for (int m = 0; m < kTile; ++m) best_dot[m] = 2.0, best_a[m] = 0, best_b[m] = 0;
+    double worst = -2.0;                        // the largest best dot of the tile
+    for (int m = 0; m < n; ++m) {
+      best_dot[m] = best_dot_io[start + m], best_a[m] = best_a_io[start + m],
+      best_b[m] = best_b_io[start + m];
+      worst = std::max(worst, best_dot[m]);
     }
-    for (int a = 0; a < camera_count; ++a) {
+    for (std::size_t p = 0; p < pair_count; ++p) {
+      if (order.cos_bound[p] - 1e-12 > worst) break;
+      const std::int64_t a = order.a[p], b = order.b[p];
+      if (!have[a]) directions(int(a));
+      if (!have[b]) directions(int(b));
+      tried += n;
       const double* ad = dirs + 3 * kTile * a;
-      for (int b = a + 1; b < camera_count; ++b) {
-        const double* bd = dirs + 3 * kTile * b;
-        if (!changed) {
-#pragma omp simd
-          for (int m = 0; m < n; ++m) {
-            const double dot = ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] +
-                               ad[m + 2 * kTile] * bd[m + 2 * kTile];
-            const bool take = dot < best_dot[m];  // false for NaN: a camera that does not see it
-            best_dot[m] = take ? dot : best_dot[m];
-            best_a[m] = take ? a : best_a[m];
-            best_b[m] = take ? b : best_b[m];
-          }
-        } else if (changed[a] || changed[b]) {
-#pragma omp simd
-          for (int m = 0; m < n; ++m) {
-            const double dot = ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] +
-                               ad[m + 2 * kTile] * bd[m + 2 * kTile];
-            const bool take =
-                dot < best_dot[m] ||
-                (dot == best_dot[m] && (a < best_a[m] || (a == best_a[m] && b < best_b[m])));
-            best_dot[m] = take ? dot : best_dot[m];
-            best_a[m] = take ? a : best_a[m];
-            best_b[m] = take ? b : best_b[m];
-          }
+      const double* bd = dirs + 3 * kTile * b;
+      double next_worst = -2.0;
+      if (!order.sorted && !from_cache) {
+        // Pairs in (a, b) order from no pair: the first pair with the smallest dot is the
+        // lexicographically smallest, and `<` alone keeps it.
+#pragma omp simd reduction(max : next_worst)
+        for (int m = 0; m < n; ++m) {
+          const double dot =
+              ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] + ad[m + 2 * kTile] * bd[m + 2 * kTile];
+          const bool take = dot < best_dot[m];  // false for NaN: a camera that does not see it
+          best_dot[m] = take ? dot : best_dot[m];
+          best_a[m] = take ? a : best_a[m];
+          best_b[m] = take ? b : best_b[m];
+          next_worst = next_worst > best_dot[m] ? next_worst : best_dot[m];
+        }
+      } else {
+#pragma omp simd reduction(max : next_worst)
+        for (int m = 0; m < n; ++m) {
+          const double dot =
+              ad[m] * bd[m] + ad[m + kTile] * bd[m + kTile] + ad[m + 2 * kTile] * bd[m + 2 * kTile];
+          const bool take =
+              dot < best_dot[m] ||
+              (dot == best_dot[m] && (a < best_a[m] || (a == best_a[m] && b < best_b[m])));
+          best_dot[m] = take ? dot : best_dot[m];
+          best_a[m] = take ? a : best_a[m];
+          best_b[m] = take ? b : best_b[m];
+          next_worst = next_worst > best_dot[m] ? next_worst : best_dot[m];
         }
       }
+      worst = next_worst;
+    }
+    for (int m = 0; m < n; ++m) {
+      if (!have[best_a[m]]) directions(int(best_a[m]));
+      if (!have[best_b[m]]) directions(int(best_b[m]));
     }
 #pragma omp simd
     for (int m = 0; m < n; ++m) {
@@ -270,6 +373,73 @@ void TriangulationAngles(int count, const double* x, const double* y, const doub
       best_a_io[start + m] = static_cast<std::int32_t>(best_a[m]);
       best_b_io[start + m] = static_cast<std::int32_t>(best_b[m]);
     }
+  }
+  return tried;
+}
+
+// The compacted camera-frame Jacobians of a camera's seen voxels and their information.
+struct InformationScratch {
+  alignas(64) double jac[6][512];
+  alignas(64) double info[6][512];
+  alignas(64) std::uint8_t band[512];
+};
+
+// The information contributions of n seen voxels from their Jacobians (s->jac), with whitened
+// rotation rw: AddCameraInformation on zeros, the same expressions in the same order (the file is
+// compiled without contraction), so the same bits, into s->info; and each one's Band() into
+// s->band. Vectorised over the voxels.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+void InformationLanes(int n, const double* rw, InformationScratch* s) {
+  const double* j0 = s->jac[0];
+  const double* j1 = s->jac[1];
+  const double* j2 = s->jac[2];
+  const double* j3 = s->jac[3];
+  const double* j4 = s->jac[4];
+  const double* j5 = s->jac[5];
+  double* __restrict i0 = s->info[0];
+  double* __restrict i1 = s->info[1];
+  double* __restrict i2 = s->info[2];
+  double* __restrict i3 = s->info[3];
+  double* __restrict i4 = s->info[4];
+  double* __restrict i5 = s->info[5];
+  std::uint8_t* __restrict band = s->band;
+  double R[9];
+  for (int k = 0; k < 9; ++k) R[k] = rw[k];
+#pragma omp simd
+  for (int m = 0; m < n; ++m) {
+    const double a00 = j0[m] * R[0] + j1[m] * R[3] + j2[m] * R[6];
+    const double a01 = j0[m] * R[1] + j1[m] * R[4] + j2[m] * R[7];
+    const double a02 = j0[m] * R[2] + j1[m] * R[5] + j2[m] * R[8];
+    const double a10 = j3[m] * R[0] + j4[m] * R[3] + j5[m] * R[6];
+    const double a11 = j3[m] * R[1] + j4[m] * R[4] + j5[m] * R[7];
+    const double a12 = j3[m] * R[2] + j4[m] * R[5] + j5[m] * R[8];
+    const double c0 = 0.0 + (a00 * a00 + a10 * a10);
+    const double c1 = 0.0 + (a00 * a01 + a10 * a11);
+    const double c2 = 0.0 + (a00 * a02 + a10 * a12);
+    const double c3 = 0.0 + (a01 * a01 + a11 * a11);
+    const double c4 = 0.0 + (a01 * a02 + a11 * a12);
+    const double c5 = 0.0 + (a02 * a02 + a12 * a12);
+    i0[m] = c0;
+    i1[m] = c1;
+    i2[m] = c2;
+    i3[m] = c3;
+    i4[m] = c4;
+    i5[m] = c5;
+    // Band(): the largest exponent field >> kBandShift.
+    std::uint64_t e = (DoubleBits(c0) >> 52) & 0x7ff;
+    const std::uint64_t e1 = (DoubleBits(c1) >> 52) & 0x7ff;
+    const std::uint64_t e2 = (DoubleBits(c2) >> 52) & 0x7ff;
+    const std::uint64_t e3 = (DoubleBits(c3) >> 52) & 0x7ff;
+    const std::uint64_t e4 = (DoubleBits(c4) >> 52) & 0x7ff;
+    const std::uint64_t e5 = (DoubleBits(c5) >> 52) & 0x7ff;
+    e = e > e1 ? e : e1;
+    e = e > e2 ? e : e2;
+    e = e > e3 ? e : e3;
+    e = e > e4 ? e : e4;
+    e = e > e5 ? e : e5;
+    band[m] = static_cast<std::uint8_t>(e >> kBandShift);
   }
 }
 
@@ -307,6 +477,27 @@ struct CameraEntry {
   }
 };
 
+// An allocator whose value-initialisation leaves trivial types uninitialised: resize() without
+// zeroing, for caches that are written before they are read.
+template <class T>
+struct DefaultInit : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInit<U>;
+  };
+  DefaultInit() = default;
+  template <class U>
+  DefaultInit(const DefaultInit<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 enum VoxelStatus : std::uint8_t { kUnseen, kSeenOnly, kTriangulable, kUnobservable };
 
 struct BlockState {
@@ -325,7 +516,7 @@ struct BlockState {
   std::vector<std::int32_t> best_camera;
   // With an information field: the exact sums, their band (kNotExact: summed in double, or no
   // camera) and how many contributions lie in that band.
-  std::vector<Sum6> sums;
+  std::vector<SumLimbs, DefaultInit<SumLimbs>> sums;
   std::vector<std::uint8_t> sum_band;
   std::vector<std::int32_t> band_count;
   // Summary.
@@ -414,6 +605,9 @@ struct FieldEvaluator::State {
   std::array<bool, kFloatFieldCount> want_float{};
   MotionModel motion;
   double frame_period = 0;
+  // (voxel, camera pair) dot products of triangulation_angle in the current update, and all the
+  // pairs there were to try.
+  mutable std::atomic<std::int64_t> angle_pairs_tried{0}, angle_pairs_all{0};
 
   State(const Scene& s, const RayCaster& c) : scene(s), caster(c) {}
 
@@ -538,27 +732,35 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
     for (std::size_t i = 0; i < n; ++i) rays->push_back(batch.segment(int(i)));
   entry->camera = camera;
   entry->rays = static_cast<std::int32_t>(n);
-  std::size_t visible = 0;
-  for (std::size_t i = 0; i < n; ++i) visible += occluded[i] ? 0 : 1;
-  if (want_resolution) entry->density.reserve(visible);
-  if (want_information) {
-    entry->information.reserve(6 * visible);
-    entry->band.reserve(visible);
-  }
   // Offsets come in ascending order (x, y, z loops, Offset = 64 x + 8 y + z).
+  thread_local InformationScratch scratch;  // 49 kB: not on the worker's stack
+  if (want_resolution) {
+    std::size_t seen = 0;
+    for (std::size_t i = 0; i < n; ++i) seen += occluded[i] ? 0 : 1;
+    entry->density.reserve(seen);
+  }
+  int visible = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (occluded[i]) continue;
-    SetBit(entry->bits, points.offset[batch.index[i]]);
-    ++entry->seen;
-    if (!want_jacobian) continue;
-    const Mat23 jacobian = batch.jacobian(int(i));
-    if (want_resolution) entry->density.push_back(static_cast<float>(PixelDensity(jacobian)));
-    if (want_information) {
-      double contribution[6] = {0, 0, 0, 0, 0, 0};
-      AddCameraInformation(jacobian, rd.whitened[camera].data(), contribution);
-      entry->information.insert(entry->information.end(), contribution, contribution + 6);
-      entry->band.push_back(Band(contribution));
+    const int p = batch.index[i];
+    SetBit(entry->bits, points.offset[p]);
+    if (want_information)
+      for (int r = 0; r < 6; ++r) scratch.jac[r][visible] = batch.jac[r][p];
+    if (want_resolution) {
+      const float density = static_cast<float>(PixelDensity(batch.jacobian(int(i))));
+      entry->density.push_back(density);
     }
+    ++visible;
+  }
+  entry->seen = visible;
+  if (want_information && visible > 0) {
+    InformationLanes(visible, rd.whitened[camera].data(), &scratch);
+    entry->information.resize(6 * std::size_t(visible));
+    entry->band.resize(std::size_t(visible));
+    double* info = entry->information.data();
+    for (int j = 0; j < visible; ++j)
+      for (int r = 0; r < 6; ++r) info[6 * j + r] = scratch.info[r][j];
+    std::memcpy(entry->band.data(), scratch.band, std::size_t(visible));
   }
   int before = 0;
   for (int w = 0; w < kWords; ++w) {
@@ -596,7 +798,7 @@ void FieldEvaluator::State::PrepareCaches(const BlockState& old, bool fresh, boo
       next->best_camera.assign(512, -1);
     }
     if (want_information) {
-      next->sums.assign(512, Sum6{});
+      next->sums.resize(512);  // not zeroed: Rescan clears each voxel it sums
       next->sum_band.assign(512, kNotExact);
       next->band_count.assign(512, 0);
     }
@@ -676,7 +878,7 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
               SetBit(rescan_info, o);
             } else {
               if (b == k) ++next->band_count[o];
-              Accumulate(next->sums[o], &e->information[6 * index], scales[k], true);
+              AccumulateLimbs(next->sums[o], &e->information[6 * index], scales[k].down, true);
             }
           }
         });
@@ -693,7 +895,7 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
               SetBit(rescan_info, o);
             } else {
               if (b == k) --next->band_count[o];
-              Accumulate(next->sums[o], &e.information[6 * index], scales[k], false);
+              AccumulateLimbs(next->sums[o], &e.information[6 * index], scales[k].down, false);
             }
           }
         });
@@ -749,7 +951,7 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
       }
       for (std::uint64_t bits = rescan_info[w]; bits; bits &= bits - 1) {
         const int o = 64 * w + __builtin_ctzll(bits);
-        next->sums[o] = Sum6{};
+        next->sums[o] = SumLimbs{};
         next->sum_band[o] = 0;
         next->band_count[o] = 0;
       }
@@ -797,7 +999,7 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
                 std::array<double, 6>& d = double_sum[double_index[o]];
                 for (int k = 0; k < 6; ++k) d[k] += c[k];
               } else {
-                Accumulate(next->sums[o], c, scales[next->sum_band[o]], true);
+                AccumulateLimbs(next->sums[o], c, scales[next->sum_band[o]].down, true);
               }
             });
   }
@@ -846,7 +1048,7 @@ void FieldEvaluator::State::WriteDirtyVoxels(const Block& block, const Bits& dir
       } else {
         const BandScale& scale = scales[next->sum_band[o]];
         for (int k = 0; k < 6; ++k)
-          upper[k][candidate_count] = ToDouble(next->sums[o].v[k]) * scale.up[0] * scale.up[1];
+          upper[k][candidate_count] = SumLimbsToDouble(next->sums[o], k, scale.up);
       }
       if (want_angle) {
         const int x = o >> 6, y = (o >> 3) & 7, z = o & 7;
@@ -941,12 +1143,28 @@ void FieldEvaluator::State::CandidateAngles(const std::vector<const CameraEntry*
   }
   // Scratch, every entry written before it is read: no zero fill (36 KiB for 24 cameras).
   const std::unique_ptr<double[]> directions(new double[3 * 64 * view.size()]);
-  for (int g = 0; g < 2; ++g)
-    if (size[g] > 0)
-      TriangulationAngles(size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
-                          static_cast<int>(view.size()), sees.data(), entry_centres.data(),
-                          g == 1 ? entry_changed.data() : nullptr, dot[g].data(), pa[g].data(),
-                          pb[g].data(), directions.get(), degrees[g].data());
+  const std::unique_ptr<unsigned char[]> have(new unsigned char[view.size()]);
+  for (int g = 0; g < 2; ++g) {
+    if (size[g] == 0) continue;
+    if (g == 0)
+      for (int k = 0; k < size[g]; ++k) dot[g][k] = 2.0, pa[g][k] = 0, pb[g][k] = 0;
+    // The group's voxels in a ball: their bounding box's centre and half diagonal.
+    Vec3 lo(gx[g][0], gy[g][0], gz[g][0]), hi = lo;
+    for (int k = 1; k < size[g]; ++k) {
+      const Vec3 p(gx[g][k], gy[g][k], gz[g][k]);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const PairOrder order =
+        OrderPairs(static_cast<int>(view.size()), entry_centres.data(), 0.5 * (lo + hi),
+                   0.5 * (hi - lo).norm(), g == 1 ? entry_changed.data() : nullptr,
+                   options.exhaustive_angle_pairs);
+    angle_pairs_tried += TriangulationAngles(
+        size[g], gx[g].data(), gy[g].data(), gz[g].data(), offsets[g].data(),
+        static_cast<int>(view.size()), sees.data(), entry_centres.data(), order, g == 1,
+        dot[g].data(), pa[g].data(), pb[g].data(), directions.get(), have.get(), degrees[g].data());
+    angle_pairs_all += std::int64_t(size[g]) * std::int64_t(order.a.size());
+  }
   for (int m = 0; m < candidate_count; ++m) {
     const int g = which[m], k = group_of[m], o = candidate[m];
     angle_deg[m] = degrees[g][k];
@@ -1044,9 +1262,9 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
   // Coverage, best density and information of the dirty voxels. A full evaluation sums every
   // camera of every voxel. An update starts from the cached values and takes out the changed
   // cameras' old contributions and puts in their new ones: coverage is a count, the density a
-  // maximum and the information an exact fixed-point sum (see Sum6), so the result has the bits of
-  // a full evaluation. A voxel whose best density came from a changed camera, or whose sum's band
-  // changes (or that is summed in double), is re-summed from every camera ("rescan").
+  // maximum and the information an exact fixed-point sum (see Sum6 and SumLimbs), so the result has
+  // the bits of a full evaluation. A voxel whose best density came from a changed camera, or whose
+  // sum's band changes (or that is summed in double), is re-summed from every camera ("rescan").
   if (fresh) {
     scratch.cover.fill(0);
     if (want_resolution) scratch.rescan_density = dirty;
@@ -1300,7 +1518,8 @@ double FieldEvaluator::state_bytes() const {
              s.histogram.capacity() * 8 + (s.sigma_list.capacity() + s.steady_list.capacity()) * 4 +
              s.pair_dot.capacity() * 8 + (s.pair_a.capacity() + s.pair_b.capacity()) * 4 +
              (s.best_density.capacity() + s.best_camera.capacity()) * 4 +
-             s.sums.capacity() * sizeof(Sum6) + s.sum_band.capacity() + s.band_count.capacity() * 4;
+             s.sums.capacity() * sizeof(SumLimbs) + s.sum_band.capacity() +
+             s.band_count.capacity() * 4;
     for (const CameraEntry& e : s.entries) bytes += e.Bytes();
   }
   return bytes;
@@ -1420,7 +1639,7 @@ void CheckKeptBudget(const State& S, const Rig& rig,
   const double per_pair = (S.want_information ? 49.0 : 0.0) + (S.want_resolution ? 4.0 : 0.0);
   // Per voxel caches: coverage, status, sigmas, best pair, best density, exact sums.
   const double per_voxel = 13 + (S.want_angle ? 16 : 0) + (S.want_resolution ? 8 : 0) +
-                           (S.want_information ? sizeof(Sum6) + 5 : 0);
+                           (S.want_information ? sizeof(SumLimbs) + 5 : 0);
   double bytes = 0;
   for (std::size_t b = 0; b < S.blocks.size(); ++b)
     bytes += 512.0 * per_voxel + double(candidates[b].size()) *
@@ -1480,7 +1699,7 @@ void DropPairData(BlockState& old, UpdatePass* u, std::size_t i) {
   std::vector<std::int32_t>().swap(next[i].pair_b);
   std::vector<float>().swap(next[i].best_density);
   std::vector<std::int32_t>().swap(next[i].best_camera);
-  std::vector<Sum6>().swap(next[i].sums);
+  decltype(next[i].sums)().swap(next[i].sums);
   std::vector<std::uint8_t>().swap(next[i].sum_band);
   std::vector<std::int32_t>().swap(next[i].band_count);
 }
@@ -1708,6 +1927,8 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   }
   if (!S.evaluated || new_count > old_count) CheckCameraBudget(S, new_count);
   const RigData rd = S.Prepare(rig);
+  S.angle_pairs_tried = 0;
+  S.angle_pairs_all = 0;
 
   // New candidate lists; the blocks to visit are those a changed camera's old or new frustum
   // meets (all of them the first time).
@@ -1759,6 +1980,8 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   const double estimated = st.estimated_bytes;
   S.Totals(&st, new_count, rd.enabled);
   st.estimated_bytes = estimated;
+  st.angle_pairs_tried = S.angle_pairs_tried;
+  st.angle_pairs_all = S.angle_pairs_all;
   st.active_set_seconds = update.full ? S.active_set_seconds : 0.0;
   if (opt.record_rays && update.full) {
     S.fields.recorded_rays.clear();

@@ -43,6 +43,9 @@ struct FieldOptions {
   std::function<void(double)> progress;
   /// Keep every occlusion segment cast, in evaluation order (benchmarks replay them).
   bool record_rays = false;
+  /// Try every camera pair for triangulation_angle instead of only those whose angle bound can
+  /// still win (the same values, more work): for tests and benchmarks.
+  bool exhaustive_angle_pairs = false;
   /// Set from another thread to stop FieldEvaluator::Update early; the evaluator then keeps the
   /// fields of the previous update (nothing half updated). Checked once per block.
   const std::atomic<bool>* cancel = nullptr;
@@ -105,6 +108,9 @@ struct FieldStats {
   double cpu_seconds = 0;
   double active_set_seconds = 0;  ///< Of which building the active set.
   double estimated_bytes = 0;     ///< The memory estimate checked against the budget.
+  /// triangulation_angle's work in this evaluation or update: (voxel, camera pair) dot products
+  /// computed, and those an all-pairs search would compute (docs/performance.md).
+  std::int64_t angle_pairs_tried = 0, angle_pairs_all = 0;
 };
 
 /// Opaque holder of the evaluated grids (OpenVDB inside).

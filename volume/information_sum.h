@@ -42,20 +42,20 @@ void StaticStatistics(int n, double* const* eigenvalues, double* const* out);
 // field e (biased, 0..2047) of the contribution's six entries, shifted right by 5 (bands of 32
 // binades). A voxel's band k is the largest band of its contributions; then every entry is below
 // 2^(32 (k + 1) - 1023), q = 32 (k + 1) - 1129, every rounded entry is below 2^106 in magnitude and
-// the sum of up to 2^20 of them below 2^126: no overflow. The spacing is 2^-74 .. 2^-106 of the
+// the sum of up to 2^17 of them below 2^123: no overflow. The spacing is 2^-74 .. 2^-106 of the
 // largest entry of the largest contribution, itself at most the largest eigenvalue of J (J is a
 // sum of positive semi-definite matrices, so its largest entry is on the diagonal), so the
 // rounding moves every eigenvalue by at most 2^-75 N lambda_max (Weyl), far below the 2^-53
 // lambda_max of the double sum and of the eigenvalue solver. The integer sum is then rounded to
 // double once (correctly rounded), so J is at least as accurate as a double sum in rig order.
-// Voxels with a contribution in band 63 (an entry >= 2^993, inf or NaN) or more than 2^20 cameras
+// Voxels with a contribution in band 63 (an entry >= 2^993, inf or NaN) or more than 2^16 cameras
 // are summed in double in rig order as before (a function of the contributions only, so a full
 // evaluation and an update choose alike). Per voxel the evaluator keeps the sums, the band and how
 // many contributions are in it; an update that removes the last one of the top band, or adds one
 // above it, re-sums that voxel from every camera.
 constexpr int kBandShift = 5;
 constexpr std::uint8_t kNotExact = 63;  // also: a voxel without contributions
-constexpr int kMaxExactCameras = 1 << 20;
+constexpr int kMaxExactCameras = 1 << 16;
 using Int128 = __int128;
 struct Sum6 {
   Int128 v[6];
@@ -81,6 +81,7 @@ inline std::uint8_t Band(const double* c) {
 struct BandScale {
   int q;
   double up[2];
+  double down[2];  // 2^-q as two factors
 };
 inline const std::array<BandScale, 64>& BandScales() {
   static const std::array<BandScale, 64> table = [] {
@@ -91,6 +92,8 @@ inline const std::array<BandScale, 64>& BandScales() {
       t[k].q = q;
       t[k].up[0] = std::ldexp(1.0, half);
       t[k].up[1] = std::ldexp(1.0, q - half);
+      t[k].down[0] = std::ldexp(1.0, -half);
+      t[k].down[1] = std::ldexp(1.0, half - q);
     }
     return t;
   }();
@@ -143,12 +146,79 @@ inline double ToDouble(Int128 s) {
   return negative ? -d : d;
 }
 
-// Adds (`add`) or subtracts contribution c rounded on its band's grid.
+// Adds (`add`) or subtracts contribution c rounded on its band's grid (N-1's per-voxel sums).
 inline void Accumulate(Sum6& sum, const double* c, const BandScale& scale, bool add) {
   for (int k = 0; k < 6; ++k) {
     const Int128 v = ToFixed(c[k], scale.q);
     sum.v[k] = add ? sum.v[k] + v : sum.v[k] - v;
   }
+}
+
+}  // namespace pandora::information
+
+namespace pandora::information {
+
+// The same exact sum held in three doubles per entry ("limbs"), which the field evaluation adds
+// in SIMD instead of in 128-bit integers. A contribution c on band k's grid is y = c 2^-q (two
+// exact power-of-two products: y is exact, or below 2^-1022 where it rounds to 0 either way),
+// |y| < 2^106, split without error into y = hi + mid + lo + r with hi a multiple of 2^70, mid of
+// 2^35 and lo an integer, each the nearest (ties to even) of what is left, by adding and
+// subtracting 1.5 2^(52+g) (exact in round-to-nearest for |x| <= 2^(51+g); the file is compiled
+// without contraction and without -ffast-math). Then hi + mid + lo is exactly ToFixed(c, q): each
+// step rounds what is left on a grid that the later grids divide, ties to even on the sum, and
+// hi, mid are even multiples of 2^0. Each limb has at most 36 significant bits (hi <= 2^36 units,
+// mid and lo <= 2^34), so up to 2^17 of them sum exactly in double in any order, and an update
+// may add the changed cameras' new views before it takes out their old ones (kMaxExactCameras is
+// 2^16). SumLimbsToDouble assembles the same int128 as the Sum6 route and rounds it the same way.
+struct SumLimbs {
+  double hi[6], mid[6], lo[6];
+};
+
+typedef double V2 __attribute__((vector_size(16)));
+
+// Adds (`add`) or subtracts contribution c (six doubles) on band scale `down` (2^-q as two
+// factors) to s: six entries as three pairs, so SSE2 adds two at a time.
+__attribute__((always_inline)) inline void AccumulateLimbs(SumLimbs& s, const double* c,
+                                                           const double* down, bool add) {
+  const V2 d0 = {down[0], down[0]}, d1 = {down[1], down[1]};
+  const V2 m_hi = {0x1.8p122, 0x1.8p122}, m_mid = {0x1.8p87, 0x1.8p87}, m_lo = {0x1.8p52, 0x1.8p52};
+  for (int k = 0; k < 6; k += 2) {
+    V2 y;
+    std::memcpy(&y, c + k, sizeof(y));
+    y = (y * d0) * d1;
+    const V2 hi = (y + m_hi) - m_hi;
+    const V2 r1 = y - hi;
+    const V2 mid = (r1 + m_mid) - m_mid;
+    const V2 r2 = r1 - mid;
+    const V2 lo = (r2 + m_lo) - m_lo;
+    V2 a, b, e;
+    std::memcpy(&a, s.hi + k, sizeof(a));
+    std::memcpy(&b, s.mid + k, sizeof(b));
+    std::memcpy(&e, s.lo + k, sizeof(e));
+    if (add) {
+      a += hi, b += mid, e += lo;
+    } else {
+      a -= hi, b -= mid, e -= lo;
+    }
+    std::memcpy(s.hi + k, &a, sizeof(a));
+    std::memcpy(s.mid + k, &b, sizeof(b));
+    std::memcpy(s.lo + k, &e, sizeof(e));
+  }
+}
+
+// Entry k of s in units of 2^q: the integer Sum6 holds for the same contributions.
+inline Int128 SumLimbsUnits(const SumLimbs& s, int k) {
+  return static_cast<Int128>(static_cast<std::int64_t>(s.hi[k] * 0x1p-70)) *
+             (static_cast<Int128>(1) << 70) +
+         static_cast<Int128>(static_cast<std::int64_t>(s.mid[k] * 0x1p-35)) *
+             (static_cast<Int128>(1) << 35) +
+         static_cast<Int128>(static_cast<std::int64_t>(s.lo[k]));
+}
+
+// Entry k of s as the nearest double, scaled by 2^q (`up`, two factors): the bits of
+// ToDouble(sum of ToFixed(c, q)) * up[0] * up[1].
+inline double SumLimbsToDouble(const SumLimbs& s, int k, const double* up) {
+  return ToDouble(SumLimbsUnits(s, k)) * up[0] * up[1];
 }
 
 }  // namespace pandora::information
