@@ -427,19 +427,7 @@ void InformationLanes(int n, const double* rw, InformationScratch* s) {
     i3[m] = c3;
     i4[m] = c4;
     i5[m] = c5;
-    // Band(): the largest exponent field >> kBandShift.
-    std::uint64_t e = (DoubleBits(c0) >> 52) & 0x7ff;
-    const std::uint64_t e1 = (DoubleBits(c1) >> 52) & 0x7ff;
-    const std::uint64_t e2 = (DoubleBits(c2) >> 52) & 0x7ff;
-    const std::uint64_t e3 = (DoubleBits(c3) >> 52) & 0x7ff;
-    const std::uint64_t e4 = (DoubleBits(c4) >> 52) & 0x7ff;
-    const std::uint64_t e5 = (DoubleBits(c5) >> 52) & 0x7ff;
-    e = e > e1 ? e : e1;
-    e = e > e2 ? e : e2;
-    e = e > e3 ? e : e3;
-    e = e > e4 ? e : e4;
-    e = e > e5 ? e : e5;
-    band[m] = static_cast<std::uint8_t>(e >> kBandShift);
+    band[m] = Band(c0, c1, c2, c3, c4, c5);
   }
 }
 
