@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 
 #include "analysis/geometry/inside_mesh.h"
@@ -567,11 +568,45 @@ struct DeriveScratch {
   std::array<std::int16_t, 512> double_index;
 };
 
+// Per point p < count of `batch`: whether its segment (origin, unit direction, [t_near, t_far])
+// meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all points,
+// vectorised.
+void SegmentsMeetBoxes(const VisibilityTester::GeometryBatch& batch, int count,
+                       const std::vector<Aabb>& boxes, std::uint8_t* meets) {
+  alignas(64) double inv[3][512];
+  const double* d[3] = {batch.dx, batch.dy, batch.dz};
+  for (int k = 0; k < 3; ++k)
+#pragma omp simd
+    for (int p = 0; p < count; ++p) inv[k][p] = 1.0 / d[k][p];  // +-inf along an axis
+  std::fill(meets, meets + count, std::uint8_t{0});
+  for (const Aabb& box : boxes) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = box.min[k] - batch.origin[k];
+      hi[k] = box.max[k] - batch.origin[k];
+    }
+#pragma omp simd
+    for (int p = 0; p < count; ++p) {
+      double t0 = batch.t_near[p], t1 = batch.t_far[p];
+      for (int k = 0; k < 3; ++k) {
+        // A direction of 0 along k: the slab's times are -inf..inf when the origin is inside it
+        // (0 * inf would be NaN: max/min below keep t0, t1 then, as inside), else +-inf.
+        const double ta = lo[k] * inv[k][p], tb = hi[k] * inv[k][p];
+        const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
+        t0 = near > t0 ? near : t0;
+        t1 = far < t1 ? far : t1;
+      }
+      meets[p] |= t0 <= t1 ? 1 : 0;
+    }
+  }
+}
+
 }  // namespace
 
 struct FieldEvaluator::State {
-  const Scene& scene;
-  const RayCaster& caster;
+  // The scene and its caster as of the last update (UpdateScene replaces them).
+  const Scene* scene;
+  const RayCaster* caster;
   FieldOptions options;
   bool keep = true;
   std::string file;
@@ -597,7 +632,7 @@ struct FieldEvaluator::State {
   // pairs there were to try.
   mutable std::atomic<std::int64_t> angle_pairs_tried{0}, angle_pairs_all{0};
 
-  State(const Scene& s, const RayCaster& c) : scene(s), caster(c) {}
+  State(const Scene& s, const RayCaster& c) : scene(&s), caster(&c) {}
 
   RigData Prepare(const Rig& rig) const;
   // A block's free voxels (x, y, z loops, so offsets ascend): their centres in three arrays for
@@ -608,8 +643,19 @@ struct FieldEvaluator::State {
     std::array<std::int16_t, 512> offset;
   };
   void Points(const Block& block, BlockPoints* points) const;
-  void Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
-            std::vector<Ray>* rays) const;
+  // A scene update's view of a block cast again: the camera's previous view of it and the moved
+  // boxes its segments may meet.
+  struct Again {
+    const Bits* seen = nullptr;
+    const std::vector<Aabb>* before = nullptr;  // what moved, where it was
+    const std::vector<Aabb>* after = nullptr;   // and where it is
+  };
+  // Returns the segments cast: all in view, or with `again` only those whose answer can have
+  // changed: those that meet a moved box where it is now, and the occluded ones that meet one
+  // where it was (the others keep their previous answer; `entry` holds only the bits when
+  // nothing changed).
+  int Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
+           std::vector<Ray>* rays, const Again* again = nullptr) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
               const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
@@ -651,7 +697,7 @@ void MakeGrid(GridPtr& grid, const char* name, const openvdb::math::Transform::P
 
 void FieldEvaluator::State::ResetGrids(int camera_count) {
   Fields::Impl& g = fields.impl();
-  g.transform = openvdb::math::Transform::createLinearTransform(scene.study.voxel_size);
+  g.transform = openvdb::math::Transform::createLinearTransform(scene->study.voxel_size);
   const VoxelLattice& lattice = fields.lattice;
   g.transform->postTranslate(
       openvdb::Vec3d(lattice.origin.x(), lattice.origin.y(), lattice.origin.z()));
@@ -674,12 +720,12 @@ void FieldEvaluator::State::ResetGrids(int camera_count) {
 
 RigData FieldEvaluator::State::Prepare(const Rig& r) const {
   RigData rd;
-  rd.tester = std::make_unique<VisibilityTester>(r.cameras, caster, scene_scale);
+  rd.tester = std::make_unique<VisibilityTester>(r.cameras, *caster, scene_scale);
   rd.culler = std::make_unique<FrustumCuller>(r.cameras);
   rd.whitened.resize(r.cameras.size());
   for (std::size_t c = 0; c < r.cameras.size(); ++c) {
     const Camera& cam = r.cameras[c];
-    const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene.study.pixel_sigma;
+    const double sigma = cam.pixel_sigma > 0 ? cam.pixel_sigma : scene->study.pixel_sigma;
     WhitenedRotation(rd.tester->camera_rotation(int(c)), sigma, rd.whitened[c].data());
     rd.centres.push_back(cam.center());
   }
@@ -708,14 +754,52 @@ void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) cons
 // Camera `camera`'s view of a block: the geometric tests first (vectorised over the block's free
 // voxels), then the segments in view traced together as coherent packets (one origin,
 // neighbouring directions) straight from the test's arrays.
-void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const RigData& rd,
-                                 CameraEntry* entry, std::vector<Ray>* rays) const {
+int FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const RigData& rd,
+                                CameraEntry* entry, std::vector<Ray>* rays,
+                                const Again* again) const {
   std::array<std::uint8_t, 512> occluded;
   thread_local VisibilityTester::GeometryBatch batch;  // 46 kB: not on the worker's stack
   rd.tester->TestGeometryBatch(camera, points.count, points.x.data(), points.y.data(),
                                points.z.data(), &batch);
   const std::size_t n = static_cast<std::size_t>(batch.count);
-  caster.OccludedFan(batch.fan(), n, occluded.data());
+  int cast = static_cast<int>(n);
+  if (!again) {
+    caster->OccludedFan(batch.fan(), n, occluded.data());
+  } else {
+    // Only the segments that meet a moved box; the others saw what they saw (the same test).
+    std::array<std::uint8_t, 512> meets_after, meets_before;
+    SegmentsMeetBoxes(batch, points.count, *again->after, meets_after.data());
+    SegmentsMeetBoxes(batch, points.count, *again->before, meets_before.data());
+    std::array<std::int16_t, 512> subset, where;
+    cast = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int p = batch.index[i];
+      const bool seen = TestBit(*again->seen, points.offset[p]);
+      if (meets_after[p] || (meets_before[p] && !seen)) {
+        subset[cast] = batch.index[i];
+        where[cast++] = static_cast<std::int16_t>(i);
+      } else {
+        occluded[i] = seen ? 0 : 1;
+      }
+    }
+    if (cast > 0) {
+      RayCaster::Fan fan = batch.fan();
+      fan.index = subset.data();
+      std::array<std::uint8_t, 512> answer;
+      caster->OccludedFan(fan, std::size_t(cast), answer.data());
+      for (int k = 0; k < cast; ++k) occluded[where[k]] = answer[k];
+    }
+    // Nothing seen differently: the bits are enough (the view is kept).
+    Bits bits{};
+    for (std::size_t i = 0; i < n; ++i)
+      if (!occluded[i]) SetBit(bits, points.offset[batch.index[i]]);
+    if (bits == *again->seen) {
+      entry->camera = camera;
+      entry->rays = static_cast<std::int32_t>(n);
+      entry->bits = bits;
+      return cast;
+    }
+  }
   if (rays)
     for (std::size_t i = 0; i < n; ++i) rays->push_back(batch.segment(int(i)));
   entry->camera = camera;
@@ -754,6 +838,28 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
   for (int w = 0; w < kWords; ++w) {
     entry->before[w] = static_cast<std::int16_t>(before);
     before += __builtin_popcountll(entry->bits[w]);
+  }
+  return cast;
+}
+
+// Calls f(offset, index) for every voxel of `mask` that `e` sees, with its index among e's seen
+// voxels (ascending offset).
+template <class F>
+inline __attribute__((always_inline)) void WalkMasked(const CameraEntry& e, const Bits& mask,
+                                                      F&& f) {
+  for (int w = 0; w < kWords; ++w) {
+    const std::uint64_t seen = e.bits[w], wanted = seen & mask[w];
+    if (!wanted) continue;
+    if (wanted == seen) {
+      int index = e.before[w];
+      for (std::uint64_t bits = seen; bits; bits &= bits - 1)
+        f(64 * w + __builtin_ctzll(bits), index++);
+    } else {
+      for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
+        const int bit = __builtin_ctzll(bits);
+        f(64 * w + bit, e.before[w] + PopcountInline(seen & ((std::uint64_t{1} << bit) - 1)));
+      }
+    }
   }
 }
 
@@ -843,12 +949,11 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   Bits& rescan_density = scratch->rescan_density;
   Bits& rescan_info = scratch->rescan_info;
   const std::array<BandScale, 64>& scales = BandScales();
-  const auto walk = [](const CameraEntry& e, auto&& f)
-      __attribute__((always_inline)) {  // every seen voxel, with its index
-    int index = 0;
-    for (int w = 0; w < kWords; ++w)
-      for (std::uint64_t bits = e.bits[w]; bits; bits &= bits - 1)
-        f(64 * w + __builtin_ctzll(bits), index++);
+  // Only the dirty voxels: elsewhere a changed camera's old and new contributions are the same
+  // bits (a scene update: its view there did not change), and adding one while taking out the
+  // other would change nothing.
+  const auto walk = [&dirty](const CameraEntry& e, auto&& f) __attribute__((always_inline)) {
+    WalkMasked(e, dirty, f);
   };
   for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
   for (const CameraEntry* e : view) {
@@ -913,20 +1018,7 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
   if (fresh) rescan = dirty;
   const auto walk_masked =
       [](const CameraEntry& e, const Bits& mask, auto&& f) __attribute__((always_inline)) {
-    for (int w = 0; w < kWords; ++w) {
-      const std::uint64_t seen = e.bits[w], wanted = seen & mask[w];
-      if (!wanted) continue;
-      if (wanted == seen) {
-        int index = e.before[w];
-        for (std::uint64_t bits = seen; bits; bits &= bits - 1)
-          f(64 * w + __builtin_ctzll(bits), index++);
-      } else {
-        for (std::uint64_t bits = wanted; bits; bits &= bits - 1) {
-          const int bit = __builtin_ctzll(bits);
-          f(64 * w + bit, e.before[w] + PopcountInline(seen & ((std::uint64_t{1} << bit) - 1)));
-        }
-      }
-    }
+    WalkMasked(e, mask, f);
   };
   bool any_rescan = false;
   for (std::uint64_t word : rescan) any_rescan |= word != 0;
@@ -1072,7 +1164,7 @@ void FieldEvaluator::State::CandidateStatistics(const std::vector<const CameraEn
     const double frame = frame_period;
     for (int k = 0; k < 3; ++k)
       SteadyPositionVariances(motion.q, frame, stats[kVar0 + k].data(), stats[kVar0 + k].data(),
-                              candidate_count, scene.study.steady_prior);
+                              candidate_count, scene->study.steady_prior);
     SteadyStatistics(candidate_count, stats_ptr);
   }
 }
@@ -1337,6 +1429,97 @@ void FieldOptions::Check(const Scene& scene) const {
                      "ranks are 0 .. partition_count - 1");
 }
 
+namespace {
+
+// The scene's solid objects that can contain a region voxel (the others cost nothing).
+std::vector<const SceneObject*> RegionSolids(const Scene& scene) {
+  const Study& study = scene.study;
+  std::vector<const SceneObject*> solid_objects;
+  for (const SceneObject& o : scene.objects) {
+    if (!o.solid || o.mesh.triangles.empty()) continue;
+    const Aabb b = o.mesh.Bounds();
+    if ((b.max.array() < study.region.box.min.array()).any() ||
+        (b.min.array() > study.region.box.max.array()).any())
+      continue;
+    solid_objects.push_back(&o);
+  }
+  return solid_objects;
+}
+
+// The active set of `scene` into S.blocks and S.active_stats: the free region voxels (its solids
+// and region mesh classified, no cameras), with FieldOptions::tile and voxel_filter applied.
+// `check_budget`, when set, is called with the fields' estimate for the blocks kept.
+void BuildBlocks(FieldEvaluator::State& S, const Scene& scene,
+                 const std::vector<const SceneObject*>& solid_objects,
+                 const std::function<void(double)>& check_budget) {
+  const FieldOptions& opt = S.options;
+  const Study& study = scene.study;
+  // The active set without cameras: which voxels are free region voxels (solids and the region
+  // mesh are classified once; cameras are culled per update).
+  // Their search trees: the study's kept ones (built at first use), else built here, in parallel
+  // (a crowd of finely tessellated people: ~100 trees).
+  std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
+  std::vector<const InsideMesh*> solids(solid_objects.size(), nullptr);
+  const SolidTrees* kept = S.options.solid_trees;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          if (kept)
+            solids[i] = kept->Object(scene, std::size_t(solid_objects[i] - scene.objects.data()));
+          if (solids[i]) continue;
+          solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
+          solids[i] = solid_meshes[i].get();
+        }
+      });
+  std::unique_ptr<InsideMesh> own_region_mesh;
+  const InsideMesh* region_mesh = nullptr;
+  if (study.region.kind == Region::Kind::kMesh) {
+    if (kept) region_mesh = kept->RegionMesh(scene);
+    if (!region_mesh) {
+      own_region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
+      region_mesh = own_region_mesh.get();
+    }
+  }
+  const FrustumCuller no_cameras(std::vector<Camera>{});
+  S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
+                            &S.active_stats, opt.tile ? &*opt.tile : nullptr);
+  if (check_budget)
+    check_budget(EstimateBytesForVoxels(512.0 * double(S.blocks.size()), opt.fields, 0));
+  if (opt.voxel_filter) {
+    // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4),
+                      [&](const auto& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                          Block& block = S.blocks[b];
+                          std::vector<std::uint8_t> mask(512, 0);
+                          block.free_voxels = 0;
+                          for (int x = 0; x < block.extent.x(); ++x)
+                            for (int y = 0; y < block.extent.y(); ++y)
+                              for (int z = 0; z < block.extent.z(); ++z)
+                                if (block.IsFree(x, y, z) &&
+                                    opt.voxel_filter(block.origin.x() + x, block.origin.y() + y,
+                                                     block.origin.z() + z)) {
+                                  mask[Block::Offset(x, y, z)] = 1;
+                                  ++block.free_voxels;
+                                }
+                          block.mask = std::move(mask);
+                          block.full = false;
+                        }
+                      });
+    std::vector<Block> kept_blocks;
+    S.active_stats.region_voxels = 0;
+    for (Block& block : S.blocks) {
+      if (block.free_voxels == 0) continue;
+      S.active_stats.region_voxels += block.free_voxels;
+      kept_blocks.push_back(std::move(block));
+    }
+    S.blocks = std::move(kept_blocks);
+    S.active_stats.blocks = static_cast<std::int64_t>(S.blocks.size());
+  }
+}
+
+}  // namespace
+
 FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, FieldOptions options,
                                bool keep_state)
     : state_(std::make_unique<State>(scene, caster)) {
@@ -1355,16 +1538,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   S.fields.lattice = MakeLattice(study.region.box, study.voxel_size, size_file, size_path);
   VoxelLattice estimated = S.fields.lattice;  // a tile's own box when streamed
   if (opt.tile) estimated.dims = (opt.tile->VoxelEnd(estimated) - opt.tile->VoxelMin()).cwiseMax(0);
-  // Solids that cannot contain a region voxel cost nothing.
-  std::vector<const SceneObject*> solid_objects;
-  for (const SceneObject& o : scene.objects) {
-    if (!o.solid || o.mesh.triangles.empty()) continue;
-    const Aabb b = o.mesh.Bounds();
-    if ((b.max.array() < study.region.box.min.array()).any() ||
-        (b.min.array() > study.region.box.max.array()).any())
-      continue;
-    solid_objects.push_back(&o);
-  }
+  const std::vector<const SceneObject*> solid_objects = RegionSolids(scene);
   // The memory budget, against the voxels that hold fields: the blocks with free voxels. Known
   // before anything is allocated for a box region no solid meets (its box); otherwise checked in
   // two steps: what building the active set needs (a record and a mask per block of the box)
@@ -1410,67 +1584,9 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   S.frame_period = 1.0 / S.motion.rate_hz;
   S.scene_scale = scene.ContentBounds().diagonal();
 
-  // The active set without cameras: which voxels are free region voxels (solids and the region
-  // mesh are classified once; cameras are culled per update).
-  // Their search trees: the study's kept ones (built at first use), else built here, in parallel
-  // (a crowd of finely tessellated people: ~100 trees).
-  std::vector<std::unique_ptr<InsideMesh>> solid_meshes(solid_objects.size());
-  std::vector<const InsideMesh*> solids(solid_objects.size(), nullptr);
-  const SolidTrees* kept = S.options.solid_trees;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, solid_objects.size(), 1), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          if (kept)
-            solids[i] = kept->Object(scene, std::size_t(solid_objects[i] - scene.objects.data()));
-          if (solids[i]) continue;
-          solid_meshes[i] = std::make_unique<InsideMesh>(solid_objects[i]->mesh);
-          solids[i] = solid_meshes[i].get();
-        }
-      });
-  std::unique_ptr<InsideMesh> own_region_mesh;
-  const InsideMesh* region_mesh = nullptr;
-  if (study.region.kind == Region::Kind::kMesh) {
-    if (kept) region_mesh = kept->RegionMesh(scene);
-    if (!region_mesh) {
-      own_region_mesh = std::make_unique<InsideMesh>(study.region.mesh);
-      region_mesh = own_region_mesh.get();
-    }
-  }
-  const FrustumCuller no_cameras(std::vector<Camera>{});
-  S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
-                            &S.active_stats, opt.tile ? &*opt.tile : nullptr);
-  if (sparse) check_budget(EstimateBytesForVoxels(512.0 * double(S.blocks.size()), opt.fields, 0));
-  if (opt.voxel_filter) {
-    // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4),
-                      [&](const auto& range) {
-                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
-                          Block& block = S.blocks[b];
-                          std::vector<std::uint8_t> mask(512, 0);
-                          block.free_voxels = 0;
-                          for (int x = 0; x < block.extent.x(); ++x)
-                            for (int y = 0; y < block.extent.y(); ++y)
-                              for (int z = 0; z < block.extent.z(); ++z)
-                                if (block.IsFree(x, y, z) &&
-                                    opt.voxel_filter(block.origin.x() + x, block.origin.y() + y,
-                                                     block.origin.z() + z)) {
-                                  mask[Block::Offset(x, y, z)] = 1;
-                                  ++block.free_voxels;
-                                }
-                          block.mask = std::move(mask);
-                          block.full = false;
-                        }
-                      });
-    std::vector<Block> kept_blocks;
-    S.active_stats.region_voxels = 0;
-    for (Block& block : S.blocks) {
-      if (block.free_voxels == 0) continue;
-      S.active_stats.region_voxels += block.free_voxels;
-      kept_blocks.push_back(std::move(block));
-    }
-    S.blocks = std::move(kept_blocks);
-    S.active_stats.blocks = static_cast<std::int64_t>(S.blocks.size());
-  }
+  std::function<void(double)> blocks_budget;
+  if (sparse) blocks_budget = check_budget;
+  BuildBlocks(S, scene, solid_objects, blocks_budget);
   S.active_set_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -1530,7 +1646,18 @@ struct UpdatePass {
   std::vector<BlockLeaves> leaves;
   std::atomic<std::size_t> done{0};
   std::atomic<std::int64_t> dirty_voxels{0};
+  std::atomic<std::int64_t> rays{0};  // occlusion segments cast
   std::atomic<bool> cancelled{false};
+  // A scene update (FieldEvaluator::UpdateScene): the cameras change per block, not for the whole
+  // rig. block_changed[i] (ascending) are dirty block i's cameras to re-cast, then those whose
+  // view of it changed.
+  bool per_block = false;
+  std::vector<std::vector<int>> block_changed;
+  SceneChange moved;  // padded
+  bool Changed(std::size_t i, int camera) const {
+    if (!per_block) return is_changed[camera] != 0;
+    return std::binary_search(block_changed[i].begin(), block_changed[i].end(), camera);
+  }
 };
 
 // Throws InputError when the fields with `new_count` cameras and the scene's structures exceed the
@@ -1546,7 +1673,7 @@ void CheckCameraBudget(const State& S, int new_count) {
   // structures held for the run (its meshes, the Embree BVH and the solids' search trees:
   // SceneStructureBytes). The program itself (code and libraries, about 45 MiB resident before
   // any input) comes on top; summary.json's timing.peak_rss_mib shows the whole.
-  const double scene_bytes = SceneStructureBytes(S.scene);
+  const double scene_bytes = SceneStructureBytes(*S.scene);
   const double need =
       S.fields.stats.estimated_bytes + scene_bytes +
       double(new_count) * PerCameraBytes(S.fields.lattice, blocks, opt.fields, S.keep);
@@ -1632,7 +1759,7 @@ void CheckKeptBudget(const State& S, const Rig& rig,
   for (std::size_t b = 0; b < S.blocks.size(); ++b)
     bytes += 512.0 * per_voxel + double(candidates[b].size()) *
                                      (sizeof(CameraEntry) + per_pair * S.blocks[b].free_voxels);
-  const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(S.scene);
+  const double total = bytes + S.fields.stats.estimated_bytes + SceneStructureBytes(*S.scene);
   if (total > opt.memory_budget_bytes) {
     std::ostringstream reason;
     reason << "incremental updates of rig '" << rig.name << "' need up to "
@@ -1692,9 +1819,59 @@ void DropPairData(BlockState& old, UpdatePass* u, std::size_t i) {
   std::vector<std::int32_t>().swap(next[i].band_count);
 }
 
+// Whether a segment from `eye` to a point of `box` can meet `moved` (conservative): the convex hull
+// of the eye and the box against the moved box, along the world axes, and the cone from the eye
+// around the box's bounding ball against the moved box's bounding ball.
+bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min(eye[k], box.min[k]), hi = std::max(eye[k], box.max[k]);
+    if (hi < moved.min[k] || lo > moved.max[k]) return false;
+  }
+  const Vec3 d = 0.5 * (box.min + box.max) - eye, e = 0.5 * (moved.min + moved.max) - eye;
+  const double rb = 0.5 * (box.max - box.min).norm(), rm = 0.5 * (moved.max - moved.min).norm();
+  const double nd = d.norm(), ne = e.norm();
+  if (nd <= rb || ne <= rm) return true;  // the eye inside a ball
+  if (ne - rm > nd + rb) return false;    // the moved box beyond the segments' ends
+  const double alpha = std::asin(std::min(1.0, rb / nd)), beta = std::asin(std::min(1.0, rm / ne));
+  if (alpha + beta >= kPi) return true;
+  const double cos_between = std::clamp(d.dot(e) / (nd * ne), -1.0, 1.0);
+  return std::acos(cos_between) <= alpha + beta + 1e-12;
+}
+
+// The entry of `camera` among `entries` (ascending camera), or nullptr.
+const CameraEntry* FindEntry(const std::vector<CameraEntry>& entries, int camera) {
+  const auto it = std::lower_bound(entries.begin(), entries.end(), camera,
+                                   [](const CameraEntry& e, int c) { return e.camera < c; });
+  return it != entries.end() && it->camera == camera ? &*it : nullptr;
+}
+
+// A scene update: drops block i's re-cast views that equal the kept ones (nothing changed for
+// that camera there), from the cast and from the block's changed cameras.
+void DropUnchangedViews(const BlockState& old, UpdatePass* u, std::size_t i) {
+  std::vector<CameraEntry>& cast = u->cast[i];
+  std::vector<int>& changed = u->block_changed[i];
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < cast.size(); ++k) {
+    const CameraEntry* was = FindEntry(old.entries, cast[k].camera);
+    if (was && was->bits == cast[k].bits) {
+      changed.erase(std::find(changed.begin(), changed.end(), cast[k].camera));
+      continue;
+    }
+    if (kept != k) cast[kept] = std::move(cast[k]);
+    ++kept;
+  }
+  cast.resize(kept);
+}
+
 // Derives block i of `dirty` from its kept and re-cast entries, and makes its camera leaves.
 void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
-  const std::vector<std::uint8_t>& is_changed = u->is_changed;
+  // A scene update's changed cameras are the block's own.
+  thread_local std::vector<std::uint8_t> block_is_changed;
+  if (u->per_block) {
+    block_is_changed.assign(rd.centres.size() + 1, 0);
+    for (int c : u->block_changed[i]) block_is_changed[c] = 1;
+  }
+  const std::vector<std::uint8_t>& is_changed = u->per_block ? block_is_changed : u->is_changed;
   std::vector<std::vector<CameraEntry>>& cast = u->cast;
   std::vector<BlockState>& next = u->next;
   std::vector<BlockLeaves>& leaves = u->leaves;
@@ -1709,6 +1886,14 @@ void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
       for (int y = 0; y < block.extent.y(); ++y)
         for (int z = 0; z < block.extent.z(); ++z)
           if (block.IsFree(x, y, z)) SetBit(voxels, Block::Offset(x, y, z));
+  } else if (u->per_block) {
+    // Only the occlusion changed: the voxels a camera sees now and did not, or the reverse. The
+    // others' contributions are the same bits (the same expressions, lane by lane), so their sums
+    // and everything derived from them stay.
+    for (const CameraEntry& e : cast[i]) {
+      const CameraEntry* was = FindEntry(old.entries, e.camera);
+      for (int w = 0; w < kWords; ++w) voxels[w] |= e.bits[w] ^ (was ? was->bits[w] : 0);
+    }
   } else {
     for (const CameraEntry& e : old.entries)
       if (is_changed[e.camera])
@@ -1769,12 +1954,32 @@ bool CastAndDerive(State& S, const RigData& rd, UpdatePass* u) {
       // The changed cameras that may see the block now.
       thread_local State::BlockPoints points;
       points.count = -1;
-      for (int c : changed)
-        if (std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
+      const bool again = u->per_block && !S.states[b].coverage.empty();
+      for (int c : u->per_block ? u->block_changed[i] : changed)
+        if (u->per_block || std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
           if (points.count < 0) S.Points(S.blocks[b], &points);
           cast[i].emplace_back();
-          S.Cast(points, c, rd, &cast[i].back(), opt.record_rays ? &next[i].rays : nullptr);
+          State::Again view;
+          // The moved boxes this camera's segments to the block may meet.
+          thread_local std::vector<Aabb> before, after;
+          if (again) {
+            const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
+            const auto near = [&](const std::vector<Aabb>& all, std::vector<Aabb>* out) {
+              out->clear();
+              for (const Aabb& m : all)
+                if (SegmentsMayMeet(rd.centres[c], box, m)) out->push_back(m);
+            };
+            near(u->moved.before, &before);
+            near(u->moved.after, &after);
+            const CameraEntry* was = FindEntry(S.states[b].entries, c);
+            view.seen = was ? &was->bits : nullptr;
+            view.before = &before;
+            view.after = &after;
+          }
+          u->rays += S.Cast(points, c, rd, &cast[i].back(),
+                            opt.record_rays ? &next[i].rays : nullptr, view.seen ? &view : nullptr);
         }
+      if (u->per_block && !S.states[b].coverage.empty()) DropUnchangedViews(S.states[b], u, i);
       if (!in_place) derive(i);
       report(0.0);
     }
@@ -1794,7 +1999,6 @@ bool CastAndDerive(State& S, const RigData& rd, UpdatePass* u) {
 
 // Puts the new leaves into the grids, a task per grid (the trees are independent).
 void InsertLeaves(State& S, int new_count, UpdatePass* u) {
-  const std::vector<std::uint8_t>& is_changed = u->is_changed;
   const std::vector<std::size_t>& dirty = u->dirty;
   std::vector<BlockLeaves>& leaves = u->leaves;
   Fields::Impl& g = S.fields.impl();
@@ -1838,7 +2042,7 @@ void InsertLeaves(State& S, int new_count, UpdatePass* u) {
   if (S.want_cameras) {
     for (std::size_t i = 0; i < dirty.size(); ++i) {
       for (const CameraEntry& e : S.states[dirty[i]].entries)
-        if (is_changed[e.camera] && e.camera < new_count && e.seen > 0)
+        if (u->Changed(i, e.camera) && e.camera < new_count && e.seen > 0)
           camera_removed[e.camera].push_back(i);
       for (auto& [camera, leaf] : leaves[i].visible) camera_added[camera].push_back(leaf);
     }
@@ -1856,7 +2060,6 @@ void InsertLeaves(State& S, int new_count, UpdatePass* u) {
 
 // Puts the new candidate lists, entries and caches into the state.
 void StoreStates(State& S, UpdatePass* u) {
-  const std::vector<std::uint8_t>& is_changed = u->is_changed;
   const std::vector<std::size_t>& dirty = u->dirty;
   std::vector<std::vector<std::int32_t>>& candidates = u->candidates;
   std::vector<std::vector<CameraEntry>>& cast = u->cast;
@@ -1870,7 +2073,7 @@ void StoreStates(State& S, UpdatePass* u) {
       std::vector<CameraEntry> entries;
       entries.reserve(s.entries.size() + cast[i].size());
       for (CameraEntry& e : s.entries)
-        if (!is_changed[e.camera]) entries.push_back(std::move(e));
+        if (!u->Changed(i, e.camera)) entries.push_back(std::move(e));
       for (CameraEntry& e : cast[i]) entries.push_back(std::move(e));
       std::sort(entries.begin(), entries.end(),
                 [](const CameraEntry& a, const CameraEntry& b) { return a.camera < b.camera; });
@@ -1887,13 +2090,49 @@ void StoreStates(State& S, UpdatePass* u) {
   });
 }
 
+// The serial phase of an update: the new leaves into the grids, the new entries and caches into
+// the state, then the statistics.
+void FinishUpdate(State& S, const Rig& rig, const RigData& rd, UpdatePass* u, FieldUpdate* update,
+                  std::chrono::steady_clock::time_point t0, std::clock_t cpu0) {
+  const FieldOptions& opt = S.options;
+  const int new_count = static_cast<int>(rig.cameras.size());
+  InsertLeaves(S, new_count, u);
+  StoreStates(S, u);
+  Fields::Impl& g = S.fields.impl();
+  if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
+  if (S.evaluated) {
+    if (u->per_block && g.coverage) openvdb::tools::pruneInactive(g.coverage->tree());
+    for (auto& [name, grid] : g.floats) openvdb::tools::pruneInactive(grid->tree());
+    for (auto& v : g.visible) openvdb::tools::pruneInactive(v->tree());
+  }
+
+  S.rig = rig;
+  S.evaluated = true;
+  update->dirty_voxels = u->dirty_voxels;
+  update->rays = u->rays;
+  FieldStats& st = S.fields.stats;
+  const double estimated = st.estimated_bytes;
+  S.Totals(&st, new_count, rd.enabled);
+  st.estimated_bytes = estimated;
+  st.angle_pairs_tried = S.angle_pairs_tried;
+  st.angle_pairs_all = S.angle_pairs_all;
+  st.active_set_seconds = update->full || u->per_block ? S.active_set_seconds : 0.0;
+  if (opt.record_rays && update->full) {
+    S.fields.recorded_rays.clear();
+    for (const BlockState& s : S.states)
+      S.fields.recorded_rays.insert(S.fields.recorded_rays.end(), s.rays.begin(), s.rays.end());
+  }
+  update->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.seconds = update->seconds + (update->full ? S.active_set_seconds : 0.0);
+  st.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+}
+
 }  // namespace
 
 FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
   State& S = *state_;
-  const FieldOptions& opt = S.options;
   FieldUpdate update;
   if (S.evaluated && !S.keep) TakeFields();  // nothing kept: evaluate again in full
 
@@ -1946,39 +2185,154 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
     return update;
   }
 
-  // The serial phase: the new leaves into the grids, the new entries and caches into the state.
-  InsertLeaves(S, new_count, &u);
-  StoreStates(S, &u);
-  Fields::Impl& g = S.fields.impl();
-  if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
-  if (S.evaluated) {
-    for (auto& [name, grid] : g.floats) openvdb::tools::pruneInactive(grid->tree());
-    for (auto& v : g.visible) openvdb::tools::pruneInactive(v->tree());
-  }
+  FinishUpdate(S, rig, rd, &u, &update, t0, cpu0);
+  return update;
+}
 
-  S.rig = rig;
-  S.evaluated = true;
-  update.dirty_voxels = u.dirty_voxels;
-  for (const auto& c : u.cast)
-    for (const CameraEntry& e : c) update.rays += e.rays;
-  if (!S.keep)  // the entries went block by block; their counts stayed
-    for (std::size_t b : u.dirty)
-      for (const BlockState::CameraCount& e : S.states[b].counts) update.rays += e.rays;
-  FieldStats& st = S.fields.stats;
-  const double estimated = st.estimated_bytes;
-  S.Totals(&st, new_count, rd.enabled);
-  st.estimated_bytes = estimated;
-  st.angle_pairs_tried = S.angle_pairs_tried;
-  st.angle_pairs_all = S.angle_pairs_all;
-  st.active_set_seconds = update.full ? S.active_set_seconds : 0.0;
-  if (opt.record_rays && update.full) {
-    S.fields.recorded_rays.clear();
-    for (const BlockState& s : S.states)
-      S.fields.recorded_rays.insert(S.fields.recorded_rays.end(), s.rays.begin(), s.rays.end());
+namespace {
+
+// A block's key for matching blocks by origin (lattice indices below 2^21).
+std::uint64_t OriginKey(const Block& block) {
+  return (std::uint64_t(block.origin.x()) << 42) | (std::uint64_t(block.origin.y()) << 21) |
+         std::uint64_t(block.origin.z());
+}
+
+// Whether two blocks at the same origin hold the same free voxels.
+bool SameVoxels(const Block& a, const Block& b) {
+  if (a.extent != b.extent || a.free_voxels != b.free_voxels) return false;
+  if (a.mask.empty() && b.mask.empty()) return true;
+  for (int x = 0; x < a.extent.x(); ++x)
+    for (int y = 0; y < a.extent.y(); ++y)
+      for (int z = 0; z < a.extent.z(); ++z)
+        if (a.IsFree(x, y, z) != b.IsFree(x, y, z)) return false;
+  return true;
+}
+
+// Removes a block's leaves from every grid (its voxels leave the region or are evaluated anew).
+void RemoveBlockLeaves(State& S, const Block& block) {
+  Fields::Impl& g = S.fields.impl();
+  const openvdb::Coord origin(block.origin.x(), block.origin.y(), block.origin.z());
+  if (g.coverage) g.coverage->tree().addTile(1, origin, 0, false);
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    if (S.want_float[f]) S.float_grids[f]->tree().addTile(1, origin, 0.0f, false);
+  for (auto& v : g.visible) v->tree().addTile(1, origin, false, false);
+}
+
+}  // namespace
+
+FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& caster,
+                                        const SceneChange& moved) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  State& S = *state_;
+  const double scale = scene.ContentBounds().diagonal();
+  if (!S.evaluated || !S.keep || scale != S.scene_scale) {
+    // Nothing kept, or the visibility tolerance (a share of the scene's size) changes with it:
+    // the new scene evaluated in full.
+    const bool evaluated = S.evaluated;
+    const Rig rig = S.rig;
+    const double estimated = S.fields.stats.estimated_bytes;
+    if (evaluated) TakeFields();
+    S.scene = &scene;
+    S.caster = &caster;
+    S.scene_scale = scale;
+    BuildBlocks(S, scene, RegionSolids(scene), {});
+    S.active_set_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    S.fields.stats.estimated_bytes = estimated;
+    if (!evaluated) return FieldUpdate{};
+    FieldUpdate update = Update(rig);
+    update.seconds += S.active_set_seconds;
+    return update;
   }
-  update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  st.seconds = update.seconds + (update.full ? S.active_set_seconds : 0.0);
-  st.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  FieldUpdate update;
+  // The new active set; blocks matched to the old ones by origin.
+  std::vector<Block> old_blocks = std::move(S.blocks);
+  std::vector<BlockState> old_states = std::move(S.states);
+  S.scene = &scene;
+  S.caster = &caster;
+  BuildBlocks(S, scene, RegionSolids(scene), {});
+  S.active_set_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::unordered_map<std::uint64_t, std::size_t> old_index;
+  old_index.reserve(old_blocks.size());
+  for (std::size_t i = 0; i < old_blocks.size(); ++i)
+    old_index.emplace(OriginKey(old_blocks[i]), i);
+
+  const Rig& rig = S.rig;
+  const RigData rd = S.Prepare(rig);
+  S.angle_pairs_tried = 0;
+  S.angle_pairs_all = 0;
+  // Boxes padded for round-off: a segment that misses one cannot meet what moved inside it.
+  const double pad = 1e-6 * scale + 1e-9;
+  const auto padded = [pad](const std::vector<Aabb>& in) {
+    std::vector<Aabb> out;
+    for (Aabb b : in) {
+      if (b.empty()) continue;
+      b.min.array() -= pad;
+      b.max.array() += pad;
+      out.push_back(b);
+    }
+    return out;
+  };
+  std::vector<Aabb> boxes = padded(moved.before);
+  const std::vector<Aabb> after = padded(moved.after);
+  boxes.insert(boxes.end(), after.begin(), after.end());
+  UpdatePass u;
+  u.per_block = true;
+  u.moved = {padded(moved.before), after};
+  u.candidates.resize(S.blocks.size());
+  S.states.resize(S.blocks.size());
+  std::vector<std::vector<int>> recast(S.blocks.size());
+  std::vector<std::uint8_t> dirty_block(S.blocks.size(), 0), old_kept(old_blocks.size(), 0);
+  const int count = static_cast<int>(rig.cameras.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      const Block& block = S.blocks[b];
+      const Aabb box = BlockCentreBox(S.fields.lattice, block);
+      const auto it = old_index.find(OriginKey(block));
+      if (it != old_index.end() && SameVoxels(old_blocks[it->second], block)) {
+        // The same voxels: re-cast the cameras whose segments to them can meet what moved.
+        old_kept[it->second] = 1;
+        S.states[b] = std::move(old_states[it->second]);
+        u.candidates[b] = S.states[b].candidates;
+        for (int c : u.candidates[b])
+          for (const Aabb& m : boxes)
+            if (SegmentsMayMeet(rd.centres[c], box, m)) {
+              recast[b].push_back(c);
+              break;
+            }
+        dirty_block[b] = !recast[b].empty();
+      } else {
+        // New or other voxels (a moved solid came or went): evaluated anew.
+        S.states[b] = BlockState{};
+        for (int c = 0; c < count; ++c)
+          if (rd.culler->MayIntersect(c, box)) u.candidates[b].push_back(c);
+        recast[b] = u.candidates[b];
+        dirty_block[b] = 1;
+      }
+    }
+  });
+  for (std::size_t i = 0; i < old_blocks.size(); ++i)
+    if (!old_kept[i]) RemoveBlockLeaves(S, old_blocks[i]);
+  old_states.clear();
+  for (std::size_t b = 0; b < S.blocks.size(); ++b)
+    if (dirty_block[b]) {
+      u.dirty.push_back(b);
+      u.block_changed.push_back(std::move(recast[b]));
+    }
+  update.dirty_blocks = static_cast<std::int64_t>(u.dirty.size());
+  S.fields.stats.active_set = S.active_stats;
+  // Not cancellable: the blocks are already the new scene's.
+  const std::atomic<bool>* cancel = S.options.cancel;
+  S.options.cancel = nullptr;
+  CastAndDerive(S, rd, &u);
+  S.options.cancel = cancel;
+  std::vector<std::uint8_t> camera_changed(rig.cameras.size(), 0);
+  for (const std::vector<int>& changed : u.block_changed)
+    for (int c : changed) camera_changed[c] = 1;
+  for (std::uint8_t c : camera_changed) update.changed_cameras += c;
+  FinishUpdate(S, rig, rd, &u, &update, t0, cpu0);
   return update;
 }
 

@@ -164,6 +164,12 @@ struct FieldUpdate {
   bool cancelled = false;         ///< FieldOptions::cancel was set: nothing changed.
 };
 
+/// What moved between two scenes (FieldEvaluator::UpdateScene): boxes around every triangle that
+/// differs, where it was and where it is.
+struct SceneChange {
+  std::vector<Aabb> before, after;
+};
+
 /// The incremental field evaluator. It keeps, per 8^3 block, which cameras see which voxel (a
 /// 512-bit mask per camera that sees the block: sparse, any number of cameras) and each seen
 /// (voxel, camera) pair's information contribution and pixel density. When cameras change it
@@ -191,6 +197,19 @@ class FieldEvaluator {
   /// The rig may have any number of cameras. Returns what it did; on cancellation the previous
   /// fields stay. Throws InputError when the kept state would exceed the memory budget.
   FieldUpdate Update(const Rig& rig);
+
+  /// Brings the fields up to date with a new `scene` and its `caster` (the next time sample of a
+  /// scene with moving objects): the same study, rig and camera geometry, where every triangle
+  /// that differs from the previous scene's lies inside one of the `moved` boxes, in its old place
+  /// (SceneChange::before) and in its new one (after). Re-builds the active set (a moved solid
+  /// takes its voxels out of the region), evaluates anew the blocks whose free voxels changed, and
+  /// elsewhere re-casts only the (block, camera) pairs whose segments can meet a moved box; only
+  /// the voxels a camera sees now and did not, or the reverse, are re-derived. The fields equal a
+  /// full evaluation of `scene` voxel for voxel, bit for bit (test volume/time_fields_test.cpp).
+  /// Evaluates in full when nothing is kept, or when the scene's extent (the visibility tolerance's
+  /// scale) changed. Not cancellable. `scene` and `caster` must outlive the evaluator or the next
+  /// UpdateScene.
+  FieldUpdate UpdateScene(const Scene& scene, const RayCaster& caster, const SceneChange& moved);
 
   const Fields& fields() const;
   /// Replaces FieldOptions::progress and FieldOptions::cancel for the next updates (a session's

@@ -5,16 +5,80 @@
 #include <limits>
 
 #include "analysis/geometry/ray_caster.h"
+#include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
 namespace pandora {
 
+SceneChange MovedBounds(const Scene& before, const Scene& after) {
+  SceneChange out;
+  const std::size_t n = std::min(before.objects.size(), after.objects.size());
+  for (std::size_t o = 0; o < n; ++o) {
+    const TriangleMesh& a = before.objects[o].mesh;
+    const TriangleMesh& b = after.objects[o].mesh;
+    if (a.vertices == b.vertices && a.triangles == b.triangles) continue;
+    out.before.push_back(a.Bounds());
+    out.after.push_back(b.Bounds());
+  }
+  for (std::size_t o = n; o < before.objects.size(); ++o)
+    out.before.push_back(before.objects[o].mesh.Bounds());
+  for (std::size_t o = n; o < after.objects.size(); ++o)
+    out.after.push_back(after.objects[o].mesh.Bounds());
+  return out;
+}
+
+void EvaluateSamples(
+    const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
+    const std::vector<TimeSample>& samples, const FieldOptions& options,
+    const std::function<void(std::size_t, const Fields&, const SampleCost&)>& visit) {
+  using Clock = std::chrono::steady_clock;
+  // The evaluator keeps the previous sample's scene and caster until the next one replaces them.
+  std::unique_ptr<Scene> previous;
+  std::unique_ptr<RayCaster> previous_caster;
+  std::unique_ptr<FieldEvaluator> evaluator;
+  bool keep = true;
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const auto t0 = Clock::now();
+    auto at = std::make_unique<Scene>(SceneAtSample(scene, samples[s]));
+    std::unique_ptr<RayCaster> caster = CasterAtSample(parts, scene, samples[s]);
+    SampleCost cost;
+    if (!evaluator || !keep) {
+      cost.full = true;
+      // Kept state when it fits the budget (an InputError from the first update), else none.
+      for (;;) {
+        evaluator = std::make_unique<FieldEvaluator>(*at, *caster, options, keep);
+        try {
+          const FieldUpdate u = evaluator->Update(rig);
+          cost.dirty_blocks = u.dirty_blocks;
+          cost.rays = u.rays;
+          break;
+        } catch (const InputError&) {
+          if (!keep) throw;
+          keep = false;
+        }
+      }
+    } else {
+      const FieldUpdate u = evaluator->UpdateScene(*at, *caster, MovedBounds(*previous, *at));
+      cost.full = u.full;
+      cost.dirty_blocks = u.dirty_blocks;
+      cost.rays = u.rays;
+    }
+    previous = std::move(at);
+    previous_caster = std::move(caster);
+    cost.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    visit(s, evaluator->fields(), cost);
+  }
+}
+
 FieldOptions OverTimeOptions(FieldOptions options) {
   options.partition_count = 1;
   options.partition_rank = 0;
-  options.fields.erase(std::remove(options.fields.begin(), options.fields.end(), "cameras"),
-                       options.fields.end());
+  bool uncertainty = false;
+  for (const std::string& f : options.fields)
+    uncertainty |= f != "coverage" && f != "cameras" && f != "resolution";
+  options.fields = {"coverage"};
+  if (uncertainty) options.fields.push_back("sigma_max");
   return options;
 }
 
@@ -40,13 +104,10 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
   std::vector<float> sigma_all;
   openvdb::math::Transform::Ptr transform;
   std::int64_t good_pairs = 0, free_pairs = 0;
-  for (std::size_t s = 0; s < samples.size(); ++s) {
-    const auto t0 = Clock::now();
-    const Scene at = SceneAtSample(scene, samples[s]);
-    const auto caster = CasterAtSample(parts, scene, samples[s]);
-    if (progress)
-      options.progress = [&, s](double f) { progress((double(s) + f) / double(samples.size())); };
-    const Fields f = EvaluateFields(at, rig, *caster, options);
+  std::size_t current = 0;  // the sample being evaluated, for the progress
+  if (progress)
+    options.progress = [&](double f) { progress((double(current) + f) / double(samples.size())); };
+  const auto visit = [&](std::size_t s, const Fields& f, const SampleCost& cost) {
     TimeSampleSummary row;
     row.label = samples[s].label;
     row.time = samples[s].time;
@@ -83,9 +144,11 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
         good_pairs += value >= min_cameras;
       });
     }
-    row.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    row.seconds = cost.seconds;
     out.samples.push_back(row);
-  }
+    current = s + 1;
+  };
+  EvaluateSamples(scene, rig, parts, samples, options, visit);
   // The combined grids, active on every voxel free in some sample.
   openvdb::FloatGrid::Ptr min_out = openvdb::FloatGrid::create(0.0f),
                           share_out = openvdb::FloatGrid::create(0.0f);

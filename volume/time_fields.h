@@ -7,6 +7,7 @@
 /// the share of time, and per sample into the summary's rows. docs/time.md.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,16 +57,42 @@ struct TimeFieldsResult {
   Fields grids;
 };
 
-/// Evaluates `options.fields` for `rig` at every sample and combines them. `parts` is
-/// MakeSceneParts(scene). Throws as EvaluateFields.
+/// What evaluating one sample cost (EvaluateSamples).
+struct SampleCost {
+  bool full = false;              ///< Evaluated in full (the first sample, or nothing kept).
+  std::int64_t dirty_blocks = 0;  ///< 8^3 blocks re-derived.
+  std::int64_t rays = 0;          ///< Occlusion segments cast.
+  double seconds = 0;             ///< The scene at the sample, its caster and the fields.
+};
+
+/// The objects' bounds that differ between two samples' scenes (SceneAtSample of one scene): for
+/// every object whose vertices moved, its bounds in each. What FieldEvaluator::UpdateScene needs.
+SceneChange MovedBounds(const Scene& before, const Scene& after);
+
+/// Evaluates `options.fields` for `rig` at every sample in turn and calls `visit(s, fields, cost)`
+/// with sample s's fields: equal, voxel for voxel and bit for bit, to EvaluateFields of
+/// SceneAtSample(scene, samples[s]) with CasterAtSample(parts, scene, samples[s]). The first sample
+/// is evaluated in full, the next ones by difference (FieldEvaluator::UpdateScene with the bounds
+/// of what moved since the previous sample: only the (block, camera) pairs whose segments can meet
+/// them are cast again). When the evaluator's kept state would exceed the memory budget, every
+/// sample is evaluated in full. docs/time.md.
+void EvaluateSamples(
+    const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
+    const std::vector<TimeSample>& samples, const FieldOptions& options,
+    const std::function<void(std::size_t, const Fields&, const SampleCost&)>& visit);
+
+/// Evaluates `options.fields` for `rig` at every sample (EvaluateSamples) and combines them.
+/// `parts` is MakeSceneParts(scene). Throws as EvaluateFields.
 TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
                                         const RigidPartsRayCaster& parts,
                                         const std::vector<TimeSample>& samples,
                                         const FieldOptions& options, int min_cameras);
 
 /// The options of EvaluateFieldsOverTime from a run's fields options: the samples evaluated whole
-/// (one partition: under MPI rank 0 evaluates them, docs/scale.md), without the per-camera sets
-/// ("cameras": not kept for every sample). What `pandora analyze` and the viewer's Compare use.
+/// (one partition: under MPI rank 0 evaluates them, docs/scale.md), with only the fields the time
+/// summary and grids are made of: "coverage", and "sigma_max" when the run asks for any
+/// uncertainty field (its percentiles per sample); the others are never written per sample, so
+/// they are not evaluated. What `pandora analyze` and the viewer's Compare use.
 FieldOptions OverTimeOptions(FieldOptions options);
 
 /// Moves the result's grids into `fields` (written to fields.vdb with them).

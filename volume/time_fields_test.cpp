@@ -10,6 +10,7 @@
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/geometry/visibility.h"
 #include "analysis/scene/surface_targets.h"
+#include "volume/fields_test_util.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 
@@ -105,6 +106,48 @@ TEST(TimeFields, EqualABruteForceLoopOverSamples) {
   // The worst sample is the one with the lowest share.
   for (const TimeSampleSummary& r : t.samples) EXPECT_LE(t.samples[t.worst_sample].ge_k, r.ge_k);
   EXPECT_LT(t.always, t.mean);  // something is covered only part of the time
+}
+
+// Every field (the steady ones with a motion model, the per-camera sets too) of every sample,
+// evaluated by difference from the previous sample, against a full evaluation of that sample's
+// scene: voxel for voxel, bit for bit, statistics included. Two scenes: the test room (a cart and a
+// solid person whose voxels leave and join the region) and the bundled mocap lab (two people in six
+// poses); a repeated sample moves nothing and costs nothing.
+TEST(TimeFields, SamplesByDifferenceEqualFullEvaluations) {
+  for (const std::string& which : {std::string("test room"), std::string("mocap lab")}) {
+    Scene scene = which == "test room" ? TestScene() : LoadScene("examples/mocap_lab/scene.json");
+    scene.study.motion = MotionModel{};
+    const Rig& rig = scene.rigs[0];
+    std::vector<TimeSample> samples = scene.TimeSamples();
+    ASSERT_GE(samples.size(), 5u);
+    samples.insert(samples.begin() + 2, samples[1]);  // nothing moves from 1 to 2
+    const auto parts = MakeSceneParts(scene);
+    FieldOptions options;
+    options.fields = FieldNames();
+    std::vector<SampleCost> costs;
+    std::int64_t full_rays = 0;
+    EvaluateSamples(scene, rig, *parts, samples, options,
+                    [&](std::size_t s, const Fields& f, const SampleCost& cost) {
+                      const Scene at = SceneAtSample(scene, samples[s]);
+                      const auto caster = CasterAtSample(*parts, scene, samples[s]);
+                      const Fields full = EvaluateFields(at, rig, *caster, options);
+                      testing::ExpectSameFields(f, full, which + " sample " + std::to_string(s));
+                      costs.push_back(cost);
+                      full_rays = std::max(full_rays, full.stats.rays);
+                    });
+    ASSERT_EQ(costs.size(), samples.size());
+    EXPECT_TRUE(costs[0].full);
+    EXPECT_EQ(costs[2].dirty_blocks, 0) << which;  // the repeated sample
+    EXPECT_EQ(costs[2].rays, 0) << which;
+    for (std::size_t s = 1; s < costs.size(); ++s) {
+      EXPECT_FALSE(costs[s].full) << which << " " << s;
+      EXPECT_LT(costs[s].rays, costs[0].rays) << which << " " << s;
+      if (s != 2) {
+        EXPECT_GT(costs[s].rays, 0) << which << " " << s;
+      }
+    }
+    EXPECT_GT(full_rays, 0);
+  }
 }
 
 // Surface targets against each sample's scene built from scratch (a fresh BVH of the moved scene,
