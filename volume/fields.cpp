@@ -568,6 +568,25 @@ struct DeriveScratch {
   std::array<std::int16_t, 512> double_index;
 };
 
+// Whether a segment from `eye` to a point of `box` can meet `moved` (conservative): the convex hull
+// of the eye and the box against the moved box, along the world axes, and the cone from the eye
+// around the box's bounding ball against the moved box's bounding ball.
+bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min(eye[k], box.min[k]), hi = std::max(eye[k], box.max[k]);
+    if (hi < moved.min[k] || lo > moved.max[k]) return false;
+  }
+  const Vec3 d = 0.5 * (box.min + box.max) - eye, e = 0.5 * (moved.min + moved.max) - eye;
+  const double rb = 0.5 * (box.max - box.min).norm(), rm = 0.5 * (moved.max - moved.min).norm();
+  const double nd = d.norm(), ne = e.norm();
+  if (nd <= rb || ne <= rm) return true;  // the eye inside a ball
+  if (ne - rm > nd + rb) return false;    // the moved box beyond the segments' ends
+  const double alpha = std::asin(std::min(1.0, rb / nd)), beta = std::asin(std::min(1.0, rm / ne));
+  if (alpha + beta >= kPi) return true;
+  const double cos_between = std::clamp(d.dot(e) / (nd * ne), -1.0, 1.0);
+  return std::acos(cos_between) <= alpha + beta + 1e-12;
+}
+
 // Per point p < count of `batch`: whether its segment (origin, unit direction, [t_near, t_far])
 // meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all points,
 // vectorised.
@@ -646,16 +665,18 @@ struct FieldEvaluator::State {
   // A scene update's view of a block cast again: the camera's previous view of it and the moved
   // boxes its segments may meet.
   struct Again {
-    const Bits* seen = nullptr;
     const std::vector<Aabb>* before = nullptr;  // what moved, where it was
     const std::vector<Aabb>* after = nullptr;   // and where it is
   };
-  // Returns the segments cast: all in view, or with `again` only those whose answer can have
-  // changed: those that meet a moved box where it is now, and the occluded ones that meet one
-  // where it was (the others keep their previous answer; `entry` holds only the bits when
-  // nothing changed).
-  int Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
-           std::vector<Ray>* rays, const Again* again = nullptr) const;
+  void Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
+            std::vector<Ray>* rays) const;
+  // A scene update's Cast of a camera whose view `was` of the block may have changed: only the
+  // block's octants whose segments can meet a moved box are tested again, and of their segments
+  // only those whose answer can have changed are cast (returns how many). The contributions of
+  // the voxels seen before are copied (the same bits), the newly seen ones' computed; `entry`
+  // holds only the bits when nothing is seen differently.
+  int CastAgain(const BlockPoints& points, int camera, const RigData& rd, const CameraEntry& was,
+                const Again& again, CameraEntry* entry) const;
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
               const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
@@ -754,52 +775,14 @@ void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) cons
 // Camera `camera`'s view of a block: the geometric tests first (vectorised over the block's free
 // voxels), then the segments in view traced together as coherent packets (one origin,
 // neighbouring directions) straight from the test's arrays.
-int FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const RigData& rd,
-                                CameraEntry* entry, std::vector<Ray>* rays,
-                                const Again* again) const {
+void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const RigData& rd,
+                                 CameraEntry* entry, std::vector<Ray>* rays) const {
   std::array<std::uint8_t, 512> occluded;
   thread_local VisibilityTester::GeometryBatch batch;  // 46 kB: not on the worker's stack
   rd.tester->TestGeometryBatch(camera, points.count, points.x.data(), points.y.data(),
                                points.z.data(), &batch);
   const std::size_t n = static_cast<std::size_t>(batch.count);
-  int cast = static_cast<int>(n);
-  if (!again) {
-    caster->OccludedFan(batch.fan(), n, occluded.data());
-  } else {
-    // Only the segments that meet a moved box; the others saw what they saw (the same test).
-    std::array<std::uint8_t, 512> meets_after, meets_before;
-    SegmentsMeetBoxes(batch, points.count, *again->after, meets_after.data());
-    SegmentsMeetBoxes(batch, points.count, *again->before, meets_before.data());
-    std::array<std::int16_t, 512> subset, where;
-    cast = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const int p = batch.index[i];
-      const bool seen = TestBit(*again->seen, points.offset[p]);
-      if (meets_after[p] || (meets_before[p] && !seen)) {
-        subset[cast] = batch.index[i];
-        where[cast++] = static_cast<std::int16_t>(i);
-      } else {
-        occluded[i] = seen ? 0 : 1;
-      }
-    }
-    if (cast > 0) {
-      RayCaster::Fan fan = batch.fan();
-      fan.index = subset.data();
-      std::array<std::uint8_t, 512> answer;
-      caster->OccludedFan(fan, std::size_t(cast), answer.data());
-      for (int k = 0; k < cast; ++k) occluded[where[k]] = answer[k];
-    }
-    // Nothing seen differently: the bits are enough (the view is kept).
-    Bits bits{};
-    for (std::size_t i = 0; i < n; ++i)
-      if (!occluded[i]) SetBit(bits, points.offset[batch.index[i]]);
-    if (bits == *again->seen) {
-      entry->camera = camera;
-      entry->rays = static_cast<std::int32_t>(n);
-      entry->bits = bits;
-      return cast;
-    }
-  }
+  caster->OccludedFan(batch.fan(), n, occluded.data());
   if (rays)
     for (std::size_t i = 0; i < n; ++i) rays->push_back(batch.segment(int(i)));
   entry->camera = camera;
@@ -838,6 +821,121 @@ int FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Rig
   for (int w = 0; w < kWords; ++w) {
     entry->before[w] = static_cast<std::int16_t>(before);
     before += __builtin_popcountll(entry->bits[w]);
+  }
+}
+
+// The octant (4^3 voxels) of a block offset.
+inline int OctantOf(int o) { return ((o >> 8) << 2) | (((o >> 5) & 1) << 1) | ((o >> 2) & 1); }
+
+int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, const RigData& rd,
+                                     const CameraEntry& was, const Again& again,
+                                     CameraEntry* entry) const {
+  entry->camera = camera;
+  entry->rays = was.rays;  // the segments in view: geometry, unchanged
+  entry->bits = was.bits;
+  // The octants whose segments can meet a moved box; only their points are looked at again.
+  std::array<Aabb, 8> octant;
+  for (int p = 0; p < points.count; ++p)
+    octant[OctantOf(points.offset[p])].Extend(Vec3(points.x[p], points.y[p], points.z[p]));
+  std::array<bool, 8> flagged{};
+  const Vec3& eye = rd.centres[camera];
+  for (int k = 0; k < 8; ++k) {
+    if (octant[k].empty()) continue;
+    for (const std::vector<Aabb>* boxes : {again.after, again.before})
+      for (const Aabb& box : *boxes)
+        flagged[k] = flagged[k] || SegmentsMayMeet(eye, octant[k], box);
+  }
+  thread_local BlockPoints sub;
+  int m = 0;
+  for (int p = 0; p < points.count; ++p) {
+    if (!flagged[OctantOf(points.offset[p])]) continue;
+    sub.x[m] = points.x[p];
+    sub.y[m] = points.y[p];
+    sub.z[m] = points.z[p];
+    sub.offset[m++] = points.offset[p];
+  }
+  sub.count = m;
+  if (m == 0) return 0;
+  thread_local VisibilityTester::GeometryBatch batch;
+  rd.tester->TestGeometryBatch(camera, m, sub.x.data(), sub.y.data(), sub.z.data(), &batch);
+  const int n = batch.count;
+  // Cast only the segments whose answer can have changed: those that meet a moved box where it
+  // is now, and the occluded ones that meet one where it was; the others keep their answer.
+  std::array<std::uint8_t, 512> meets_after, meets_before, occluded;
+  SegmentsMeetBoxes(batch, m, *again.after, meets_after.data());
+  SegmentsMeetBoxes(batch, m, *again.before, meets_before.data());
+  std::array<std::int16_t, 512> subset, where;
+  int cast = 0;
+  for (int i = 0; i < n; ++i) {
+    const int q = batch.index[i];
+    const bool seen = TestBit(was.bits, sub.offset[q]);
+    if (meets_after[q] || (meets_before[q] && !seen)) {
+      subset[cast] = batch.index[i];
+      where[cast++] = static_cast<std::int16_t>(i);
+    } else {
+      occluded[i] = seen ? 0 : 1;
+    }
+  }
+  if (cast > 0) {
+    RayCaster::Fan fan = batch.fan();
+    fan.index = subset.data();
+    std::array<std::uint8_t, 512> answer;
+    caster->OccludedFan(fan, std::size_t(cast), answer.data());
+    for (int k = 0; k < cast; ++k) occluded[where[k]] = answer[k];
+  }
+  for (int i = 0; i < n; ++i) {
+    const int o = sub.offset[batch.index[i]];
+    if (occluded[i])
+      entry->bits[o >> 6] &= ~(std::uint64_t{1} << (o & 63));
+    else
+      SetBit(entry->bits, o);
+  }
+  if (entry->bits == was.bits) return cast;  // nothing seen differently: the view is kept
+  // The newly seen voxels' contributions (ascending offset, as the batch keeps the points' order);
+  // the others' are the previous view's, the same bits.
+  thread_local InformationScratch scratch;
+  std::array<float, 512> density;
+  int fresh = 0;
+  for (int i = 0; i < n; ++i) {
+    const int q = batch.index[i];
+    if (occluded[i] || TestBit(was.bits, sub.offset[q])) continue;
+    if (want_information)
+      for (int r = 0; r < 6; ++r) scratch.jac[r][fresh] = batch.jac[r][q];
+    if (want_resolution) density[fresh] = static_cast<float>(PixelDensity(batch.jacobian(i)));
+    ++fresh;
+  }
+  if (want_information && fresh > 0) InformationLanes(fresh, rd.whitened[camera].data(), &scratch);
+  int seen = 0;
+  for (std::uint64_t w : entry->bits) seen += __builtin_popcountll(w);
+  entry->seen = seen;
+  if (want_information) {
+    entry->information.resize(6 * std::size_t(seen));
+    entry->band.resize(std::size_t(seen));
+  }
+  if (want_resolution) entry->density.resize(std::size_t(seen));
+  int index = 0, f = 0;
+  for (int w = 0; w < kWords; ++w) {
+    entry->before[w] = static_cast<std::int16_t>(index);
+    for (std::uint64_t bits = entry->bits[w]; bits; bits &= bits - 1, ++index) {
+      const int bit = __builtin_ctzll(bits);
+      if (was.bits[w] >> bit & 1) {
+        const int old =
+            was.before[w] + PopcountInline(was.bits[w] & ((std::uint64_t{1} << bit) - 1));
+        if (want_information) {
+          std::memcpy(&entry->information[6 * index], &was.information[6 * old],
+                      6 * sizeof(double));
+          entry->band[index] = was.band[old];
+        }
+        if (want_resolution) entry->density[index] = was.density[old];
+      } else {
+        if (want_information) {
+          for (int r = 0; r < 6; ++r) entry->information[6 * index + r] = scratch.info[r][f];
+          entry->band[index] = scratch.band[f];
+        }
+        if (want_resolution) entry->density[index] = density[f];
+        ++f;
+      }
+    }
   }
   return cast;
 }
@@ -1819,25 +1917,6 @@ void DropPairData(BlockState& old, UpdatePass* u, std::size_t i) {
   std::vector<std::int32_t>().swap(next[i].band_count);
 }
 
-// Whether a segment from `eye` to a point of `box` can meet `moved` (conservative): the convex hull
-// of the eye and the box against the moved box, along the world axes, and the cone from the eye
-// around the box's bounding ball against the moved box's bounding ball.
-bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
-  for (int k = 0; k < 3; ++k) {
-    const double lo = std::min(eye[k], box.min[k]), hi = std::max(eye[k], box.max[k]);
-    if (hi < moved.min[k] || lo > moved.max[k]) return false;
-  }
-  const Vec3 d = 0.5 * (box.min + box.max) - eye, e = 0.5 * (moved.min + moved.max) - eye;
-  const double rb = 0.5 * (box.max - box.min).norm(), rm = 0.5 * (moved.max - moved.min).norm();
-  const double nd = d.norm(), ne = e.norm();
-  if (nd <= rb || ne <= rm) return true;  // the eye inside a ball
-  if (ne - rm > nd + rb) return false;    // the moved box beyond the segments' ends
-  const double alpha = std::asin(std::min(1.0, rb / nd)), beta = std::asin(std::min(1.0, rm / ne));
-  if (alpha + beta >= kPi) return true;
-  const double cos_between = std::clamp(d.dot(e) / (nd * ne), -1.0, 1.0);
-  return std::acos(cos_between) <= alpha + beta + 1e-12;
-}
-
 // The entry of `camera` among `entries` (ascending camera), or nullptr.
 const CameraEntry* FindEntry(const std::vector<CameraEntry>& entries, int camera) {
   const auto it = std::lower_bound(entries.begin(), entries.end(), camera,
@@ -1919,20 +1998,53 @@ void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
   if (!S.keep) DropPairData(old, u, i);
 }
 
+// Casts dirty block i's changed cameras (a camera update: those that may see it now; a scene
+// update: the block's own, again where the block is kept, then drops the views that did not
+// change).
+void CastBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
+  const FieldOptions& opt = S.options;
+  const std::size_t b = u->dirty[i];
+  const std::vector<std::int32_t>& candidates = u->candidates[b];
+  std::vector<CameraEntry>& cast = u->cast[i];
+  std::vector<Ray>* rays = opt.record_rays ? &u->next[i].rays : nullptr;
+  const bool again = u->per_block && !S.states[b].coverage.empty();
+  thread_local State::BlockPoints points;
+  points.count = -1;
+  for (int c : u->per_block ? u->block_changed[i] : u->changed) {
+    if (!u->per_block && !std::binary_search(candidates.begin(), candidates.end(), c)) continue;
+    if (points.count < 0) S.Points(S.blocks[b], &points);
+    cast.emplace_back();
+    const CameraEntry* was = again ? FindEntry(S.states[b].entries, c) : nullptr;
+    if (!was) {
+      S.Cast(points, c, rd, &cast.back(), rays);
+      u->rays += cast.back().rays;
+      continue;
+    }
+    // The moved boxes this camera's segments to the block may meet.
+    thread_local std::vector<Aabb> before, after;
+    const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
+    const auto near = [&](const std::vector<Aabb>& all, std::vector<Aabb>* out) {
+      out->clear();
+      for (const Aabb& m : all)
+        if (SegmentsMayMeet(rd.centres[c], box, m)) out->push_back(m);
+    };
+    near(u->moved.before, &before);
+    near(u->moved.after, &after);
+    u->rays += S.CastAgain(points, c, rd, *was, State::Again{&before, &after}, &cast.back());
+  }
+  if (again) DropUnchangedViews(S.states[b], u, i);
+}
+
 // The parallel phase: casts the changed cameras and derives the dirty blocks (`u->dirty`).
 // Returns false, with nothing derived in place, when cancelled.
 bool CastAndDerive(State& S, const RigData& rd, UpdatePass* u) {
   const FieldOptions& opt = S.options;
-  const std::vector<int>& changed = u->changed;
-  const std::vector<std::vector<std::int32_t>>& candidates = u->candidates;
   const std::vector<std::size_t>& dirty = u->dirty;
   u->in_place = S.evaluated;
   const bool in_place = u->in_place;
   u->next.resize(dirty.size());
   u->cast.resize(dirty.size());
   u->leaves.resize(dirty.size());
-  std::vector<BlockState>& next = u->next;
-  std::vector<std::vector<CameraEntry>>& cast = u->cast;
   std::atomic<std::size_t>& done = u->done;
   std::atomic<bool>& cancelled = u->cancelled;
   const std::size_t report_every = std::max<std::size_t>(1, dirty.size() / 200);
@@ -1950,36 +2062,7 @@ bool CastAndDerive(State& S, const RigData& rd, UpdatePass* u) {
         cancelled = true;
         return;
       }
-      const std::size_t b = dirty[i];
-      // The changed cameras that may see the block now.
-      thread_local State::BlockPoints points;
-      points.count = -1;
-      const bool again = u->per_block && !S.states[b].coverage.empty();
-      for (int c : u->per_block ? u->block_changed[i] : changed)
-        if (u->per_block || std::binary_search(candidates[b].begin(), candidates[b].end(), c)) {
-          if (points.count < 0) S.Points(S.blocks[b], &points);
-          cast[i].emplace_back();
-          State::Again view;
-          // The moved boxes this camera's segments to the block may meet.
-          thread_local std::vector<Aabb> before, after;
-          if (again) {
-            const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
-            const auto near = [&](const std::vector<Aabb>& all, std::vector<Aabb>* out) {
-              out->clear();
-              for (const Aabb& m : all)
-                if (SegmentsMayMeet(rd.centres[c], box, m)) out->push_back(m);
-            };
-            near(u->moved.before, &before);
-            near(u->moved.after, &after);
-            const CameraEntry* was = FindEntry(S.states[b].entries, c);
-            view.seen = was ? &was->bits : nullptr;
-            view.before = &before;
-            view.after = &after;
-          }
-          u->rays += S.Cast(points, c, rd, &cast[i].back(),
-                            opt.record_rays ? &next[i].rays : nullptr, view.seen ? &view : nullptr);
-        }
-      if (u->per_block && !S.states[b].coverage.empty()) DropUnchangedViews(S.states[b], u, i);
+      CastBlock(S, rd, u, i);
       if (!in_place) derive(i);
       report(0.0);
     }
