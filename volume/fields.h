@@ -207,8 +207,8 @@ class FieldEvaluator {
   /// the voxels a camera sees now and did not, or the reverse, are re-derived. The fields equal a
   /// full evaluation of `scene` voxel for voxel, bit for bit (test volume/time_fields_test.cpp).
   /// Evaluates in full when nothing is kept, or when the scene's extent (the visibility tolerance's
-  /// scale) changed. Not cancellable. `scene` and `caster` must outlive the evaluator or the next
-  /// UpdateScene.
+  /// scale) changed; before the first Update (or after a cancelled one) only takes the new scene.
+  /// Not cancellable. `scene` and `caster` must outlive the evaluator or the next UpdateScene.
   FieldUpdate UpdateScene(const Scene& scene, const RayCaster& caster, const SceneChange& moved);
 
   const Fields& fields() const;

@@ -68,6 +68,7 @@ void EvaluateSamples(
     previous_caster = std::move(caster);
     cost.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     visit(s, evaluator->fields(), cost);
+    if (options.cancel && options.cancel->load()) return;  // the caller drops what it has
   }
 }
 

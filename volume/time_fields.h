@@ -75,7 +75,8 @@ SceneChange MovedBounds(const Scene& before, const Scene& after);
 /// is evaluated in full, the next ones by difference (FieldEvaluator::UpdateScene with the bounds
 /// of what moved since the previous sample: only the (block, camera) pairs whose segments can meet
 /// them are cast again). When the evaluator's kept state would exceed the memory budget, every
-/// sample is evaluated in full. docs/time.md.
+/// sample is evaluated in full. Stops after the sample during which FieldOptions::cancel is set
+/// (a sample evaluated by difference runs to its end). docs/time.md.
 void EvaluateSamples(
     const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
     const std::vector<TimeSample>& samples, const FieldOptions& options,
