@@ -601,15 +601,20 @@ void SegmentsMeetBoxes(const VisibilityTester::GeometryBatch& batch, int count,
   for (const Aabb& box : boxes) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
+      // Never exactly 0 (an origin on a face, widened outwards by the least double): 0 times an
+      // infinite inverse would be NaN.
+      const double tiny = std::numeric_limits<double>::denorm_min();
       lo[k] = box.min[k] - batch.origin[k];
       hi[k] = box.max[k] - batch.origin[k];
+      if (lo[k] == 0.0) lo[k] = -tiny;
+      if (hi[k] == 0.0) hi[k] = tiny;
     }
 #pragma omp simd
     for (int p = 0; p < count; ++p) {
       double t0 = batch.t_near[p], t1 = batch.t_far[p];
       for (int k = 0; k < 3; ++k) {
-        // A direction of 0 along k: the slab's times are -inf..inf when the origin is inside it
-        // (0 * inf would be NaN: max/min below keep t0, t1 then, as inside), else +-inf.
+        // A direction of 0 along k: the slab's times are -inf..inf when the origin is inside it,
+        // else both +inf or both -inf (a miss).
         const double ta = lo[k] * inv[k][p], tb = hi[k] * inv[k][p];
         const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
         t0 = near > t0 ? near : t0;
