@@ -2015,6 +2015,7 @@ void CastBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
   const bool again = u->per_block && !S.states[b].coverage.empty();
   thread_local State::BlockPoints points;
   points.count = -1;
+  const Aabb box = again ? BlockCentreBox(S.fields.lattice, S.blocks[b]) : Aabb();
   for (int c : u->per_block ? u->block_changed[i] : u->changed) {
     if (!u->per_block && !std::binary_search(candidates.begin(), candidates.end(), c)) continue;
     if (points.count < 0) S.Points(S.blocks[b], &points);
@@ -2027,7 +2028,6 @@ void CastBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
     }
     // The moved boxes this camera's segments to the block may meet.
     thread_local std::vector<Aabb> before, after;
-    const Aabb box = BlockCentreBox(S.fields.lattice, S.blocks[b]);
     const auto near = [&](const std::vector<Aabb>& all, std::vector<Aabb>* out) {
       out->clear();
       for (const Aabb& m : all)
@@ -2363,12 +2363,11 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
     }
     return out;
   };
-  std::vector<Aabb> boxes = padded(moved.before);
-  const std::vector<Aabb> after = padded(moved.after);
-  boxes.insert(boxes.end(), after.begin(), after.end());
   UpdatePass u;
+  u.moved = {padded(moved.before), padded(moved.after)};
+  std::vector<Aabb> boxes = u.moved.before;  // both
+  boxes.insert(boxes.end(), u.moved.after.begin(), u.moved.after.end());
   u.per_block = true;
-  u.moved = {padded(moved.before), after};
   u.candidates.resize(S.blocks.size());
   S.states.resize(S.blocks.size());
   std::vector<std::vector<int>> recast(S.blocks.size());
