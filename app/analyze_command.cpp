@@ -28,8 +28,10 @@
 #include "volume/fields.h"
 #include "volume/fields_transfer.h"
 #include "volume/pixel_targets.h"
+#include "volume/ptz_fields.h"
 #include "volume/robustness.h"
 #include "volume/summary.h"
+#include "volume/summary_parts.h"
 #include "volume/time_fields.h"
 #include "volume/value_spill.h"
 #include "volume/vdb_io.h"
@@ -289,33 +291,6 @@ int RunAnalyze(const AnalyzeArgs& args) {
 namespace pandora::app {
 namespace {
 
-// What a streamed run cannot compute: the analyses that need the whole fields at once. Each refused
-// with one line naming where the study (or --fields) asks for it.
-void CheckStreamable(const AnalyzeArgs& args, const Scene& scene, const Rig& rig,
-                     const std::vector<std::string>& fields) {
-  const std::string hint =
-      "run without --stream (at a voxel size the memory budget allows), or leave it out";
-  const auto refuse = [&](const std::string& file, const std::string& path,
-                          const std::string& what) {
-    throw InputError(
-        file, path,
-        what + " needs the whole fields in memory and is not computed by a streamed run (--stream)",
-        hint);
-  };
-  if (std::find(fields.begin(), fields.end(), "cameras") != fields.end())
-    throw InputError(args.fields.empty() ? scene.path : "--fields",
-                     args.fields.empty() ? "$.study.fields" : "",
-                     "the field 'cameras' (per-camera grids, N-1 criticality) is not computed by a "
-                     "streamed run (--stream)",
-                     "ask for the others, e.g. --fields coverage,resolution,sigma_max");
-  if (RigHasPtz(rig)) refuse(scene.path, "$.rigs", "the PTZ fields of rig '" + rig.name + "'");
-  if (scene.Animated())
-    refuse(scene.path, scene.motions.empty() ? "$.objects" : "$.motions",
-           "moving objects' fields over time");
-  if (!scene.study.pixel_targets.empty())
-    refuse(scene.path, "$.study.pixel_targets", "the pixel-size targets");
-}
-
 std::string Triple(const Eigen::Vector3i& v) {
   return std::to_string(v.x()) + "," + std::to_string(v.y()) + "," + std::to_string(v.z());
 }
@@ -382,6 +357,17 @@ std::vector<std::int64_t> SumCountsAtRoot(const MpiSession& mpi,
   return sum;
 }
 
+// Every process's `counts` summed, on every process (a collective).
+std::vector<std::int64_t> AllSum(const MpiSession& mpi, const std::vector<std::int64_t>& counts) {
+  if (!mpi.active()) return counts;
+  const std::vector<std::int64_t> sum = SumCountsAtRoot(mpi, counts, counts.size());
+  const std::string sent = mpi.Broadcast(
+      std::string(reinterpret_cast<const char*>(sum.data()), sum.size() * sizeof(std::int64_t)));
+  std::vector<std::int64_t> out(sent.size() / sizeof(std::int64_t));
+  std::memcpy(out.data(), sent.data(), out.size() * sizeof(std::int64_t));
+  return out;
+}
+
 // What a streamed run reads and plans before anything is staged.
 struct StreamSetup {
   std::shared_ptr<const session::Study> study;
@@ -389,6 +375,10 @@ struct StreamSetup {
   FieldOptions options;
   std::vector<BlockColumns> tiles;
   VoxelLattice lattice;
+  // Moving objects: the time samples and the scene's rigid parts (built once, for every tile).
+  std::vector<TimeSample> samples;
+  std::unique_ptr<RigidPartsRayCaster> parts;
+  double parts_seconds = 0;
 };
 
 StreamSetup PrepareStream(const AnalyzeArgs& args) {
@@ -400,11 +390,9 @@ StreamSetup PrepareStream(const AnalyzeArgs& args) {
   const auto& study = setup.study;
   const Scene& scene = study->scene();
   setup.rig = session::DisableCameras(study->FindRig(args.rig, "--rig"), args.disable, "--disable");
-  const Rig& rig = setup.rig;
   setup.options = AnalyzeFieldOptions(args, scene);
   FieldOptions& options = setup.options;
   options.solid_trees = &study->solid_trees();
-  CheckStreamable(args, scene, rig, options.fields);
   const double tile_side = std::isnan(args.tile_size)
                                ? 0.0
                                : CheckPositiveOption("--tile-size", args.tile_size, "metres");
@@ -418,6 +406,13 @@ StreamSetup PrepareStream(const AnalyzeArgs& args) {
       PlanTiles(lattice, options.fields,
                 std::max(0.0, options.memory_budget_bytes - SceneStructureBytes(scene)), tile_side);
   const std::vector<BlockColumns>& tiles = setup.tiles;
+  if (scene.Animated() || scene.study.targets) {
+    const auto t0 = std::chrono::steady_clock::now();
+    setup.samples = scene.TimeSamples();
+    setup.parts = MakeSceneParts(scene);
+    setup.parts_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   constexpr std::size_t kMostTiles = 10000;
   if (tiles.size() > kMostTiles) {
     // Blame what sized the tiles: --tile-size, --memory-budget, or the scene's budget.
@@ -467,16 +462,45 @@ std::string StageStreamOutputs(OutputTransaction& output, const Scene& scene,
 // A process's tiles added up: their statistics, the tile list for the summary, and the values
 // behind the summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
 struct StreamTotals {
-  explicit StreamTotals(std::size_t region_count)
-      : regions(region_count), region_spills(2 * region_count) {}
+  StreamTotals(std::size_t region_count, const std::string& spill_folder, CountReducer reduce)
+      : regions(region_count),
+        region_spills(2 * region_count),
+        time(spill_folder, "--out", reduce),
+        pixel_targets(spill_folder, "--out", reduce),
+        criticality(spill_folder, "--out", reduce),
+        ptz(spill_folder, "--out", reduce) {}
   std::unique_ptr<ValueSpill> spills[3];  // resolution, sigma_max, sigma_max_steady
   FieldStats total;
   DoriSummary dori;
   // The named sub-regions: counts added up, values spilled (density, sigma_max per region).
   std::vector<RegionCounts> regions;
   std::vector<std::unique_ptr<ValueSpill>> region_spills;
+  // The analyses beside the fields, part by part (volume/summary_parts.h): the fields over time,
+  // pixel-size targets, N-1 criticality and PTZ fields of each tile.
+  SpilledParts time, pixel_targets, criticality, ptz;
   nlohmann::json tile_list = nlohmann::json::array();
 };
+
+// The analyses beside the fields over one tile's fields `f` (evaluated with `tile_options`), as
+// CompleteAnalysis runs them in memory (app/session/analyze.h): their derived grids into `f`,
+// their parts added to `totals`.
+void AnalyzeStreamTile(const StreamSetup& setup, const FieldOptions& tile_options, Fields& f,
+                       StreamTotals& totals) {
+  const Scene& scene = setup.study->scene();
+  const Rig& rig = setup.rig;
+  const int k = scene.TimeMinCameras();
+  if (scene.Animated() && !setup.samples.empty()) {
+    FieldOptions over_time = OverTimeOptions(tile_options);
+    over_time.progress = nullptr;
+    totals.time.Add(TimeFieldsParts(scene, rig, *setup.parts, setup.samples, over_time, k, &f));
+  }
+  totals.pixel_targets.Add(PixelTargetParts(scene, rig, f, k, &f));
+  if (HasCameraSets(f)) {
+    totals.criticality.Add(CriticalityParts(scene, rig, f, setup.study->caster(), k));
+    AddCoverageN1Grid(&f);
+  }
+  if (RigHasPtz(rig)) totals.ptz.Add(PtzFieldsParts(scene, rig, setup.study->caster(), f, &f));
+}
 
 // Evaluates this process's tiles (every size-th) one at a time, each written to its staged path
 // and then dropped; adds them up in `totals`, the values spilled into `spill_folder`.
@@ -510,6 +534,7 @@ void EvaluateStreamTiles(const StreamSetup& setup, const MpiSession& mpi,
     o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
     Fields f = EvaluateFields(scene, rig, study->caster(), o);
     FieldStats& st = f.stats;
+    AnalyzeStreamTile(setup, o, f, totals);
     // DORI classes: the tile's grid, and its counts added up (the shares at the end).
     if (scene.study.dori) {
       const DoriSummary d = EvaluateDori(scene, f, &f);
@@ -661,6 +686,59 @@ nlohmann::json StreamPartJson(const StreamTotals& totals) {
   return part;
 }
 
+// The analyses beside the fields, finished from every tile's parts.
+struct StreamAnalyses {
+  std::optional<TimeSummary> time;
+  std::vector<PixelTargetSummary> pixel_targets;
+  std::optional<CriticalityTable> criticality;
+  std::optional<PtzFieldsSummary> ptz;
+};
+
+// Sums every process's parts and finishes each analysis (a collective: every process calls it; the
+// results are rank 0's to use).
+StreamAnalyses FinishStreamAnalyses(const StreamSetup& setup, StreamTotals& totals) {
+  const Scene& scene = setup.study->scene();
+  const Rig& rig = setup.rig;
+  const int k = scene.TimeMinCameras();
+  StreamAnalyses out;
+  for (SpilledParts* parts :
+       {&totals.time, &totals.pixel_targets, &totals.criticality, &totals.ptz})
+    parts->Reduce();
+  if (scene.Animated() && !setup.samples.empty()) {
+    out.time = FinishTimeFields(setup.samples, k, totals.time.Counts(), totals.time.Seconds(),
+                                totals.time);
+    double seconds = 0;
+    for (double s : totals.time.Seconds()) seconds += s;
+    out.time->seconds = seconds;
+    out.time->parts_seconds = setup.parts_seconds;
+  }
+  SummaryParts pixel;
+  pixel.counts = totals.pixel_targets.Counts();
+  pixel.seconds = totals.pixel_targets.Seconds();
+  out.pixel_targets = FinishPixelTargets(scene, k, pixel);
+  if (!totals.criticality.Counts().empty())  // (the region's size is rank 0's sum: its result)
+    out.criticality = FinishCriticality(rig, k, totals.total.active_set.region_voxels,
+                                        totals.criticality.Counts(), totals.criticality);
+  if (RigHasPtz(rig))
+    out.ptz = FinishPtzFields(scene, rig, totals.ptz.Counts(), totals.ptz.Seconds(), totals.ptz);
+  return out;
+}
+
+// The finished analyses into the summary, as CompleteAnalysis sets them in memory; the surface
+// targets (they do not depend on the region) computed here.
+void ApplyStreamAnalyses(const StreamSetup& setup, StreamAnalyses&& analyses, Summary& typed) {
+  const Scene& scene = setup.study->scene();
+  if (scene.Animated() || scene.study.targets) {
+    for (const TimeSample& s : setup.samples) typed.sample_labels.push_back(s.label);
+    typed.time = std::move(analyses.time);
+    typed.targets = EvaluateSurfaceTargets(scene, setup.rig, *setup.parts, setup.samples,
+                                           scene.TimeMinCameras());
+  }
+  typed.pixel_targets = std::move(analyses.pixel_targets);
+  typed.robustness = std::move(analyses.criticality);
+  typed.ptz = std::move(analyses.ptz);
+}
+
 }  // namespace
 
 int RunStreamedAnalyze(const AnalyzeArgs& args) {
@@ -710,7 +788,8 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   // summary's percentiles spilled to disk (volume/value_spill.h) beside the staged tiles.
   const std::string spill_folder = std::filesystem::path(tile_paths[0]).parent_path().string();
   const std::size_t region_count = scene.study.regions.size();
-  StreamTotals totals(region_count);
+  StreamTotals totals(region_count, spill_folder,
+                      [&mpi](const std::vector<std::int64_t>& v) { return AllSum(mpi, v); });
   ProgressBar bar("analyze " + rig.name + " (streamed, " + std::to_string(tiles.size()) + " tiles" +
                       (mpi.active() ? ", rank 0 of " + std::to_string(mpi.size()) : "") + ")",
                   !(args.quiet || !root));
@@ -732,6 +811,8 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
   nlohmann::json all_tiles = nlohmann::json::array(), peak_rss = nlohmann::json::array();
   if (root) AddUpAtRoot(parts, region_count, totals, all_tiles, peak_rss);
   StreamPercentiles p = SelectStreamPercentiles(mpi, scene, options, totals, want_resolution);
+  // The analyses beside the fields from every tile's parts (collectives: every process finishes).
+  StreamAnalyses analyses = FinishStreamAnalyses(setup, totals);
   if (!root) return 0;
 
   Fields merged;
@@ -749,9 +830,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
     typed.dori = totals.dori;
   }
   typed.regions = std::move(p.region_summaries);
-  if (scene.study.targets)
-    typed.targets =
-        EvaluateSurfaceTargets(scene, rig, *MakeSceneParts(scene), {}, scene.TimeMinCameras());
+  ApplyStreamAnalyses(setup, std::move(analyses), typed);
   if (scene.study.calibration)
     typed.calibration = SimulateCalibration(scene, rig, study->caster(), *scene.study.calibration);
   nlohmann::json summary = typed;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include "analysis/geometry/visibility.h"
 #include "analysis/util/error.h"
@@ -12,10 +13,9 @@
 
 namespace pandora {
 
-std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig,
-                                                     const Fields& fields, int min_cameras,
-                                                     Fields* grids) {
-  std::vector<PixelTargetSummary> out;
+SummaryParts PixelTargetParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                              int min_cameras, Fields* grids) {
+  SummaryParts out;
   if (scene.study.pixel_targets.empty()) return out;
   const Fields::Impl& g = fields.impl();
   if (g.visible.empty() || !g.coverage)
@@ -24,10 +24,10 @@ std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const R
                      "add \"coverage\" and \"cameras\" to the study's fields");
   const int kmax = std::max(3, min_cameras);
   const auto t0 = std::chrono::steady_clock::now();
-  // The caster is not used: the visibility is known; only TestGeometry's Jacobian is needed.
+  // The projection alone: no ray is cast (the camera sets already hold the occlusion).
   const auto none = MakeBruteForceRayCaster(TriangleMesh());
   const VisibilityTester tester(rig.cameras, *none, scene.ContentBounds().diagonal());
-  // Per target, the cameras meeting it at each voxel; each (voxel, camera) density computed once.
+  // Per target: how many cameras meet it at each voxel.
   const std::vector<PixelTarget>& targets = scene.study.pixel_targets;
   std::vector<openvdb::Int32Grid::Ptr> counts;
   for (std::size_t t = 0; t < targets.size(); ++t) counts.push_back(openvdb::Int32Grid::create(0));
@@ -52,35 +52,57 @@ std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const R
           acc.setValue(voxels[i], acc.getValue(voxels[i]) + 1);
     }
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Per target: the free region voxels, then those met by >= 1 .. kmax cameras.
+  out.counts.assign(targets.size() * std::size_t(1 + kmax), 0);
   for (std::size_t t = 0; t < targets.size(); ++t) {
-    PixelTargetSummary s;
-    s.target = targets[t];
-    s.share_ge.assign(kmax, 0.0);
-    std::int64_t voxels = 0;
+    std::int64_t* row = &out.counts[t * std::size_t(1 + kmax)];
     openvdb::FloatGrid::Ptr grid;
     if (grids) {
       grid = openvdb::FloatGrid::create(0.0f);
       grid->setTransform(g.coverage->transformPtr()->copy());
     }
-    // Over the free voxels (the coverage grid's active set).
+    // Every free region voxel (coverage is active on them), met or not.
     auto count = counts[t]->getConstAccessor();
     ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) {
       const int n = count.getValue(c);
-      for (int j = 1; j <= std::min(n, kmax); ++j) s.share_ge[j - 1] += 1;
+      for (int j = 1; j <= std::min(n, kmax); ++j) ++row[j];
       if (grid) grid->tree().setValue(c, float(n));
-      ++voxels;
+      ++row[0];
     });
-    for (double& v : s.share_ge) v = voxels > 0 ? v / double(voxels) : 0.0;
     if (grid) {
       grid->pruneGrid();
       grids->impl().extra["pixels_" + targets[t].name] = grid;
     }
-    s.seconds = seconds;
+  }
+  out.seconds = {std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+  return out;
+}
+
+std::vector<PixelTargetSummary> FinishPixelTargets(const Scene& scene, int min_cameras,
+                                                   const SummaryParts& parts) {
+  std::vector<PixelTargetSummary> out;
+  const std::vector<PixelTarget>& targets = scene.study.pixel_targets;
+  const int kmax = std::max(3, min_cameras);
+  if (targets.empty()) return out;
+  if (parts.counts.size() != targets.size() * std::size_t(1 + kmax))
+    throw std::invalid_argument("FinishPixelTargets: the parts are of another study");
+  for (std::size_t t = 0; t < targets.size(); ++t) {
+    const std::int64_t* row = &parts.counts[t * std::size_t(1 + kmax)];
+    PixelTargetSummary s;
+    s.target = targets[t];
+    for (int j = 1; j <= kmax; ++j)
+      s.share_ge.push_back(row[0] > 0 ? double(row[j]) / double(row[0]) : 0.0);
+    s.seconds = parts.seconds.empty() ? 0.0 : parts.seconds[0];
     out.push_back(s);
   }
   return out;
+}
+
+std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig,
+                                                     const Fields& fields, int min_cameras,
+                                                     Fields* grids) {
+  return FinishPixelTargets(scene, min_cameras,
+                            PixelTargetParts(scene, rig, fields, min_cameras, grids));
 }
 
 DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids) {

@@ -14,6 +14,7 @@
 
 #include "analysis/scene/scene.h"
 #include "volume/fields.h"
+#include "volume/summary_parts.h"
 
 namespace pandora {
 
@@ -55,6 +56,14 @@ inline constexpr double kDoriPxPerM[4] = {25.0, 62.5, 125.0, 250.0};
 std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const Rig& rig,
                                                      const Fields& fields, int min_cameras,
                                                      Fields* grids);
+
+/// EvaluatePixelTargets in parts (volume/summary_parts.h): the counts over the voxels of `fields`
+/// (a streamed run's tile, or the whole region), its grids into `grids` as EvaluatePixelTargets.
+SummaryParts PixelTargetParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                              int min_cameras, Fields* grids);
+/// The summaries from every part added up (SummaryParts::Add).
+std::vector<PixelTargetSummary> FinishPixelTargets(const Scene& scene, int min_cameras,
+                                                   const SummaryParts& parts);
 
 /// The DORI shares from the resolution field (InputError "$.study.dori" when it is missing); with
 /// `grids`, adds a float grid "dori" (the class 0 .. 4 reached, active on the free region voxels).

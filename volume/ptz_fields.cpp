@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include "analysis/geometry/camera.h"
 #include "volume/fields_vdb.h"
@@ -97,94 +98,91 @@ PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera,
   return WatchTour(head, base, legs, sees, &target);
 }
 
-PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                                   const Fields& fields, Fields* grids) {
-  const auto t0 = std::chrono::steady_clock::now();
-  PtzFieldsSummary out;
-  out.min_px_per_m = scene.study.ptz.min_px_per_m;
-  out.pixel_target = scene.study.ptz.pixel_target;
-  out.within_s = scene.study.ptz.within_s;
-  const Fields::Impl& g = fields.impl();
-  if (!RigHasPtz(rig) || !g.coverage) return out;
-  std::vector<openvdb::Coord> voxels;
-  ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) { voxels.push_back(c); });
-  const std::size_t n = voxels.size();
-  out.region_voxels = static_cast<std::int64_t>(n);
-  const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
-  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal(),
-                                surfaces.get());
+namespace {
+
+// The enabled PTZ cameras of the rig, rig order.
+std::vector<int> PtzCameras(const Rig& rig) {
   std::vector<int> ptz;
   for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c)
     if (rig.cameras[c].enabled && rig.cameras[c].ptz) ptz.push_back(c);
+  return ptz;
+}
+
+// The parts' layout: counts [region voxels, rays, reachable by some PTZ, within each budget, then
+// per PTZ camera: reachable, within each budget, within the trace, watched at some time, the
+// watched fractions' exact sum (kFixedLimbs)]; lists per PTZ camera: the finite reach times and
+// the gaps of the voxels watched at some time.
+constexpr std::size_t kPtzCounts = 3;
+std::size_t PerPtzCamera(std::size_t budgets) { return budgets + 3 + kFixedLimbs; }
+
+}  // namespace
+
+SummaryParts PtzFieldsParts(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                            const Fields& fields, Fields* grids) {
+  SummaryParts out;
+  const Fields::Impl& g = fields.impl();
+  if (!RigHasPtz(rig) || !g.coverage) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<double>& within_s = scene.study.ptz.within_s;
+  const std::size_t budgets = within_s.size(), per = PerPtzCamera(budgets);
+  std::vector<openvdb::Coord> voxels;
+  ForEachActiveVoxel(*g.coverage, [&](const openvdb::Coord& c, int) { voxels.push_back(c); });
+  const std::size_t n = voxels.size();
+  const std::unique_ptr<SurfaceDistance> surfaces = PtzSweptOccluders(scene, rig);
+  const VisibilityTester tester(rig.cameras, caster, scene.ContentBounds().diagonal(),
+                                surfaces.get());
+  const std::vector<int> ptz = PtzCameras(rig);
+  out.counts.assign(kPtzCounts + budgets + per * ptz.size(), 0);
+  out.lists.resize(2 * ptz.size());
+  out.counts[0] = static_cast<std::int64_t>(n);
   std::vector<float> rig_min(n, std::numeric_limits<float>::infinity());
   std::atomic<std::int64_t> rays{0};
-  const double px = out.min_px_per_m;
-  auto share = [n](std::int64_t count) {
-    return n ? static_cast<double>(count) / static_cast<double>(n) : 0.0;
-  };
+  const double px = scene.study.ptz.min_px_per_m;
   auto make_grid = [&](const std::string& name) {
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
     grid->setName(name);
     grid->setTransform(g.coverage->transformPtr()->copy());
     return grid;
   };
-  for (int c : ptz) {
+  for (std::size_t p = 0; p < ptz.size(); ++p) {
+    const int c = ptz[p];
     const Camera& cam = rig.cameras[c];
     const PtzHead& head = *cam.ptz;
-    PtzCameraFields f;
-    f.id = cam.id;
-    f.camera = c;
-    f.max_time_s = PtzReach(cam, head, head.current, px).MaxTime();
-    f.trace_s = head.trace_s;
     const std::vector<PtzHead::TourLeg> legs = head.TourLegs();
-    f.tour = !legs.empty();
-    f.stops = static_cast<int>(legs.size());
-    f.period_s = f.tour ? legs.back().end() : 0.0;
-    std::vector<float> reach(n), watched(f.tour ? n : 0), gap(f.tour ? n : 0);
+    const bool tour = !legs.empty();
+    const double period_s = tour ? legs.back().end() : 0.0;
+    std::vector<float> reach(n), watched(tour ? n : 0), gap(tour ? n : 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
       std::int64_t local = 0;
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const openvdb::Vec3d w = g.coverage->indexToWorld(voxels[i]);
         const Vec3 X(w.x(), w.y(), w.z());
         reach[i] = static_cast<float>(PtzReachTime(tester, c, X, px, 1e-3, &local));
-        if (f.tour) {
+        if (tour) {
           const PtzWatch watch = PtzTourWatch(tester, c, legs, X, px, &local);
-          watched[i] = static_cast<float>(f.period_s > 0 ? watch.watched_s() / f.period_s : 0.0);
+          watched[i] = static_cast<float>(period_s > 0 ? watch.watched_s() / period_s : 0.0);
           gap[i] = watch.intervals.empty() ? -1.0f : static_cast<float>(watch.longest_gap_s());
         }
       }
       rays += local;
     });
-    std::vector<float> finite;
-    f.within.assign(out.within_s.size(), 0.0);
-    std::vector<std::int64_t> within(out.within_s.size(), 0);
-    std::int64_t within_trace = 0;
+    std::int64_t* row = &out.counts[kPtzCounts + budgets + per * p];
+    std::vector<float>& finite = out.lists[2 * p];
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(reach[i])) continue;
       finite.push_back(reach[i]);
       rig_min[i] = std::min(rig_min[i], reach[i]);
-      for (std::size_t k = 0; k < out.within_s.size(); ++k)
-        within[k] += reach[i] <= out.within_s[k];
-      within_trace += reach[i] <= head.trace_s;
+      for (std::size_t k = 0; k < budgets; ++k) row[1 + k] += reach[i] <= within_s[k];
+      row[1 + budgets] += reach[i] <= head.trace_s;
     }
-    f.reachable_voxels = static_cast<std::int64_t>(finite.size());
-    f.reachable_share = share(f.reachable_voxels);
-    for (std::size_t k = 0; k < within.size(); ++k) f.within[k] = share(within[k]);
-    f.within_trace = share(within_trace);
-    f.reach_p50_s = NearestRankPercentile(finite, 50);
-    f.reach_p90_s = NearestRankPercentile(finite, 90);
-    if (f.tour) {
-      double sum = 0;
-      std::vector<float> gaps;
+    row[0] = static_cast<std::int64_t>(finite.size());
+    if (tour) {
+      std::vector<float>& gaps = out.lists[2 * p + 1];
       for (std::size_t i = 0; i < n; ++i) {
-        sum += watched[i];
+        AddFixedLimbs(std::clamp(double(watched[i]), 0.0, 1.0), &row[3 + budgets]);
         if (gap[i] >= 0) gaps.push_back(gap[i]);
       }
-      f.watched_mean = n ? sum / static_cast<double>(n) : 0.0;
-      f.watched_share = share(static_cast<std::int64_t>(gaps.size()));
-      f.gap_p50_s = NearestRankPercentile(gaps, 50);
-      f.gap_p90_s = NearestRankPercentile(gaps, 90);
-      f.gap_max_s = NearestRankPercentile(gaps, 100);
+      row[2 + budgets] = static_cast<std::int64_t>(gaps.size());
     }
     if (grids) {
       auto reach_grid = make_grid("ptz_reach_time/" + cam.id);
@@ -192,7 +190,7 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
       for (std::size_t i = 0; i < n; ++i)
         if (std::isfinite(reach[i])) acc.setValueOn(voxels[i], reach[i]);
       grids->impl().extra[reach_grid->getName()] = reach_grid;
-      if (f.tour) {
+      if (tour) {
         auto watched_grid = make_grid("ptz_watched/" + cam.id);
         auto gap_grid = make_grid("ptz_gap/" + cam.id);
         auto wa = watched_grid->getAccessor();
@@ -205,18 +203,13 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
         grids->impl().extra[gap_grid->getName()] = gap_grid;
       }
     }
-    out.cameras.push_back(std::move(f));
   }
-  std::int64_t reachable = 0;
-  std::vector<std::int64_t> within(out.within_s.size(), 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(rig_min[i])) continue;
-    ++reachable;
-    for (std::size_t k = 0; k < out.within_s.size(); ++k)
-      within[k] += rig_min[i] <= out.within_s[k];
+    ++out.counts[2];
+    for (std::size_t k = 0; k < budgets; ++k)
+      out.counts[kPtzCounts + k] += rig_min[i] <= within_s[k];
   }
-  out.reachable_share = share(reachable);
-  for (std::int64_t w : within) out.within.push_back(share(w));
   if (grids) {
     auto grid = make_grid("ptz_reach_time");
     auto acc = grid->getAccessor();
@@ -224,7 +217,71 @@ PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const Ray
       if (std::isfinite(rig_min[i])) acc.setValueOn(voxels[i], rig_min[i]);
     grids->impl().extra["ptz_reach_time"] = grid;
   }
-  out.rays = rays.load();
+  out.counts[1] = rays.load();
+  out.seconds = {std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+  return out;
+}
+
+PtzFieldsSummary FinishPtzFields(const Scene& scene, const Rig& rig,
+                                 const std::vector<std::int64_t>& counts,
+                                 const std::vector<double>& seconds, PercentileSource& lists) {
+  PtzFieldsSummary out;
+  out.min_px_per_m = scene.study.ptz.min_px_per_m;
+  out.pixel_target = scene.study.ptz.pixel_target;
+  out.within_s = scene.study.ptz.within_s;
+  if (counts.empty()) return out;  // no PTZ camera, or no coverage field
+  const std::vector<int> ptz = PtzCameras(rig);
+  const std::size_t budgets = out.within_s.size(), per = PerPtzCamera(budgets);
+  if (counts.size() != kPtzCounts + budgets + per * ptz.size())
+    throw std::invalid_argument("FinishPtzFields: the parts are of another rig");
+  const std::int64_t n = counts[0];
+  out.region_voxels = n;
+  const auto share = [n](std::int64_t count) {
+    return n ? static_cast<double>(count) / static_cast<double>(n) : 0.0;
+  };
+  for (std::size_t p = 0; p < ptz.size(); ++p) {
+    const Camera& cam = rig.cameras[ptz[p]];
+    const PtzHead& head = *cam.ptz;
+    const std::int64_t* row = &counts[kPtzCounts + budgets + per * p];
+    PtzCameraFields f;
+    f.id = cam.id;
+    f.camera = ptz[p];
+    f.max_time_s = PtzReach(cam, head, head.current, out.min_px_per_m).MaxTime();
+    f.trace_s = head.trace_s;
+    const std::vector<PtzHead::TourLeg> legs = head.TourLegs();
+    f.tour = !legs.empty();
+    f.stops = static_cast<int>(legs.size());
+    f.period_s = f.tour ? legs.back().end() : 0.0;
+    f.reachable_voxels = row[0];
+    f.reachable_share = share(row[0]);
+    for (std::size_t k = 0; k < budgets; ++k) f.within.push_back(share(row[1 + k]));
+    f.within_trace = share(row[1 + budgets]);
+    const ListPercentiles reach = lists.Percentiles(2 * p, {50, 90});
+    f.reach_p50_s = reach.values[0];
+    f.reach_p90_s = reach.values[1];
+    const ListPercentiles gaps = lists.Percentiles(2 * p + 1, {50, 90, 100});
+    if (f.tour) {
+      f.watched_mean = n ? FixedLimbsToDouble(&row[3 + budgets]) / static_cast<double>(n) : 0.0;
+      f.watched_share = share(row[2 + budgets]);
+      f.gap_p50_s = gaps.values[0];
+      f.gap_p90_s = gaps.values[1];
+      f.gap_max_s = gaps.values[2];
+    }
+    out.cameras.push_back(std::move(f));
+  }
+  out.reachable_share = share(counts[2]);
+  for (std::size_t k = 0; k < budgets; ++k) out.within.push_back(share(counts[kPtzCounts + k]));
+  out.rays = counts[1];
+  out.seconds = seconds.empty() ? 0.0 : seconds[0];
+  return out;
+}
+
+PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                                   const Fields& fields, Fields* grids) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SummaryParts parts = PtzFieldsParts(scene, rig, caster, fields, grids);
+  InMemoryPercentiles lists(parts.lists);
+  PtzFieldsSummary out = FinishPtzFields(scene, rig, parts.counts, parts.seconds, lists);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

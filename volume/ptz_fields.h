@@ -20,6 +20,7 @@
 #include "analysis/scene/ptz.h"
 #include "analysis/scene/scene.h"
 #include "volume/fields.h"
+#include "volume/summary_parts.h"
 
 namespace pandora {
 
@@ -90,6 +91,16 @@ PtzWatch PtzTourWatch(const VisibilityTester& tester, int camera,
 /// Parallel (TBB).
 PtzFieldsSummary EvaluatePtzFields(const Scene& scene, const Rig& rig, const RayCaster& caster,
                                    const Fields& fields, Fields* grids);
+
+/// EvaluatePtzFields in parts (volume/summary_parts.h): the counts and lists over the free region
+/// voxels of `fields` (a streamed run's tile, or the whole region), the grids into `grids`. Empty
+/// without a PTZ camera or a coverage grid.
+SummaryParts PtzFieldsParts(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                            const Fields& fields, Fields* grids);
+/// The summary from every part's counts and timings added up and their lists.
+PtzFieldsSummary FinishPtzFields(const Scene& scene, const Rig& rig,
+                                 const std::vector<std::int64_t>& counts,
+                                 const std::vector<double>& seconds, PercentileSource& lists);
 
 /// {min_px_per_m, pixel_target, within_s, region_voxels, cameras [{id, max_time_s, reachable_share,
 /// within, trace_s, within_trace, reach_p50_s, reach_p90_s, tour: null | {stops, period_s,

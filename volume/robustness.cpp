@@ -42,10 +42,9 @@ struct Partial {
   // Per rig camera: voxels it sees with exactly j[t] cameras (they drop below j[t] when it fails).
   std::vector<std::array<std::int64_t, 4>> exactly;
   std::vector<std::int64_t> seen;
-  // Per rig camera: the voxels it sees that are triangulable intact (indices into the intact
-  // sigma_max list: removed when it fails) and sigma_max (mm) where they are after it fails
-  // (added).
-  std::vector<std::vector<std::int64_t>> removed;
+  // Per rig camera: the intact sigma_max (mm) of the voxels it sees that are triangulable intact
+  // (removed when it fails) and sigma_max where they are after it fails (added).
+  std::vector<std::vector<float>> removed;
   std::vector<std::vector<float>> added;
   explicit Partial(std::size_t cameras)
       : exactly(cameras), seen(cameras, 0), removed(cameras), added(cameras) {}
@@ -212,9 +211,10 @@ void LeafWorker::Uncertainty(std::size_t i, const openvdb::Coord& origin) {
   std::int64_t index = in.base[i];
   for (int o = 0; o < 512; ++o) {
     if (sigma_leaf && sigma_leaf->isValueOn(o)) {  // triangulable intact
-      in.intact[static_cast<std::size_t>(index)] = sigma_leaf->getValue(o);
+      const float sigma = sigma_leaf->getValue(o);
+      in.intact[static_cast<std::size_t>(index)] = sigma;
       for (std::size_t e = 0; e < n_cams; ++e)
-        if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(index);
+        if (bits[e][o >> 6] >> (o & 63) & 1) part.removed[cams[e]].push_back(sigma);
       ++index;
     }
     if (count[o] < 3) continue;
@@ -330,7 +330,7 @@ Partial JoinPartials(tbb::enumerable_thread_specific<Partial>& partials, std::si
   std::array<std::int64_t, 4>& at_least = total.at_least;
   std::vector<std::array<std::int64_t, 4>>& exactly = total.exactly;
   std::vector<std::int64_t>& seen = total.seen;
-  std::vector<std::vector<std::int64_t>>& removed = total.removed;
+  std::vector<std::vector<float>>& removed = total.removed;
   std::vector<std::vector<float>>& added = total.added;
   for (Partial& p : partials) {
     for (int t = 0; t < 4; ++t) at_least[t] += p.at_least[t];
@@ -339,7 +339,7 @@ Partial JoinPartials(tbb::enumerable_thread_specific<Partial>& partials, std::si
       seen[c] += p.seen[c];
     }
   }
-  // The per-camera lists hold about 12 bytes per (triangulable voxel, camera that sees it): joined
+  // The per-camera lists hold about 8 bytes per (triangulable voxel, camera that sees it): joined
   // camera by camera, each thread's part freed as soon as it is copied, so that they are never
   // held twice (a camera's list at most).
   for (std::size_t c = 0; c < camera_count; ++c) {
@@ -351,46 +351,21 @@ Partial JoinPartials(tbb::enumerable_thread_specific<Partial>& partials, std::si
     for (Partial& p : partials) {
       removed[c].insert(removed[c].end(), p.removed[c].begin(), p.removed[c].end());
       added[c].insert(added[c].end(), p.added[c].begin(), p.added[c].end());
-      std::vector<std::int64_t>().swap(p.removed[c]);
+      std::vector<float>().swap(p.removed[c]);
       std::vector<float>().swap(p.added[c]);
     }
   }
   return total;
 }
 
-// Each row's triangulable share and sigma_max percentiles without its camera.
-void FailedUncertainty(const Partial& total, const std::vector<float>& intact, std::int64_t region,
-                       CriticalityTable* table) {
-  const std::vector<std::vector<std::int64_t>>& removed = total.removed;
-  const std::vector<std::vector<float>>& added = total.added;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, table->rows.size(), 1),
-                    [&](const auto& range) {
-                      for (std::size_t r = range.begin(); r != range.end(); ++r) {
-                        CriticalityRow& row = table->rows[r];
-                        const std::vector<std::int64_t>& out = removed[row.camera];
-                        const std::vector<float>& in = added[row.camera];
-                        // The multiset intact - out + in: the sigma_max list of the rig without
-                        // this camera.
-                        std::vector<unsigned char> gone(intact.size(), 0);
-                        for (std::int64_t index : out) gone[static_cast<std::size_t>(index)] = 1;
-                        std::vector<float> after;
-                        after.reserve(intact.size() - out.size() + in.size());
-                        for (std::size_t v = 0; v < intact.size(); ++v)
-                          if (!gone[v]) after.push_back(intact[v]);
-                        after.insert(after.end(), in.begin(), in.end());
-                        row.triangulable_voxels = static_cast<std::int64_t>(after.size());
-                        row.triangulable = Fraction(row.triangulable_voxels, region);
-                        row.sigma_max_p50_mm = NearestRankPercentile(after, 50);
-                        row.sigma_max_p90_mm = NearestRankPercentile(std::move(after), 90);
-                      }
-                    });
-}
-
 }  // namespace
 
-CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
-                                    const RayCaster& caster, int k) {
-  const auto t0 = std::chrono::steady_clock::now();
+// The parts' layout: counts [has sigma_max, >= 1, 2, 3, k cameras, then per camera its exactly
+// 1, 2, 3, k and seen]; lists [intact sigma_max, per camera removed, per camera added].
+constexpr std::size_t kCountsBefore = 5, kPerCamera = 5;
+
+SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                              const RayCaster& caster, int k) {
   const Fields::Impl& g = fields.impl();
   if (!HasCameraSets(fields))
     throw std::invalid_argument("ComputeCriticality: the fields hold no per-camera sets");
@@ -399,12 +374,8 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
   const std::size_t camera_count = rig.cameras.size();
   const Thresholds th{{1, 2, 3, k}};
-
-  CriticalityTable table;
-  table.k = k;
-  table.region_voxels = fields.stats.active_set.region_voxels;
   const openvdb::FloatGrid::Ptr sigma_grid = g.Float("sigma_max");
-  table.uncertainty = sigma_grid != nullptr;
+  const bool uncertainty = sigma_grid != nullptr;
 
   // Leaves seen by some enabled camera.
   const std::vector<openvdb::Coord> origins = SeenLeafOrigins(rig, g);
@@ -413,7 +384,7 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   // camera frame and the whitened rotation.
   std::unique_ptr<VisibilityTester> tester;
   std::vector<std::array<double, 9>> whitened(camera_count);
-  if (table.uncertainty) {
+  if (uncertainty) {
     tester =
         std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
     for (std::size_t c = 0; c < camera_count; ++c) {
@@ -427,41 +398,83 @@ CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fi
   // a leaf): base[i] is where leaf i's values start.
   std::vector<std::int64_t> base(origins.size() + 1, 0);
   std::vector<float> intact;
-  if (table.uncertainty) SizeIntactSigmas(*sigma_grid, origins, &base, &intact);
+  if (uncertainty) SizeIntactSigmas(*sigma_grid, origins, &base, &intact);
 
-  const CriticalityInputs in{
-      rig,      fields, g,    th,    table.uncertainty, sigma_grid.get(), tester.get(),
-      whitened, scales, base, intact};
+  const CriticalityInputs in{rig,          fields,   g,      th,   uncertainty, sigma_grid.get(),
+                             tester.get(), whitened, scales, base, intact};
   tbb::enumerable_thread_specific<Partial> partials([&] { return Partial(camera_count); });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4), [&](const auto& range) {
     LeafWorker worker(in, partials.local());
     for (std::size_t i = range.begin(); i != range.end(); ++i) worker.Leaf(i, origins[i]);
   });
 
-  // Totals.
-  const Partial total = JoinPartials(partials, camera_count);
-  const std::array<std::int64_t, 4>& at_least = total.at_least;
-  const std::vector<std::array<std::int64_t, 4>>& exactly = total.exactly;
-  const std::vector<std::int64_t>& seen = total.seen;
-  const std::int64_t region = table.region_voxels;
+  Partial total = JoinPartials(partials, camera_count);
+  SummaryParts out;
+  out.counts.reserve(kCountsBefore + kPerCamera * camera_count);
+  out.counts.push_back(uncertainty ? 1 : 0);
+  for (int t = 0; t < 4; ++t) out.counts.push_back(total.at_least[t]);
+  for (std::size_t c = 0; c < camera_count; ++c) {
+    for (int t = 0; t < 4; ++t) out.counts.push_back(total.exactly[c][t]);
+    out.counts.push_back(total.seen[c]);
+  }
+  out.lists.resize(1 + 2 * camera_count);
+  out.lists[0] = std::move(intact);
+  for (std::size_t c = 0; c < camera_count; ++c) {
+    out.lists[1 + c] = std::move(total.removed[c]);
+    out.lists[1 + camera_count + c] = std::move(total.added[c]);
+  }
+  return out;
+}
+
+CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_voxels,
+                                   const std::vector<std::int64_t>& counts,
+                                   PercentileSource& lists) {
+  const std::size_t camera_count = rig.cameras.size();
+  if (counts.size() != kCountsBefore + kPerCamera * camera_count)
+    throw std::invalid_argument("FinishCriticality: the parts are of another rig");
+  CriticalityTable table;
+  table.k = k;
+  table.region_voxels = region_voxels;
+  table.uncertainty = counts[0] > 0;
+  const std::int64_t region = region_voxels;
+  const std::int64_t* at_least = &counts[1];
   table.ge_k = Fraction(at_least[3], region);
   for (std::size_t c = 0; c < camera_count; ++c) {
     if (!rig.cameras[c].enabled) continue;
+    const std::int64_t* exactly = &counts[kCountsBefore + kPerCamera * c];
     CriticalityRow row;
     row.camera = static_cast<int>(c);
     row.id = rig.cameras[c].id;
-    row.seen_voxels = seen[c];
-    row.ge1 = Fraction(at_least[0] - exactly[c][0], region);
-    row.ge2 = Fraction(at_least[1] - exactly[c][1], region);
-    row.ge3 = Fraction(at_least[2] - exactly[c][2], region);
-    row.ge_k = Fraction(at_least[3] - exactly[c][3], region);
+    row.seen_voxels = exactly[4];
+    row.ge1 = Fraction(at_least[0] - exactly[0], region);
+    row.ge2 = Fraction(at_least[1] - exactly[1], region);
+    row.ge3 = Fraction(at_least[2] - exactly[2], region);
+    row.ge_k = Fraction(at_least[3] - exactly[3], region);
+    if (table.uncertainty) {
+      // The multiset intact - removed + added: the sigma_max list of the rig without this camera.
+      const ListPercentiles after =
+          lists.Percentiles({{0, 1}, {1 + c, -1}, {1 + camera_count + c, 1}}, {50, 90});
+      row.triangulable_voxels = after.count;
+      row.triangulable = Fraction(after.count, region);
+      row.sigma_max_p50_mm = after.values[0];
+      row.sigma_max_p90_mm = after.values[1];
+    }
     table.rows.push_back(row);
   }
-  if (table.uncertainty) FailedUncertainty(total, intact, region, &table);
   double sum = 0;
   for (const CriticalityRow& row : table.rows) sum += row.ge_k;
   table.mean_ge_k = table.rows.empty() ? table.ge_k : sum / static_cast<double>(table.rows.size());
   if (!table.rows.empty()) table.worst = table.MostCritical().front();
+  return table;
+}
+
+CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
+                                    const RayCaster& caster, int k) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SummaryParts parts = CriticalityParts(scene, rig, fields, caster, k);
+  InMemoryPercentiles lists(parts.lists);
+  CriticalityTable table =
+      FinishCriticality(rig, k, fields.stats.active_set.region_voxels, parts.counts, lists);
   table.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return table;
 }

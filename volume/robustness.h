@@ -18,6 +18,7 @@
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/scene/scene.h"
 #include "volume/fields.h"
+#include "volume/summary_parts.h"
 
 namespace pandora {
 
@@ -64,6 +65,16 @@ bool HasCameraSets(const Fields& fields);
 /// is cast). `k` >= 1: the camera count of ge_k. Runs in parallel with TBB.
 CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
                                     const RayCaster& caster, int k);
+
+/// ComputeCriticality in parts (volume/summary_parts.h): the counts and sigma_max lists over the
+/// voxels of `fields` (a streamed run's tile, or the whole region). Throws as ComputeCriticality.
+SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                              const RayCaster& caster, int k);
+/// The table from every part's counts added up and their lists; `region_voxels`: the free region
+/// voxels of all the parts. Equal to ComputeCriticality of the whole region (seconds left 0).
+CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_voxels,
+                                   const std::vector<std::int64_t>& counts,
+                                   PercentileSource& lists);
 
 /// Adds the float grid "coverage_n1" to `fields` (Fields::Impl::extra, written to fields.vdb):
 /// per free region voxel the coverage after the worst single failure there, max(coverage - 1, 0).

@@ -17,6 +17,7 @@
 #include "analysis/geometry/visibility.h"
 #include "tests/fixtures.h"
 #include "volume/active_set.h"
+#include "volume/summary_parts.h"
 #include "volume/value_spill.h"
 
 namespace pandora {
@@ -90,6 +91,81 @@ TEST(ValueSpill, EqualsNearestRankPercentileAndCounts) {
   for (double limit : {-1e9, -3.0, 0.0, 1.0000001, 2.5, 1e9})
     EXPECT_EQ(spill.CountAtMost(limit),
               std::count_if(all.begin(), all.end(), [&](float v) { return double(v) <= limit; }));
+}
+
+// A multiset difference's percentiles (N-1: the rig's values, less those a camera sees, plus their
+// values without it), in memory and from parts spilled tile by tile, against NearestRankPercentile
+// of the explicit multiset; a query taking out values it does not hold is refused.
+TEST(SummaryParts, SignedPercentilesEqualTheExplicitMultiset) {
+  std::mt19937_64 rng(11);
+  const auto value = [&] { return float(rng() % 5000) * 0.01f + float(rng() % 3) * 1e-6f; };
+  // Three "tiles": each with its intact list, a removed subset of it and added values.
+  std::vector<SummaryParts> tiles(3);
+  std::vector<float> expected;
+  for (SummaryParts& t : tiles) {
+    t.lists.resize(3);
+    t.counts = {std::int64_t(rng() % 100)};
+    for (int i = 0; i < 20000; ++i) {
+      const float v = value();
+      t.lists[0].push_back(v);
+      if (rng() % 3 == 0)
+        t.lists[1].push_back(v);  // taken out
+      else
+        expected.push_back(v);
+    }
+    for (int i = 0; i < 5000; ++i)
+      t.lists[2].push_back(value()), expected.push_back(t.lists[2].back());
+  }
+  const std::vector<double> ps{0, 10, 50, 90, 99.9, 100};
+  const std::vector<ListTerm> terms{{0, 1}, {1, -1}, {2, 1}};
+  SummaryParts whole;
+  for (const SummaryParts& t : tiles) whole.Add(t);
+  EXPECT_EQ(whole.counts[0], tiles[0].counts[0] + tiles[1].counts[0] + tiles[2].counts[0]);
+  InMemoryPercentiles memory(whole.lists);
+  SpilledParts spilled(std::filesystem::temp_directory_path().string(), "test");
+  for (SummaryParts t : tiles) spilled.Add(std::move(t));
+  spilled.Reduce();
+  EXPECT_EQ(spilled.Counts(), whole.counts);
+  for (PercentileSource* source :
+       {static_cast<PercentileSource*>(&memory), static_cast<PercentileSource*>(&spilled)}) {
+    for (int repeat = 0; repeat < 2; ++repeat) {  // the in-memory upper counts are kept
+      const ListPercentiles got = source->Percentiles(terms, ps);
+      ASSERT_EQ(got.count, std::int64_t(expected.size()));
+      for (std::size_t i = 0; i < ps.size(); ++i)
+        EXPECT_EQ(got.values[i], NearestRankPercentile(expected, ps[i])) << ps[i];
+    }
+    const ListPercentiles one = source->Percentiles(2, {50});
+    EXPECT_EQ(one.count, 15000);
+    EXPECT_EQ(one.values[0], NearestRankPercentile(whole.lists[2], 50));
+    EXPECT_EQ(source->Percentiles(7, {50}).count, 0);  // a list no part has: empty
+    EXPECT_FALSE(source->Percentiles(7, {50}).values[0]);
+    EXPECT_THROW(source->Percentiles({{2, 1}, {1, -1}}, {50}), std::logic_error);
+  }
+}
+
+// The fixed-point sum of values in [0, 1]: the same in any order and split, within 2^-64 per
+// value of the exact sum.
+TEST(SummaryParts, FixedLimbsAddInAnyOrder) {
+  std::mt19937_64 rng(5);
+  std::vector<double> values;
+  for (int i = 0; i < 100000; ++i) values.push_back(double(float(double(rng() % 1000001) / 1e6)));
+  values.push_back(1.0);
+  values.push_back(0.0);
+  std::int64_t forward[kFixedLimbs] = {}, backward[kFixedLimbs] = {}, a[kFixedLimbs] = {},
+               b[kFixedLimbs] = {};
+  long double exact = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    AddFixedLimbs(values[i], forward);
+    AddFixedLimbs(values[values.size() - 1 - i], backward);
+    AddFixedLimbs(values[i], i % 2 ? a : b);
+    exact += values[i];
+  }
+  for (int k = 0; k < kFixedLimbs; ++k) a[k] += b[k];
+  EXPECT_EQ(FixedLimbsToDouble(forward), FixedLimbsToDouble(backward));
+  EXPECT_EQ(FixedLimbsToDouble(forward), FixedLimbsToDouble(a));
+  EXPECT_NEAR(FixedLimbsToDouble(forward), double(exact), 1e-9);
+  EXPECT_THROW(AddFixedLimbs(1.5, forward), std::invalid_argument);
+  EXPECT_THROW(AddFixedLimbs(std::nan(""), forward), std::invalid_argument);
 }
 
 // The box room with a solid cube in the middle of a 1 m region at 0.1 m voxels, a ring of six

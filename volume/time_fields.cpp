@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <stdexcept>
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/util/error.h"
@@ -83,15 +84,22 @@ FieldOptions OverTimeOptions(FieldOptions options) {
   return options;
 }
 
-TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
-                                        const RigidPartsRayCaster& parts,
-                                        const std::vector<TimeSample>& samples,
-                                        const FieldOptions& options_in, int min_cameras) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  TimeFieldsResult result;
-  TimeSummary& out = result.summary;
-  out.min_cameras = min_cameras;
+namespace {
+
+// The parts' layout: counts [voxels, always, good pairs, free pairs, then per sample its free
+// region voxels and those seen by >= 1, 2, 3, min_cameras]; lists: per sample, its sigma_max
+// values; seconds: per sample.
+constexpr std::size_t kTimeCounts = 4, kPerSample = 5;
+
+}  // namespace
+
+SummaryParts TimeFieldsParts(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
+                             const std::vector<TimeSample>& samples, const FieldOptions& options_in,
+                             int min_cameras, Fields* grids) {
+  SummaryParts out;
+  out.counts.assign(kTimeCounts + kPerSample * samples.size(), 0);
+  out.lists.resize(samples.size());
+  out.seconds.assign(samples.size(), 0.0);
   FieldOptions options = options_in;
   if (std::find(options.fields.begin(), options.fields.end(), "coverage") == options.fields.end())
     options.fields.insert(options.fields.begin(), "coverage");
@@ -102,34 +110,21 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
   auto min_acc = min_grid->getAccessor();
   auto free_acc = free_grid->getAccessor();
   auto good_acc = good_grid->getAccessor();
-  std::vector<float> sigma_all;
   openvdb::math::Transform::Ptr transform;
-  std::int64_t good_pairs = 0, free_pairs = 0;
+  std::int64_t& good_pairs = out.counts[2];
+  std::int64_t& free_pairs = out.counts[3];
   std::size_t current = 0;  // the sample being evaluated, for the progress
   if (progress)
     options.progress = [&](double f) { progress((double(current) + f) / double(samples.size())); };
   const auto visit = [&](std::size_t s, const Fields& f, const SampleCost& cost) {
-    TimeSampleSummary row;
-    row.label = samples[s].label;
-    row.time = samples[s].time;
+    std::int64_t* row = &out.counts[kTimeCounts + kPerSample * s];
     const std::vector<std::int64_t>& hist = f.stats.coverage_histogram;
-    std::int64_t total = 0;
-    for (std::int64_t v : hist) total += v;
-    row.region_voxels = total;
-    auto share = [&](int k) {
-      std::int64_t n = 0;
-      for (std::size_t j = std::size_t(k); j < hist.size(); ++j) n += hist[j];
-      return total > 0 ? double(n) / double(total) : 0.0;
-    };
-    row.ge1 = share(1);
-    row.ge2 = share(2);
-    row.ge3 = share(3);
-    row.ge_k = share(min_cameras);
-    if (!f.stats.sigma_max_mm.empty()) {
-      row.sigma_max_p50 = NearestRankPercentile(f.stats.sigma_max_mm, 50);
-      row.sigma_max_p90 = NearestRankPercentile(f.stats.sigma_max_mm, 90);
-      sigma_all.insert(sigma_all.end(), f.stats.sigma_max_mm.begin(), f.stats.sigma_max_mm.end());
+    const int at_least[4] = {1, 2, 3, min_cameras};
+    for (std::size_t j = 0; j < hist.size(); ++j) {
+      row[0] += hist[j];
+      for (int t = 0; t < 4; ++t) row[1 + t] += j >= std::size_t(at_least[t]) ? hist[j] : 0;
     }
+    out.lists[s] = f.stats.sigma_max_mm;
     // Per voxel: the fewest cameras, the free samples and those with >= k (tiles voxel by voxel).
     const openvdb::Int32Grid::Ptr& coverage = f.impl().coverage;
     if (coverage) {
@@ -145,8 +140,7 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
         good_pairs += value >= min_cameras;
       });
     }
-    row.seconds = cost.seconds;
-    out.samples.push_back(row);
+    out.seconds[s] = cost.seconds;
     current = s + 1;
   };
   EvaluateSamples(scene, rig, parts, samples, options, visit);
@@ -155,7 +149,6 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
                           share_out = openvdb::FloatGrid::create(0.0f);
   auto mo = min_out->getAccessor();
   auto so = share_out->getAccessor();
-  std::int64_t voxels = 0, always = 0;
   for (auto it = free_grid->cbeginValueOn(); it; ++it) {
     const openvdb::Coord c = it.getCoord();
     const int free = *it;
@@ -163,9 +156,10 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
     const int good = good_acc.getValue(c);
     mo.setValue(c, float(least));
     so.setValue(c, free > 0 ? float(double(good) / free) : 0.0f);
-    ++voxels;
-    always += least >= min_cameras;
+    ++out.counts[0];
+    out.counts[1] += least >= min_cameras;
   }
+  if (!grids) return out;
   if (transform) {
     min_out->setTransform(transform);
     share_out->setTransform(transform->copy());
@@ -174,20 +168,68 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
   share_out->setName("coverage_time_share");
   min_out->pruneGrid();
   share_out->pruneGrid();
-  result.grids.impl().extra["coverage_min"] = min_out;
-  result.grids.impl().extra["coverage_time_share"] = share_out;
-  out.voxels = voxels;
-  out.always = voxels > 0 ? double(always) / double(voxels) : 0.0;
-  out.mean = free_pairs > 0 ? double(good_pairs) / double(free_pairs) : 0.0;
+  grids->impl().extra["coverage_min"] = min_out;
+  grids->impl().extra["coverage_time_share"] = share_out;
+  return out;
+}
+
+TimeSummary FinishTimeFields(const std::vector<TimeSample>& samples, int min_cameras,
+                             const std::vector<std::int64_t>& counts,
+                             const std::vector<double>& seconds, PercentileSource& lists) {
+  if (counts.size() != kTimeCounts + kPerSample * samples.size())
+    throw std::invalid_argument("FinishTimeFields: the parts are of other samples");
+  TimeSummary out;
+  out.min_cameras = min_cameras;
+  const auto share = [](std::int64_t part, std::int64_t whole) {
+    return whole > 0 ? double(part) / double(whole) : 0.0;
+  };
+  std::vector<ListTerm> every;
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const std::int64_t* row = &counts[kTimeCounts + kPerSample * s];
+    TimeSampleSummary r;
+    r.label = samples[s].label;
+    r.time = samples[s].time;
+    r.region_voxels = row[0];
+    r.ge1 = share(row[1], row[0]);
+    r.ge2 = share(row[2], row[0]);
+    r.ge3 = share(row[3], row[0]);
+    r.ge_k = share(row[4], row[0]);
+    const ListPercentiles sigma = lists.Percentiles(s, {50, 90});
+    if (sigma.count > 0) {
+      r.sigma_max_p50 = sigma.values[0];
+      r.sigma_max_p90 = sigma.values[1];
+    }
+    r.seconds = s < seconds.size() ? seconds[s] : 0.0;
+    out.samples.push_back(r);
+    every.push_back({s, 1});
+  }
+  out.voxels = counts[0];
+  out.always = share(counts[1], counts[0]);
+  out.mean = share(counts[2], counts[3]);
   out.worst_sample = 0;
   for (std::size_t s = 1; s < out.samples.size(); ++s)
     if (out.samples[s].ge_k < out.samples[out.worst_sample].ge_k) out.worst_sample = int(s);
-  if (!sigma_all.empty()) {
-    out.sigma_max_p50 = NearestRankPercentile(sigma_all, 50);
-    out.sigma_max_p90 = NearestRankPercentile(sigma_all, 90);
-    out.sigma_max_p99 = NearestRankPercentile(sigma_all, 99);
+  const ListPercentiles all = lists.Percentiles(every, {50, 90, 99});
+  if (all.count > 0) {
+    out.sigma_max_p50 = all.values[0];
+    out.sigma_max_p90 = all.values[1];
+    out.sigma_max_p99 = all.values[2];
   }
-  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
+                                        const RigidPartsRayCaster& parts,
+                                        const std::vector<TimeSample>& samples,
+                                        const FieldOptions& options, int min_cameras) {
+  const auto start = std::chrono::steady_clock::now();
+  TimeFieldsResult result;
+  const SummaryParts p =
+      TimeFieldsParts(scene, rig, parts, samples, options, min_cameras, &result.grids);
+  InMemoryPercentiles lists(p.lists);
+  result.summary = FinishTimeFields(samples, min_cameras, p.counts, p.seconds, lists);
+  result.summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -15,6 +15,7 @@
 #include "analysis/scene/motion.h"
 #include "analysis/scene/scene.h"
 #include "volume/fields.h"
+#include "volume/summary_parts.h"
 
 namespace pandora {
 
@@ -88,6 +89,17 @@ TimeFieldsResult EvaluateFieldsOverTime(const Scene& scene, const Rig& rig,
                                         const RigidPartsRayCaster& parts,
                                         const std::vector<TimeSample>& samples,
                                         const FieldOptions& options, int min_cameras);
+
+/// EvaluateFieldsOverTime in parts (volume/summary_parts.h): the samples over options.tile (a
+/// streamed run's tile) or the whole region, their counts and sigma_max lists; the combined grids
+/// ("coverage_min", "coverage_time_share") into `grids` when not null.
+SummaryParts TimeFieldsParts(const Scene& scene, const Rig& rig, const RigidPartsRayCaster& parts,
+                             const std::vector<TimeSample>& samples, const FieldOptions& options,
+                             int min_cameras, Fields* grids);
+/// The summary from every part's counts and timings added up and their lists (seconds left 0).
+TimeSummary FinishTimeFields(const std::vector<TimeSample>& samples, int min_cameras,
+                             const std::vector<std::int64_t>& counts,
+                             const std::vector<double>& seconds, PercentileSource& lists);
 
 /// The options of EvaluateFieldsOverTime from a run's fields options: the samples evaluated whole
 /// (one partition: under MPI rank 0 evaluates them, docs/scale.md), with only the fields the time

@@ -79,30 +79,44 @@ void ValueSpill::ForEachChunk(Fn&& fn) const {
   }
 }
 
+void AddHighCounts(const float* values, std::size_t n, std::int64_t sign,
+                   std::vector<std::int64_t>& high) {
+  high.resize(1 << 16, 0);
+  for (std::size_t i = 0; i < n; ++i) high[Key(values[i]) >> 16] += sign;
+}
+
+void AddLowCounts(const float* values, std::size_t n, std::int64_t sign,
+                  const std::vector<std::uint32_t>& bins, std::vector<std::int64_t>& low) {
+  low.resize(bins.size() << 16, 0);
+  if (bins.empty()) return;
+  // Each distinct bin's place: the first index asking for it (copied to the others at the end).
+  std::map<std::uint32_t, std::size_t> first;
+  for (std::size_t i = 0; i < bins.size(); ++i) first.emplace(bins[i], i);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t k = Key(values[i]);
+    const auto it = first.find(k >> 16);
+    if (it != first.end()) low[(it->second << 16) | (k & 0xffffu)] += sign;
+  }
+  for (std::size_t i = 0; i < bins.size(); ++i) {
+    const std::size_t from = first[bins[i]];
+    if (from != i)
+      std::copy(low.begin() + std::ptrdiff_t(from << 16),
+                low.begin() + std::ptrdiff_t((from + 1) << 16),
+                low.begin() + std::ptrdiff_t(i << 16));
+  }
+}
+
 std::vector<std::int64_t> ValueSpill::HighCounts() const {
   std::vector<std::int64_t> high(1 << 16, 0);
-  ForEachChunk([&](const float* v, std::size_t m) {
-    for (std::size_t i = 0; i < m; ++i) ++high[Key(v[i]) >> 16];
-  });
+  ForEachChunk([&](const float* v, std::size_t m) { AddHighCounts(v, m, 1, high); });
   return high;
 }
 
 std::vector<std::int64_t> ValueSpill::LowCounts(const std::vector<std::uint32_t>& bins) const {
   std::vector<std::int64_t> low(bins.size() << 16, 0);
   if (bins.empty()) return low;
-  // Each distinct bin's counts once, copied to every place that asks for it.
-  std::map<std::uint32_t, std::vector<std::int64_t>> by_bin;
-  for (std::uint32_t b : bins) by_bin[b].assign(1 << 16, 0);
-  ForEachChunk([&](const float* v, std::size_t m) {
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t k = Key(v[i]);
-      const auto it = by_bin.find(k >> 16);
-      if (it != by_bin.end()) ++it->second[k & 0xffffu];
-    }
-  });
-  for (std::size_t i = 0; i < bins.size(); ++i)
-    std::copy(by_bin[bins[i]].begin(), by_bin[bins[i]].end(),
-              low.begin() + (std::ptrdiff_t(i) << 16));
+  // (A bin asked for twice is counted once and copied, after every chunk: the copies end whole.)
+  ForEachChunk([&](const float* v, std::size_t m) { AddLowCounts(v, m, 1, bins, low); });
   return low;
 }
 

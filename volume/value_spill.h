@@ -59,6 +59,12 @@ struct PercentileBins {
 };
 PercentileBins SelectPercentileBins(const std::vector<std::int64_t>& high,
                                     const std::vector<double>& p);
+/// The counts of HighCounts and LowCounts over `n` values in memory, times `sign` (+1, or -1 for
+/// values taken out of a multiset), added to `high` (65,536 counts) and `low` (65,536 per bin).
+void AddHighCounts(const float* values, std::size_t n, std::int64_t sign,
+                   std::vector<std::int64_t>& high);
+void AddLowCounts(const float* values, std::size_t n, std::int64_t sign,
+                  const std::vector<std::uint32_t>& bins, std::vector<std::int64_t>& low);
 /// The percentiles (nullopt when there are no values), from the (summed) LowCounts(selection.bins).
 std::vector<std::optional<double>> ResolvePercentiles(const PercentileBins& selection,
                                                       const std::vector<std::int64_t>& low,
