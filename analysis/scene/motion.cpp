@@ -12,7 +12,7 @@
 namespace pandora {
 namespace {
 
-std::string Short(double v) {
+std::string SixDigits(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.6g", v);
   return b;
@@ -117,7 +117,7 @@ std::vector<TimeSample> Scene::TimeSamples() const {
     s.time = !times.empty() ? times[i] : double(i);
     s.timed = !times.empty();
     s.label = !pose_names.empty() ? "pose '" + pose_names[i] + "'"
-              : !times.empty()    ? "t=" + Short(times[i]) + " s"
+              : !times.empty()    ? "t=" + SixDigits(times[i]) + " s"
                                   : "draw " + std::to_string(i + 1);
     for (const ObjectMotion& m : motions) {
       switch (m.kind) {

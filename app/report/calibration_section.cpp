@@ -20,7 +20,7 @@ constexpr int kComponentColorCount = sizeof(kComponentColors) / sizeof(kComponen
 constexpr const char* kUncalibratable = "#c00000";
 constexpr const char* kBelowMinimum = "#d9d9d9";
 
-std::string Num(double v) {
+std::string OneDecimal(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f", v);
   return b;
@@ -74,8 +74,8 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
   }
 
   std::ostringstream s;
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(width) << "\" height=\""
-    << Num(height) << "\" viewBox=\"0 0 " << Num(width) << " " << Num(height)
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << OneDecimal(width) << "\" height=\""
+    << OneDecimal(height) << "\" viewBox=\"0 0 " << OneDecimal(width) << " " << OneDecimal(height)
     << "\" font-family=\"DejaVu Sans, Arial, Helvetica, sans-serif\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
     << "<text x=\"12\" y=\"20\" font-size=\"14\" font-weight=\"bold\">" << HtmlEscape(title)
@@ -86,17 +86,19 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
     const bool bad = IsUncalibratable(r, c);
     const std::string fill = !r.enabled[c] ? "#999999" : bad ? kUncalibratable : "#222222";
     const std::string weight = bad ? " font-weight=\"bold\"" : "";
-    s << "<text x=\"" << Num(12 + label) << "\" y=\"" << Num(top + mid + 4)
+    s << "<text x=\"" << OneDecimal(12 + label) << "\" y=\"" << OneDecimal(top + mid + 4)
       << "\" font-size=\"12\" text-anchor=\"end\" fill=\"" << fill << "\"" << weight << ">"
       << HtmlEscape(r.camera_ids[c]) << "</text>\n";
-    s << "<text transform=\"translate(" << Num(left + mid + 4) << "," << Num(34 + label)
-      << ") rotate(-90)\" font-size=\"12\" fill=\"" << fill << "\"" << weight << ">"
-      << HtmlEscape(r.camera_ids[c]) << "</text>\n";
+    s << "<text transform=\"translate(" << OneDecimal(left + mid + 4) << ","
+      << OneDecimal(34 + label) << ") rotate(-90)\" font-size=\"12\" fill=\"" << fill << "\""
+      << weight << ">" << HtmlEscape(r.camera_ids[c]) << "</text>\n";
     const std::string color = ComponentColor(r.graph.component[c]);
-    s << "<rect x=\"" << Num(left - gap - band) << "\" y=\"" << Num(top + c * cell) << "\" width=\""
-      << Num(band) << "\" height=\"" << cell << "\" fill=\"" << color << "\"/>\n";
-    s << "<rect x=\"" << Num(left + c * cell) << "\" y=\"" << Num(top - gap - band) << "\" width=\""
-      << cell << "\" height=\"" << Num(band) << "\" fill=\"" << color << "\"/>\n";
+    s << "<rect x=\"" << OneDecimal(left - gap - band) << "\" y=\"" << OneDecimal(top + c * cell)
+      << "\" width=\"" << OneDecimal(band) << "\" height=\"" << cell << "\" fill=\"" << color
+      << "\"/>\n";
+    s << "<rect x=\"" << OneDecimal(left + c * cell) << "\" y=\"" << OneDecimal(top - gap - band)
+      << "\" width=\"" << cell << "\" height=\"" << OneDecimal(band) << "\" fill=\"" << color
+      << "\"/>\n";
   }
   // Cells.
   const bool numbers = cell >= 24;
@@ -117,13 +119,15 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
         fill = kBelowMinimum;
       }
       const double x = left + b * cell, y = top + a * cell;
-      s << "<rect x=\"" << Num(x) << "\" y=\"" << Num(y) << "\" width=\"" << cell << "\" height=\""
-        << cell << "\" fill=\"" << fill << "\" stroke=\"#cccccc\" stroke-width=\"0.5\"/>\n";
+      s << "<rect x=\"" << OneDecimal(x) << "\" y=\"" << OneDecimal(y) << "\" width=\"" << cell
+        << "\" height=\"" << cell << "\" fill=\"" << fill
+        << "\" stroke=\"#cccccc\" stroke-width=\"0.5\"/>\n";
       if (numbers && r.enabled[a] && r.enabled[b] && (v > 0 || a == b)) {
-        const std::string text = v >= 10000 ? Num(v / 1000.0) + "k" : std::to_string(v);
+        const std::string text = v >= 10000 ? OneDecimal(v / 1000.0) + "k" : std::to_string(v);
         const int size = text.size() <= 3 ? 10 : 8;
-        s << "<text x=\"" << Num(x + cell / 2.0) << "\" y=\"" << Num(y + cell / 2.0 + size * 0.35)
-          << "\" font-size=\"" << size << "\" text-anchor=\"middle\" fill=\"" << text_color << "\""
+        s << "<text x=\"" << OneDecimal(x + cell / 2.0) << "\" y=\""
+          << OneDecimal(y + cell / 2.0 + size * 0.35) << "\" font-size=\"" << size
+          << "\" text-anchor=\"middle\" fill=\"" << text_color << "\""
           << (a == b ? " font-style=\"italic\"" : "") << ">" << text << "</text>\n";
       }
     }
@@ -132,31 +136,33 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b)
       if (link[a][b])
-        s << "<rect x=\"" << Num(left + b * cell + 1) << "\" y=\"" << Num(top + a * cell + 1)
-          << "\" width=\"" << cell - 2 << "\" height=\"" << cell - 2 << "\" fill=\"none\" stroke=\""
+        s << "<rect x=\"" << OneDecimal(left + b * cell + 1) << "\" y=\""
+          << OneDecimal(top + a * cell + 1) << "\" width=\"" << cell - 2 << "\" height=\""
+          << cell - 2 << "\" fill=\"none\" stroke=\""
           << (link[a][b] == 2 ? kUncalibratable : "#000000") << "\" stroke-width=\"2\"/>\n";
-  s << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(side)
-    << "\" height=\"" << Num(side) << "\" fill=\"none\" stroke=\"#555555\" stroke-width=\"1\"/>\n";
+  s << "<rect x=\"" << OneDecimal(left) << "\" y=\"" << OneDecimal(top) << "\" width=\""
+    << OneDecimal(side) << "\" height=\"" << OneDecimal(side)
+    << "\" fill=\"none\" stroke=\"#555555\" stroke-width=\"1\"/>\n";
 
   // Legend: the ramp with its ends, then the special cells.
   const double ramp_w = 200, ramp_h = 12, lx = 12;
-  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top - 6)
+  s << "<text x=\"" << OneDecimal(lx) << "\" y=\"" << OneDecimal(legend_top - 6)
     << "\" font-size=\"11\">poses both cameras "
     << "observe (linked at &#8805; " << r.spec.min_shared << ")</text>\n";
   for (int i = 0; i < 50; ++i)
-    s << "<rect x=\"" << Num(lx + ramp_w * i / 50) << "\" y=\"" << Num(legend_top) << "\" width=\""
-      << Num(ramp_w / 50 + 0.5) << "\" height=\"" << Num(ramp_h) << "\" fill=\""
-      << HexColor(Viridis((i + 0.5) / 50)).data() << "\"/>\n";
-  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top + ramp_h + 12)
+    s << "<rect x=\"" << OneDecimal(lx + ramp_w * i / 50) << "\" y=\"" << OneDecimal(legend_top)
+      << "\" width=\"" << OneDecimal(ramp_w / 50 + 0.5) << "\" height=\"" << OneDecimal(ramp_h)
+      << "\" fill=\"" << HexColor(Viridis((i + 0.5) / 50)).data() << "\"/>\n";
+  s << "<text x=\"" << OneDecimal(lx) << "\" y=\"" << OneDecimal(legend_top + ramp_h + 12)
     << "\" font-size=\"10\">0</text>\n"
-    << "<text x=\"" << Num(lx + ramp_w) << "\" y=\"" << Num(legend_top + ramp_h + 12)
+    << "<text x=\"" << OneDecimal(lx + ramp_w) << "\" y=\"" << OneDecimal(legend_top + ramp_h + 12)
     << "\" font-size=\"10\" text-anchor=\"end\">" << max_shared << "</text>\n";
   const double sx = lx + 265;
   const auto swatch = [&](double y, const std::string& rect_attrs, const std::string& text) {
-    s << "<rect x=\"" << Num(sx) << "\" y=\"" << Num(y) << "\" width=\"12\" height=\"12\" "
-      << rect_attrs << "/>\n"
-      << "<text x=\"" << Num(sx + 18) << "\" y=\"" << Num(y + 10) << "\" font-size=\"10\">" << text
-      << "</text>\n";
+    s << "<rect x=\"" << OneDecimal(sx) << "\" y=\"" << OneDecimal(y)
+      << "\" width=\"12\" height=\"12\" " << rect_attrs << "/>\n"
+      << "<text x=\"" << OneDecimal(sx + 18) << "\" y=\"" << OneDecimal(y + 10)
+      << "\" font-size=\"10\">" << text << "</text>\n";
   };
   swatch(legend_top - 16, "fill=\"" + std::string(kBelowMinimum) + "\" stroke=\"#cccccc\"",
          "1 to " + std::to_string(std::max(1, r.spec.min_shared - 1)) + " shared: no link");
@@ -166,7 +172,7 @@ std::string CalibrationMatrixSvg(const CalibrationResult& r, const std::string& 
          "weakest link");
   swatch(legend_top + 32, "fill=\"" + std::string(kComponentColors[0]) + "\"",
          "band: component (red id: uncalibratable)");
-  s << "<text x=\"" << Num(lx) << "\" y=\"" << Num(legend_top + ramp_h + 28)
+  s << "<text x=\"" << OneDecimal(lx) << "\" y=\"" << OneDecimal(legend_top + ramp_h + 28)
     << "\" font-size=\"10\" fill=\"#555555\">diagonal (italic): poses the camera observes</text>\n";
   s << "</svg>\n";
   return s.str();
@@ -194,8 +200,8 @@ std::string CalibrationIntroHtml(const CalibrationSpec& spec) {
       << "; a camera observes a pose when every grid corner projects into its image and is "
          "unoccluded, "
          "the board faces it within "
-      << Num(b.tilt_max_deg) << "&deg;, and every square edge spans at least "
-      << Num(b.min_px_per_square) << " px.";
+      << OneDecimal(b.tilt_max_deg) << "&deg;, and every square edge spans at least "
+      << OneDecimal(b.min_px_per_square) << " px.";
   }
   s << " Two cameras are linked when they share at least " << spec.min_shared
     << " poses; a camera outside the largest linked group, or observing fewer poses, cannot be "
@@ -215,7 +221,7 @@ std::string CalibrationCellHtml(
     << ", " << r.graph.uncalibratable.size() << " uncalibratable camera"
     << (r.graph.uncalibratable.size() == 1 ? "" : "s") << "; " << r.poses_observed << " of "
     << r.poses << " poses seen by a camera, " << r.poses_shared << " by two or more (simulated in "
-    << Num(r.seconds * 1e3) << " ms).</p>\n";
+    << OneDecimal(r.seconds * 1e3) << " ms).</p>\n";
   s << svg_image(CalibrationMatrixSvg(r, "Co-visibility: " + rig_name),
                  rig_name + " calibration co-visibility matrix");
   s << "<div class=\"scroll\"><table "
@@ -235,7 +241,7 @@ std::string CalibrationCellHtml(
     else
       s << "disabled";
     s << "</td><td>" << r.observed[c] << "</td><td>"
-      << (r.poses > 0 ? Num(100.0 * r.observed[c] / r.poses) + "%" : "&ndash;") << "</td>"
+      << (r.poses > 0 ? OneDecimal(100.0 * r.observed[c] / r.poses) + "%" : "&ndash;") << "</td>"
       << "<td style=\"text-align:left\">" << (r.enabled[c] ? MissText(r, c) : "&ndash;")
       << "</td></tr>\n";
   }

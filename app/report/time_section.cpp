@@ -9,7 +9,7 @@
 namespace pandora::report {
 namespace {
 
-std::string Percent(double v) {
+std::string SpacedPercent(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f %%", 100 * v);
   return b;
@@ -23,7 +23,7 @@ std::string Row(const std::string& label, const std::vector<std::optional<double
     if (v) best = std::max(best, *v);
   std::string out = "<tr><th>" + label + "</th>";
   for (std::size_t i = 0; i < values.size(); ++i) {
-    std::string cell = values[i] ? Percent(*values[i]) : "&ndash;";
+    std::string cell = values[i] ? SpacedPercent(*values[i]) : "&ndash;";
     if (values[i] && values.size() > 1 && *values[i] == best) cell = "<b>" + cell + "</b>";
     if (i < notes.size() && !notes[i].empty())
       cell += " <span class=\"note\">" + HtmlEscape(notes[i]) + "</span>";
@@ -142,13 +142,14 @@ std::string TimeSectionHtml(const std::vector<const Summary*>& summaries,
       for (const Summary* s : summaries) {
         if (samples > 0)
           html += "<td>" +
-                  (s->time && i < s->time->samples.size() ? Percent(s->time->samples[i].ge_k)
+                  (s->time && i < s->time->samples.size() ? SpacedPercent(s->time->samples[i].ge_k)
                                                           : "&ndash;") +
                   "</td>";
         for (const std::string& target : targets) {
           std::string cell = "&ndash;";
           for (const SurfaceTargetResult& t : s->targets)
-            if (t.name == target && i < t.sample_share.size()) cell = Percent(t.sample_share[i]);
+            if (t.name == target && i < t.sample_share.size())
+              cell = SpacedPercent(t.sample_share[i]);
           html += "<td>" + cell + "</td>";
         }
       }
