@@ -492,6 +492,10 @@ void AnalyzeStreamTile(const StreamSetup& setup, const FieldOptions& tile_option
   if (scene.Animated() && !setup.samples.empty()) {
     FieldOptions over_time = OverTimeOptions(tile_options);
     over_time.progress = nullptr;
+    // The tile's fields stay held while its samples run: the samples get what the budget leaves
+    // (PlanTiles gave the tile at most half of it, and the samples need at most what the tile did).
+    over_time.memory_budget_bytes =
+        std::max(0.0, tile_options.memory_budget_bytes - f.stats.estimated_bytes);
     totals.time.Add(TimeFieldsParts(scene, rig, *setup.parts, setup.samples, over_time, k, &f));
   }
   totals.pixel_targets.Add(PixelTargetParts(scene, rig, f, k, &f));
