@@ -794,25 +794,23 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
   entry->rays = static_cast<std::int32_t>(n);
   // Offsets come in ascending order (x, y, z loops, Offset = 64 x + 8 y + z).
   thread_local InformationScratch scratch;  // 49 kB: not on the worker's stack
-  if (want_resolution) {
-    std::size_t seen = 0;
-    for (std::size_t i = 0; i < n; ++i) seen += occluded[i] ? 0 : 1;
-    entry->density.reserve(seen);
-  }
+  const bool want_jacobians = want_information || want_resolution;
   int visible = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (occluded[i]) continue;
     const int p = batch.index[i];
     SetBit(entry->bits, points.offset[p]);
-    if (want_information)
+    if (want_jacobians)
       for (int r = 0; r < 6; ++r) scratch.jac[r][visible] = batch.jac[r][p];
-    if (want_resolution) {
-      const float density = static_cast<float>(PixelDensity(batch.jacobian(int(i))));
-      entry->density.push_back(density);
-    }
     ++visible;
   }
   entry->seen = visible;
+  if (want_resolution && visible > 0) {
+    const double* const jac[6] = {scratch.jac[0], scratch.jac[1], scratch.jac[2],
+                                  scratch.jac[3], scratch.jac[4], scratch.jac[5]};
+    entry->density.resize(std::size_t(visible));
+    PixelDensityLanes(visible, jac, entry->density.data());
+  }
   if (want_information && visible > 0) {
     InformationLanes(visible, rd.whitened[camera].data(), &scratch);
     entry->information.resize(6 * std::size_t(visible));
@@ -904,10 +902,14 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   for (int i = 0; i < n; ++i) {
     const int q = batch.index[i];
     if (occluded[i] || TestBit(was.bits, sub.offset[q])) continue;
-    if (want_information)
+    if (want_information || want_resolution)
       for (int r = 0; r < 6; ++r) scratch.jac[r][fresh] = batch.jac[r][q];
-    if (want_resolution) density[fresh] = static_cast<float>(PixelDensity(batch.jacobian(i)));
     ++fresh;
+  }
+  if (want_resolution && fresh > 0) {
+    const double* const jac[6] = {scratch.jac[0], scratch.jac[1], scratch.jac[2],
+                                  scratch.jac[3], scratch.jac[4], scratch.jac[5]};
+    PixelDensityLanes(fresh, jac, density.data());
   }
   if (want_information && fresh > 0) InformationLanes(fresh, rd.whitened[camera].data(), &scratch);
   int seen = 0;
@@ -1134,7 +1136,7 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
       }
       for (std::uint64_t bits = rescan_info[w]; bits; bits &= bits - 1) {
         const int o = 64 * w + __builtin_ctzll(bits);
-        next->sums[o] = SumLimbs{};
+        ClearLimbs(next->sums[o]);
         next->sum_band[o] = 0;
         next->band_count[o] = 0;
       }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace pandora {
@@ -196,7 +197,41 @@ bool HaveAvx2() {
   return have;
 }
 
+// PixelDensity's expressions lane by lane: Eigen sums a 3-vector's squared norm and dot product
+// as x0 + (x1 + x2); a degenerate or non-finite determinant gives 0 (the select keeps the square
+// roots of the other lanes exact; both are correctly rounded in scalar and vector code).
+inline void DensityLanes(int n, const double* const jac[6], float* out) {
+  const double* __restrict j0 = jac[0];
+  const double* __restrict j1 = jac[1];
+  const double* __restrict j2 = jac[2];
+  const double* __restrict j3 = jac[3];
+  const double* __restrict j4 = jac[4];
+  const double* __restrict j5 = jac[5];
+  float* __restrict o = out;
+#pragma omp simd
+  for (int m = 0; m < n; ++m) {
+    const double a = j0[m] * j0[m] + (j1[m] * j1[m] + j2[m] * j2[m]);
+    const double b = j0[m] * j3[m] + (j1[m] * j4[m] + j2[m] * j5[m]);
+    const double c = j3[m] * j3[m] + (j4[m] * j4[m] + j5[m] * j5[m]);
+    const double det = a * c - b * b;
+    const bool good = det > 0.0 && det <= std::numeric_limits<double>::max();
+    const double root = std::sqrt(std::sqrt(good ? det : 1.0));
+    o[m] = good ? static_cast<float>(root) : 0.0f;
+  }
+}
+__attribute__((target("avx2"))) void DensityLanesAvx2(int n, const double* const jac[6],
+                                                      float* out) {
+  DensityLanes(n, jac, out);
+}
+
 }  // namespace
+
+void PixelDensityLanes(int n, const double* const jac[6], float* out) {
+  if (HaveAvx2())
+    DensityLanesAvx2(n, jac, out);
+  else
+    DensityLanes(n, jac, out);
+}
 
 void VisibilityTester::TestGeometryBatch(int camera, int n, const double* x, const double* y,
                                          const double* z, GeometryBatch* out) const {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <memory>
 #include <random>
 
@@ -71,6 +72,60 @@ TEST(Visibility, PixelDensityMatchesPinholeClosedForm) {
   const double Z = 2.0, x = 0.6;
   ASSERT_EQ(vis.Test(0, Vec3(x * Z, Z, 0), nullptr, &J), ViewResult::kSeen);
   EXPECT_NEAR(PixelDensity(J), f / Z * std::pow(1 + x * x, 0.25), 1e-9 * f);
+}
+
+// PixelDensityLanes against PixelDensity rounded to float, bit for bit: random Jacobians over 40
+// binades, rank-one and zero ones, and entries whose determinant overflows, underflows, or is
+// NaN or infinite (those give 0); an odd count, so the vector loop's tail runs too.
+TEST(Visibility, PixelDensityLanesGiveTheOnePointBits) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), binade(-20.0, 20.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  constexpr int n = 4099;
+  std::vector<double> rows[6];
+  for (auto& r : rows) r.resize(n);
+  for (int m = 0; m < n; ++m) {
+    const double scale = std::exp2(binade(rng));
+    for (auto& r : rows) r[m] = unit(rng) * scale;
+    switch (m % 9) {
+      case 1:  // rank one: the second row a multiple of the first
+        for (int k = 0; k < 3; ++k) rows[3 + k][m] = 0.5 * rows[k][m];
+        break;
+      case 2:
+        for (auto& r : rows) r[m] = 0.0;
+        break;
+      case 3:
+        rows[m % 6][m] = 1e200;  // det overflows
+        break;
+      case 4:
+        for (auto& r : rows) r[m] *= 1e-160;  // det underflows
+        break;
+      case 5:
+        rows[m % 6][m] = (m % 2) ? inf : -inf;
+        break;
+      case 6:
+        rows[m % 6][m] = nan;
+        break;
+      default:
+        break;
+    }
+  }
+  const double* const jac[6] = {rows[0].data(), rows[1].data(), rows[2].data(),
+                                rows[3].data(), rows[4].data(), rows[5].data()};
+  std::vector<float> lanes(n, -1.0f);
+  PixelDensityLanes(n, jac, lanes.data());
+  int zeros = 0;
+  for (int m = 0; m < n; ++m) {
+    Mat23 J;
+    J << rows[0][m], rows[1][m], rows[2][m], rows[3][m], rows[4][m], rows[5][m];
+    const float expected = static_cast<float>(PixelDensity(J));
+    ASSERT_EQ(std::memcmp(&expected, &lanes[m], sizeof(float)), 0)
+        << "m " << m << ": " << expected << " vs " << lanes[m];
+    zeros += expected == 0.0f ? 1 : 0;
+  }
+  EXPECT_GT(zeros, n / 9 * 3);  // the degenerate cases took the zero branch
+  EXPECT_LT(zeros, n / 9 * 7);
 }
 
 // The vectorised batch test against the one-point test, bit for bit: random cameras of every lens
