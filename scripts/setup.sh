@@ -16,9 +16,9 @@ PACKAGES=(
   libopenmpi-dev openmpi-bin
   # python/ (import pandora) and its tests.
   pybind11-dev python3-dev python3-numpy python3-pytest
-  # viewer/ (the only code that links GL): window, GL loader, UI; headless tests under Xvfb with
-  # Mesa's llvmpipe (software GL 4.5).
-  libglfw3-dev libepoxy-dev libimgui-dev xvfb xauth libgl1-mesa-dri mesa-utils
+  # viewer/ (the only code that links GL): window, GL loader, UI; headless tests through EGL
+  # (libegl-mesa0: Mesa's software EGL device) and under Xvfb, with Mesa's llvmpipe (GL 4.5).
+  libglfw3-dev libepoxy-dev libimgui-dev xvfb xauth libgl1-mesa-dri mesa-utils libegl1 libegl-mesa0
 )
 
 missing=()

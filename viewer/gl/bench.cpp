@@ -3,6 +3,7 @@
 //
 //   pandora_gl_bench examples/trauma_room/scene.json --rig octagon --view overview --size 1280x720
 //   pandora_gl_bench lens_room --size 1280x720       (the generated scene of gl_test_scenes.h)
+//   pandora_gl_bench lens_room --gl egl              (headless: a GPU server without X)
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -49,6 +50,11 @@ int main(int argc, char** argv) {
   app.add_option("--shadow-mode", shadow_mode, "0 distance, 1 plane, 2 either");
   app.add_flag("--verbose", verbose, "per-camera disagreement");
   app.add_option("--png", png_dir, "write CPU | GPU comparison PNGs into this folder");
+  std::string gl_backend = "auto";
+  app.add_option("--gl", gl_backend,
+                 "GL context: egl (headless, no display), glfw (hidden window, needs a display) "
+                 "or auto (PANDORA_GL, else glfw with a display, egl without)")
+      ->check(CLI::IsMember({"auto", "egl", "glfw"}));
   std::string csv_path;
   app.add_option(
       "--csv", csv_path,
@@ -82,7 +88,9 @@ int main(int argc, char** argv) {
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
 
-    GlContext context;
+    GlBackend backend = GlBackend::kAuto;
+    ParseGlBackend(gl_backend, &backend);
+    GlContext context(backend);
     GlRenderer renderer(scene, &prepared);
     std::printf("device: %s\n", context.Description().c_str());
     std::printf("scene: %s (%zu triangles), rig %s (%d enabled cameras), %dx%d, pattern %s\n",

@@ -1,5 +1,6 @@
-// The GPU renderer against the exact CPU renderer (docs/viewer.md, "Tests"). Runs under
-// `xvfb-run -a` with Mesa's llvmpipe (ctest sets LIBGL_ALWAYS_SOFTWARE=1); each case renders the
+// The GPU renderer against the exact CPU renderer (docs/viewer.md, "Tests"). ctest runs it twice
+// with Mesa's llvmpipe (LIBGL_ALWAYS_SOFTWARE=1): headless through EGL (PANDORA_GL=egl) and in a
+// hidden GLFW window under Xvfb (PANDORA_GL=glfw); each case renders the
 // same rig, view and size on both and compares the per-pixel camera sets away from the one-pixel
 // band around the CPU image's edges (footprint and shadow edges, silhouettes), and the colours.
 #include "viewer/gl/renderer.h"
@@ -13,7 +14,9 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "analysis/geometry/primitives.h"
 #include "render/prepared_scene.h"
@@ -109,6 +112,57 @@ CameraAtPoint OnGrid(double u, double v, double du, double dv) {
   c.du = du;
   c.dv = dv;
   return c;
+}
+
+// The context is the backend PANDORA_GL asks for (ctest runs this program both ways: EGL without
+// a display, GLFW under Xvfb), and it says so.
+TEST(GlContext, IsTheBackendAskedFor) {
+  GlContext& context = Context();
+  const char* asked = std::getenv("PANDORA_GL");
+  const std::string description = context.Description();
+  if (asked && std::string(asked) == "egl") EXPECT_EQ(context.backend(), GlBackend::kEgl);
+  if (asked && std::string(asked) == "glfw") EXPECT_EQ(context.backend(), GlBackend::kGlfw);
+  EXPECT_NE(description.find(context.backend() == GlBackend::kEgl ? "[EGL " : "[GLFW "),
+            std::string::npos)
+      << description;
+  EXPECT_GE(context.Version(), 33) << description;
+}
+
+// kAuto: PANDORA_GL first, then GLFW where a display is set and EGL elsewhere; names round-trip.
+TEST(GlContext, AutoFollowsPandoraGlThenTheDisplay) {
+  struct Saved {
+    std::string name;
+    bool had;
+    std::string value;
+  };
+  std::vector<Saved> saved;
+  for (const char* name : {"PANDORA_GL", "DISPLAY", "WAYLAND_DISPLAY"}) {
+    const char* v = std::getenv(name);
+    saved.push_back({name, v != nullptr, v ? v : ""});
+    unsetenv(name);
+  }
+  EXPECT_EQ(ResolveGlBackend(GlBackend::kAuto), GlBackend::kEgl);
+  setenv("DISPLAY", ":99", 1);
+  EXPECT_EQ(ResolveGlBackend(GlBackend::kAuto), GlBackend::kGlfw);
+  EXPECT_EQ(ResolveGlBackend(GlBackend::kEgl), GlBackend::kEgl);
+  setenv("PANDORA_GL", "egl", 1);
+  EXPECT_EQ(ResolveGlBackend(GlBackend::kAuto), GlBackend::kEgl);
+  EXPECT_EQ(ResolveGlBackend(GlBackend::kGlfw), GlBackend::kGlfw);
+  setenv("PANDORA_GL", "vulkan", 1);
+  EXPECT_THROW(ResolveGlBackend(GlBackend::kAuto), std::invalid_argument);
+  for (GlBackend b : {GlBackend::kAuto, GlBackend::kGlfw, GlBackend::kEgl}) {
+    GlBackend parsed = GlBackend::kAuto;
+    EXPECT_TRUE(ParseGlBackend(GlBackendName(b), &parsed));
+    EXPECT_EQ(parsed, b);
+  }
+  GlBackend untouched = GlBackend::kGlfw;
+  EXPECT_FALSE(ParseGlBackend("EGL", &untouched));
+  EXPECT_EQ(untouched, GlBackend::kGlfw);
+  for (const Saved& s : saved)
+    if (s.had)
+      setenv(s.name.c_str(), s.value.c_str(), 1);
+    else
+      unsetenv(s.name.c_str());
 }
 
 TEST(GlLightRule, ShaderMatchesCameraLightWeightAtTheLightTestInputs) {
