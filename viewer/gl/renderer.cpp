@@ -20,6 +20,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -246,62 +247,183 @@ void PackCamera(const Camera& cam, int index, bool cube, int layer, const Vec3& 
 
 // ------------------------------------------------------------------------------------------
 
+namespace {
+
+// This thread's CPU time, seconds: what preparing the maps costs the CPU, not the wall time (which
+// counts llvmpipe's and the fields' threads taking the cores meanwhile).
+double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// Inward plane normals through the apex of the pyramid of `bounds`: x - x_min z >= 0,
+// x_max z - x >= 0, ...
+std::array<Vec3, 4> PyramidPlanes(const Eigen::Vector4d& bounds) {
+  return {Vec3(1, 0, -bounds(0)), Vec3(-1, 0, bounds(1)), Vec3(0, 1, -bounds(2)),
+          Vec3(0, -1, bounds(3))};
+}
+
+// Widens [*zmin, *zmax] by the depths of triangle (a, b, c) (camera frame) clipped to `planes`.
+void ClipTriangleDepth(const Vec3& a, const Vec3& b, const Vec3& c,
+                       const std::array<Vec3, 4>& planes, double* zmin, double* zmax) {
+  std::array<Vec3, 16> poly, next;
+  int count = 3;
+  poly[0] = a;
+  poly[1] = b;
+  poly[2] = c;
+  bool all_inside = true;
+  for (const Vec3& p : planes) {
+    int outside = 0;
+    for (int k = 0; k < 3; ++k) outside += p.dot(poly[k]) < 0;
+    if (outside == 3) return;
+    all_inside &= outside == 0;
+  }
+  if (!all_inside) {
+    // Sutherland-Hodgman against the four planes.
+    for (const Vec3& p : planes) {
+      int out = 0;
+      for (int k = 0; k < count; ++k) {
+        const Vec3& u = poly[k];
+        const Vec3& v = poly[(k + 1) % count];
+        const double du = p.dot(u), dv = p.dot(v);
+        if (du >= 0) next[out++] = u;
+        if ((du >= 0) != (dv >= 0)) next[out++] = u + (du / (du - dv)) * (v - u);
+      }
+      count = out;
+      poly = next;
+      if (count == 0) return;
+    }
+  }
+  for (int k = 0; k < count; ++k) {
+    *zmin = std::min(*zmin, poly[k].z());
+    *zmax = std::max(*zmax, poly[k].z());
+  }
+}
+
+}  // namespace
+
 std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh,
                                               const Eigen::Isometry3d& camera_from_world,
                                               const Eigen::Vector4d& bounds) {
-  // Inward plane normals through the apex: x - x_min z >= 0, x_max z - x >= 0, ...
-  const std::array<Vec3, 4> planes = {Vec3(1, 0, -bounds(0)), Vec3(-1, 0, bounds(1)),
-                                      Vec3(0, 1, -bounds(2)), Vec3(0, -1, bounds(3))};
+  const std::array<Vec3, 4> planes = PyramidPlanes(bounds);
   double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
   std::vector<Vec3> camera_vertices(mesh.vertices.size());
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
     camera_vertices[i] = camera_from_world * mesh.vertices[i];
-  std::array<Vec3, 16> poly, next;
-  for (const Eigen::Vector3i& tri : mesh.triangles) {
-    int count = 3;
-    for (int k = 0; k < 3; ++k) poly[k] = camera_vertices[tri[k]];
-    bool all_inside = true;
-    for (const Vec3& p : planes) {
-      int outside = 0;
-      for (int k = 0; k < 3; ++k) outside += p.dot(poly[k]) < 0;
-      if (outside == 3) {
-        count = 0;
-        break;
-      }
-      all_inside &= outside == 0;
+  for (const Eigen::Vector3i& tri : mesh.triangles)
+    ClipTriangleDepth(camera_vertices[tri[0]], camera_vertices[tri[1]], camera_vertices[tri[2]],
+                      planes, &zmin, &zmax);
+  return {zmin, zmax};
+}
+
+TriangleBoxTree BuildTriangleBoxTree(const TriangleMesh& mesh) {
+  TriangleBoxTree tree;
+  const int n = int(mesh.triangles.size());
+  if (n == 0) return tree;
+  std::vector<Aabb> boxes(static_cast<std::size_t>(n));
+  std::vector<Vec3> centres(static_cast<std::size_t>(n));
+  for (int t = 0; t < n; ++t) {
+    for (int k = 0; k < 3; ++k) boxes[t].Extend(mesh.vertices[mesh.triangles[t][k]]);
+    centres[t] = 0.5 * (boxes[t].min + boxes[t].max);
+  }
+  tree.order.resize(std::size_t(n));
+  for (int t = 0; t < n; ++t) tree.order[t] = t;
+  tree.nodes.reserve(std::size_t(n));  // about n / 2 for leaves of 3-4
+  // Median split along the longest axis of the triangles' centres, leaves of at most 4.
+  struct Pending {
+    int node, first, count;
+  };
+  std::vector<Pending> stack{{0, 0, n}};
+  tree.nodes.emplace_back();
+  while (!stack.empty()) {
+    const Pending job = stack.back();
+    stack.pop_back();
+    Aabb box, spread;
+    for (int i = job.first; i < job.first + job.count; ++i) {
+      box.Extend(boxes[tree.order[i]]);
+      spread.Extend(centres[tree.order[i]]);
     }
-    if (count == 0) continue;
-    if (!all_inside) {
-      // Sutherland-Hodgman against the four planes.
+    tree.nodes[job.node].box = box;
+    if (job.count <= 4) {
+      tree.nodes[job.node].first = job.first;
+      tree.nodes[job.node].count = job.count;
+      continue;
+    }
+    int axis = 0;
+    (spread.max - spread.min).maxCoeff(&axis);
+    const int half = job.count / 2;
+    const auto begin = tree.order.begin() + job.first;
+    std::nth_element(begin, begin + half, begin + job.count,
+                     [&](int a, int b) { return centres[a](axis) < centres[b](axis); });
+    const int left = int(tree.nodes.size());
+    tree.nodes.emplace_back();
+    tree.nodes.emplace_back();
+    tree.nodes[job.node].left = left;
+    tree.nodes[job.node].right = left + 1;
+    stack.push_back({left, job.first, half});
+    stack.push_back({left + 1, job.first + half, job.count - half});
+  }
+  return tree;
+}
+
+std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh, const TriangleBoxTree& tree,
+                                              const Eigen::Isometry3d& camera_from_world,
+                                              const Eigen::Vector4d& bounds,
+                                              std::int64_t* visited) {
+  const std::array<Vec3, 4> planes = PyramidPlanes(bounds);
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  std::int64_t clipped = 0;
+  if (!tree.nodes.empty()) {
+    const Mat3& R = camera_from_world.linear();
+    const Mat3 abs_r = R.cwiseAbs();
+    std::vector<int> stack{0};
+    while (!stack.empty()) {
+      const TriangleBoxTree::Node& node = tree.nodes[std::size_t(stack.back())];
+      stack.pop_back();
+      // The node's box in the camera frame (the box around the rotated box), widened by a margin
+      // far above the rounding of these few products, so that a skipped triangle's own
+      // transformed vertices lie inside it.
+      const Vec3 centre = camera_from_world * (0.5 * (node.box.min + node.box.max));
+      const Vec3 half = abs_r * (0.5 * (node.box.max - node.box.min));
+      const Vec3 pad = Vec3::Constant(1e-9 * (centre.cwiseAbs().maxCoeff() + half.maxCoeff()));
+      const Vec3 lo = centre - half - pad, hi = centre + half + pad;
+      bool outside = false;
       for (const Vec3& p : planes) {
-        int out = 0;
-        for (int k = 0; k < count; ++k) {
-          const Vec3& a = poly[k];
-          const Vec3& b = poly[(k + 1) % count];
-          const double da = p.dot(a), db = p.dot(b);
-          if (da >= 0) next[out++] = a;
-          if ((da >= 0) != (db >= 0)) next[out++] = a + (da / (da - db)) * (b - a);
-        }
-        count = out;
-        poly = next;
-        if (count == 0) break;
+        double most = 0;  // the largest p . x over the box
+        for (int k = 0; k < 3; ++k) most += std::max(p(k) * lo(k), p(k) * hi(k));
+        outside |= most < 0;
       }
-    }
-    for (int k = 0; k < count; ++k) {
-      zmin = std::min(zmin, poly[k].z());
-      zmax = std::max(zmax, poly[k].z());
+      if (outside) continue;
+      // Inside the pyramid z >= 0: the node can only give depths in [max(lo.z, 0), hi.z].
+      if (std::max(lo.z(), 0.0) >= zmin && hi.z() <= zmax) continue;
+      if (node.left < 0) {
+        for (int i = node.first; i < node.first + node.count; ++i) {
+          const Eigen::Vector3i& tri = mesh.triangles[std::size_t(tree.order[i])];
+          ClipTriangleDepth(camera_from_world * mesh.vertices[tri[0]],
+                            camera_from_world * mesh.vertices[tri[1]],
+                            camera_from_world * mesh.vertices[tri[2]], planes, &zmin, &zmax);
+          ++clipped;
+        }
+        continue;
+      }
+      stack.push_back(node.right);
+      stack.push_back(node.left);
     }
   }
+  if (visited) *visited = clipped;
   return {zmin, zmax};
 }
 
 struct GlRenderer::Impl {
-  TriangleMesh mesh;  // world, double: the depth ranges
+  TriangleMesh mesh;           // world, double: the depth ranges
+  TriangleBoxTree boxes;       // over mesh: each map's range from the triangles that can widen it
+  double map_cpu_seconds = 0;  // this frame's depth ranges of maps
   Vec3 origin = Vec3::Zero();
   double scene_scale = 1.0;
   GLsizei vertex_count = 0;
   GLuint vao = 0, vbo = 0;
-  GLuint gbuffer_program = 0, shadow_program = 0, compose_program = 0;
+  GLuint gbuffer_program = 0, shadow_program = 0, compose_program = 0, encode_program = 0;
   std::map<int, GLuint> light_programs;  // by variant bits: 1 grid, 2 fisheye, 4 distortion, 8 cube
 
   GLuint LightProgram(int variant) {
@@ -334,6 +456,7 @@ struct GlRenderer::Impl {
   GLuint g_fbo = 0, g_position = 0, g_normal = 0, g_albedo = 0, g_depth = 0;
   GLuint light_fbo[2] = {0, 0}, light_accum = 0, mask[2] = {0, 0};
   GLuint compose_fbo = 0, compose_color = 0;
+  GLuint encode_fbo = 0, encoded = 0;  // the composed frame as 8-bit sRGB (DrawToTexture)
 
   // Distance maps: perspective maps (one layer per camera) and cubes (six layers per camera),
   // with the camera each layer group was last drawn for (reused while it stays the same).
@@ -343,12 +466,12 @@ struct GlRenderer::Impl {
   std::vector<std::optional<Camera>> map_camera, cube_camera;
 
   void FreeViewTargets() {
-    GLuint textures[] = {g_position, g_normal, g_albedo,     light_accum,
-                         mask[0],    mask[1],  compose_color};
-    glDeleteTextures(7, textures);
+    GLuint textures[] = {g_position, g_normal, g_albedo,      light_accum,
+                         mask[0],    mask[1],  compose_color, encoded};
+    glDeleteTextures(8, textures);
     glDeleteRenderbuffers(1, &g_depth);
-    GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo};
-    glDeleteFramebuffers(4, fbos);
+    GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo, encode_fbo};
+    glDeleteFramebuffers(5, fbos);
     width = height = 0;
   }
 
@@ -385,6 +508,14 @@ struct GlRenderer::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, compose_fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, compose_color, 0);
     CheckFramebuffer("compose");
+    encoded = MakeTexture(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE);
+    glBindTexture(GL_TEXTURE_2D, encoded);  // shown scaled in the window
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glGenFramebuffers(1, &encode_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, encode_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, encoded, 0);
+    CheckFramebuffer("encode");
   }
 
   static GLuint MapArray(int size, int layers) {
@@ -494,7 +625,9 @@ struct GlRenderer::Impl {
       Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
       face_from_world.linear() = face_from_camera * cfw.linear();
       face_from_world.translation() = face_from_camera * cfw.translation();
-      auto range = DepthRangeInPyramid(mesh, face_from_world, bounds);
+      const double prepare = ThreadCpuSeconds();
+      auto range = DepthRangeInPyramid(mesh, boxes, face_from_world, bounds);
+      map_cpu_seconds += ThreadCpuSeconds() - prepare;
       range.second = std::min(range.second, cam.far);  // occluders lie nearer than the point
       if (!(range.first <= range.second)) continue;
       const auto [near, far] = PadRange(range);
@@ -518,7 +651,7 @@ struct GlRenderer::Impl {
     const Mat3 eye_R = eye.pose.linear().transpose();  // camera_from_world
     const Eigen::Isometry3d cfw = eye.pose.inverse();
     const Eigen::Vector4d bounds(-0.5 * W / f, 0.5 * W / f, -0.5 * H / f, 0.5 * H / f);
-    auto range = DepthRangeInPyramid(mesh, cfw, bounds);
+    auto range = DepthRangeInPyramid(mesh, boxes, cfw, bounds);
     if (!(range.first <= range.second)) range = {1.0, 2.0};  // nothing in view: any range
     // The depth range spans the content in view (an eye 500 scene sizes away: far / near ~ 1.002).
     // Depths are taken relative to the near plane in the shaders and the depth test's value is
@@ -687,6 +820,42 @@ struct GlRenderer::Impl {
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
 
+  // What DrawFrame drew: the frame's size, the mask holding its camera sets, and its costs.
+  struct Frame {
+    int W = 0, H = 0, src = 0, camera_count = 0, maps_drawn = 0, light_passes = 0;
+    double shadow_seconds = 0, light_seconds = 0, total_seconds = 0, map_cpu_seconds = 0;
+  };
+  // Steps 1-4 of a frame (G-buffer, maps, light, compose), nothing read back; `timed` waits for
+  // the GPU after each part.
+  Frame DrawFrame(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
+                  bool timed);
+  static void FinishFrame(const Frame& f, std::chrono::steady_clock::time_point read,
+                          std::int64_t readback_bytes, GlFrameStats* stats);
+
+  // The composed colour as 8-bit sRGB into `encoded`, on the GPU.
+  void Encode(int W, int H) {
+    glBindFramebuffer(GL_FRAMEBUFFER, encode_fbo);
+    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer0);
+    glViewport(0, 0, W, H);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(encode_program);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, compose_color);
+    glUniform1i(Loc(encode_program, "color_tex"), 0);
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+
+  // Bytes ReadBack reads from the GPU for a W x H frame: two RGBA float images (colour, surface
+  // hits) and, up to 64 cameras, the two-word camera mask.
+  static std::int64_t ReadBackBytes(int W, int H, int camera_count) {
+    const std::int64_t pixels = std::int64_t(W) * H;
+    return pixels * (2 * 16 + (camera_count <= 64 ? 8 : 0));
+  }
+
   // Reads the composed colour, the surface hits and (up to 64 cameras) mask `src` back.
   GlImage ReadBack(int W, int H, int src, int camera_count) {
     const std::size_t pixels = std::size_t(W) * H;
@@ -725,6 +894,7 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
   Impl& m = *impl_;
   std::vector<int> triangle_object;
   m.mesh = scene.AllTriangles(&triangle_object);
+  m.boxes = BuildTriangleBoxTree(m.mesh);
   const Aabb content = scene.ContentBounds();
   m.origin = content.empty() ? Vec3::Zero() : content.center();
   m.scene_scale = std::max(content.diagonal(), 1e-9);
@@ -817,6 +987,7 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
   m.gbuffer_program = Link(kGBufferVertex, kGBufferFragment, "gbuffer");
   m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
+  m.encode_program = Link(kFullScreenVertex, kEncodeFragment, "encode");
   m.LightProgram(15);  // every branch compiled once now: a shader error shows at construction
   glGenBuffers(1, &m.camera_ubo);
   glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
@@ -828,11 +999,12 @@ GlRenderer::~GlRenderer() = default;
 
 std::size_t GlRenderer::triangle_count() const { return impl_->mesh.triangles.size(); }
 
-GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
-                           GlFrameStats* stats) {
+GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const RenderView& view,
+                                                    const GlRenderOptions& options, bool timed) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  Impl& m = *impl_;
+  Impl& m = *this;
+  m.map_cpu_seconds = 0;
   if (view.camera >= 0)
     throw std::invalid_argument(
         "GlRenderer: camera's-eye views (RenderView::camera) are not drawn on the GPU yet; use "
@@ -901,11 +1073,11 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
   std::vector<float> block(4 * kCameraVec4 * kMaxBatch, 0.0f);
   for (const Batch& batch : batches) {
     // 2. The batch's distance maps (those not kept from the last frame).
-    if (stats) glFinish();
+    if (timed) glFinish();
     const auto shadow_start = Clock::now();
     std::vector<int> layer(batch.cameras.size());
     maps_drawn += m.DrawBatchMaps(rig, batch, keep, options, layer);
-    if (stats) {
+    if (timed) {
       glFinish();
       shadow_seconds += std::chrono::duration<double>(Clock::now() - shadow_start).count();
     }
@@ -913,7 +1085,7 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
     // 3. The batch's light over the G-buffer, in one pass.
     const auto light_start = Clock::now();
     src = m.DrawBatchLight(rig, batch, layer, eye, options, brightness, src, block);
-    if (stats) {
+    if (timed) {
       glFinish();
       light_seconds += std::chrono::duration<double>(Clock::now() - light_start).count();
     }
@@ -921,23 +1093,66 @@ GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRende
 
   // 4. Compose.
   m.Compose(eye, options);
-  if (stats) glFinish();
+  if (timed) glFinish();
   const auto drawn = Clock::now();
 
-  // 5. Read back.
-  GlImage image = m.ReadBack(W, H, src, camera_count);
+  Frame frame;
+  frame.W = W;
+  frame.H = H;
+  frame.src = src;
+  frame.camera_count = camera_count;
+  frame.maps_drawn = maps_drawn;
+  frame.light_passes = int(batches.size());
+  frame.shadow_seconds = shadow_seconds;
+  frame.light_seconds = light_seconds;
+  frame.total_seconds = std::chrono::duration<double>(drawn - start).count();
+  frame.map_cpu_seconds = m.map_cpu_seconds;
+  return frame;
+}
+
+// The frame's statistics, the read-back's time and bytes with them; throws on a GL error.
+void GlRenderer::Impl::FinishFrame(const Frame& f, std::chrono::steady_clock::time_point read,
+                                   std::int64_t readback_bytes, GlFrameStats* stats) {
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR)
     throw std::runtime_error("GlRenderer: GL error " + std::to_string(error) + " in a frame");
-  if (stats) {
-    stats->shadow_seconds = shadow_seconds;
-    stats->light_seconds = light_seconds;
-    stats->total_seconds = std::chrono::duration<double>(drawn - start).count();
-    stats->readback_seconds = std::chrono::duration<double>(Clock::now() - drawn).count();
-    stats->shadow_maps = maps_drawn;
-    stats->light_passes = int(batches.size());
-  }
+  if (!stats) return;
+  stats->shadow_seconds = f.shadow_seconds;
+  stats->map_cpu_seconds = f.map_cpu_seconds;
+  stats->light_seconds = f.light_seconds;
+  stats->total_seconds = f.total_seconds;
+  stats->readback_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - read).count();
+  stats->readback_bytes = readback_bytes;
+  stats->shadow_maps = f.maps_drawn;
+  stats->light_passes = f.light_passes;
+}
+
+GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
+                           GlFrameStats* stats) {
+  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part);
+  const auto read = std::chrono::steady_clock::now();
+  GlImage image = impl_->ReadBack(f.W, f.H, f.src, f.camera_count);
+  Impl::FinishFrame(f, read, Impl::ReadBackBytes(f.W, f.H, f.camera_count), stats);
   return image;
+}
+
+unsigned GlRenderer::DrawToTexture(const Rig& rig, const RenderView& view,
+                                   const GlRenderOptions& options, GlFrameStats* stats) {
+  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part);
+  const auto read = std::chrono::steady_clock::now();
+  impl_->Encode(f.W, f.H);
+  if (stats && stats->per_part) glFinish();
+  Impl::FinishFrame(f, read, 0, stats);
+  return impl_->encoded;
+}
+
+std::vector<unsigned char> GlReadRgba8(unsigned texture, int width, int height) {
+  std::vector<unsigned char> rgba(4 * std::size_t(width) * std::size_t(height));
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  return rgba;
 }
 
 std::vector<double> GlCameraLightWeights(const LightRule& rule,

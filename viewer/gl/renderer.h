@@ -83,13 +83,20 @@ struct GlImage {
   std::vector<uint8_t> hit;
 };
 
-/// Timing of a frame, seconds. With stats requested the renderer waits for the GPU (glFinish)
-/// after each part, so the parts do not overlap.
+/// Timing of a frame, seconds. With stats requested (and per_part) the renderer waits for the GPU
+/// (glFinish) after each part, so the parts do not overlap.
 struct GlFrameStats {
+  /// Wait for the GPU after each part so that the times below are the parts' own (a bench); false
+  /// (a window) fills only what costs nothing to count: the bytes, maps and the CPU time of maps.
+  bool per_part = true;
   double shadow_seconds = 0;  ///< Distance maps of every enabled camera.
-  double light_seconds = 0;   ///< The per-camera light passes over the G-buffer.
-  double total_seconds = 0;   ///< The whole frame up to the read-back (not included).
-  double readback_seconds = 0;
+  /// CPU time (of the calling thread) spent preparing the maps: each map's depth range from the
+  /// triangle tree, seconds.
+  double map_cpu_seconds = 0;
+  double light_seconds = 0;         ///< The per-camera light passes over the G-buffer.
+  double total_seconds = 0;         ///< The whole frame up to the read-back (not included).
+  double readback_seconds = 0;      ///< Render: the read-back; DrawToTexture: the encode pass.
+  std::int64_t readback_bytes = 0;  ///< Bytes read from the GPU to the CPU (0: DrawToTexture).
   int shadow_maps = 0;   ///< Maps drawn (a cube counts 6, fewer where a face is not needed).
   int light_passes = 0;  ///< Passes over the G-buffer (batches of cameras).
 };
@@ -114,6 +121,13 @@ class GlRenderer {
   /// beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for a GL error in the frame.
   GlImage Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                  GlFrameStats* stats = nullptr);
+  /// The same frame, kept on the GPU for a window to show: its colour encoded as 8-bit sRGB RGBA
+  /// (opaque; per channel what the CPU path's 8-bit sRGB of Render's rgb gives, within one level)
+  /// in a GL_TEXTURE_2D this renderer owns, row 0 the image's top row, linear filtering. Returns
+  /// the texture's name, valid until the next call with another size or the renderer's end.
+  /// Nothing is read back (stats->readback_bytes = 0). Throws as Render.
+  unsigned DrawToTexture(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
+                         GlFrameStats* stats = nullptr);
 
   std::size_t triangle_count() const;
 
@@ -121,6 +135,10 @@ class GlRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The RGBA8 texels of `texture` (a GL_TEXTURE_2D of width x height, e.g. DrawToTexture's), row 0
+/// first: what a screenshot or a test reads back of a frame kept on the GPU.
+std::vector<unsigned char> GlReadRgba8(unsigned texture, int width, int height);
 
 /// The tightest [near, far] of camera-frame depth z that the scene's triangles reach inside the
 /// pyramid {|x| / z, |y| / z within `bounds`} (x_min, x_max, y_min, y_max of normalized image
@@ -130,6 +148,29 @@ class GlRenderer {
 std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh,
                                               const Eigen::Isometry3d& camera_from_world,
                                               const Eigen::Vector4d& bounds);
+
+/// A bounding-box hierarchy over a mesh's triangles (leaves of at most 4), for the depth range.
+struct TriangleBoxTree {
+  struct Node {
+    Aabb box;
+    int left = -1, right = -1;  // children (both or neither)
+    int first = 0, count = 0;   // a leaf's triangles: order[first .. first + count)
+  };
+  std::vector<Node> nodes;  // nodes[0] is the root (none for an empty mesh)
+  std::vector<int> order;   // triangle indices, grouped by leaf
+};
+TriangleBoxTree BuildTriangleBoxTree(const TriangleMesh& mesh);
+
+/// DepthRangeInPyramid with `tree` (BuildTriangleBoxTree(mesh)): the same two numbers, bit for
+/// bit, from only the triangles that can widen the range found so far: a node is skipped when its
+/// box lies outside one of the pyramid's planes or within the current [near, far] (both tested
+/// with a margin over the boxes' rounding). What each shadow map and the G-buffer use: a map of the
+/// trauma room's 10k triangles visits a few hundred. `visited`, when set, receives the triangles
+/// clipped.
+std::pair<double, double> DepthRangeInPyramid(const TriangleMesh& mesh, const TriangleBoxTree& tree,
+                                              const Eigen::Isometry3d& camera_from_world,
+                                              const Eigen::Vector4d& bounds,
+                                              std::int64_t* visited = nullptr);
 
 /// The light rule's weight as the renderer's GLSL computes it (render/light.h CameraLightWeight
 /// for `rule`'s pattern, grid spacing, fill and line width; brightness and colour aside), one

@@ -7,18 +7,22 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "analysis/geometry/primitives.h"
+#include "analysis/util/color.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
 #include "tests/fixtures.h"
@@ -251,6 +255,76 @@ TEST(DepthRangeInPyramid, MatchesDenseSamplingOfClippedTriangles) {
   EXPECT_GT(behind.first, behind.second);
 }
 
+// The tree's depth range is the brute-force one bit for bit (every map of the trauma room's rigs,
+// the lens room's cameras and random frames in and around both scenes, inside and outside the
+// content, looking anywhere), from far fewer triangles.
+TEST(DepthRangeInPyramid, TreeGivesTheSameRangeFromFewTriangles) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::int64_t visited_total = 0, triangles_total = 0;  // over every frame
+  int frames = 0, empty = 0;
+  const Scene trauma = LoadScene("examples/trauma_room/scene.json");
+  for (const Scene* scene : {&trauma}) {
+    const TriangleMesh mesh = scene->AllTriangles();
+    const TriangleBoxTree tree = BuildTriangleBoxTree(mesh);
+    const Aabb content = scene->ContentBounds();
+    std::vector<Eigen::Isometry3d> poses;
+    std::vector<Eigen::Vector4d> bounds;
+    for (const Rig& rig : scene->rigs)
+      for (const Camera& cam : rig.cameras) {
+        poses.push_back(cam.camera_from_world());
+        bounds.push_back(cam.model.normalized_bounds());
+      }
+    const std::size_t rig_cameras = poses.size();  // the rigs' own maps come first
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 span = content.max - content.min;
+      const Vec3 from =
+          content.min +
+          (0.5 * (Vec3(unit(rng), unit(rng), unit(rng)) + Vec3::Ones())).cwiseProduct(1.6 * span) -
+          0.3 * span;
+      const Vec3 to = from + Vec3(unit(rng), unit(rng), unit(rng));
+      const auto pose = LookAt(
+          from, to,
+          std::abs(to.z() - from.z()) > 0.99 * (to - from).norm() ? Vec3::UnitX() : Vec3::UnitZ());
+      if (!pose) continue;
+      poses.push_back(pose->inverse());
+      const double w = 0.05 + 1.5 * (0.5 + 0.5 * unit(rng)), h = 0.05 + w * 0.6;
+      bounds.push_back(Eigen::Vector4d(-w, w * (0.5 + 0.5 * unit(rng)), -h, h));
+    }
+    std::int64_t rig_visited = 0;
+    double brute_seconds = 0, tree_seconds = 0, rig_tree_seconds = 0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto brute = DepthRangeInPyramid(mesh, poses[k], bounds[k]);
+      const auto t1 = std::chrono::steady_clock::now();
+      std::int64_t visited = 0;
+      const auto fast = DepthRangeInPyramid(mesh, tree, poses[k], bounds[k], &visited);
+      const auto t2 = std::chrono::steady_clock::now();
+      brute_seconds += std::chrono::duration<double>(t1 - t0).count();
+      tree_seconds += std::chrono::duration<double>(t2 - t1).count();
+      if (k < rig_cameras) rig_tree_seconds += std::chrono::duration<double>(t2 - t1).count();
+      if (k < rig_cameras) rig_visited += visited;
+      ASSERT_EQ(std::memcmp(&brute.first, &fast.first, sizeof(double)), 0) << k;
+      ASSERT_EQ(std::memcmp(&brute.second, &fast.second, sizeof(double)), 0) << k;
+      empty += brute.first > brute.second ? 1 : 0;
+      visited_total += visited;
+      triangles_total += std::int64_t(mesh.triangles.size());
+      ++frames;
+    }
+    std::printf(
+        "depth ranges of the %zu rig cameras: %.2f %% of %zu triangles clipped, %.3f ms each; "
+        "all %zu frames: %.3f ms brute force, %.3f ms with the tree per frame (not asserted)\n",
+        rig_cameras, 100.0 * double(rig_visited) / double(rig_cameras * mesh.triangles.size()),
+        mesh.triangles.size(), 1e3 * rig_tree_seconds / double(rig_cameras), poses.size(),
+        1e3 * brute_seconds / double(poses.size()), 1e3 * tree_seconds / double(poses.size()));
+  }
+  std::printf("depth ranges: %d frames (%d empty), %.2f %% of the triangles clipped\n", frames,
+              empty, 100.0 * double(visited_total) / double(triangles_total));
+  EXPECT_GT(frames, 150);
+  EXPECT_GT(empty, 0);                            // some frames look out of the content
+  EXPECT_LT(visited_total * 5, triangles_total);  // at most a fifth of the brute-force work
+}
+
 TEST(GlRenderer, TraumaRoomOctagonMatchesCpu) {
   const Scene scene = LoadScene("examples/trauma_room/scene.json");
   const Rig& rig = scene.FindRig("octagon");
@@ -262,6 +336,48 @@ TEST(GlRenderer, TraumaRoomOctagonMatchesCpu) {
   std::size_t lit2 = 0;
   for (uint64_t m : r.gpu.cameras) lit2 += __builtin_popcountll(m) >= 2;
   EXPECT_GT(lit2, r.gpu.cameras.size() / 20);
+}
+
+// A frame kept on the GPU (DrawToTexture, what the window shows) is Render's colour as 8-bit sRGB:
+// per channel within one level of the CPU conversion (SrgbFromLinear, rounded; the GPU evaluates
+// the curve in float, 2^-24 relative, and rounds to the nearest level itself), the same level on
+// almost every channel, alpha opaque; and it reads nothing back, where Render reads two RGBA float
+// images and the camera mask (40 bytes a pixel).
+TEST(GlRenderer, FrameKeptOnTheGpuIsTheReadBackOneInSrgb8) {
+  Context();
+  const Scene scene = LoadScene("examples/trauma_room/scene.json");
+  const Rig& rig = scene.FindRig("octagon");
+  const RenderView view = ViewFromScene(scene.views.at("overview"), 320, 180);
+  const PreparedScene prepared(scene);
+  GlRenderer renderer(scene, &prepared);
+  GlRenderOptions options;
+  options.shadow_map_size = 1024;
+  GlFrameStats read_stats, kept_stats;
+  const GlImage image = renderer.Render(rig, view, options, &read_stats);
+  const unsigned texture = renderer.DrawToTexture(rig, view, options, &kept_stats);
+  EXPECT_EQ(read_stats.readback_bytes, std::int64_t(320) * 180 * 40);
+  EXPECT_EQ(kept_stats.readback_bytes, 0);
+  EXPECT_EQ(kept_stats.shadow_maps, 0);  // the maps of the frame before are kept
+  const std::vector<unsigned char> rgba = GlReadRgba8(texture, 320, 180);
+  ASSERT_EQ(rgba.size(), std::size_t(4) * 320 * 180);
+  int worst = 0;
+  std::size_t differ = 0, lit = 0;
+  for (std::size_t i = 0; i < rgba.size() / 4; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const double linear = image.rgb[3 * i + k];
+      const int cpu = int(std::lround(255.0 * SrgbFromLinear(linear)));
+      const int d = std::abs(cpu - int(rgba[4 * i + k]));
+      worst = std::max(worst, d);
+      differ += d > 0 ? 1 : 0;
+      lit += linear > 0.05 ? 1 : 0;
+    }
+    ASSERT_EQ(rgba[4 * i + 3], 255);
+  }
+  std::printf("kept frame: %zu of %zu channels one level off the CPU conversion, worst %d\n",
+              differ, rgba.size() / 4 * 3, worst);
+  EXPECT_LE(worst, 1);
+  EXPECT_LT(double(differ), 0.01 * double(rgba.size() / 4 * 3));
+  EXPECT_GT(double(lit), 0.2 * double(rgba.size() / 4 * 3));  // a real picture, not black
 }
 
 TEST(GlRenderer, TraumaRoomCloseUpMatchesCpu) {

@@ -79,6 +79,7 @@ void ViewerApp::Impl::UploadAllTrace() {
   if (!all_trace->fresh) return;
   all_trace->fresh = false;
   if (model.ptz_trace != "all") return;  // a pass that finished after the mode changed
+  shown_texture = main_texture;
   Upload(&main_texture, all_trace->image.width, all_trace->image.height,
          ToRgba8(all_trace->image.rgb));
 }
@@ -112,7 +113,7 @@ void ViewerApp::Impl::RenderMain() {
   // Reduced while things move, full once idle.
   const bool moving =
       options.motion_scale < 1 && !full_now && (drag != Drag::kNone || since(last_change) < 0.3);
-  if (key == main_key && main_texture && (moving || main_full)) return;
+  if (key == main_key && shown_texture && (moving || main_full)) return;
   main_key = key;
   main_full = !moving;
   if (moving) {
@@ -149,6 +150,7 @@ void ViewerApp::Impl::RenderMain() {
       const Image image =
           RenderWithStats(model.session().study().prepared(), traced, view, o, nullptr, nullptr);
       Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+      shown_texture = main_texture;
       all_trace_key = key;
     } else if (key != all_trace_key) {
       // Coarse first (1/64 of the pixels), then refined; a newer frame cancels this one.
@@ -170,9 +172,13 @@ void ViewerApp::Impl::RenderMain() {
     GlRenderOptions o = gl_options;
     if (model.ptz_trace != "single" && std::isnan(o.brightness))
       o.brightness = DefaultBrightness(model.rig().enabled_count());
-    const GlImage image =
-        gl->Render(model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o);
-    Upload(&main_texture, image.width, image.height, ToRgba8(image.rgb));
+    // Kept on the GPU: the renderer's own 8-bit sRGB texture is what the window shows.
+    GlFrameStats counts;
+    counts.per_part = false;  // no waits: only what costs nothing to count
+    shown_texture = gl->DrawToTexture(
+        model.ptz_trace == "single" ? model.rig() : model.TracedRig(nullptr), view, o, &counts);
+    readback_bytes += counts.readback_bytes;
+    map_cpu_seconds += counts.map_cpu_seconds;
   }
   gl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   frame_gl_seconds = gl_seconds;
@@ -190,6 +196,7 @@ void ViewerApp::Impl::RenderMain() {
 
 void ViewerApp::Impl::Upload(GLuint* texture, int w, int h,
                              const std::vector<unsigned char>& rgba) {
+  upload_bytes += std::int64_t(rgba.size());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (!*texture) glGenTextures(1, texture);
   glBindTexture(GL_TEXTURE_2D, *texture);
@@ -604,7 +611,7 @@ bool ViewerApp::Impl::OneFrame() {
   Handle3d(mouse_free);
   RenderMain();
   ImDrawList* bg = ImGui::GetBackgroundDrawList();
-  bg->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(main_texture)), ImVec2(0, 0),
+  bg->AddImage(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(shown_texture)), ImVec2(0, 0),
                ImVec2(float(model.width), float(model.height)));
   DrawOverlays(bg);
   Panels();
@@ -715,7 +722,10 @@ ViewerApp::~ViewerApp() {
 
 bool ViewerApp::Frame() {
   glfwPollEvents();
+  impl_->readback_bytes = impl_->upload_bytes = 0;
+  impl_->map_cpu_seconds = 0;
   const bool open = impl_->OneFrame();
+  impl_->last_transfer = {impl_->readback_bytes, impl_->upload_bytes, impl_->map_cpu_seconds};
   glfwSwapBuffers(impl_->window);
   return open;
 }
@@ -728,6 +738,8 @@ void ViewerApp::SetMotionScale(double scale, double target_hz) {
 }
 
 double ViewerApp::MotionScaleNow() const { return impl_->motion_now; }
+
+FrameTransfer ViewerApp::LastFrameTransfer() const { return impl_->last_transfer; }
 
 void ViewerApp::Loop() {
   while (Frame()) {

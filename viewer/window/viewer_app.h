@@ -6,6 +6,7 @@
 /// mouse, keyboard and gamepad input into the model's actions; scripted input goes through the same
 /// handlers. Light header: no GL, GLFW or ImGui in it.
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -30,6 +31,14 @@ struct AppOptions {
   double target_hz = 30;
 };
 
+/// What a frame of the window moved between CPU and GPU for its pictures, and the CPU time it
+/// spent preparing shadow maps.
+struct FrameTransfer {
+  std::int64_t readback_bytes = 0;  ///< GPU -> CPU
+  std::int64_t upload_bytes = 0;    ///< CPU -> GPU
+  double map_cpu_seconds = 0;       ///< the maps' depth ranges (GlFrameStats::map_cpu_seconds)
+};
+
 class ViewerApp : public Frontend {
  public:
   /// Opens the window and its GL context. Throws std::runtime_error naming the cause (no display:
@@ -46,6 +55,10 @@ class ViewerApp : public Frontend {
   void SetMotionScale(double scale, double target_hz = 0);
   /// The scale the next moving frame is drawn at (adapted when target_hz is set).
   double MotionScaleNow() const;
+  /// Picture bytes the last frame read back from the GPU and uploaded to it: 0 and 0 while the
+  /// GPU renderer draws the main view (it stays on the GPU); the camera's-eye insets, the PTZ
+  /// "all" view and screenshots are the exact CPU renderer's, uploaded.
+  FrameTransfer LastFrameTransfer() const;
 
   // Frontend: the window's own picture (after a frame is drawn), or a camera's exact view.
   void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;

@@ -134,10 +134,11 @@ struct ViewerApp::Impl {
   GLFWwindow* window = nullptr;
   std::unique_ptr<GlRenderer> gl;
   GlRenderOptions gl_options;
-  GLuint main_texture = 0;
-  std::string main_key;    // what the main texture shows
-  bool main_full = false;  // ... at full resolution
-  bool full_now = false;   // a screenshot: draw in full whatever moved just before
+  GLuint main_texture = 0;   // the main view drawn on the CPU (PTZ "all"), uploaded
+  GLuint shown_texture = 0;  // what the window shows: main_texture or the GPU renderer's own
+  std::string main_key;      // what the shown texture shows
+  bool main_full = false;    // ... at full resolution
+  bool full_now = false;     // a screenshot: draw in full whatever moved just before
   std::chrono::steady_clock::time_point last_change, last_rig_change;
   std::int64_t main_rig_version = -1;
   double motion_now = 0.5;  // the scale of the next moving frame (adapted to AppOptions::target_hz)
@@ -221,7 +222,12 @@ struct ViewerApp::Impl {
 
   void RenderMain();
 
-  static void Upload(GLuint* texture, int w, int h, const std::vector<unsigned char>& rgba);
+  // Uploads an 8-bit RGBA image into *texture (made at first use), counted in upload_bytes.
+  void Upload(GLuint* texture, int w, int h, const std::vector<unsigned char>& rgba);
+  // Bytes this frame moved between CPU and GPU for pictures (LastFrameTransfer).
+  std::int64_t readback_bytes = 0, upload_bytes = 0;
+  double map_cpu_seconds = 0;  // CPU time preparing the GPU renderer's maps this frame
+  FrameTransfer last_transfer;
 
   // The display settings for the small exact views (a camera's, a station's display): the light
   // and surfaces as in the main view, without the slice, isosurface, key or float layers.
