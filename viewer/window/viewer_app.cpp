@@ -79,9 +79,9 @@ void ViewerApp::Impl::UploadAllTrace() {
   if (!all_trace->fresh) return;
   all_trace->fresh = false;
   if (model.ptz_trace != "all") return;  // a pass that finished after the mode changed
-  shown_texture = main_texture;
   Upload(&main_texture, all_trace->image.width, all_trace->image.height,
          ToRgba8(all_trace->image.rgb));
+  shown_texture = main_texture;  // made by the first upload
 }
 
 void ViewerApp::Impl::RenderMain() {
