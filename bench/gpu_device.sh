@@ -10,7 +10,8 @@
 #                                                  logs and tables into OUT (default $OUT or gpu_out)
 #
 # `run` needs the machine's EGL (libEGL.so.1 with its vendor library, e.g. NVIDIA's) and no
-# display. It writes gl_renderer_test.log, the bench tables per scene (bench_*.md) and device.txt.
+# display. It writes gl_renderer_test.log, the bench tables per scene (bench_*.md: the trauma room,
+# the capture stage with its 24 cameras, 64 and 200) and device.txt.
 # Here (no GPU) the same `run` goes through Mesa's software EGL device: a rehearsal (QUICK=1 for
 # small frames).
 set -euo pipefail
@@ -63,6 +64,12 @@ run() {
     > "$out/bench_trauma_room.md" 2>&1 || echo "bench trauma room failed" >&2
   "$dir/bin/pandora_gl_bench" examples/capture_stage/scene.json "${bench[@]}" \
     > "$out/bench_capture_stage.md" 2>&1 || echo "bench capture stage failed" >&2
+  # Rigs of 64 and 200 cameras: the stage's 24 turned about its axis (--cameras); above 64 the
+  # camera sets are compared on sampled pixels.
+  for n in 64 200; do
+    "$dir/bin/pandora_gl_bench" examples/capture_stage/scene.json --cameras "$n" "${bench[@]}" \
+      > "$out/bench_capture_stage_$n.md" 2>&1 || echo "bench capture stage $n failed" >&2
+  done
   head -n 1 "$out/bench_trauma_room.md" >> "$out/device.txt"
   cat "$out/device.txt"
   rm -rf "$dir"

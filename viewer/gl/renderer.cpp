@@ -166,7 +166,9 @@ constexpr int kMaxBatch = 64;
 bool IsCube(const Camera& cam) { return cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle; }
 
 // Batches of enabled cameras in rig order, each within the map memory budget and the uniform
-// block; each batch is one light pass over the G-buffer with all its maps bound.
+// block, and within one 64-camera word of the per-pixel camera sets (rig indices 64 w .. 64 w +
+// 63, so one RG32UI mask holds a batch's bits); each batch is one light pass over the G-buffer
+// with all its maps bound.
 struct Batch {
   std::vector<int> cameras;
   int perspective = 0, cube = 0;
@@ -187,6 +189,7 @@ std::vector<Batch> LightBatches(const Rig& rig, const GlRenderOptions& options, 
     // A new batch when this one is full: the uniform block, the map budget, or the layers a
     // texture array may have (GL_MAX_ARRAY_TEXTURE_LAYERS, at least 256 in GL 3.3).
     if (batches.empty() || int(batches.back().cameras.size()) == kMaxBatch ||
+        batches.back().cameras.front() / 64 != c / 64 ||
         (bytes + need > budget && !batches.back().cameras.empty()) ||
         (cube ? 6 * (batches.back().cube + 1) : batches.back().perspective + 1) > max_layers) {
       batches.emplace_back();
@@ -213,7 +216,8 @@ Eigen::Vector4d MapCoefficients(const Eigen::Vector4d& b) {
                          (b(2) + b(3)) / (b(3) - b(2)));
 }
 
-// Camera `index` of the rig as the light shader reads it (kLightFragment's c0 .. c9).
+// Camera `index` of the rig as the light shader reads it (kLightFragment's c0 .. c9); its bit is
+// index % 64 of the mask of word index / 64.
 void PackCamera(const Camera& cam, int index, bool cube, int layer, const Vec3& origin,
                 double brightness, float* out) {
   const Intrinsics& k = cam.model.intrinsics();
@@ -236,7 +240,7 @@ void PackCamera(const Camera& cam, int index, bool cube, int layer, const Vec3& 
       {k.k1, k.k2, k.model == LensModel::kFisheye ? k.k3 : k.p1,
        k.model == LensModel::kFisheye ? k.k4 : k.p2},
       {double(k.width), double(k.height), cam.near, std::isfinite(cam.far) ? cam.far : 3e38},
-      {light.x(), light.y(), light.z(), double(std::min(index, 64))},
+      {light.x(), light.y(), light.z(), double(index % 64)},  // its bit in its word
       {map(0), map(1), map(2), map(3)},
   };
   for (int i = 0; i < kCameraVec4; ++i)
@@ -820,15 +824,39 @@ struct GlRenderer::Impl {
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
 
-  // What DrawFrame drew: the frame's size, the mask holding its camera sets, and its costs.
+  // Camera sets of rigs over 64 cameras: word w's RG32UI mask texels, read back when the light
+  // passes move on to word w + 1 (empty: no enabled camera in the word, or not read).
+  std::vector<std::vector<GLuint>> word_bits;
+
+  // Mask `src` (word `word` of the camera sets) read back into word_bits[word].
+  void ReadMaskWord(int W, int H, int src, int word) {
+    word_bits[std::size_t(word)].resize(2 * std::size_t(W) * H);
+    glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[src]);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, W, H, GL_RG_INTEGER, GL_UNSIGNED_INT, word_bits[std::size_t(word)].data());
+  }
+  // Mask `src` set to no camera (the light beside it kept).
+  void ClearMask(int src) {
+    glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[src]);
+    const GLenum buffers[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    const GLuint zero_u[4] = {0, 0, 0, 0};
+    glClearBufferuiv(GL_COLOR, 1, zero_u);
+  }
+
+  // What DrawFrame drew: the frame's size, the mask holding its camera sets (of word mask_word;
+  // earlier words in word_bits), and its costs.
   struct Frame {
     int W = 0, H = 0, src = 0, camera_count = 0, maps_drawn = 0, light_passes = 0;
+    int mask_word = 0, words_read = 0;
     double shadow_seconds = 0, light_seconds = 0, total_seconds = 0, map_cpu_seconds = 0;
   };
-  // Steps 1-4 of a frame (G-buffer, maps, light, compose), nothing read back; `timed` waits for
-  // the GPU after each part.
+  // Steps 1-4 of a frame (G-buffer, maps, light, compose); `timed` waits for the GPU after each
+  // part. Nothing is read back but, with `sets` and a rig of over 64 cameras, each finished word
+  // of the camera sets (into word_bits) before the next word's light passes.
   Frame DrawFrame(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
-                  bool timed);
+                  bool timed, bool sets);
   static void FinishFrame(const Frame& f, std::chrono::steady_clock::time_point read,
                           std::int64_t readback_bytes, GlFrameStats* stats);
 
@@ -849,15 +877,16 @@ struct GlRenderer::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 
-  // Bytes ReadBack reads from the GPU for a W x H frame: two RGBA float images (colour, surface
-  // hits) and, up to 64 cameras, the two-word camera mask.
-  static std::int64_t ReadBackBytes(int W, int H, int camera_count) {
-    const std::int64_t pixels = std::int64_t(W) * H;
-    return pixels * (2 * 16 + (camera_count <= 64 ? 8 : 0));
+  // Bytes Render reads from the GPU for a frame: two RGBA float images (colour, surface hits) and
+  // 8 per pixel for each word of the camera sets that has an enabled camera.
+  static std::int64_t ReadBackBytes(const Frame& f) {
+    return std::int64_t(f.W) * f.H * (2 * 16 + 8 * std::int64_t(f.words_read));
   }
 
-  // Reads the composed colour, the surface hits and (up to 64 cameras) mask `src` back.
-  GlImage ReadBack(int W, int H, int src, int camera_count) {
+  // Reads the composed colour, the surface hits and the camera sets back (the last word from
+  // mask f.src, the earlier ones from word_bits).
+  GlImage ReadBack(const Frame& f) {
+    const int W = f.W, H = f.H;
     const std::size_t pixels = std::size_t(W) * H;
     // GL's row r is the image's row r: no flip.
     GlImage image;
@@ -875,14 +904,15 @@ struct GlRenderer::Impl {
     glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, rgba.data());
     image.hit.resize(pixels);
     for (std::size_t i = 0; i < pixels; ++i) image.hit[i] = rgba[4 * i + 3] >= 0;
-    if (camera_count <= 64) {
-      std::vector<GLuint> bits(2 * pixels);
-      glBindFramebuffer(GL_FRAMEBUFFER, light_fbo[src]);
-      glReadBuffer(GL_COLOR_ATTACHMENT1);
-      glReadPixels(0, 0, W, H, GL_RG_INTEGER, GL_UNSIGNED_INT, bits.data());
-      image.cameras.resize(pixels);
+    ReadMaskWord(W, H, f.src, f.mask_word);
+    const std::size_t words = word_bits.size();
+    image.camera_words = int(words);
+    image.cameras.assign(pixels * words, 0);
+    for (std::size_t w = 0; w < words; ++w) {
+      const std::vector<GLuint>& bits = word_bits[w];
+      if (bits.empty()) continue;  // no enabled camera in this word
       for (std::size_t i = 0; i < pixels; ++i)
-        image.cameras[i] = uint64_t(bits[2 * i]) | (uint64_t(bits[2 * i + 1]) << 32);
+        image.cameras[i * words + w] = uint64_t(bits[2 * i]) | (uint64_t(bits[2 * i + 1]) << 32);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return image;
@@ -1000,7 +1030,8 @@ GlRenderer::~GlRenderer() = default;
 std::size_t GlRenderer::triangle_count() const { return impl_->mesh.triangles.size(); }
 
 GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const RenderView& view,
-                                                    const GlRenderOptions& options, bool timed) {
+                                                    const GlRenderOptions& options, bool timed,
+                                                    bool sets) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Impl& m = *this;
@@ -1071,7 +1102,17 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
   double shadow_seconds = 0, light_seconds = 0;
   int maps_drawn = 0;
   std::vector<float> block(4 * kCameraVec4 * kMaxBatch, 0.0f);
+  // The camera sets' words: batches never straddle one (LightBatches); the mask starts each word
+  // from no camera, the finished word read back first when the sets are wanted.
+  m.word_bits.assign(std::size_t(std::max(1, (camera_count + 63) / 64)), {});
+  int mask_word = batches.empty() ? 0 : batches.front().cameras.front() / 64, words_read = 1;
   for (const Batch& batch : batches) {
+    if (const int word = batch.cameras.front() / 64; word != mask_word) {
+      if (sets) m.ReadMaskWord(W, H, src, mask_word);
+      ++words_read;
+      m.ClearMask(src);
+      mask_word = word;
+    }
     // 2. The batch's distance maps (those not kept from the last frame).
     if (timed) glFinish();
     const auto shadow_start = Clock::now();
@@ -1100,6 +1141,8 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
   frame.W = W;
   frame.H = H;
   frame.src = src;
+  frame.mask_word = mask_word;
+  frame.words_read = words_read;
   frame.camera_count = camera_count;
   frame.maps_drawn = maps_drawn;
   frame.light_passes = int(batches.size());
@@ -1130,16 +1173,16 @@ void GlRenderer::Impl::FinishFrame(const Frame& f, std::chrono::steady_clock::ti
 
 GlImage GlRenderer::Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                            GlFrameStats* stats) {
-  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part);
+  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part, true);
   const auto read = std::chrono::steady_clock::now();
-  GlImage image = impl_->ReadBack(f.W, f.H, f.src, f.camera_count);
-  Impl::FinishFrame(f, read, Impl::ReadBackBytes(f.W, f.H, f.camera_count), stats);
+  GlImage image = impl_->ReadBack(f);
+  Impl::FinishFrame(f, read, Impl::ReadBackBytes(f), stats);
   return image;
 }
 
 unsigned GlRenderer::DrawToTexture(const Rig& rig, const RenderView& view,
                                    const GlRenderOptions& options, GlFrameStats* stats) {
-  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part);
+  const Impl::Frame f = impl_->DrawFrame(rig, view, options, stats && stats->per_part, false);
   const auto read = std::chrono::steady_clock::now();
   impl_->Encode(f.W, f.H);
   if (stats && stats->per_part) glFinish();

@@ -76,9 +76,16 @@ struct GlRenderOptions {
 struct GlImage {
   int width = 0, height = 0;
   std::vector<float> rgb;  ///< Linear RGB, 3 per pixel, unclamped.
-  /// Bit c set when rig camera c lights the pixel's surface point: render's Image::cameras layout.
-  /// Empty for rigs of more than 64 cameras (their light is still drawn).
+  /// The per-pixel camera sets, camera_words 64-bit words per pixel (pixel p's word w at
+  /// p * camera_words + w): bit c % 64 of word c / 64 set when rig camera c lights the pixel's
+  /// surface point. camera_words = max(1, ceil(rig cameras / 64)): for rigs of up to 64 cameras,
+  /// one word per pixel, render's Image::cameras layout.
+  int camera_words = 0;
   std::vector<uint64_t> cameras;
+  /// Whether rig camera c lights pixel p.
+  bool Lights(std::size_t p, int c) const {
+    return (cameras[p * std::size_t(camera_words) + std::size_t(c / 64)] >> (c % 64)) & 1u;
+  }
   /// true where the pixel shows a surface.
   std::vector<uint8_t> hit;
 };

@@ -2,8 +2,12 @@
 // Scenes the GPU renderer is measured on besides the examples (viewer test and bench): a room
 // lit by distorted cameras of every lens model the shaders implement.
 
+#include <cmath>
+#include <string>
+
 #include "analysis/geometry/primitives.h"
 #include "analysis/util/palette.h"
+#include "analysis/util/units.h"
 #include "tests/fixtures.h"
 
 namespace pandora::testing {
@@ -79,6 +83,32 @@ inline Scene LensRoom() {
   view.fov_deg = 80;
   scene.views["room"] = view;
   return scene;
+}
+
+/// `rig` grown to `n` cameras, for rigs of hundreds of cameras (the GPU bench's 200-camera case):
+/// camera c is the rig's camera c % m (m cameras) turned about the vertical through `centre` by
+/// (c / m) golden angles (137.5 degrees: no copy coincides with another), id "<id>_<c / m>" for
+/// the copies, colours from the palette by index.
+inline Rig TurnedCopies(const Rig& rig, int n, const Vec3& centre) {
+  Rig out = rig;
+  out.cameras.clear();
+  const int m = int(rig.cameras.size());
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int c = 0; m > 0 && c < n; ++c) {
+    Camera cam = rig.cameras[std::size_t(c % m)];
+    const int copy = c / m;
+    if (copy > 0) {
+      const Eigen::Isometry3d turn = Eigen::Translation3d(centre) *
+                                     Eigen::AngleAxisd(copy * golden, Vec3::UnitZ()) *
+                                     Eigen::Translation3d(-centre);
+      cam.world_from_camera = turn * cam.world_from_camera;
+      cam.id += "_" + std::to_string(copy);
+      cam.name = cam.id;
+    }
+    cam.color = CameraPaletteColor(c);
+    out.cameras.push_back(cam);
+  }
+  return out;
 }
 
 }  // namespace pandora::testing
