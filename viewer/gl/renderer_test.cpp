@@ -410,10 +410,22 @@ TEST(GlRenderer, DistortedLensesMatchCpu) {
 
 // Diffuse textures (Surface::kMaterial): an OBJ floor with an 8 x 8 texture of random colours,
 // repeated twice in u and v (wrapping), lit by one camera from above. Bilinear filtering on the GPU
-// (sRGB8 texels decoded to linear before filtering) against the CPU's double-precision bilinear
-// lookup of the same decoded texels: llvmpipe computes the filter weights in 8 bits, so colours
-// differ by a fraction of a texel step. Measured: mean 6.2e-5, max 1.0e-3 (linear colour); the
-// bounds leave 8x and 5x. Without the textures (no PreparedScene) the mean difference is 0.069.
+// (sRGB8 texels decoded to linear before filtering, as GL says it should) against the CPU's
+// double-precision bilinear lookup of the same decoded texels. The bounds come from the filtering
+// rule, not from one driver. GL leaves the sub-texel precision to the implementation; the D3D
+// rules that GPU drivers also serve ask for at least 8 fractional bits in the texel coordinate
+// and in the filter weights, and either may truncate, so a weight may be off by up to two steps
+// of 2^-8 per axis, and a bilinear lookup by (|b - a| + |c - a|) 2^-7 <= 2^-6 D, D the largest
+// difference between adjacent texels (wrapping), per channel in linear. The pixel's colour is
+// MaterialColor: Kd texel (light + ambient shade), light <= brightness (1 for one camera) times
+// the camera's colour, shade <= 1; so max |GPU - CPU| <= 2^-6 max_k D_k Kd_k (colour_k +
+// ambient). The mean takes one step per axis (2^-7) and the mean adjacent difference. Float
+// rounding (1e-6) and the sRGB8 decode (exact to float on both sides: the CPU decodes the PNG's
+// same 8-bit values) are far below. Measured (llvmpipe): mean 6.2e-5, max 1.0e-3 (one 2^-8 step
+// per axis would allow 6.3e-3); an NVIDIA driver (issue 30): max 7.6e-3, over the 5e-3 once
+// tuned on llvmpipe and within this bound (1.26e-2). The faults it must catch are far larger:
+// no sRGB decode, a half-texel shift or nearest filtering move colours by 0.1 to 0.5, and the
+// floor without its texture (no PreparedScene) differs by 0.069 on average.
 TEST(GlRenderer, TexturesMatchCpu) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::path(::testing::TempDir()) / "pandora_gl_texture_test";
@@ -455,12 +467,39 @@ TEST(GlRenderer, TexturesMatchCpu) {
     std::filesystem::create_directories(out);
     WriteComparisonPng(cpu, gpu, std::string(out) + "/textured_floor.png");
   }
-  std::printf("textured floor: sets differ on %.4f %%, colour mean %.2e, max %.2e\n",
-              100 * c.mask_share(), c.rgb_mean, c.rgb_max);
+  // The bounds of the filtering rule above, from the decoded texels the CPU filters.
+  const Image& texels = prepared.Textures()[0];
+  const Camera& light = scene.rigs[0].cameras[0];
+  const Vec3 kd(0.9, 0.8, 1.0);
+  const double ambient = GlRenderOptions().ambient, weight_error = std::ldexp(1.0, -6);
+  double max_bound = 0, mean_bound = 0;
+  for (int k = 0; k < 3; ++k) {
+    double d_max = 0, d_sum = 0;
+    for (int y = 0; y < texels.height; ++y)
+      for (int x = 0; x < texels.width; ++x) {
+        const auto at = [&](int i, int j) {
+          return double(texels.rgb[3 * (std::size_t(j % texels.height) * texels.width +
+                                        std::size_t(i % texels.width)) +
+                                   std::size_t(k)]);
+        };
+        for (const double d :
+             {std::abs(at(x + 1, y) - at(x, y)), std::abs(at(x, y + 1) - at(x, y))}) {
+          d_max = std::max(d_max, d);
+          d_sum += d;
+        }
+      }
+    const double scale = weight_error * kd(k) * (light.color(k) + ambient);
+    max_bound = std::max(max_bound, scale * d_max);
+    mean_bound = std::max(mean_bound, 0.5 * scale * d_sum / (2.0 * texels.width * texels.height));
+  }
+  std::printf(
+      "textured floor: sets differ on %.4f %%, colour mean %.2e (bound %.2e), max %.2e (bound "
+      "%.2e)\n",
+      100 * c.mask_share(), c.rgb_mean, mean_bound, c.rgb_max, max_bound);
   EXPECT_GT(c.compared, c.pixels / 2);
   EXPECT_LE(c.mask_share(), kMaxMaskShare);
-  EXPECT_LE(c.rgb_mean, 5e-4);
-  EXPECT_LE(c.rgb_max, 5e-3);
+  EXPECT_LE(c.rgb_mean, mean_bound + 1e-6);
+  EXPECT_LE(c.rgb_max, max_bound + 1e-6);
   // The negative control: the same floor in its material colour alone.
   GlRenderer plain(scene);
   const GlComparison p = Compare(cpu, plain.Render(scene.rigs[0], view, GlRenderOptions()));
