@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The GPU renderer measured on a headless GPU machine (issue 30; docs/viewer.md, "Frame time").
 #
-#   bash bench/gpu_device.sh pack [BUILD] [PACK]   here: BUILD's pandora_gl_bench and gl_renderer_test
+#   bash bench/gpu_device.sh pack [BUILD] [PACK]   here: BUILD's pandora_gl_bench, gl_renderer_test, pandora-view
 #                                                  with every shared library they load (but the GL and
 #                                                  EGL of the machine they run on) into PACK
 #                                                  (default build/gpu_pack.tar.xz)
@@ -11,7 +11,8 @@
 #
 # `run` needs the machine's EGL (libEGL.so.1 with its vendor library, e.g. NVIDIA's) and no
 # display. It writes gl_renderer_test.log, the bench tables per scene (bench_*.md: the trauma room,
-# the capture stage with its 24 cameras, 64 and 200) and device.txt.
+# the capture stage with its 24 cameras, 64 and 200), the whole window's frame rates headless
+# (bench_viewer_*.txt) and device.txt.
 # Here (no GPU) the same `run` goes through Mesa's software EGL device: a rehearsal (QUICK=1 for
 # small frames).
 set -euo pipefail
@@ -23,7 +24,7 @@ pack() {
   stage=$(mktemp -d)
   trap 'rm -rf "$stage"' RETURN
   mkdir -p "$stage/bin" "$stage/lib"
-  for exe in pandora_gl_bench gl_renderer_test; do
+  for exe in pandora_gl_bench gl_renderer_test pandora-view; do
     [ -x "$build/$exe" ] || { echo "gpu_device.sh: $build/$exe is not built" >&2; return 2; }
     cp "$build/$exe" "$stage/bin/"
     # Every library the loader resolves, but those that must be the target's own: the C library
@@ -69,6 +70,14 @@ run() {
   for n in 64 200; do
     "$dir/bin/pandora_gl_bench" examples/capture_stage/scene.json --cameras "$n" "${bench[@]}" \
       > "$out/bench_capture_stage_$n.md" 2>&1 || echo "bench capture stage $n failed" >&2
+  done
+  # The whole window headless (a hidden window is an offscreen framebuffer on EGL): frames
+  # navigating and with every camera moving, panels and overlays included (`pandora bench --viewer`).
+  local view=(--bench 20 --size 1920x1080 --shadow-map 2048)
+  [ "${QUICK:-0}" = 1 ] && view=(--bench 2 --size 480x270 --shadow-map 1024)
+  for scene in trauma_room capture_stage; do
+    "$dir/bin/pandora-view" "examples/$scene/scene.json" --no-autosave "${view[@]}" \
+      > "$out/bench_viewer_$scene.txt" 2>&1 || echo "viewer bench $scene failed" >&2
   done
   head -n 1 "$out/bench_trauma_room.md" >> "$out/device.txt"
   cat "$out/device.txt"

@@ -5,7 +5,8 @@
 # (mouse events) and redo with ctrl+y, save, then the coverage isosurface (2.5, slice hidden). Checks the log's numbers, the saved file and its backup,
 # and compares each screenshot with tests/data/viewer/<name>.png (at most 0.5 % of pixels off by more
 # than 8/255: measured run to run 0 %; a moved camera changes several percent).
-# Usage: check_view_session.sh PANDORA PNG_DIFF OUT_DIR   (UPDATE_REFERENCES=1 rewrites the references)
+# Usage: check_view_session.sh PANDORA PNG_DIFF OUT_DIR   (UPDATE_REFERENCES=1 rewrites the references;
+# HEADLESS=1 runs it with no display, through EGL)
 set -euo pipefail
 pandora=$1; diff=$2; out=$3
 src=$(cd "$(dirname "$0")/../.." && pwd)
@@ -13,7 +14,10 @@ refs=$src/tests/data/viewer
 rm -rf "$out"; mkdir -p "$out"
 cp "$src"/examples/trauma_room/scene.json "$out"/scene.json
 sed "s|OUT/|$out/|g" "$src"/tests/viewer/session.json > "$out"/script.json
-run=("$(dirname "$0")"/with_xvfb.sh "$pandora" view "$out"/scene.json --script "$out"/script.json
+# HEADLESS=1: no display at all, the hidden window's GL through EGL (the same references).
+launch=("$(dirname "$0")"/with_xvfb.sh)
+[ "${HEADLESS:-0}" = 1 ] && launch=(env -u DISPLAY -u WAYLAND_DISPLAY -u PANDORA_GL)
+run=("${launch[@]}" "$pandora" view "$out"/scene.json --script "$out"/script.json
      --hidden --size 960x540 --log "$out"/log.json)
 "${run[@]}"
 

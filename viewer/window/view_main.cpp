@@ -155,7 +155,9 @@ int Run(int argc, char** argv) {
                  "(0: a fixed half resolution); full resolution 0.3 s after it stops")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 240.0));
-  app.add_flag("--hidden", hidden, "No visible window (scripts, tests)");
+  app.add_flag("--hidden", hidden,
+               "No visible window (scripts, tests); without a display (or with PANDORA_GL=egl) "
+               "drawn offscreen through headless EGL");
   app.add_option("--bench", bench_frames,
                  "Measure frame rates over this many frames (navigating; all cameras moving) "
                  "against the exact CPU renderer, print them and exit")
@@ -214,6 +216,7 @@ int Run(int argc, char** argv) {
   if (bench_frames > 0) {
     // Full resolution throughout, then as interaction draws it (reduced while moving).
     pandora::viewer::ViewerApp window(model, ao);
+    std::printf("pandora bench --viewer: GL %s\n", window.GlDescription().c_str());
     // Full resolution throughout, a fixed half, then what the window does: adaptive, 30 Hz.
     for (const auto& [scale, hz] :
          {std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{0.5, 30.0}}) {

@@ -426,6 +426,7 @@ void ViewerApp::Impl::Keys() {
 
 void ViewerApp::Impl::Gamepad() {
   GLFWgamepadstate s;
+  if (!window) return;  // headless: no input devices
   if (!glfwJoystickIsGamepad(GLFW_JOYSTICK_1) || !glfwGetGamepadState(GLFW_JOYSTICK_1, &s)) return;
   GamepadAxes g;
   g.left_x = s.axes[GLFW_GAMEPAD_AXIS_LEFT_X];
@@ -559,9 +560,9 @@ void ViewerApp::Impl::Panels() {
 }
 
 void ViewerApp::Impl::Draw() {
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, FrameFramebuffer());
   int fw = 0, fh = 0;
-  glfwGetFramebufferSize(window, &fw, &fh);
+  FramebufferSize(&fw, &fh);
   glViewport(0, 0, fw, fh);
   glClearColor(0.02f, 0.02f, 0.03f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
@@ -597,7 +598,7 @@ bool ViewerApp::Impl::OneFrame() {
         0.7 * overhead_seconds + 0.3 * std::max(0.0, frame_seconds - frame_gl_seconds);
   frame_gl_seconds = 0;
   int w = 0, h = 0;
-  glfwGetWindowSize(window, &w, &h);
+  if (window) glfwGetWindowSize(window, &w, &h);
   if (w > 0 && h > 0 && (w != model.width || h != model.height) && options.visible) {
     model.width = w;
     model.height = h;
@@ -616,7 +617,7 @@ bool ViewerApp::Impl::OneFrame() {
   DrawOverlays(bg);
   Panels();
   Draw();
-  return !glfwWindowShouldClose(window);
+  return !window || !glfwWindowShouldClose(window);
 }
 
 namespace {
@@ -647,32 +648,65 @@ void OnChar(GLFWwindow*, unsigned c) { g_app->input.chars.push_back(c); }
 ViewerApp::ViewerApp(ViewerModel& model, AppOptions options)
     : impl_(std::make_unique<Impl>(model, options)) {
   Impl& m = *impl_;
+  model.width = options.width;
+  model.height = options.height;
+  if (!options.visible && ResolveGlBackend(options.gl) == GlBackend::kEgl)
+    m.OpenHeadless();
+  else
+    m.OpenWindow();
+  m.InitImGui();
+  m.gl = std::make_unique<GlRenderer>(model.scene(), &model.session().study().prepared());
+  m.shadow_map_size = options.shadow_map_size;
+  m.map_index = options.shadow_map_size >= 4096   ? 3
+                : options.shadow_map_size >= 2048 ? 2
+                : options.shadow_map_size >= 1024 ? 1
+                                                  : 0;
+}
+
+void ViewerApp::Impl::OpenHeadless() {
+  headless = std::make_unique<GlContext>(GlBackend::kEgl);
+  glGenTextures(1, &frame_color);
+  glBindTexture(GL_TEXTURE_2D, frame_color);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, options.width, options.height, 0, GL_RGBA,
+               GL_UNSIGNED_BYTE, nullptr);
+  glGenFramebuffers(1, &frame_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, frame_fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, frame_color, 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error("pandora view: the headless window's framebuffer is incomplete");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void ViewerApp::Impl::OpenWindow() {
   glfwSetErrorCallback(OnGlfwError);
   if (!glfwInit())
     throw std::runtime_error("pandora view: no display (" + g_glfw_error +
-                             "); on a machine without one run under `xvfb-run -a`");
+                             "); on a machine without one run under `xvfb-run -a`, or add "
+                             "--hidden for a headless session (EGL)");
   glfwWindowHint(GLFW_VISIBLE, options.visible ? GLFW_TRUE : GLFW_FALSE);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  model.width = options.width;
-  model.height = options.height;
-  m.window = glfwCreateWindow(options.width, options.height,
-                              ("Pandora: " + model.scene().path).c_str(), nullptr, nullptr);
-  if (!m.window) {
+  window = glfwCreateWindow(options.width, options.height,
+                            ("Pandora: " + model.scene().path).c_str(), nullptr, nullptr);
+  if (!window) {
     glfwTerminate();
     throw std::runtime_error("pandora view: no OpenGL 3.3 core context (" + g_glfw_error +
                              "); install Mesa (libgl1-mesa-dri) or a GPU driver");
   }
-  glfwMakeContextCurrent(m.window);
+  glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
-  g_app = &m;
-  glfwSetCursorPosCallback(m.window, OnCursor);
-  glfwSetMouseButtonCallback(m.window, OnButton);
-  glfwSetScrollCallback(m.window, OnScroll);
-  glfwSetKeyCallback(m.window, OnKey);
-  glfwSetCharCallback(m.window, OnChar);
+  g_app = this;
+  glfwSetCursorPosCallback(window, OnCursor);
+  glfwSetMouseButtonCallback(window, OnButton);
+  glfwSetScrollCallback(window, OnScroll);
+  glfwSetKeyCallback(window, OnKey);
+  glfwSetCharCallback(window, OnChar);
+}
+
+void ViewerApp::Impl::InitImGui() {
+  Impl& m = *this;
   IMGUI_CHECKVERSION();
   m.imgui = ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
@@ -696,17 +730,14 @@ ViewerApp::ViewerApp(ViewerModel& model, AppOptions options)
   ImGui::StyleColorsDark();
   ImGui::GetStyle().WindowRounding = 3.0f;
   ImGui_ImplOpenGL3_Init("#version 330 core");
-  m.gl = std::make_unique<GlRenderer>(model.scene(), &model.session().study().prepared());
-  m.shadow_map_size = options.shadow_map_size;
-  m.map_index = options.shadow_map_size >= 4096   ? 3
-                : options.shadow_map_size >= 2048 ? 2
-                : options.shadow_map_size >= 1024 ? 1
-                                                  : 0;
 }
 
 ViewerApp::~ViewerApp() {
   Impl& m = *impl_;
-  glfwMakeContextCurrent(m.window);
+  if (m.window)
+    glfwMakeContextCurrent(m.window);
+  else
+    m.headless->MakeCurrent();
   m.gl.reset();
   if (m.main_texture) glDeleteTextures(1, &m.main_texture);
   for (auto& [c, v] : m.camera_views)
@@ -715,18 +746,23 @@ ViewerApp::~ViewerApp() {
     if (v.texture) glDeleteTextures(1, &v.texture);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui::DestroyContext(m.imgui);
-  glfwDestroyWindow(m.window);
-  glfwTerminate();
-  g_app = nullptr;
+  if (m.window) {
+    glfwDestroyWindow(m.window);
+    glfwTerminate();
+    g_app = nullptr;
+  } else {
+    glDeleteFramebuffers(1, &m.frame_fbo);
+    glDeleteTextures(1, &m.frame_color);
+  }
 }
 
 bool ViewerApp::Frame() {
-  glfwPollEvents();
+  if (impl_->window) glfwPollEvents();
   impl_->readback_bytes = impl_->upload_bytes = 0;
   impl_->map_cpu_seconds = 0;
   const bool open = impl_->OneFrame();
   impl_->last_transfer = {impl_->readback_bytes, impl_->upload_bytes, impl_->map_cpu_seconds};
-  glfwSwapBuffers(impl_->window);
+  impl_->Present();
   return open;
 }
 
@@ -740,6 +776,14 @@ void ViewerApp::SetMotionScale(double scale, double target_hz) {
 double ViewerApp::MotionScaleNow() const { return impl_->motion_now; }
 
 FrameTransfer ViewerApp::LastFrameTransfer() const { return impl_->last_transfer; }
+
+std::string ViewerApp::GlDescription() const {
+  if (impl_->headless) return impl_->headless->Description() + " (headless)";
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  return std::string(renderer ? renderer : "?") + ", " + (version ? version : "?") +
+         " [GLFW window]";
+}
 
 void ViewerApp::Loop() {
   while (Frame()) {
@@ -756,16 +800,17 @@ void ViewerApp::Screenshot(const ViewerModel& model, const std::string& path, in
   Impl& m = *impl_;
   m.full_now = true;
   m.OneFrame();
-  glfwSwapBuffers(m.window);
+  m.Present();
   m.OneFrame();
   m.full_now = false;
   int fw = 0, fh = 0;
-  glfwGetFramebufferSize(m.window, &fw, &fh);
+  m.FramebufferSize(&fw, &fh);
   std::vector<unsigned char> pixels(std::size_t(fw) * fh * 4);
-  glReadBuffer(GL_BACK);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, m.FrameFramebuffer());
+  glReadBuffer(m.window ? GL_BACK : GL_COLOR_ATTACHMENT0);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
-  glfwSwapBuffers(m.window);
+  m.Present();
   // To linear RGB for WritePng (which applies the sRGB curve again), rows flipped to y down.
   Image image;
   image.width = fw;

@@ -11,12 +11,17 @@
 #include <string>
 
 #include "viewer/core/model.h"
+#include "viewer/gl/context.h"
 
 namespace pandora::viewer {
 
 struct AppOptions {
   int width = 1280, height = 720;  ///< Window size (the main view fills it).
   bool visible = true;             ///< false: a hidden window (scripts, tests).
+  /// A hidden window's GL: kAuto is PANDORA_GL, else GLFW with a display and headless EGL
+  /// without one (viewer/gl/context.h); headless, the window is an offscreen framebuffer of
+  /// width x height that screenshots read. A visible window is always GLFW's.
+  GlBackend gl = GlBackend::kAuto;
   int shadow_map_size = 2048;
   /// Frame times in the status bar (off in scripts, whose screenshots are compared with
   /// references).
@@ -41,8 +46,8 @@ struct FrameTransfer {
 
 class ViewerApp : public Frontend {
  public:
-  /// Opens the window and its GL context. Throws std::runtime_error naming the cause (no display:
-  /// run under `xvfb-run -a`; no GL 3.3 core).
+  /// Opens the window and its GL context. Throws std::runtime_error naming the cause (no display
+  /// for a visible window: run under `xvfb-run -a`; no GL 3.3 core; no EGL device headless).
   ViewerApp(ViewerModel& model, AppOptions options);
   ~ViewerApp() override;
 
@@ -59,6 +64,9 @@ class ViewerApp : public Frontend {
   /// GPU renderer draws the main view (it stays on the GPU); the camera's-eye insets, the PTZ
   /// "all" view and screenshots are the exact CPU renderer's, uploaded.
   FrameTransfer LastFrameTransfer() const;
+  /// The GL the window draws with: GL_RENDERER, GL_VERSION and "[GLFW window]" or, headless, the
+  /// EGL device ("[EGL device 0 of 1]"), for benchmark tables.
+  std::string GlDescription() const;
 
   // Frontend: the window's own picture (after a frame is drawn), or a camera's exact view.
   void Screenshot(const ViewerModel& model, const std::string& path, int camera) override;

@@ -131,7 +131,21 @@ enum class Drag { kNone, kOrbit, kPan, kAxis, kRing, kClick };
 struct ViewerApp::Impl {
   ViewerModel& model;
   AppOptions options;
-  GLFWwindow* window = nullptr;
+  GLFWwindow* window = nullptr;  // null when headless
+  // Headless (AppOptions::gl resolved to EGL for a hidden window): the context, and the offscreen
+  // framebuffer that stands in for the window's (RGBA8, width x height).
+  std::unique_ptr<GlContext> headless;
+  GLuint frame_fbo = 0, frame_color = 0;
+  // The window's framebuffer and its size in pixels.
+  GLuint FrameFramebuffer() const { return frame_fbo; }
+  void FramebufferSize(int* w, int* h) const {
+    if (window) {
+      glfwGetFramebufferSize(window, w, h);
+    } else {
+      *w = options.width;
+      *h = options.height;
+    }
+  }
   std::unique_ptr<GlRenderer> gl;
   GlRenderOptions gl_options;
   GLuint main_texture = 0;   // the main view drawn on the CPU (PTZ "all"), uploaded
@@ -333,6 +347,18 @@ struct ViewerApp::Impl {
   int map_index = 2;
 
   void Draw();
+  // Opening: a hidden window's headless EGL context and framebuffer, or a GLFW window; then Dear
+  // ImGui and its OpenGL 3 backend (no platform backend: FeedImGui gives it our input).
+  void OpenHeadless();
+  void OpenWindow();
+  void InitImGui();
+  // The drawn frame to the screen (a swap), or finished (headless).
+  void Present() {
+    if (window)
+      glfwSwapBuffers(window);
+    else
+      glFlush();
+  }
 
   void FeedImGui();
 
