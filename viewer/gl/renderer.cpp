@@ -15,11 +15,13 @@
 #include "viewer/gl/renderer.h"
 
 #include <epoxy/gl.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <map>
 #include <optional>
@@ -37,6 +39,11 @@ namespace {
 // A camera whose field reaches this far off its axis gets a cube of maps: one perspective map
 // would spend most of its texels at the edges (tan 75 deg = 3.7 times the centre's spacing).
 constexpr double kMaxPerspectiveFieldAngle = 75.0 * kPi / 180.0;
+// A camera's-eye view's cover G-buffer: texels per output pixel where the lens's rays are
+// densest (each output ray then lands within a quarter of an output pixel of its cover texel's
+// centre), and at most this many texels (52 bytes each).
+constexpr double kCoverScale = 2.0;
+constexpr double kMaxCoverTexels = 8e6;
 
 // ------------------------------------------------------------------------------------------
 // Shaders (GLSL 3.30 core): viewer/gl/shaders/, one file per stage of each pass, embedded at
@@ -208,6 +215,7 @@ struct FrameEye {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world_from_camera
   double f = 0;                                            // focal length, pixels
   Vec3 rel = Vec3::Zero();                                 // relative to the scene's centre
+  bool table = false;  // a camera's-eye view: its rays from the lens's table, not a pinhole
 };
 
 // (sx, sy, ox, oy) with ndc = (sx x / z - ox, sy y / z - oy) mapping `bounds` onto [-1, 1]^2.
@@ -428,6 +436,23 @@ struct GlRenderer::Impl {
   GLsizei vertex_count = 0;
   GLuint vao = 0, vbo = 0;
   GLuint gbuffer_program = 0, shadow_program = 0, compose_program = 0, encode_program = 0;
+  GLuint resample_program = 0;
+  // The triangles' corners (relative to the scene's centre, VBO order), 3 RGBA32F texels each,
+  // as a texture buffer for the camera's-eye views' ray-triangle tests; 0 where the GL's texture
+  // buffers cannot hold them.
+  GLuint corner_buffer = 0, corner_texture = 0;
+  Aabb mesh_box;  // the triangles' bounds: the ray caster's float frame (camera's-eye t_near)
+
+  // Camera's-eye views: the lens's rays per output pixel (camera frame, RGBA32F, w = 1 inside
+  // the domain) for the lens and size of eye_dirs_key, their normalized-coordinate bounds and
+  // the smallest step between neighbouring pixels' rays; and the cover G-buffer.
+  GLuint eye_dirs = 0, eye_dx = 0, eye_dy = 0;  // with the rays' derivatives per output pixel
+  std::string eye_dirs_key;
+  Eigen::Vector4d eye_dirs_bounds = Eigen::Vector4d::Zero();
+  double eye_dirs_step = 0;
+  int cover_w = 0, cover_h = 0;
+  GLuint cover_fbo = 0, cover_position = 0, cover_normal = 0, cover_albedo = 0, cover_depth = 0;
+  double last_cover_scale = 0;           // cover texels per output pixel at the finest, last frame
   std::map<int, GLuint> light_programs;  // by variant bits: 1 grid, 2 fisheye, 4 distortion, 8 cube
 
   GLuint LightProgram(int variant) {
@@ -685,6 +710,8 @@ struct GlRenderer::Impl {
     glUniform4f(Loc(gbuffer_program, "proj"), float(2 * f / W), float(2 * f / H), float(ab(0)),
                 float(ab(0) * near + ab(1)));
     glUniform2f(Loc(gbuffer_program, "depth_map"), float(cut_rel), float(1.0 / (far - near)));
+    glUniform2f(Loc(gbuffer_program, "proj_offset"), 0.0f, 0.0f);  // the cover's, reset
+    glUniform1f(Loc(gbuffer_program, "min_distance"), 0.0f);
     SetVec3(gbuffer_program, "eye", eye.rel);
     glUniform1i(Loc(gbuffer_program, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
     glUniform1f(Loc(gbuffer_program, "line_width"), float(options.line_width_px));
@@ -694,9 +721,200 @@ struct GlRenderer::Impl {
     for (const Draw& d : draws) {
       glUniform1i(Loc(gbuffer_program, "textured"),
                   d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
+      glUniform1i(Loc(gbuffer_program, "first_triangle"), d.first / 3);
       glBindTexture(GL_TEXTURE_2D, d.texture);
       glDrawArrays(GL_TRIANGLES, d.first, d.count);
     }
+  }
+
+  // The rays of camera `cam`'s image scaled to W x H (RenderView::camera), unprojected as the CPU's
+  // ViewRays does (the same pixel mapping, CameraModel::Unproject and exact differentials
+  // J^T (J J^T)^-1 per output pixel, rounded to float), into eye_dirs, eye_dx and eye_dy; with
+  // their bounds in normalized coordinates and the smallest step between neighbouring pixels'
+  // rays. Computed (in parallel) and uploaded only when the lens or the size
+  // changes: the rays are in the camera's frame, so a camera that moves keeps them.
+  void EnsureEyeTable(const Camera& cam, int W, int H) {
+    const Intrinsics& k = cam.model.intrinsics();
+    char key[400];
+    std::snprintf(key, sizeof key,
+                  "%d %d %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g",
+                  int(k.model), k.width, k.height, W, H, k.fx, k.fy, k.cx, k.cy, k.k1, k.k2, k.p1,
+                  k.p2, k.k3, k.k4);
+    if (eye_dirs != 0 && eye_dirs_key == key) return;
+    const double sx = double(cam.model.width()) / W, sy = double(cam.model.height()) / H;
+    const std::size_t n = std::size_t(W) * std::size_t(H);
+    std::vector<float> texels(4 * n, 0.0f), dx(4 * n, 0.0f), dy(4 * n, 0.0f);
+    std::vector<Vec2> q(n, Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+    tbb::parallel_for(0, H, [&](int y) {
+      for (int x = 0; x < W; ++x) {
+        const auto dir = cam.model.Unproject(Vec2((x + 0.5) * sx - 0.5, (y + 0.5) * sy - 0.5));
+        Mat23 J;
+        if (!dir || !cam.model.Project(*dir, &J)) continue;
+        const Eigen::Matrix2d JJt = J * J.transpose();
+        if (!(std::abs(JJt.determinant()) > 0)) continue;  // as the CPU: no ray
+        const Eigen::Matrix<double, 3, 2> M = J.transpose() * JJt.inverse();
+        const std::size_t i = std::size_t(y) * W + std::size_t(x);
+        for (int c = 0; c < 3; ++c) {
+          texels[4 * i + std::size_t(c)] = float((*dir)(c));
+          dx[4 * i + std::size_t(c)] = float(M(c, 0) * sx);
+          dy[4 * i + std::size_t(c)] = float(M(c, 1) * sy);
+        }
+        texels[4 * i + 3] = 1.0f;
+        if (dir->z() > 1e-9) q[i] = dir->head<2>() / dir->z();
+      }
+    });
+    Eigen::Vector4d bounds(1e300, -1e300, 1e300, -1e300);
+    double step = 1e300;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const Vec2& a = q[std::size_t(y) * W + std::size_t(x)];
+        if (!a.allFinite()) continue;
+        bounds = Eigen::Vector4d(std::min(bounds(0), a.x()), std::max(bounds(1), a.x()),
+                                 std::min(bounds(2), a.y()), std::max(bounds(3), a.y()));
+        if (x + 1 < W && q[std::size_t(y) * W + std::size_t(x) + 1].allFinite())
+          step = std::min(step, (q[std::size_t(y) * W + std::size_t(x) + 1] - a).norm());
+        if (y + 1 < H && q[std::size_t(y + 1) * W + std::size_t(x)].allFinite())
+          step = std::min(step, (q[std::size_t(y + 1) * W + std::size_t(x)] - a).norm());
+      }
+    for (auto [texture, data] : {std::pair{&eye_dirs, &texels}, {&eye_dx, &dx}, {&eye_dy, &dy}}) {
+      if (*texture == 0) *texture = MakeTexture(GL_RGBA32F, W, H, GL_RGBA, GL_FLOAT);
+      glBindTexture(GL_TEXTURE_2D, *texture);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, W, H, 0, GL_RGBA, GL_FLOAT, data->data());
+    }
+    eye_dirs_key = key;
+    eye_dirs_bounds = bounds;
+    eye_dirs_step = step;
+  }
+
+  // The cover G-buffer's targets at w x h (kept while the size stays).
+  void EnsureCover(int w, int h) {
+    if (w == cover_w && h == cover_h) return;
+    const GLuint textures[3] = {cover_position, cover_normal, cover_albedo};
+    glDeleteTextures(3, textures);
+    glDeleteRenderbuffers(1, &cover_depth);
+    glDeleteFramebuffers(1, &cover_fbo);
+    cover_w = w;
+    cover_h = h;
+    cover_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    cover_normal = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    cover_albedo = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+    glGenRenderbuffers(1, &cover_depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, cover_depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glGenFramebuffers(1, &cover_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, cover_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cover_position, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, cover_normal, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_TEXTURE_2D, cover_albedo, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, cover_depth);
+    CheckFramebuffer("camera's-eye cover");
+  }
+
+  // A camera's-eye view's G-buffer (view.camera): the camera's pinhole G-buffer over its lens's
+  // whole field at kCoverScale times the output's finest ray spacing (the cover), then per output
+  // pixel the lens's own ray resampled from it (shaders/resample.frag). Primary rays start where
+  // the CPU's do, VisibilityTester::Tolerance(camera, 0) from the centre (a camera on a wall's
+  // face does not see the wall), here from the triangles' bounds as the ray caster's frame.
+  void DrawCameraGBuffer(const Camera& cam, const FrameEye& eye, const GlRenderOptions& options) {
+    const int W = eye.W, H = eye.H;
+    EnsureEyeTable(cam, W, H);
+    Eigen::Vector4d b = eye_dirs_bounds;
+    const bool empty =
+        !(b(0) <= b(1) && b(2) <= b(3)) || !(eye_dirs_step > 0) || !std::isfinite(eye_dirs_step);
+    if (empty) b = Eigen::Vector4d(-1, 1, -1, 1);
+    GLint max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    // Cover texels per unit of normalized coordinates: kCoverScale per output step at the finest,
+    // within the GL's texture size and kMaxCoverTexels.
+    double density = empty ? 1.0 : kCoverScale / eye_dirs_step;
+    const double span_x = b(1) - b(0), span_y = b(3) - b(2);
+    density = std::min({density, (max_size - 2) / std::max(span_x, 1e-12),
+                        (max_size - 2) / std::max(span_y, 1e-12),
+                        std::sqrt(kMaxCoverTexels / std::max(span_x * span_y, 1e-24))});
+    const int cw = std::max(2, int(std::ceil(density * span_x)) + 2);
+    const int ch = std::max(2, int(std::ceil(density * span_y)) + 2);
+    last_cover_scale = empty ? 0.0 : density * eye_dirs_step;
+    // One texel of margin on each side.
+    b += Eigen::Vector4d(-1.0 / density, 1.0 / density, -1.0 / density, 1.0 / density);
+    EnsureCover(cw, ch);
+
+    const Eigen::Isometry3d cfw = cam.camera_from_world();
+    auto range = DepthRangeInPyramid(mesh, boxes, cfw, b);
+    if (!(range.first <= range.second)) range = {1.0, 2.0};
+    const auto [near, far] = PadRange(range);
+    const Eigen::Vector2d ab = DepthCoefficients(near, far);
+    const Eigen::Vector4d m = MapCoefficients(b);
+    const Mat3 R = cfw.linear();
+    const double t_near = std::max(
+        1e-5 * scene_scale,
+        4.0 * 0x1p-24 * (0.5 * mesh_box.diagonal() + (cam.center() - mesh_box.center()).norm()));
+
+    glBindFramebuffer(GL_FRAMEBUFFER, cover_fbo);
+    const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, buffers);
+    glViewport(0, 0, cw, ch);
+    const float no_hit[4] = {0, 0, 0, -1}, zero[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, no_hit);
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    const GLuint p = gbuffer_program;
+    glUseProgram(p);
+    SetMat3(p, "view_R", R);
+    SetVec3(p, "view_t", R * (origin - cam.center()) - Vec3(0, 0, near));
+    glUniform1f(Loc(p, "view_d0"), float(near));
+    glUniform4f(Loc(p, "proj"), float(m(0)), float(m(1)), float(ab(0)),
+                float(ab(0) * near + ab(1)));
+    glUniform2f(Loc(p, "proj_offset"), float(m(2)), float(m(3)));
+    glUniform2f(Loc(p, "depth_map"), -1.0f, float(1.0 / (far - near)));
+    glUniform1f(Loc(p, "min_distance"), float(t_near));
+    SetVec3(p, "eye", eye.rel);
+    glUniform1i(Loc(p, "edges"), options.surface == Surface::kHiddenLine ? 1 : 0);
+    // Lines are drawn in cover texels: kCoverScale (at the finest) per output pixel.
+    glUniform1f(Loc(p, "line_width"),
+                float(options.line_width_px * std::max(1.0, last_cover_scale)));
+    glUniform1i(Loc(p, "albedo_tex"), 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindVertexArray(vao);
+    for (const Draw& d : draws) {
+      glUniform1i(Loc(p, "textured"),
+                  d.texture != 0 && options.surface == Surface::kMaterial ? 1 : 0);
+      glUniform1i(Loc(p, "first_triangle"), d.first / 3);
+      glBindTexture(GL_TEXTURE_2D, d.texture);
+      glDrawArrays(GL_TRIANGLES, d.first, d.count);
+    }
+
+    // Resample into the output's G-buffer.
+    glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+    glDrawBuffers(3, buffers);
+    glViewport(0, 0, W, H);
+    glDisable(GL_DEPTH_TEST);
+    const GLuint r = resample_program;
+    glUseProgram(r);
+    const GLuint inputs[4] = {eye_dirs, cover_position, cover_normal, cover_albedo};
+    const char* names[4] = {"eye_dirs", "cover_position", "cover_normal", "cover_albedo"};
+    for (int i = 0; i < 4; ++i) {
+      glActiveTexture(GLenum(GL_TEXTURE0 + i));
+      glBindTexture(GL_TEXTURE_2D, inputs[i]);
+      glUniform1i(Loc(r, names[i]), i);
+    }
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_BUFFER, corner_texture);
+    glUniform1i(Loc(r, "triangles"), 4);
+    glUniform1i(Loc(r, "use_triangles"), corner_texture != 0 ? 1 : 0);
+    glUniform1f(Loc(r, "min_distance"), float(t_near));
+    glUniform4f(Loc(r, "cover_map"), float(m(0)), float(m(1)), float(m(2)), float(m(3)));
+    glUniform2i(Loc(r, "cover_size"), cw, ch);
+    SetMat3(r, "eye_R", cam.world_from_camera.linear());
+    SetVec3(r, "eye", eye.rel);
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glActiveTexture(GL_TEXTURE0);
   }
 
   // Draws the distance maps of a batch's cameras not kept from the last frame and sets each
@@ -783,6 +1001,15 @@ struct GlRenderer::Impl {
     SetVec3(p, "eye", eye.rel);
     SetMat3(p, "view_Rt", eye.pose.linear());
     glUniform3f(Loc(p, "view_f"), float(eye.f), float(0.5 * eye.W - 0.5), float(0.5 * eye.H - 0.5));
+    glUniform1i(Loc(p, "eye_table"), eye.table ? 1 : 0);
+    const GLuint table[3] = {eye_dirs, eye_dx, eye_dy};
+    const char* table_names[3] = {"eye_dirs", "eye_dx", "eye_dy"};
+    for (int i = 0; i < 3; ++i) {
+      glActiveTexture(GLenum(GL_TEXTURE5 + i));
+      glBindTexture(GL_TEXTURE_2D, eye.table ? table[i] : 0);
+      glUniform1i(Loc(p, table_names[i]), 5 + i);
+    }
+    glActiveTexture(GL_TEXTURE0);
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDisablei(GL_BLEND, 0);
@@ -857,6 +1084,9 @@ struct GlRenderer::Impl {
   // of the camera sets (into word_bits) before the next word's light passes.
   Frame DrawFrame(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                   bool timed, bool sets);
+  Frame LightAndCompose(const Rig& rig, const FrameEye& eye, const GlRenderOptions& options,
+                        const std::vector<Batch>& batches, bool keep, bool timed, bool sets,
+                        std::chrono::steady_clock::time_point start);
   static void FinishFrame(const Frame& f, std::chrono::steady_clock::time_point read,
                           std::int64_t readback_bytes, GlFrameStats* stats);
 
@@ -1000,6 +1230,25 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
     }
   }
   m.vertex_count = GLsizei(3 * m.mesh.triangles.size());
+  GLint max_buffer_texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_buffer_texels);
+  if (!order.empty() && double(max_buffer_texels) >= 3.0 * double(order.size())) {
+    std::vector<float> corners;
+    corners.reserve(12 * order.size());
+    for (const std::size_t t : std::vector<std::size_t>(order.begin(), order.end()))
+      for (int corner = 0; corner < 3; ++corner) {
+        const Vec3 r = m.mesh.vertices[std::size_t(m.mesh.triangles[t][corner])] - m.origin;
+        corners.insert(corners.end(), {float(r.x()), float(r.y()), float(r.z()), 0.0f});
+      }
+    glGenBuffers(1, &m.corner_buffer);
+    glBindBuffer(GL_TEXTURE_BUFFER, m.corner_buffer);
+    glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(corners.size() * sizeof(float)), corners.data(),
+                 GL_STATIC_DRAW);
+    glGenTextures(1, &m.corner_texture);
+    glBindTexture(GL_TEXTURE_BUFFER, m.corner_texture);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, m.corner_buffer);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+  }
   glGenVertexArrays(1, &m.vao);
   glBindVertexArray(m.vao);
   glGenBuffers(1, &m.vbo);
@@ -1018,6 +1267,8 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
   m.shadow_program = Link(kShadowVertex, kShadowFragment, "shadow");
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
   m.encode_program = Link(kFullScreenVertex, kEncodeFragment, "encode");
+  m.resample_program = Link(kFullScreenVertex, kResampleFragment, "resample");
+  for (const Vec3& v : m.mesh.vertices) m.mesh_box.Extend(v);
   m.LightProgram(15);  // every branch compiled once now: a shader error shows at construction
   glGenBuffers(1, &m.camera_ubo);
   glBindBuffer(GL_UNIFORM_BUFFER, m.camera_ubo);
@@ -1036,18 +1287,24 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
   const auto start = Clock::now();
   Impl& m = *this;
   m.map_cpu_seconds = 0;
-  if (view.camera >= 0)
+  const bool camera_eye = view.camera >= 0;
+  if (camera_eye && view.camera >= int(rig.cameras.size()))
+    throw std::invalid_argument("GlRenderer: no camera " + std::to_string(view.camera) +
+                                " in the rig (RenderView::camera)");
+  if (camera_eye && IsCube(rig.cameras[std::size_t(view.camera)]))
     throw std::invalid_argument(
-        "GlRenderer: camera's-eye views (RenderView::camera) are not drawn on the GPU yet; use "
-        "the CPU renderer (render/render.h)");
+        "GlRenderer: camera's-eye views of lenses reaching 75 degrees off their axis (wide "
+        "fisheyes) are drawn by the CPU renderer (render/render.h)");
   GLint max_size = 0;
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
   if (view.width <= 0 || view.height <= 0 || view.width > max_size || view.height > max_size)
     throw std::invalid_argument("GlRenderer: the image size must be 1 .. " +
                                 std::to_string(max_size) + " pixels per side");
-  if (!(view.fov_deg > 0 && view.fov_deg < 180))
+  if (!camera_eye && !(view.fov_deg > 0 && view.fov_deg < 180))
     throw std::invalid_argument("GlRenderer: fov must be in (0, 180) degrees");
-  const auto pose = LookAt(view.from, view.at, view.up);
+  const auto pose = camera_eye
+                        ? std::optional(rig.cameras[std::size_t(view.camera)].world_from_camera)
+                        : LookAt(view.from, view.at, view.up);
   if (!pose)
     throw std::invalid_argument(
         "GlRenderer: 'at' equals 'from', or 'up' is parallel to the viewing direction");
@@ -1061,7 +1318,6 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
   GLint max_layers = 0;
   glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   const int W = view.width, H = view.height;
-  const int camera_count = int(rig.cameras.size());
 
   const std::vector<Batch> batches = LightBatches(rig, options, max_layers);
   int perspective_layers = 0, cube_count = 0;
@@ -1080,10 +1336,28 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
 
   // 1. G-buffer. The eye: OpenCV frame (x right, y down, z forward); GL's window row r is the
   // image's row r.
+  if (camera_eye) {
+    const Camera& cam = rig.cameras[std::size_t(view.camera)];
+    const FrameEye eye{W, H, *pose, 0.0, cam.center() - m.origin, true};
+    m.DrawCameraGBuffer(cam, eye, options);
+    return m.LightAndCompose(rig, eye, options, batches, keep, timed, sets, start);
+  }
   const double f = 0.5 * W / std::tan(0.5 * view.fov_deg * kPi / 180.0);
   const Vec3 eye_rel = view.from - m.origin;
-  const FrameEye eye{W, H, *pose, f, eye_rel};
+  const FrameEye eye{W, H, *pose, f, eye_rel, false};
   m.DrawGBuffer(view, eye, options);
+  return m.LightAndCompose(rig, eye, options, batches, keep, timed, sets, start);
+}
+
+// Steps 2-4 of a frame over the G-buffer drawn (maps, light, compose).
+GlRenderer::Impl::Frame GlRenderer::Impl::LightAndCompose(
+    const Rig& rig, const FrameEye& eye, const GlRenderOptions& options,
+    const std::vector<Batch>& batches, bool keep, bool timed, bool sets,
+    std::chrono::steady_clock::time_point start) {
+  using Clock = std::chrono::steady_clock;
+  Impl& m = *this;
+  const int W = eye.W, H = eye.H;
+  const int camera_count = int(rig.cameras.size());
 
   // Clear the light and the first mask.
   glBindFramebuffer(GL_FRAMEBUFFER, m.light_fbo[0]);

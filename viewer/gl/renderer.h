@@ -122,10 +122,18 @@ class GlRenderer {
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;
 
-  /// Renders `rig` lit scene seen from `view` (a main view: from/at/up/fov_deg, width x height)
-  /// and reads it back. Throws std::invalid_argument for a camera's-eye view (view.camera >= 0:
-  /// not drawn on the GPU yet), a bad size, fov or look-at, or a map size outside 512 .. 4096 or
-  /// beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for a GL error in the frame.
+  /// Renders `rig` lit scene seen from `view` and reads it back: a main view (from/at/up/fov_deg,
+  /// width x height), or a camera's-eye view (view.camera >= 0: what that rig camera images, its
+  /// lens and distortion included, the camera's image scaled to width x height, as the CPU draws
+  /// it). A camera's-eye view takes the lens's rays from a table the CPU unprojects once per lens
+  /// and size (with their exact differentials for the grid), draws a pinhole G-buffer of the
+  /// camera twice as fine as the output over the lens's field, and per output pixel keeps the
+  /// nearest of the triangles there that the pixel's own ray hits (an exact ray-triangle test);
+  /// primary rays start where the CPU's do (a camera on a wall does not see the wall). Throws
+  /// std::invalid_argument for a camera index outside the rig, a camera's-eye view of a lens
+  /// reaching 75 degrees off its axis (wide fisheyes: the CPU's), a bad size, fov or look-at, or a
+  /// map size outside 512 .. 4096 or beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for
+  /// a GL error in the frame.
   GlImage Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                  GlFrameStats* stats = nullptr);
   /// The same frame, kept on the GPU for a window to show: its colour encoded as 8-bit sRGB RGBA

@@ -8,6 +8,7 @@ uniform mat3 view_R;   // camera_from_world rotation of the eye (OpenCV frame: y
 uniform vec3 view_t;   // camera-frame position of the scene's centre, less (0, 0, view_d0)
 uniform float view_d0; // the near plane's depth: z is kept relative to it (precision far away)
 uniform vec4 proj;     // 2f/W, 2f/H, A, B': clip = (proj.x x, proj.y y, A z + B', z + d0)
+uniform vec2 proj_offset;  // an off-centre pyramid (a camera's-eye cover): clip.xy -= offset w
 out vec3 v_position;
 out float v_z;         // depth beyond the near plane, m (the fragment's depth and the cut)
 flat out vec3 v_normal;
@@ -19,7 +20,9 @@ void main() {
   vec3 c = view_R * position + view_t;  // c.z: depth less view_d0
   v_uv = uv;
   v_z = c.z;
-  gl_Position = vec4(proj.x * c.x, proj.y * c.y, proj.z * c.z + proj.w, c.z + view_d0);
+  float w = c.z + view_d0;
+  gl_Position = vec4(proj.x * c.x - proj_offset.x * w, proj.y * c.y - proj_offset.y * w,
+                     proj.z * c.z + proj.w, w);
   v_position = position;
   v_normal = normal;
   v_albedo = albedo;

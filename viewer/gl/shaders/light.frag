@@ -28,6 +28,29 @@ uniform float line_width;
 uniform vec3 eye;
 uniform mat3 view_Rt;          // world_from_camera rotation of the eye: columns x, y, z
 uniform vec3 view_f;           // f, cx, cy of the eye
+uniform int eye_table;         // 1: a camera's-eye view, its rays in eye_dirs (camera frame)
+uniform sampler2D eye_dirs;    // unit direction per output pixel; w: 1 inside the lens's domain
+uniform sampler2D eye_dx;      // its derivatives per output pixel (the CPU's exact ones)
+uniform sampler2D eye_dy;
+
+// The eye ray's unit direction through output pixel `ip` and its derivatives per output pixel.
+void EyeRay(ivec2 ip, out vec3 d, out vec3 ddx, out vec3 ddy) {
+  if (eye_table == 0) {
+    vec2 pp = vec2(ip);
+    vec3 D = view_Rt[2] + ((pp.x - view_f.y) / view_f.x) * view_Rt[0] +
+             ((pp.y - view_f.z) / view_f.x) * view_Rt[1];
+    float len = length(D);
+    d = D / len;
+    vec3 Dx = view_Rt[0] / view_f.x, Dy = view_Rt[1] / view_f.x;
+    ddx = (Dx - d * dot(d, Dx)) / len;
+    ddy = (Dy - d * dot(d, Dy)) / len;
+    return;
+  }
+  // The lens's rays and their exact differentials (camera frame), computed on the CPU.
+  d = view_Rt * texelFetch(eye_dirs, ip, 0).xyz;
+  ddx = view_Rt * texelFetch(eye_dx, ip, 0).xyz;
+  ddy = view_Rt * texelFetch(eye_dy, ip, 0).xyz;
+}
 layout(location = 0) out vec4 o_light;
 layout(location = 1) out uvec2 o_mask;
 
@@ -163,13 +186,8 @@ void main() {
     {
       // Ray differentials of the hit point on its plane, then the camera pixel's change per
       // output pixel by central differences of the projection along them.
-      vec2 pp = gl_FragCoord.xy - 0.5;
-      vec3 D = view_Rt[2] + ((pp.x - view_f.y) / view_f.x) * view_Rt[0] +
-               ((pp.y - view_f.z) / view_f.x) * view_Rt[1];
-      float len = length(D);
-      vec3 d = D / len;
-      vec3 Dx = view_Rt[0] / view_f.x, Dy = view_Rt[1] / view_f.x;
-      vec3 ddx = (Dx - d * dot(d, Dx)) / len, ddy = (Dy - d * dot(d, Dy)) / len;
+      vec3 d, ddx, ddy;
+      EyeRay(ip, d, ddx, ddy);
       float t = length(g.xyz - eye);
       float nd = dot(n, d);
       vec3 dXdx = t * (ddx - (dot(n, ddx) / nd) * d);
