@@ -117,6 +117,11 @@ struct RenderArgs {
   /// reachable from home within --ptz-time seconds, later seconds darker).
   std::string ptz = "single";
   double ptz_time = kUnset;  ///< `--ptz-time`: the budget of "all" (default: each head's trace_s).
+  /// `--gpu`: drawn by the GPU renderer (pandora_gl_render beside this program, headless EGL
+  /// without a display), with the agreement with the exact renderer printed (not --no-compare).
+  bool gpu = false;
+  bool no_compare = false;
+  int shadow_map = 2048;  ///< `--shadow-map`: the GPU's shadow-map size per camera.
   bool quiet = false;
 };
 int RunRender(const RenderArgs& args);

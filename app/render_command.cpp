@@ -1,9 +1,14 @@
 // `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its
 // own colour (render/render.h), written as PNG or multi-layer OpenEXR.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/ptz.h"
@@ -181,6 +186,85 @@ std::unique_ptr<Fields> ReadOverlayFields(const RenderArgs& args, const Scene& s
   return fields;
 }
 
+// --gpu: what the GPU renderer draws of a request (the rest is the exact renderer's), refused
+// naming the option otherwise.
+void CheckGpuRequest(const RenderArgs& args, const std::string& ext) {
+  if (!args.gpu) {
+    if (args.no_compare) throw InputError("--no-compare", "", "is for --gpu");
+    return;
+  }
+  const char* hint = "the exact renderer draws it: leave out --gpu";
+  if (ext != ".png") throw InputError("--out", "", "--gpu writes PNG only (no layers)", hint);
+  if (!args.fields.empty())
+    throw InputError("--fields", "", "overlays are not drawn by --gpu", hint);
+  if (args.samples != 1) throw InputError("--samples", "", "--gpu draws one sample a pixel", hint);
+  if (!args.time_sample.empty())
+    throw InputError("--time-sample", "", "cannot be combined with --gpu", hint);
+  if (Lower(args.ptz) != "single")
+    throw InputError("--ptz", "", "PTZ traces are not drawn by --gpu", hint);
+  if (args.shadow_map < 512 || args.shadow_map > 4096)
+    throw InputError("--shadow-map", "", "must be 512 .. 4096 texels");
+}
+
+// --gpu: pandora_gl_render (beside this program; the only code that links GL is outside it)
+// draws `view` into `staged` and prints its time and its agreement with the exact renderer.
+void RenderOnGpu(const RenderArgs& args, const Rig& rig, const RenderView& view,
+                 const std::string& staged) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::string tool = (self.parent_path() / "pandora_gl_render").string();
+  if (!std::filesystem::exists(tool))
+    throw InputError("--gpu", "", "the GPU renderer " + tool + " is not built",
+                     "build the pandora_gl_render target");
+  auto number = [](double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return std::string(text);
+  };
+  auto triple = [&](const Vec3& v) {
+    return number(v.x()) + "," + number(v.y()) + "," + number(v.z());
+  };
+  std::vector<std::string> a{
+      tool,     args.scene,
+      "--rig",  rig.name,
+      "--out",  staged,
+      "--size", std::to_string(view.width) + "x" + std::to_string(view.height)};
+  if (view.camera >= 0) {
+    a.insert(a.end(), {"--camera-index", std::to_string(view.camera)});
+  } else {
+    a.insert(a.end(),
+             {"--from", triple(view.from), "--at", triple(view.at), "--up", triple(view.up),
+              "--fov", number(view.fov_deg), "--clip-near", number(view.clip_near)});
+  }
+  std::string disabled;
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c)
+    if (!rig.cameras[c].enabled) disabled += (disabled.empty() ? "" : ",") + std::to_string(c);
+  if (!disabled.empty()) a.insert(a.end(), {"--disabled", disabled});
+  a.insert(a.end(),
+           {"--pattern", Lower(args.pattern), "--grid", std::to_string(args.grid), "--surface",
+            Lower(args.surface), "--shadow-map", std::to_string(args.shadow_map)});
+  if (!std::isnan(args.brightness)) a.insert(a.end(), {"--brightness", number(args.brightness)});
+  if (args.no_compare) a.push_back("--no-compare");
+  std::vector<char*> argv;
+  for (std::string& s : a) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    execv(tool.c_str(), argv.data());
+    std::_Exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw InputError("--gpu", "",
+                     "the GPU renderer failed (exit " +
+                         std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                         "; its message is above)",
+                     "without a display it needs EGL: install libegl1 and libegl-mesa0, or leave "
+                     "out --gpu");
+}
+
 }  // namespace
 
 int RunRender(const RenderArgs& args) {
@@ -190,6 +274,7 @@ int RunRender(const RenderArgs& args) {
     throw InputError("--out", "", "unsupported image type '" + ext + "'",
                      "name the output FILE.png (8-bit sRGB) or FILE.exr (float RGB and layers)");
   CheckViewpoint(args);
+  CheckGpuRequest(args, ext);
   RenderOptions options = ParseRenderOptions(args);
 
   // The study (scene, ray caster and prepared scene, built once) through the session layer.
@@ -210,6 +295,16 @@ int RunRender(const RenderArgs& args) {
   double plan_scale = 0;  // metres per pixel of a plan or elevation
   RenderView view = ChooseView(args, scene, rig, options, plan_scale);
 
+  if (args.gpu) {
+    RenderOnGpu(args, rig, view, staged);
+    output.Commit();
+    if (!args.quiet)
+      std::printf(
+          "wrote %s: %dx%d on the GPU, rig %s (%d enabled cameras); no overlays (camera "
+          "bodies, key and labels are the exact renderer's)\n",
+          args.out.c_str(), view.width, view.height, rig.name.c_str(), rig.enabled_count());
+    return 0;
+  }
   const std::unique_ptr<Fields> fields = ReadOverlayFields(args, scene, rig);
 
   // One BVH for the image and the rig checks: the study's, under its prepared scene.
@@ -334,6 +429,14 @@ Command AddRenderCommand(CLI::App& app, CommonOptions& common) {
   rn->add_option("--iso-value", render.iso_value, "Iso value (default 1.5: coverage >= 2)")
       ->check(Number(-HUGE_VAL, HUGE_VAL, "the field's unit"));
   rn->add_option("--threads", threads, "Worker threads (default: all cores)")->check(threads_check);
+  rn->add_flag("--gpu", render.gpu,
+               "Draw with the GPU renderer (pandora_gl_render; headless EGL without a display): "
+               "PNG, no overlays; prints its agreement with the exact renderer");
+  rn->add_flag("--no-compare", render.no_compare,
+               "With --gpu: skip the exact renderer's picture and the comparison");
+  rn->add_option("--shadow-map", render.shadow_map,
+                 "With --gpu: shadow-map size per camera, 512 to 4096")
+      ->capture_default_str();
   rn->add_flag("--quiet,-q", render.quiet, "Print nothing but errors");
   return {rn, [args] { return RunRender(*args); }};
 }

@@ -24,7 +24,7 @@ pack() {
   stage=$(mktemp -d)
   trap 'rm -rf "$stage"' RETURN
   mkdir -p "$stage/bin" "$stage/lib"
-  for exe in pandora_gl_bench gl_renderer_test pandora-view; do
+  for exe in pandora_gl_bench gl_renderer_test pandora-view pandora_gl_render; do
     [ -x "$build/$exe" ] || { echo "gpu_device.sh: $build/$exe is not built" >&2; return 2; }
     cp "$build/$exe" "$stage/bin/"
     # Every library the loader resolves, but those that must be the target's own: the C library
@@ -79,6 +79,11 @@ run() {
     "$dir/bin/pandora-view" "examples/$scene/scene.json" --no-autosave "${view[@]}" \
       > "$out/bench_viewer_$scene.txt" 2>&1 || echo "viewer bench $scene failed" >&2
   done
+  # A camera's native view (the capture stage's c01, 2048 x 1088) on the GPU against the exact
+  # renderer (`pandora render --gpu`).
+  "$dir/bin/pandora_gl_render" examples/capture_stage/scene.json --camera-index 0 \
+    --size "$([ "${QUICK:-0}" = 1 ] && echo 512x272 || echo 2048x1088)" --out "$out/c01_gpu.png" \
+    > "$out/render_camera_view.txt" 2>&1 || echo "camera view failed" >&2
   head -n 1 "$out/bench_trauma_room.md" >> "$out/device.txt"
   cat "$out/device.txt"
   rm -rf "$dir"

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <list>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -446,12 +447,31 @@ struct GlRenderer::Impl {
   // Camera's-eye views: the lens's rays per output pixel (camera frame, RGBA32F, w = 1 inside
   // the domain) for the lens and size of eye_dirs_key, their normalized-coordinate bounds and
   // the smallest step between neighbouring pixels' rays; and the cover G-buffer.
+  // The current one's textures, bounds and step; the last kEyeTables lenses' are kept (a window
+  // draws up to four camera's-eye insets every frame).
   GLuint eye_dirs = 0, eye_dx = 0, eye_dy = 0;  // with the rays' derivatives per output pixel
-  std::string eye_dirs_key;
   Eigen::Vector4d eye_dirs_bounds = Eigen::Vector4d::Zero();
   double eye_dirs_step = 0;
+  struct EyeTable {
+    std::string key;
+    GLuint textures[3] = {0, 0, 0};  // directions, d/dx, d/dy
+    Eigen::Vector4d bounds = Eigen::Vector4d::Zero();
+    double step = 0;
+  };
+  static constexpr std::size_t kEyeTables = 8;
+  std::list<EyeTable> eye_tables;  // most recently used first
   int cover_w = 0, cover_h = 0;
   GLuint cover_fbo = 0, cover_position = 0, cover_normal = 0, cover_albedo = 0, cover_depth = 0;
+  struct Cover {
+    GLuint fbo, textures[3], depth;
+  };
+  static constexpr std::size_t kCovers = 4;
+  std::list<std::pair<std::pair<int, int>, Cover>> covers;  // most recently used first, current too
+  static void FreeCover(const Cover& c) {
+    glDeleteTextures(3, c.textures);
+    glDeleteRenderbuffers(1, &c.depth);
+    glDeleteFramebuffers(1, &c.fbo);
+  }
   double last_cover_scale = 0;           // cover texels per output pixel at the finest, last frame
   std::map<int, GLuint> light_programs;  // by variant bits: 1 grid, 2 fisheye, 4 distortion, 8 cube
 
@@ -494,19 +514,57 @@ struct GlRenderer::Impl {
   GLuint shadow_fbo = 0, maps = 0, cubes = 0, map_depth = 0, cube_depth = 0;
   std::vector<std::optional<Camera>> map_camera, cube_camera;
 
-  void FreeViewTargets() {
-    GLuint textures[] = {g_position, g_normal, g_albedo,      light_accum,
-                         mask[0],    mask[1],  compose_color, encoded};
-    glDeleteTextures(8, textures);
-    glDeleteRenderbuffers(1, &g_depth);
-    GLuint fbos[] = {g_fbo, light_fbo[0], light_fbo[1], compose_fbo, encode_fbo};
-    glDeleteFramebuffers(5, fbos);
-    width = height = 0;
+  // The targets of one view size. A window draws its main view and camera's-eye insets of other
+  // sizes every frame: the last kParkedSizes sizes' targets are kept (parked), so switching
+  // between them allocates nothing, and each size's DrawToTexture texture stays valid while its
+  // size is among them.
+  struct ViewTargets {
+    GLuint fbo[5], texture[8], depth;
+  };
+  static constexpr std::size_t kParkedSizes = 6;
+  std::list<std::pair<std::pair<int, int>, ViewTargets>> parked;  // most recently used first
+
+  ViewTargets CurrentTargets() const {
+    return {{g_fbo, light_fbo[0], light_fbo[1], compose_fbo, encode_fbo},
+            {g_position, g_normal, g_albedo, light_accum, mask[0], mask[1], compose_color, encoded},
+            g_depth};
+  }
+  void UseTargets(const ViewTargets& t) {
+    g_fbo = t.fbo[0], light_fbo[0] = t.fbo[1], light_fbo[1] = t.fbo[2], compose_fbo = t.fbo[3];
+    encode_fbo = t.fbo[4];
+    g_position = t.texture[0], g_normal = t.texture[1], g_albedo = t.texture[2];
+    light_accum = t.texture[3], mask[0] = t.texture[4], mask[1] = t.texture[5];
+    compose_color = t.texture[6], encoded = t.texture[7];
+    g_depth = t.depth;
+  }
+  static void FreeTargets(const ViewTargets& t) {
+    glDeleteTextures(8, t.texture);
+    glDeleteRenderbuffers(1, &t.depth);
+    glDeleteFramebuffers(5, t.fbo);
   }
 
   void EnsureViewTargets(int w, int h) {
     if (w == width && h == height) return;
-    FreeViewTargets();
+    if (width > 0) parked.push_front({{width, height}, CurrentTargets()});
+    width = height = 0;
+    const auto it = std::find_if(parked.begin(), parked.end(), [&](const auto& p) {
+      return p.first == std::pair{w, h};
+    });
+    if (it != parked.end()) {
+      UseTargets(it->second);
+      parked.erase(it);
+      width = w;
+      height = h;
+    } else {
+      AllocateViewTargets(w, h);
+    }
+    while (parked.size() > kParkedSizes) {
+      FreeTargets(parked.back().second);
+      parked.pop_back();
+    }
+  }
+
+  void AllocateViewTargets(int w, int h) {
     width = w;
     height = h;
     g_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
@@ -602,7 +660,12 @@ struct GlRenderer::Impl {
   }
 
   ~Impl() {
-    FreeViewTargets();
+    if (width > 0) FreeTargets(CurrentTargets());
+    for (const auto& p : parked) FreeTargets(p.second);
+    for (const EyeTable& t : eye_tables) glDeleteTextures(3, t.textures);
+    for (const auto& c : covers) FreeCover(c.second);
+    glDeleteTextures(1, &corner_texture);
+    glDeleteBuffers(1, &corner_buffer);
     glDeleteTextures(1, &maps);
     glDeleteTextures(1, &cubes);
     glDeleteRenderbuffers(1, &map_depth);
@@ -613,7 +676,9 @@ struct GlRenderer::Impl {
     if (!texture_ids.empty()) glDeleteTextures(GLsizei(texture_ids.size()), texture_ids.data());
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
-    for (GLuint p : {gbuffer_program, shadow_program, compose_program}) glDeleteProgram(p);
+    for (GLuint p :
+         {gbuffer_program, shadow_program, compose_program, encode_program, resample_program})
+      glDeleteProgram(p);
     for (const auto& [variant, program] : light_programs) glDeleteProgram(program);
   }
 
@@ -740,7 +805,26 @@ struct GlRenderer::Impl {
                   "%d %d %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g",
                   int(k.model), k.width, k.height, W, H, k.fx, k.fy, k.cx, k.cy, k.k1, k.k2, k.p1,
                   k.p2, k.k3, k.k4);
-    if (eye_dirs != 0 && eye_dirs_key == key) return;
+    const auto kept = std::find_if(eye_tables.begin(), eye_tables.end(),
+                                   [&](const EyeTable& t) { return t.key == key; });
+    if (kept != eye_tables.end()) {
+      eye_tables.splice(eye_tables.begin(), eye_tables, kept);
+    } else {
+      eye_tables.push_front(ComputeEyeTable(cam, W, H, key));
+      while (eye_tables.size() > kEyeTables) {
+        glDeleteTextures(3, eye_tables.back().textures);
+        eye_tables.pop_back();
+      }
+    }
+    const EyeTable& t = eye_tables.front();
+    eye_dirs = t.textures[0];
+    eye_dx = t.textures[1];
+    eye_dy = t.textures[2];
+    eye_dirs_bounds = t.bounds;
+    eye_dirs_step = t.step;
+  }
+
+  static EyeTable ComputeEyeTable(const Camera& cam, int W, int H, const std::string& key) {
     const double sx = double(cam.model.width()) / W, sy = double(cam.model.height()) / H;
     const std::size_t n = std::size_t(W) * std::size_t(H);
     std::vector<float> texels(4 * n, 0.0f), dx(4 * n, 0.0f), dy(4 * n, 0.0f);
@@ -776,26 +860,35 @@ struct GlRenderer::Impl {
         if (y + 1 < H && q[std::size_t(y + 1) * W + std::size_t(x)].allFinite())
           step = std::min(step, (q[std::size_t(y + 1) * W + std::size_t(x)] - a).norm());
       }
-    for (auto [texture, data] : {std::pair{&eye_dirs, &texels}, {&eye_dx, &dx}, {&eye_dy, &dy}}) {
-      if (*texture == 0) *texture = MakeTexture(GL_RGBA32F, W, H, GL_RGBA, GL_FLOAT);
-      glBindTexture(GL_TEXTURE_2D, *texture);
+    EyeTable table;
+    table.key = key;
+    table.bounds = bounds;
+    table.step = step;
+    const std::vector<float>* data[3] = {&texels, &dx, &dy};
+    for (int i = 0; i < 3; ++i) {
+      table.textures[i] = MakeTexture(GL_RGBA32F, W, H, GL_RGBA, GL_FLOAT);
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, W, H, 0, GL_RGBA, GL_FLOAT, data->data());
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, W, H, 0, GL_RGBA, GL_FLOAT, data[i]->data());
     }
-    eye_dirs_key = key;
-    eye_dirs_bounds = bounds;
-    eye_dirs_step = step;
+    return table;
   }
 
-  // The cover G-buffer's targets at w x h (kept while the size stays).
+  // The cover G-buffer's targets at w x h (the last kCovers sizes' kept).
   void EnsureCover(int w, int h) {
     if (w == cover_w && h == cover_h) return;
-    const GLuint textures[3] = {cover_position, cover_normal, cover_albedo};
-    glDeleteTextures(3, textures);
-    glDeleteRenderbuffers(1, &cover_depth);
-    glDeleteFramebuffers(1, &cover_fbo);
     cover_w = w;
     cover_h = h;
+    const auto kept = std::find_if(covers.begin(), covers.end(), [&](const auto& c) {
+      return c.first == std::pair{w, h};
+    });
+    if (kept != covers.end()) {
+      covers.splice(covers.begin(), covers, kept);
+      const Cover& c = covers.front().second;
+      cover_fbo = c.fbo;
+      cover_position = c.textures[0], cover_normal = c.textures[1], cover_albedo = c.textures[2];
+      cover_depth = c.depth;
+      return;
+    }
     cover_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
     cover_normal = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
     cover_albedo = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
@@ -809,6 +902,12 @@ struct GlRenderer::Impl {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_TEXTURE_2D, cover_albedo, 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, cover_depth);
     CheckFramebuffer("camera's-eye cover");
+    covers.push_front(
+        {{w, h}, Cover{cover_fbo, {cover_position, cover_normal, cover_albedo}, cover_depth}});
+    while (covers.size() > kCovers) {
+      FreeCover(covers.back().second);
+      covers.pop_back();
+    }
   }
 
   // A camera's-eye view's G-buffer (view.camera): the camera's pinhole G-buffer over its lens's
@@ -1471,6 +1570,23 @@ std::vector<unsigned char> GlReadRgba8(unsigned texture, int width, int height) 
   glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   return rgba;
 }
+
+void GlCopyTexture(unsigned from, unsigned to, int width, int height) {
+  GLuint fbo[2] = {0, 0};
+  glGenFramebuffers(2, fbo);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo[0]);
+  glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, from, 0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo[1]);
+  glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, to, 0);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &buffer0);
+  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(2, fbo);
+}
+
+bool GlDrawsCameraEye(const Camera& cam) { return !IsCube(cam); }
 
 std::vector<double> GlCameraLightWeights(const LightRule& rule,
                                          const std::vector<CameraAtPoint>& points) {

@@ -155,6 +155,14 @@ class GlRenderer {
 /// first: what a screenshot or a test reads back of a frame kept on the GPU.
 std::vector<unsigned char> GlReadRgba8(unsigned texture, int width, int height);
 
+/// Copies `from` into `to` (both GL_TEXTURE_2D RGBA8 of width x height) on the GPU: a window keeps
+/// a DrawToTexture frame of its own (the renderer's texture is its size's, drawn again next time).
+void GlCopyTexture(unsigned from, unsigned to, int width, int height);
+
+/// Whether GlRenderer draws `cam`'s camera's-eye view (lenses reaching 75 degrees off their axis,
+/// wide fisheyes, are the CPU renderer's).
+bool GlDrawsCameraEye(const Camera& cam);
+
 /// The tightest [near, far] of camera-frame depth z that the scene's triangles reach inside the
 /// pyramid {|x| / z, |y| / z within `bounds`} (x_min, x_max, y_min, y_max of normalized image
 /// coordinates) of the frame `camera_from_world`: each triangle is clipped to the pyramid's four

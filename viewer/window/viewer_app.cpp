@@ -217,20 +217,45 @@ RenderOptions ViewerApp::Impl::InsetOptions() const {
 
 void ViewerApp::Impl::RenderCameraView(int c) {
   CameraView& v = camera_views[c];
-  const std::int64_t version =
-      model.session().rig().camera_version(c) * 1000003 + model.session().rig().version();
-  if (v.texture && v.version == version) return;
-  const CameraModel& m = model.rig().cameras[c].model;
+  const Camera& cam = model.rig().cameras[c];
+  // On the GPU (live while cameras move: the maps are the main view's, kept), but for wide
+  // fisheyes, which the exact CPU renderer draws.
+  const bool gpu = GlDrawsCameraEye(cam);
+  char key[256];
+  std::snprintf(key, sizeof key, "%lld %lld %d %d %d %.17g %d %d",
+                static_cast<long long>(model.session().rig().camera_version(c)),
+                static_cast<long long>(model.session().rig().version()), int(model.display.pattern),
+                model.display.grid_pixels, int(model.display.surface), model.display.brightness,
+                gl_options.shadow_map_size, gpu ? 1 : 0);
+  if (v.texture && v.key == key) return;
+  const CameraModel& m = cam.model;
   const double scale = std::min(1.0, 256.0 / m.width());
   RenderView view;
   view.camera = c;
   view.width = std::max(16, int(std::lround(m.width() * scale)));
   view.height = std::max(16, int(std::lround(m.height() * scale)));
-  const Image image = model.session().Render(view, InsetOptions());
-  Upload(&v.texture, image.width, image.height, ToRgba8(image.rgb));
-  v.version = version;
-  v.width = image.width;
-  v.height = image.height;
+  if (gpu) {
+    GlFrameStats counts;
+    counts.per_part = false;
+    const unsigned frame = gl->DrawToTexture(model.rig(), view, gl_options, &counts);
+    readback_bytes += counts.readback_bytes;
+    map_cpu_seconds += counts.map_cpu_seconds;
+    if (!v.texture || v.width != view.width || v.height != view.height) {
+      if (!v.texture) glGenTextures(1, &v.texture);
+      glBindTexture(GL_TEXTURE_2D, v.texture);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, view.width, view.height, 0, GL_RGBA,
+                   GL_UNSIGNED_BYTE, nullptr);
+    }
+    GlCopyTexture(frame, v.texture, view.width, view.height);
+  } else {
+    const Image image = model.session().Render(view, InsetOptions());
+    Upload(&v.texture, image.width, image.height, ToRgba8(image.rgb));
+  }
+  v.key = key;
+  v.width = view.width;
+  v.height = view.height;
 }
 
 int ViewerApp::Impl::HandleAt(double x, double y) const {
@@ -517,7 +542,8 @@ void ViewerApp::Impl::Panels() {
   SuggestPanel();
   DisplayPanel();
 
-  // Camera's-eye views of up to four selected cameras, exact (CPU), distortion included.
+  // Camera's-eye views of up to four selected cameras, distortion included: the GPU's (the exact
+  // CPU renderer's for wide fisheyes), live while cameras move.
   for (std::size_t i = 0; i < model.selection.size() && i < 4; ++i) {
     const int c = model.selection[i];
     RenderCameraView(c);

@@ -184,7 +184,8 @@ struct ViewerApp::Impl {
   // Camera views (exact, CPU) of the selected cameras.
   struct CameraView {
     GLuint texture = 0;
-    std::int64_t version = -1;
+    std::int64_t version = -1;  // station views: what the texture shows
+    std::string key;            // camera views: what the texture shows
     int width = 0, height = 0;
   };
   std::map<int, CameraView> camera_views;
