@@ -101,6 +101,11 @@ int main(int argc, char** argv) {
                  "GL context: egl (headless, no display), glfw (hidden window, needs a display) "
                  "or auto (PANDORA_GL, else glfw with a display, egl without)")
       ->check(CLI::IsMember({"auto", "egl", "glfw"}));
+  std::string map_draws = "one-pass";
+  app.add_option("--map-draws", map_draws,
+                 "one-pass (every map of a frame in one layered, instanced draw) or per-map (one "
+                 "draw and a CPU depth range per map)")
+      ->check(CLI::IsMember({"one-pass", "per-map"}));
   int grow = 0;
   app.add_option("--cameras", grow,
                  "grow the rig to this many cameras: its cameras turned about the vertical through "
@@ -176,6 +181,7 @@ int main(int argc, char** argv) {
       options.reuse_maps = false;  // every frame draws every map
       options.shadow_bias_scale = bias;
       options.shadow_test = GlRenderOptions::ShadowTest(shadow_mode);
+      options.one_pass_maps = map_draws == "one-pass";
       GlImage gpu;
       const GpuTimes t = TimeFrames(renderer, rig, view, options, frames, &gpu);
       const GlComparison c =

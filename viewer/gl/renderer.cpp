@@ -100,6 +100,26 @@ GLuint Link(const char* vertex, const char* fragment, const char* name) {
   return program;
 }
 
+// A program with a geometry shader between the two (the maps' layered pass).
+GLuint Link(const char* vertex, const char* geometry, const char* fragment, const char* name) {
+  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex, name);
+  const GLuint gs = Compile(GL_GEOMETRY_SHADER, geometry, name);
+  const GLuint fs = Compile(GL_FRAGMENT_SHADER, fragment, name);
+  const GLuint program = glCreateProgram();
+  for (GLuint s : {vs, gs, fs}) glAttachShader(program, s);
+  glLinkProgram(program);
+  for (GLuint s : {vs, gs, fs}) glDeleteShader(s);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    glDeleteProgram(program);
+    throw std::runtime_error(std::string("GlRenderer: program ") + name + " does not link: " + log);
+  }
+  return program;
+}
+
 GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
 void SetMat3(GLuint program, const char* name, const Mat3& m) {
@@ -438,6 +458,9 @@ struct GlRenderer::Impl {
   GLuint vao = 0, vbo = 0;
   GLuint gbuffer_program = 0, shadow_program = 0, compose_program = 0, encode_program = 0;
   GLuint resample_program = 0;
+  // The layered maps pass: up to kMaxMaps maps per instanced draw, their frames in map_ubo.
+  static constexpr int kMaxMaps = 64;
+  GLuint maps_program = 0, map_ubo = 0;
   // The triangles' corners (relative to the scene's centre, VBO order), 3 RGBA32F texels each,
   // as a texture buffer for the camera's-eye views' ray-triangle tests; 0 where the GL's texture
   // buffers cannot hold them.
@@ -676,9 +699,10 @@ struct GlRenderer::Impl {
     if (!texture_ids.empty()) glDeleteTextures(GLsizei(texture_ids.size()), texture_ids.data());
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
-    for (GLuint p :
-         {gbuffer_program, shadow_program, compose_program, encode_program, resample_program})
+    for (GLuint p : {gbuffer_program, shadow_program, compose_program, encode_program,
+                     resample_program, maps_program})
       glDeleteProgram(p);
+    glDeleteBuffers(1, &map_ubo);
     for (const auto& [variant, program] : light_programs) glDeleteProgram(program);
   }
 
@@ -1016,10 +1040,111 @@ struct GlRenderer::Impl {
     glActiveTexture(GL_TEXTURE0);
   }
 
+  // One distance map of a layered pass: its frame, its pyramid's bounds and its layer.
+  struct MapInstance {
+    Eigen::Isometry3d face_from_world;
+    Eigen::Vector4d bounds;
+    int layer = 0;
+  };
+
+  // GlRenderOptions::one_pass_maps: the distance maps of a batch's cameras not kept from the last
+  // frame, drawn as instances of one layered draw per texture array (perspective maps, cube
+  // faces) with no per-map CPU work; sets each camera's layer. Returns the maps drawn.
+  int DrawBatchMapsLayered(const Rig& rig, const Batch& batch, bool keep,
+                           const GlRenderOptions& options, std::vector<int>& layer) {
+    static const std::array<Mat3, 6> kCube = CubeFaces();
+    std::vector<MapInstance> flat, faces;
+    std::vector<int> clear_flat, clear_faces;
+    int next_map = 0, next_cube = 0;
+    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
+      const Camera& cam = rig.cameras[batch.cameras[i]];
+      const bool cube = IsCube(cam);
+      layer[i] = cube ? next_cube++ : next_map++;
+      std::optional<Camera>& held = cube ? cube_camera[layer[i]] : map_camera[layer[i]];
+      if (held && SameCameraGeometry(*held, cam)) continue;
+      const Eigen::Isometry3d cfw = cam.camera_from_world();
+      if (!cube) {
+        clear_flat.push_back(layer[i]);
+        flat.push_back({cfw, cam.model.normalized_bounds(), layer[i]});
+      }
+      for (int f = 0; cube && f < 6; ++f) {
+        clear_faces.push_back(6 * layer[i] + f);
+        // A face whose pyramid (54.7 degrees around its axis) the field cannot reach stays
+        // cleared.
+        const double axis_angle = std::acos(std::clamp(kCube[f].row(2).z(), -1.0, 1.0));
+        if (axis_angle - std::atan(std::sqrt(2.0)) >= cam.model.max_field_angle()) continue;
+        Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
+        face_from_world.linear() = kCube[f] * cfw.linear();
+        face_from_world.translation() = kCube[f] * cfw.translation();
+        faces.push_back({face_from_world, Eigen::Vector4d(-1, 1, -1, 1), 6 * layer[i] + f});
+      }
+      if (keep && options.reuse_maps)
+        held = cam;
+      else
+        held.reset();
+    }
+    DrawLayered(maps, map_size, clear_flat, flat);
+    DrawLayered(cubes, cube_size, clear_faces, faces);
+    return int(flat.size() + faces.size());
+  }
+
+  // Clears the layers `clear` of `array` (size x size) and draws `maps_to_draw` into their layers
+  // in instanced draws of kMaxMaps, keeping the nearest distance by MIN blending.
+  void DrawLayered(GLuint array, int size, const std::vector<int>& clear,
+                   const std::vector<MapInstance>& maps_to_draw) {
+    if (clear.empty()) return;
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, 0);
+    const GLenum buffer0 = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer0);
+    const float cleared[4] = {3e38f, 0, 0, 0};
+    for (int l : clear) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, array, 0, l);
+      glClearBufferfv(GL_COLOR, 0, cleared);
+    }
+    if (maps_to_draw.empty()) return;
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, array, 0);
+    CheckFramebuffer("distance maps (layered)");
+    glViewport(0, 0, size, size);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_MIN);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUseProgram(maps_program);
+    glBindVertexArray(vao);
+    // What lies nearer the map's plane than the CPU's smallest occlusion tolerance is clipped.
+    const double near = 1e-5 * scene_scale;
+    std::vector<float> block(std::size_t(20 * kMaxMaps), 0.0f);
+    for (std::size_t first = 0; first < maps_to_draw.size(); first += kMaxMaps) {
+      const std::size_t n = std::min<std::size_t>(kMaxMaps, maps_to_draw.size() - first);
+      for (std::size_t k = 0; k < n; ++k) {
+        const MapInstance& m = maps_to_draw[first + k];
+        const Mat3 R = m.face_from_world.linear();
+        const Vec3 t = m.face_from_world * origin;
+        const Eigen::Vector4d c = MapCoefficients(m.bounds);
+        float* out = &block[20 * k];
+        for (int r = 0; r < 3; ++r) {
+          for (int j = 0; j < 3; ++j) out[4 * r + j] = float(R(r, j));
+          out[4 * r + 3] = float(t(r));
+        }
+        for (int j = 0; j < 4; ++j) out[12 + j] = float(c(j));
+        out[16] = float(m.layer);
+        out[17] = float(near);
+      }
+      glBindBuffer(GL_UNIFORM_BUFFER, map_ubo);
+      glBufferSubData(GL_UNIFORM_BUFFER, 0, GLsizeiptr(20 * n * sizeof(float)), block.data());
+      glBindBufferBase(GL_UNIFORM_BUFFER, 1, map_ubo);
+      glDrawArraysInstanced(GL_TRIANGLES, 0, vertex_count, GLsizei(n));
+    }
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_BLEND);
+  }
+
   // Draws the distance maps of a batch's cameras not kept from the last frame and sets each
   // camera's layer. Returns the maps drawn.
   int DrawBatchMaps(const Rig& rig, const Batch& batch, bool keep, const GlRenderOptions& options,
                     std::vector<int>& layer) {
+    if (options.one_pass_maps) return DrawBatchMapsLayered(rig, batch, keep, options, layer);
     int maps_drawn = 0;
     int next_map = 0, next_cube = 0;
     for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
@@ -1367,6 +1492,17 @@ GlRenderer::GlRenderer(const Scene& scene, const PreparedScene* prepared)
   m.compose_program = Link(kFullScreenVertex, kComposeFragment, "compose");
   m.encode_program = Link(kFullScreenVertex, kEncodeFragment, "encode");
   m.resample_program = Link(kFullScreenVertex, kResampleFragment, "resample");
+  {
+    std::string geometry = kMapsGeometry;
+    geometry.insert(geometry.find('\n') + 1,
+                    "#define MAX_MAPS " + std::to_string(Impl::kMaxMaps) + "\n");
+    m.maps_program = Link(kMapsVertex, geometry.c_str(), kMapsFragment, "maps");
+    glUniformBlockBinding(m.maps_program, glGetUniformBlockIndex(m.maps_program, "MapBlock"), 1);
+    glGenBuffers(1, &m.map_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, m.map_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(20 * Impl::kMaxMaps * sizeof(float)), nullptr,
+                 GL_DYNAMIC_DRAW);
+  }
   for (const Vec3& v : m.mesh.vertices) m.mesh_box.Extend(v);
   m.LightProgram(15);  // every branch compiled once now: a shader error shows at construction
   glGenBuffers(1, &m.camera_ubo);

@@ -66,6 +66,11 @@ struct GlRenderOptions {
   /// geometry changed (SameCameraGeometry): a frame that moves only the eye draws no maps. Only
   /// when the whole rig fits one light pass (see map_memory_mib).
   bool reuse_maps = true;
+  /// Draw every map a frame needs in one instanced, layered draw per texture array (a geometry
+  /// shader routes each map to its layer; the nearest distance kept by MIN blending, so no depth
+  /// range and no per-map CPU work). false: one draw per map with a depth test and a depth range
+  /// from the triangle tree (DepthRangeInPyramid), as before; both give the same maps (tested).
+  bool one_pass_maps = true;
   /// Memory for the maps of one light pass, MiB. All maps of a pass are bound at once; a rig whose
   /// maps need more is lit in several passes (and its maps are drawn every frame). A map takes
   /// 4 map_size^2 bytes (16 MiB at 2048, 64 MiB at 4096), a cube 1.5 times that.
