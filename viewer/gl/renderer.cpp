@@ -1543,8 +1543,8 @@ GlRenderer::Impl::Frame GlRenderer::Impl::DrawFrame(const Rig& rig, const Render
   if (!pose)
     throw std::invalid_argument(
         "GlRenderer: 'at' equals 'from', or 'up' is parallel to the viewing direction");
-  if (options.shadow_map_size < 512 || options.shadow_map_size > 4096)
-    throw std::invalid_argument("GlRenderer: shadow_map_size must be 512 .. 4096 (is " +
+  if (options.shadow_map_size < 256 || options.shadow_map_size > 4096)
+    throw std::invalid_argument("GlRenderer: shadow_map_size must be 256 .. 4096 (is " +
                                 std::to_string(options.shadow_map_size) + ")");
   if (options.shadow_map_size > max_size)
     throw std::invalid_argument("GlRenderer: this GL's textures are at most " +

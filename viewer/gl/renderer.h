@@ -47,7 +47,8 @@ struct GlRenderOptions {
   double line_width_px = 1.2;  ///< Grid lines and mesh edges, output pixels.
   double line_grey = 0.25;     ///< Linear grey of mesh edges and contours.
   Vec3 background{0.02, 0.02, 0.03};
-  /// Texels per side of each camera's distance map, 512 .. 4096 (std::invalid_argument outside).
+  /// Texels per side of each camera's distance map, 256 .. 4096 (std::invalid_argument outside;
+  /// the window's frames while cameras move use 256, what users choose is 512 .. 4096).
   /// A camera whose field reaches 75 degrees off its axis or more (wide fisheyes) gets a cube of
   /// six maps of map_size / 2 texels around its centre instead of one.
   int shadow_map_size = 2048;
@@ -137,7 +138,7 @@ class GlRenderer {
   /// primary rays start where the CPU's do (a camera on a wall does not see the wall). Throws
   /// std::invalid_argument for a camera index outside the rig, a camera's-eye view of a lens
   /// reaching 75 degrees off its axis (wide fisheyes: the CPU's), a bad size, fov or look-at, or a
-  /// map size outside 512 .. 4096 or beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for
+  /// map size outside 256 .. 4096 or beyond this GL's GL_MAX_TEXTURE_SIZE; std::runtime_error for
   /// a GL error in the frame.
   GlImage Render(const Rig& rig, const RenderView& view, const GlRenderOptions& options,
                  GlFrameStats* stats = nullptr);

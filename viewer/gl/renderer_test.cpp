@@ -766,7 +766,7 @@ TEST(GlRenderer, RefusesWhatItCannotDraw) {
     EXPECT_THROW(lenses.Render(lens_room.rigs[0], fisheye, options), std::invalid_argument);
   }
   view.camera = -1;
-  options.shadow_map_size = 256;
+  options.shadow_map_size = 128;
   EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
   options.shadow_map_size = 8192;
   EXPECT_THROW(renderer.Render(scene.rigs[0], view, options), std::invalid_argument);
