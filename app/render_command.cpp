@@ -14,6 +14,7 @@
 #include "analysis/scene/ptz.h"
 #include "analysis/util/error.h"
 #include "analysis/util/text.h"
+#include "analysis/util/units.h"
 #include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -296,6 +297,15 @@ int RunRender(const RenderArgs& args) {
   RenderView view = ChooseView(args, scene, rig, options, plan_scale);
 
   if (args.gpu) {
+    // A camera's-eye view of a lens reaching 75 degrees off its axis (a wide fisheye, whose maps
+    // are cubes) is the exact renderer's (GlDrawsCameraEye): refused here in one line.
+    if (view.camera >= 0 &&
+        rig.cameras[std::size_t(view.camera)].model.max_field_angle() >= 75.0 * kPi / 180.0)
+      throw InputError("--gpu", "",
+                       "camera " + rig.cameras[std::size_t(view.camera)].id +
+                           "'s lens reaches 75 degrees or more off its axis: its view is drawn "
+                           "by the exact renderer only",
+                       "leave out --gpu");
     RenderOnGpu(args, rig, view, staged);
     output.Commit();
     if (!args.quiet)
