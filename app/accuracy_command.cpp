@@ -2,7 +2,6 @@
 // (issue 3, point 6). The studies are app/session/accuracy.h, their tables, CSV files and plots
 // app/report/accuracy_tables.h; this runs them in turn, prints each table as it is done and
 // writes every file in one output transaction.
-#include <sys/wait.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include "analysis/util/input_file.h"
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/helper_program.h"
 #include "app/output.h"
 #include "app/report/accuracy_tables.h"
 #include "app/session/accuracy.h"
@@ -32,12 +32,7 @@ namespace {
 // links GL) on the scene's first view, its CSV read back.
 // The bench program; InputError naming --gpu when it cannot run (checked before any study runs).
 std::string GpuBench(const Scene& scene) {
-  std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::string bench = (self.parent_path() / "pandora_gl_bench").string();
-  if (!std::filesystem::exists(bench))
-    throw InputError("--gpu", "", "the GPU bench " + bench + " is not built",
-                     "build the pandora_gl_bench target");
+  const std::string bench = HelperProgram("pandora_gl_bench", "--gpu", "the GPU bench");
   // No display needed: without one the bench's GL context is headless EGL (viewer/gl/context.h).
   if (scene.views.empty())
     throw InputError("--gpu", "", "the scene has no views to render", "add one to \"views\"");
@@ -52,30 +47,19 @@ report::AccuracySection GpuStudy(const Scene& scene, const Rig& rig, bool quick)
   close(fd);
   const std::string size = quick ? "320x180" : "1280x720";
   const std::string frames = quick ? "1" : "5";
-  std::vector<std::string> args{bench,   scene.path, "--rig", rig.name,       "--size",
-                                size,    "--frames", frames,  "--cpu-frames", quick ? "1" : "3",
-                                "--csv", name};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::freopen("/dev/null", "w", stdout);
-    execv(bench.c_str(), argv.data());
-    std::_Exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  const std::string csv = WIFEXITED(status) && WEXITSTATUS(status) == 0
-                              ? ReadInputFile(name, 1 << 20, "GPU bench output")
-                              : std::string();
+  const int status =
+      RunHelperProgram({bench, scene.path, "--rig", rig.name, "--size", size, "--frames", frames,
+                        "--cpu-frames", quick ? "1" : "3", "--csv", name},
+                       true);
+  const std::string csv =
+      status == 0 ? ReadInputFile(name, 1 << 20, "GPU bench output") : std::string();
   std::remove(name);
   if (csv.empty())
-    throw InputError("--gpu", "",
-                     "the GPU bench failed (exit " + std::to_string(WEXITSTATUS(status)) +
-                         "; its message is above)",
-                     "without a display it needs EGL: install libegl1 and libegl-mesa0, or run "
-                     "under `xvfb-run -a`");
+    throw InputError(
+        "--gpu", "",
+        "the GPU bench failed (exit " + std::to_string(status) + "; its message is above)",
+        "without a display it needs EGL: install libegl1 and libegl-mesa0, or run "
+        "under `xvfb-run -a`");
   const std::string note = "view '" + scene.views.begin()->first + "' at " + size + ", rig " +
                            rig.name + " (" + std::to_string(rig.enabled_count()) +
                            " cameras); times are of this machine's GL";

@@ -1,13 +1,11 @@
 // `pandora render`: the scene from a viewpoint lit by every enabled camera as a projector of its
 // own colour (render/render.h), written as PNG or multi-layer OpenEXR.
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/rig/rig_check.h"
@@ -17,6 +15,7 @@
 #include "analysis/util/units.h"
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/helper_program.h"
 #include "app/options.h"
 #include "app/output.h"
 #include "app/session/ptz_edit.h"
@@ -211,12 +210,7 @@ void CheckGpuRequest(const RenderArgs& args, const std::string& ext) {
 // draws `view` into `staged` and prints its time and its agreement with the exact renderer.
 void RenderOnGpu(const RenderArgs& args, const Rig& rig, const RenderView& view,
                  const std::string& staged) {
-  std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::string tool = (self.parent_path() / "pandora_gl_render").string();
-  if (!std::filesystem::exists(tool))
-    throw InputError("--gpu", "", "the GPU renderer " + tool + " is not built",
-                     "build the pandora_gl_render target");
+  const std::string tool = HelperProgram("pandora_gl_render", "--gpu", "the GPU renderer");
   auto number = [](double v) {
     char text[40];
     std::snprintf(text, sizeof text, "%.17g", v);
@@ -246,24 +240,13 @@ void RenderOnGpu(const RenderArgs& args, const Rig& rig, const RenderView& view,
             Lower(args.surface), "--shadow-map", std::to_string(args.shadow_map)});
   if (!std::isnan(args.brightness)) a.insert(a.end(), {"--brightness", number(args.brightness)});
   if (args.no_compare) a.push_back("--no-compare");
-  std::vector<char*> argv;
-  for (std::string& s : a) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  std::fflush(stdout);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    execv(tool.c_str(), argv.data());
-    std::_Exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw InputError("--gpu", "",
-                     "the GPU renderer failed (exit " +
-                         std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
-                         "; its message is above)",
-                     "without a display it needs EGL: install libegl1 and libegl-mesa0, or leave "
-                     "out --gpu");
+  const int status = RunHelperProgram(std::move(a), false);
+  if (status != 0)
+    throw InputError(
+        "--gpu", "",
+        "the GPU renderer failed (exit " + std::to_string(status) + "; its message is above)",
+        "without a display it needs EGL: install libegl1 and libegl-mesa0, or leave "
+        "out --gpu");
 }
 
 }  // namespace

@@ -144,6 +144,25 @@ GLuint MakeTexture(GLenum internal, int width, int height, GLenum format, GLenum
   return tex;
 }
 
+void CheckFramebuffer(const char* what);
+
+// A G-buffer of w x h: three RGBA32F targets (point, normal, albedo) and a depth buffer on one
+// framebuffer (the view's, and a camera's-eye cover).
+void MakeGBuffer(int w, int h, const char* what, GLuint* fbo, GLuint (&textures)[3],
+                 GLuint* depth) {
+  for (GLuint& t : textures) t = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
+  glGenRenderbuffers(1, depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, *depth);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+  glGenFramebuffers(1, fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+  for (int i = 0; i < 3; ++i)
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_TEXTURE_2D,
+                           textures[i], 0);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth);
+  CheckFramebuffer(what);
+}
+
 void CheckFramebuffer(const char* what) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
@@ -190,6 +209,14 @@ std::array<Mat3, 6> CubeFaces() {
 // least GL 3.3 guarantees, fits 64 x 10 x 16 bytes).
 constexpr int kCameraVec4 = 10;
 constexpr int kMaxBatch = 64;
+
+// Whether cube face `face` (CubeFaces) lies wholly outside `cam`'s field: its pyramid reaches
+// 54.7 degrees around its axis.
+bool FaceOutOfField(const Camera& cam, int face) {
+  static const std::array<Mat3, 6> kCube = CubeFaces();
+  const double axis_angle = std::acos(std::clamp(kCube[face].row(2).z(), -1.0, 1.0));
+  return axis_angle - std::atan(std::sqrt(2.0)) >= cam.model.max_field_angle();
+}
 
 bool IsCube(const Camera& cam) { return cam.model.max_field_angle() >= kMaxPerspectiveFieldAngle; }
 
@@ -486,7 +513,7 @@ struct GlRenderer::Impl {
   int cover_w = 0, cover_h = 0;
   GLuint cover_fbo = 0, cover_position = 0, cover_normal = 0, cover_albedo = 0, cover_depth = 0;
   struct Cover {
-    GLuint fbo, textures[3], depth;
+    GLuint fbo = 0, textures[3] = {0, 0, 0}, depth = 0;
   };
   static constexpr std::size_t kCovers = 4;
   std::list<std::pair<std::pair<int, int>, Cover>> covers;  // most recently used first, current too
@@ -590,19 +617,9 @@ struct GlRenderer::Impl {
   void AllocateViewTargets(int w, int h) {
     width = w;
     height = h;
-    g_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    g_normal = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    g_albedo = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    glGenRenderbuffers(1, &g_depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, g_depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-    glGenFramebuffers(1, &g_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, g_position, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, g_normal, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_TEXTURE_2D, g_albedo, 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g_depth);
-    CheckFramebuffer("G-buffer");
+    GLuint g[3];
+    MakeGBuffer(w, h, "G-buffer", &g_fbo, g, &g_depth);
+    g_position = g[0], g_normal = g[1], g_albedo = g[2];
 
     light_accum = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
     for (int k = 0; k < 2; ++k) {
@@ -736,10 +753,7 @@ struct GlRenderer::Impl {
       glClearBufferfv(GL_COLOR, 0, cleared);
       // A cube face whose pyramid (54.7 degrees around its axis) the field cannot reach stays
       // cleared.
-      if (cube) {
-        const double axis_angle = std::acos(std::clamp(kCube[i].row(2).z(), -1.0, 1.0));
-        if (axis_angle - std::atan(std::sqrt(2.0)) >= cam.model.max_field_angle()) continue;
-      }
+      if (cube && FaceOutOfField(cam, i)) continue;
       Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
       face_from_world.linear() = face_from_camera * cfw.linear();
       face_from_world.translation() = face_from_camera * cfw.translation();
@@ -907,31 +921,19 @@ struct GlRenderer::Impl {
     });
     if (kept != covers.end()) {
       covers.splice(covers.begin(), covers, kept);
-      const Cover& c = covers.front().second;
-      cover_fbo = c.fbo;
-      cover_position = c.textures[0], cover_normal = c.textures[1], cover_albedo = c.textures[2];
-      cover_depth = c.depth;
-      return;
+    } else {
+      Cover c;
+      MakeGBuffer(w, h, "camera's-eye cover", &c.fbo, c.textures, &c.depth);
+      covers.push_front({{w, h}, c});
+      while (covers.size() > kCovers) {
+        FreeCover(covers.back().second);
+        covers.pop_back();
+      }
     }
-    cover_position = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    cover_normal = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    cover_albedo = MakeTexture(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT);
-    glGenRenderbuffers(1, &cover_depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, cover_depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-    glGenFramebuffers(1, &cover_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, cover_fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, cover_position, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, cover_normal, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_TEXTURE_2D, cover_albedo, 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, cover_depth);
-    CheckFramebuffer("camera's-eye cover");
-    covers.push_front(
-        {{w, h}, Cover{cover_fbo, {cover_position, cover_normal, cover_albedo}, cover_depth}});
-    while (covers.size() > kCovers) {
-      FreeCover(covers.back().second);
-      covers.pop_back();
-    }
+    const Cover& c = covers.front().second;
+    cover_fbo = c.fbo;
+    cover_position = c.textures[0], cover_normal = c.textures[1], cover_albedo = c.textures[2];
+    cover_depth = c.depth;
   }
 
   // A camera's-eye view's G-buffer (view.camera): the camera's pinhole G-buffer over its lens's
@@ -1047,45 +1049,29 @@ struct GlRenderer::Impl {
     int layer = 0;
   };
 
-  // GlRenderOptions::one_pass_maps: the distance maps of a batch's cameras not kept from the last
-  // frame, drawn as instances of one layered draw per texture array (perspective maps, cube
-  // faces) with no per-map CPU work; sets each camera's layer. Returns the maps drawn.
-  int DrawBatchMapsLayered(const Rig& rig, const Batch& batch, bool keep,
-                           const GlRenderOptions& options, std::vector<int>& layer) {
-    static const std::array<Mat3, 6> kCube = CubeFaces();
+  // The layered pass's part of camera `cam` (GlRenderOptions::one_pass_maps): its map, or its cube
+  // faces, as instances, and the layers to clear (a cube's faces its field cannot reach, 54.7
+  // degrees around their axes, stay cleared).
+  struct LayeredMaps {
     std::vector<MapInstance> flat, faces;
     std::vector<int> clear_flat, clear_faces;
-    int next_map = 0, next_cube = 0;
-    for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
-      const Camera& cam = rig.cameras[batch.cameras[i]];
-      const bool cube = IsCube(cam);
-      layer[i] = cube ? next_cube++ : next_map++;
-      std::optional<Camera>& held = cube ? cube_camera[layer[i]] : map_camera[layer[i]];
-      if (held && SameCameraGeometry(*held, cam)) continue;
-      const Eigen::Isometry3d cfw = cam.camera_from_world();
-      if (!cube) {
-        clear_flat.push_back(layer[i]);
-        flat.push_back({cfw, cam.model.normalized_bounds(), layer[i]});
-      }
-      for (int f = 0; cube && f < 6; ++f) {
-        clear_faces.push_back(6 * layer[i] + f);
-        // A face whose pyramid (54.7 degrees around its axis) the field cannot reach stays
-        // cleared.
-        const double axis_angle = std::acos(std::clamp(kCube[f].row(2).z(), -1.0, 1.0));
-        if (axis_angle - std::atan(std::sqrt(2.0)) >= cam.model.max_field_angle()) continue;
-        Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
-        face_from_world.linear() = kCube[f] * cfw.linear();
-        face_from_world.translation() = kCube[f] * cfw.translation();
-        faces.push_back({face_from_world, Eigen::Vector4d(-1, 1, -1, 1), 6 * layer[i] + f});
-      }
-      if (keep && options.reuse_maps)
-        held = cam;
-      else
-        held.reset();
+  };
+  static void AddLayered(const Camera& cam, bool cube, int layer, LayeredMaps* out) {
+    static const std::array<Mat3, 6> kCube = CubeFaces();
+    const Eigen::Isometry3d cfw = cam.camera_from_world();
+    if (!cube) {
+      out->clear_flat.push_back(layer);
+      out->flat.push_back({cfw, cam.model.normalized_bounds(), layer});
+      return;
     }
-    DrawLayered(maps, map_size, clear_flat, flat);
-    DrawLayered(cubes, cube_size, clear_faces, faces);
-    return int(flat.size() + faces.size());
+    for (int f = 0; f < 6; ++f) {
+      out->clear_faces.push_back(6 * layer + f);
+      if (FaceOutOfField(cam, f)) continue;
+      Eigen::Isometry3d face_from_world = Eigen::Isometry3d::Identity();
+      face_from_world.linear() = kCube[f] * cfw.linear();
+      face_from_world.translation() = kCube[f] * cfw.translation();
+      out->faces.push_back({face_from_world, Eigen::Vector4d(-1, 1, -1, 1), 6 * layer + f});
+    }
   }
 
   // Clears the layers `clear` of `array` (size x size) and draws `maps_to_draw` into their layers
@@ -1140,24 +1126,33 @@ struct GlRenderer::Impl {
     glDisable(GL_BLEND);
   }
 
-  // Draws the distance maps of a batch's cameras not kept from the last frame and sets each
+  // Draws the distance maps of a batch's cameras not kept from the last frame (in one layered
+  // pass with GlRenderOptions::one_pass_maps, else one draw per map) and sets each
   // camera's layer. Returns the maps drawn.
   int DrawBatchMaps(const Rig& rig, const Batch& batch, bool keep, const GlRenderOptions& options,
                     std::vector<int>& layer) {
-    if (options.one_pass_maps) return DrawBatchMapsLayered(rig, batch, keep, options, layer);
     int maps_drawn = 0;
     int next_map = 0, next_cube = 0;
+    LayeredMaps layered;  // one_pass_maps: every map drawn after the loop, in one pass
     for (std::size_t i = 0; i < batch.cameras.size(); ++i) {
       const Camera& cam = rig.cameras[batch.cameras[i]];
       const bool cube = IsCube(cam);
       layer[i] = cube ? next_cube++ : next_map++;
       std::optional<Camera>& held = cube ? cube_camera[layer[i]] : map_camera[layer[i]];
       if (held && SameCameraGeometry(*held, cam)) continue;
-      maps_drawn += DrawMaps(cam, cube, layer[i]);
+      if (options.one_pass_maps)
+        AddLayered(cam, cube, layer[i], &layered);
+      else
+        maps_drawn += DrawMaps(cam, cube, layer[i]);
       if (keep && options.reuse_maps)
         held = cam;
       else
         held.reset();
+    }
+    if (options.one_pass_maps) {
+      DrawLayered(maps, map_size, layered.clear_flat, layered.flat);
+      DrawLayered(cubes, cube_size, layered.clear_faces, layered.faces);
+      maps_drawn = int(layered.flat.size() + layered.faces.size());
     }
     return maps_drawn;
   }
