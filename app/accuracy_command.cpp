@@ -113,6 +113,7 @@ int RunAccuracy(const AccuracyArgs& args) {
   emit(report::MonteCarloSection(monte_carlo, threads));
   emit(report::SteadySection(RunSteadyStudy(scene, monte_carlo, options)));
   emit(report::RefineSection(RunRefineStudy(scene, rig, *caster, &study->solid_trees())));
+  emit(report::GateSection(RunGateStudy(scene, rig, *caster, options)));
   if (args.gpu) emit(GpuStudy(scene, rig, args.quick));
 
   WriteFileAtomically(tables_path, markdown);
@@ -133,7 +134,8 @@ Command AddAccuracyCommand(CLI::App& app, CommonOptions& common) {
   const CLI::Validator& threads_check = common.threads_check;
   CLI::App* acc = app.add_subcommand("accuracy",
                                      "Error against run time: voxel size, Monte Carlo trials, "
-                                     "steady-state solvers, coarse-to-fine");
+                                     "steady-state solvers, coarse-to-fine, and the Monte Carlo "
+                                     "gate per voxel");
   acc->add_option("scene", accuracy.scene, "Scene file (JSON)")->required();
   acc->add_option("--rig", accuracy.rig, "Rig name (default: the first rig)");
   acc->add_option("--disable", accuracy.disable,

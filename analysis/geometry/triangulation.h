@@ -96,8 +96,11 @@ struct MonteCarloResult {
 /// triangulable from them (fewer than two cameras, or a direction without information), when
 /// sigma_px <= 0, or when trials < 2. When fewer than two trials succeed the empirical statistics
 /// stay zero and both relative errors are +infinity.
+/// `offsets` (if given) receives every successful estimate minus X, in trial order (for statistics
+/// beyond the covariance: the skew of the errors, their distribution).
 MonteCarloResult MonteCarloCovariance(const std::vector<Camera>& cameras, const Vec3& X,
                                       double sigma_px, int trials, uint64_t seed,
-                                      const TriangulationOptions& options = {});
+                                      const TriangulationOptions& options = {},
+                                      std::vector<Vec3>* offsets = nullptr);
 
 }  // namespace pandora

@@ -122,7 +122,8 @@ std::optional<Vec3> TriangulatePoint(const std::vector<Camera>& cameras,
 
 MonteCarloResult MonteCarloCovariance(const std::vector<Camera>& cameras, const Vec3& X,
                                       double sigma_px, int trials, uint64_t seed,
-                                      const TriangulationOptions& options) {
+                                      const TriangulationOptions& options,
+                                      std::vector<Vec3>* offsets) {
   const auto start = std::chrono::steady_clock::now();
   if (!(sigma_px > 0))
     throw std::invalid_argument("MonteCarloCovariance: sigma_px " + std::to_string(sigma_px) +
@@ -185,6 +186,12 @@ MonteCarloResult MonteCarloCovariance(const std::vector<Camera>& cameras, const 
     ++good;
   }
   result.failures = trials - good;
+  if (offsets) {
+    offsets->clear();
+    offsets->reserve(static_cast<std::size_t>(good));
+    for (int k = 0; k < trials; ++k)
+      if (ok[k]) offsets->push_back(estimates[k] - X);
+  }
   if (good >= 2) {
     const Vec3 mean_offset = sum / good;
     Mat3 scatter = Mat3::Zero();

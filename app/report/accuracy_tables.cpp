@@ -227,6 +227,113 @@ AccuracySection MonteCarloSection(const MonteCarloStudy& mc, int threads) {
   return section;
 }
 
+namespace {
+
+// Nearest-rank percentile p in [0, 1] of the finite values; NaN when none.
+double PercentileOf(std::vector<double> v, double p) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size())));
+  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+}  // namespace
+
+AccuracySection GateSection(const GateStudy& st) {
+  AccuracySection section;
+  section.title =
+      Format("(f) Monte Carlo gate per voxel: %d noisy triangulations against J^-1", st.trials);
+  section.csv_name = "accuracy_gate.csv";
+  section.svg_name = "accuracy_gate.svg";
+  section.table =
+      Table({"axis", "tolerance", "measured/predicted p2.5", "median", "p97.5", "within",
+             "resolvable axes", "angle median °", "p95 °", "max °", "within 3°"});
+  static const char* const kAxis[3] = {"major", "middle", "minor"};
+  std::vector<std::vector<std::string>> csv;
+  PlotSeries axes[3];
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> ratio, angle;
+    int within = 0, within_angle = 0;
+    for (const GateVoxel& v : st.voxels) {
+      ratio.push_back(v.Ratio(a));
+      within += std::abs(v.Ratio(a) - 1) <= kGateEigenTolerance[a] ? 1 : 0;
+      if (std::isfinite(v.axis_deg[a])) {
+        angle.push_back(v.axis_deg[a]);
+        within_angle += v.axis_deg[a] <= kGateAngleDeg ? 1 : 0;
+      }
+      axes[a].x.push_back(1e3 * std::sqrt(v.predicted[a]));
+      axes[a].y.push_back(1e3 * std::sqrt(v.empirical[a]));
+    }
+    const double n = static_cast<double>(st.voxels.size());
+    section.table.AddRow(
+        {kAxis[a], Format("±%.0f%%", 100 * kGateEigenTolerance[a]),
+         Cell("%.3f", PercentileOf(ratio, 0.025)), Cell("%.3f", PercentileOf(ratio, 0.5)),
+         Cell("%.3f", PercentileOf(ratio, 0.975)), Cell("%.1f%%", 100 * within / n),
+         Format("%zu", angle.size()), Cell("%.2f", PercentileOf(angle, 0.5)),
+         Cell("%.2f", PercentileOf(angle, 0.95)), Cell("%.2f", PercentileOf(angle, 1.0)),
+         angle.empty() ? "-" : Format("%.1f%%", 100.0 * within_angle / angle.size())});
+    axes[a].label = Format("%s axis", kAxis[a]);
+    axes[a].line = false;
+  }
+  std::vector<double> skew;
+  for (const GateVoxel& v : st.voxels) {
+    skew.push_back(std::abs(v.skew_major));
+    csv.push_back(
+        {CsvNumber(v.X.x()), CsvNumber(v.X.y()), CsvNumber(v.X.z()), std::to_string(v.cameras),
+         CsvNumber(v.angle_deg), CsvNumber(1e3 * std::sqrt(v.predicted[0])),
+         CsvNumber(1e3 * std::sqrt(v.predicted[1])), CsvNumber(1e3 * std::sqrt(v.predicted[2])),
+         CsvNumber(v.Ratio(0)), CsvNumber(v.Ratio(1)), CsvNumber(v.Ratio(2)),
+         CsvNumber(v.axis_deg[0]), CsvNumber(v.axis_deg[1]), CsvNumber(v.axis_deg[2]),
+         CsvNumber(v.skew_major), std::to_string(v.failures), v.pass ? "1" : "0"});
+  }
+  section.notes = st.notes;
+  section.notes.push_back(Format(
+      "%zu voxels sampled uniformly in the region among those >= 2 cameras see; %.1f%% pass every "
+      "eigenvalue tolerance and every resolvable axis within %.0f°; pixel sigma %.3g px; %.3g s",
+      st.voxels.size(), 100 * st.PassShare(), kGateAngleDeg, st.sigma_px, st.seconds));
+  section.notes.push_back(Format(
+      "an axis is resolvable when the sample's own error of its direction (from the eigenvalue "
+      "gaps and %d trials) is <= %.0f°; nearly equal eigenvalues leave their plane's directions "
+      "undetermined",
+      st.trials, kGateResolvableDeg));
+  if (!st.voxels.empty()) {
+    const auto worst = std::max_element(st.voxels.begin(), st.voxels.end(),
+                                        [](const GateVoxel& a, const GateVoxel& b) {
+                                          return std::abs(a.skew_major) < std::abs(b.skew_major);
+                                        });
+    section.notes.push_back(Format(
+        "skew of the errors along the major axis (0 for the Gaussian the first-order prediction "
+        "assumes): median |skew| %.3f, largest %.3f at (%.3f, %.3f, %.3f) m, %d cameras, best "
+        "triangulation angle %.1f°, measured/predicted major variance %.3f",
+        PercentileOf(skew, 0.5), std::abs(worst->skew_major), worst->X.x(), worst->X.y(),
+        worst->X.z(), worst->cameras, worst->angle_deg, worst->Ratio(0)));
+  }
+  LogLogPlot plot;
+  plot.title = "Measured against predicted sigma per principal axis";
+  plot.x_label = "predicted sigma along the axis (mm)";
+  plot.y_label = "Monte Carlo sigma along the axis (mm)";
+  plot.note = Format("%zu voxels, %d trials each; dashed: measured = predicted", st.voxels.size(),
+                     st.trials);
+  PlotSeries identity;
+  identity.label = "measured = predicted";
+  identity.markers = false;
+  identity.dashed = true;
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (const PlotSeries& s : axes)
+    for (double x : s.x)
+      if (x > 0 && std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  if (hi > 0) identity.x = identity.y = {lo, hi};
+  plot.series = {axes[0], axes[1], axes[2], identity};
+  section.csv = CsvText(
+      {"x_m", "y_m", "z_m", "cameras", "angle_deg", "predicted_major_mm", "predicted_middle_mm",
+       "predicted_minor_mm", "ratio_major", "ratio_middle", "ratio_minor", "axis_major_deg",
+       "axis_middle_deg", "axis_minor_deg", "skew_major", "failures", "pass"},
+      csv);
+  section.svg = RenderLogLogSvg(plot);
+  return section;
+}
+
 AccuracySection RefineSection(const RefineStudy& st) {
   AccuracySection section;
   section.title = "(e) Coarse-to-fine evaluation against the full one at the study's voxel size";

@@ -41,6 +41,12 @@ AccuracySection SteadySection(const SteadyStudy& study);
 /// (e) accuracy_refine.{csv,svg}: per coarse size and tolerance the share of voxels refined, the
 /// time against the full evaluation, the voxels whose coverage is wrong and the sigma_max errors.
 AccuracySection RefineSection(const RefineStudy& study);
+/// (f) accuracy_gate.{csv,svg}: per principal axis (major, middle, minor) the spread of the
+/// measured / predicted variance over the sampled voxels and the share within its tolerance, the
+/// eigenvector angles where resolvable, the share of voxels passing, the skew where the prediction
+/// stops holding; the CSV per voxel; the plot measured against predicted sigma per axis.
+AccuracySection GateSection(const GateStudy& study);
+
 /// "# pandora accuracy: SCENE, rig RIG" and a blank line: the head of accuracy_tables.md.
 std::string AccuracyTablesHeading(const std::string& scene_path, const std::string& rig);
 

@@ -65,6 +65,7 @@ AccuracyOptions AccuracyOptions::Quick() {
   o.trials = {100, 300, 1000, 3000};
   o.min_timing_seconds = 0.01;
   o.run_on_iterations = 100000;
+  o.gate_voxels = 12;
   return o;
 }
 
@@ -86,6 +87,8 @@ void AccuracyOptions::Check() const {
   if (!(min_timing_seconds > 0 && std::isfinite(min_timing_seconds)))
     throw InputError("min_timing_seconds", "", "must be a positive number of seconds");
   if (run_on_iterations < 1) throw InputError("run_on_iterations", "", "must be at least 1");
+  if (gate_voxels < 1) throw InputError("gate_voxels", "", "must be at least 1");
+  if (gate_trials < 2) throw InputError("gate_trials", "", "must be at least 2");
 }
 
 // ---------------------------------------------------------------------------------------------

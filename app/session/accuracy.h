@@ -9,7 +9,10 @@
 ///   (c) steady state: the closed form, doubling and plain Riccati iteration in double against the
 ///       long-double reference (analysis/geometry/uncertainty_reference.h) (RunSteadyStudy);
 ///   (e) coarse-to-fine: a coarse evaluation refined where the field changes, against the full
-///       evaluation at the study's voxel size (RunRefineStudy, refine_study.cpp).
+///       evaluation at the study's voxel size (RunRefineStudy, refine_study.cpp);
+///   (f) Monte Carlo gate per voxel: at randomly sampled voxels seen by >= 2 cameras, the sample
+///       covariance of 2,000 noisy triangulations against the predicted one, axis by axis
+///       (eigenvalues and eigenvector directions) (RunGateStudy, monte_carlo_gate.cpp).
 /// Each returns a typed result (rows and notes); app/report/accuracy_tables.h turns them into the
 /// tables, CSV files and plots. Timings are wall times on this machine.
 ///
@@ -49,9 +52,12 @@ struct AccuracyOptions {
   /// Seed of the Monte Carlo noise: the first (trial count, point) run uses it, each next one the
   /// next integer (MonteCarloCovariance seeds its trials from it).
   std::uint64_t seed = 1;
+  /// Monte Carlo gate (f): voxels sampled (>= 1) and noisy triangulations per voxel (>= 2).
+  int gate_voxels = 100;
+  int gate_trials = 2000;
 
   /// The short study: factors 4, 2, 1, 0.5; 3 points; 100 .. 3000 trials; 0.01 s timings; 1e5
-  /// run-on steps.
+  /// run-on steps; a gate of 12 voxels (still 2,000 trials each).
   static AccuracyOptions Quick();
 
   /// Throws InputError(file = the field's name, e.g. "trials", json_path "", reason) when a value
@@ -216,5 +222,56 @@ struct RefineStudy {
 /// between the evaluations.
 RefineStudy RunRefineStudy(const Scene& scene, const Rig& rig, const RayCaster& caster,
                            const SolidTrees* solid_trees = nullptr);
+
+// ---------------------------------------------------------------------------------------------
+// (f) Monte Carlo gate per voxel.
+
+/// The gate's tolerances: each eigenvalue of the sample covariance (a variance, m^2) within this
+/// relative distance of the predicted one, major (largest) to minor, and each resolvable
+/// eigenvector within kGateAngleDeg of the predicted one.
+inline constexpr double kGateEigenTolerance[3] = {0.10, 0.15, 0.20};
+inline constexpr double kGateAngleDeg = 3.0;
+/// An axis is resolvable when the sample's own statistical error of its direction, the largest over
+/// the other axes j of sqrt(l_i l_j / (n - 1)) / |l_i - l_j| (first-order perturbation of a sample
+/// covariance's eigenvectors; n trials, predicted eigenvalues l), is at most this many degrees: at
+/// 1 degree the 3-degree tolerance is three standard errors. Nearly equal eigenvalues leave their
+/// plane's directions undetermined at any sample count; such axes are counted, not compared.
+inline constexpr double kGateResolvableDeg = 1.0;
+
+/// One sampled voxel.
+struct GateVoxel {
+  Vec3 X = Vec3::Zero();  ///< The voxel's centre, m.
+  int cameras = 0;        ///< Enabled cameras that see it (exact visibility).
+  double angle_deg = 0;   ///< Largest triangulation angle among them.
+  /// Eigenvalues (variances, m^2), largest first: predicted (J^-1) and of the sample covariance.
+  double predicted[3] = {0, 0, 0}, empirical[3] = {0, 0, 0};
+  /// Angle between each predicted eigenvector and the sample's matching one, degrees (NaN: the
+  /// axis is not resolvable at this trial count, see kGateResolvableDeg).
+  double axis_deg[3] = {0, 0, 0};
+  /// Sample skewness of the errors along the predicted major axis: 0 for the Gaussian the
+  /// first-order prediction assumes; large where it stops holding (small angles, grazing views).
+  double skew_major = 0;
+  int failures = 0;  ///< Trials whose triangulation failed (excluded).
+  /// Every eigenvalue within its tolerance and every resolvable axis within kGateAngleDeg.
+  bool pass = false;
+  double Ratio(int axis) const { return empirical[axis] / predicted[axis]; }
+};
+
+struct GateStudy {
+  int trials = 0;
+  double sigma_px = 0;
+  std::vector<GateVoxel> voxels;  ///< In sampling order.
+  double seconds = 0;             ///< Wall time of every voxel's trials.
+  std::vector<std::string> notes;
+  /// Share of the voxels that pass (NaN: no voxel).
+  double PassShare() const;
+};
+
+/// Samples options.gate_voxels voxel centres of the study region uniformly at random (seeded by
+/// options.seed; up to 200 candidates per wanted voxel), keeps those that >= 2 enabled cameras see
+/// and that are triangulable, and runs MonteCarloCovariance (options.gate_trials, Ceres) at each
+/// at the study's pixel sigma, comparing the sample covariance with J^-1 axis by axis.
+GateStudy RunGateStudy(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                       const AccuracyOptions& options);
 
 }  // namespace pandora

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Runs `pandora accuracy --quick` on a scene and checks its outputs: the three CSV files and three SVG
-# plots exist (no temporary file left), the named columns hold finite numbers on every row, and the
+# Runs `pandora accuracy --quick` on a scene and checks its outputs: the CSV files and SVG plots
+# exist (no temporary file left), the named columns hold finite numbers on every row, and the
 # Monte Carlo relative error of sigma_max (mean over the sample points) at the largest trial count
-# is below 10%.
+# is below 10%; at least 95% of the Monte Carlo gate's voxels pass.
 # Usage: check_accuracy.sh PANDORA SCENE OUT_DIR
 set -eu
 pandora=$1; scene=$2; out=$3
@@ -10,12 +10,13 @@ rm -rf "$out"; mkdir -p "$(dirname "$out")"
 "$pandora" accuracy "$scene" --out "$out" --quick > "$out.log" 2>&1 || { echo "FAIL: pandora accuracy exited $?"; cat "$out.log"; exit 1; }
 fail() { echo "FAIL: $*"; exit 1; }
 
-for f in accuracy_voxel.csv accuracy_montecarlo.csv accuracy_steady.csv \
-         accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg accuracy_tables.md; do
+for f in accuracy_voxel.csv accuracy_montecarlo.csv accuracy_steady.csv accuracy_gate.csv \
+         accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg accuracy_gate.svg \
+         accuracy_tables.md; do
   [ -s "$out/$f" ] || fail "$f missing or empty"
   [ -z "$(ls "$out" | grep -F "$f.tmp")" ] || fail "$f.tmp* left behind"
 done
-for f in accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg; do
+for f in accuracy_voxel.svg accuracy_montecarlo.svg accuracy_steady.svg accuracy_gate.svg; do
   head -c 200 "$out/$f" | grep -q '<svg ' || fail "$f does not start an SVG document"
   tail -n 1 "$out/$f" | grep -q '</svg>' || fail "$f is not closed"
   if command -v xmllint >/dev/null; then xmllint --noout "$out/$f" || fail "$f is not well-formed XML"; fi
@@ -57,4 +58,11 @@ awk -v r="$frob" 'BEGIN { exit !(r < 10) }' || fail "Monte Carlo Frobenius error
 awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
          $(c["method"]) ~ /^closed form/ { n++; if (!($(c["rel_err"]) + 0 < 1e-13)) bad = 1 }
          END { exit !(n >= 3 && !bad) }' "$out/accuracy_steady.csv" || fail "closed form off its long-double reference"
+# The Monte Carlo gate (f): voxels with finite predicted sigmas and ratios; >= 95% of them pass.
+check_columns accuracy_gate.csv 2 x_m y_m z_m cameras predicted_major_mm ratio_major ratio_middle \
+  ratio_minor skew_major failures pass
+read -r voxels passed < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+  { n++; p += $(c["pass"]) } END { print n, p }' "$out/accuracy_gate.csv")
+awk -v n="$voxels" -v p="$passed" 'BEGIN { exit !(p >= 0.95 * n) }' ||
+  fail "Monte Carlo gate: $passed of $voxels voxels pass (< 95%)"
 echo "ok: accuracy tables and plots written; Monte Carlo at N=$trials: sigma_max error $rel%, Frobenius $frob%"
