@@ -48,5 +48,8 @@ Command AddReportCommand(CLI::App& app, CommonOptions& common);
 Command AddRigCommand(CLI::App& app, CommonOptions& common);
 Command AddSuggestCommand(CLI::App& app, CommonOptions& common);
 Command AddAcceptCommand(CLI::App& app, CommonOptions& common);
+/// `pandora synth` and `pandora validate` (app/synth_command.cpp, app/validate_command.cpp).
+Command AddSynthCommand(CLI::App& app, CommonOptions& common);
+Command AddValidateCommand(CLI::App& app, CommonOptions& common);
 
 }  // namespace pandora::app

@@ -123,7 +123,8 @@ int main(int argc, char** argv) {
       AddExportSurfaceCommand(app, common), AddExportRigCommand(app, common),
       AddImportRigCommand(app, common),     AddReportCommand(app, common),
       AddRigCommand(app, common),           AddSuggestCommand(app, common),
-      AddAcceptCommand(app, common)};
+      AddAcceptCommand(app, common),        AddSynthCommand(app, common),
+      AddValidateCommand(app, common)};
 
   RefuseEmptyValues(&app);
 

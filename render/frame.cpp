@@ -72,14 +72,18 @@ class ViewRays {
   // the same camera (VisibilityTester::Tolerance(camera, 0)): a surface through the camera centre
   // (a camera mounted on a wall's face) is behind it for the image as for the fields.
   ViewRays(const RenderView& view, const Rig& rig, bool table, double camera_t_near = 0.0)
-      : width_(view.width), height_(view.height) {
+      : width_(view.OutputWidth()), height_(view.OutputHeight()) {
     if (view.camera >= 0) {
       cam_ = &rig.cameras[view.camera];
       camera_t_near_ = camera_t_near;
       eye_ = cam_->center();
       R_ = cam_->world_from_camera.linear();
-      sx_ = double(cam_->model.width()) / width_;
-      sy_ = double(cam_->model.height()) / height_;
+      sx_ = double(cam_->model.width()) / view.width;
+      sy_ = double(cam_->model.height()) / view.height;
+      if (!view.window.empty()) {
+        ox_ = view.window.x;
+        oy_ = view.window.y;
+      }
       if (table) {
         const std::size_t n = std::size_t(width_) * height_;
         table_.resize(n);
@@ -123,7 +127,7 @@ class ViewRays {
       *d = (R_ * Vec3((px - cx_) / f_, (py - cy_) / f_, 1.0)).normalized();
       return true;
     }
-    const Vec2 pixel((px + 0.5) * sx_ - 0.5, (py + 0.5) * sy_ - 0.5);
+    const Vec2 pixel((px + ox_ + 0.5) * sx_ - 0.5, (py + oy_ + 0.5) * sy_ - 0.5);
     const auto dir = cam_->model.Unproject(pixel);
     if (!dir) return false;
     *d = R_ * *dir;
@@ -164,7 +168,7 @@ class ViewRays {
   // space, so M = J^T (J J^T)^-1 is d(direction)/d(pixel), perpendicular to the direction.
   Entry CameraEntry(int x, int y) const {
     Entry e;
-    const Vec2 pixel((x + 0.5) * sx_ - 0.5, (y + 0.5) * sy_ - 0.5);
+    const Vec2 pixel((x + ox_ + 0.5) * sx_ - 0.5, (y + oy_ + 0.5) * sy_ - 0.5);
     const auto dir = cam_->model.Unproject(pixel);
     if (!dir) return e;
     Mat23 J;
@@ -187,6 +191,7 @@ class ViewRays {
   double camera_t_near_ = 0;
   double f_ = 1, cx_ = 0, cy_ = 0;
   double sx_ = 1, sy_ = 1;
+  int ox_ = 0, oy_ = 0;  // RenderView::window's corner
   std::vector<Entry> table_;
   Camera pinhole_;
 };
@@ -297,6 +302,13 @@ void CheckView(const RenderView& view, const Rig& rig) {
     throw InputError("{size}", "", "the image size must be positive");
   if (view.camera >= int(rig.cameras.size()))
     throw InputError("{camera}", "", "no camera " + std::to_string(view.camera) + " in the rig");
+  if (!view.window.empty()) {
+    const RenderView::Window& w = view.window;
+    if (view.camera < 0)
+      throw InputError("{window}", "", "a window is for a camera's-eye view only");
+    if (w.x < 0 || w.y < 0 || w.x + w.width > view.width || w.y + w.height > view.height)
+      throw InputError("{window}", "", "the window must lie inside the image");
+  }
   if (view.camera < 0) {
     if (!(view.fov_deg > 0 && view.fov_deg < 180))
       throw InputError("{fov_deg}", "", "must be in (0, 180) degrees");
@@ -317,6 +329,18 @@ const std::vector<int>& PreparedSceneData::ObjectTextures() const {
     // leaves its objects their plain colour, with one warning line on stderr.
     std::vector<int> of_material(material_texture.size(), -1);
     for (std::size_t m = 0; m < material_texture.size(); ++m) {
+      if (m < material_printed.size() && material_printed[m]) {  // reflectance, 255 = paper
+        const PrintedPattern& print = *material_printed[m];
+        Image tex;
+        tex.width = print.width;
+        tex.height = print.height;
+        tex.rgb.resize(3 * print.grey.size());
+        for (std::size_t i = 0; i < print.grey.size(); ++i)
+          tex.rgb[3 * i] = tex.rgb[3 * i + 1] = tex.rgb[3 * i + 2] = print.grey[i] / 255.0f;
+        textures.push_back(std::move(tex));
+        of_material[m] = static_cast<int>(textures.size()) - 1;
+        continue;
+      }
       const std::string& path = material_texture[m];
       if (path.empty()) continue;
       std::string ext = std::filesystem::path(path).extension().string();
@@ -373,7 +397,10 @@ std::unique_ptr<PreparedSceneData> Prepare(const Scene& scene,
     d->object_has_uvs[o] = !scene.objects[o].mesh.corner_uvs.empty();
     if (m >= 0 && m < int(scene.materials.size())) d->object_color[o] = scene.materials[m].color;
   }
-  for (const Material& m : scene.materials) d->material_texture.push_back(m.texture);
+  for (const Material& m : scene.materials) {
+    d->material_texture.push_back(m.texture);
+    d->material_printed.push_back(m.printed);
+  }
   d->has_uvs = !d->mesh.corner_uvs.empty();
   d->scene_scale = std::max(scene.ContentBounds().diagonal(), 1e-9);
   return d;
@@ -525,8 +552,8 @@ FrameRenderer::FrameRenderer(const PreparedScene& prepared, const Rig& rig, cons
     throw std::invalid_argument(
         "Render: the prepared overlays were made for another slice or isosurface than "
         "options.overlays asks for; prepare them again (PreparedOverlays)");
-  width_ = view.width;
-  height_ = view.height;
+  width_ = view.OutputWidth();
+  height_ = view.OutputHeight();
   tiles_x_ = (width_ + kTile - 1) / kTile;
   tiles_y_ = (height_ + kTile - 1) / kTile;
   const PreparedSceneData& scene = prepared.data();
@@ -1077,8 +1104,8 @@ struct PixelPicker::Impl {
   Impl(const internal::PreparedSceneData& scene, const Rig& rig, const RenderView& view)
       : scene(scene),
         rig(rig),
-        width(view.width),
-        height(view.height),
+        width(view.OutputWidth()),
+        height(view.OutputHeight()),
         tester(rig.cameras, *scene.caster, scene.scene_scale),
         rays(view, rig, /*table=*/false,
              view.camera >= 0 ? tester.Tolerance(view.camera, 0.0) : 0.0) {}

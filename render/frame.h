@@ -43,8 +43,10 @@ struct PreparedSceneData {
   std::vector<Vec3> object_color;    // material colour per object
   double scene_scale = 1.0;          // diagonal of Scene::ContentBounds() (visibility epsilon)
   std::vector<std::string> material_texture;  // texture path per material ("" none)
-  std::vector<int> object_material;           // material per object
-  std::vector<bool> object_has_uvs;           // per object: its mesh has texture coordinates
+  // A fiducial's print per material (null: none), used in place of the texture path.
+  std::vector<std::shared_ptr<const PrintedPattern>> material_printed;
+  std::vector<int> object_material;  // material per object
+  std::vector<bool> object_has_uvs;  // per object: its mesh has texture coordinates
   bool has_uvs = false;
 
   // Prepared at first use.

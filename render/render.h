@@ -55,6 +55,17 @@ struct RenderView {
   /// origin moved there in double, so a far eye costs no float precision); the GPU renderer
   /// discards fragments nearer than it.
   double clip_near = 0;
+  /// Camera's-eye views only: render just the rectangle [x, x + width) x [y, y + height) of the
+  /// width x height image; the Image is then window.width x window.height, its pixel (i, j) the
+  /// full image's (x + i, y + j), every ray and value as in the full image. Empty (width or height
+  /// 0): the whole image. `pandora synth` renders only where a fiducial may show.
+  struct Window {
+    int x = 0, y = 0, width = 0, height = 0;
+    bool empty() const { return width <= 0 || height <= 0; }
+  };
+  Window window;
+  int OutputWidth() const { return window.empty() ? width : window.width; }
+  int OutputHeight() const { return window.empty() ? height : window.height; }
 };
 
 /// A RenderView from a named scene view (View::fov_deg unset: `default_fov_deg`).

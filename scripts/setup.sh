@@ -19,8 +19,9 @@ PACKAGES=(
   # viewer/ (the only code that links GL): window, GL loader, UI; headless tests through EGL
   # (libegl-mesa0: Mesa's software EGL device) and under Xvfb, with Mesa's llvmpipe (GL 4.5).
   libglfw3-dev libepoxy-dev libimgui-dev xvfb xauth libgl1-mesa-dri mesa-utils libegl1 libegl-mesa0
-  # OpenCV's core (cv::FileStorage): rig export read back by OpenCV itself (ctest rigio.*OpenCV*).
-  libopencv-core-dev
+  # OpenCV (validation/: fiducial prints with aruco, detection, calibration; cv::FileStorage reads
+  # the rig exports back in ctest rigio.*OpenCV*). contrib holds aruco in Debian 12's OpenCV 4.6.
+  libopencv-dev libopencv-contrib-dev
 )
 
 missing=()

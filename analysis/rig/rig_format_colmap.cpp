@@ -117,10 +117,12 @@ ColmapText RigToColmap(const Rig& rig) {
     const Vec3 t = cw.translation();
     out.images += id + " " + Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) + " " + Num(q.z()) +
                   " " + Num(t.x()) + " " + Num(t.y()) + " " + Num(t.z()) + " " + id + " " +
-                  PercentEncode(camera.id) + ".png\n\n";
+                  ColmapImageName(camera) + "\n\n";
   }
   return out;
 }
+
+std::string ColmapImageName(const Camera& camera) { return PercentEncode(camera.id) + ".png"; }
 
 namespace {
 

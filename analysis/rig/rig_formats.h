@@ -45,6 +45,9 @@ struct ColmapText {
 /// empty. COLMAP's principal point is Pandora's + 0.5 (COLMAP puts the centre of the top-left
 /// pixel at (0.5, 0.5), Pandora and OpenCV at (0, 0)).
 ColmapText RigToColmap(const Rig& rig);
+/// The image NAME RigToColmap gives `camera`: its id percent-encoded (letters, digits, - _ . kept)
+/// + ".png"; `pandora synth` names its images so.
+std::string ColmapImageName(const Camera& camera);
 
 /// Reads cameras.txt and images.txt of a COLMAP text model: one Pandora camera per image, its id
 /// the image NAME percent-decoded without its image extension. Camera models SIMPLE_PINHOLE,

@@ -447,8 +447,8 @@ void AddMeshObjects(const Node& node, const Node& geometry, const std::optional<
     object.solid = solid;
     object.material = material;
     if (material < 0 && part.has_material) {
-      object.material =
-          AddMaterial(scene, Material{name + "/" + part.material_name, part.color, part.texture});
+      object.material = AddMaterial(
+          scene, Material{name + "/" + part.material_name, part.color, part.texture, nullptr});
     }
     if (solid) all.Append(object.mesh);
     if (skin) {
@@ -499,10 +499,102 @@ TriangleMesh MakePrimitive(const std::string& kind, const Node& geometry, double
   return mesh;
 }
 
+// A "marker" or "board" object's fiducial (analysis/scene/fiducial.h), checked.
+Fiducial ReadFiducial(const std::string& kind, const Node& geometry, const std::string& name) {
+  Fiducial f;
+  f.name = name;
+  auto dictionary = [&](const char* fallback) {
+    const std::optional<Node> n = geometry.Find("dictionary");
+    f.dictionary = n ? n->NonEmptyString() : std::string(fallback);
+    const ArucoDictionaryInfo* d = FindArucoDictionary(f.dictionary);
+    if (!d)
+      (n ? *n : geometry)
+          .Fail("unknown ArUco dictionary " + Quoted(f.dictionary),
+                DidYouMean(f.dictionary, ArucoDictionaryNames(), "OpenCV's dictionaries"));
+    return d;
+  };
+  auto length = [&](const char* key, double fallback) {
+    const std::optional<Node> n = geometry.Find(key);
+    return n ? n->NonNegativeLength() : fallback;
+  };
+  if (kind == "marker") {
+    geometry.CheckKeys({"dictionary", "id", "size", "margin", "thickness"});
+    f.kind = Fiducial::Kind::kMarker;
+    const ArucoDictionaryInfo* d = dictionary("DICT_4X4_50");
+    const Node id = geometry.Get("id");
+    f.id = id.Integer(0, d->size - 1);
+    f.square_m = geometry.Get("size").PositiveLength();
+    f.margin_m = length("margin", f.square_m / (d->bits + 2));
+  } else {
+    geometry.CheckKeys(
+        {"type", "squares", "square", "marker", "dictionary", "first_id", "margin", "thickness"});
+    const std::string type = geometry.Get("type").Enum({"charuco", "checkerboard"});
+    f.kind = type == "charuco" ? Fiducial::Kind::kCharuco : Fiducial::Kind::kCheckerboard;
+    const Node squares = geometry.Get("squares");
+    if (squares.ArraySize("an array of 2 integers [x, y]") != 2)
+      squares.Fail("expected an array of 2 integers [x, y]");
+    f.squares_x = squares.At(0).Integer(2, 100);
+    f.squares_y = squares.At(1).Integer(2, 100);
+    f.square_m = geometry.Get("square").PositiveLength();
+    f.margin_m = length("margin", 0.5 * f.square_m);
+    if (f.kind == Fiducial::Kind::kCharuco) {
+      const ArucoDictionaryInfo* d = dictionary("DICT_4X4_50");
+      f.marker_m = length("marker", 0.75 * f.square_m);
+      if (!(f.marker_m > 0 && f.marker_m < f.square_m))
+        geometry.Get("marker").Fail("a ChArUco marker must be smaller than its square (" +
+                                    FormatNumber(f.square_m) + " m) and positive");
+      if (auto n = geometry.Find("first_id")) f.id = n->Integer(0, d->size - 1);
+      if (f.id + f.Markers() > d->size)
+        geometry.Fail("the board needs " + std::to_string(f.Markers()) + " markers from id " +
+                          std::to_string(f.id) + ", but " + f.dictionary + " has " +
+                          std::to_string(d->size),
+                      "use fewer squares, a lower first_id or a larger dictionary");
+    } else {
+      for (const char* key : {"marker", "dictionary", "first_id"})
+        if (geometry.Has(key))
+          geometry.Get(key).Fail(std::string("a checkerboard has no markers: '") + key +
+                                 "' is for \"type\": \"charuco\"");
+    }
+  }
+  f.thickness_m = length("thickness", 0.003);
+  f.margin_m = f.MarginTexels() / f.TexelsPerMetre();  // whole texels
+  int tw = 0, th = 0;
+  FiducialTextureSize(f, &tw, &th);
+  if (tw > 8192 || th > 8192)
+    geometry.Fail("its print would be " + std::to_string(tw) + " x " + std::to_string(th) +
+                      " texels (12 per marker cell), more than 8192",
+                  "use a smaller margin or larger markers");
+  return f;
+}
+
+// Adds a "marker" or "board" object: the sheet (analysis/scene/fiducial.h) placed by the object's
+// pose, its own white material for the print, and the fiducial. The group is set by the caller.
+void AddFiducialObject(const Node& node, const std::string& kind, const std::string& name,
+                       Scene* scene) {
+  for (const char* key : {"scale", "material", "color", "solid", "animation"})
+    if (node.Has(key))
+      node.Get(key).Fail(std::string("'") + key + "' does not apply to a printed " + kind,
+                         "its size and print are given in \"" + kind + "\"");
+  const Fiducial f = ReadFiducial(kind, node.Get(kind), name);
+  for (const Fiducial& other : scene->fiducials) {  // a detector could not tell them apart
+    if (f.kind == Fiducial::Kind::kCheckerboard || other.kind == Fiducial::Kind::kCheckerboard ||
+        f.dictionary != other.dictionary)
+      continue;
+    const int lo = std::max(f.id, other.id);
+    const int hi = std::min(f.id + f.Markers(), other.id + other.Markers());
+    if (lo < hi)
+      node.Get(kind).Fail("marker id " + std::to_string(lo) + " of " + f.dictionary +
+                              " is also printed on " + Quoted(other.name),
+                          "give each printed marker its own id");
+  }
+  AddFiducial(scene, f, ReadObjectTransform(node));
+  CheckObjectBounds(scene->objects.back().mesh, node);
+}
+
 void ReadObject(const Node& node, const std::map<std::string, int>& material_index,
                 std::set<std::string>* names, Scene* scene) {
-  const std::vector<std::string> geometry_keys = {"box",     "sphere", "cylinder",
-                                                  "capsule", "plane",  "mesh"};
+  const std::vector<std::string> geometry_keys = {"box",   "sphere", "cylinder", "capsule",
+                                                  "plane", "mesh",   "marker",   "board"};
   std::vector<std::string> allowed = {"name",  "position", "rotation_deg", "quaternion",
                                       "scale", "material", "color",        "solid",
                                       "group", "animation"};
@@ -529,6 +621,10 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     }
   } assign{scene, first_object, group};
 
+  if (kind == "marker" || kind == "board") {
+    AddFiducialObject(node, kind, name, scene);
+    return;
+  }
   const Eigen::Affine3d world_from_object = ReadObjectTransform(node);
 
   bool solid = false;

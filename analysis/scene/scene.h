@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
@@ -14,10 +15,19 @@
 #include "analysis/geometry/geometry.h"
 #include "analysis/geometry/uncertainty.h"
 #include "analysis/scene/calibration_spec.h"
+#include "analysis/scene/fiducial.h"
 #include "analysis/scene/motion.h"
 #include "analysis/scene/skinning.h"
 
 namespace pandora {
+
+/// A printed pattern's pixels (a fiducial's print, analysis/scene/fiducial.h): grey levels, 0 ink
+/// to 255 paper, row 0 at the top seen from the printed side. Taken as reflectance (255 = the
+/// material's colour).
+struct PrintedPattern {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> grey;
+};
 
 /// Surface appearance, kept for rendering.
 struct Material {
@@ -26,6 +36,9 @@ struct Material {
   /// Path of a diffuse texture (resolved against the scene file's folder, or the mesh file's folder
   /// for materials read from mesh files), empty when none.
   std::string texture;
+  /// A fiducial's print (validation/print.h fills it; null until then: the sheet shows `color`).
+  /// Takes the place of `texture`.
+  std::shared_ptr<const PrintedPattern> printed;
 };
 
 /// One object of the scene after its instance transform: world coordinates, metres.
@@ -226,6 +239,8 @@ struct Scene {
   std::map<std::string, ViewingStation> stations;  ///< Viewing stations, by name.
   /// Moving groups ("motions"), in file order; empty for a static scene.
   std::vector<ObjectMotion> motions;
+  /// Printed fiducials ("marker" and "board" objects), in object order; empty when none.
+  std::vector<Fiducial> fiducials;
   /// Objects that play a skinned animation ("animation" on a mesh object), in object order; empty
   /// when none. Their meshes in `objects` are the rest pose (analysis/scene/skinning.h).
   std::vector<SkinnedObject> skins;

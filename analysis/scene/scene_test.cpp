@@ -374,6 +374,91 @@ TEST(SceneObjectsTest, MaterialsAndColorShortcut) {
   EXPECT_EQ(s.objects[2].material, -1);
 }
 
+// A marker and a ChArUco board: their sheets are placed by pose (front +z of the pattern frame,
+// a plain back 3 mm behind), every corner lies on the sheet where FiducialCorners says, the margin
+// snaps to whole print texels, and a moving group takes them along.
+TEST(SceneFiducialsTest, MarkersAndBoardsArePlacedSheets) {
+  json scene = BaseScene();
+  scene["units"] = "cm";
+  scene["objects"] = json::parse(R"([
+    {"name": "m7", "marker": {"id": 7, "size": 15}, "position": [0, 0, 100],
+     "rotation_deg": [90, 0, 0], "group": "wand"},
+    {"name": "board", "board": {"type": "charuco", "squares": [5, 4], "square": 10,
+     "dictionary": "DICT_5X5_100", "first_id": 3}, "position": [50, 0, 100]},
+    {"name": "check", "board": {"type": "checkerboard", "squares": [9, 6], "square": 3,
+     "margin": 0}, "position": [-50, 0, 100]}
+  ])");
+  scene["rigs"][0]["cameras"][0]["position"] = json::array({0, -100, 100});
+  scene["rigs"][0]["cameras"][0]["look_at"] = json::array({0, 0, 100});
+  const Scene s = Parse(scene);
+  ASSERT_EQ(s.fiducials.size(), 3u);
+  const Fiducial& m = s.fiducials[0];
+  EXPECT_EQ(m.kind, Fiducial::Kind::kMarker);
+  EXPECT_EQ(m.dictionary, "DICT_4X4_50");
+  EXPECT_EQ(m.id, 7);
+  EXPECT_NEAR(m.square_m, 0.15, 1e-12);
+  EXPECT_EQ(s.objects[m.object].group, "wand");
+  EXPECT_EQ(s.objects[m.object].mesh.triangles.size(), 4u);
+  // Default margin one marker cell (2.5 cm), snapped to the print's 72 / 0.15 m texels: 12.
+  EXPECT_EQ(m.MarginTexels(), 12);
+  EXPECT_NEAR(m.margin_m, 0.025, 1e-12);
+  // Turned 90 degrees about x: the print faces -y (the camera), its y axis is world +z.
+  ExpectVecNear(FiducialNormal(s, m), Vec3(0, -1, 0), 1e-12);
+  const std::vector<FiducialCorner> corners = FiducialCorners(m);
+  ASSERT_EQ(corners.size(), 4u);
+  EXPECT_EQ(corners[0].id, 28);  // 4 x id + k, top-left first
+  ExpectVecNear(FiducialPoint(s, m, corners[0].xy), Vec3(-0.075, 0, 1.075), 1e-12);
+  ExpectVecNear(FiducialPoint(s, m, corners[2].xy), Vec3(0.075, 0, 0.925), 1e-12);
+
+  const Fiducial& b = s.fiducials[1];
+  EXPECT_EQ(b.Markers(), 10);
+  EXPECT_NEAR(b.marker_m, 0.075, 1e-12);  // default 0.75 of the square
+  EXPECT_EQ(s.materials[b.material].name, "board (print)");
+  const std::vector<FiducialCorner> inner = FiducialCorners(b);
+  ASSERT_EQ(inner.size(), 12u);  // 4 x 3 inner corners, id 0 top-left
+  EXPECT_EQ(inner[0].id, 0);
+  ExpectVecNear(FiducialPoint(s, b, inner[0].xy), Vec3(0.5 - 0.15, 0.1, 1.0), 1e-12);
+  const Fiducial& c = s.fiducials[2];
+  EXPECT_EQ(c.MarginTexels(), 0);
+  EXPECT_EQ(FiducialCorners(c).size(), 40u);
+  int tw = 0, th = 0;
+  FiducialTextureSize(c, &tw, &th);
+  EXPECT_EQ(tw, 9 * 24 + 2);
+  EXPECT_EQ(th, 6 * 24 + 2);
+}
+
+TEST(SceneFiducialsTest, BadFiducialsNameTheField) {
+  auto with = [](const char* objects) {
+    json scene = BaseScene();
+    scene["objects"] = json::parse(objects);
+    return scene;
+  };
+  EXPECT_INPUT_ERROR(
+      ErrorFor(with(
+          R"([{"name": "m", "marker": {"dictionary": "DICT_4X4_55", "id": 1, "size": 0.1}}])")),
+      "$.objects[0].marker.dictionary", "unknown ArUco dictionary");
+  EXPECT_INPUT_ERROR(ErrorFor(with(R"([{"name": "m", "marker": {"id": 50, "size": 0.1}}])")),
+                     "$.objects[0].marker.id", "");
+  EXPECT_INPUT_ERROR(ErrorFor(with(R"([{"name": "a", "marker": {"id": 4, "size": 0.1}},
+                        {"name": "b", "board": {"type": "charuco", "squares": [4, 3],
+                         "square": 0.1}}])")),
+                     "$.objects[1].board", "marker id 4 of DICT_4X4_50 is also printed on 'a'");
+  EXPECT_INPUT_ERROR(
+      ErrorFor(with(R"([{"name": "m", "marker": {"id": 1, "size": 0.1}, "scale": [2, 2, 2]}])")),
+      "$.objects[0].scale", "does not apply to a printed marker");
+  EXPECT_INPUT_ERROR(
+      ErrorFor(with(R"([{"name": "b", "board": {"type": "checkerboard", "squares": [4, 3],
+                         "square": 0.1, "marker": 0.05}}])")),
+      "$.objects[0].board.marker", "a checkerboard has no markers");
+  EXPECT_INPUT_ERROR(ErrorFor(with(R"([{"name": "b", "board": {"type": "charuco", "squares": [4, 3],
+                         "square": 0.1, "marker": 0.1}}])")),
+                     "$.objects[0].board.marker", "smaller than its square");
+  EXPECT_INPUT_ERROR(
+      ErrorFor(with(R"([{"name": "b", "board": {"type": "charuco", "squares": [40, 40],
+                         "square": 0.1, "dictionary": "DICT_4X4_1000", "first_id": 900}}])")),
+      "$.objects[0].board", "needs 800 markers from id 900");
+}
+
 TEST(SceneUnitsTest, EveryLengthIsScaled) {
   json scene = BaseScene();
   scene["units"] = "cm";

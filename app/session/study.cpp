@@ -6,6 +6,7 @@
 
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
+#include "validation/print.h"
 
 namespace pandora::session {
 
@@ -15,6 +16,7 @@ std::shared_ptr<const Study> Study::Load(const std::string& path,
   // Read once: the parsed scene and the kept text are the same bytes (scene_.sha256 is theirs).
   study->text_ = ReadInputFile(path, InputLimits::kJsonBytes, "scene file");
   study->scene_ = ParseScene(study->text_, path);
+  PrintFiducials(&study->scene_);  // the markers' and boards' pixels, OpenCV's own
 #if defined(__GLIBC__)
   // The mesh importers (assimp) free most of what they allocated; glibc keeps it resident unless
   // asked. A 1,002,252-triangle OBJ: 434 MiB resident after its import, 71 MiB after this, for the
@@ -30,6 +32,7 @@ std::shared_ptr<const Study> Study::Load(const std::string& path,
 std::shared_ptr<const Study> Study::FromScene(Scene scene, std::string text) {
   auto study = std::shared_ptr<Study>(new Study());
   study->scene_ = std::move(scene);
+  PrintFiducials(&study->scene_);
   study->text_ = std::move(text);
   study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
   study->solid_trees_ = std::make_unique<SolidTrees>(study->scene_);

@@ -20,8 +20,8 @@ namespace pandora::testing {
 inline Scene LensRoom() {
   Scene scene = BoxRoom(Vec3(6, 6, 3));
   scene.path = "lens_room";
-  scene.materials.push_back(Material{"grey", Vec3(0.7, 0.7, 0.7), ""});
-  scene.materials.push_back(Material{"warm", Vec3(0.8, 0.6, 0.4), ""});
+  scene.materials.push_back(Material{"grey", Vec3(0.7, 0.7, 0.7), "", nullptr});
+  scene.materials.push_back(Material{"warm", Vec3(0.8, 0.6, 0.4), "", nullptr});
   for (SceneObject& o : scene.objects) o.material = 0;
   SceneObject box = TestObject("box", MakeBox(Vec3(0.8, 0.6, 1.0)), Vec3(0.3, -0.2, 0.5), true);
   box.material = 1;
