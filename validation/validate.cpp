@@ -112,6 +112,8 @@ bool NeighbourhoodHidden(const Scene& s, const Fiducial& f, const Vec2& xy,
   return false;
 }
 
+constexpr double kViewOutlier = 5.0;
+
 struct Observation {
   int pose, camera, id;
   Vec2 found, truth;
@@ -156,6 +158,21 @@ ViewDetections RunView(const Scene& s, const PreparedScene& prepared, const Rig&
     v.truth.push_back(it->second - Vec2(window.x, window.y));
   }
   if (v.inliers.size() >= 6) {
+    // The view's robust noise (1.4826 x the median absolute coordinate residual); a detection
+    // beyond kViewOutlier of it (and 0.05 px) is a misdetection, as a pipeline's reprojection check
+    // would reject it; the view's noise is the RMS of the rest.
+    std::vector<double> coordinates;
+    for (const Observation& ob : v.inliers) {
+      coordinates.push_back(std::abs(ob.found.x() - ob.truth.x()));
+      coordinates.push_back(std::abs(ob.found.y() - ob.truth.y()));
+    }
+    const double robust = 1.4826 * Median(coordinates);
+    const double limit = std::max(kViewOutlier * robust, 0.05);
+    std::vector<Observation> kept;
+    for (const Observation& ob : v.inliers)
+      if ((ob.found - ob.truth).norm() <= limit) kept.push_back(ob);
+    v.misdetected += static_cast<std::int64_t>(v.inliers.size() - kept.size());
+    v.inliers = std::move(kept);
     double sum2 = 0;
     for (const Observation& ob : v.inliers) sum2 += (ob.found - ob.truth).squaredNorm();
     const double sigma = std::sqrt(sum2 / (2.0 * v.inliers.size()));
@@ -450,6 +467,17 @@ ValidateResult RunValidation(const Scene& scene, const Rig& rig, const ValidateO
     r.mean_residual /= static_cast<double>(observations.size());
   }
 
+  // Views of fewer than 6 corners cannot tell their own noise: they share the RMS of theirs
+  // pooled (mostly partly hidden or small boards, noisier than the rest).
+  double small_sum2 = 0;
+  std::size_t small = 0;
+  for (const Observation& ob : observations)
+    if (!(ob.view_sigma > 0)) small_sum2 += (ob.found - ob.truth).squaredNorm(), ++small;
+  if (small >= 6) {
+    r.small_view_sigma = std::sqrt(small_sum2 / (2.0 * small));
+    for (Observation& ob : observations)
+      if (!(ob.view_sigma > 0)) ob.view_sigma = r.small_view_sigma;
+  }
   r.points = TriangulateAndPredict(rig, observations, poses, corner_xy, r.sigma_px);
   BinValidatedPoints(&r, o.min_bin);
   r.total_seconds = Since(start);

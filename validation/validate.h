@@ -90,8 +90,11 @@ struct ValidateResult {
   std::int64_t misdetected = 0;  ///< Detections farther than outlier_px from the truth.
   double sigma_px = 0;           ///< RMS per coordinate of the detections' residuals.
   /// Per view (pose, camera) used: the RMS per coordinate of its residuals, the pixel noise of its
-  /// detections in the prediction (sigma_px for a view of fewer than 6 detections).
+  /// detections in the prediction (for a view of fewer than 6 detections: small_view_sigma).
   std::vector<double> view_sigma;
+  /// The pooled RMS of the detections in views of fewer than 6 (their noise in the prediction;
+  /// 0 when fewer than 6 such detections: sigma_px then).
+  double small_view_sigma = 0;
   Vec2 mean_residual = Vec2::Zero();  ///< Their mean (a detector's bias), pixels.
   std::vector<ValidatedPoint> points;
   std::vector<ValidateBin> sigma_bins;  ///< By predicted sigma_max, equal counts.

@@ -290,7 +290,7 @@ TEST(Validation, SmallRigMatchesThePrediction) {
         b.ratio_one_sigma[1], b.ratio_one_sigma[2], b.skew_major, b.median_angle_deg);
   EXPECT_EQ(r.poses, 30);
   EXPECT_GT(r.detected, 0.8 * r.expected);
-  EXPECT_LT(r.misdetected, 0.02 * r.expected + 2);
+  EXPECT_LT(r.misdetected, 0.05 * r.expected);  // beyond 5 robust sigma of their view
   EXPECT_GT(r.sigma_px, 0.01);
   EXPECT_LT(r.sigma_px, 0.5);
   EXPECT_LT(r.mean_residual.norm(), 0.05);  // no half-pixel bias left
