@@ -302,12 +302,12 @@ void CheckView(const RenderView& view, const Rig& rig) {
     throw InputError("{size}", "", "the image size must be positive");
   if (view.camera >= int(rig.cameras.size()))
     throw InputError("{camera}", "", "no camera " + std::to_string(view.camera) + " in the rig");
-  if (!view.window.empty()) {
+  if (!view.window.empty()) {  // set by code (pandora synth), never by a user: a caller's bug
     const RenderView::Window& w = view.window;
     if (view.camera < 0)
-      throw InputError("{window}", "", "a window is for a camera's-eye view only");
+      throw std::invalid_argument("Render: a window is for a camera's-eye view only");
     if (w.x < 0 || w.y < 0 || w.x + w.width > view.width || w.y + w.height > view.height)
-      throw InputError("{window}", "", "the window must lie inside the image");
+      throw std::invalid_argument("Render: the window must lie inside the image");
   }
   if (view.camera < 0) {
     if (!(view.fov_deg > 0 && view.fov_deg < 180))
