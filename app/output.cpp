@@ -8,7 +8,9 @@
 #include <cstdlib>
 
 #include "analysis/util/error.h"
+#include "analysis/util/text.h"
 #include "app/commands.h"
+#include "validation/print.h"
 
 namespace pandora::app {
 
@@ -70,6 +72,35 @@ std::shared_ptr<const session::Study> LoadStudyWithVoxelSize(const std::string& 
     if (!std::isnan(voxel_size))
       scene.study.voxel_size = CheckPositiveOption("--voxel-size", voxel_size, "metres");
   });
+}
+
+Scene LoadSceneAtSample(const std::string& path, int time_sample, std::string* label) {
+  Scene scene = LoadScene(path);
+  if (scene.Animated()) {
+    const std::vector<TimeSample> samples = scene.TimeSamples();
+    const int k = time_sample < 0 ? 0 : time_sample;
+    if (k >= static_cast<int>(samples.size()))
+      throw InputError(
+          "--time-sample", "",
+          Format("the scene has %zu time samples (0 to %zu)", samples.size(), samples.size() - 1));
+    if (label) *label = samples[k].label;
+    Scene at = SceneAtSample(scene, samples[k]);
+    at.path = scene.path;
+    at.sha256 = scene.sha256;
+    scene = std::move(at);
+  } else if (time_sample > 0) {
+    throw InputError("--time-sample", "", "the scene does not move: it has one time (0)");
+  }
+  PrintFiducials(&scene);
+  return scene;
+}
+
+const Rig& FindRigOption(const Scene& scene, const std::string& name) {
+  try {
+    return scene.FindRig(name);
+  } catch (const InputError& e) {
+    throw InputError("--rig", "", e.reason(), e.hint());
+  }
 }
 
 void AddSceneInputs(OutputTransaction& transaction, const Scene& scene) {

@@ -23,6 +23,14 @@ namespace pandora::app {
 std::shared_ptr<const session::Study> LoadStudyWithVoxelSize(const std::string& scene_path,
                                                              double voxel_size);
 
+/// `pandora synth` and `validate`: the scene file at time sample `time_sample` (-1: the first of an
+/// animated scene; a static scene has only 0) with its fiducials printed; `label` (if given)
+/// receives the sample's label (empty for a static scene). InputError naming --time-sample.
+Scene LoadSceneAtSample(const std::string& path, int time_sample, std::string* label = nullptr);
+
+/// scene.FindRig(name), an unknown name blamed on --rig.
+const Rig& FindRigOption(const Scene& scene, const std::string& name);
+
 /// Registers every file `scene` was read from (Scene::InputFiles) as an input of `transaction`, so
 /// that no output replaces the scene file, a mesh file or a texture.
 void AddSceneInputs(OutputTransaction& transaction, const Scene& scene);

@@ -25,13 +25,7 @@ int RunExportRig(const ExportRigArgs& args) {
   LoadOptions load;
   load.load_meshes = f == "gltf";
   const Scene scene = LoadScene(args.scene, load);
-  const Rig& rig = [&]() -> const Rig& {
-    try {
-      return scene.FindRig(args.rig);
-    } catch (const InputError& e) {
-      throw InputError("--rig", "", e.reason(), e.hint());
-    }
-  }();
+  const Rig& rig = FindRigOption(scene, args.rig);
   OutputTransaction output;
   AddSceneInputs(output, scene);
   std::vector<std::string> written;

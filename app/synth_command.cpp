@@ -19,7 +19,6 @@
 #include "app/output.h"
 #include "render/prepared_scene.h"
 #include "render/render.h"
-#include "validation/print.h"
 #include "validation/synth.h"
 
 namespace pandora::app {
@@ -32,29 +31,6 @@ struct SynthArgs {
   int time_sample = -1;  ///< -1: the first of an animated scene.
   bool quiet = false;
 };
-
-// The scene at the chosen time sample (an animated scene's first by default), with its fiducials
-// printed; `label` receives the sample's label (empty for a static scene).
-Scene SceneForSynth(const std::string& path, int time_sample, std::string* label) {
-  Scene scene = LoadScene(path);
-  if (scene.Animated()) {
-    const std::vector<TimeSample> samples = scene.TimeSamples();
-    const int k = time_sample < 0 ? 0 : time_sample;
-    if (k >= static_cast<int>(samples.size()))
-      throw InputError(
-          "--time-sample", "",
-          Format("the scene has %zu time samples (0 to %zu)", samples.size(), samples.size() - 1));
-    *label = samples[k].label;
-    Scene at = SceneAtSample(scene, samples[k]);
-    at.path = scene.path;
-    at.sha256 = scene.sha256;
-    scene = std::move(at);
-  } else if (time_sample > 0) {
-    throw InputError("--time-sample", "", "the scene does not move: it has one time (0)");
-  }
-  PrintFiducials(&scene);
-  return scene;
-}
 
 std::vector<int> ChosenCameras(const Rig& rig, const std::vector<std::string>& ids) {
   std::vector<int> chosen;
@@ -91,14 +67,8 @@ int RunSynth(const SynthArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   args.synth.Check();
   std::string label;
-  const Scene scene = SceneForSynth(args.scene, args.time_sample, &label);
-  const Rig& rig = [&]() -> const Rig& {
-    try {
-      return scene.FindRig(args.rig);
-    } catch (const InputError& e) {
-      throw InputError("--rig", "", e.reason(), e.hint());
-    }
-  }();
+  const Scene scene = LoadSceneAtSample(args.scene, args.time_sample, &label);
+  const Rig& rig = FindRigOption(scene, args.rig);
   const std::vector<int> cameras = ChosenCameras(rig, args.cameras);
   if (cameras.empty()) throw InputError("--rig", "", "rig " + rig.name + " has no enabled camera");
   OutputTransaction output;

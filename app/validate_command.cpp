@@ -195,27 +195,8 @@ std::string Markdown(const ValidateArgs& args, const Rig& rig, const ValidateRes
 
 int RunValidate(const ValidateArgs& args) {
   args.options.Check();
-  Scene scene = LoadScene(args.scene);
-  if (scene.Animated()) {
-    const std::vector<TimeSample> samples = scene.TimeSamples();
-    const int k = std::max(0, args.time_sample);
-    if (k >= static_cast<int>(samples.size()))
-      throw InputError("--time-sample", "",
-                       Format("the scene has %zu time samples", samples.size()));
-    Scene at = SceneAtSample(scene, samples[k]);
-    at.path = scene.path;
-    at.sha256 = scene.sha256;
-    scene = std::move(at);
-  } else if (args.time_sample > 0) {
-    throw InputError("--time-sample", "", "the scene does not move: it has one time (0)");
-  }
-  const Rig& rig = [&]() -> const Rig& {
-    try {
-      return scene.FindRig(args.rig);
-    } catch (const InputError& e) {
-      throw InputError("--rig", "", e.reason(), e.hint());
-    }
-  }();
+  const Scene scene = LoadSceneAtSample(args.scene, args.time_sample);
+  const Rig& rig = FindRigOption(scene, args.rig);
   OutputTransaction output;
   AddSceneInputs(output, scene);
   const std::filesystem::path dir(args.out);

@@ -225,19 +225,23 @@ double PowerLawCrossing(const std::vector<double>& x, const std::vector<double>&
   return b < 0 ? std::exp(mx + (std::log(y_target) - my) / b) : kNaN;
 }
 
+std::string OwnPixelSigmaNote(const Rig& rig, double sigma_px) {
+  for (const Camera& c : rig.cameras)
+    if (c.enabled && c.pixel_sigma > 0 && c.pixel_sigma != sigma_px)
+      return Format(
+          "camera %s sets its own pixel_sigma; here every camera uses the study's %.3g px",
+          c.id.c_str(), sigma_px);
+  return {};
+}
+
 MonteCarloStudy RunMonteCarloStudy(const Scene& scene, const Rig& rig, const RayCaster& caster,
                                    const AccuracyOptions& options) {
   options.Check();
   MonteCarloStudy study;
   study.sigma_px = scene.study.pixel_sigma;
   study.points = SamplePoints(scene, rig, caster, static_cast<std::size_t>(options.sample_points));
-  for (const Camera& c : rig.cameras)
-    if (c.enabled && c.pixel_sigma > 0 && c.pixel_sigma != study.sigma_px) {
-      study.notes.push_back(
-          Format("camera %s sets its own pixel_sigma; here every camera uses the study's %.3g px",
-                 c.id.c_str(), study.sigma_px));
-      break;
-    }
+  if (std::string note = OwnPixelSigmaNote(rig, study.sigma_px); !note.empty())
+    study.notes.push_back(note);
   for (SamplePoint& p : study.points) {
     const StaticUncertainty u = PredictUncertainty(p, study.sigma_px, &p.info);
     p.sigma_max = u.sigma_max;

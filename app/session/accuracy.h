@@ -115,6 +115,10 @@ std::vector<SamplePoint> SamplePoints(const Scene& scene, const Rig& rig, const 
 StaticUncertainty PredictUncertainty(const SamplePoint& point, double sigma_px,
                                      Information* info = nullptr);
 
+/// The note the Monte Carlo studies add when an enabled camera of `rig` sets its own pixel sigma
+/// (they use the study's `sigma_px` for every camera); empty when none does.
+std::string OwnPixelSigmaNote(const Rig& rig, double sigma_px);
+
 /// One trial count over every sample point.
 struct MonteCarloRow {
   int trials = 0, points = 0, failures = 0;

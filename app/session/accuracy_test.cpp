@@ -255,7 +255,9 @@ TEST(GateStudy, NarrowBaselineMatchesThePredictionAxisByAxis) {
       const double index = (v.X[a] - box.min[a]) / scene.study.voxel_size - 0.5;
       EXPECT_NEAR(index, std::round(index), 1e-9);
       EXPECT_NEAR(v.Ratio(a), 1.0, kGateEigenTolerance[a]) << a;
-      if (std::isfinite(v.axis_deg[a])) EXPECT_LE(v.axis_deg[a], kGateAngleDeg);
+      if (std::isfinite(v.axis_deg[a])) {
+        EXPECT_LE(v.axis_deg[a], kGateAngleDeg);
+      }
     }
     resolvable_major += std::isfinite(v.axis_deg[0]) ? 1 : 0;
     EXPECT_GT(v.predicted[0], 10 * v.predicted[1]);  // depth: long

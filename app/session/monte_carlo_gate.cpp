@@ -140,13 +140,8 @@ GateStudy RunGateStudy(const Scene& scene, const Rig& rig, const RayCaster& cast
     study.voxels.push_back(v);
   }
   study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const Camera& c : rig.cameras)
-    if (c.enabled && c.pixel_sigma > 0 && c.pixel_sigma != study.sigma_px) {
-      study.notes.push_back(
-          Format("camera %s sets its own pixel_sigma; here every camera uses the study's %.3g px",
-                 c.id.c_str(), study.sigma_px));
-      break;
-    }
+  if (std::string note = OwnPixelSigmaNote(rig, study.sigma_px); !note.empty())
+    study.notes.push_back(note);
   return study;
 }
 
