@@ -20,6 +20,7 @@
 #include "app/output.h"
 #include "app/report/plot.h"
 #include "app/report/table.h"
+#include "app/validate_calibration.h"
 #include "render/render.h"
 #include "validation/validate.h"
 
@@ -32,6 +33,9 @@ struct ValidateArgs {
   int time_sample = -1;
   double tolerance = 0.25;  ///< The verdict: every bin's ratios within this of 1.
   bool quiet = false;
+  bool calibration = false;  ///< The calibration study instead (validate_calibration.h).
+  bool poses_given = false, squares_given = false;
+  bool partial_views = false;  ///< --partial-views (calibration only).
 };
 
 report::Table BinTable(const std::vector<ValidateBin>& bins, const char* first) {
@@ -193,7 +197,24 @@ std::string Markdown(const ValidateArgs& args, const Rig& rig, const ValidateRes
   return md;
 }
 
+// The calibration study with the options given (its own defaults for --poses and --squares).
+int RunCalibration(const ValidateArgs& args) {
+  CalibrateOptions o;
+  if (args.poses_given) o.poses = args.options.poses;
+  if (args.squares_given)
+    o.squares_x = args.options.squares_x, o.squares_y = args.options.squares_y;
+  o.seed = args.options.seed;
+  o.square_m = args.options.square_m;
+  o.synth = args.options.synth;
+  o.partial_views = args.partial_views;
+  o.Check();
+  const Scene scene = LoadSceneAtSample(args.scene, args.time_sample);
+  const Rig& rig = FindRigOption(scene, args.rig);
+  return RunValidateCalibration(args.scene, scene, rig, o, args.out, args.quiet);
+}
+
 int RunValidate(const ValidateArgs& args) {
+  if (args.calibration) return RunCalibration(args);
   args.options.Check();
   const Scene scene = LoadSceneAtSample(args.scene, args.time_sample);
   const Rig& rig = FindRigOption(scene, args.rig);
@@ -234,8 +255,20 @@ Command AddValidateCommand(CLI::App& app, CommonOptions& common) {
   cmd->add_option("scene", a.scene, "Scene file (JSON)")->required();
   cmd->add_option("--rig", a.rig, "Rig name (default: the first rig)");
   cmd->add_option("--out", a.out, "Output folder")->capture_default_str();
-  cmd->add_option("--poses", a.options.poses, "Board poses")
-      ->capture_default_str()
+  cmd->add_flag("--calibration", a.calibration,
+                "Calibrate the rig end to end from the synthetic board views (OpenCV per camera, "
+                "a Ceres bundle adjustment of the rig) and compare with the truth and with "
+                "Pandora's feasibility verdict");
+  cmd->add_flag("--partial-views", a.partial_views,
+                "With --calibration: use partly hidden boards too (ChArUco), not only the views "
+                "the feasibility simulation counts");
+  cmd->add_option_function<int>(
+         "--poses",
+         [&a](int poses) {
+           a.options.poses = poses;
+           a.poses_given = true;
+         },
+         "Board poses (default 60; 200 with --calibration)")
       ->check(Number(1, 100000, "poses", true));
   cmd->add_option("--square", a.options.square_m,
                   "Board square, metres (default: sized from the rig's distances and focal "
@@ -248,8 +281,10 @@ Command AddValidateCommand(CLI::App& app, CommonOptions& common) {
              throw CLI::ValidationError("--squares", "give two numbers of squares, e.g. 5,4");
            a.options.squares_x = v[0];
            a.options.squares_y = v[1];
+           a.squares_given = true;
          },
-         "Board squares across and up (3 to 20 each; default 5,4)")
+         "Board squares across and up (3 to 20 each; default 5,4; with --calibration 7,5 "
+         "unless the study names its board)")
       ->delimiter(',')
       ->check(Number(3, 20, "squares", true));
   cmd->add_option("--seed", a.options.seed, "Seed of the poses and the noise")

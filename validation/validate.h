@@ -16,6 +16,7 @@
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/scene/scene.h"
+#include "validation/board_capture.h"
 #include "validation/synth.h"
 
 namespace pandora {
@@ -102,12 +103,9 @@ struct ValidateResult {
   ValidateBin all;
   double render_seconds = 0, detect_seconds = 0, total_seconds = 0;
   std::vector<std::string> notes;
-  /// Detections of one view for a picture: pose, camera, the window's image, found and truth.
-  struct Sample {
-    int pose = -1, camera = -1;
-    SynthImage image;
-    std::vector<Vec2> found, truth;
-  } sample;
+  /// Detections of one view for a picture (the view with the most).
+  using Sample = BoardViewSample;
+  Sample sample;
 };
 
 /// Runs the study on `rig` in `scene` (the scene at one time sample: static). `progress` (may be

@@ -17,6 +17,7 @@
 #include "analysis/util/error.h"
 #include "render/prepared_scene.h"
 #include "tests/fixtures.h"
+#include "validation/calibrate.h"
 #include "validation/detect.h"
 #include "validation/print.h"
 #include "validation/synth.h"
@@ -302,6 +303,73 @@ TEST(Validation, SmallRigMatchesThePrediction) {
     EXPECT_GE(p.cameras.size(), 2u);
     EXPECT_LT((p.estimate - p.truth).norm(), 0.01);  // millimetres, not centimetres
   }
+}
+
+// Calibration end to end: four cameras on an arc and a fifth facing them from the far side of the
+// region. The board is printed on one side, so the fifth camera sees only boards turned away from
+// the arc: it calibrates its own intrinsics but shares no view with the others. Pandora's
+// simulation calls it uncalibratable and the end-to-end calibration cannot place it. The arc is
+// calibrated within the bounds docs/validation.md states: OpenCV's per-camera focal length and
+// principal point within 4 of its own standard deviations; after the bundle adjustment focal
+// lengths within 0.1 %, principal points within 1 px, the calibrated cameras' pixels of the board
+// corners they saw within 1 px RMS of the true cameras', poses within 0.1 degree and 3 mm (a
+// 0.06 px detection noise over 2.2 m through a 693 px focal length).
+TEST(Validation, CalibrationEndToEndFollowsTheVerdict) {
+  Scene scene = testing::BoxRoom(Vec3(6, 6, 3), 0.1, Vec3(-0.6, -0.6, 0.6), Vec3(0.6, 0.6, 1.6));
+  Rig rig;
+  rig.name = "arc and opposite";
+  for (int i = 0; i < 4; ++i) {
+    const double a = (-40.0 + 80.0 / 3 * i) * kPi / 180.0;
+    rig.cameras.push_back(testing::TestCamera("c" + std::to_string(i),
+                                              Vec3(-2.2 * std::cos(a), 2.2 * std::sin(a), 1.7),
+                                              Vec3(0, 0, 1.1), 60, 800, 600));
+  }
+  rig.cameras.push_back(
+      testing::TestCamera("far", Vec3(2.2, 0.1, 1.7), Vec3(0, 0, 1.1), 60, 800, 600));
+  scene.rigs.push_back(rig);
+  CalibrateOptions options;
+  options.poses = 60;
+  options.synth.samples = 2;
+  const CalibrationStudy s = RunCalibrationStudy(scene, scene.rigs[0], options);
+  std::printf("board %s; %d poses, %lld views, %zu detections; BA %.4f px, %d iterations; %.1f s\n",
+              s.board.c_str(), s.capture.poses, (long long)s.capture.views,
+              s.capture.observations.size(), s.ba_rms_px, s.ba_iterations, s.total_seconds);
+  for (const CameraCalibration& c : s.cameras)
+    std::printf(
+        "  %s: %d views, predicted %lld poses link %lld %s; %s; OpenCV fx %+.3f (sd %.3f) cx "
+        "%+.3f (sd %.3f); final fx %+.3f (sd %.3f) fy %+.3f cx %+.3f (sd %.3f) cy %+.3f; map "
+        "%.3f/%.3f footprint %.3f world %.3f px; %.4f deg (sd %.4f) %.2f mm (sd %.2f)\n",
+        c.id.c_str(), c.views, (long long)c.predicted_observed, (long long)c.link_strength,
+        c.predicted_calibratable ? "calibratable" : "uncalibratable", c.status.c_str(),
+        c.opencv.fx - c.truth.fx, c.opencv_std_fx, c.opencv.cx - c.truth.cx, c.opencv_std_cx,
+        c.final.fx - c.truth.fx, c.std_fx, c.final.fy - c.truth.fy, c.final.cx - c.truth.cx,
+        c.std_cx, c.final.cy - c.truth.cy, c.map_rms_px, c.map_max_px, c.map_footprint_rms_px,
+        c.world_rms_px, c.rotation_error_deg, c.rotation_sd_deg, c.position_error_mm,
+        c.position_sd_mm);
+  ASSERT_EQ(s.cameras.size(), 5u);
+  EXPECT_TRUE(s.verdict_holds);
+  const CameraCalibration& far = s.cameras[4];
+  EXPECT_FALSE(far.predicted_calibratable);
+  EXPECT_FALSE(far.linked);
+  EXPECT_EQ(far.status, "not linked to the rig");
+  EXPECT_TRUE(far.intrinsics_ok);  // its own views calibrate its lens
+  for (int c = 0; c < 4; ++c) {
+    const CameraCalibration& k = s.cameras[c];
+    SCOPED_TRACE(k.id);
+    EXPECT_TRUE(k.predicted_calibratable);
+    ASSERT_TRUE(k.calibrated) << k.status;
+    ASSERT_GT(k.opencv_std_fx, 0);
+    EXPECT_LT(std::abs(k.opencv.fx - k.truth.fx), 4 * k.opencv_std_fx);
+    EXPECT_LT(std::abs(k.opencv.cx - k.truth.cx), 4 * k.opencv_std_cx);
+    EXPECT_LT(std::abs(k.final.fx - k.truth.fx), 1e-3 * k.truth.fx);
+    EXPECT_LT(std::abs(k.final.fy - k.truth.fy), 1e-3 * k.truth.fy);
+    EXPECT_LT(std::abs(k.final.cx - k.truth.cx), 1.0);
+    EXPECT_LT(std::abs(k.final.cy - k.truth.cy), 1.0);
+    EXPECT_LT(k.world_rms_px, 1.0);
+    EXPECT_LT(k.rotation_error_deg, 0.1);
+    EXPECT_LT(k.position_error_mm, 3.0);
+  }
+  EXPECT_LT(s.ba_rms_px, 0.5);
 }
 
 }  // namespace
