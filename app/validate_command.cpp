@@ -94,6 +94,18 @@ std::string PointsCsv(const ValidateResult& r) {
                          rows);
 }
 
+std::string DetectionsCsv(const Rig& rig, const ValidateResult& r) {
+  std::vector<std::vector<std::string>> rows;
+  for (const BoardObservation& ob : r.observations)
+    rows.push_back({std::to_string(ob.pose), rig.cameras[ob.camera].id, std::to_string(ob.id),
+                    report::CsvNumber(ob.found.x()), report::CsvNumber(ob.found.y()),
+                    report::CsvNumber(ob.truth.x()), report::CsvNumber(ob.truth.y()),
+                    report::CsvNumber(ob.view_sigma), std::to_string(ob.window)});
+  return report::CsvText({"pose", "camera", "corner", "found_x", "found_y", "truth_x", "truth_y",
+                          "sigma_px", "window_px"},
+                         rows);
+}
+
 // Measured against predicted RMS per sigma bin and axis (log-log, the identity dashed).
 std::string PlotSvg(const ValidateResult& r) {
   report::LogLogPlot plot;
@@ -233,6 +245,7 @@ int RunValidate(const ValidateArgs& args) {
   const std::string md = Markdown(args, rig, r, pass);
   output.Write((dir / "validation_bins.csv").string(), "--out", BinsCsv(r));
   output.Write((dir / "validation_points.csv").string(), "--out", PointsCsv(r));
+  output.Write((dir / "validation_detections.csv").string(), "--out", DetectionsCsv(rig, r));
   output.Write((dir / "validation.svg").string(), "--out", PlotSvg(r));
   if (r.sample.image.width > 0)
     output.Write((dir / "detections.png").string(), "--out", DetectionsPng(r.sample));
@@ -301,6 +314,15 @@ Command AddValidateCommand(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--min-bin", a.options.min_bin, "Corners per bin of predicted sigma")
       ->capture_default_str()
       ->check(Number(2, 1e9, "corners", true));
+  cmd->add_option_function<std::string>(
+         "--noise-model",
+         [&a](const std::string& v) {
+           a.options.noise_model = v == "view" ? ValidateOptions::NoiseModel::kView
+                                               : ValidateOptions::NoiseModel::kCorner;
+         },
+         "Each detection's noise in the prediction: corner (its window's precision scaled by "
+         "its view's residuals; default) or view (its view's residual RMS)")
+      ->check(CLI::IsMember({"corner", "view"}));
   cmd->add_option("--tolerance", a.tolerance, "The verdict's tolerance on measured / predicted RMS")
       ->capture_default_str()
       ->check(Number(0, 10, "", false, true));

@@ -134,7 +134,7 @@ ViewDetections RunView(const Scene& s, const PreparedScene& prepared, const Rig&
       ++v.misdetected;
       continue;
     }
-    v.inliers.push_back({pose, c, d.id, d.pixel, it->second, 0.0});
+    v.inliers.push_back({pose, c, d.id, d.pixel, it->second, 0.0, d.window, d.shape});
     v.found.push_back(d.pixel - Vec2(window.x, window.y));
     v.truth.push_back(it->second - Vec2(window.x, window.y));
   }
@@ -210,10 +210,10 @@ Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, in
       }
     const int cells = FindArucoDictionary(board.dictionary)->bits + 2;
     const double cell = cell_pixels * CaptureMedian(distance) / std::max(CaptureMedian(focal), 1.0);
-    square_m = std::max(0.005, 0.005 * std::round(cell * cells / 0.75 / 0.005));
+    square_m = std::max(0.005, 0.005 * std::round(cell * cells / kCharucoMarkerRatio / 0.005));
   }
   board.square_m = square_m;
-  board.marker_m = 0.75 * board.square_m;
+  board.marker_m = kCharucoMarkerRatio * board.square_m;
   board.margin_m = 0.5 * board.square_m;
   board.margin_m = board.MarginTexels() / board.TexelsPerMetre();
   board.thickness_m = 0.005;

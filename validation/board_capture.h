@@ -25,6 +25,9 @@ struct BoardObservation {
   /// Its view's residual RMS per coordinate; 0 for a view of fewer than 6 detections (too few to
   /// tell).
   double view_sigma = 0;
+  int window = 0;  ///< The detector's window half-width (Detection::window; 0: none).
+  /// The shape of its error covariance (Detection::shape; identity: isotropic).
+  Eigen::Matrix2d shape = Eigen::Matrix2d::Identity();
 };
 
 /// One view's detections for a picture: pose, camera, the window's image, found and truth (in the
@@ -46,6 +49,11 @@ struct BoardCaptureOptions {
   bool partial_views = true;
 };
 inline constexpr double kViewOutlierSigmas = 5.0;
+/// The validation boards' marker edge over square edge. OpenCV's chessboard corner refinement
+/// needs a window clear of the markers (detect.h); at 0.75 a 30-pixel square leaves windows of
+/// half-width 2-3 pixels, whose corners err 3-10x more than at 5 (0.29 px RMS at 2, 0.03 at 5 on
+/// the trauma room); at 0.6 the same square leaves 5.
+inline constexpr double kCharucoMarkerRatio = 0.6;
 
 struct BoardCapture {
   int poses = 0;                               ///< Poses rendered.
@@ -60,9 +68,9 @@ struct BoardCapture {
 
 /// A ChArUco board of `squares_x` x `squares_y` squares of `square_m` (0: sized so that its
 /// markers' cells span about `cell_pixels` at the median distance from the rig's enabled cameras to
-/// the region's centre through their median focal length, rounded to 5 mm), markers 3/4 of a
-/// square, a margin of half a square in whole texels; DICT_4X4_50, or DICT_6X6_250 when the scene
-/// prints DICT_4X4_50 markers of its own.
+/// the region's centre through their median focal length, rounded to 5 mm), markers
+/// kCharucoMarkerRatio of a square, a margin of half a square in whole texels; DICT_4X4_50, or
+/// DICT_6X6_250 when the scene prints DICT_4X4_50 markers of its own.
 Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, int squares_y,
                            double square_m, double cell_pixels, const std::string& name);
 

@@ -49,7 +49,8 @@ struct CalibrateOptions {
   /// Throws InputError naming the option.
   void Check() const;
 };
-inline constexpr double kCalibrationCellPixels = 5.0;
+/// The calibration board's marker cells at the median camera distance, pixels (its square: 40).
+inline constexpr double kCalibrationCellPixels = 4.0;
 
 /// One camera's calibration against its truth.
 struct CameraCalibration {

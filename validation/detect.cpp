@@ -1,6 +1,8 @@
 #include "validation/detect.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <opencv2/aruco.hpp>
 #include <opencv2/aruco/charuco.hpp>
@@ -34,9 +36,34 @@ cv::Ptr<cv::aruco::DetectorParameters> Parameters(bool board) {
 // pixels away (opencv/opencv_contrib#3301) and adds (0.5, 0.5) to every corner
 // (opencv/opencv#25539): on the small validation rig it left 8 % of the corner views as
 // misdetections and every other corner half a pixel off; this finds 791 of 792 within 1.5 px.
+// The shape of corner `q`'s error covariance (Detection::shape) over cv::cornerSubPix's window
+// of half-width `half` (its mask w = exp(-(dx/half)^2 - (dy/half)^2), central-difference
+// gradients): each edge pixel constrains the corner along its gradient, so the corner's
+// covariance is proportional to G^-1. Eigenvalues are kept within a factor 100 of each other.
+Eigen::Matrix2d CornerShape(const cv::Mat& image, const cv::Point2f& q, int half) {
+  const int cx = static_cast<int>(std::lround(q.x)), cy = static_cast<int>(std::lround(q.y));
+  Eigen::Matrix2d G = Eigen::Matrix2d::Zero();
+  for (int y = cy - half; y <= cy + half; ++y)
+    for (int x = cx - half; x <= cx + half; ++x) {
+      if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
+      const Vec2 g(0.5 * (image.at<std::uint8_t>(y, x + 1) - image.at<std::uint8_t>(y, x - 1)),
+                   0.5 * (image.at<std::uint8_t>(y + 1, x) - image.at<std::uint8_t>(y - 1, x)));
+      const double dx = x - q.x, dy = y - q.y;
+      G += std::exp(-(dx * dx + dy * dy) / double(half * half)) * g * g.transpose();
+    }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(G);
+  const double top = eig.eigenvalues()[1];
+  if (!(top > 0)) return Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d inverse(1 / std::max(eig.eigenvalues()[0], 0.01 * top), 1 / top);
+  const Eigen::Matrix2d C =
+      eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  return 2 * C / C.trace();
+}
+
 void CharucoCorners(const cv::Mat& image, const cv::aruco::CharucoBoard& board,
                     const std::map<int, std::vector<cv::Point2f>>& markers,
-                    std::vector<cv::Point2f>* corners, std::vector<int>* ids) {
+                    std::vector<cv::Point2f>* corners, std::vector<int>* ids,
+                    std::vector<int>* windows, std::vector<Eigen::Matrix2d>* shapes) {
   for (std::size_t i = 0; i < board.chessboardCorners.size(); ++i) {
     std::vector<cv::Point2f> object, seen;
     for (int m : board.nearestMarkerIdx[i]) {
@@ -69,6 +96,8 @@ void CharucoCorners(const cv::Mat& image, const cv::aruco::CharucoBoard& board,
     if (cv::norm(refined[0] - guess[0]) > half) continue;
     corners->push_back(refined[0]);
     ids->push_back(static_cast<int>(i));
+    windows->push_back(half);
+    shapes->push_back(CornerShape(image, refined[0], half));
   }
 }
 
@@ -127,9 +156,12 @@ std::vector<Detection> DetectFiducials(const std::vector<Fiducial>& fiducials,
       for (int& id : board->ids) id += f.id;
       std::vector<cv::Point2f> chess;
       std::vector<int> chess_ids;
-      CharucoCorners(image, *board, mine, &chess, &chess_ids);
+      std::vector<int> windows;
+      std::vector<Eigen::Matrix2d> shapes;
+      CharucoCorners(image, *board, mine, &chess, &chess_ids, &windows, &shapes);
       for (std::size_t k = 0; k < chess_ids.size(); ++k)
-        found.push_back({fi, chess_ids[k], origin + Vec2(chess[k].x, chess[k].y)});
+        found.push_back(
+            {fi, chess_ids[k], origin + Vec2(chess[k].x, chess[k].y), windows[k], shapes[k]});
     }
   }
   if (checkerboards == 1) {

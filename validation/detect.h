@@ -21,6 +21,16 @@ struct Detection {
   /// board's two 180-degree turns it sees: the caller matches it to the truth).
   int id = -1;
   Vec2 pixel = Vec2::Zero();  ///< Camera pixel (OpenCV convention: pixel centres at integers).
+  /// A ChArUco chessboard corner's cv::cornerSubPix window half-width (2 to 5 pixels: the window
+  /// stops short of the nearest marker corner); 0 for markers and checkerboards. The detections'
+  /// error grows as the window shrinks (validation.md: 0.03 px RMS at 5, 0.29 px at 2 on the
+  /// trauma room), so a pipeline can weight a corner by it.
+  int window = 0;
+  /// The shape of a ChArUco chessboard corner's error covariance from its window's structure
+  /// tensor G = sum w g g^T (the inverse, scaled to trace 2: per-coordinate RMS 1): a corner whose
+  /// edges meet at a sharp angle (a foreshortened board) is less certain across the angle's
+  /// bisector. Identity when not computed.
+  Eigen::Matrix2d shape = Eigen::Matrix2d::Identity();
 };
 
 /// Finds the corners of `fiducials` in `grey` (width x height, row-major, y down), an image whose

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -26,6 +27,7 @@ double Since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 constexpr double kValidateDegPerRad = 57.29577951308232;
+constexpr double kViewOutlier = kViewOutlierSigmas;
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -50,6 +52,52 @@ Vec3 RayMidpoint(const std::vector<Camera>& cameras, const std::vector<Vec2>& pi
   return A.ldlt().solve(b);
 }
 
+// The maximum-likelihood point for detections `pixels` with whitening matrices `whiten` (each
+// W^T W = the detection's inverse covariance): Gauss-Newton on sum |W (Project(X) - pixel)|^2
+// from `initial`, steps halved while they do not lower the cost; nullopt when a camera cannot
+// project the start.
+std::optional<Vec3> TriangulateWhitened(const std::vector<Camera>& cameras,
+                                        const std::vector<Vec2>& pixels,
+                                        const std::vector<Eigen::Matrix2d>& whiten,
+                                        const Vec3& initial) {
+  auto cost = [&](const Vec3& X, Mat3* H, Vec3* g) {
+    double c = 0;
+    if (H) H->setZero(), g->setZero();
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+      Mat23 A;
+      const std::optional<Vec2> p = cameras[i].Project(X, H ? &A : nullptr);
+      if (!p) return std::numeric_limits<double>::infinity();
+      const Vec2 r = whiten[i] * (*p - pixels[i]);
+      c += r.squaredNorm();
+      if (H) {
+        const Mat23 WA = whiten[i] * A;
+        *H += WA.transpose() * WA;
+        *g += WA.transpose() * r;
+      }
+    }
+    return c;
+  };
+  Vec3 X = initial;
+  Mat3 H;
+  Vec3 g;
+  double c = cost(X, &H, &g);
+  if (!std::isfinite(c)) return std::nullopt;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    Vec3 step = -H.ldlt().solve(g);
+    double next = c;
+    for (int halving = 0; halving < 30; ++halving, step *= 0.5) {
+      next = cost(X + step, nullptr, nullptr);
+      if (next <= c) break;
+    }
+    if (!(next <= c)) break;
+    X += step;
+    const bool converged = step.norm() < 1e-12 * std::max(1.0, X.norm()) || c - next < 1e-15 * c;
+    c = cost(X, &H, &g);
+    if (converged) break;
+  }
+  return X;
+}
+
 // Every corner seen by >= 2 cameras, triangulated from its detections (weighted by each view's own
 // noise: the maximum-likelihood estimate the prediction describes), against the prediction at its
 // true point: per-view noise, and one noise `sigma_px` for every camera.
@@ -65,7 +113,9 @@ std::vector<ValidatedPoint> TriangulateAndPredict(const Rig& rig,
   const std::vector<std::pair<std::pair<int, int>, std::vector<const BoardObservation*>>> list(
       corners.begin(), corners.end());
   std::vector<std::optional<ValidatedPoint>> points(list.size());
-  std::vector<std::vector<double>> sigmas(list.size());  // per detection used, pixels
+  // Per detection used, the square root of its inverse covariance (sigma^2 x shape): W^T W =
+  // Sigma^-1, so that W r is the whitened residual.
+  std::vector<std::vector<Eigen::Matrix2d>> whiten(list.size());
   tbb::parallel_for(std::size_t(0), list.size(), [&](std::size_t i) {
     const auto& obs = list[i].second;
     if (obs.size() < 2) return;
@@ -78,10 +128,12 @@ std::vector<ValidatedPoint> TriangulateAndPredict(const Rig& rig,
       cams.push_back(rig.cameras[ob->camera]);
       found.push_back(ob->found);
       p.cameras.push_back(ob->camera);
-      sigmas[i].push_back(ob->view_sigma > 0 ? std::max(ob->view_sigma, 1e-3) : sigma_px);
+      const double sigma = ob->view_sigma > 0 ? std::max(ob->view_sigma, 1e-3) : sigma_px;
+      const Eigen::Matrix2d information = (sigma * sigma * ob->shape).inverse();
+      whiten[i].push_back(Eigen::LLT<Eigen::Matrix2d>(information).matrixU());
     }
     const std::optional<Vec3> estimate =
-        TriangulatePoint(cams, found, sigmas[i], RayMidpoint(cams, found));
+        TriangulateWhitened(cams, found, whiten[i], RayMidpoint(cams, found));
     if (!estimate) return;
     p.estimate = *estimate;
     points[i] = p;
@@ -98,7 +150,7 @@ std::vector<ValidatedPoint> TriangulateAndPredict(const Rig& rig,
       const Camera& cam = rig.cameras[p.cameras[j]];
       Mat23 A;
       if (!cam.Project(p.truth, &A)) continue;
-      builder.Add(A, sigmas[i][j]);
+      builder.Add(whiten[i][j] * A, 1.0);
       one_sigma.Add(A, sigma_px);
       directions.push_back((p.truth - cam.center()).normalized());
     }
@@ -163,6 +215,72 @@ ValidateBin MakeBin(const std::vector<const ValidatedPoint*>& points, std::strin
   bin.median_cameras = Median(cameras);
   bin.median_angle_deg = Median(angles);
   return bin;
+}
+
+// A detection's squared residual in units of its covariance shape: r^T S^-1 r.
+double Mahalanobis2(const BoardObservation& ob) {
+  const Vec2 r = ob.found - ob.truth;
+  return r.dot(ob.shape.ldlt().solve(r));
+}
+
+// The per-corner noise model. Each detector window size w has a robust noise (1.4826 x the median
+// absolute coordinate residual of its detections); a detection in a view of fewer than 6 (which
+// the view's own 5-sigma rule cannot check) beyond kViewOutlier of it (and 0.05 px) is a
+// misdetection, as a pipeline's reprojection check would reject it. f(w), the RMS of the rest in
+// units of each detection's covariance shape (Detection::shape), is each window size's noise; a
+// view of >= 6 detections scales it to its own residuals (alpha_v^2 = sum r^2 / (2 sum f^2)), the
+// small views together to theirs. Detections without a window keep their view's noise. Every noise
+// goes into view_sigma (the prediction's input: the detection's covariance is view_sigma^2 x
+// shape).
+void CornerNoise(std::vector<BoardObservation>* observations, ValidateResult* r) {
+  std::map<int, std::vector<double>> coordinates;
+  for (const BoardObservation& ob : *observations)
+    if (ob.window > 0) {
+      coordinates[ob.window].push_back(std::abs(ob.found.x() - ob.truth.x()));
+      coordinates[ob.window].push_back(std::abs(ob.found.y() - ob.truth.y()));
+    }
+  std::map<int, double> limit;
+  for (auto& [window, v] : coordinates)
+    limit[window] = std::max(kViewOutlier * 1.4826 * Median(v), 0.05);
+  std::vector<BoardObservation> kept;
+  for (const BoardObservation& ob : *observations)
+    if (ob.window > 0 && !(ob.view_sigma > 0) && (ob.found - ob.truth).norm() > limit[ob.window])
+      ++r->misdetected;
+    else
+      kept.push_back(ob);
+  *observations = std::move(kept);
+  std::map<int, std::pair<double, std::int64_t>> by_window;  // sum r^T S^-1 r, count
+  for (const BoardObservation& ob : *observations)
+    if (ob.window > 0) {
+      auto& w = by_window[ob.window];
+      w.first += Mahalanobis2(ob), ++w.second;
+    }
+  r->window_sigma.clear();
+  for (const auto& [window, sums] : by_window)
+    r->window_sigma[window] = std::sqrt(sums.first / (2.0 * sums.second));
+  std::map<std::pair<int, int>, std::pair<double, double>> view_sums;  // r^2 and f^2 sums
+  double small_r2 = 0, small_f2 = 0;
+  for (const BoardObservation& ob : *observations) {
+    if (ob.window <= 0) continue;
+    const double r2 = Mahalanobis2(ob);
+    const double f = r->window_sigma.at(ob.window);
+    if (ob.view_sigma > 0) {
+      auto& sums = view_sums[{ob.pose, ob.camera}];
+      sums.first += r2, sums.second += 2 * f * f;
+    } else {
+      small_r2 += r2, small_f2 += 2 * f * f;
+    }
+  }
+  r->corner_noise_scale = small_f2 > 0 ? std::sqrt(small_r2 / small_f2) : 0;
+  for (BoardObservation& ob : *observations) {
+    if (ob.window <= 0) continue;
+    double scale = r->corner_noise_scale;
+    if (ob.view_sigma > 0) {
+      const auto& sums = view_sums[{ob.pose, ob.camera}];
+      scale = std::sqrt(sums.first / sums.second);
+    }
+    if (scale > 0) ob.view_sigma = std::max(scale * r->window_sigma.at(ob.window), 1e-3);
+  }
 }
 
 }  // namespace
@@ -252,6 +370,10 @@ ValidateResult RunValidation(const Scene& scene, const Rig& rig, const ValidateO
   r.detect_seconds = capture.detect_seconds;
   r.view_sigma = capture.view_sigma;
   r.sample = std::move(capture.sample);
+  if (o.noise_model == ValidateOptions::NoiseModel::kCorner)
+    CornerNoise(&observations, &r);
+  else
+    for (BoardObservation& ob : observations) ob.shape = Eigen::Matrix2d::Identity();
   r.detected = static_cast<std::int64_t>(observations.size());
 
   // The detections' own noise: RMS per coordinate of their residuals.
@@ -277,6 +399,7 @@ ValidateResult RunValidation(const Scene& scene, const Rig& rig, const ValidateO
       if (!(ob.view_sigma > 0)) ob.view_sigma = r.small_view_sigma;
   }
   r.points = TriangulateAndPredict(rig, observations, poses, corner_xy, r.sigma_px);
+  r.observations = observations;
   BinValidatedPoints(&r, o.min_bin);
   r.total_seconds = Since(start);
   return r;

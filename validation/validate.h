@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,13 @@ struct ValidateOptions {
   /// used), pixels.
   double outlier_px = 1.5;
   int min_bin = 50;  ///< Corners per bin of predicted sigma (>= 2).
+  /// Each detection's pixel noise in the prediction. kView: its view's residual RMS (views of
+  /// fewer than 6 detections: theirs pooled). kCorner: the residual RMS of every detection with
+  /// its detector window size (Detection::window) times the scale its view's residuals show
+  /// (small views: the scale of theirs pooled), so that corners of one view differ as their
+  /// windows do.
+  enum class NoiseModel { kView, kCorner };
+  NoiseModel noise_model = NoiseModel::kCorner;
   /// The views used: as a calibration tool would keep them (CalibrationBoard's rules, the whole
   /// board in the image): turned at most this far from facing the camera, degrees, ...
   double tilt_max_deg = 60;
@@ -45,7 +53,8 @@ struct ValidateOptions {
   /// Throws InputError naming the option.
   void Check() const;
 };
-inline constexpr double kBoardCellPixels = 5.0;
+/// The validation board's marker cells at the median camera distance, pixels (its square: 40).
+inline constexpr double kBoardCellPixels = 4.0;
 
 /// One triangulated corner.
 struct ValidatedPoint {
@@ -96,7 +105,13 @@ struct ValidateResult {
   /// The pooled RMS of the detections in views of fewer than 6 (their noise in the prediction;
   /// 0 when fewer than 6 such detections: sigma_px then).
   double small_view_sigma = 0;
+  /// kCorner: the residual RMS per detector window half-width (pixels), and the small views'
+  /// pooled scale of it (1: as the window sizes say); empty and 0 otherwise.
+  std::map<int, double> window_sigma;
+  double corner_noise_scale = 0;
   Vec2 mean_residual = Vec2::Zero();  ///< Their mean (a detector's bias), pixels.
+  /// Every detection kept, with its noise in the prediction (view_sigma).
+  std::vector<BoardObservation> observations;
   std::vector<ValidatedPoint> points;
   std::vector<ValidateBin> sigma_bins;  ///< By predicted sigma_max, equal counts.
   std::vector<ValidateBin> angle_bins;  ///< By triangulation angle.
