@@ -186,14 +186,31 @@ std::string Markdown(const ValidateArgs& args, const Rig& rig, const ValidateRes
   if (!views.empty())
     md += Format(
         "Each view's own noise (RMS of its residuals, %zu views of >= 6 corners): median %.3f px, "
-        "from %.3f to %.3f px. The prediction gives each detection its view's noise, and the "
-        "triangulation weights it so (the maximum-likelihood estimate the prediction "
-        "describes); the columns \"one σ\" compare with the design's assumption instead: one "
-        "noise (%.3f px) for every camera and view.\n\n",
-        views.size(), views[views.size() / 2], views.front(), views.back(), r.sigma_px);
-  if (r.small_view_sigma > 0)
-    md += Format("Views of fewer than 6 corners share their pooled noise: %.3f px.\n\n",
-                 r.small_view_sigma);
+        "from %.3f to %.3f px.\n\n",
+        views.size(), views[views.size() / 2], views.front(), views.back());
+  if (args.options.noise_model == ValidateOptions::NoiseModel::kCorner) {
+    std::string windows;
+    for (const auto& [window, sigma] : r.window_sigma)
+      windows += Format("%s%d px: %.3f px", windows.empty() ? "" : ", ", window, sigma);
+    md += Format(
+        "Noise model (`--noise-model corner`): each detection's noise is the residual RMS of the "
+        "detections refined in a window of its size (half-width %s), scaled to its view's "
+        "residuals (views of fewer than 6 corners: to theirs together, x %.3f), and shaped by its "
+        "window's structure tensor (a foreshortened corner is less certain across its sharp "
+        "angle). The triangulation weights each detection by that covariance (the "
+        "maximum-likelihood estimate the prediction describes).\n\n",
+        windows.c_str(), r.corner_noise_scale);
+  } else {
+    md += "Noise model (`--noise-model view`): each detection has its view's noise";
+    if (r.small_view_sigma > 0)
+      md += Format("; views of fewer than 6 corners share their pooled noise, %.3f px",
+                   r.small_view_sigma);
+    md += ". The triangulation weights each detection so.\n\n";
+  }
+  md += Format(
+      "The columns \"one σ\" compare with the design's assumption instead: one noise (%.3f px) "
+      "for every camera and view.\n\n",
+      r.sigma_px);
   md += Format(
       "%zu corners seen by >= 2 cameras triangulated. Measured / predicted RMS along each "
       "principal axis of the predicted covariance (1 = as predicted):\n\n",

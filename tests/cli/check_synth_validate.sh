@@ -4,7 +4,8 @@
 # together (images, depth EXR, corners.csv, rig.yaml, the COLMAP model, synth.json), the corner
 # table consistent with the scene (4 marker corners, 15 ChArUco and 24 checkerboard inner corners),
 # every corner pixel inside its image; validate's tables with finite ratios and its pictures; bad
-# input as one line and exit code 2 with nothing written; COLMAP (where installed) reads the model.
+# input as one line and exit code 2 with nothing written; COLMAP (where installed) reads the model;
+# validate --calibration's table (a row and a status per camera) and verdict.
 # Usage: check_synth_validate.sh PANDORA MARKERS_JSON WORK_DIR
 set -u
 pandora=$1; scene=$2; work=$3
@@ -48,9 +49,23 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
          END { exit !(all && !bad) }' "$val/validation_bins.csv" || fail "validation_bins.csv: no plausible 'all' row"
 grep -q "Verdict:" "$val/validation.md" || fail "validation.md has no verdict"
 
+# The calibration study: a row per camera (the fisheye through cv::fisheye::calibrate), each with a
+# status, the verdict line; its outputs only.
+cal="$work/calibration"
+"$pandora" validate "$scene" --calibration --out "$cal" --poses 30 --samples 2 --quiet ||
+  fail "validate --calibration exited $?"
+for f in calibration.md calibration_cameras.csv; do [ -s "$cal/$f" ] || fail "$f missing or empty"; done
+[ ! -e "$cal/validation.md" ] || fail "validate --calibration wrote validation.md"
+[ "$(tail -n +2 "$cal/calibration_cameras.csv" | wc -l)" = 3 ] || fail "calibration_cameras.csv: not 3 cameras"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+         { if ($(c["status"]) == "") bad = 1; if ($(c["lens"]) == "fisheye") fish = 1 }
+         END { exit !(fish && !bad) }' "$cal/calibration_cameras.csv" || fail "calibration_cameras.csv: a camera without status"
+grep -q "The verdict holds" "$cal/calibration.md" || fail "calibration.md has no verdict"
+
 # Bad input: one line, exit code 2, nothing written.
 bash "$here/expect_error.sh" "$pandora" "$work/bad1" "--samples" -- synth "$scene" --out "$work/bad1" --samples 0 || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/bad2" "--time-sample" -- synth "$scene" --out "$work/bad2" --time-sample 2 || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/bad3" "--rig" -- validate "$scene" --rig nope --out "$work/bad3" || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/bad4" "--cameras" -- synth "$scene" --cameras left,nope --out "$work/bad4" || exit 1
-echo "ok: synth wrote 3 images and 43 corners; validate wrote its tables"
+bash "$here/expect_error.sh" "$pandora" "$work/bad5" "--squares" -- validate "$scene" --calibration --squares 2,2 --out "$work/bad5" || exit 1
+echo "ok: synth wrote 3 images and 43 corners; validate wrote its tables; the calibration study its table"
