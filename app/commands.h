@@ -155,6 +155,10 @@ struct ReportArgs {
   int camera_width = 320;      ///< Pixels across each camera's own view.
   double brightness = kUnset;  ///< Scale of every camera's light; kUnset: DefaultBrightness.
   bool quiet = false;
+  /// --validate: the "Predicted against measured" section (`pandora validate` per rig, its
+  /// defaults, --validate-poses board poses; docs/validation.md).
+  bool validate = false;
+  int validate_poses = 60;
 };
 int RunReport(const ReportArgs& args);
 /// `pandora suggest` (issue 5): nudge the selected cameras within limits (docs/suggest.md); prints

@@ -15,6 +15,8 @@
 #include "app/output.h"
 #include "app/report/report.h"
 #include "app/session/study.h"
+#include "app/validate_report.h"
+#include "validation/validate.h"
 
 namespace pandora::app {
 namespace {
@@ -74,6 +76,27 @@ int RunReport(const ReportArgs& args) {
   options.rig_started = [&](const std::string& rig) { bar.emplace("report " + rig, !args.quiet); };
   options.progress = [&](double fraction) { bar->Update(fraction); };
   options.Check(scene);
+  // --validate: each rig's validation study on the scene at its first time sample.
+  Scene validation_scene;
+  if (args.validate) {
+    validation_scene = scene.Animated() ? SceneAtSample(scene, scene.TimeSamples().front()) : scene;
+    options.validation_intro =
+        "A ChArUco board waved through the region, rendered in every camera, detected by OpenCV "
+        "and triangulated with the known cameras: measured / predicted RMS error along each "
+        "principal axis of the predicted covariance, per bin of predicted &sigma;max (1 = as "
+        "predicted; &ldquo;one &sigma;&rdquo;: against the design's single pixel noise). "
+        "<code>pandora validate</code> writes the full tables (docs/validation.md).";
+    options.validation = [&](const Rig& rig, const auto& svg_image) {
+      ValidateOptions o;
+      o.poses = args.validate_poses;
+      ProgressBar validation_bar("validate " + rig.name, !args.quiet);
+      const ValidateResult r = RunValidation(validation_scene, rig, o, [&](int done, int total) {
+        validation_bar.Update(double(done) / total);
+      });
+      validation_bar.Finish();
+      return ValidationCellHtml(r, o.min_bin, 0.25, svg_image);
+    };
+  }
   // --disable applies to a copy of the scene whose rigs the report evaluates.
   Scene disabled;
   if (!args.disable.empty()) {
@@ -136,6 +159,13 @@ Command AddReportCommand(CLI::App& app, CommonOptions& common) {
   rep->add_option("--threads", threads, "Worker threads (default: all cores)")
       ->check(threads_check);
   rep->add_flag("--quiet,-q", report.quiet, "Print nothing but errors");
+  rep->add_flag("--validate", report.validate,
+                "Add a \"Predicted against measured\" section: a board synthesised through the "
+                "region, detected by OpenCV, triangulated, against the predicted uncertainty (a "
+                "minute per rig)");
+  rep->add_option("--validate-poses", report.validate_poses, "Board poses of --validate")
+      ->capture_default_str()
+      ->check(Number(1, 100000, "poses", true));
   return {rep, [args] { return RunReport(*args); }};
 }
 

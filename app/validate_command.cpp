@@ -21,6 +21,7 @@
 #include "app/report/plot.h"
 #include "app/report/table.h"
 #include "app/validate_calibration.h"
+#include "app/validate_report.h"
 #include "render/render.h"
 #include "validation/validate.h"
 
@@ -106,39 +107,6 @@ std::string DetectionsCsv(const Rig& rig, const ValidateResult& r) {
                          rows);
 }
 
-// Measured against predicted RMS per sigma bin and axis (log-log, the identity dashed).
-std::string PlotSvg(const ValidateResult& r) {
-  report::LogLogPlot plot;
-  plot.title = "Measured against predicted error, by bin of predicted sigma";
-  plot.x_label = "predicted RMS error along the axis (mm)";
-  plot.y_label = "measured RMS error along the axis (mm)";
-  plot.note = Format(
-      "%zu corners triangulated from OpenCV's detections; pixel sigma %.3f px "
-      "from their residuals",
-      r.points.size(), r.sigma_px);
-  static const char* const kAxis[3] = {"major", "middle", "minor"};
-  double lo = 1e300, hi = 0;
-  for (int a = 0; a < 3; ++a) {
-    report::PlotSeries s;
-    s.label = Format("%s axis", kAxis[a]);
-    s.line = false;
-    for (const ValidateBin& b : r.sigma_bins) {
-      s.x.push_back(b.predicted_mm[a]);
-      s.y.push_back(b.measured_mm[a]);
-      lo = std::min(lo, b.predicted_mm[a]);
-      hi = std::max(hi, b.predicted_mm[a]);
-    }
-    plot.series.push_back(s);
-  }
-  report::PlotSeries identity;
-  identity.label = "measured = predicted";
-  identity.markers = false;
-  identity.dashed = true;
-  if (hi > 0) identity.x = identity.y = {lo, hi};
-  plot.series.push_back(identity);
-  return report::RenderLogLogSvg(plot);
-}
-
 // The sample view three times enlarged, its detections as green crosses and the exact projections
 // as red dots.
 std::string DetectionsPng(const ValidateResult::Sample& s) {
@@ -195,11 +163,15 @@ std::string Markdown(const ValidateArgs& args, const Rig& rig, const ValidateRes
     md += Format(
         "Noise model (`--noise-model corner`): each detection's noise is the residual RMS of the "
         "detections refined in a window of its size (half-width %s), scaled to its view's "
-        "residuals (views of fewer than 6 corners: to theirs together, x %.3f), and shaped by its "
-        "window's structure tensor (a foreshortened corner is less certain across its sharp "
-        "angle). The triangulation weights each detection by that covariance (the "
-        "maximum-likelihood estimate the prediction describes).\n\n",
-        windows.c_str(), r.corner_noise_scale);
+        "residuals%s, and shaped by its window's structure tensor (a foreshortened corner is less "
+        "certain across its sharp angle). The triangulation weights each detection by that "
+        "covariance (the maximum-likelihood estimate the prediction describes).\n\n",
+        windows.c_str(),
+        r.corner_noise_scale > 0
+            ? Format(" (views of fewer than 6 corners: to theirs together, x %.3f)",
+                     r.corner_noise_scale)
+                  .c_str()
+            : "");
   } else {
     md += "Noise model (`--noise-model view`): each detection has its view's noise";
     if (r.small_view_sigma > 0)
@@ -255,15 +227,12 @@ int RunValidate(const ValidateArgs& args) {
   const ValidateResult r = RunValidation(
       scene, rig, args.options, [&](int done, int total) { bar.Update(double(done) / total); });
   bar.Finish();
-  bool pass = !r.sigma_bins.empty();
-  for (const ValidateBin& b : r.sigma_bins)
-    if (b.points >= args.options.min_bin)
-      for (int a = 0; a < 3; ++a) pass = pass && std::abs(b.ratio[a] - 1) <= args.tolerance;
+  const bool pass = ValidationPasses(r, args.options.min_bin, args.tolerance);
   const std::string md = Markdown(args, rig, r, pass);
   output.Write((dir / "validation_bins.csv").string(), "--out", BinsCsv(r));
   output.Write((dir / "validation_points.csv").string(), "--out", PointsCsv(r));
   output.Write((dir / "validation_detections.csv").string(), "--out", DetectionsCsv(rig, r));
-  output.Write((dir / "validation.svg").string(), "--out", PlotSvg(r));
+  output.Write((dir / "validation.svg").string(), "--out", ValidationPlotSvg(r));
   if (r.sample.image.width > 0)
     output.Write((dir / "detections.png").string(), "--out", DetectionsPng(r.sample));
   WriteFileAtomically(md_path, md);

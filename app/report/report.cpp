@@ -390,6 +390,7 @@ struct ReportPage {
   void Calibration();
   void OverTime();
   void Robustness();
+  void Validation();
   std::string Html() const;
 
   const Scene& scene;
@@ -777,6 +778,20 @@ void ReportPage::Robustness() {
   }
 }
 
+// Predicted against measured (ReportOptions::validation): each rig's cell from the caller.
+void ReportPage::Validation() {
+  if (!options.validation) return;
+  body << "<h2 id=\"validation\">Predicted against measured</h2>\n<p class=\"note\">"
+       << options.validation_intro << "</p>\n"
+       << RigRow(heads);
+  const auto svg_image = [&](const std::string& svg, const std::string& alt) {
+    return fig.Svg(svg, alt);
+  };
+  std::vector<std::string> cells;
+  for (const RigReport& r : reports) cells.push_back(options.validation(r.rig, svg_image));
+  body << RigRow(cells);
+}
+
 // The whole page: head and style, the body, each rig's summary.json and the image check.
 std::string ReportPage::Html() const {
   // summary.json of each rig (as `pandora analyze` writes it), for readers and tools; not executed.
@@ -869,6 +884,7 @@ ReportFile WriteReport(const Scene& scene, const RayCaster& caster, const Report
   page.Calibration();
   page.OverTime();
   page.Robustness();
+  page.Validation();
   const std::string html = page.Html();
   WriteFileAtomically(target.staged, html);
   ReportFile file;

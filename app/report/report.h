@@ -47,6 +47,15 @@ struct ReportOptions {
   std::function<void(const std::string& rig)> rig_started;
   /// The fraction of the current rig's evaluation done, from worker threads (thread-safe, cheap).
   std::function<void(double fraction)> progress;
+  /// The "Predicted against measured" section (`pandora report --validate`, docs/validation.md):
+  /// when set, called once per reported rig while the page is written, with the rig and a function
+  /// that embeds an SVG figure (returning its HTML); returns the rig's cell (HTML). The section's
+  /// introduction is validation_intro (HTML). Empty: no section.
+  std::function<std::string(
+      const Rig& rig,
+      const std::function<std::string(const std::string& svg, const std::string& alt)>& svg_image)>
+      validation;
+  std::string validation_intro;
 
   /// The limits of each option.
   static constexpr int kMinWidth = 16, kMaxWidth = 8192;

@@ -5,7 +5,8 @@
 # table consistent with the scene (4 marker corners, 15 ChArUco and 24 checkerboard inner corners),
 # every corner pixel inside its image; validate's tables with finite ratios and its pictures; bad
 # input as one line and exit code 2 with nothing written; COLMAP (where installed) reads the model;
-# validate --calibration's table (a row and a status per camera) and verdict.
+# validate --calibration's table (a row and a status per camera) and verdict; report --validate's
+# section.
 # Usage: check_synth_validate.sh PANDORA MARKERS_JSON WORK_DIR
 set -u
 pandora=$1; scene=$2; work=$3
@@ -61,6 +62,14 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
          { if ($(c["status"]) == "") bad = 1; if ($(c["lens"]) == "fisheye") fish = 1 }
          END { exit !(fish && !bad) }' "$cal/calibration_cameras.csv" || fail "calibration_cameras.csv: a camera without status"
 grep -q "The verdict holds" "$cal/calibration.md" || fail "calibration.md has no verdict"
+
+# The report's "Predicted against measured" section (report --validate): a cell per rig with the
+# verdict and the plot.
+rep="$work/report"
+"$pandora" report "$scene" --validate --validate-poses 10 --width 64 --camera-width 32 --out "$rep" --quiet ||
+  fail "report --validate exited $?"
+grep -q 'id="validation"' "$rep/report.html" || fail "report.html has no validation section"
+grep -q "corners triangulated" "$rep/report.html" || fail "the validation section has no result"
 
 # Bad input: one line, exit code 2, nothing written.
 bash "$here/expect_error.sh" "$pandora" "$work/bad1" "--samples" -- synth "$scene" --out "$work/bad1" --samples 0 || exit 1
