@@ -10,6 +10,7 @@
 #include <set>
 
 #include "analysis/geometry/visibility.h"
+#include "analysis/util/error.h"
 #include "render/prepared_scene.h"
 #include "validation/detect.h"
 #include "validation/print.h"
@@ -20,13 +21,6 @@ namespace {
 using CaptureClock = std::chrono::steady_clock;
 double CaptureSince(CaptureClock::time_point t) {
   return std::chrono::duration<double>(CaptureClock::now() - t).count();
-}
-
-double CaptureMedian(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // Where the sheet of fiducial `f` shows in camera `camera`: the bounding box of a 9 x 9 grid over
@@ -97,8 +91,7 @@ void RejectViewOutliers(ViewDetections* v) {
     coordinates.push_back(std::abs(ob.found.x() - ob.truth.x()));
     coordinates.push_back(std::abs(ob.found.y() - ob.truth.y()));
   }
-  const double robust = 1.4826 * CaptureMedian(coordinates);
-  const double limit = std::max(kViewOutlierSigmas * robust, 0.05);
+  const double limit = OutlierLimitPx(std::move(coordinates));
   std::vector<BoardObservation> kept;
   for (const BoardObservation& ob : v->inliers)
     if ((ob.found - ob.truth).norm() <= limit) kept.push_back(ob);
@@ -190,6 +183,28 @@ void CollectViews(int k, std::vector<ViewDetections>* views, BoardCapture* r,
 
 }  // namespace
 
+double SampleMedian(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double OutlierLimitPx(std::vector<double> coordinates) {
+  return std::max(kViewOutlierSigmas * 1.4826 * SampleMedian(std::move(coordinates)), 0.05);
+}
+
+Vec3 BoardPoint(const CalibrationPose& pose, const Vec2& xy) {
+  return pose.position + pose.orientation.col(0) * xy.x() + pose.orientation.col(1) * xy.y();
+}
+
+void CheckBoardStudyOptions(int poses, double square_m, int squares_x, int squares_y) {
+  if (poses < 1 || poses > 100000) throw InputError("--poses", "", "must be 1 to 100000");
+  if (!(square_m >= 0 && square_m < 100)) throw InputError("--square", "", "must be >= 0 m");
+  if (squares_x < 3 || squares_y < 3 || squares_x > 20 || squares_y > 20)
+    throw InputError("--squares", "", "each must be 3 to 20");
+}
+
 Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, int squares_y,
                            double square_m, double cell_pixels, const std::string& name) {
   Fiducial board;
@@ -209,7 +224,7 @@ Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, in
         focal.push_back(c.model.intrinsics().fx);
       }
     const int cells = FindArucoDictionary(board.dictionary)->bits + 2;
-    const double cell = cell_pixels * CaptureMedian(distance) / std::max(CaptureMedian(focal), 1.0);
+    const double cell = cell_pixels * SampleMedian(distance) / std::max(SampleMedian(focal), 1.0);
     square_m = std::max(0.005, 0.005 * std::round(cell * cells / kCharucoMarkerRatio / 0.005));
   }
   board.square_m = square_m;
@@ -220,14 +235,13 @@ Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, in
   return board;
 }
 
-BoardCapture CaptureBoard(const Scene& scene, const Rig& rig, const Fiducial& board,
-                          const std::vector<CalibrationPose>& poses, const CalibrationBoard& rules,
-                          const BoardCaptureOptions& o,
+BoardCapture CaptureBoard(const Scene& scene, const RayCaster& scene_caster, const Rig& rig,
+                          const Fiducial& board, const std::vector<CalibrationPose>& poses,
+                          const CalibrationBoard& rules, const BoardCaptureOptions& o,
                           const std::function<void(int, int)>& progress) {
   BoardCapture r;
   const auto print = std::make_shared<const PrintedPattern>(PrintFiducial(board));
-  const auto base_caster = MakeEmbreeRayCaster(scene.AllTriangles());
-  const VisibilityTester tester(rig.cameras, *base_caster, scene.ContentBounds().diagonal());
+  const VisibilityTester tester(rig.cameras, scene_caster, scene.ContentBounds().diagonal());
   std::map<int, Vec2> corner_xy;
   for (const FiducialCorner& c : FiducialCorners(board)) corner_xy[c.id] = c.xy;
   std::size_t best_sample = 0;

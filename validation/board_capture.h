@@ -66,6 +66,20 @@ struct BoardCapture {
   BoardViewSample sample;                         ///< The view with the most detections.
 };
 
+/// The median of `v` (the mean of the middle two for an even count; 0 when empty).
+double SampleMedian(std::vector<double> v);
+
+/// The misdetection limit for detections whose absolute coordinate residuals are `coordinates`:
+/// kViewOutlierSigmas robust sigmas (1.4826 x their median), and at least 0.05 px.
+double OutlierLimitPx(std::vector<double> coordinates);
+
+/// The world point of the board's pattern-frame point `xy` (metres) at `pose`.
+Vec3 BoardPoint(const CalibrationPose& pose, const Vec2& xy);
+
+/// The options a board study shares (`pandora validate`, with or without --calibration): throws
+/// InputError naming --poses, --square or --squares when out of range.
+void CheckBoardStudyOptions(int poses, double square_m, int squares_x, int squares_y);
+
 /// A ChArUco board of `squares_x` x `squares_y` squares of `square_m` (0: sized so that its
 /// markers' cells span about `cell_pixels` at the median distance from the rig's enabled cameras to
 /// the region's centre through their median focal length, rounded to 5 mm), markers
@@ -74,14 +88,15 @@ struct BoardCapture {
 Fiducial SizedCharucoBoard(const Scene& scene, const Rig& rig, int squares_x, int squares_y,
                            double square_m, double cell_pixels, const std::string& name);
 
-/// Renders and detects `board` at every pose of `poses` in every enabled camera of `rig` whose
+/// Renders and detects `board` at every pose of `poses` in every enabled camera of `rig` (`caster`
+/// over scene.AllTriangles(), as the poses were sampled with) whose
 /// view `rules` keep (TestBoard: seen, or partly hidden by the scene when options.partial_views),
 /// when the truth says it images at least 4 corners. A corner whose neighbouring squares are not
 /// all visible (at an occluding edge) is left out of both truth and detections. `progress` (may be
 /// empty) is called after each pose with (done, total).
-BoardCapture CaptureBoard(const Scene& scene, const Rig& rig, const Fiducial& board,
-                          const std::vector<CalibrationPose>& poses, const CalibrationBoard& rules,
-                          const BoardCaptureOptions& options,
+BoardCapture CaptureBoard(const Scene& scene, const RayCaster& caster, const Rig& rig,
+                          const Fiducial& board, const std::vector<CalibrationPose>& poses,
+                          const CalibrationBoard& rules, const BoardCaptureOptions& options,
                           const std::function<void(int, int)>& progress = {});
 
 }  // namespace pandora

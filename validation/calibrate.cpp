@@ -8,7 +8,6 @@
 #include <numeric>
 
 #include "analysis/geometry/visibility.h"
-#include "analysis/util/error.h"
 #include "analysis/util/text.h"
 #include "validation/calibrate_internal.h"
 
@@ -154,10 +153,7 @@ int ChooseReference(const std::vector<std::vector<ViewCorners>>& views,
 
 void CalibrateOptions::Check() const {
   synth.Check();
-  if (poses < 1 || poses > 100000) throw InputError("--poses", "", "must be 1 to 100000");
-  if (!(square_m >= 0 && square_m < 100)) throw InputError("--square", "", "must be >= 0 m");
-  if (squares_x < 3 || squares_y < 3 || squares_x > 20 || squares_y > 20)
-    throw InputError("--squares", "", "each must be 3 to 20");
+  CheckBoardStudyOptions(poses, square_m, squares_x, squares_y);
   if (!(outlier_px > 0)) throw std::invalid_argument("CalibrateOptions: outlier_px must be > 0");
   if (!(bound_px > 0)) throw std::invalid_argument("CalibrateOptions: bound_px must be > 0");
   if (min_view_corners < 6 || min_views < 3)
@@ -273,8 +269,7 @@ void CompareWithTruth(const Rig& rig, const BoardCapture& capture,
     if (!cc.linked) continue;
     const CalibrationPose& pose = poses[ob.pose];
     const Vec2 xy = corner_xy.at(ob.id);
-    const Vec3 X =
-        pose.position + pose.orientation.col(0) * xy.x() + pose.orientation.col(1) * xy.y();
+    const Vec3 X = BoardPoint(pose, xy);
     Vec2 uv;
     if (!ProjectWithIntrinsics(cc.final, camera_from_world[ob.camera] * X, &uv)) continue;
     world_sum2[ob.camera] += (uv - ob.truth).squaredNorm();
@@ -349,7 +344,8 @@ CalibrationStudy RunCalibrationStudy(const Scene& scene, const Rig& rig, const C
   capture_options.seed = o.seed;
   capture_options.outlier_px = o.outlier_px;
   capture_options.partial_views = o.partial_views;
-  r.capture = CaptureBoard(scene, rig, board, poses, r.spec.board, capture_options, progress);
+  r.capture =
+      CaptureBoard(scene, *caster, rig, board, poses, r.spec.board, capture_options, progress);
 
   const StudyClock::time_point calibrate_start = StudyClock::now();
   double sum2 = 0;

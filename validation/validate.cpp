@@ -27,14 +27,6 @@ double Since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 constexpr double kValidateDegPerRad = 57.29577951308232;
-constexpr double kViewOutlier = kViewOutlierSigmas;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // The point nearest (least squares) to the cameras' rays through `pixels`: the start of the
 // nonlinear triangulation, as a user's pipeline would make it (no truth involved).
@@ -143,7 +135,7 @@ std::vector<ValidatedPoint> TriangulateAndPredict(const Rig& rig,
     ValidatedPoint p = *points[i];
     const CalibrationPose& pose = poses[p.pose];
     const Vec2 xy = corner_xy.at(p.id);
-    p.truth = pose.position + pose.orientation.col(0) * xy.x() + pose.orientation.col(1) * xy.y();
+    p.truth = BoardPoint(pose, xy);
     InformationBuilder builder, one_sigma;
     std::vector<Vec3> directions;
     for (std::size_t j = 0; j < p.cameras.size(); ++j) {
@@ -212,8 +204,8 @@ ValidateBin MakeBin(const std::vector<const ValidatedPoint*>& points, std::strin
   bin.measured_mm = 1e3 * (measured / n).cwiseSqrt();
   bin.predicted_mm = 1e3 * (predicted / n).cwiseSqrt();
   bin.skew_major = Skewness(major);
-  bin.median_cameras = Median(cameras);
-  bin.median_angle_deg = Median(angles);
+  bin.median_cameras = SampleMedian(cameras);
+  bin.median_angle_deg = SampleMedian(angles);
   return bin;
 }
 
@@ -225,8 +217,8 @@ double Mahalanobis2(const BoardObservation& ob) {
 
 // The per-corner noise model. Each detector window size w has a robust noise (1.4826 x the median
 // absolute coordinate residual of its detections); a detection in a view of fewer than 6 (which
-// the view's own 5-sigma rule cannot check) beyond kViewOutlier of it (and 0.05 px) is a
-// misdetection, as a pipeline's reprojection check would reject it. f(w), the RMS of the rest in
+// the view's own 5-sigma rule cannot check) beyond OutlierLimitPx of its window size's residuals is
+// a misdetection, as a pipeline's reprojection check would reject it. f(w), the RMS of the rest in
 // units of each detection's covariance shape (Detection::shape), is each window size's noise; a
 // view of >= 6 detections scales it to its own residuals (alpha_v^2 = sum r^2 / (2 sum f^2)), the
 // small views together to theirs. Detections without a window keep their view's noise. Every noise
@@ -240,8 +232,7 @@ void CornerNoise(std::vector<BoardObservation>* observations, ValidateResult* r)
       coordinates[ob.window].push_back(std::abs(ob.found.y() - ob.truth.y()));
     }
   std::map<int, double> limit;
-  for (auto& [window, v] : coordinates)
-    limit[window] = std::max(kViewOutlier * 1.4826 * Median(v), 0.05);
+  for (auto& [window, v] : coordinates) limit[window] = OutlierLimitPx(std::move(v));
   std::vector<BoardObservation> kept;
   for (const BoardObservation& ob : *observations)
     if (ob.window > 0 && !(ob.view_sigma > 0) && (ob.found - ob.truth).norm() > limit[ob.window])
@@ -287,10 +278,7 @@ void CornerNoise(std::vector<BoardObservation>* observations, ValidateResult* r)
 
 void ValidateOptions::Check() const {
   synth.Check();
-  if (poses < 1 || poses > 100000) throw InputError("--poses", "", "must be 1 to 100000");
-  if (!(square_m >= 0 && square_m < 100)) throw InputError("--square", "", "must be >= 0 m");
-  if (squares_x < 3 || squares_y < 3 || squares_x > 20 || squares_y > 20)
-    throw InputError("--squares", "", "each must be 3 to 20");
+  CheckBoardStudyOptions(poses, square_m, squares_x, squares_y);
   if (!(outlier_px > 0)) throw InputError("--outlier", "", "must be a positive number of pixels");
   if (min_bin < 2) throw InputError("--min-bin", "", "must be at least 2");
 }
@@ -343,9 +331,9 @@ ValidateResult RunValidation(const Scene& scene, const Rig& rig, const ValidateO
   spec.board.square_m = board.square_m;
   spec.board.tilt_max_deg = o.tilt_max_deg;
   spec.board.min_px_per_square = o.min_px_per_square;
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   std::vector<CalibrationPose> poses;
   {
-    const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
     const VisibilityTester tester(rig.cameras, *caster, scene.ContentBounds().diagonal());
     poses = SampleCalibrationPoses(scene, tester, spec);
   }
@@ -360,7 +348,7 @@ ValidateResult RunValidation(const Scene& scene, const Rig& rig, const ValidateO
   capture_options.seed = o.seed;
   capture_options.outlier_px = o.outlier_px;
   BoardCapture capture =
-      CaptureBoard(scene, rig, board, poses, spec.board, capture_options, progress);
+      CaptureBoard(scene, *caster, rig, board, poses, spec.board, capture_options, progress);
   std::vector<BoardObservation>& observations = capture.observations;
   r.poses = capture.poses;
   r.views = capture.views;
