@@ -46,6 +46,8 @@ Command AddExportRigCommand(CLI::App& app, CommonOptions& common);
 Command AddImportRigCommand(CLI::App& app, CommonOptions& common);
 Command AddReportCommand(CLI::App& app, CommonOptions& common);
 Command AddRigCommand(CLI::App& app, CommonOptions& common);
+/// `pandora import-plan`: a scene file from a DXF floor plan (app/import_plan_command.cpp).
+Command AddImportPlanCommand(CLI::App& app, CommonOptions& common);
 Command AddSuggestCommand(CLI::App& app, CommonOptions& common);
 Command AddAcceptCommand(CLI::App& app, CommonOptions& common);
 /// `pandora synth` and `pandora validate` (app/synth_command.cpp, app/validate_command.cpp).

@@ -122,9 +122,9 @@ int main(int argc, char** argv) {
       AddAccuracyCommand(app, common),      AddRenderCommand(app, common),
       AddExportSurfaceCommand(app, common), AddExportRigCommand(app, common),
       AddImportRigCommand(app, common),     AddReportCommand(app, common),
-      AddRigCommand(app, common),           AddSuggestCommand(app, common),
-      AddAcceptCommand(app, common),        AddSynthCommand(app, common),
-      AddValidateCommand(app, common)};
+      AddRigCommand(app, common),           AddImportPlanCommand(app, common),
+      AddSuggestCommand(app, common),       AddAcceptCommand(app, common),
+      AddSynthCommand(app, common),         AddValidateCommand(app, common)};
 
   RefuseEmptyValues(&app);
 

@@ -22,6 +22,8 @@ PACKAGES=(
   # OpenCV (validation/: fiducial prints with aruco, detection, calibration; cv::FileStorage reads
   # the rig exports back in ctest rigio.*OpenCV*). contrib holds aruco in Debian 12's OpenCV 4.6.
   libopencv-dev libopencv-contrib-dev
+  # pandora import-plan: floor plans from DXF.
+  libdxflib-dev
 )
 
 missing=()

@@ -16,6 +16,7 @@
 
 #include "analysis/geometry/pose.h"
 #include "analysis/geometry/primitives.h"
+#include "analysis/scene/builders.h"
 #include "analysis/scene/mesh_io.h"
 #include "analysis/scene/ptz.h"
 #include "analysis/util/allocation_budget.h"
@@ -411,7 +412,8 @@ void AddMeshObjects(const Node& node, const Node& geometry, const std::optional<
   std::optional<SkinnedObject> skin;
   if (animation) skin = ReadAnimation(*animation);
   if (!context.options.load_meshes) {
-    scene->objects.push_back({name, reference.file, TriangleMesh(), material, solid, {}, -1});
+    scene->objects.push_back(
+        {name, reference.file, TriangleMesh(), material, solid, {}, -1, std::nullopt});
     if (skin) {  // no skeleton: the object stays as placed
       skin->object = int(scene->objects.size()) - 1;
       scene->objects.back().skin = int(scene->skins.size());
@@ -591,10 +593,176 @@ void AddFiducialObject(const Node& node, const std::string& kind, const std::str
   CheckObjectBounds(scene->objects.back().mesh, node);
 }
 
+// ---- Rooms, furniture and people (analysis/scene/builders.h).
+
+// A 2D point list [[x, y], ...] in the file's unit.
+Polygon2 ReadPolygon(const Node& node, std::size_t max_points) {
+  const std::size_t n = node.ArraySize(max_points, "an array of [x, y] points");
+  Polygon2 out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 v = node.At(i).Vector2() * node.context().metres_per_unit;
+    for (int k = 0; k < 2; ++k) node.At(i).At(k).Bounded(v[k]);
+    out.push_back(v);
+  }
+  return out;
+}
+
+// "openings": [{"wall", "type": "door" | "window", "offset", "width", "height", "sill"}].
+WallOpening ReadOpening(const Node& node) {
+  node.CheckKeys({"wall", "type", "offset", "width", "height", "sill"});
+  WallOpening o;
+  const std::string type = node.Has("type") ? node.Get("type").Enum({"door", "window"}) : "door";
+  if (type == "window") o.width = 1.2, o.height = 1.2, o.sill = 0.9;
+  o.wall = node.Get("wall").Integer(0, 100000);
+  o.offset = node.Get("offset").NonNegativeLength();
+  if (auto n = node.Find("width")) o.width = n->PositiveLength();
+  if (auto n = node.Find("height")) o.height = n->PositiveLength();
+  if (auto n = node.Find("sill")) o.sill = n->NonNegativeLength();
+  if (type == "door" && node.Has("sill") && o.sill > 0)
+    node.Get("sill").Fail("a door starts at the floor", "give \"type\": \"window\" for a sill");
+  return o;
+}
+
+void AddPart(Scene* scene, const std::string& name, const std::string& source, TriangleMesh mesh,
+             const Eigen::Affine3d& transform, int material, bool solid, const Node& node) {
+  SceneObject object;
+  object.name = name;
+  object.source = source;
+  object.mesh = Transformed(mesh, transform);
+  object.material = material;
+  object.solid = solid;
+  CheckObjectBounds(object.mesh, node);
+  scene->objects.push_back(std::move(object));
+}
+
+// "furniture": [{"type", "name", "at": [x, y], "yaw_deg", "size", "color"}]: solid boxes on the
+// floor, named ROOM/NAME (NAME: the name, else the type, numbered when repeated).
+void AddFurniture(const Node& list, const std::string& room, const Eigen::Affine3d& transform,
+                  int material, std::set<std::string>* names, Scene* scene) {
+  const std::size_t n = list.ArraySize(10000, "an array of furniture");
+  for (std::size_t i = 0; i < n; ++i) {
+    const Node f = list.At(i);
+    f.CheckKeys({"type", "name", "at", "yaw_deg", "size", "color", "solid"});
+    Vec3 size;
+    std::string type;
+    if (auto t = f.Find("type")) {
+      type = t->NonEmptyString();
+      if (!FurnitureSize(type, &size))
+        t->Fail("unknown furniture type " + Quoted(type),
+                DidYouMean(type, FurnitureTypes(), "furniture types") +
+                    "; or give \"size\": [x, y, height]");
+    } else if (!f.Has("size")) {
+      f.Fail("furniture needs a \"type\" or a \"size\"",
+             "known types: " + JoinQuoted(FurnitureTypes()));
+    }
+    if (auto s = f.Find("size")) size = s->PositiveVector3() * f.context().metres_per_unit;
+    std::string name = f.Has("name") ? f.Get("name").NonEmptyString() : type;
+    if (name.empty()) name = "box";
+    std::string full = room + "/" + name;
+    for (int k = 2; names->count(full); ++k) {
+      if (f.Has("name")) f.Get("name").Fail("duplicate furniture name " + Quoted(name));
+      full = room + "/" + name + std::to_string(k);
+    }
+    names->insert(full);
+    const Vec2 at = f.Get("at").Vector2() * f.context().metres_per_unit;
+    const double yaw = f.Has("yaw_deg") ? f.Get("yaw_deg").Number(-36000, 36000) : 0.0;
+    Eigen::Affine3d place = Eigen::Affine3d::Identity();
+    place.translation() = Vec3(at.x(), at.y(), 0.5 * size.z());
+    place.linear() = RotationXyzDegrees(Vec3(0, 0, yaw));
+    int m = material;
+    if (auto c = f.Find("color")) m = AddMaterial(scene, Material{full, c->Color(), "", nullptr});
+    const bool solid = f.Has("solid") ? f.Get("solid").Bool() : true;
+    AddPart(scene, full, "furniture", MakeBox(size), transform * place, m, solid, f);
+  }
+}
+
+// A "room" entry: walls round a footprint with openings, floor, ceiling, furniture.
+void AddRoomObjects(const Node& node, const Node& geometry, const std::string& name,
+                    const Eigen::Affine3d& transform, int material, bool solid,
+                    std::set<std::string>* names, Scene* scene) {
+  geometry.CheckKeys({"footprint", "height", "wall_thickness", "slab", "floor", "ceiling",
+                      "openings", "furniture"});
+  RoomSpec room;
+  room.footprint = ReadPolygon(geometry.Get("footprint"), 10000);
+  if (auto n = geometry.Find("height")) room.height = n->PositiveLength();
+  if (auto n = geometry.Find("wall_thickness")) room.thickness = n->PositiveLength();
+  if (auto n = geometry.Find("slab")) room.slab = n->PositiveLength();
+  if (auto n = geometry.Find("floor")) room.floor = n->Bool();
+  if (auto n = geometry.Find("ceiling")) room.ceiling = n->Bool();
+  std::optional<Node> openings = geometry.Find("openings");
+  if (openings) {
+    const std::size_t n = openings->ArraySize(10000, "an array of openings");
+    for (std::size_t i = 0; i < n; ++i) room.openings.push_back(ReadOpening(openings->At(i)));
+  }
+  int bad_opening = -1;
+  const std::string problem = RoomProblem(room, &bad_opening);
+  if (!problem.empty()) {
+    if (bad_opening >= 0) openings->At(std::size_t(bad_opening)).Fail(problem);
+    const bool outer = problem.rfind("footprint", 0) != 0;
+    geometry.Get(outer ? "wall_thickness" : "footprint")
+        .Fail(problem, outer ? "thinner walls, or a footprint with fewer narrow spots"
+                             : "list the corners in order round the room");
+  }
+  for (BuiltPart& part : BuildRoom(room)) {
+    names->insert(name + "/" + part.name);
+    AddPart(scene, name + "/" + part.name, "room", std::move(part.mesh), transform, material, solid,
+            node);
+  }
+  if (auto f = geometry.Find("furniture"))
+    AddFurniture(*f, name, transform, material, names, scene);
+}
+
+// An "extrusion": {"polygon": [[x, y], ...], "height"}: the prism of a simple polygon from z = 0.
+TriangleMesh ReadExtrusion(const Node& geometry) {
+  geometry.CheckKeys({"polygon", "height"});
+  const Polygon2 polygon = ReadPolygon(geometry.Get("polygon"), 100000);
+  const std::string problem = PolygonProblem(polygon);
+  if (!problem.empty())
+    geometry.Get("polygon").Fail(problem, "list the outline's corners in order round it");
+  return ExtrudePolygon(polygon, 0, geometry.Get("height").PositiveLength());
+}
+
+// A "person" entry: an articulated figure of capsules, feet at the object's position, facing the
+// object's +x.
+void AddPersonObjects(const Node& geometry, const std::string& name,
+                      const Eigen::Affine3d& transform, int material, bool solid, Scene* scene) {
+  geometry.CheckKeys({"height", "pose", "girth", "segments"});
+  PersonSpec spec;
+  if (auto n = geometry.Find("height")) {
+    spec.height = n->PositiveLength();
+    if (spec.height < 0.5 || spec.height > 2.5)
+      n->Fail("a person's height must be 0.5 to 2.5 m, got " + Short(spec.height) + " m");
+  }
+  if (auto n = geometry.Find("pose")) spec.pose = n->Enum(PersonPoses());
+  if (auto n = geometry.Find("girth")) spec.girth = n->Number(0.5, 2.0);
+  if (auto n = geometry.Find("segments")) spec.segments = n->Integer(kMinSegments, 64);
+  Scene::Person person;
+  person.name = name;
+  person.pose = spec.pose;
+  person.height = spec.height;
+  const Vec3 forward = transform.linear() * Vec3::UnitX();
+  person.facing_deg = std::atan2(forward.y(), forward.x()) * 180.0 / M_PI;
+  for (BuiltPart& part : BuildPerson(spec)) {
+    SceneObject object;
+    object.name = name + "/" + part.name;
+    object.source = "person";
+    object.mesh = Transformed(part.mesh, transform);
+    object.material = material;
+    object.solid = solid;
+    object.capsule =
+        SceneObject::CapsuleAxis{transform * part.axis_a, transform * part.axis_b, part.radius};
+    CheckObjectBounds(object.mesh, geometry);
+    person.objects.push_back(int(scene->objects.size()));
+    scene->objects.push_back(std::move(object));
+  }
+  scene->people.push_back(std::move(person));
+}
+
 void ReadObject(const Node& node, const std::map<std::string, int>& material_index,
                 std::set<std::string>* names, Scene* scene) {
   const std::vector<std::string> geometry_keys = {"box",   "sphere", "cylinder", "capsule",
-                                                  "plane", "mesh",   "marker",   "board"};
+                                                  "plane", "mesh",   "marker",   "board",
+                                                  "room",  "person", "extrusion"};
   std::vector<std::string> allowed = {"name",  "position", "rotation_deg", "quaternion",
                                       "scale", "material", "color",        "solid",
                                       "group", "animation"};
@@ -625,15 +793,34 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     AddFiducialObject(node, kind, name, scene);
     return;
   }
+  const bool built = kind == "room" || kind == "person";
+  if (built && node.Has("scale"))
+    node.Get("scale").Fail("a " + kind + " is sized by its own keys, not scaled",
+                           kind == "room" ? "give the footprint and height in the file's units"
+                                          : "give \"height\" (and \"girth\")");
   const Eigen::Affine3d world_from_object = ReadObjectTransform(node);
 
-  bool solid = false;
+  // Rooms and people are solid unless told otherwise (their parts are closed by construction).
+  bool solid = built;
   if (auto n = node.Find("solid")) {
     solid = n->Bool();
     if (solid && kind == "plane") n->Fail("a plane is an open sheet and cannot be solid");
   }
 
   const int material = ReadObjectMaterial(node, material_index, name, scene);
+  if (kind == "room") {
+    if (node.Has("animation")) node.Get("animation").Fail("a room has no animation");
+    AddRoomObjects(node, geometry, name, world_from_object, material, solid, names, scene);
+    return;
+  }
+  if (kind == "person") {
+    if (node.Has("animation"))
+      node.Get("animation")
+          .Fail("a person's motion is given under \"motions\"",
+                "\"walk\" or \"wander\" in \"motions\" (docs/scene-format.md)");
+    AddPersonObjects(geometry, name, world_from_object, material, solid, scene);
+    return;
+  }
 
   const Context& context = node.context();
   const double unit = context.metres_per_unit;
@@ -649,9 +836,10 @@ void ReadObject(const Node& node, const std::map<std::string, int>& material_ind
     return;
   }
 
-  const TriangleMesh mesh = MakePrimitive(kind, geometry, unit);
+  const TriangleMesh mesh =
+      kind == "extrusion" ? ReadExtrusion(geometry) : MakePrimitive(kind, geometry, unit);
   scene->objects.push_back(
-      {name, kind, Transformed(mesh, world_from_object), material, solid, {}, -1});
+      {name, kind, Transformed(mesh, world_from_object), material, solid, {}, -1, std::nullopt});
   CheckObjectBounds(scene->objects.back().mesh, node);
   // Primitives are closed by construction; the check guards against degenerate transforms.
   if (solid) {
@@ -1283,10 +1471,12 @@ Study ReadStudy(const Node& node) {
   if (auto t = node.Find("targets")) {
     t->CheckKeys({"objects", "points", "seed"});
     SurfaceTargets targets;
-    const Node names = t->Get("objects");
-    const size_t count = names.ArraySize("an array of object or group names");
-    if (count == 0 || count > 1000) names.Fail("expected 1 to 1000 names");
-    for (size_t i = 0; i < count; ++i) targets.names.push_back(names.At(i).NonEmptyString());
+    // Without "objects": every person of the scene (filled in by ParseScene).
+    if (auto names = t->Find("objects")) {
+      const size_t count = names->ArraySize("an array of object or group names");
+      if (count == 0 || count > 1000) names->Fail("expected 1 to 1000 names");
+      for (size_t i = 0; i < count; ++i) targets.names.push_back(names->At(i).NonEmptyString());
+    }
     if (auto n = t->Find("points")) targets.points = n->Integer(1, 10000000);
     if (auto n = t->Find("seed")) targets.seed = std::uint64_t(n->Integer(0, 2147483647));
     study.targets = targets;
@@ -1532,6 +1722,98 @@ GroupPose ReadGroupPose(const Node& node) {
   return p;
 }
 
+// The heading of a moving group as placed: a person's own, else "facing_deg" (default +x).
+double GroupFacing(const Node& node, const ObjectMotion& motion, const Scene& scene) {
+  if (auto n = node.Find("facing_deg")) return n->Number(-36000, 36000);
+  for (const Scene::Person& p : scene.people)
+    if (!p.objects.empty() && p.objects.size() == motion.objects.size() &&
+        std::is_permutation(p.objects.begin(), p.objects.end(), motion.objects.begin()))
+      return p.facing_deg;
+  return 0;
+}
+
+// The footprints (x, y) of the solids a walker must keep clear of: solid objects that no motion
+// moves, whose height overlaps the walker's [5 cm, its top].
+Footprint2 StaticObstacles(const Node& motions, const ObjectMotion& walker, const Scene& scene) {
+  Aabb body;
+  for (int o : walker.objects) body.Extend(scene.objects[o].mesh.Bounds());
+  const double low = body.min.z() + 0.05, high = body.max.z();
+  Footprint2 out;
+  for (const SceneObject& object : scene.objects) {
+    if (!object.solid || object.skin >= 0) continue;
+    bool moving = false;
+    for (const auto& item : motions.value().items()) moving |= object.InGroup(item.key());
+    if (moving) continue;
+    for (const Eigen::Vector3i& t : object.mesh.triangles) {
+      const Vec3 &a = object.mesh.vertices[t[0]], &b = object.mesh.vertices[t[1]],
+                 &c = object.mesh.vertices[t[2]];
+      if (std::max({a.z(), b.z(), c.z()}) < low || std::min({a.z(), b.z(), c.z()}) > high) continue;
+      out.triangles.push_back({a.head<2>(), b.head<2>(), c.head<2>()});
+    }
+  }
+  return out;
+}
+
+// "walk": {"path": [[x, y], ...], "speed", "start_s", "turn_s", "closed", "facing_deg"} or
+// "wander": {"region": {"min": [x, y], "max": [x, y]}, "duration_s", "speed", "pause_s",
+// "turn_s", "radius", "seed", "facing_deg"}: keyframes (analysis/scene/builders.h).
+std::vector<std::pair<double, GroupPose>> ReadWalk(const Node& node, const std::string& kind,
+                                                   const ObjectMotion& motion, const Node& motions,
+                                                   const Scene& scene) {
+  const double facing = GroupFacing(node, motion, scene);
+  auto speed = [&node](double fallback) {
+    if (auto n = node.Find("speed")) {
+      const double v = n->PositiveLength();
+      if (v < 0.01 || v > 100) n->Fail("expected a speed of 0.01 to 100 m/s");
+      return v;
+    }
+    return fallback;
+  };
+  if (kind == "walk") {
+    node.CheckKeys({"path", "speed", "start_s", "turn_s", "closed", "facing_deg"});
+    WalkSpec walk;
+    walk.path = ReadPolygon(node.Get("path"), 100000);
+    if (walk.path.size() < 2) node.Get("path").Fail("a walk needs at least 2 way points");
+    for (std::size_t i = 1; i < walk.path.size(); ++i)
+      if ((walk.path[i] - walk.path[i - 1]).norm() < 1e-3)
+        node.Get("path").At(i).Fail("the same way point twice in a row");
+    walk.speed = speed(walk.speed);
+    if (auto n = node.Find("start_s")) walk.start_s = n->Number(-1e6, 1e6);
+    if (auto n = node.Find("turn_s")) walk.turn_s = n->Number(0, 60);
+    if (auto n = node.Find("closed")) walk.closed = n->Bool();
+    return WalkKeyframes(walk, motion.anchor, facing);
+  }
+  node.CheckKeys(
+      {"region", "duration_s", "speed", "pause_s", "turn_s", "radius", "seed", "facing_deg"});
+  WanderSpec wander;
+  const Node region = node.Get("region");
+  region.CheckKeys({"min", "max"});
+  const Vec2 lo = region.Get("min").Vector2() * node.context().metres_per_unit,
+             hi = region.Get("max").Vector2() * node.context().metres_per_unit;
+  for (int i = 0; i < 2; ++i)
+    if (!(hi[i] > lo[i]))
+      region.Get("max").At(i).Fail("max must be greater than min (axis " + std::string(1, "xy"[i]) +
+                                   ")");
+  wander.region.Extend(Vec3(lo.x(), lo.y(), 0));
+  wander.region.Extend(Vec3(hi.x(), hi.y(), 0));
+  if (auto n = node.Find("duration_s")) wander.duration_s = n->Number(0.1, 86400);
+  wander.speed = speed(wander.speed);
+  if (auto n = node.Find("pause_s")) wander.pause_s = n->Number(0, 3600);
+  if (auto n = node.Find("turn_s")) wander.turn_s = n->Number(0, 60);
+  if (auto n = node.Find("radius")) wander.radius = n->PositiveLength();
+  if (auto n = node.Find("seed")) wander.seed = std::uint64_t(n->Integer(0, 2147483647));
+  std::vector<OtherWalker> others;
+  for (const ObjectMotion& m : scene.motions)
+    if (m.kind == ObjectMotion::Kind::kKeyframes) others.push_back({m.anchor, m.keyframes});
+  try {
+    return WanderKeyframes(wander, motion.anchor, facing, StaticObstacles(motions, motion, scene),
+                           others);
+  } catch (const std::invalid_argument& e) {
+    node.Fail(e.what(), "place the group where it is free, or give a smaller \"radius\"");
+  }
+  return {};
+}
+
 void ReadMotions(const Node& motions, Scene* scene) {
   motions.ExpectObject("an object of motions by group or object name");
   std::vector<int> owner(scene->objects.size(), -1);
@@ -1556,9 +1838,13 @@ void ReadMotions(const Node& motions, Scene* scene) {
              DidYouMean(motion.name, GroupNames(*scene), "objects and groups"));
     if (!bounds.empty())
       motion.anchor = Vec3(bounds.center().x(), bounds.center().y(), bounds.min.z());
-    m.CheckKeys({"keyframes", "poses", "random"});
-    const std::string kind = m.OneOf({"keyframes", "poses", "random"}, "kind of motion");
-    if (kind == "keyframes") {
+    m.CheckKeys({"keyframes", "poses", "random", "walk", "wander"});
+    const std::string kind =
+        m.OneOf({"keyframes", "poses", "random", "walk", "wander"}, "kind of motion");
+    if (kind == "walk" || kind == "wander") {
+      motion.kind = ObjectMotion::Kind::kKeyframes;
+      motion.keyframes = ReadWalk(m.Get(kind), kind, motion, motions, *scene);
+    } else if (kind == "keyframes") {
       motion.kind = ObjectMotion::Kind::kKeyframes;
       const Node k = m.Get("keyframes");
       const size_t count = k.ArraySize("an array of keyframes {\"t\", \"move\", \"yaw_deg\"}");
@@ -1724,7 +2010,13 @@ Scene ParseScene(const std::string& json_text, const std::string& path,
   scene.study = ReadStudy(root.Get("study"));
 
   if (auto motions = root.Find("motions")) ReadMotions(*motions, &scene);
-  if (scene.study.targets) {
+  if (scene.study.targets && scene.study.targets->names.empty()) {
+    if (scene.people.empty())
+      root.Get("study").Get("targets").Fail(
+          "no \"objects\" are given and the scene has no people",
+          "list the objects or groups whose surfaces are targets");
+    for (const Scene::Person& p : scene.people) scene.study.targets->names.push_back(p.name);
+  } else if (scene.study.targets) {
     const Node names = root.Get("study").Get("targets").Get("objects");
     const std::vector<std::string> known = GroupNames(scene);
     for (size_t i = 0; i < scene.study.targets->names.size(); ++i) {

@@ -55,6 +55,14 @@ struct SceneObject {
   std::string group;
   /// Index into Scene::skins when the object plays a skinned animation ("animation"); else -1.
   int skin = -1;
+  /// For a part of a "person": its capsule's axis ends (world frame as placed) and the radius of
+  /// the capsule its tessellation surely contains, so that target points inside another part of
+  /// the same body are not taken for skin (analysis/scene/surface_targets.cpp).
+  struct CapsuleAxis {
+    Vec3 a, b;
+    double radius = 0;
+  };
+  std::optional<CapsuleAxis> capsule;
 
   /// True when a motion or a target named `n` takes this object: its group, its own name, or the
   /// part before the '/' of a mesh file's part ("patient/torso" belongs to "patient").
@@ -239,6 +247,14 @@ struct Scene {
   std::map<std::string, ViewingStation> stations;  ///< Viewing stations, by name.
   /// Moving groups ("motions"), in file order; empty for a static scene.
   std::vector<ObjectMotion> motions;
+  /// The "person" objects, in file order: name (their parts are "NAME/head", ...), height,
+  /// heading as placed (degrees counter-clockwise from +x) and their parts' indices in `objects`.
+  struct Person {
+    std::string name, pose;
+    double height = 0, facing_deg = 0;
+    std::vector<int> objects;
+  };
+  std::vector<Person> people;
   /// Printed fiducials ("marker" and "board" objects), in object order; empty when none.
   std::vector<Fiducial> fiducials;
   /// Objects that play a skinned animation ("animation" on a mesh object), in object order; empty

@@ -45,10 +45,52 @@ void SampleSurface(const TriangleMesh& mesh, int count, std::uint64_t seed,
   }
 }
 
+namespace {
+
+// True when `p`, on the surface of object `own`, lies inside another part's capsule.
+bool InsideAnotherPart(const TargetSurface& surface, const Vec3& p, std::size_t own) {
+  for (std::size_t o = 0; o < surface.capsules.size(); ++o) {
+    if (o == own || !surface.capsules[o]) continue;
+    const SceneObject::CapsuleAxis& c = *surface.capsules[o];
+    const Vec3 ab = c.b - c.a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((p - c.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    if ((c.a + t * ab - p).norm() < c.radius) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 SurfacePoints SampleTargetPoints(const TargetSurface& surface, int count, std::uint64_t seed) {
   SurfacePoints out;
-  SampleSurface(surface.mesh, count, seed, &out.points, &out.normals, &out.triangles,
-                &out.barycentric);
+  const bool capsules = std::any_of(surface.capsules.begin(), surface.capsules.end(),
+                                    [](const auto& c) { return c.has_value(); });
+  if (!capsules) {
+    SampleSurface(surface.mesh, count, seed, &out.points, &out.normals, &out.triangles,
+                  &out.barycentric);
+    return out;
+  }
+  // A person's parts overlap at the joints: keep the first `count` draws that are not inside
+  // another part (draw i is the same whatever the count, so drawing more keeps the first ones).
+  for (int drawn = 2 * count; drawn <= 64 * count; drawn *= 2) {
+    SurfacePoints all;
+    SampleSurface(surface.mesh, drawn, seed, &all.points, &all.normals, &all.triangles,
+                  &all.barycentric);
+    out = SurfacePoints();
+    for (std::size_t i = 0; i < all.points.size() && int(out.points.size()) < count; ++i) {
+      const std::size_t own =
+          std::size_t(std::upper_bound(surface.first_triangle.begin(), surface.first_triangle.end(),
+                                       all.triangles[i]) -
+                      surface.first_triangle.begin() - 1);
+      if (InsideAnotherPart(surface, all.points[i], own)) continue;
+      out.points.push_back(all.points[i]);
+      out.normals.push_back(all.normals[i]);
+      out.triangles.push_back(all.triangles[i]);
+      out.barycentric.push_back(all.barycentric[i]);
+    }
+    if (int(out.points.size()) == count) break;
+  }
   return out;
 }
 
@@ -89,6 +131,8 @@ TargetSurface FindTargetSurface(const Scene& scene, const std::string& name) {
       for (std::size_t k = 0; k < scene.motions.size(); ++k)
         for (int member : scene.motions[k].objects)
           if (member == int(o)) t.motion = int(k);
+    t.first_triangle.push_back(int(t.mesh.triangles.size()));
+    t.capsules.push_back(scene.objects[o].capsule);
     t.mesh.Append(scene.objects[o].mesh);
     t.objects.push_back(int(o));
     t.skinned |= scene.objects[o].skin >= 0;

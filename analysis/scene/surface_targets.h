@@ -7,6 +7,7 @@
 /// markers and skin on moving bodies, not the empty volume around them. docs/time.md.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,11 @@ struct TargetSurface {
   std::vector<int> objects;  ///< The objects whose meshes `mesh` appends, in order.
   /// Some of them play a skinned animation: their points follow the skin (PlaceTargetPoints).
   bool skinned = false;
+  /// Per object of `objects`: its first triangle in `mesh`, and its capsule when it is a part of
+  /// a person (points inside another part are not on the body's surface: SampleTargetPoints
+  /// skips them).
+  std::vector<int> first_triangle;
+  std::vector<std::optional<SceneObject::CapsuleAxis>> capsules;
 };
 TargetSurface FindTargetSurface(const Scene& scene, const std::string& name);
 
