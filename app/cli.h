@@ -48,6 +48,8 @@ Command AddReportCommand(CLI::App& app, CommonOptions& common);
 Command AddRigCommand(CLI::App& app, CommonOptions& common);
 /// `pandora import-plan`: a scene file from a DXF floor plan (app/import_plan_command.cpp).
 Command AddImportPlanCommand(CLI::App& app, CommonOptions& common);
+/// `pandora propose`: global layout proposals (app/propose_command.cpp).
+Command AddProposeCommand(CLI::App& app, CommonOptions& common);
 Command AddSuggestCommand(CLI::App& app, CommonOptions& common);
 Command AddAcceptCommand(CLI::App& app, CommonOptions& common);
 /// `pandora synth` and `pandora validate` (app/synth_command.cpp, app/validate_command.cpp).

@@ -225,8 +225,16 @@ struct AcceptArgs {
   std::string cameras;  ///< Comma-separated ids; empty: all.
   bool force = false;
   bool quiet = false;
+  /// A proposals file (`pandora propose`): which proposal (1-based) to add as a rig, and its name
+  /// (default: the proposal's).
+  int proposal = 0;
+  std::string name;
 };
 int RunAccept(const AcceptArgs& args);
+/// `pandora accept PROPOSALS --proposal N [--name NAME]`: adds proposal N as a rig to the scene the
+/// proposals were made for (lock, hash check unless `force`, backup; app/propose_command.cpp).
+int AcceptProposal(const std::string& file, int number, const std::string& name, bool force,
+                   bool quiet);
 
 }  // namespace pandora::app
 

@@ -123,8 +123,9 @@ int main(int argc, char** argv) {
       AddExportSurfaceCommand(app, common), AddExportRigCommand(app, common),
       AddImportRigCommand(app, common),     AddReportCommand(app, common),
       AddRigCommand(app, common),           AddImportPlanCommand(app, common),
-      AddSuggestCommand(app, common),       AddAcceptCommand(app, common),
-      AddSynthCommand(app, common),         AddValidateCommand(app, common)};
+      AddProposeCommand(app, common),       AddSuggestCommand(app, common),
+      AddAcceptCommand(app, common),        AddSynthCommand(app, common),
+      AddValidateCommand(app, common)};
 
   RefuseEmptyValues(&app);
 

@@ -10,6 +10,7 @@
 #include "analysis/rig/rig_check.h"
 #include "analysis/scene/motion.h"
 #include "analysis/util/error.h"
+#include "analysis/util/json_reader.h"
 #include "app/cli.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -106,6 +107,15 @@ int RunSuggest(const SuggestArgs& args) {
 }
 
 int RunAccept(const AcceptArgs& args) {
+  if (args.proposal > 0) {
+    if (!args.cameras.empty())
+      throw InputError("--cameras", "", "a proposal is accepted whole, as a new rig");
+    return AcceptProposal(args.suggestion, args.proposal, args.name, args.force, args.quiet);
+  }
+  if (!args.name.empty()) throw InputError("--name", "", "--name goes with --proposal");
+  if (ReadJsonFile(args.suggestion, "suggestion file").contains("pandora_proposals"))
+    throw InputError("--proposal", "", "a proposals file: which proposal?",
+                     "give --proposal N (proposals.md lists them)");
   AcceptOptions options;
   options.force = args.force;
   if (!args.cameras.empty()) options.cameras = SplitList(args.cameras);
@@ -221,11 +231,16 @@ Command AddAcceptCommand(CLI::App& app, CommonOptions& /*common*/) {
   auto args = std::make_shared<AcceptArgs>();
   AcceptArgs& accept = *args;
   CLI::App* ac = app.add_subcommand(
-      "accept", "Write a suggestion's poses into the scene file (keeps a backup)");
+      "accept",
+      "Write a suggestion's poses, or a proposal as a new rig, into the scene file (keeps a "
+      "backup)");
   ac->add_option("suggestion", accept.suggestion, "Suggestion file from pandora suggest")
       ->required();
   ac->add_option("--cameras", accept.cameras, "Comma-separated ids to accept (default: all)");
   ac->add_flag("--force", accept.force, "Accept even if the scene file changed since");
+  ac->add_option("--proposal", accept.proposal,
+                 "With a proposals file (pandora propose): add proposal N as a rig");
+  ac->add_option("--name", accept.name, "With --proposal: the new rig's name");
   ac->add_flag("--quiet,-q", accept.quiet, "Print nothing but errors");
   return {ac, [args] { return RunAccept(*args); }};
 }

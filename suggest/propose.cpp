@@ -1,0 +1,490 @@
+#include "suggest/propose.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/geometry/visibility.h"
+#include "analysis/util/error.h"
+#include "analysis/util/palette.h"
+#include "analysis/util/seeded.h"
+#include "analysis/util/units.h"
+
+namespace pandora {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The triangles of the objects no motion moves and no skin animates.
+TriangleMesh StaticMesh(const Scene& scene) {
+  std::vector<char> moving(scene.objects.size(), 0);
+  for (const ObjectMotion& m : scene.motions)
+    for (int o : m.objects) moving[o] = 1;
+  TriangleMesh mesh;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o)
+    if (!moving[o] && scene.objects[o].skin < 0) mesh.Append(scene.objects[o].mesh);
+  return mesh;
+}
+
+// The mount `clearance` off a surface a ray hit, on the ray's side.
+Vec3 OffSurface(const Ray& ray, const RayHit& hit, double clearance) {
+  Vec3 n = hit.normal;
+  if (n.dot(ray.direction) > 0) n = -n;
+  return ray.origin + hit.t * ray.direction + clearance * n;
+}
+
+// Seeded k-means (k-means++ start, 20 rounds) of the target points' positions.
+std::vector<Vec3> AimPoints(const std::vector<TargetPoint>& targets, int k, std::uint64_t seed) {
+  std::vector<Vec3> p;
+  const std::size_t step = std::max<std::size_t>(1, targets.size() / 4000);
+  for (std::size_t i = 0; i < targets.size(); i += step) p.push_back(targets[i].p);
+  Vec3 centroid = Vec3::Zero();
+  for (const Vec3& v : p) centroid += v;
+  centroid /= double(p.size());
+  std::vector<Vec3> centres;
+  if (k > 0 && int(p.size()) > k) {
+    centres.push_back(p[std::size_t(SeededUniform(seed, 0) * p.size()) % p.size()]);
+    std::vector<double> d2(p.size());
+    while (int(centres.size()) < k) {
+      double total = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        d2[i] = 1e300;
+        for (const Vec3& c : centres) d2[i] = std::min(d2[i], (p[i] - c).squaredNorm());
+        total += d2[i];
+      }
+      double pick = SeededUniform(seed, centres.size()) * total;
+      std::size_t i = 0;
+      while (i + 1 < p.size() && pick > d2[i]) pick -= d2[i++];
+      centres.push_back(p[i]);
+    }
+    for (int round = 0; round < 20; ++round) {
+      std::vector<Vec3> sum(centres.size(), Vec3::Zero());
+      std::vector<int> count(centres.size(), 0);
+      for (const Vec3& v : p) {
+        std::size_t best = 0;
+        for (std::size_t c = 1; c < centres.size(); ++c)
+          if ((v - centres[c]).squaredNorm() < (v - centres[best]).squaredNorm()) best = c;
+        sum[best] += v;
+        ++count[best];
+      }
+      for (std::size_t c = 0; c < centres.size(); ++c)
+        if (count[c] > 0) centres[c] = sum[c] / count[c];
+    }
+  }
+  centres.insert(centres.begin(), centroid);
+  return centres;
+}
+
+// The search state over the visibility bit matrix.
+struct Search {
+  const std::vector<std::vector<std::uint64_t>>& vis;
+  const std::vector<double>& price;
+  const std::vector<int>& mount_of;
+  int points, k;
+  bool n1;
+  double budget;
+  std::vector<int> counts;
+  std::vector<int> selected;
+  int ge_k = 0;
+  long soft = 0;
+
+  void Reset() {
+    counts.assign(std::size_t(points), 0);
+    selected.clear();
+    ge_k = 0, soft = 0;
+  }
+  void Add(int c, int sign) {
+    const std::vector<std::uint64_t>& bits = vis[std::size_t(c)];
+    for (std::size_t w = 0; w < bits.size(); ++w)
+      for (std::uint64_t b = bits[w]; b; b &= b - 1) {
+        int& n = counts[w * 64 + std::size_t(__builtin_ctzll(b))];
+        if (sign > 0) {
+          soft += n < k;
+          ++n;
+          ge_k += n == k;
+        } else {
+          ge_k -= n == k;
+          --n;
+          soft -= n < k;
+        }
+      }
+  }
+  // The share seen by >= k after the worst single failure among the selected cameras.
+  double N1Share() const {
+    std::vector<std::uint64_t> at_k((std::size_t(points) + 63) / 64, 0);
+    for (int i = 0; i < points; ++i)
+      if (counts[std::size_t(i)] == k) at_k[std::size_t(i) / 64] |= 1ull << (i % 64);
+    int worst = 0;
+    for (int c : selected) {
+      int lost = 0;
+      const std::vector<std::uint64_t>& bits = vis[std::size_t(c)];
+      for (std::size_t w = 0; w < bits.size(); ++w) lost += __builtin_popcountll(bits[w] & at_k[w]);
+      worst = std::max(worst, lost);
+    }
+    return double(ge_k - worst) / points;
+  }
+  double Exact() const { return n1 ? N1Share() : double(ge_k) / points; }
+  // What the search maximises: the exact objective, the soft one as a tie-break, less the
+  // diversity penalty.
+  double Score(const std::vector<char>& taken_mounts, double diversity) const {
+    double s = Exact() + 1e-3 * double(soft) / (double(points) * k);
+    for (int c : selected) s -= taken_mounts[std::size_t(mount_of[std::size_t(c)])] ? diversity : 0;
+    return s;
+  }
+  double Price() const {
+    double p = 0;
+    for (int c : selected) p += price[std::size_t(c)];
+    return p;
+  }
+};
+
+// Greedy on the soft objective, then simulated annealing of swaps for `seconds`.
+void Optimise(Search* s, int n, const std::vector<char>& taken_mounts, double diversity,
+              double seconds, std::int64_t iterations, std::uint64_t seed) {
+  const int candidates = int(s->vis.size());
+  s->Reset();
+  std::vector<char> in(std::size_t(candidates), 0);
+  for (int step = 0; step < n; ++step) {
+    int best = -1;
+    double best_gain = -1e300;
+    const double left = s->budget > 0 ? s->budget - s->Price() : 1e300;
+    for (int c = 0; c < candidates; ++c) {
+      if (in[std::size_t(c)] || s->price[std::size_t(c)] > left) continue;
+      long gain = 0;
+      const std::vector<std::uint64_t>& bits = s->vis[std::size_t(c)];
+      for (std::size_t w = 0; w < bits.size(); ++w)
+        for (std::uint64_t b = bits[w]; b; b &= b - 1)
+          gain += s->counts[w * 64 + std::size_t(__builtin_ctzll(b))] < s->k;
+      // With a budget, value for money: the gain per unit of price.
+      const double per_price =
+          s->budget > 0 ? 1.0 / std::max(s->price[std::size_t(c)], 1e-9 * s->budget) : 1.0;
+      const double g = double(gain) / s->points * per_price -
+                       (taken_mounts[std::size_t(s->mount_of[std::size_t(c)])] ? diversity : 0);
+      if (g > best_gain) best_gain = g, best = c;
+    }
+    if (best < 0) break;
+    s->Add(best, +1);
+    s->selected.push_back(best);
+    in[std::size_t(best)] = 1;
+  }
+  if (s->selected.empty()) return;
+  const Clock::time_point t0 = Clock::now();
+  double score = s->Score(taken_mounts, diversity), best_score = score;
+  std::vector<int> best = s->selected;
+  const double t_hot = 0.01, t_cold = 1e-4;
+  for (std::uint64_t it = 0;; ++it) {
+    const double done =
+        iterations > 0 ? double(it) / double(iterations) : Since(t0) / std::max(seconds, 1e-9);
+    if (done >= 1) break;
+    const double temperature = t_hot * std::pow(t_cold / t_hot, done);
+    const std::size_t i = std::size_t(SeededUniform(seed, it, 0) * s->selected.size());
+    const int out = s->selected[i];
+    int j = int(SeededUniform(seed, it, 1) * candidates) % candidates;
+    if (in[std::size_t(j)]) continue;
+    // Under a budget with room for more cameras, an added one is tried first.
+    if (s->budget > 0 && int(s->selected.size()) < n &&
+        s->Price() + s->price[std::size_t(j)] <= s->budget + 1e-9) {
+      s->Add(j, +1);
+      s->selected.push_back(j);
+      const double next = s->Score(taken_mounts, diversity);
+      if (next >= score) {
+        score = next;
+        in[std::size_t(j)] = 1;
+        if (score > best_score) best_score = score, best = s->selected;
+        continue;
+      }
+      s->Add(j, -1);
+      s->selected.pop_back();
+    }
+    if (s->budget > 0 &&
+        s->Price() - s->price[std::size_t(out)] + s->price[std::size_t(j)] > s->budget + 1e-9)
+      continue;
+    s->Add(out, -1);
+    s->Add(j, +1);
+    s->selected[i] = j;
+    const double next = s->Score(taken_mounts, diversity);
+    if (next >= score || SeededUniform(seed, it, 2) < std::exp((next - score) / temperature)) {
+      score = next;
+      in[std::size_t(out)] = 0, in[std::size_t(j)] = 1;
+      if (score > best_score) best_score = score, best = s->selected;
+    } else {
+      s->Add(j, -1);
+      s->Add(out, +1);
+      s->selected[i] = out;
+    }
+  }
+  s->Reset();
+  for (int c : best) {
+    s->Add(c, +1);
+    s->selected.push_back(c);
+  }
+}
+
+// Candidate cameras: every mount looking at every aim point through every lens.
+void MakeCandidates(const ProposeOptions& options, const std::vector<Vec3>& aims,
+                    ProposeResult* result, std::vector<int>* mount_of) {
+  for (std::size_t m = 0; m < options.mounts.size(); ++m)
+    for (const Vec3& aim : aims)
+      for (std::size_t l = 0; l < options.lenses.size(); ++l) {
+        const Vec3& at = options.mounts[m].position;
+        std::optional<Eigen::Isometry3d> pose = LookAt(at, aim, Vec3::UnitZ());
+        if (!pose) pose = LookAt(at, aim, Vec3::UnitY());
+        if (!pose) continue;
+        const ProposeLens& lens = options.lenses[l];
+        Camera c;
+        c.id = "candidate_" + std::to_string(result->candidates.size() + 1);
+        c.world_from_camera = *pose;
+        c.model = CameraModel(lens.intrinsics);
+        c.near = lens.near;
+        c.far = lens.far;
+        result->candidates.push_back(c);
+        result->candidate_lens.push_back(int(l));
+        result->candidate_surface.push_back(options.mounts[m].surface);
+        mount_of->push_back(int(m));
+      }
+}
+
+// vis[c]: bit i set when candidate c sees target point i (exact tests, the point's own sample).
+std::vector<std::vector<std::uint64_t>> Visibility(
+    const Scene& scene, const RayCaster& caster,
+    const std::vector<const RayCaster*>& sample_casters, const std::vector<TargetPoint>& targets,
+    const std::vector<Camera>& candidates, const ProposeOptions& options) {
+  const std::size_t words = (targets.size() + 63) / 64;
+  std::vector<std::vector<std::uint64_t>> vis(candidates.size(),
+                                              std::vector<std::uint64_t>(words, 0));
+  const double scale = scene.ContentBounds().diagonal();
+  std::vector<std::unique_ptr<VisibilityTester>> testers;
+  const std::size_t samples = std::max<std::size_t>(1, sample_casters.size());
+  for (std::size_t s = 0; s < samples; ++s)
+    testers.push_back(std::make_unique<VisibilityTester>(
+        candidates, sample_casters.empty() ? caster : *sample_casters[s], scale));
+  std::atomic<std::size_t> done{0};
+  tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t c) {
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      const TargetPoint& t = targets[i];
+      const VisibilityTester& tester = *testers[sample_casters.empty() ? 0 : std::size_t(t.sample)];
+      const Vec3* normal = t.normal ? &*t.normal : nullptr;
+      if (tester.Test(int(c), t.p, normal) == ViewResult::kSeen) vis[c][i / 64] |= 1ull << (i % 64);
+    }
+    const std::size_t n = ++done;
+    if (options.progress && n % 64 == 0)
+      options.progress("visibility", double(n) / double(candidates.size()));
+  });
+  return vis;
+}
+
+}  // namespace
+
+std::vector<MountPoint> WallMounts(const Scene& scene, const std::vector<double>& heights,
+                                   double spacing, double clearance) {
+  const TriangleMesh mesh = StaticMesh(scene);
+  std::vector<MountPoint> out;
+  if (mesh.triangles.empty()) return out;
+  const auto caster = MakeEmbreeRayCaster(mesh);
+  const Vec3 centre = scene.study.region.box.center();
+  constexpr int kRays = 1440;
+  for (double h : heights) {
+    std::vector<Vec3> hits;
+    for (int r = 0; r < kRays; ++r) {
+      const double a = 2 * kPi * r / kRays;
+      const Ray ray{Vec3(centre.x(), centre.y(), h), Vec3(std::cos(a), std::sin(a), 0), 0, 1e4};
+      const auto hit = caster->Intersect(ray);
+      hits.push_back(hit ? OffSurface(ray, *hit, clearance) : Vec3::Constant(1e300));
+    }
+    // One mount per `spacing` metres along the chain of hits (gaps: doors, open sides, restart).
+    double run = spacing;
+    for (int r = 0; r < kRays; ++r) {
+      const Vec3& p = hits[std::size_t(r)];
+      if (p.x() > 1e299) continue;
+      const Vec3& q = hits[std::size_t((r + kRays - 1) % kRays)];
+      if (q.x() < 1e299) run += (p - q).norm();
+      if (run >= spacing) {
+        out.push_back({p, "wall"});
+        run = 0;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<MountPoint> CeilingMounts(const Scene& scene, double spacing, double clearance) {
+  const TriangleMesh mesh = StaticMesh(scene);
+  std::vector<MountPoint> out;
+  if (mesh.triangles.empty()) return out;
+  const auto caster = MakeEmbreeRayCaster(mesh);
+  // Over the whole static scene's plan (inset by the clearance), from the region's top up: a hit on
+  // a downward face is a ceiling (an upward one is the inside of a closed solid: skipped).
+  Aabb region = mesh.Bounds();
+  region.min += Vec3::Constant(clearance), region.max -= Vec3::Constant(clearance);
+  region.max.z() = scene.study.region.box.max.z();
+  const int nx = std::max(1, int(std::round((region.max.x() - region.min.x()) / spacing))),
+            ny = std::max(1, int(std::round((region.max.y() - region.min.y()) / spacing)));
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const Vec3 o(region.min.x() + (i + 0.5) * (region.max.x() - region.min.x()) / nx,
+                   region.min.y() + (j + 0.5) * (region.max.y() - region.min.y()) / ny,
+                   region.max.z());
+      const Ray ray{o, Vec3::UnitZ(), 0, 1e4};
+      const auto hit = caster->Intersect(ray);
+      if (hit && hit->normal.z() < 0) out.push_back({OffSurface(ray, *hit, clearance), "ceiling"});
+    }
+  return out;
+}
+
+std::vector<MountPoint> ObjectMounts(const Scene& scene, const std::vector<std::string>& names,
+                                     double spacing, double clearance) {
+  std::vector<MountPoint> out;
+  for (const std::string& name : names) {
+    Aabb b;
+    for (const SceneObject& o : scene.objects)
+      if (o.InGroup(name)) b.Extend(o.mesh.Bounds());
+    if (b.empty())
+      throw InputError(scene.path, "", "no object or group named '" + name + "' to mount on");
+    const int nx = std::max(1, int(std::round((b.max.x() - b.min.x()) / spacing))),
+              ny = std::max(1, int(std::round((b.max.y() - b.min.y()) / spacing)));
+    for (int i = 0; i < nx; ++i)
+      for (int j = 0; j < ny; ++j)
+        out.push_back(
+            {Vec3(b.min.x() + (i + 0.5) * (b.max.x() - b.min.x()) / nx,
+                  b.min.y() + (j + 0.5) * (b.max.y() - b.min.y()) / ny, b.min.z() - clearance),
+             name});
+  }
+  return out;
+}
+
+std::vector<MountPoint> BoxMounts(const Scene& scene, const Aabb& box, double spacing,
+                                  double clearance) {
+  const TriangleMesh mesh = scene.AllTriangles();
+  const SurfaceDistance distance(mesh);
+  std::vector<MountPoint> out;
+  int n[3];
+  for (int a = 0; a < 3; ++a)
+    n[a] = std::max(1, int(std::round((box.max[a] - box.min[a]) / spacing)) + 1);
+  for (int i = 0; i < n[0]; ++i)
+    for (int j = 0; j < n[1]; ++j)
+      for (int k = 0; k < n[2]; ++k) {
+        Vec3 p;
+        const int at[3] = {i, j, k};
+        for (int a = 0; a < 3; ++a)
+          p[a] = n[a] == 1 ? 0.5 * (box.min[a] + box.max[a])
+                           : box.min[a] + (box.max[a] - box.min[a]) * at[a] / (n[a] - 1);
+        if (mesh.triangles.empty() || distance.Distance(p, 2 * clearance) >= clearance)
+          out.push_back({p, "box"});
+      }
+  return out;
+}
+
+ProposeResult Propose(const Scene& scene, const RayCaster& caster,
+                      const std::vector<const RayCaster*>& sample_casters,
+                      const std::vector<TargetPoint>& targets, const ProposeOptions& options,
+                      int curve_from, int curve_to) {
+  if (options.mounts.empty())
+    throw InputError(scene.path, "", "no mount points", "give walls, ceiling, objects or points");
+  if (options.lenses.empty()) throw InputError(scene.path, "", "no camera models");
+  if (targets.empty()) throw InputError(scene.path, "", "no target points");
+  ProposeResult result;
+  result.points = int(targets.size());
+  const Clock::time_point t0 = Clock::now();
+  std::vector<int> mount_of;
+  MakeCandidates(options, AimPoints(targets, options.aims, options.seed), &result, &mount_of);
+  std::vector<std::vector<std::uint64_t>> vis =
+      Visibility(scene, caster, sample_casters, targets, result.candidates, options);
+  result.visibility_seconds = Since(t0);
+  std::vector<double> price;
+  for (int l : result.candidate_lens) price.push_back(options.lenses[std::size_t(l)].price);
+  bool any = false;
+  for (const auto& v : vis)
+    for (std::uint64_t w : v) any |= w != 0;
+  if (!any)
+    throw InputError(scene.path, "", "no candidate camera sees any target point",
+                     "check the mounts (walls, ceiling) and the lenses' range");
+  const Clock::time_point t1 = Clock::now();
+  const bool n1 = options.objective.kind == ObjectiveKind::kCoverageN1;
+  Search search{vis, price, mount_of, result.points, options.objective.k, n1, options.budget, {},
+                {},  0,     0};
+  const int curve_n = curve_to >= curve_from && curve_from > 0 ? curve_to - curve_from + 1 : 0;
+  const double per = options.seconds / std::max(1, options.proposals + curve_n);
+  std::vector<char> taken(options.mounts.size(), 0);
+  for (int p = 0; p < options.proposals; ++p) {
+    if (options.progress) options.progress("search", double(p) / options.proposals);
+    Optimise(&search, options.cameras, taken, p == 0 ? 0.0 : options.diversity, per,
+             options.iterations, options.seed + std::uint64_t(p) * 7919);
+    Proposal proposal;
+    proposal.candidates = search.selected;
+    proposal.coverage_k = double(search.ge_k) / result.points;
+    proposal.n1 = search.N1Share();
+    proposal.objective = search.Exact();
+    proposal.price = search.Price();
+    for (int c : search.selected) taken[std::size_t(mount_of[std::size_t(c)])] = 1;
+    result.proposals.push_back(proposal);
+  }
+  const std::vector<char> none(options.mounts.size(), 0);
+  for (int n = curve_from; curve_n > 0 && n <= curve_to; ++n) {
+    if (options.progress) options.progress("curve", double(n - curve_from) / curve_n);
+    Optimise(&search, n, none, 0.0, per, options.iterations,
+             options.seed + 104729 * std::uint64_t(n));
+    result.curve.emplace_back(n, search.Exact());
+  }
+  std::sort(result.proposals.begin(), result.proposals.end(),
+            [](const Proposal& a, const Proposal& b) { return a.objective > b.objective; });
+  result.search_seconds = Since(t1);
+  return result;
+}
+
+Proposal ScoreCameras(const Scene& scene, const RayCaster& caster,
+                      const std::vector<const RayCaster*>& sample_casters,
+                      const std::vector<TargetPoint>& targets, const std::vector<Camera>& cameras,
+                      const Objective& objective) {
+  std::vector<Camera> enabled;
+  for (const Camera& c : cameras)
+    if (c.enabled) enabled.push_back(c);
+  const ProposeOptions options;
+  const std::vector<std::vector<std::uint64_t>> vis =
+      Visibility(scene, caster, sample_casters, targets, enabled, options);
+  const std::vector<double> price(enabled.size(), 0.0);
+  const std::vector<int> mount_of(enabled.size(), 0);
+  Search search{vis,
+                price,
+                mount_of,
+                int(targets.size()),
+                objective.k,
+                objective.kind == ObjectiveKind::kCoverageN1,
+                0,
+                {},
+                {},
+                0,
+                0};
+  search.Reset();
+  for (std::size_t c = 0; c < enabled.size(); ++c) {
+    search.Add(int(c), +1);
+    search.selected.push_back(int(c));
+  }
+  Proposal p;
+  p.coverage_k = targets.empty() ? 0 : double(search.ge_k) / double(targets.size());
+  p.n1 = targets.empty() ? 0 : search.N1Share();
+  p.objective = search.Exact();
+  return p;
+}
+
+Rig ProposalRig(const ProposeResult& result, const Proposal& proposal, const std::string& name) {
+  Rig rig;
+  rig.name = name;
+  for (std::size_t i = 0; i < proposal.candidates.size(); ++i) {
+    Camera c = result.candidates[std::size_t(proposal.candidates[i])];
+    c.id = name + "_" + std::to_string(i + 1);
+    c.name = c.id;
+    c.color = CameraPaletteColor(int(i));
+    rig.cameras.push_back(c);
+  }
+  return rig;
+}
+
+}  // namespace pandora

@@ -1,0 +1,117 @@
+#pragma once
+/// \file propose.h
+/// Global layout proposals (`pandora propose`, docs/propose.md): how many cameras, which mounts,
+/// which lenses. From a candidate set (mount points on the walls, the ceiling, named objects or a
+/// list, times aim points, times lenses), every candidate's visibility of the target points is
+/// computed once (the exact tests of VisibilityTester, at every time sample); a greedy selection
+/// on the soft objective (sum of min(cameras, k)) starts each proposal and a simulated annealing
+/// of swaps (one camera out, one candidate in) over the exact objective finishes it. Several
+/// proposals are kept different by a penalty on the candidates earlier ones took. The suggest
+/// nudge (Ceres) can polish each one after. Nothing here writes files.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "analysis/geometry/camera.h"
+#include "analysis/scene/scene.h"
+#include "suggest/suggest.h"
+
+namespace pandora {
+
+/// A camera model at one zoom: what a catalogue entry offers.
+struct ProposeLens {
+  std::string model;  ///< The catalogue's name ("" for the scene's own camera).
+  Intrinsics intrinsics;
+  double hfov_deg = 0;
+  double price = 0;
+  double near = 0.3, far = 1e9;
+};
+
+/// A catalogue of camera models (JSON, docs/propose.md): each model's sensor, resolution, focal
+/// range (or field-of-view range), distortion and price; zoom lenses give `zooms` settings over
+/// their range. Throws InputError naming the file and the JSON path.
+std::vector<ProposeLens> ReadCameraCatalogue(const std::string& path, int zooms = 3);
+
+/// A point a camera may be mounted at, and what it is on ("wall", "ceiling", "point", an object's
+/// name).
+struct MountPoint {
+  Vec3 position = Vec3::Zero();
+  std::string surface;
+};
+
+/// Mount points on the static scene's walls (rays cast horizontally from the study region's
+/// centre at each height, one per `spacing` metres of the walls' perimeter as seen from there) and
+/// ceiling (rays cast up from the region's top over a grid of the static scene's plan, kept where
+/// they meet a downward face), each `clearance` in from the surface it hit (along the surface's
+/// normal). Moving objects are left out.
+std::vector<MountPoint> WallMounts(const Scene& scene, const std::vector<double>& heights,
+                                   double spacing, double clearance);
+std::vector<MountPoint> CeilingMounts(const Scene& scene, double spacing, double clearance);
+/// Mount points under the named objects (a truss, a rail): a grid over the bottom face of each
+/// one's bounds, `clearance` below it. Throws InputError(scene.path, "", ...) for an unknown name.
+std::vector<MountPoint> ObjectMounts(const Scene& scene, const std::vector<std::string>& names,
+                                     double spacing, double clearance);
+
+/// Mount points filling a box (free space a frame or a rig of poles may hold cameras in): a grid at
+/// `spacing`, without the points closer than `clearance` to any surface of the scene as placed.
+std::vector<MountPoint> BoxMounts(const Scene& scene, const Aabb& box, double spacing,
+                                  double clearance);
+
+struct ProposeOptions {
+  int cameras = 12;     ///< Cameras per proposal (the most, with a budget).
+  double budget = 0;    ///< > 0: the total price may not exceed it.
+  int proposals = 3;    ///< How many different layouts.
+  Objective objective;  ///< kCoverage or kCoverageN1, with its k.
+  std::vector<MountPoint> mounts;
+  std::vector<ProposeLens> lenses;  ///< At least one.
+  int aims = 4;                     ///< Aim points per mount besides the targets' centroid.
+  double seconds = 20;              ///< The annealing's time, all proposals together.
+  /// > 0: the annealing takes this many swap trials per layout instead of a time (reproducible
+  /// whatever the machine's speed; `seconds` is then ignored).
+  std::int64_t iterations = 0;
+  double diversity = 0.004;  ///< Objective penalty per candidate an earlier proposal took.
+  std::uint64_t seed = 1;
+  std::function<void(const std::string& stage, double fraction)> progress;
+};
+
+struct Proposal {
+  std::vector<int> candidates;  ///< Indices into ProposeResult::candidates.
+  double objective = 0;         ///< Exact, over the target points (share, 0..1).
+  double coverage_k = 0;        ///< Share seen by >= k cameras.
+  double n1 = 0;                ///< Share seen by >= k after the worst single failure.
+  double price = 0;
+};
+
+struct ProposeResult {
+  std::vector<Camera> candidates;
+  std::vector<int> candidate_lens;  ///< Index into ProposeOptions::lenses per candidate.
+  std::vector<std::string> candidate_surface;
+  std::vector<Proposal> proposals;
+  int points = 0;
+  double visibility_seconds = 0, search_seconds = 0;
+  /// Greedy + annealing per camera count (ProposeCurve): (cameras, objective).
+  std::vector<std::pair<int, double>> curve;
+};
+
+/// The candidates (mount x aim x lens, looking at the aim, level) and their visibility of
+/// `targets` (each against sample_casters[target.sample], or `caster`), then the proposals.
+/// Throws InputError(scene.path, ...) when there are no mounts or lenses, or no candidate sees any
+/// target point.
+ProposeResult Propose(const Scene& scene, const RayCaster& caster,
+                      const std::vector<const RayCaster*>& sample_casters,
+                      const std::vector<TargetPoint>& targets, const ProposeOptions& options,
+                      int curve_from = 0, int curve_to = 0);
+
+/// Fixed cameras (an existing rig's enabled ones) judged as Propose judges its proposals, over the
+/// same target points: for the comparison beside them.
+Proposal ScoreCameras(const Scene& scene, const RayCaster& caster,
+                      const std::vector<const RayCaster*>& sample_casters,
+                      const std::vector<TargetPoint>& targets, const std::vector<Camera>& cameras,
+                      const Objective& objective);
+
+/// A proposal as a rig named `name` with ids NAME_1, ... and the candidates' colours.
+Rig ProposalRig(const ProposeResult& result, const Proposal& proposal, const std::string& name);
+
+}  // namespace pandora
