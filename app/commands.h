@@ -216,6 +216,9 @@ struct RigArgs {
   std::string resolution = "1920x1080";
   bool dry_run = false;
   bool quiet = false;
+  bool add = false;              ///< --add: append to the rig of that name (created when absent).
+  std::string catalogue, model;  ///< --catalogue F --model NAME: the cameras' lens.
+  std::string ptz;               ///< --ptz WIDEST,NARROWEST: PTZ heads.
 };
 int RunRig(const RigArgs& args);
 

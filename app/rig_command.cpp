@@ -1,8 +1,11 @@
 // `pandora rig`: generate a rig (ring, ceiling or wall grid, cameras along walls) and write it into
 // the scene file, with a backup (docs/rig-generators.md).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -17,6 +20,7 @@
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/output.h"
+#include "suggest/propose.h"
 #include "suggest/suggestion_file.h"
 
 namespace pandora::app {
@@ -34,55 +38,69 @@ double Positive(const std::string& option, double v) {
   return v;
 }
 
-std::string Metres(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
-
-// Moves each generated camera away from the scene's surfaces until its centre is at least
-// `clearance` from every one (a camera near a corner, set in from its own wall, can sit on the next
-// wall's face): along the distance's gradient (away from the nearest point), a few steps for
-// corners. The aim point stays. Returns one note per moved camera; throws InputError naming
-// `option` when a camera cannot be cleared (it is inside a solid thicker than the room allows).
-std::vector<std::string> KeepClearance(const Scene& scene, double clearance,
-                                       const std::string& option,
-                                       std::vector<GeneratedCamera>* cameras) {
-  std::vector<std::string> notes;
-  const TriangleMesh mesh = scene.AllTriangles();
-  if (mesh.triangles.empty()) return notes;
-  const SurfaceDistance distance(mesh);
-  const double h = 1e-5 * std::max(1.0, clearance);
-  for (GeneratedCamera& c : *cameras) {
-    const Vec3 start = c.position;
-    for (int step = 0; step < 32; ++step) {
-      const double d = distance.Distance(c.position, 2 * clearance);
-      if (d >= clearance * (1 - 1e-9)) break;
-      Vec3 grad;
-      for (int a = 0; a < 3; ++a) {
-        Vec3 e = Vec3::Zero();
-        e[a] = h;
-        grad[a] = (distance.Distance(c.position + e, 4 * clearance) -
-                   distance.Distance(c.position - e, 4 * clearance)) /
-                  (2 * h);
-      }
-      if (!(grad.norm() > 1e-6))
-        grad = (c.look_at - c.position).normalized();  // on a surface: go towards the aim
-      c.position += (clearance - d + 1e-6 * clearance) * grad.normalized();
+// The lens keys every generated camera gets: --resolution and --hfov, or a catalogue model
+// (its resolution, widest zoom, distortion, range); with --ptz a head zooming over WIDEST,NARROWEST
+// (or, `--ptz zoom`, over the catalogue model's zoom range).
+struct CameraTemplate {
+  scene_text::ordered_json keys;
+  std::optional<Vec2> range_m;  ///< near, far in metres (written in the file's units).
+};
+CameraTemplate CameraTemplateOf(const RigArgs& args, int width, int height) {
+  using scene_text::Clean;
+  using scene_text::Number;
+  using scene_text::ordered_json;
+  CameraTemplate t;
+  double hfov = args.hfov_deg;
+  if (!args.catalogue.empty()) {
+    if (args.model.empty()) throw InputError("--model", "", "which catalogue model?");
+    std::vector<ProposeLens> lenses;
+    for (const ProposeLens& l : ReadCameraCatalogue(args.catalogue))
+      if (l.model == args.model) lenses.push_back(l);
+    if (lenses.empty())
+      throw InputError("--model", "", "no model '" + args.model + "' in " + args.catalogue);
+    const ProposeLens& widest = *std::max_element(
+        lenses.begin(), lenses.end(),
+        [](const ProposeLens& a, const ProposeLens& b) { return a.hfov_deg < b.hfov_deg; });
+    const Intrinsics& k = widest.intrinsics;
+    width = k.width, height = k.height, hfov = widest.hfov_deg;
+    t.keys["resolution"] = {width, height};
+    t.keys["hfov_deg"] = Number(Clean(hfov));
+    if (k.model != LensModel::kPinhole) {
+      ordered_json d = {{"model", LensModelName(k.model)}, {"k1", k.k1}, {"k2", k.k2}};
+      if (k.model == LensModel::kFisheye)
+        d["k3"] = k.k3, d["k4"] = k.k4;
+      else
+        d["p1"] = k.p1, d["p2"] = k.p2, d["k3"] = k.k3;
+      t.keys["distortion"] = d;
     }
-    const double d = distance.Distance(c.position, 2 * clearance);
-    if (d < clearance * (1 - 1e-6))
-      throw InputError(option, "",
-                       "camera " + c.id + " cannot be kept " + Metres(clearance) +
-                           " m from every surface (it is " + Metres(d) + " m from one)",
-                       "move the layout away from the walls and objects");
-    if ((c.position - start).norm() > 0)
-      notes.push_back("camera " + c.id + " moved " + Metres((c.position - start).norm()) +
-                      " m away from a surface it was within " + Metres(clearance) + " m of");
+    t.range_m = Vec2(widest.near, widest.far < 1e8 ? widest.far : 1e6);
+    if (args.ptz == "zoom") {
+      if (lenses.size() < 2)
+        throw InputError("--ptz", "", "model '" + args.model + "' has no zoom range",
+                         "give --ptz WIDEST,NARROWEST");
+      const double narrow = std::min_element(lenses.begin(), lenses.end(),
+                                             [](const ProposeLens& a, const ProposeLens& b) {
+                                               return a.hfov_deg < b.hfov_deg;
+                                             })
+                                ->hfov_deg;
+      t.keys["ptz"] = {{"zoom_hfov_deg", {Number(Clean(hfov)), Number(Clean(narrow))}}};
+    }
+  } else {
+    if (!args.model.empty()) throw InputError("--model", "", "--model needs --catalogue");
+    if (args.ptz == "zoom") throw InputError("--ptz", "", "--ptz zoom needs --catalogue");
+    t.keys["resolution"] = {width, height};
+    t.keys["hfov_deg"] = Number(Clean(hfov));
   }
-  return notes;
+  if (!args.ptz.empty() && args.ptz != "zoom") {
+    const std::vector<double> z = ParseNumbers("--ptz", args.ptz, 2);
+    if (!(z[0] >= hfov - 1e-9 && z[1] <= hfov + 1e-9 && z[1] > 0 && z[0] < 180))
+      throw InputError("--ptz", "",
+                       "expected WIDEST,NARROWEST fields of view (degrees) round the camera's " +
+                           Number(Clean(hfov)).dump() + " (WIDEST >= it >= NARROWEST > 0)");
+    t.keys["ptz"] = {{"zoom_hfov_deg", {Number(Clean(z[0])), Number(Clean(z[1]))}}};
+  }
+  return t;
 }
-
 }  // namespace
 
 int RunRig(const RigArgs& args) {
@@ -185,24 +203,46 @@ int RunRig(const RigArgs& args) {
                                 scene_text::Number(scene_text::Clean(v.y() / mpu)),
                                 scene_text::Number(scene_text::Clean(v.z() / mpu))});
   };
-  ordered_json rig = {{"name", args.name}, {"cameras", ordered_json::array()}};
-  for (const GeneratedCamera& c : cameras)
-    rig["cameras"].push_back({{"id", c.id},
-                              {"position", point(c.position)},
-                              {"look_at", point(c.look_at)},
-                              {"up", ordered_json::array({c.up.x(), c.up.y(), c.up.z()})},
-                              {"resolution", {width, height}},
-                              {"hfov_deg", scene_text::Number(scene_text::Clean(args.hfov_deg))}});
-  bool replaced = false;
+  ordered_json* existing = nullptr;
   for (ordered_json& r : root["rigs"])
-    if (r.is_object() && r.contains("name") && r["name"] == args.name) {
-      if (!args.replace)
-        throw InputError("--name", "", "the scene already has a rig '" + args.name + "'",
-                         "choose another --name, or --replace to overwrite it");
-      r = rig;
-      replaced = true;
+    if (r.is_object() && r.contains("name") && r["name"] == args.name) existing = &r;
+  if (args.add && args.replace) throw InputError("--add", "", "give --add or --replace, not both");
+  if (existing && !args.replace && !args.add)
+    throw InputError("--name", "", "the scene already has a rig '" + args.name + "'",
+                     "choose another --name, --replace to overwrite it, or --add to add to it");
+  // Added to a rig: the new ids continue after the ones it has (name_13, name_14, ...).
+  if (existing && args.add) {
+    std::set<std::string> used;
+    for (const ordered_json& c : (*existing)["cameras"])
+      if (c.is_object() && c.contains("id")) used.insert(scene_text::IdOf(c["id"]));
+    int next = int(used.size());
+    for (GeneratedCamera& c : cameras) {
+      while (used.count(c.id = prefix + std::to_string(++next))) {
+      }
+      used.insert(c.id);
     }
-  if (!replaced) root["rigs"].push_back(rig);
+  }
+  const CameraTemplate lens = CameraTemplateOf(args, width, height);
+  ordered_json added = ordered_json::array();
+  for (const GeneratedCamera& c : cameras) {
+    ordered_json camera = {{"id", c.id},
+                           {"position", point(c.position)},
+                           {"look_at", point(c.look_at)},
+                           {"up", ordered_json::array({c.up.x(), c.up.y(), c.up.z()})}};
+    for (const auto& [key, value] : lens.keys.items()) camera[key] = value;
+    if (lens.range_m)
+      camera["range"] = {{"near", scene_text::Number(scene_text::Clean(lens.range_m->x() / mpu))},
+                         {"far", scene_text::Number(scene_text::Clean(lens.range_m->y() / mpu))}};
+    added.push_back(camera);
+  }
+  const bool replaced = existing && !args.add;
+  if (existing && args.add) {
+    for (const ordered_json& c : added) (*existing)["cameras"].push_back(c);
+  } else if (existing) {
+    *existing = {{"name", args.name}, {"cameras", added}};
+  } else {
+    root["rigs"].push_back({{"name", args.name}, {"cameras", added}});
+  }
   const std::string new_text = scene_text::DumpLike(root, text);
   // The new file must read: the whole scene (meshes too), for the rig's plausibility warnings.
   const Scene after = ParseScene(new_text, args.scene);
@@ -215,8 +255,8 @@ int RunRig(const RigArgs& args) {
     const std::string backup = ReplaceSceneFileWithBackup(args.scene, text, new_text);
     if (!args.quiet)
       std::printf("%s rig %s (%zu cameras) in %s (previous file kept as %s)\n",
-                  replaced ? "replaced" : "wrote", args.name.c_str(), cameras.size(),
-                  args.scene.c_str(), backup.c_str());
+                  replaced ? "replaced" : (existing ? "added to" : "wrote"), args.name.c_str(),
+                  cameras.size(), args.scene.c_str(), backup.c_str());
   }
   if (!args.quiet)
     for (const std::string& note : moved) std::printf("%s\n", note.c_str());
@@ -236,6 +276,14 @@ Command AddRigCommand(CLI::App& app, CommonOptions& /*common*/) {
   rg->add_option("scene", rig_args.scene, "Scene file (JSON)")->required();
   rg->add_option("--name", rig_args.name, "Name of the new rig")->required();
   rg->add_flag("--replace", rig_args.replace, "Overwrite the rig of that name");
+  rg->add_flag("--add", rig_args.add,
+               "Add the cameras to the rig of that name (several layouts into one rig)");
+  rg->add_option("--catalogue", rig_args.catalogue,
+                 "Camera catalogue (JSON, docs/propose.md): the cameras are --model");
+  rg->add_option("--model", rig_args.model, "The catalogue's model for every camera");
+  rg->add_option("--ptz", rig_args.ptz,
+                 "Make every camera a PTZ head zooming over WIDEST,NARROWEST degrees (or \"zoom\": "
+                 "the catalogue model's zoom range)");
   rg->add_option(
       "--ring", rig_args.ring,
       "Layout: N cameras on a horizontal circle (--radius, --height, --center X,Y,Z, --start-deg)");

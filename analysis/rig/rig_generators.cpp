@@ -2,8 +2,14 @@
 #include "analysis/rig/rig_generators.h"
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 #include <stdexcept>
 
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/geometry/surface_distance.h"
+#include "analysis/scene/scene.h"
+#include "analysis/util/error.h"
 #include "analysis/util/units.h"
 
 namespace pandora {
@@ -90,6 +96,79 @@ std::vector<GeneratedCamera> AlongWallsCameras(int count, const std::vector<Vec2
     out.push_back(Aimed(Id(prefix, k), Vec3(xy.x(), xy.y(), z), aim));
   }
   return out;
+}
+
+namespace {
+std::string ClearanceMetres(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+}  // namespace
+
+// Moves each generated camera away from the scene's surfaces until its centre is at least
+// `clearance` from every one (a camera near a corner, set in from its own wall, can sit on the next
+// wall's face): along the distance's gradient (away from the nearest point), a few steps for
+// corners. The aim point stays. Returns one note per moved camera; throws InputError naming
+// `option` when a camera cannot be cleared (it is inside a solid thicker than the room allows).
+std::vector<std::string> KeepClearance(const Scene& scene, double clearance,
+                                       const std::string& option,
+                                       std::vector<GeneratedCamera>* cameras) {
+  std::vector<std::string> notes;
+  const TriangleMesh mesh = scene.AllTriangles();
+  if (mesh.triangles.empty()) return notes;
+  const SurfaceDistance distance(mesh);
+  const double h = 1e-5 * std::max(1.0, clearance);
+  // The solids a camera may have landed inside (a cabinet a ring passes through).
+  std::vector<std::unique_ptr<InsideMesh>> solids;
+  for (const SceneObject& o : scene.objects)
+    if (o.solid) solids.push_back(std::make_unique<InsideMesh>(o.mesh));
+  auto gradient = [&](const Vec3& p, double limit) {
+    Vec3 g;
+    for (int a = 0; a < 3; ++a) {
+      Vec3 e = Vec3::Zero();
+      e[a] = h;
+      g[a] = (distance.Distance(p + e, limit) - distance.Distance(p - e, limit)) / (2 * h);
+    }
+    return g;
+  };
+  for (GeneratedCamera& c : *cameras) {
+    const Vec3 start = c.position;
+    // Inside a solid: out towards the aim point (into the open room), then on.
+    auto inside = [&solids](const Vec3& p) {
+      for (const auto& s : solids)
+        if (s->Inside(p)) return true;
+      return false;
+    };
+    if (inside(c.position)) {
+      const Vec3 to_aim = c.look_at - c.position;
+      const double step = std::max(0.25 * clearance, 1e-3);
+      for (double t = step; t < to_aim.norm() && inside(c.position); t += step)
+        c.position = start + t * to_aim.normalized();
+    }
+    for (int step = 0; step < 32; ++step) {
+      const double d = distance.Distance(c.position, 2 * clearance);
+      if (d >= clearance * (1 - 1e-9)) break;
+      Vec3 grad = gradient(c.position, 4 * clearance);
+      if (!(grad.norm() > 1e-6))
+        grad = (c.look_at - c.position).normalized();  // on a surface: go towards the aim
+      c.position += (clearance - d + 1e-6 * clearance) * grad.normalized();
+    }
+    const double d = distance.Distance(c.position, 2 * clearance);
+    if (inside(c.position))
+      throw InputError(option, "", "camera " + c.id + " is inside a solid object",
+                       "move the layout out of the objects");
+    if (d < clearance * (1 - 1e-6))
+      throw InputError(option, "",
+                       "camera " + c.id + " cannot be kept " + ClearanceMetres(clearance) +
+                           " m from every surface (it is " + ClearanceMetres(d) + " m from one)",
+                       "move the layout away from the walls and objects");
+    if ((c.position - start).norm() > 0)
+      notes.push_back("camera " + c.id + " moved " + ClearanceMetres((c.position - start).norm()) +
+                      " m away from a surface it was within " + ClearanceMetres(clearance) +
+                      " m of (or inside)");
+  }
+  return notes;
 }
 
 }  // namespace pandora

@@ -16,6 +16,8 @@
 
 namespace pandora {
 
+struct Scene;
+
 /// One generated camera: an id and a look_at pose (world, metres).
 struct GeneratedCamera {
   std::string id;
@@ -48,5 +50,14 @@ std::vector<GeneratedCamera> WallGridCameras(int nu, int nz, const Vec2& a, cons
 std::vector<GeneratedCamera> AlongWallsCameras(int count, const std::vector<Vec2>& walls, double z,
                                                double inset, const Vec3& aim,
                                                const std::string& prefix);
+
+/// Moves each generated camera away from the scene's surfaces until its centre is at least
+/// `clearance` from every one (a camera near a corner, set in from its own wall, can sit on the
+/// next wall's face): along the distance's gradient (away from the nearest point), a few steps for
+/// corners. The aim point stays. Returns one note per moved camera; throws InputError naming
+/// `option` when a camera cannot be cleared (it is inside a solid thicker than the room allows).
+std::vector<std::string> KeepClearance(const Scene& scene, double clearance,
+                                       const std::string& option,
+                                       std::vector<GeneratedCamera>* cameras);
 
 }  // namespace pandora

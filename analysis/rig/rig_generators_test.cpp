@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/geometry/camera.h"
+#include "analysis/geometry/inside_mesh.h"
+#include "analysis/geometry/surface_distance.h"
 #include "analysis/scene/scene.h"
 #include "analysis/util/units.h"
 
@@ -91,6 +93,55 @@ TEST(RigGenerators, AlongWallsIsEvenByLengthAndInset) {
       {-2, -2.85, 2.4}, {0, -2.85, 2.4}, {2, -2.85, 2.4}, {2.85, -2, 2.4}, {2.85, 0, 2.4}};
   for (int k = 0; k < 5; ++k) EXPECT_LE((cams[k].position - expected[k]).norm(), 1e-12) << k;
   ExpectAimedAt(ReadBack(cams), aim);
+}
+
+// Every generated camera keeps its stated clearance from every surface (issue 32): an L-shaped
+// room (walls, floor, ceiling) with a cabinet, and layouts that put cameras on or in them: along
+// the walls round the reflex corner, a wall grid beside the cabinet, a ceiling grid 2 cm under the
+// ceiling, a ring with a camera inside the cabinet.
+TEST(RigGenerators, EveryCameraKeepsItsClearance) {
+  const Scene scene = ParseScene(R"({"objects": [
+    {"name": "lab", "room": {"footprint": [[0, 0], [7, 0], [7, 3], [4, 3], [4, 5], [0, 5]],
+     "height": 2.8, "furniture": [{"type": "cabinet", "at": [1, 4.7]}]}}],
+    "rigs": [{"name": "r", "cameras": [{"id": "c", "position": [1, 1, 2], "look_at": [2, 2, 1],
+      "resolution": [640, 480], "hfov_deg": 60}]}],
+    "study": {"region": {"box": {"min": [0.5, 0.5, 0.1], "max": [3.5, 4.5, 2]}}}})",
+                                 "l.json");
+  const Vec3 aim(2, 2, 1);
+  struct Case {
+    const char* name;
+    std::vector<GeneratedCamera> cameras;
+    double clearance;
+  };
+  // Along [(0, 0), (7, 0), (7, 3)] (10 m), camera 3 of 5 is at 7 m: the corner.
+  const std::vector<Vec2> walls = {{0, 0}, {7, 0}, {7, 3}};
+  const std::vector<Case> cases = {
+      {"along", AlongWallsCameras(5, walls, 2.4, 0.1, aim, "a"), 0.1},
+      {"wall grid", WallGridCameras(4, 3, Vec2(0, 5), Vec2(3, 5), 0.5, 2.5, 0.1, aim, "w"), 0.1},
+      {"ceiling grid", CeilingGridCameras(3, 3, Vec2(0.2, 0.2), Vec2(3.8, 4.8), 2.78, nullptr, "g"),
+       0.05},
+      {"ring", RingCameras(8, Vec3(1.3, 3.5, 1.5), 1.2, 0, aim, "r"), 0.05}};
+  const SurfaceDistance distance(scene.AllTriangles());
+  for (Case c : cases) {
+    int closer = 0;
+    for (const GeneratedCamera& g : c.cameras) {
+      bool inside = false;
+      for (const SceneObject& o : scene.objects)
+        inside |= o.solid && InsideMesh(o.mesh).Inside(g.position);
+      closer += inside || distance.Distance(g.position) < c.clearance * (1 - 1e-6);
+    }
+    EXPECT_GT(closer, 0) << c.name << ": the case must start with cameras too close "
+                         << c.cameras[0].position.transpose();
+    const std::vector<std::string> notes =
+        KeepClearance(scene, c.clearance, "--" + std::string(c.name), &c.cameras);
+    EXPECT_EQ(int(notes.size()), closer) << c.name;
+    for (const GeneratedCamera& g : c.cameras) {
+      EXPECT_GE(distance.Distance(g.position), c.clearance * (1 - 1e-6))
+          << c.name << " " << g.id << " at " << g.position.transpose();
+      for (const SceneObject& o : scene.objects)
+        EXPECT_FALSE(o.solid && InsideMesh(o.mesh).Inside(g.position)) << c.name << " " << g.id;
+    }
+  }
 }
 
 }  // namespace

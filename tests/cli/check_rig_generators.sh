@@ -55,4 +55,18 @@ err 5 "X0 < X1" rig "$work/s.json" --name x --grid 2,2 --rect 1,1,0,0 --height 2
 err 6 "has no length" rig "$work/s.json" --name x --along 1,1,1,1 --count 3 --height 2
 err 7 "needs its radius" rig "$work/s.json" --name x --ring 3 --height 2
 err 8 "on the point" rig "$work/s.json" --name x --grid 1,1 --rect=-1,-1,1,1 --height 1 --aim 0,0,1
+# Several layouts into one rig (--add): the ids continue; a catalogue model's lens; PTZ heads.
+catalogue="$(dirname "$0")/../../examples/lab_from_room/cameras.json"
+"$pandora" rig "$work/s.json" --name mixed --ring 3 --radius 1 --height 2 -q || fail "mixed ring"
+"$pandora" rig "$work/s.json" --name mixed --add --grid 2,1 --rect=-1,-1,1,1 --height 2.3 \
+  --catalogue "$catalogue" --model zoom-4MP --ptz zoom -q || fail "--add"
+jq -e '[.rigs[] | select(.name == "mixed") | .cameras[] | .id] == ["mixed_1", "mixed_2", "mixed_3", "mixed_4", "mixed_5"]' "$work/s.json" >/dev/null || fail "--add ids"
+jq -e '[.rigs[] | select(.name == "mixed") | .cameras[3] | .resolution == [2688, 1520] and .distortion.model == "brown_conrady" and .ptz.zoom_hfov_deg[0] == .hfov_deg and .ptz.zoom_hfov_deg[1] < 30] | all' "$work/s.json" >/dev/null || fail "catalogue + ptz"
+"$pandora" analyze "$work/s.json" --rig mixed --out "$work/mixed" --quiet || fail "analyze mixed"
+"$pandora" rig "$work/s.json" --name ptz2 --ring 2 --radius 1 --height 2 --hfov 60 --ptz 60,10 -q || fail "--ptz"
+jq -e '[.rigs[] | select(.name == "ptz2") | .cameras[].ptz.zoom_hfov_deg] == [[60, 10], [60, 10]]' "$work/s.json" >/dev/null || fail "ptz block"
+err 9 "not both" rig "$work/s.json" --name mixed --add --replace --ring 2 --radius 1 --height 2
+err 10 "no model 'nope'" rig "$work/s.json" --name y --ring 2 --radius 1 --height 2 --catalogue "$catalogue" --model nope
+err 11 "WIDEST,NARROWEST" rig "$work/s.json" --name y --ring 2 --radius 1 --height 2 --hfov 60 --ptz 50,10
+err 12 "no zoom range" rig "$work/s.json" --name y --ring 2 --radius 1 --height 2 --catalogue "$catalogue" --model mocap-3MP --ptz zoom
 echo "ok"
