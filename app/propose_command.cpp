@@ -71,6 +71,18 @@ ordered_json CameraJson(const Camera& c, const ProposeLens& lens, const std::str
   return j;
 }
 
+ordered_json TermsJson(const std::vector<ProposeTerm>& terms, const Proposal& p) {
+  ordered_json out = ordered_json::array();
+  for (std::size_t t = 0; t < terms.size(); ++t)
+    out.push_back({{"term", terms[t].name},
+                   {"weight", terms[t].weight},
+                   {"k", terms[t].k},
+                   {"n1", terms[t].n1},
+                   {"min_px_per_m", terms[t].min_px_per_m},
+                   {"value", p.terms[t]}});
+  return out;
+}
+
 std::vector<ProposeLens> Lenses(const ProposeArgs& args, const Scene& scene) {
   std::vector<ProposeLens> lenses;
   if (!args.catalogue.empty()) {
@@ -159,11 +171,7 @@ std::string ProposalPercent(double v) {
 }
 
 // The options' values checked (InputError naming the option); the objective and the curve's range.
-Objective CheckProposeArgs(const ProposeArgs& args, int* curve_from, int* curve_to) {
-  const std::optional<Objective> objective = ParseObjective(args.objective);
-  if (!objective || (objective->kind != ObjectiveKind::kCoverage &&
-                     objective->kind != ObjectiveKind::kCoverageN1))
-    throw InputError("--objective", "", "expected coverageK or coverageK-n1 (e.g. coverage3)");
+void CheckProposeArgs(const ProposeArgs& args, int* curve_from, int* curve_to) {
   if (args.cameras < 1 || args.cameras > 500)
     throw InputError("--cameras", "", "expected 1 to 500 cameras");
   if (args.proposals < 1 || args.proposals > 20)
@@ -185,19 +193,18 @@ Objective CheckProposeArgs(const ProposeArgs& args, int* curve_from, int* curve_
       throw InputError("--curve", "", "expected FROM:TO cameras, 1 <= FROM <= TO <= 200");
     *curve_from = int(r[0]), *curve_to = int(r[1]);
   }
-  return *objective;
 }
 
 int RunPropose(const ProposeArgs& args) {
   int curve_from = 0, curve_to = 0;
-  const std::optional<Objective> objective = CheckProposeArgs(args, &curve_from, &curve_to);
+  CheckProposeArgs(args, &curve_from, &curve_to);
   const std::string text = scene_text::ReadJsonText(args.scene, "scene file");
   const Scene scene = ParseScene(text, args.scene);
   ProposeOptions options;
   options.cameras = args.cameras;
   options.budget = args.budget;
   options.proposals = args.proposals;
-  options.objective = *objective;
+  options.terms = ParseProposeObjective(args.objective, scene);
   options.aims = args.aims;
   options.seconds = args.seconds;
   options.seed = args.seed;
@@ -238,7 +245,7 @@ int RunPropose(const ProposeArgs& args) {
   for (const Rig& rig : scene.rigs)
     if (args.compare == "all" || std::find(names.begin(), names.end(), rig.name) != names.end())
       compared.emplace_back(
-          rig.name, ScoreCameras(scene, *caster, casters, targets, rig.cameras, *objective));
+          rig.name, ScoreCameras(scene, *caster, casters, targets, rig.cameras, options.terms));
   for (const std::string& n : names)
     if (n != "all") FindRigOption(scene, n);
 
@@ -246,7 +253,7 @@ int RunPropose(const ProposeArgs& args) {
       {"pandora_proposals", 1},
       {"scene", std::filesystem::absolute(args.scene).lexically_normal().string()},
       {"scene_sha256", Sha256Hex(text)},
-      {"objective", ObjectiveName(*objective)},
+      {"objective", args.objective},
       {"points", result.points},
       {"samples", std::max<std::size_t>(1, casters.size())},
       {"mounts", options.mounts.size()},
@@ -255,8 +262,8 @@ int RunPropose(const ProposeArgs& args) {
       {"seconds", {{"visibility", result.visibility_seconds}, {"search", result.search_seconds}}},
       {"proposals", ordered_json::array()},
       {"compared", ordered_json::array()}};
-  std::string md = "# Proposals for " + args.scene + "\n\nObjective " + ObjectiveName(*objective) +
-                   " over " + std::to_string(result.points) + " target points; " +
+  std::string md = "# Proposals for " + args.scene + "\n\nObjective " + args.objective + " over " +
+                   std::to_string(result.points) + " target points; " +
                    std::to_string(result.candidates.size()) + " candidates (" +
                    std::to_string(options.mounts.size()) + " mounts x " +
                    std::to_string(options.aims + 1) + " aims x " +
@@ -276,6 +283,7 @@ int RunPropose(const ProposeArgs& args) {
     }
     doc["proposals"].push_back({{"name", name},
                                 {"objective", proposal.objective},
+                                {"terms", TermsJson(options.terms, proposal)},
                                 {"coverage_k", proposal.coverage_k},
                                 {"n1", proposal.n1},
                                 {"price", proposal.price},
@@ -288,6 +296,7 @@ int RunPropose(const ProposeArgs& args) {
   for (const auto& [name, score] : compared) {
     doc["compared"].push_back({{"rig", name},
                                {"objective", score.objective},
+                               {"terms", TermsJson(options.terms, score)},
                                {"coverage_k", score.coverage_k},
                                {"n1", score.n1}});
     md += "| " + name + " (in the scene) | " + std::to_string(scene.FindRig(name).enabled_count()) +
@@ -386,7 +395,9 @@ Command AddProposeCommand(CLI::App& app, CommonOptions& /*common*/) {
       ->capture_default_str();
   c->add_option("--budget", a.budget, "Total price limit (the catalogue's prices)");
   c->add_option("--proposals", a.proposals, "How many different layouts")->capture_default_str();
-  c->add_option("--objective", a.objective, "coverageK or coverageK-n1 over the target points")
+  c->add_option("--objective", a.objective,
+                "Terms [W*]coverageK[-n1][@DENSITY] joined by +, DENSITY px/m, a DORI class or a "
+                "pixel target (docs/propose.md)")
       ->capture_default_str();
   c->add_option("--points", a.points,
                 "Target points (per target and sample with the study's targets, else in the "

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include "analysis/geometry/ray_caster.h"
@@ -83,61 +84,95 @@ std::vector<Vec3> AimPoints(const std::vector<TargetPoint>& targets, int k, std:
   return centres;
 }
 
-// The search state over the visibility bit matrix.
-struct Search {
-  const std::vector<std::vector<std::uint64_t>>& vis;
-  const std::vector<double>& price;
-  const std::vector<int>& mount_of;
-  int points, k;
+using BitMatrix = std::vector<std::vector<std::uint64_t>>;
+
+// One objective term's state: counts of the selected cameras per point (at the term's density).
+struct TermState {
+  const BitMatrix* vis;
+  int k;
   bool n1;
-  double budget;
+  double weight;
   std::vector<int> counts;
-  std::vector<int> selected;
   int ge_k = 0;
   long soft = 0;
+};
 
+// The search state over the visibility bit matrices, one per term.
+struct Search {
+  std::vector<TermState> terms;
+  const std::vector<double>& price;
+  const std::vector<int>& mount_of;
+  int points;
+  double budget;
+  std::vector<int> selected;
+
+  int candidates() const { return int(terms.front().vis->size()); }
   void Reset() {
-    counts.assign(std::size_t(points), 0);
+    for (TermState& t : terms) {
+      t.counts.assign(std::size_t(points), 0);
+      t.ge_k = 0, t.soft = 0;
+    }
     selected.clear();
-    ge_k = 0, soft = 0;
   }
   void Add(int c, int sign) {
-    const std::vector<std::uint64_t>& bits = vis[std::size_t(c)];
-    for (std::size_t w = 0; w < bits.size(); ++w)
-      for (std::uint64_t b = bits[w]; b; b &= b - 1) {
-        int& n = counts[w * 64 + std::size_t(__builtin_ctzll(b))];
-        if (sign > 0) {
-          soft += n < k;
-          ++n;
-          ge_k += n == k;
-        } else {
-          ge_k -= n == k;
-          --n;
-          soft -= n < k;
+    for (TermState& t : terms) {
+      const std::vector<std::uint64_t>& bits = (*t.vis)[std::size_t(c)];
+      for (std::size_t w = 0; w < bits.size(); ++w)
+        for (std::uint64_t b = bits[w]; b; b &= b - 1) {
+          int& n = t.counts[w * 64 + std::size_t(__builtin_ctzll(b))];
+          if (sign > 0) {
+            t.soft += n < t.k;
+            ++n;
+            t.ge_k += n == t.k;
+          } else {
+            t.ge_k -= n == t.k;
+            --n;
+            t.soft -= n < t.k;
+          }
         }
-      }
+    }
   }
-  // The share seen by >= k after the worst single failure among the selected cameras.
-  double N1Share() const {
+  // A term's share seen by >= k after the worst single failure among the selected cameras.
+  double N1Share(const TermState& t) const {
     std::vector<std::uint64_t> at_k((std::size_t(points) + 63) / 64, 0);
     for (int i = 0; i < points; ++i)
-      if (counts[std::size_t(i)] == k) at_k[std::size_t(i) / 64] |= 1ull << (i % 64);
+      if (t.counts[std::size_t(i)] == t.k) at_k[std::size_t(i) / 64] |= 1ull << (i % 64);
     int worst = 0;
     for (int c : selected) {
       int lost = 0;
-      const std::vector<std::uint64_t>& bits = vis[std::size_t(c)];
+      const std::vector<std::uint64_t>& bits = (*t.vis)[std::size_t(c)];
       for (std::size_t w = 0; w < bits.size(); ++w) lost += __builtin_popcountll(bits[w] & at_k[w]);
       worst = std::max(worst, lost);
     }
-    return double(ge_k - worst) / points;
+    return double(t.ge_k - worst) / points;
   }
-  double Exact() const { return n1 ? N1Share() : double(ge_k) / points; }
+  double Share(const TermState& t) const { return double(t.ge_k) / points; }
+  double TermValue(const TermState& t) const { return t.n1 ? N1Share(t) : Share(t); }
+  double Exact() const {
+    double v = 0;
+    for (const TermState& t : terms) v += t.weight * TermValue(t);
+    return v;
+  }
   // What the search maximises: the exact objective, the soft one as a tie-break, less the
   // diversity penalty.
   double Score(const std::vector<char>& taken_mounts, double diversity) const {
-    double s = Exact() + 1e-3 * double(soft) / (double(points) * k);
+    double s = Exact();
+    for (const TermState& t : terms) s += 1e-3 * t.weight * double(t.soft) / (double(points) * t.k);
     for (int c : selected) s -= taken_mounts[std::size_t(mount_of[std::size_t(c)])] ? diversity : 0;
     return s;
+  }
+  // The soft objective's gain of adding candidate c.
+  double Gain(int c) const {
+    double g = 0;
+    for (const TermState& t : terms) {
+      long n = 0;
+      const std::vector<std::uint64_t>& bits = (*t.vis)[std::size_t(c)];
+      for (std::size_t w = 0; w < bits.size(); ++w)
+        for (std::uint64_t b = bits[w]; b; b &= b - 1)
+          n += t.counts[w * 64 + std::size_t(__builtin_ctzll(b))] < t.k;
+      g += t.weight * double(n) / (double(points) * t.k);
+    }
+    return g;
   }
   double Price() const {
     double p = 0;
@@ -149,7 +184,7 @@ struct Search {
 // Greedy on the soft objective, then simulated annealing of swaps for `seconds`.
 void Optimise(Search* s, int n, const std::vector<char>& taken_mounts, double diversity,
               double seconds, std::int64_t iterations, std::uint64_t seed) {
-  const int candidates = int(s->vis.size());
+  const int candidates = s->candidates();
   s->Reset();
   std::vector<char> in(std::size_t(candidates), 0);
   for (int step = 0; step < n; ++step) {
@@ -158,15 +193,10 @@ void Optimise(Search* s, int n, const std::vector<char>& taken_mounts, double di
     const double left = s->budget > 0 ? s->budget - s->Price() : 1e300;
     for (int c = 0; c < candidates; ++c) {
       if (in[std::size_t(c)] || s->price[std::size_t(c)] > left) continue;
-      long gain = 0;
-      const std::vector<std::uint64_t>& bits = s->vis[std::size_t(c)];
-      for (std::size_t w = 0; w < bits.size(); ++w)
-        for (std::uint64_t b = bits[w]; b; b &= b - 1)
-          gain += s->counts[w * 64 + std::size_t(__builtin_ctzll(b))] < s->k;
       // With a budget, value for money: the gain per unit of price.
       const double per_price =
           s->budget > 0 ? 1.0 / std::max(s->price[std::size_t(c)], 1e-9 * s->budget) : 1.0;
-      const double g = double(gain) / s->points * per_price -
+      const double g = s->Gain(c) * per_price -
                        (taken_mounts[std::size_t(s->mount_of[std::size_t(c)])] ? diversity : 0);
       if (g > best_gain) best_gain = g, best = c;
     }
@@ -252,14 +282,17 @@ void MakeCandidates(const ProposeOptions& options, const std::vector<Vec3>& aims
       }
 }
 
-// vis[c]: bit i set when candidate c sees target point i (exact tests, the point's own sample).
-std::vector<std::vector<std::uint64_t>> Visibility(
-    const Scene& scene, const RayCaster& caster,
-    const std::vector<const RayCaster*>& sample_casters, const std::vector<TargetPoint>& targets,
-    const std::vector<Camera>& candidates, const ProposeOptions& options) {
+// vis[d][c]: bit i set when candidate c sees target point i at densities[d] px/m or more (exact
+// tests, the point's own sample; density 0: seen at all).
+std::vector<BitMatrix> Visibility(const Scene& scene, const RayCaster& caster,
+                                  const std::vector<const RayCaster*>& sample_casters,
+                                  const std::vector<TargetPoint>& targets,
+                                  const std::vector<Camera>& candidates,
+                                  const std::vector<double>& densities,
+                                  const ProposeOptions& options) {
   const std::size_t words = (targets.size() + 63) / 64;
-  std::vector<std::vector<std::uint64_t>> vis(candidates.size(),
-                                              std::vector<std::uint64_t>(words, 0));
+  std::vector<BitMatrix> vis(densities.size(),
+                             BitMatrix(candidates.size(), std::vector<std::uint64_t>(words, 0)));
   const double scale = scene.ContentBounds().diagonal();
   std::vector<std::unique_ptr<VisibilityTester>> testers;
   const std::size_t samples = std::max<std::size_t>(1, sample_casters.size());
@@ -272,7 +305,11 @@ std::vector<std::vector<std::uint64_t>> Visibility(
       const TargetPoint& t = targets[i];
       const VisibilityTester& tester = *testers[sample_casters.empty() ? 0 : std::size_t(t.sample)];
       const Vec3* normal = t.normal ? &*t.normal : nullptr;
-      if (tester.Test(int(c), t.p, normal) == ViewResult::kSeen) vis[c][i / 64] |= 1ull << (i % 64);
+      Mat23 J;
+      if (tester.Test(int(c), t.p, normal, &J) != ViewResult::kSeen) continue;
+      const double density = PixelDensity(J);
+      for (std::size_t d = 0; d < densities.size(); ++d)
+        if (density >= densities[d]) vis[d][c][i / 64] |= 1ull << (i % 64);
     }
     const std::size_t n = ++done;
     if (options.progress && n % 64 == 0)
@@ -281,7 +318,102 @@ std::vector<std::vector<std::uint64_t>> Visibility(
   return vis;
 }
 
+// The distinct densities of the terms, and the search's term states over their matrices.
+std::vector<double> TermDensities(const std::vector<ProposeTerm>& terms) {
+  std::vector<double> d;
+  for (const ProposeTerm& t : terms)
+    if (std::find(d.begin(), d.end(), t.min_px_per_m) == d.end()) d.push_back(t.min_px_per_m);
+  return d;
+}
+std::vector<TermState> TermStates(const std::vector<ProposeTerm>& terms,
+                                  const std::vector<double>& densities,
+                                  const std::vector<BitMatrix>& vis) {
+  std::vector<TermState> out;
+  for (const ProposeTerm& t : terms) {
+    const std::size_t d = std::size_t(
+        std::find(densities.begin(), densities.end(), t.min_px_per_m) - densities.begin());
+    out.push_back({&vis[d], t.k, t.n1, t.weight, {}, 0, 0});
+  }
+  return out;
+}
+
+// The proposal's numbers from the search's state.
+Proposal Measure(const Search& search) {
+  Proposal p;
+  p.candidates = search.selected;
+  p.objective = search.Exact();
+  for (const TermState& t : search.terms) p.terms.push_back(search.TermValue(t));
+  p.coverage_k = search.Share(search.terms.front());
+  p.n1 = search.N1Share(search.terms.front());
+  p.price = search.Price();
+  return p;
+}
+
 }  // namespace
+
+std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Scene& scene) {
+  auto fail = [&text](const std::string& why) -> std::vector<ProposeTerm> {
+    throw InputError("--objective", "", "'" + text + "': " + why,
+                     "terms [W*]coverageK[-n1][@DENSITY] joined by '+', DENSITY px/m, detection, "
+                     "observation, recognition, identification or a pixel target, e.g. "
+                     "0.7*coverage3+0.3*coverage1@identification");
+  };
+  std::vector<ProposeTerm> terms;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t plus = text.find('+', at);
+    std::string term = text.substr(at, plus == std::string::npos ? std::string::npos : plus - at);
+    at = plus == std::string::npos ? text.size() + 1 : plus + 1;
+    ProposeTerm t;
+    t.name = term;
+    const std::size_t star = term.find('*');
+    if (star != std::string::npos) {
+      char* end = nullptr;
+      const std::string w = term.substr(0, star);
+      t.weight = std::strtod(w.c_str(), &end);
+      if (w.empty() || *end != '\0' || !(t.weight > 0 && t.weight <= 1e6))
+        return fail("a weight must be a positive number");
+      term = term.substr(star + 1);
+      t.name = term;
+    }
+    const std::size_t sign = term.find('@');
+    if (sign != std::string::npos) {
+      const std::string d = term.substr(sign + 1);
+      term = term.substr(0, sign);
+      const std::vector<std::string> dori = {"detection", "observation", "recognition",
+                                             "identification"};
+      const double px[4] = {25.0, 62.5, 125.0, 250.0};
+      bool found = false;
+      for (std::size_t i = 0; i < dori.size(); ++i)
+        if (d == dori[i]) t.min_px_per_m = px[i], found = true;
+      for (const PixelTarget& p : scene.study.pixel_targets)
+        if (!found && d == p.name) t.min_px_per_m = p.px_per_m(), found = true;
+      if (!found) {
+        char* end = nullptr;
+        t.min_px_per_m = std::strtod(d.c_str(), &end);
+        if (d.empty() || *end != '\0' || !(t.min_px_per_m > 0 && t.min_px_per_m < 1e9))
+          return fail("unknown density '" + d + "'");
+      }
+    }
+    if (term.size() > 3 && term.compare(term.size() - 3, 3, "-n1") == 0) {
+      t.n1 = true;
+      term.resize(term.size() - 3);
+    }
+    if (term.rfind("coverage", 0) != 0) return fail("a term is coverageK, not '" + term + "'");
+    const std::string k = term.substr(8);
+    if (k.empty()) {
+      t.k = 1;
+    } else {
+      char* end = nullptr;
+      const long v = std::strtol(k.c_str(), &end, 10);
+      if (*end != '\0' || v < 1 || v > 64) return fail("K must be 1 to 64");
+      t.k = int(v);
+    }
+    terms.push_back(t);
+    if (terms.size() > 8) return fail("at most 8 terms");
+  }
+  return terms;
+}
 
 std::vector<MountPoint> WallMounts(const Scene& scene, const std::vector<double>& heights,
                                    double spacing, double clearance) {
@@ -395,21 +527,25 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
   const Clock::time_point t0 = Clock::now();
   std::vector<int> mount_of;
   MakeCandidates(options, AimPoints(targets, options.aims, options.seed), &result, &mount_of);
-  std::vector<std::vector<std::uint64_t>> vis =
-      Visibility(scene, caster, sample_casters, targets, result.candidates, options);
+  const std::vector<double> densities = TermDensities(options.terms);
+  const std::vector<BitMatrix> vis =
+      Visibility(scene, caster, sample_casters, targets, result.candidates, densities, options);
   result.visibility_seconds = Since(t0);
   std::vector<double> price;
   for (int l : result.candidate_lens) price.push_back(options.lenses[std::size_t(l)].price);
   bool any = false;
-  for (const auto& v : vis)
+  for (const auto& v : vis.front())
     for (std::uint64_t w : v) any |= w != 0;
   if (!any)
     throw InputError(scene.path, "", "no candidate camera sees any target point",
                      "check the mounts (walls, ceiling) and the lenses' range");
   const Clock::time_point t1 = Clock::now();
-  const bool n1 = options.objective.kind == ObjectiveKind::kCoverageN1;
-  Search search{vis, price, mount_of, result.points, options.objective.k, n1, options.budget, {},
-                {},  0,     0};
+  Search search{TermStates(options.terms, densities, vis),
+                price,
+                mount_of,
+                result.points,
+                options.budget,
+                {}};
   const int curve_n = curve_to >= curve_from && curve_from > 0 ? curve_to - curve_from + 1 : 0;
   const double per = options.seconds / std::max(1, options.proposals + curve_n);
   std::vector<char> taken(options.mounts.size(), 0);
@@ -417,14 +553,8 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
     if (options.progress) options.progress("search", double(p) / options.proposals);
     Optimise(&search, options.cameras, taken, p == 0 ? 0.0 : options.diversity, per,
              options.iterations, options.seed + std::uint64_t(p) * 7919);
-    Proposal proposal;
-    proposal.candidates = search.selected;
-    proposal.coverage_k = double(search.ge_k) / result.points;
-    proposal.n1 = search.N1Share();
-    proposal.objective = search.Exact();
-    proposal.price = search.Price();
     for (int c : search.selected) taken[std::size_t(mount_of[std::size_t(c)])] = 1;
-    result.proposals.push_back(proposal);
+    result.proposals.push_back(Measure(search));
   }
   const std::vector<char> none(options.mounts.size(), 0);
   for (int n = curve_from; curve_n > 0 && n <= curve_to; ++n) {
@@ -442,36 +572,23 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
 Proposal ScoreCameras(const Scene& scene, const RayCaster& caster,
                       const std::vector<const RayCaster*>& sample_casters,
                       const std::vector<TargetPoint>& targets, const std::vector<Camera>& cameras,
-                      const Objective& objective) {
+                      const std::vector<ProposeTerm>& terms) {
   std::vector<Camera> enabled;
   for (const Camera& c : cameras)
     if (c.enabled) enabled.push_back(c);
   const ProposeOptions options;
-  const std::vector<std::vector<std::uint64_t>> vis =
-      Visibility(scene, caster, sample_casters, targets, enabled, options);
+  const std::vector<double> densities = TermDensities(terms);
+  const std::vector<BitMatrix> vis =
+      Visibility(scene, caster, sample_casters, targets, enabled, densities, options);
   const std::vector<double> price(enabled.size(), 0.0);
   const std::vector<int> mount_of(enabled.size(), 0);
-  Search search{vis,
-                price,
-                mount_of,
-                int(targets.size()),
-                objective.k,
-                objective.kind == ObjectiveKind::kCoverageN1,
-                0,
-                {},
-                {},
-                0,
-                0};
+  Search search{TermStates(terms, densities, vis), price, mount_of, int(targets.size()), 0, {}};
   search.Reset();
   for (std::size_t c = 0; c < enabled.size(); ++c) {
     search.Add(int(c), +1);
     search.selected.push_back(int(c));
   }
-  Proposal p;
-  p.coverage_k = targets.empty() ? 0 : double(search.ge_k) / double(targets.size());
-  p.n1 = targets.empty() ? 0 : search.N1Share();
-  p.objective = search.Exact();
-  return p;
+  return Measure(search);
 }
 
 Rig ProposalRig(const ProposeResult& result, const Proposal& proposal, const std::string& name) {

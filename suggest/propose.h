@@ -59,11 +59,29 @@ std::vector<MountPoint> ObjectMounts(const Scene& scene, const std::vector<std::
 std::vector<MountPoint> BoxMounts(const Scene& scene, const Aabb& box, double spacing,
                                   double clearance);
 
+/// One term of a proposal's objective: `weight` times the share of target points seen by at least
+/// `k` cameras, each at `min_px_per_m` or more (0: any density), after the worst single camera
+/// failure when `n1`.
+struct ProposeTerm {
+  double weight = 1;
+  int k = 3;
+  bool n1 = false;
+  double min_px_per_m = 0;
+  std::string name;  ///< As written ("coverage3", "coverage1@identification").
+};
+
+/// Parses an objective: terms joined by '+', each "[W*]coverageK[-n1][@DENSITY]", DENSITY a number
+/// of px/m, a DORI class of EN 62676-4 (detection 25, observation 62.5, recognition 125,
+/// identification 250) or a pixel target of the scene's study (its min_px / size_m), e.g.
+/// "coverage3", "coverage3-n1", "0.7*coverage3+0.3*coverage1@identification". Throws
+/// InputError("--objective", ...) naming what is wrong.
+std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Scene& scene);
+
 struct ProposeOptions {
-  int cameras = 12;     ///< Cameras per proposal (the most, with a budget).
-  double budget = 0;    ///< > 0: the total price may not exceed it.
-  int proposals = 3;    ///< How many different layouts.
-  Objective objective;  ///< kCoverage or kCoverageN1, with its k.
+  int cameras = 12;   ///< Cameras per proposal (the most, with a budget).
+  double budget = 0;  ///< > 0: the total price may not exceed it.
+  int proposals = 3;  ///< How many different layouts.
+  std::vector<ProposeTerm> terms = {ProposeTerm()};  ///< The objective: their weighted sum.
   std::vector<MountPoint> mounts;
   std::vector<ProposeLens> lenses;  ///< At least one.
   int aims = 4;                     ///< Aim points per mount besides the targets' centroid.
@@ -78,9 +96,10 @@ struct ProposeOptions {
 
 struct Proposal {
   std::vector<int> candidates;  ///< Indices into ProposeResult::candidates.
-  double objective = 0;         ///< Exact, over the target points (share, 0..1).
-  double coverage_k = 0;        ///< Share seen by >= k cameras.
-  double n1 = 0;                ///< Share seen by >= k after the worst single failure.
+  double objective = 0;         ///< Exact: the terms' weighted sum over the target points.
+  std::vector<double> terms;    ///< Each term's value (share, 0..1), in ProposeOptions order.
+  double coverage_k = 0;        ///< The first term's share seen by >= k cameras (at its density).
+  double n1 = 0;                ///< The first term's share after the worst single failure.
   double price = 0;
 };
 
@@ -109,7 +128,7 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
 Proposal ScoreCameras(const Scene& scene, const RayCaster& caster,
                       const std::vector<const RayCaster*>& sample_casters,
                       const std::vector<TargetPoint>& targets, const std::vector<Camera>& cameras,
-                      const Objective& objective);
+                      const std::vector<ProposeTerm>& terms);
 
 /// A proposal as a rig named `name` with ids NAME_1, ... and the candidates' colours.
 Rig ProposalRig(const ProposeResult& result, const Proposal& proposal, const std::string& name);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "analysis/geometry/ray_caster.h"
+#include "analysis/geometry/visibility.h"
 #include "analysis/util/error.h"
 #include "analysis/util/units.h"
 #include "tests/temp_dir.h"
@@ -32,8 +33,8 @@ ProposeOptions Options(const Scene& scene) {
   lens.intrinsics = scene.rigs[0].cameras[0].model.intrinsics();
   lens.hfov_deg = 60;
   o.lenses = {lens};
-  o.objective.kind = ObjectiveKind::kCoverage;
-  o.objective.k = 2;
+  o.terms = {ProposeTerm()};
+  o.terms[0].k = 2;
   o.iterations = 20000;
   return o;
 }
@@ -62,8 +63,7 @@ TEST(Propose, TheAnnealingFindsTheBruteForceOptimum) {
     for (int b = a + 1; b < n; ++b)
       for (int c = b + 1; c < n; ++c) {
         const std::vector<Camera> cams = {r.candidates[a], r.candidates[b], r.candidates[c]};
-        best =
-            std::max(best, ScoreCameras(scene, *caster, {}, targets, cams, o.objective).objective);
+        best = std::max(best, ScoreCameras(scene, *caster, {}, targets, cams, o.terms).objective);
       }
   ASSERT_EQ(r.proposals.size(), 1u);
   EXPECT_DOUBLE_EQ(r.proposals[0].objective, best);
@@ -71,7 +71,10 @@ TEST(Propose, TheAnnealingFindsTheBruteForceOptimum) {
   EXPECT_LT(best, 0.999);
   // The proposal's rig, judged by suggest's exact evaluation, has the same share.
   const Rig rig = ProposalRig(r, r.proposals[0], "p");
-  const Metrics m = EvaluateExact(scene, rig, *caster, targets, o.objective);
+  Objective coverage2;
+  coverage2.kind = ObjectiveKind::kCoverage;
+  coverage2.k = 2;
+  const Metrics m = EvaluateExact(scene, rig, *caster, targets, coverage2);
   EXPECT_DOUBLE_EQ(m.coverage_k, r.proposals[0].coverage_k);
   EXPECT_EQ(rig.cameras[0].id, "p_1");
 }
@@ -81,7 +84,7 @@ TEST(Propose, NMinusOneIsTheWorstSingleFailure) {
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
   const std::vector<TargetPoint> targets = SampleTargets(scene, 300, {}, true, 5);
   ProposeOptions o = Options(scene);
-  o.objective.kind = ObjectiveKind::kCoverageN1;
+  o.terms[0].n1 = true;
   o.mounts = WallMounts(scene, {2.2, 2.6}, 0.8, 0.1);
   o.cameras = 5;
   o.proposals = 3;
@@ -94,8 +97,8 @@ TEST(Propose, NMinusOneIsTheWorstSingleFailure) {
     for (std::size_t f = 0; f < rig.cameras.size(); ++f) {
       std::vector<Camera> rest = rig.cameras;
       rest.erase(rest.begin() + std::ptrdiff_t(f));
-      Objective k2 = o.objective;
-      k2.kind = ObjectiveKind::kCoverage;
+      std::vector<ProposeTerm> k2 = o.terms;
+      k2[0].n1 = false;
       worst = std::min(worst, ScoreCameras(scene, *caster, {}, targets, rest, k2).coverage_k);
     }
     EXPECT_DOUBLE_EQ(p.n1, worst);
@@ -153,6 +156,54 @@ TEST(Propose, TheCatalogueGivesEveryZoom) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("$.models[0]"), std::string::npos) << e.what();
   }
+}
+
+// A weighted objective with a density term: each proposal's objective is the weighted sum of its
+// terms, and each term equals the same layout judged by that term alone; the parser's forms.
+TEST(Propose, WeightedTermsAndDensities) {
+  const Scene scene = Room();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const std::vector<TargetPoint> targets = SampleTargets(scene, 300, {}, true, 9);
+  ProposeOptions o = Options(scene);
+  o.terms = ParseProposeObjective("0.7*coverage2+0.3*coverage1@250", scene);
+  ASSERT_EQ(o.terms.size(), 2u);
+  EXPECT_DOUBLE_EQ(o.terms[1].min_px_per_m, 250);
+  EXPECT_EQ(o.terms[1].k, 1);
+  o.mounts = WallMounts(scene, {2.4}, 0.8, 0.1);
+  o.cameras = 4;
+  o.proposals = 1;
+  const ProposeResult r = Propose(scene, *caster, {}, targets, o);
+  const Proposal& p = r.proposals[0];
+  ASSERT_EQ(p.terms.size(), 2u);
+  EXPECT_NEAR(p.objective, 0.7 * p.terms[0] + 0.3 * p.terms[1], 1e-12);
+  const Rig rig = ProposalRig(r, p, "p");
+  for (std::size_t t = 0; t < 2; ++t) {
+    std::vector<ProposeTerm> alone = {o.terms[t]};
+    alone[0].weight = 1;
+    EXPECT_DOUBLE_EQ(ScoreCameras(scene, *caster, {}, targets, rig.cameras, alone).objective,
+                     p.terms[t]);
+  }
+  // The density term by hand: points seen by a camera at >= 250 px/m.
+  const double scale = scene.ContentBounds().diagonal();
+  const VisibilityTester tester(rig.cameras, *caster, scale);
+  int dense = 0;
+  for (const TargetPoint& t : targets) {
+    bool any = false;
+    for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+      Mat23 J;
+      any |= tester.Test(int(c), t.p, nullptr, &J) == ViewResult::kSeen && PixelDensity(J) >= 250;
+    }
+    dense += any;
+  }
+  EXPECT_DOUBLE_EQ(p.terms[1], double(dense) / targets.size());
+  EXPECT_GT(p.terms[1], 0.05);
+  EXPECT_LT(p.terms[1], 0.999);
+  EXPECT_DOUBLE_EQ(ParseProposeObjective("coverage3-n1@identification", scene)[0].min_px_per_m,
+                   250);
+  EXPECT_TRUE(ParseProposeObjective("coverage3-n1@identification", scene)[0].n1);
+  for (const char* bad :
+       {"sigma-mean", "coverage0", "2*coverage3+", "coverage2@far", "-1*coverage2"})
+    EXPECT_THROW(ParseProposeObjective(bad, scene), InputError) << bad;
 }
 
 }  // namespace
