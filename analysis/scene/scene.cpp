@@ -1734,10 +1734,16 @@ double GroupFacing(const Node& node, const ObjectMotion& motion, const Scene& sc
 
 // The footprints (x, y) of the solids a walker must keep clear of: solid objects that no motion
 // moves, whose height overlaps the walker's [5 cm, its top].
-Footprint2 StaticObstacles(const Node& motions, const ObjectMotion& walker, const Scene& scene) {
+Footprint2 StaticObstacles(const Node& motions, const ObjectMotion& walker, const Scene& scene,
+                           const WanderSpec& wander) {
   Aabb body;
   for (int o : walker.objects) body.Extend(scene.objects[o].mesh.Bounds());
   const double low = body.min.z() + 0.05, high = body.max.z();
+  // Only what the walker can come near: the region and its start, grown by its radius.
+  Aabb reach = wander.region;
+  reach.Extend(walker.anchor);
+  const Vec2 lo = reach.min.head<2>() - Vec2::Constant(wander.radius),
+             hi = reach.max.head<2>() + Vec2::Constant(wander.radius);
   Footprint2 out;
   for (const SceneObject& object : scene.objects) {
     if (!object.solid || object.skin >= 0) continue;
@@ -1748,6 +1754,9 @@ Footprint2 StaticObstacles(const Node& motions, const ObjectMotion& walker, cons
       const Vec3 &a = object.mesh.vertices[t[0]], &b = object.mesh.vertices[t[1]],
                  &c = object.mesh.vertices[t[2]];
       if (std::max({a.z(), b.z(), c.z()}) < low || std::min({a.z(), b.z(), c.z()}) > high) continue;
+      if (std::max({a.x(), b.x(), c.x()}) < lo.x() || std::min({a.x(), b.x(), c.x()}) > hi.x() ||
+          std::max({a.y(), b.y(), c.y()}) < lo.y() || std::min({a.y(), b.y(), c.y()}) > hi.y())
+        continue;
       out.triangles.push_back({a.head<2>(), b.head<2>(), c.head<2>()});
     }
   }
@@ -1806,8 +1815,8 @@ std::vector<std::pair<double, GroupPose>> ReadWalk(const Node& node, const std::
   for (const ObjectMotion& m : scene.motions)
     if (m.kind == ObjectMotion::Kind::kKeyframes) others.push_back({m.anchor, m.keyframes});
   try {
-    return WanderKeyframes(wander, motion.anchor, facing, StaticObstacles(motions, motion, scene),
-                           others);
+    return WanderKeyframes(wander, motion.anchor, facing,
+                           StaticObstacles(motions, motion, scene, wander), others);
   } catch (const std::invalid_argument& e) {
     node.Fail(e.what(), "place the group where it is free, or give a smaller \"radius\"");
   }
