@@ -11,6 +11,7 @@
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/geometry/surface_distance.h"
 #include "analysis/geometry/visibility.h"
+#include "analysis/rig/calibration.h"
 #include "analysis/util/error.h"
 #include "analysis/util/palette.h"
 #include "analysis/util/seeded.h"
@@ -88,14 +89,47 @@ using BitMatrix = std::vector<std::vector<std::uint64_t>>;
 
 // One objective term's state: counts of the selected cameras per point (at the term's density).
 struct TermState {
-  const BitMatrix* vis;
+  const BitMatrix* vis;  ///< Per candidate: the points (coverage) or poses (calibration) it sees.
   int k;
   bool n1;
   double weight;
   std::vector<int> counts;
   int ge_k = 0;
   long soft = 0;
+  int min_shared = 0;  ///< > 0: a calibration term over pose bits.
 };
+
+// The weakest edge of the maximum spanning tree of the cameras' shared pose counts (Prim's), 0
+// when they do not all connect; over min_shared, at most 1.
+double CalibrationStrength(const BitMatrix& poses, const std::vector<int>& cameras,
+                           int min_shared) {
+  const std::size_t n = cameras.size();
+  if (n < 2) return 0;
+  std::vector<std::vector<int>> shared(n, std::vector<int>(n, 0));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const std::vector<std::uint64_t>&x = poses[std::size_t(cameras[a])],
+            &y = poses[std::size_t(cameras[b])];
+      int c = 0;
+      for (std::size_t w = 0; w < x.size(); ++w) c += __builtin_popcountll(x[w] & y[w]);
+      shared[a][b] = shared[b][a] = c;
+    }
+  std::vector<char> in(n, 0);
+  std::vector<int> best(n, -1);
+  in[0] = 1;
+  for (std::size_t v = 1; v < n; ++v) best[v] = shared[0][v];
+  int weakest = 1 << 30;
+  for (std::size_t step = 1; step < n; ++step) {
+    std::size_t pick = n;
+    for (std::size_t v = 0; v < n; ++v)
+      if (!in[v] && (pick == n || best[v] > best[pick])) pick = v;
+    weakest = std::min(weakest, best[pick]);
+    in[pick] = 1;
+    for (std::size_t v = 0; v < n; ++v)
+      if (!in[v]) best[v] = std::max(best[v], shared[pick][v]);
+  }
+  return std::min(1.0, double(weakest) / std::max(1, min_shared));
+}
 
 // The search state over the visibility bit matrices, one per term.
 struct Search {
@@ -116,6 +150,7 @@ struct Search {
   }
   void Add(int c, int sign) {
     for (TermState& t : terms) {
+      if (t.min_shared > 0) continue;  // calibration: judged from the selection itself
       const std::vector<std::uint64_t>& bits = (*t.vis)[std::size_t(c)];
       for (std::size_t w = 0; w < bits.size(); ++w)
         for (std::uint64_t b = bits[w]; b; b &= b - 1) {
@@ -147,7 +182,10 @@ struct Search {
     return double(t.ge_k - worst) / points;
   }
   double Share(const TermState& t) const { return double(t.ge_k) / points; }
-  double TermValue(const TermState& t) const { return t.n1 ? N1Share(t) : Share(t); }
+  double TermValue(const TermState& t) const {
+    if (t.min_shared > 0) return CalibrationStrength(*t.vis, selected, t.min_shared);
+    return t.n1 ? N1Share(t) : Share(t);
+  }
   double Exact() const {
     double v = 0;
     for (const TermState& t : terms) v += t.weight * TermValue(t);
@@ -157,14 +195,22 @@ struct Search {
   // diversity penalty.
   double Score(const std::vector<char>& taken_mounts, double diversity) const {
     double s = Exact();
-    for (const TermState& t : terms) s += 1e-3 * t.weight * double(t.soft) / (double(points) * t.k);
+    for (const TermState& t : terms)
+      if (t.min_shared == 0) s += 1e-3 * t.weight * double(t.soft) / (double(points) * t.k);
     for (int c : selected) s -= taken_mounts[std::size_t(mount_of[std::size_t(c)])] ? diversity : 0;
     return s;
   }
   // The soft objective's gain of adding candidate c.
-  double Gain(int c) const {
+  double Gain(int c) {
     double g = 0;
     for (const TermState& t : terms) {
+      if (t.min_shared > 0) {  // the strength's change with c added
+        const double before = TermValue(t);
+        selected.push_back(c);
+        g += t.weight * (TermValue(t) - before);
+        selected.pop_back();
+        continue;
+      }
       long n = 0;
       const std::vector<std::uint64_t>& bits = (*t.vis)[std::size_t(c)];
       for (std::size_t w = 0; w < bits.size(); ++w)
@@ -320,19 +366,53 @@ std::vector<BitMatrix> Visibility(const Scene& scene, const RayCaster& caster,
 
 // The distinct densities of the terms, and the search's term states over their matrices.
 std::vector<double> TermDensities(const std::vector<ProposeTerm>& terms) {
-  std::vector<double> d;
+  std::vector<double> d = {0.0};  // seen at all: the candidates' check
   for (const ProposeTerm& t : terms)
-    if (std::find(d.begin(), d.end(), t.min_px_per_m) == d.end()) d.push_back(t.min_px_per_m);
+    if (!t.calibration && std::find(d.begin(), d.end(), t.min_px_per_m) == d.end())
+      d.push_back(t.min_px_per_m);
   return d;
+}
+
+// Per camera, the calibration poses it observes (the study's board or wand through the region,
+// the static scene as placed occluding; poses sampled with the cameras given, as
+// SimulateCalibration does for a rig). Empty without a calibration term.
+BitMatrix CalibrationPoses(const Scene& scene, const RayCaster& caster,
+                           const std::vector<Camera>& cameras,
+                           const std::vector<ProposeTerm>& terms) {
+  if (std::none_of(terms.begin(), terms.end(), [](const ProposeTerm& t) { return t.calibration; }))
+    return {};
+  if (!scene.study.calibration)
+    throw InputError("--objective", "", "a calibration term needs the study's \"calibration\"",
+                     "add \"calibration\": {\"target\": \"board\", ...} to the study "
+                     "(docs/calibration.md)");
+  const CalibrationSpec& spec = *scene.study.calibration;
+  const VisibilityTester tester(cameras, caster, scene.ContentBounds().diagonal());
+  const std::vector<CalibrationPose> poses = SampleCalibrationPoses(scene, tester, spec);
+  const std::size_t words = (poses.size() + 63) / 64;
+  BitMatrix out(cameras.size(), std::vector<std::uint64_t>(words, 0));
+  tbb::parallel_for(std::size_t(0), cameras.size(), [&](std::size_t c) {
+    for (std::size_t p = 0; p < poses.size(); ++p)
+      if (ObservesPose(tester, int(c), spec, poses[p])) out[c][p / 64] |= 1ull << (p % 64);
+  });
+  return out;
+}
+
+int MinShared(const Scene& scene) {
+  return scene.study.calibration ? scene.study.calibration->min_shared : 0;
 }
 std::vector<TermState> TermStates(const std::vector<ProposeTerm>& terms,
                                   const std::vector<double>& densities,
-                                  const std::vector<BitMatrix>& vis) {
+                                  const std::vector<BitMatrix>& vis, const BitMatrix* poses,
+                                  int min_shared) {
   std::vector<TermState> out;
   for (const ProposeTerm& t : terms) {
+    if (t.calibration) {
+      out.push_back({poses, 1, false, t.weight, {}, 0, 0, min_shared});
+      continue;
+    }
     const std::size_t d = std::size_t(
         std::find(densities.begin(), densities.end(), t.min_px_per_m) - densities.begin());
-    out.push_back({&vis[d], t.k, t.n1, t.weight, {}, 0, 0});
+    out.push_back({&vis[d], t.k, t.n1, t.weight, {}, 0, 0, 0});
   }
   return out;
 }
@@ -343,8 +423,12 @@ Proposal Measure(const Search& search) {
   p.candidates = search.selected;
   p.objective = search.Exact();
   for (const TermState& t : search.terms) p.terms.push_back(search.TermValue(t));
-  p.coverage_k = search.Share(search.terms.front());
-  p.n1 = search.N1Share(search.terms.front());
+  for (const TermState& t : search.terms)
+    if (t.min_shared == 0) {  // the first coverage term
+      p.coverage_k = search.Share(t);
+      p.n1 = search.N1Share(t);
+      break;
+    }
   p.price = search.Price();
   return p;
 }
@@ -354,9 +438,9 @@ Proposal Measure(const Search& search) {
 std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Scene& scene) {
   auto fail = [&text](const std::string& why) -> std::vector<ProposeTerm> {
     throw InputError("--objective", "", "'" + text + "': " + why,
-                     "terms [W*]coverageK[-n1][@DENSITY] joined by '+', DENSITY px/m, detection, "
-                     "observation, recognition, identification or a pixel target, e.g. "
-                     "0.7*coverage3+0.3*coverage1@identification");
+                     "terms [W*]coverageK[-n1][@DENSITY] or [W*]calibration joined by '+', DENSITY "
+                     "px/m, detection, observation, recognition, identification or a pixel "
+                     "target, e.g. 0.7*coverage3+0.3*coverage1@identification");
   };
   std::vector<ProposeTerm> terms;
   std::size_t at = 0;
@@ -375,6 +459,11 @@ std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Sc
         return fail("a weight must be a positive number");
       term = term.substr(star + 1);
       t.name = term;
+    }
+    if (term == "calibration") {
+      t.calibration = true;
+      terms.push_back(t);
+      continue;
     }
     const std::size_t sign = term.find('@');
     if (sign != std::string::npos) {
@@ -530,6 +619,7 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
   const std::vector<double> densities = TermDensities(options.terms);
   const std::vector<BitMatrix> vis =
       Visibility(scene, caster, sample_casters, targets, result.candidates, densities, options);
+  const BitMatrix poses = CalibrationPoses(scene, caster, result.candidates, options.terms);
   result.visibility_seconds = Since(t0);
   std::vector<double> price;
   for (int l : result.candidate_lens) price.push_back(options.lenses[std::size_t(l)].price);
@@ -540,7 +630,7 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
     throw InputError(scene.path, "", "no candidate camera sees any target point",
                      "check the mounts (walls, ceiling) and the lenses' range");
   const Clock::time_point t1 = Clock::now();
-  Search search{TermStates(options.terms, densities, vis),
+  Search search{TermStates(options.terms, densities, vis, &poses, MinShared(scene)),
                 price,
                 mount_of,
                 result.points,
@@ -580,9 +670,15 @@ Proposal ScoreCameras(const Scene& scene, const RayCaster& caster,
   const std::vector<double> densities = TermDensities(terms);
   const std::vector<BitMatrix> vis =
       Visibility(scene, caster, sample_casters, targets, enabled, densities, options);
+  const BitMatrix poses = CalibrationPoses(scene, caster, enabled, terms);
   const std::vector<double> price(enabled.size(), 0.0);
   const std::vector<int> mount_of(enabled.size(), 0);
-  Search search{TermStates(terms, densities, vis), price, mount_of, int(targets.size()), 0, {}};
+  Search search{TermStates(terms, densities, vis, &poses, MinShared(scene)),
+                price,
+                mount_of,
+                int(targets.size()),
+                0,
+                {}};
   search.Reset();
   for (std::size_t c = 0; c < enabled.size(); ++c) {
     search.Add(int(c), +1);

@@ -67,10 +67,16 @@ struct ProposeTerm {
   int k = 3;
   bool n1 = false;
   double min_px_per_m = 0;
-  std::string name;  ///< As written ("coverage3", "coverage1@identification").
+  /// Instead of coverage: the calibration chain's strength (the study's "calibration": board or
+  /// wand poses through the region; the weakest edge of the maximum spanning tree of the selected
+  /// cameras' shared poses) over its min_shared, at most 1: 1 when every camera links to the rest
+  /// through at least min_shared poses (docs/calibration.md).
+  bool calibration = false;
+  std::string name;  ///< As written ("coverage3", "coverage1@identification", "calibration").
 };
 
-/// Parses an objective: terms joined by '+', each "[W*]coverageK[-n1][@DENSITY]", DENSITY a number
+/// Parses an objective: terms joined by '+', each "[W*]coverageK[-n1][@DENSITY]" or
+/// "[W*]calibration" (which needs the study's "calibration"), DENSITY a number
 /// of px/m, a DORI class of EN 62676-4 (detection 25, observation 62.5, recognition 125,
 /// identification 250) or a pixel target of the scene's study (its min_px / size_m), e.g.
 /// "coverage3", "coverage3-n1", "0.7*coverage3+0.3*coverage1@identification". Throws

@@ -9,6 +9,7 @@
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/geometry/visibility.h"
+#include "analysis/rig/calibration.h"
 #include "analysis/util/error.h"
 #include "analysis/util/units.h"
 #include "tests/temp_dir.h"
@@ -204,6 +205,39 @@ TEST(Propose, WeightedTermsAndDensities) {
   for (const char* bad :
        {"sigma-mean", "coverage0", "2*coverage3+", "coverage2@far", "-1*coverage2"})
     EXPECT_THROW(ParseProposeObjective(bad, scene), InputError) << bad;
+}
+
+// The calibration term of fixed cameras is the calibration simulation's own verdict: its weakest
+// spanning-tree link over min_shared (at most 1), on the same poses.
+TEST(Propose, CalibrationTermIsTheSimulationsWeakestLink) {
+  const Scene scene = ParseScene(R"({"objects": [
+    {"name": "room", "room": {"footprint": [[-3, -2], [3, -2], [3, 2], [-3, 2]], "height": 3}}],
+    "rigs": [{"name": "r", "cameras": [
+      {"id": "a", "position": [2.7, 1.7, 2.5], "look_at": [0, 0, 1], "resolution": [640, 480], "hfov_deg": 60},
+      {"id": "b", "position": [0, 1.85, 2.5], "look_at": [0, 0, 1], "resolution": [640, 480], "hfov_deg": 60},
+      {"id": "c", "position": [-2.7, 1.7, 2.5], "look_at": [0, 0, 1], "resolution": [640, 480], "hfov_deg": 60}]}],
+    "study": {"region": {"box": {"min": [-1, -0.75, 0.5], "max": [1, 0.75, 1.7]}},
+      "calibration": {"target": "board", "samples": 600, "seed": 3, "min_shared": 500,
+        "board": {"squares": [7, 5], "square_m": 0.05}}}})",
+                                 "cal.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const std::vector<TargetPoint> targets = SampleTargets(scene, 100, {}, true, 1);
+  const std::vector<ProposeTerm> terms = ParseProposeObjective("calibration", scene);
+  const Proposal p = ScoreCameras(scene, *caster, {}, targets, scene.rigs[0].cameras, terms);
+  const CalibrationResult sim =
+      SimulateCalibration(scene, scene.rigs[0], *caster, *scene.study.calibration);
+  // Three cameras: the maximum spanning tree keeps the two strongest pairs; its weakest edge is
+  // the middle shared count (min_shared 500 of 600 poses keeps it below 1).
+  const std::int64_t ab = sim.shared[0][1], ac = sim.shared[0][2], bc = sim.shared[1][2];
+  const std::int64_t weakest = ab + ac + bc - std::min({ab, ac, bc}) - std::max({ab, ac, bc});
+  ASSERT_GT(weakest, 0);
+  EXPECT_DOUBLE_EQ(p.terms[0], std::min(1.0, double(weakest) / 500));
+  EXPECT_LT(p.terms[0], 1);
+  const Scene plain = Room();  // no "calibration" in its study
+  const auto plain_caster = MakeEmbreeRayCaster(plain.AllTriangles());
+  EXPECT_THROW(ScoreCameras(plain, *plain_caster, {}, targets, plain.rigs[0].cameras,
+                            ParseProposeObjective("calibration", plain)),
+               InputError);
 }
 
 }  // namespace
