@@ -101,6 +101,68 @@ CameraTemplate CameraTemplateOf(const RigArgs& args, int width, int height) {
   }
   return t;
 }
+// The cameras of the one layout the options give (InputError naming the option at fault).
+std::vector<GeneratedCamera> GenerateLayout(const RigArgs& args, const Aabb& region,
+                                            const Vec3& aim, const std::string& prefix) {
+  if (!args.ring.empty()) {
+    const int n = Count("--ring", ParseNumbers("--ring", args.ring, 1)[0], 1000);
+    if (std::isnan(args.radius))
+      throw InputError("--radius", "", "a ring needs its radius", "e.g. --radius 4");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "a ring needs its height", "e.g. --height 2.5");
+    Vec2 c = region.center().head<2>();
+    if (!args.center.empty()) {
+      const std::vector<double> xy = ParseNumbers("--center", args.center, 2);
+      c = Vec2(xy[0], xy[1]);
+    }
+    return RingCameras(n, Vec3(c.x(), c.y(), args.height), Positive("--radius", args.radius),
+                       args.start_deg, aim, prefix);
+  } else if (!args.grid.empty()) {
+    const std::vector<double> g = ParseNumbers("--grid", args.grid, 2);
+    const int nx = Count("--grid", g[0], 100), ny = Count("--grid", g[1], 100);
+    if (args.rect.empty())
+      throw InputError("--rect", "", "a ceiling grid needs its rectangle X0,Y0,X1,Y1");
+    const std::vector<double> r = ParseNumbers("--rect", args.rect, 4);
+    if (!(r[2] > r[0] && r[3] > r[1]))
+      throw InputError("--rect", "", "expected X0 < X1 and Y0 < Y1");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "a ceiling grid needs its height");
+    const Vec3* aimed = args.aim.empty() ? nullptr : &aim;
+    return CeilingGridCameras(nx, ny, Vec2(r[0], r[1]), Vec2(r[2], r[3]), args.height, aimed,
+                              prefix);
+  } else if (!args.wall_grid.empty()) {
+    const std::vector<double> g = ParseNumbers("--wall-grid", args.wall_grid, 2);
+    const int nu = Count("--wall-grid", g[0], 100), nz = Count("--wall-grid", g[1], 100);
+    if (args.wall.empty()) throw InputError("--wall", "", "a wall grid needs its wall X0,Y0,X1,Y1");
+    const std::vector<double> w = ParseNumbers("--wall", args.wall, 4);
+    if (!(std::hypot(w[2] - w[0], w[3] - w[1]) > 0))
+      throw InputError("--wall", "", "the wall has no length");
+    if (args.z_range.empty())
+      throw InputError("--z-range", "", "a wall grid needs its heights Z0,Z1");
+    const std::vector<double> z = ParseNumbers("--z-range", args.z_range, 2);
+    if (!(z[1] >= z[0])) throw InputError("--z-range", "", "expected Z0 <= Z1");
+    return WallGridCameras(nu, nz, Vec2(w[0], w[1]), Vec2(w[2], w[3]), z[0], z[1], args.inset, aim,
+                           prefix);
+  } else {
+    const std::vector<std::string> items = SplitList(args.along);
+    if (items.size() < 4 || items.size() % 2)
+      throw InputError("--along", "", "expected corners X0,Y0,X1,Y1[,X2,Y2...] (two or more)");
+    const std::vector<double> xy = ParseNumbers("--along", args.along, items.size());
+    std::vector<Vec2> walls;
+    for (std::size_t i = 0; i < xy.size(); i += 2) {
+      walls.emplace_back(xy[i], xy[i + 1]);
+      if (walls.size() > 1 && !((walls.back() - walls[walls.size() - 2]).norm() > 0))
+        throw InputError("--along", "",
+                         "wall " + std::to_string(walls.size() - 1) + " has no length");
+    }
+    if (args.count < 1 || args.count > 1000)
+      throw InputError("--count", "", "expected 1 to 1000 cameras");
+    if (std::isnan(args.height))
+      throw InputError("--height", "", "cameras along walls need their height");
+    return AlongWallsCameras(args.count, walls, args.height, args.inset, aim, prefix);
+  }
+}
+
 }  // namespace
 
 int RunRig(const RigArgs& args) {
@@ -121,64 +183,7 @@ int RunRig(const RigArgs& args) {
   if (!(args.hfov_deg > 0 && args.hfov_deg < 180))
     throw InputError("--hfov", "", "must be in (0, 180) degrees");
   const std::string prefix = args.prefix.empty() ? args.name + "_" : args.prefix;
-  std::vector<GeneratedCamera> cameras;
-  if (!args.ring.empty()) {
-    const int n = Count("--ring", ParseNumbers("--ring", args.ring, 1)[0], 1000);
-    if (std::isnan(args.radius))
-      throw InputError("--radius", "", "a ring needs its radius", "e.g. --radius 4");
-    if (std::isnan(args.height))
-      throw InputError("--height", "", "a ring needs its height", "e.g. --height 2.5");
-    Vec2 c = region.center().head<2>();
-    if (!args.center.empty()) {
-      const std::vector<double> xy = ParseNumbers("--center", args.center, 2);
-      c = Vec2(xy[0], xy[1]);
-    }
-    cameras = RingCameras(n, Vec3(c.x(), c.y(), args.height), Positive("--radius", args.radius),
-                          args.start_deg, aim, prefix);
-  } else if (!args.grid.empty()) {
-    const std::vector<double> g = ParseNumbers("--grid", args.grid, 2);
-    const int nx = Count("--grid", g[0], 100), ny = Count("--grid", g[1], 100);
-    if (args.rect.empty())
-      throw InputError("--rect", "", "a ceiling grid needs its rectangle X0,Y0,X1,Y1");
-    const std::vector<double> r = ParseNumbers("--rect", args.rect, 4);
-    if (!(r[2] > r[0] && r[3] > r[1]))
-      throw InputError("--rect", "", "expected X0 < X1 and Y0 < Y1");
-    if (std::isnan(args.height))
-      throw InputError("--height", "", "a ceiling grid needs its height");
-    const Vec3* aimed = args.aim.empty() ? nullptr : &aim;
-    cameras =
-        CeilingGridCameras(nx, ny, Vec2(r[0], r[1]), Vec2(r[2], r[3]), args.height, aimed, prefix);
-  } else if (!args.wall_grid.empty()) {
-    const std::vector<double> g = ParseNumbers("--wall-grid", args.wall_grid, 2);
-    const int nu = Count("--wall-grid", g[0], 100), nz = Count("--wall-grid", g[1], 100);
-    if (args.wall.empty()) throw InputError("--wall", "", "a wall grid needs its wall X0,Y0,X1,Y1");
-    const std::vector<double> w = ParseNumbers("--wall", args.wall, 4);
-    if (!(std::hypot(w[2] - w[0], w[3] - w[1]) > 0))
-      throw InputError("--wall", "", "the wall has no length");
-    if (args.z_range.empty())
-      throw InputError("--z-range", "", "a wall grid needs its heights Z0,Z1");
-    const std::vector<double> z = ParseNumbers("--z-range", args.z_range, 2);
-    if (!(z[1] >= z[0])) throw InputError("--z-range", "", "expected Z0 <= Z1");
-    cameras = WallGridCameras(nu, nz, Vec2(w[0], w[1]), Vec2(w[2], w[3]), z[0], z[1], args.inset,
-                              aim, prefix);
-  } else {
-    const std::vector<std::string> items = SplitList(args.along);
-    if (items.size() < 4 || items.size() % 2)
-      throw InputError("--along", "", "expected corners X0,Y0,X1,Y1[,X2,Y2...] (two or more)");
-    const std::vector<double> xy = ParseNumbers("--along", args.along, items.size());
-    std::vector<Vec2> walls;
-    for (std::size_t i = 0; i < xy.size(); i += 2) {
-      walls.emplace_back(xy[i], xy[i + 1]);
-      if (walls.size() > 1 && !((walls.back() - walls[walls.size() - 2]).norm() > 0))
-        throw InputError("--along", "",
-                         "wall " + std::to_string(walls.size() - 1) + " has no length");
-    }
-    if (args.count < 1 || args.count > 1000)
-      throw InputError("--count", "", "expected 1 to 1000 cameras");
-    if (std::isnan(args.height))
-      throw InputError("--height", "", "cameras along walls need their height");
-    cameras = AlongWallsCameras(args.count, walls, args.height, args.inset, aim, prefix);
-  }
+  std::vector<GeneratedCamera> cameras = GenerateLayout(args, region, aim, prefix);
   // Every camera keeps its clearance from every surface: the inset (walls), at least 5 cm.
   const std::string layout = !args.ring.empty()        ? "--ring"
                              : !args.grid.empty()      ? "--grid"
