@@ -54,6 +54,9 @@ const std::vector<std::pair<std::string, std::string>>& CommandLineFlags() {
       // Rig import (ImportRigOptions).
       {"from", "--from"},
       {"as", "--as"},
+      // Floor plans (PlanOptions, ReadDxfPlan).
+      {"units", "--units"},
+      {"walls", "--walls"},
   };
   return kFlags;
 }

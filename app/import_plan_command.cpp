@@ -123,7 +123,7 @@ Command AddImportPlanCommand(CLI::App& app, CommonOptions& /*common*/) {
   c->add_option("plan", a.plan, "Floor plan (DXF)")->required();
   c->add_option("-o,--out", a.out, "The scene file to write")->required();
   c->add_flag("--replace", a.replace, "Overwrite --out when it exists (keeps a backup)");
-  c->add_option("--layer,--walls", o.walls, "Layer of the walls' centre lines")
+  c->add_option("--walls,--layer", o.walls, "Layer of the walls' centre lines")
       ->capture_default_str();
   c->add_option("--doors", o.doors, "Layer of door openings (a line across each)")
       ->capture_default_str();

@@ -382,7 +382,7 @@ BitMatrix CalibrationPoses(const Scene& scene, const RayCaster& caster,
   if (std::none_of(terms.begin(), terms.end(), [](const ProposeTerm& t) { return t.calibration; }))
     return {};
   if (!scene.study.calibration)
-    throw InputError("--objective", "", "a calibration term needs the study's \"calibration\"",
+    throw InputError("{objective}", "", "a calibration term needs the study's \"calibration\"",
                      "add \"calibration\": {\"target\": \"board\", ...} to the study "
                      "(docs/calibration.md)");
   const CalibrationSpec& spec = *scene.study.calibration;
@@ -437,7 +437,7 @@ Proposal Measure(const Search& search) {
 
 std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Scene& scene) {
   auto fail = [&text](const std::string& why) -> std::vector<ProposeTerm> {
-    throw InputError("--objective", "", "'" + text + "': " + why,
+    throw InputError("{objective}", "", "'" + text + "': " + why,
                      "terms [W*]coverageK[-n1][@DENSITY] or [W*]calibration joined by '+', DENSITY "
                      "px/m, detection, observation, recognition, identification or a pixel "
                      "target, e.g. 0.7*coverage3+0.3*coverage1@identification");

@@ -66,7 +66,7 @@ PlanScene BuildPlan(const PlanDrawing& drawing, const PlanOptions& options,
     throw InputError(file, "", "no lines or polylines on the walls layer '" + options.walls + "'",
                      have.empty()
                          ? "the drawing has no lines at all"
-                         : "the drawing's layers with lines: " + have + "; give --walls LAYER");
+                         : "the drawing's layers with lines: " + have + "; give {walls} LAYER");
   }
   const double t = options.thickness, h = options.height, tol = 1e-3;
   PlanScene scene;

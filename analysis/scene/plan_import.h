@@ -25,7 +25,7 @@ struct PlanDrawing {
   };
   std::vector<Polyline> polylines;  ///< LINEs are open 2-point polylines.
   double metres_per_unit = 1;
-  std::string units;  ///< How the unit was found: "$INSUNITS 6 (m)" or "--units cm".
+  std::string units;  ///< How the unit was found: "$INSUNITS 6 (m)", or as given.
   /// Every layer with a line or polyline, sorted, and how many entities of other kinds (arcs,
   /// circles, text, blocks) were skipped.
   std::vector<std::string> layers;

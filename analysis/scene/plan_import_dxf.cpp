@@ -105,7 +105,7 @@ PlanDrawing ReadDxfPlan(const std::string& path, std::optional<double> units) {
   // Lines inside block definitions are parts of blocks (door symbols, furniture), not the plan.
   if (units) {
     drawing.metres_per_unit = *units;
-    drawing.units = "--units";
+    drawing.units = "as given on the command line";
   } else {
     const auto it = InsUnits().find(reader.insunits);
     if (it == InsUnits().end())
@@ -114,7 +114,7 @@ PlanDrawing ReadDxfPlan(const std::string& path, std::optional<double> units) {
                            ? "the drawing does not say its unit (no $INSUNITS in its header)"
                            : "the drawing's unit ($INSUNITS " + std::to_string(reader.insunits) +
                                  ") is not a length",
-                       "give --units m|cm|mm|in|ft");
+                       "give {units} m|cm|mm|in|ft");
     drawing.metres_per_unit = it->second.first;
     drawing.units = "$INSUNITS " + std::to_string(it->first) + " (" + it->second.second + ")";
   }
