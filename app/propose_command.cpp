@@ -272,7 +272,7 @@ int RunPropose(const ProposeArgs& args) {
                    "|\n|---|---|---|---|---|---|\n";
   for (std::size_t p = 0; p < result.proposals.size(); ++p) {
     const Proposal& proposal = result.proposals[p];
-    const std::string name = "proposal_" + std::to_string(p + 1);
+    const std::string name = "prop" + std::to_string(p + 1);  // ids prop1_12 fit the colour key
     const Rig rig = ProposalRig(result, proposal, name);
     ordered_json cameras = ordered_json::array();
     for (std::size_t i = 0; i < rig.cameras.size(); ++i) {

@@ -21,7 +21,7 @@ start=$(date +%s%N)
 "$pandora" propose "$s" --cameras 12 --objective coverage3 --iterations 100000 --compare all --out "$work/mocap_out" -q || fail "propose mocap"
 echo "mocap: $(awk "BEGIN { print ($(date +%s%N) - $start) / 1e9 }") s"
 p="$work/mocap_out/proposals.json"
-jq -r '"proposal_1 \(.proposals[0].objective)", (.compared[] | "\(.rig) \(.objective)")' "$p"
+jq -r '"prop1 \(.proposals[0].objective)", (.compared[] | "\(.rig) \(.objective)")' "$p"
 jq -e '([.compared[] | select(.rig | startswith("gen_")) | .objective] | max) as $gen
        | ([.compared[] | select(.rig == "corners") | .objective][0]) as $corners
        | .proposals[0].objective >= $gen + 0.05 and .proposals[0].objective >= $corners' "$p" > /dev/null \
@@ -31,6 +31,6 @@ t="$examples/trauma_room/scene.json"
   --mount-box=-1.5,-1.5,1.6,2.5,1.5,2.4 --spacing 0.25 --iterations 100000 --compare grid4x2 \
   --out "$work/trauma_out" -q || fail "propose trauma"
 q="$work/trauma_out/proposals.json"
-jq -r '"proposal_1 \(.proposals[0].objective)", (.compared[] | "\(.rig) \(.objective)")' "$q"
+jq -r '"prop1 \(.proposals[0].objective)", (.compared[] | "\(.rig) \(.objective)")' "$q"
 jq -e '.proposals[0].objective >= .compared[0].objective' "$q" > /dev/null || fail "trauma: below grid4x2"
 echo "ok: proposals beat the generators and match or beat the hand-made rigs"
