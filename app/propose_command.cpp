@@ -359,12 +359,23 @@ int AcceptProposal(const std::string& file, int number, const std::string& name,
   ordered_json rig = {{"name", rig_name}, {"cameras", ordered_json::array()}};
   const JsonNode cameras = chosen.Get("cameras");
   for (std::size_t i = 0; i < cameras.ArraySize(10000, "an array of cameras"); ++i) {
-    ordered_json c = ordered_json::parse(cameras.At(i).value().dump());
-    for (const char* key : {"position", "look_at"})
-      for (auto& v : c[key]) v = scene_text::Number(scene_text::Clean(v.get<double>() / mpu));
-    if (c.contains("range"))
-      for (auto& [k, v] : c["range"].items())
-        v = scene_text::Number(scene_text::Clean(v.get<double>() / mpu));
+    const JsonNode camera = cameras.At(i);
+    camera.ExpectObject("a camera");
+    ordered_json c = ordered_json::parse(camera.value().dump());
+    // Lengths in metres, checked here (a damaged file names its own path), written in the file's
+    // unit; everything else is checked when the new scene is read.
+    for (const char* key : {"position", "look_at"}) {
+      const Eigen::VectorXd v = camera.Get(key).Numbers(3);
+      c[key] = ordered_json::array();
+      for (int a = 0; a < 3; ++a)
+        c[key].push_back(scene_text::Number(scene_text::Clean(v[a] / mpu)));
+    }
+    if (auto range = camera.Find("range")) {
+      range->ExpectObject("a range {near, far}");
+      for (const auto& item : range->value().items())
+        c["range"][item.key()] =
+            scene_text::Number(scene_text::Clean(range->Get(item.key()).Number(0, 1e12) / mpu));
+    }
     c.erase("model");
     c.erase("mount");
     if (!name.empty()) c["id"] = rig_name + "_" + std::to_string(i + 1);

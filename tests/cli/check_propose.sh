@@ -37,6 +37,12 @@ jq -e '[.rigs[].name] == ["ring", "picked"] and ([.rigs[1].cameras[].id] | .[0])
 jq -e '.cameras == 8' "$work/picked/summary.json" > /dev/null || fail "8 cameras"
 # The scene changed since: refused (unless --force).
 bash "$here/expect_error.sh" "$pandora" "$work/none" "changed since the proposals" -- accept "$p" --proposal 1 || exit 1
+# A damaged proposals file: one line naming its JSON path, the scene untouched.
+jq '.proposals[0].cameras[1].position[2] = "high"' "$p" > "$work/damaged.json"
+jq '.scene_sha256 = "'"$(sha256sum "$scene" | cut -d' ' -f1)"'"' "$work/damaged.json" > "$work/damaged2.json"
+bash "$here/expect_error.sh" "$pandora" "$work/none" '$.proposals[0].cameras[1].position[2]' -- accept "$work/damaged2.json" --proposal 1 || exit 1
+printf '{"pandora_proposals": 1, "proposals": [' > "$work/truncated.json"
+bash "$here/expect_error.sh" "$pandora" "$work/none" "malformed JSON" -- accept "$work/truncated.json" --proposal 1 || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/o1" "coverageK" -- propose "$scene" --objective sigma-mean --out "$work/o1" || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/o2" "no model 'x'" -- propose "$scene" --catalogue "$example/cameras.json" --models x --out "$work/o2" || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/o5" "needs --catalogue" -- propose "$scene" --models x --out "$work/o5" || exit 1
