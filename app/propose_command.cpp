@@ -30,7 +30,7 @@ using scene_text::ordered_json;
 
 struct ProposeArgs {
   std::string scene, out = "out/propose", objective = "coverage3", mounts = "walls,ceiling";
-  std::string heights, objects, points_list, box, catalogue, models, compare, curve;
+  std::string heights, objects, points_list, box, catalogue, models, compare, curve, budgets;
   int cameras = 12, proposals = 3, points = 500, aims = 4;
   double budget = 0, spacing = 0.5, clearance = 0.1, seconds = 20;
   std::uint64_t seed = 1;
@@ -170,6 +170,39 @@ std::string ProposalPercent(double v) {
   return b;
 }
 
+// The two trade-off curves (cameras, and cost) into the JSON document and the table; the camera
+// curve's CSV.
+std::string AddCurves(const ProposeResult& result, int cameras, ordered_json* doc_out,
+                      std::string* md_out) {
+  ordered_json& doc = *doc_out;
+  std::string& md = *md_out;
+  std::string csv;
+  if (!result.curve.empty()) {
+    doc["curve"] = ordered_json::array();
+    csv = "cameras,objective\n";
+    md += "\nTrade-off (greedy + annealing per count):\n\n| Cameras | Objective |\n|---|---|\n";
+    for (const auto& [n, v] : result.curve) {
+      doc["curve"].push_back({{"cameras", n}, {"objective", v}});
+      csv += std::to_string(n) + "," + std::to_string(v) + "\n";
+      md += "| " + std::to_string(n) + " | " + ProposalPercent(v) + " |\n";
+    }
+  }
+  if (!result.budget_curve.empty()) {
+    doc["budget_curve"] = ordered_json::array();
+    md += "\nTrade-off against cost (at most " + std::to_string(cameras) +
+          " cameras):\n\n| Budget | Cameras | Price | Objective |\n|---|---|---|---|\n";
+    for (const ProposeResult::BudgetPoint& b : result.budget_curve) {
+      doc["budget_curve"].push_back({{"budget", b.budget},
+                                     {"cameras", b.cameras},
+                                     {"price", b.price},
+                                     {"objective", b.objective}});
+      md += "| " + std::to_string(int(b.budget)) + " | " + std::to_string(b.cameras) + " | " +
+            std::to_string(int(b.price)) + " | " + ProposalPercent(b.objective) + " |\n";
+    }
+  }
+  return csv;
+}
+
 // The options' values checked (InputError naming the option); the objective and the curve's range.
 void CheckProposeArgs(const ProposeArgs& args, int* curve_from, int* curve_to) {
   if (args.cameras < 1 || args.cameras > 500)
@@ -205,6 +238,15 @@ int RunPropose(const ProposeArgs& args) {
   options.budget = args.budget;
   options.proposals = args.proposals;
   options.terms = ParseProposeObjective(args.objective, scene);
+  if (!args.budgets.empty()) {
+    options.curve_budgets =
+        ParseNumbers("--curve-budgets", args.budgets, SplitList(args.budgets).size());
+    for (double b : options.curve_budgets)
+      if (!(b > 0 && b < 1e12))
+        throw InputError("--curve-budgets", "", "expected positive budgets");
+    if (args.catalogue.empty())
+      throw InputError("--curve-budgets", "", "budgets need prices: give --catalogue");
+  }
   options.aims = args.aims;
   options.seconds = args.seconds;
   options.seed = args.seed;
@@ -303,17 +345,7 @@ int RunPropose(const ProposeArgs& args) {
           " | " + ProposalPercent(score.objective) + " | " + ProposalPercent(score.coverage_k) +
           " | " + ProposalPercent(score.n1) + " | |\n";
   }
-  std::string csv;
-  if (!result.curve.empty()) {
-    doc["curve"] = ordered_json::array();
-    csv = "cameras,objective\n";
-    md += "\nTrade-off (greedy + annealing per count):\n\n| Cameras | Objective |\n|---|---|\n";
-    for (const auto& [n, v] : result.curve) {
-      doc["curve"].push_back({{"cameras", n}, {"objective", v}});
-      csv += std::to_string(n) + "," + std::to_string(v) + "\n";
-      md += "| " + std::to_string(n) + " | " + ProposalPercent(v) + " |\n";
-    }
-  }
+  const std::string csv = AddCurves(result, args.cameras, &doc, &md);
   md += "\nAccept one into the scene as a rig: `pandora accept " + args.out +
         "/proposals.json --proposal N`.\n";
   OutputTransaction transaction;
@@ -440,6 +472,9 @@ Command AddProposeCommand(CLI::App& app, CommonOptions& /*common*/) {
   c->add_option("--compare", a.compare,
                 "Rigs of the scene to judge alike (comma-separated, or all)");
   c->add_option("--curve", a.curve, "Trade-off curve FROM:TO cameras");
+  c->add_option("--curve-budgets", a.budgets,
+                "Trade-off against cost: budgets B1,B2,... (the catalogue's prices; at most "
+                "--cameras each)");
   c->add_flag("-q,--quiet", a.quiet, "Print nothing on success");
   return {c, [args] { return RunPropose(*args); }};
 }

@@ -637,7 +637,8 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
                 options.budget,
                 {}};
   const int curve_n = curve_to >= curve_from && curve_from > 0 ? curve_to - curve_from + 1 : 0;
-  const double per = options.seconds / std::max(1, options.proposals + curve_n);
+  const double per = options.seconds /
+                     std::max(1, options.proposals + curve_n + int(options.curve_budgets.size()));
   std::vector<char> taken(options.mounts.size(), 0);
   for (int p = 0; p < options.proposals; ++p) {
     if (options.progress) options.progress("search", double(p) / options.proposals);
@@ -652,6 +653,14 @@ ProposeResult Propose(const Scene& scene, const RayCaster& caster,
     Optimise(&search, n, none, 0.0, per, options.iterations,
              options.seed + 104729 * std::uint64_t(n));
     result.curve.emplace_back(n, search.Exact());
+  }
+  for (std::size_t b = 0; b < options.curve_budgets.size(); ++b) {
+    if (options.progress) options.progress("budgets", double(b) / options.curve_budgets.size());
+    search.budget = options.curve_budgets[b];
+    Optimise(&search, options.cameras, none, 0.0, per, options.iterations,
+             options.seed + 15485863 * std::uint64_t(b + 1));
+    result.budget_curve.push_back(
+        {search.budget, search.Price(), search.Exact(), int(search.selected.size())});
   }
   std::sort(result.proposals.begin(), result.proposals.end(),
             [](const Proposal& a, const Proposal& b) { return a.objective > b.objective; });

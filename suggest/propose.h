@@ -97,6 +97,8 @@ struct ProposeOptions {
   std::int64_t iterations = 0;
   double diversity = 0.004;  ///< Objective penalty per candidate an earlier proposal took.
   std::uint64_t seed = 1;
+  /// The trade-off against cost: a layout of at most `cameras` per budget (the lenses' prices).
+  std::vector<double> curve_budgets;
   std::function<void(const std::string& stage, double fraction)> progress;
 };
 
@@ -118,6 +120,12 @@ struct ProposeResult {
   double visibility_seconds = 0, search_seconds = 0;
   /// Greedy + annealing per camera count (ProposeCurve): (cameras, objective).
   std::vector<std::pair<int, double>> curve;
+  /// Per budget of ProposeOptions::curve_budgets: the best layout of at most `cameras` within it.
+  struct BudgetPoint {
+    double budget = 0, price = 0, objective = 0;
+    int cameras = 0;
+  };
+  std::vector<BudgetPoint> budget_curve;
 };
 
 /// The candidates (mount x aim x lens, looking at the aim, level) and their visibility of

@@ -50,6 +50,12 @@ bash "$here/expect_error.sh" "$pandora" "$work/o5" "needs --catalogue" -- propos
 "$pandora" propose "$scene" --catalogue "$example/cameras.json" --cameras 10 --budget 9000 --points 100 \
   --iterations 5000 --proposals 1 --out "$work/budget" -q || fail "budget exit $?"
 jq -e '.proposals[0].price <= 9000 and .proposals[0].price > 0 and .lenses == 5' "$work/budget/proposals.json" > /dev/null || fail "budget"
+# The trade-off against cost: every budget's layout within it, more money never fewer cameras here.
+"$pandora" propose "$scene" --catalogue "$example/cameras.json" --cameras 10 --points 100 --iterations 3000 \
+  --proposals 1 --curve-budgets 2000,6000,20000 --out "$work/costs" -q || fail "curve-budgets exit $?"
+jq -e '(.budget_curve | length) == 3 and ([.budget_curve[] | .price <= .budget] | all)
+       and .budget_curve[0].cameras < .budget_curve[2].cameras' "$work/costs/proposals.json" > /dev/null || fail "budget curve"
+bash "$here/expect_error.sh" "$pandora" "$work/o6" "give --catalogue" -- propose "$scene" --curve-budgets 1000 --out "$work/o6" || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/o3" "unknown mount kind" -- propose "$scene" --mounts floor --out "$work/o3" || exit 1
 bash "$here/expect_error.sh" "$pandora" "$work/o4" "FROM:TO" -- propose "$scene" --curve 5 --out "$work/o4" || exit 1
 echo "ok: three layouts proposed, one accepted as a rig and analysed"
