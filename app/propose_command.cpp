@@ -1,5 +1,6 @@
 // `pandora propose`: global layout proposals from mounts x aims x lenses (docs/propose.md), and
 // `pandora accept PROPOSALS --proposal N`, which writes one of them into the scene as a rig.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "app/options.h"
 #include "app/output.h"
 #include "suggest/propose.h"
+#include "suggest/suggest.h"
 
 namespace pandora::app {
 namespace {
@@ -35,6 +37,7 @@ struct ProposeArgs {
   double budget = 0, spacing = 0.5, clearance = 0.1, seconds = 20;
   std::uint64_t seed = 1;
   std::int64_t iterations = 0;
+  bool polish = false;
   bool quiet = false;
 };
 
@@ -203,6 +206,42 @@ std::string AddCurves(const ProposeResult& result, int cameras, ordered_json* do
   return csv;
 }
 
+// The Ceres nudge of `pandora suggest` on every camera of a layout (within 0.3 m and 10 degrees,
+// `clearance` from every surface) over the same target points, for the first coverage term; kept
+// only when the layout's whole objective, judged again, improves.
+bool PolishLayout(const Scene& scene, const RayCaster& caster,
+                  const std::vector<const RayCaster*>& casters,
+                  const std::vector<TargetPoint>& targets, const std::vector<ProposeTerm>& terms,
+                  double clearance, Rig* rig, Proposal* score) {
+  const auto first =
+      std::find_if(terms.begin(), terms.end(), [](const ProposeTerm& t) { return !t.calibration; });
+  if (first == terms.end() || rig->cameras.empty()) return false;
+  SuggestOptions o;
+  for (std::size_t i = 0; i < rig->cameras.size(); ++i) o.cameras.push_back(int(i));
+  CameraLimits limits;
+  limits.max_move = 0.3;
+  limits.max_rotate_deg = 10;
+  o.limits = {limits};
+  o.sample_casters = casters;
+  o.clearance = clearance;
+  o.outer_iterations = 1;
+  o.scene_path = scene.path;
+  o.objective.kind = first->n1 ? ObjectiveKind::kCoverageN1 : ObjectiveKind::kCoverage;
+  o.objective.k = first->k;
+  const Suggestion s = Suggest(scene, *rig, caster, targets, o);
+  if (!s.improved) return false;
+  Rig polished = *rig;
+  for (const CameraChange& c : s.cameras)
+    polished.cameras[std::size_t(c.index)].world_from_camera = c.after;
+  Proposal after = ScoreCameras(scene, caster, casters, targets, polished.cameras, terms);
+  if (!(after.objective > score->objective)) return false;
+  after.candidates = score->candidates;
+  after.price = score->price;
+  *rig = polished;
+  *score = after;
+  return true;
+}
+
 // The options' values checked (InputError naming the option); the objective and the curve's range.
 void CheckProposeArgs(const ProposeArgs& args, int* curve_from, int* curve_to) {
   if (args.cameras < 1 || args.cameras > 500)
@@ -313,9 +352,16 @@ int RunPropose(const ProposeArgs& args) {
                    " lenses).\n\n| Layout | Cameras | Objective | Seen by >= k | N-1 | Price "
                    "|\n|---|---|---|---|---|---|\n";
   for (std::size_t p = 0; p < result.proposals.size(); ++p) {
-    const Proposal& proposal = result.proposals[p];
+    Proposal proposal = result.proposals[p];
     const std::string name = "prop" + std::to_string(p + 1);  // ids prop1_12 fit the colour key
-    const Rig rig = ProposalRig(result, proposal, name);
+    Rig rig = ProposalRig(result, proposal, name);
+    const double unpolished = proposal.objective;
+    const bool polished =
+        args.polish && PolishLayout(scene, *caster, casters, targets, options.terms, args.clearance,
+                                    &rig, &proposal);
+    if (args.polish && !args.quiet)
+      std::fprintf(stderr, "%s: polish %s (%.4f -> %.4f)\n", name.c_str(),
+                   polished ? "kept" : "did not improve it", unpolished, proposal.objective);
     ordered_json cameras = ordered_json::array();
     for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
       const int c = proposal.candidates[i];
@@ -325,6 +371,8 @@ int RunPropose(const ProposeArgs& args) {
     }
     doc["proposals"].push_back({{"name", name},
                                 {"objective", proposal.objective},
+                                {"polished", polished},
+                                {"unpolished_objective", unpolished},
                                 {"terms", TermsJson(options.terms, proposal)},
                                 {"coverage_k", proposal.coverage_k},
                                 {"n1", proposal.n1},
@@ -471,6 +519,9 @@ Command AddProposeCommand(CLI::App& app, CommonOptions& /*common*/) {
   c->add_option("--seed", a.seed, "Seed of the points and the search")->capture_default_str();
   c->add_option("--compare", a.compare,
                 "Rigs of the scene to judge alike (comma-separated, or all)");
+  c->add_flag("--polish", a.polish,
+              "Nudge every layout with suggest's Ceres search (0.3 m, 10 degrees) and keep what "
+              "improves it");
   c->add_option("--curve", a.curve, "Trade-off curve FROM:TO cameras");
   c->add_option("--curve-budgets", a.budgets,
                 "Trade-off against cost: budgets B1,B2,... (the catalogue's prices; at most "

@@ -24,6 +24,11 @@ jq -e '.proposals[0].objective >= .proposals[1].objective and .proposals[1].obje
 jq -e '.proposals[0].objective > 0.5 and (.compared | length) == 1 and .compared[0].rig == "ring"' "$p" > /dev/null || fail "objective / compared"
 jq -e '[.curve[].cameras] == [4, 5, 6]' "$p" > /dev/null || fail "curve"
 test -s "$work/prop/proposals.md" && test -s "$work/prop/curve.csv" || fail "md / csv"
+# --polish: suggest's Ceres nudge on each layout, kept only where it improves the objective.
+"$pandora" propose "$scene" --cameras 8 --points 100 --iterations 5000 --proposals 1 --polish \
+  --out "$work/polish" -q || fail "polish exit $?"
+jq -e '.proposals[0] | .objective >= .unpolished_objective and (.polished | type) == "boolean"
+       and (.polished == (.objective > .unpolished_objective))' "$work/polish/proposals.json" > /dev/null || fail "polish"
 # The same seed and iterations give the same proposals.
 "$pandora" propose "$scene" --cameras 8 --points 150 --iterations 20000 --out "$work/again" -q || fail "again"
 test "$(jq -c '[.proposals[].cameras[].position]' "$p")" = "$(jq -c '[.proposals[].cameras[].position]' "$work/again/proposals.json")" || fail "not reproducible"
