@@ -14,6 +14,7 @@
 #include "analysis/scene/scene_text.h"
 #include "analysis/util/error.h"
 #include "analysis/util/output_transaction.h"
+#include "analysis/util/units.h"
 #include "app/cli.h"
 #include "app/commands.h"
 
@@ -29,11 +30,7 @@ struct ImportPlanArgs {
 };
 
 double UnitOption(const std::string& unit) {
-  if (unit == "m") return 1;
-  if (unit == "cm") return 0.01;
-  if (unit == "mm") return 0.001;
-  if (unit == "in") return 0.0254;
-  if (unit == "ft") return 0.3048;
+  if (const double metres = MetresPerUnitNamed(unit); metres > 0) return metres;
   throw InputError("--units", "", "unknown unit '" + unit + "'", "one of m, cm, mm, in, ft");
 }
 

@@ -56,15 +56,8 @@ ordered_json CameraJson(const Camera& c, const ProposeLens& lens, const std::str
                     {"up", ProposalPoint(up)},
                     {"resolution", {lens.intrinsics.width, lens.intrinsics.height}},
                     {"hfov_deg", ProposalNumber(lens.hfov_deg)}};
-  if (lens.intrinsics.model != LensModel::kPinhole) {
-    const Intrinsics& k = lens.intrinsics;
-    j["distortion"] = {{"model", LensModelName(k.model)}, {"k1", k.k1}, {"k2", k.k2}};
-    if (k.model == LensModel::kFisheye) {
-      j["distortion"]["k3"] = k.k3, j["distortion"]["k4"] = k.k4;
-    } else {
-      j["distortion"]["p1"] = k.p1, j["distortion"]["p2"] = k.p2, j["distortion"]["k3"] = k.k3;
-    }
-  }
+  if (lens.intrinsics.model != LensModel::kPinhole)
+    j["distortion"] = scene_text::DistortionJson(lens.intrinsics);
   if (lens.far < 1e8)
     j["range"] = {{"near", ProposalNumber(lens.near)}, {"far", ProposalNumber(lens.far)}};
   else

@@ -65,14 +65,7 @@ CameraTemplate CameraTemplateOf(const RigArgs& args, int width, int height) {
     width = k.width, height = k.height, hfov = widest.hfov_deg;
     t.keys["resolution"] = {width, height};
     t.keys["hfov_deg"] = Number(Clean(hfov));
-    if (k.model != LensModel::kPinhole) {
-      ordered_json d = {{"model", LensModelName(k.model)}, {"k1", k.k1}, {"k2", k.k2}};
-      if (k.model == LensModel::kFisheye)
-        d["k3"] = k.k3, d["k4"] = k.k4;
-      else
-        d["p1"] = k.p1, d["p2"] = k.p2, d["k3"] = k.k3;
-      t.keys["distortion"] = d;
-    }
+    if (k.model != LensModel::kPinhole) t.keys["distortion"] = scene_text::DistortionJson(k);
     t.range_m = Vec2(widest.near, widest.far < 1e8 ? widest.far : 1e6);
     if (args.ptz == "zoom") {
       if (lenses.size() < 2)

@@ -16,6 +16,7 @@
 #include "analysis/util/palette.h"
 #include "analysis/util/seeded.h"
 #include "analysis/util/units.h"
+#include "volume/pixel_targets.h"
 
 namespace pandora {
 namespace {
@@ -471,10 +472,9 @@ std::vector<ProposeTerm> ParseProposeObjective(const std::string& text, const Sc
       term = term.substr(0, sign);
       const std::vector<std::string> dori = {"detection", "observation", "recognition",
                                              "identification"};
-      const double px[4] = {25.0, 62.5, 125.0, 250.0};
       bool found = false;
       for (std::size_t i = 0; i < dori.size(); ++i)
-        if (d == dori[i]) t.min_px_per_m = px[i], found = true;
+        if (d == dori[i]) t.min_px_per_m = kDoriPxPerM[i], found = true;
       for (const PixelTarget& p : scene.study.pixel_targets)
         if (!found && d == p.name) t.min_px_per_m = p.px_per_m(), found = true;
       if (!found) {

@@ -33,13 +33,6 @@ bool SegmentsMeet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d, do
          OnSegment(b, c, d, eps);
 }
 
-double DistanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
 // The wall's outward unit normal (away from the footprint's inside).
 Vec2 OutwardNormal(const Vec2& a, const Vec2& b, bool ccw) {
   const Vec2 d = (b - a).normalized();
@@ -110,6 +103,13 @@ void Limb(const Vec3& root, double l1, double l2, double swing, double bend, boo
 }
 
 }  // namespace
+
+double DistanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
 
 double SignedArea2(const Polygon2& polygon) {
   double a = 0;

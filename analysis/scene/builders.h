@@ -20,6 +20,9 @@ namespace pandora {
 
 using Polygon2 = std::vector<Vec2>;
 
+/// The distance from `p` to the segment from `a` to `b` (to `a` when they coincide).
+double DistanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b);
+
 /// Twice the signed area of a polygon (positive: counter-clockwise seen from +z).
 double SignedArea2(const Polygon2& polygon);
 

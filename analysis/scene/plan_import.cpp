@@ -30,12 +30,6 @@ std::vector<Segment> Segments(const PlanDrawing& drawing, const std::string& lay
   return out;
 }
 
-double DistanceToSegment2(const Vec2& p, const Vec2& a, const Vec2& b) {
-  const Vec2 ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (a + t * ab - p).norm();
-}
-
 // A box along the segment from a to b (a wall piece, a lintel), `thickness` wide, z0 to z1.
 PlanBox AlongSegment(const std::string& name, const Vec2& a, const Vec2& b, double thickness,
                      double z0, double z1) {
@@ -97,7 +91,7 @@ PlanScene BuildPlan(const PlanDrawing& drawing, const PlanOptions& options,
     // An end that meets another wall is extended by half the thickness, closing the corner.
     auto meets = [&](const Vec2& p) {
       for (std::size_t o = 0; o < walls.size(); ++o)
-        if (o != w && DistanceToSegment2(p, walls[o].a, walls[o].b) <= tol) return true;
+        if (o != w && DistanceToSegment(p, walls[o].a, walls[o].b) <= tol) return true;
       return false;
     };
     const double start_ext = meets(wall.a) ? 0.5 * t : 0, end_ext = meets(wall.b) ? 0.5 * t : 0;

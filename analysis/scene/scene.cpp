@@ -1581,15 +1581,7 @@ ViewingStation ReadStation(const Node& node) {
 
 double ReadUnit(const Node& node) {
   const std::string unit = node.String();
-  struct UnitScale {
-    const char* name;
-    double metres;
-  };
-  constexpr UnitScale kUnits[] = {
-      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
-  for (const UnitScale& u : kUnits) {
-    if (unit == u.name) return u.metres;
-  }
+  if (const double metres = MetresPerUnitNamed(unit); metres > 0) return metres;
   node.Fail("unknown unit " + json(unit).dump(), "use one of 'm', 'cm', 'mm', 'in', 'ft'");
 }
 

@@ -6,13 +6,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <map>
 
+#include "analysis/geometry/camera.h"
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
 #include "analysis/util/output_transaction.h"
 #include "analysis/util/sha256.h"
+#include "analysis/util/units.h"
 
 namespace pandora::scene_text {
 
@@ -54,6 +55,16 @@ ordered_json Number(double v) {
   return ordered_json(v);
 }
 
+ordered_json DistortionJson(const Intrinsics& k) {
+  if (k.model == LensModel::kPinhole) return nullptr;
+  ordered_json d = {{"model", LensModelName(k.model)}, {"k1", k.k1}, {"k2", k.k2}};
+  if (k.model == LensModel::kFisheye)
+    d["k3"] = k.k3, d["k4"] = k.k4;
+  else
+    d["p1"] = k.p1, d["p2"] = k.p2, d["k3"] = k.k3;
+  return d;
+}
+
 ordered_json ParseOrdered(const std::string& text, const std::string& scene_path) {
   try {
     return ordered_json::parse(text);
@@ -81,12 +92,8 @@ ordered_json& FindRig(ordered_json& root, const std::string& path, const std::st
 double MetresPerUnit(const ordered_json& root, const std::string& path) {
   if (!root.contains("units")) return 1.0;
   const ordered_json& u = root["units"];
-  static const std::map<std::string, double> units{
-      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
-  if (u.is_string()) {
-    auto it = units.find(u.get<std::string>());
-    if (it != units.end()) return it->second;
-  }
+  if (u.is_string())
+    if (const double metres = MetresPerUnitNamed(u.get<std::string>()); metres > 0) return metres;
   throw InputError(path, "$.units", "unknown unit", "use m, cm, mm, in or ft");
 }
 

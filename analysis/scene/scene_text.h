@@ -11,6 +11,10 @@
 #include <utility>
 #include <vector>
 
+namespace pandora {
+struct Intrinsics;
+}
+
 namespace pandora::scene_text {
 
 using ordered_json = nlohmann::ordered_json;
@@ -35,6 +39,9 @@ std::string IdOf(const ordered_json& id);
 double Clean(double v);
 /// A number as JSON: an integer when it is a whole number (as a person writes 4, not 4.0).
 ordered_json Number(double v);
+/// A lens's "distortion" in the scene format, "model" first (brown_conrady: k1 k2 p1 p2 k3;
+/// fisheye: k1 k2 k3 k4); null for a pinhole.
+ordered_json DistortionJson(const Intrinsics& k);
 
 }  // namespace pandora::scene_text
 

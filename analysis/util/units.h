@@ -2,7 +2,10 @@
 /// \file units.h
 /// Angles: the one place that says what pi is and which way degrees and radians convert. Scene
 /// files and everything a person reads are in degrees; the arithmetic is in radians. Each function
-/// is the expression the code used before it came here, so results are the same to the bit.
+/// is the expression the code used before it came here, so results are the same to the bit. And
+/// the length units a file or an option may name.
+
+#include <string>
 
 namespace pandora {
 
@@ -15,5 +18,19 @@ inline constexpr double kDegPerRad = 180.0 / kPi;
 constexpr double Rad(double deg) { return deg * kPi / 180.0; }
 /// Radians to degrees: rad * 180 / pi (in that order).
 constexpr double Deg(double rad) { return rad * 180.0 / kPi; }
+
+/// Metres per length unit named "m", "cm", "mm", "in" or "ft" (a scene file's "units",
+/// import-plan's --units); 0 for any other name.
+inline double MetresPerUnitNamed(const std::string& name) {
+  struct UnitScale {
+    const char* name;
+    double metres;
+  };
+  constexpr UnitScale kUnits[] = {
+      {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"in", 0.0254}, {"ft", 0.3048}};
+  for (const UnitScale& u : kUnits)
+    if (name == u.name) return u.metres;
+  return 0;
+}
 
 }  // namespace pandora
