@@ -446,6 +446,18 @@ double Footprint2::Distance(const Vec2& p) const {
   return best;
 }
 
+double Footprint2::SegmentDistance(const Vec2& a, const Vec2& b) const {
+  double best = std::min(Distance(a), Distance(b));
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3 && best > 0; ++k) {
+      const Vec2 &c = t[k], &d = t[(k + 1) % 3];
+      if (SegmentsMeet(a, b, c, d, 0)) return 0;
+      best = std::min({best, DistanceToSegment(c, a, b), DistanceToSegment(d, a, b),
+                       DistanceToSegment(a, c, d), DistanceToSegment(b, c, d)});
+    }
+  return best;
+}
+
 Vec2 OtherWalker::At(double t) const {
   GroupPose pose;
   if (!keyframes.empty()) {
@@ -496,7 +508,8 @@ std::vector<std::pair<double, GroupPose>> WanderKeyframes(const WanderSpec& wand
       const double target = HeadingDeg(at, goal) - facing_deg;
       const double turn = std::abs(WrapDegrees(target - yaw)) > 1e-9 ? wander.turn_s : 0;
       const double walk_s = length / wander.speed;
-      bool free = true;
+      // The static solids once for the whole leg (exactly), then the other walkers along it.
+      bool free = obstacles.SegmentDistance(at, goal) >= wander.radius;
       for (double s = 0; s <= walk_s + 1e-12 && free; s += kStep)
         free = clear_at(at + (goal - at) * (s / walk_s), t + turn + s);
       for (double s = 0; s <= wander.pause_s && free; s += kStep)

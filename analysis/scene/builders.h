@@ -133,6 +133,8 @@ struct Footprint2 {
   std::vector<std::array<Vec2, 3>> triangles;
   /// The smallest distance from `p` to the footprint (0 inside).
   double Distance(const Vec2& p) const;
+  /// The smallest distance from the segment a-b to the footprint (0 when it enters it).
+  double SegmentDistance(const Vec2& a, const Vec2& b) const;
 };
 
 /// Another walker: the anchor's x, y at time t.
