@@ -253,6 +253,8 @@ int RunAnalyze(const AnalyzeArgs& args) {
   // samples and surface targets, pixel targets and DORI, warnings, calibration, N-1, PTZ.
   session::AnalyzeOptions analysis;
   analysis.fields = options;
+  analysis.spill_folder = out.string();
+  analysis.spill_blame = "--out";
   analysis.threads = static_cast<int>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   std::optional<ProgressBar> time_bar;
@@ -500,7 +502,10 @@ void AnalyzeStreamTile(const StreamSetup& setup, const FieldOptions& tile_option
   }
   totals.pixel_targets.Add(PixelTargetParts(scene, rig, f, k, &f));
   if (HasCameraSets(f)) {
-    totals.criticality.Add(CriticalityParts(scene, rig, f, setup.study->caster(), k));
+    // A part's lists (8 bytes per triangulable voxel and camera that sees it) at a time, with
+    // their working copies about a tenth of the budget (the tile itself may take half).
+    AddCriticalityParts(scene, rig, f, setup.study->caster(), k,
+                        std::max(1.0, tile_options.memory_budget_bytes / 32.0), totals.criticality);
     AddCoverageN1Grid(&f);
   }
   if (RigHasPtz(rig)) totals.ptz.Add(PtzFieldsParts(scene, rig, setup.study->caster(), f, &f));

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/scene/scene.h"
@@ -17,53 +18,129 @@
 #include "app/output.h"
 #include "app/session/study.h"
 #include "volume/fields.h"
+#include "volume/fields_transfer.h"
 #include "volume/time_fields.h"
 
 namespace pandora::app {
 
 namespace {
 
-// Coverage alone, the uncertainty fields and every field, timed in the same run, interleaved
-// (drifts in machine load hit all alike), the best of each.
-struct FieldSetTimes {
+// The bench's tiles, evaluated one after another: the region's block columns as `pandora analyze
+// --stream` plans them within the budget (less the scene's structures), no wider than keeps one
+// tile's recorded rays within a quarter of it (a ray is 64 bytes and its Embree copy 48 more;
+// at most one per free voxel and enabled camera). One tile (the whole region) when it fits.
+std::vector<BlockColumns> BenchTiles(const Scene& scene, const Rig& rig,
+                                     const FieldOptions& options,
+                                     const std::vector<std::string>& fields,
+                                     const VoxelLattice& lattice) {
+  const double budget = std::max(0.0, options.memory_budget_bytes - SceneStructureBytes(scene));
+  const double vs = lattice.voxel_size;
+  const double ray_bytes_per_m2 = double(lattice.dims.z()) / (vs * vs) *
+                                  double(std::max(1, rig.enabled_count())) * (sizeof(Ray) + 48.0);
+  const double area = double(lattice.dims.x()) * double(lattice.dims.y()) * vs * vs;
+  const double side = ray_bytes_per_m2 * area > budget / 4
+                          ? std::max(8 * vs, std::sqrt(budget / 4 / ray_bytes_per_m2))
+                          : 0.0;
+  return PlanTiles(lattice, fields, budget, side);
+}
+
+// What the bench times, summed over its tiles: each tile's best of the repetitions (the tiles are
+// disjoint, so the sums are the whole region's), with the statistics of the whole region.
+struct BenchTimes {
+  std::size_t tiles = 0, largest_tile_rays = 0;
   std::vector<std::string> uncertainty_fields, all_fields;
-  double coverage = std::numeric_limits<double>::infinity();
-  double uncertainty = std::numeric_limits<double>::infinity();
-  double all = std::numeric_limits<double>::infinity();
-  double cpu_coverage = std::numeric_limits<double>::infinity();
-  double cpu_uncertainty = std::numeric_limits<double>::infinity();
-  FieldStats all_stats;
+  double fields = 0, raw = 0, packet = 0;  // the field evaluation and the two raw Embree loops
+  double coverage = 0, uncertainty = 0, all = 0, cpu_coverage = 0, cpu_uncertainty = 0;
+  FieldStats stats, all_stats;
+  std::size_t rays = 0, occluded = 0;
 };
 
-FieldSetTimes TimeFieldSets(const Scene& scene, const Rig& rig, const RayCaster& caster,
-                            const FieldOptions& options, int repeat) {
-  FieldSetTimes t;
-  FieldOptions coverage_only = options;
-  coverage_only.fields = {"coverage"};
-  FieldOptions with_uncertainty = options;
-  with_uncertainty.fields = {"coverage", "sigma_max", "sigma_mean", "triangulation_angle",
-                             "condition"};
+// Field set options: coverage alone, the uncertainty fields, every field the scene can have (the
+// nine with a motion model).
+void FieldSets(const Scene& scene, const FieldOptions& options, FieldOptions* coverage_only,
+               FieldOptions* with_uncertainty, FieldOptions* all_fields) {
+  *coverage_only = *with_uncertainty = *all_fields = options;
+  coverage_only->fields = {"coverage"};
+  with_uncertainty->fields = {"coverage", "sigma_max", "sigma_mean", "triangulation_angle",
+                              "condition"};
   if (scene.study.motion) {
-    with_uncertainty.fields.push_back("sigma_max_steady");
-    with_uncertainty.fields.push_back("sigma_mean_steady");
+    with_uncertainty->fields.push_back("sigma_max_steady");
+    with_uncertainty->fields.push_back("sigma_mean_steady");
   }
-  // Every field the scene can have (the nine with a motion model).
-  FieldOptions all_fields = options;
-  all_fields.fields.clear();
+  all_fields->fields.clear();
   for (const std::string& f : FieldNames())
-    if (scene.study.motion || f.find("steady") == std::string::npos) all_fields.fields.push_back(f);
+    if (scene.study.motion || f.find("steady") == std::string::npos)
+      all_fields->fields.push_back(f);
+}
+
+// One tile: a recording evaluation gives the exact rays the evaluation casts there (and warms the
+// caches); then, `repeat` times and interleaved (drifts in machine load hit all alike), the field
+// evaluation, the raw Embree loops over those rays, and the field sets; the best of each added to
+// `t`. The tile's rays and fields are dropped before the next tile.
+void TimeTile(const Scene& scene, const Rig& rig, const RayCaster& caster, FieldOptions options,
+              const std::optional<BlockColumns>& tile, int repeat, BenchTimes& t) {
+  options.tile = tile;
+  FieldOptions coverage_only, with_uncertainty, all_fields;
+  FieldSets(scene, options, &coverage_only, &with_uncertainty, &all_fields);
+  options.record_rays = true;
+  std::vector<Ray> rays = EvaluateFields(scene, rig, caster, options).recorded_rays;
+  options.record_rays = false;
+  const double inf = std::numeric_limits<double>::infinity();
+  double fields = inf, raw = inf, packet = inf, coverage = inf, uncertainty = inf, all = inf;
+  double cpu_coverage = inf, cpu_uncertainty = inf;
+  FieldStats stats, all_stats;
+  std::size_t occluded = 0;
   for (int r = 0; r < repeat; ++r) {
+    stats = EvaluateFields(scene, rig, caster, options).stats;
+    fields = std::min(fields, stats.seconds);
+    const RawOcclusionResult single = RawEmbreeOcclusion(caster, rays);
+    raw = std::min(raw, single.seconds);
+    occluded = single.occluded;
+    packet = std::min(packet, RawEmbreeOcclusion(caster, rays, RawMode::kPacket).seconds);
     const FieldStats c = EvaluateFields(scene, rig, caster, coverage_only).stats;
     const FieldStats u = EvaluateFields(scene, rig, caster, with_uncertainty).stats;
-    t.all_stats = EvaluateFields(scene, rig, caster, all_fields).stats;
-    t.all = std::min(t.all, t.all_stats.seconds);
-    t.coverage = std::min(t.coverage, c.seconds);
-    t.uncertainty = std::min(t.uncertainty, u.seconds);
-    t.cpu_coverage = std::min(t.cpu_coverage, c.cpu_seconds);
-    t.cpu_uncertainty = std::min(t.cpu_uncertainty, u.cpu_seconds);
+    all_stats = EvaluateFields(scene, rig, caster, all_fields).stats;
+    coverage = std::min(coverage, c.seconds);
+    uncertainty = std::min(uncertainty, u.seconds);
+    all = std::min(all, all_stats.seconds);
+    cpu_coverage = std::min(cpu_coverage, c.cpu_seconds);
+    cpu_uncertainty = std::min(cpu_uncertainty, u.cpu_seconds);
   }
+  ++t.tiles;
+  t.largest_tile_rays = std::max(t.largest_tile_rays, rays.size());
+  t.rays += rays.size();
+  t.occluded += occluded;
+  t.fields += fields, t.raw += raw, t.packet += packet;
+  t.coverage += coverage, t.uncertainty += uncertainty, t.all += all;
+  t.cpu_coverage += cpu_coverage, t.cpu_uncertainty += cpu_uncertainty;
+  // The statistics of the whole region: the tiles' added (their lists are not needed here).
+  stats.sigma_max_mm.clear(), stats.sigma_max_steady_mm.clear();
+  all_stats.sigma_max_mm.clear(), all_stats.sigma_max_steady_mm.clear();
+  AddFieldStats(&t.stats, stats);
+  AddFieldStats(&t.all_stats, all_stats);
+  t.all_stats.angle_pairs_tried += all_stats.angle_pairs_tried;
+  t.all_stats.angle_pairs_all += all_stats.angle_pairs_all;
   t.uncertainty_fields = with_uncertainty.fields;
   t.all_fields = all_fields.fields;
+}
+
+// The whole bench over the tiles of BenchTiles (the largest field set's plan).
+BenchTimes TimeTiles(const Scene& scene, const Rig& rig, const RayCaster& caster,
+                     const FieldOptions& options, int repeat) {
+  FieldOptions coverage_only, with_uncertainty, all_fields;
+  FieldSets(scene, options, &coverage_only, &with_uncertainty, &all_fields);
+  const VoxelLattice lattice =
+      MakeLattice(scene.study.region.box, scene.study.voxel_size,
+                  options.voxel_size_option.empty() ? scene.path : options.voxel_size_option,
+                  options.voxel_size_option.empty() ? "$.study.voxel_size" : "");
+  const std::vector<BlockColumns> tiles =
+      BenchTiles(scene, rig, options, all_fields.fields, lattice);
+  BenchTimes t;
+  if (tiles.size() == 1) {
+    TimeTile(scene, rig, caster, options, std::nullopt, repeat, t);
+    return t;
+  }
+  for (const BlockColumns& tile : tiles) TimeTile(scene, rig, caster, options, tile, repeat, t);
   return t;
 }
 
@@ -157,42 +234,28 @@ int RunBench(const BenchArgs& args) {
   if (!std::isnan(args.voxel_size)) options.voxel_size_option = "--voxel-size";
   options.fields = {"coverage", "cameras", "resolution"};
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
+  if (!std::isnan(args.memory_budget_mb)) {
+    CheckMemoryBudget(args.memory_budget_mb, "--memory-budget", "");
+    options.memory_budget_bytes = args.memory_budget_mb * 1048576.0;
+    options.memory_budget_option = "--memory-budget";
+  }
   // The solids' search trees are the study's, built once (in the recording pass) like Embree's
   // BVH and kept: the field time is what each evaluation does.
   options.solid_trees = &study->solid_trees();
 
-  // One recording pass gives the exact rays the evaluation casts (and warms caches).
-  options.record_rays = true;
-  Fields recorded = EvaluateFields(scene, rig, *caster, options);
-  options.record_rays = false;
-  const std::vector<Ray> rays = std::move(recorded.recorded_rays);
-
-  // Interleave the two measurements so drifts in machine load hit both alike; keep the best of
-  // each.
-  double best_fields = std::numeric_limits<double>::infinity();
-  double best_raw = std::numeric_limits<double>::infinity();
-  double best_packet = std::numeric_limits<double>::infinity();
-  FieldStats stats;
-  std::size_t occluded = 0;
-  for (int r = 0; r < args.repeat; ++r) {
-    const Fields f = EvaluateFields(scene, rig, *caster, options);
-    best_fields = std::min(best_fields, f.stats.seconds);
-    stats = f.stats;
-    const RawOcclusionResult raw = RawEmbreeOcclusion(*caster, rays);
-    best_raw = std::min(best_raw, raw.seconds);
-    occluded = raw.occluded;
-    best_packet =
-        std::min(best_packet, RawEmbreeOcclusion(*caster, rays, RawMode::kPacket).seconds);
-  }
-
-  const FieldSetTimes sets = TimeFieldSets(scene, rig, *caster, options, args.repeat);
-  const double best_coverage = sets.coverage, best_uncertainty = sets.uncertainty;
-  const double cpu_coverage = sets.cpu_coverage, cpu_uncertainty = sets.cpu_uncertainty;
-  const FieldStats& all_stats = sets.all_stats;
-  const std::vector<std::string>& uncertainty_fields = sets.uncertainty_fields;
-  const std::vector<std::string>& all_field_names = sets.all_fields;
+  const BenchTimes t = TimeTiles(scene, rig, *caster, options, args.repeat);
+  const double best_fields = t.fields, best_raw = t.raw, best_packet = t.packet;
+  const FieldStats& stats = t.stats;
+  const std::size_t occluded = t.occluded;
+  const double best_coverage = t.coverage, best_uncertainty = t.uncertainty;
+  const double cpu_coverage = t.cpu_coverage, cpu_uncertainty = t.cpu_uncertainty;
+  const FieldStats& all_stats = t.all_stats;
+  const std::vector<std::string>& uncertainty_fields = t.uncertainty_fields;
+  const std::vector<std::string>& all_field_names = t.all_fields;
+  // The time samples evaluate the whole region at once: with the region in one tile only.
   const TimeSampleTimes times =
-      TimeSamples(scene, rig, *caster, options, all_field_names, args.repeat);
+      t.tiles == 1 ? TimeSamples(scene, rig, *caster, options, all_field_names, args.repeat)
+                   : TimeSampleTimes{};
   const double uncertainty_overhead = best_uncertainty / best_coverage - 1.0;
   const double cpu_overhead = cpu_uncertainty / cpu_coverage - 1.0;
 
@@ -213,11 +276,18 @@ int RunBench(const BenchArgs& args) {
               stats.point_camera_tests / best_fields / 1e6, stats.rays / best_fields / 1e6);
   std::printf("  %-44s %9.4f s  %8s            %8.2f M rays/s\n",
               "raw Embree rtcOccluded1 loop, same rays", best_raw, "",
-              rays.size() / best_raw / 1e6);
+              double(t.rays) / best_raw / 1e6);
   const std::string packet_label =
       "raw Embree rtcOccluded" + std::to_string(width) + " packets, same rays";
   std::printf("  %-44s %9.4f s  %8s            %8.2f M rays/s\n", packet_label.c_str(), best_packet,
-              "", rays.size() / best_packet / 1e6);
+              "", double(t.rays) / best_packet / 1e6);
+  if (t.tiles > 1)
+    std::printf(
+        "  in %zu tiles of block columns, one at a time (at most %zu rays, %.0f MiB, held at "
+        "once; budget %.0f MiB); each tile's best of %d runs, summed\n",
+        t.tiles, t.largest_tile_rays,
+        double(t.largest_tile_rays) * (sizeof(Ray) + 48.0) / 1048576.0,
+        options.memory_budget_bytes / 1048576.0, args.repeat);
   std::printf("  of the field time, active set (region, solids, culling): %.4f s\n",
               stats.active_set_seconds);
   std::printf(
@@ -234,7 +304,7 @@ int RunBench(const BenchArgs& args) {
               cpu_coverage, cpu_uncertainty, 100.0 * cpu_overhead);
   std::printf(
       "  all %zu fields %.4f s: ratio all fields / coverage alone = %.3f (target <= 1.15)\n",
-      all_field_names.size(), sets.all, sets.all / best_coverage);
+      all_field_names.size(), t.all, t.all / best_coverage);
   const std::int64_t two_or_more =
       all_stats.seen_voxels -
       (all_stats.coverage_histogram.size() > 1 ? all_stats.coverage_histogram[1] : 0);
@@ -260,7 +330,10 @@ int RunBench(const BenchArgs& args) {
                      {"raw_embree_seconds", best_raw},
                      {"tests_per_second", stats.point_camera_tests / best_fields},
                      {"field_rays_per_second", stats.rays / best_fields},
-                     {"raw_rays_per_second", rays.size() / best_raw},
+                     {"raw_rays_per_second", double(t.rays) / best_raw},
+                     {"tiles", t.tiles},
+                     {"largest_tile_rays", t.largest_tile_rays},
+                     {"memory_budget_mib", options.memory_budget_bytes / 1048576.0},
                      {"raw_packet_seconds", best_packet},
                      {"packet_width", width},
                      {"ratio", ratio},
@@ -275,8 +348,8 @@ int RunBench(const BenchArgs& args) {
                      {"with_uncertainty_cpu_seconds", cpu_uncertainty},
                      {"uncertainty_overhead_cpu", cpu_overhead},
                      {"all_fields", all_field_names},
-                     {"all_fields_seconds", sets.all},
-                     {"all_fields_ratio", sets.all / best_coverage},
+                     {"all_fields_seconds", t.all},
+                     {"all_fields_ratio", t.all / best_coverage},
                      {"angle_pairs_tried", all_stats.angle_pairs_tried},
                      {"angle_pairs_all", all_stats.angle_pairs_all}};
     if (times.samples > 0)
@@ -308,6 +381,9 @@ Command AddBenchCommand(CLI::App& app, CommonOptions& common) {
   b->add_option("--repeat", bench.repeat, "Timed repetitions (the best is reported)")
       ->check(Number(1, 1000, "repetitions", true));
   b->add_option("--json", bench.json_out, "Also write the results to this JSON file");
+  b->add_option("--memory-budget", bench.memory_budget_mb,
+                "Memory budget in MiB (default: study.memory_budget_mb or 4096): the region is "
+                "timed in tiles whose fields and recorded rays fit it");
   b->add_flag("--render", bench.render,
               "Time `pandora render` (1280x720) against raw Embree loops over the same primary and "
               "shadow rays");

@@ -52,7 +52,8 @@ struct BenchArgs {
   /// `--incremental`: the time to update the fields after moving one camera, as a ratio to a
   /// full evaluation (bench_incremental.cpp).
   bool incremental = false;
-  double move = 0.05;  ///< With --incremental: how far each camera moves, metres.
+  double move = 0.05;                ///< With --incremental: how far each camera moves, metres.
+  double memory_budget_mb = kUnset;  ///< `--memory-budget`; kUnset: the scene's.
 };
 /// `pandora bench --render`: Render() against raw Embree loops over the very same primary rays
 /// (rtcIntersect1) and occlusion segments (rtcOccluded packets and single rays), same run.

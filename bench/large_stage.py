@@ -6,7 +6,7 @@ volume. Everything is a primitive of the scene format, so the file is small what
 count.
 
     python3 bench/large_stage.py OUT.json [--triangles 1000000] [--cameras 24] [--performers 16]
-                                          [--voxel 0.05] [--seed 1]
+                                          [--voxel 0.05] [--seed 1] [--motion]
 
 The triangle count is met to within a few per cent (printed); the scene's own count is what
 `pandora bench` prints.
@@ -124,6 +124,8 @@ def main():
     ap.add_argument("--performers", type=int, default=16)
     ap.add_argument("--voxel", type=float, default=0.05)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--motion", action="store_true",
+                    help="add a motion model (study.motion), so that all nine fields can be asked for")
     a = ap.parse_args()
     rng = random.Random(a.seed)
     fixed = 12 * 6  # floor and the six props' boxes
@@ -156,6 +158,8 @@ def main():
                   "pixel_sigma": 0.2},
         "views": {"overview": {"from": [-8.0, -7.0, 5.5], "at": [0.0, 0.0, 1.0], "fov_deg": 55}},
     }
+    if a.motion:
+        scene["study"]["motion"] = {"q": 20.0, "rate_hz": 120}
     with open(a.out, "w") as f:
         json.dump(scene, f, indent=1)
         f.write("\n")

@@ -1,5 +1,6 @@
 #include "volume/fields.h"
 
+#include <malloc.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
@@ -2203,14 +2204,30 @@ void FinishUpdate(State& S, const Rig& rig, const RigData& rd, UpdatePass* u, Fi
   FieldStats& st = S.fields.stats;
   const double estimated = st.estimated_bytes;
   S.Totals(&st, new_count, rd.enabled);
+  if (!S.keep) {
+    // One evaluation: the blocks' lists are in the totals now. Freed, and the freed pages of the
+    // heap handed back (the blocks' small allocations would otherwise stay resident: 8 bytes per
+    // triangulable voxel with the steady fields).
+    for (BlockState& s : S.states) {
+      std::vector<float>().swap(s.sigma_list);
+      std::vector<float>().swap(s.steady_list);
+    }
+    malloc_trim(0);
+  }
   st.estimated_bytes = estimated;
   st.angle_pairs_tried = S.angle_pairs_tried;
   st.angle_pairs_all = S.angle_pairs_all;
   st.active_set_seconds = update->full || u->per_block ? S.active_set_seconds : 0.0;
   if (opt.record_rays && update->full) {
+    // Joined in block order; without kept state each block's own copy goes as it is joined.
+    std::size_t count = 0;
+    for (const BlockState& s : S.states) count += s.rays.size();
     S.fields.recorded_rays.clear();
-    for (const BlockState& s : S.states)
+    S.fields.recorded_rays.reserve(count);
+    for (BlockState& s : S.states) {
       S.fields.recorded_rays.insert(S.fields.recorded_rays.end(), s.rays.begin(), s.rays.end());
+      if (!S.keep) std::vector<Ray>().swap(s.rays);
+    }
   }
   update->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   st.seconds = update->seconds + (update->full ? S.active_set_seconds : 0.0);

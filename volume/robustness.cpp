@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iterator>
 #include <stdexcept>
 
@@ -84,8 +85,7 @@ std::vector<openvdb::Coord> SeenLeafOrigins(const Rig& rig, const Fields::Impl& 
   return origins;
 }
 
-// Sizes `base` and `intact` for the triangulable voxels' sigma_max (the leaves fill the values);
-// refuses a sigma_max field outside the camera sets.
+// Sizes `base` and `intact` for the triangulable voxels' sigma_max (the leaves fill the values).
 void SizeIntactSigmas(const openvdb::FloatGrid& sigma_grid,
                       const std::vector<openvdb::Coord>& origins, std::vector<std::int64_t>* base,
                       std::vector<float>* intact) {
@@ -93,11 +93,20 @@ void SizeIntactSigmas(const openvdb::FloatGrid& sigma_grid,
     const auto* leaf = sigma_grid.tree().probeConstLeaf(origins[i]);
     (*base)[i + 1] = (*base)[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
   }
-  // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
-  if (base->back() != static_cast<std::int64_t>(sigma_grid.activeVoxelCount()))
+  intact->resize(static_cast<std::size_t>(base->back()));
+}
+
+// Refuses a sigma_max field outside the camera sets: sigma_max is active only where >= 2 cameras
+// see a voxel, so inside the leaves at `origins`.
+void CheckSigmasInside(const openvdb::FloatGrid& sigma_grid,
+                       const std::vector<openvdb::Coord>& origins) {
+  std::int64_t inside = 0;
+  for (const openvdb::Coord& origin : origins)
+    if (const auto* leaf = sigma_grid.tree().probeConstLeaf(origin))
+      inside += static_cast<std::int64_t>(leaf->onVoxelCount());
+  if (inside != static_cast<std::int64_t>(sigma_grid.activeVoxelCount()))
     throw std::invalid_argument(
         "ComputeCriticality: the sigma_max field does not match the camera sets");
-  intact->resize(static_cast<std::size_t>(base->back()));
 }
 
 // What every leaf's work reads (the rig, its fields, the thresholds, the prepared cameras) and
@@ -364,27 +373,36 @@ Partial JoinPartials(tbb::enumerable_thread_specific<Partial>& partials, std::si
 // 1, 2, 3, k and seen]; lists [intact sigma_max, per camera removed, per camera added].
 constexpr std::size_t kCountsBefore = 5, kPerCamera = 5;
 
-SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
-                              const RayCaster& caster, int k) {
-  const Fields::Impl& g = fields.impl();
-  if (!HasCameraSets(fields))
-    throw std::invalid_argument("ComputeCriticality: the fields hold no per-camera sets");
-  if (g.visible.size() != rig.cameras.size())
-    throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
-  if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
-  const std::size_t camera_count = rig.cameras.size();
-  const Thresholds th{{1, 2, 3, k}};
-  const openvdb::FloatGrid::Ptr sigma_grid = g.Float("sigma_max");
-  const bool uncertainty = sigma_grid != nullptr;
+namespace {
 
-  // Leaves seen by some enabled camera.
-  const std::vector<openvdb::Coord> origins = SeenLeafOrigins(rig, g);
-
-  // As the field evaluation prepares its rig (FieldEvaluator::State::Prepare): the Jacobian in the
-  // camera frame and the whitened rotation.
+// What every part of one criticality computation shares: the checked inputs, the leaves seen by
+// some enabled camera, and (with sigma_max) the cameras prepared as the field evaluation prepares
+// its rig (FieldEvaluator::State::Prepare): the Jacobian in the camera frame and the whitened
+// rotation.
+struct CriticalitySetup {
+  const Rig& rig;
+  const Fields& fields;
+  const Fields::Impl& g;
+  Thresholds th;
+  openvdb::FloatGrid::Ptr sigma_grid;
+  std::vector<openvdb::Coord> origins;
   std::unique_ptr<VisibilityTester> tester;
-  std::vector<std::array<double, 9>> whitened(camera_count);
-  if (uncertainty) {
+  std::vector<std::array<double, 9>> whitened;
+
+  CriticalitySetup(const Scene& scene, const Rig& r, const Fields& f, const RayCaster& caster,
+                   int k)
+      : rig(r), fields(f), g(f.impl()), th{{1, 2, 3, k}} {
+    if (!HasCameraSets(fields))
+      throw std::invalid_argument("ComputeCriticality: the fields hold no per-camera sets");
+    if (g.visible.size() != rig.cameras.size())
+      throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
+    if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
+    sigma_grid = g.Float("sigma_max");
+    origins = SeenLeafOrigins(rig, g);
+    const std::size_t camera_count = rig.cameras.size();
+    whitened.resize(camera_count);
+    if (!sigma_grid) return;
+    CheckSigmasInside(*sigma_grid, origins);
     tester =
         std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
     for (std::size_t c = 0; c < camera_count; ++c) {
@@ -393,15 +411,33 @@ SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& 
       WhitenedRotation(tester->camera_rotation(int(c)), sigma, whitened[c].data());
     }
   }
+};
+
+// The parts of the leaves origins[begin, end) of `setup`.
+SummaryParts PartsOfLeaves(const CriticalitySetup& setup, std::size_t begin, std::size_t end) {
+  const Rig& rig = setup.rig;
+  const std::size_t camera_count = rig.cameras.size();
+  const bool uncertainty = setup.sigma_grid != nullptr;
+  const std::vector<openvdb::Coord> origins(setup.origins.begin() + std::ptrdiff_t(begin),
+                                            setup.origins.begin() + std::ptrdiff_t(end));
   const std::array<BandScale, 64>& scales = BandScales();
   // Every triangulable voxel's sigma_max, leaf by leaf in `origins` order (ascending offset within
   // a leaf): base[i] is where leaf i's values start.
   std::vector<std::int64_t> base(origins.size() + 1, 0);
   std::vector<float> intact;
-  if (uncertainty) SizeIntactSigmas(*sigma_grid, origins, &base, &intact);
+  if (uncertainty) SizeIntactSigmas(*setup.sigma_grid, origins, &base, &intact);
 
-  const CriticalityInputs in{rig,          fields,   g,      th,   uncertainty, sigma_grid.get(),
-                             tester.get(), whitened, scales, base, intact};
+  const CriticalityInputs in{rig,
+                             setup.fields,
+                             setup.g,
+                             setup.th,
+                             uncertainty,
+                             setup.sigma_grid.get(),
+                             setup.tester.get(),
+                             setup.whitened,
+                             scales,
+                             base,
+                             intact};
   tbb::enumerable_thread_specific<Partial> partials([&] { return Partial(camera_count); });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 4), [&](const auto& range) {
     LeafWorker worker(in, partials.local());
@@ -424,6 +460,49 @@ SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& 
     out.lists[1 + camera_count + c] = std::move(total.added[c]);
   }
   return out;
+}
+
+// The (voxel, enabled camera) pairs of each leaf of `setup`: what its lists hold, 8 bytes each.
+std::vector<std::int64_t> PairsPerLeaf(const CriticalitySetup& setup) {
+  std::vector<std::int64_t> pairs(setup.origins.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      for (std::size_t c = 0; c < setup.rig.cameras.size(); ++c) {
+        if (!setup.rig.cameras[c].enabled || !setup.g.visible[c]) continue;
+        if (const auto* leaf = setup.g.visible[c]->tree().probeConstLeaf(setup.origins[i]))
+          pairs[i] += static_cast<std::int64_t>(leaf->onVoxelCount());
+      }
+  });
+  return pairs;
+}
+
+// The parts of `setup`'s leaves, each part's lists at most about `part_bytes` (by `pairs`), added
+// to `into` one after the other.
+void AddPartsOfLeaves(const CriticalitySetup& setup, const std::vector<std::int64_t>& pairs,
+                      double part_bytes, SpilledParts& into) {
+  const std::size_t leaves = setup.origins.size();
+  for (std::size_t begin = 0, end = 0; begin < leaves; begin = end) {
+    double bytes = 0;
+    while (end < leaves && (end == begin || bytes + 8.0 * double(pairs[end]) <= part_bytes))
+      bytes += 8.0 * double(pairs[end++]);
+    into.Add(PartsOfLeaves(setup, begin, end));
+  }
+}
+
+}  // namespace
+
+void AddCriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                         const RayCaster& caster, int k, double part_bytes, SpilledParts& into) {
+  const CriticalitySetup setup(scene, rig, fields, caster, k);
+  const std::vector<std::int64_t> pairs =
+      setup.sigma_grid ? PairsPerLeaf(setup) : std::vector<std::int64_t>(setup.origins.size(), 0);
+  AddPartsOfLeaves(setup, pairs, part_bytes, into);
+}
+
+SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                              const RayCaster& caster, int k) {
+  const CriticalitySetup setup(scene, rig, fields, caster, k);
+  return PartsOfLeaves(setup, 0, setup.origins.size());
 }
 
 CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_voxels,
@@ -469,12 +548,31 @@ CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_vo
 }
 
 CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
-                                    const RayCaster& caster, int k) {
+                                    const RayCaster& caster, int k, const ListMemory& memory) {
   const auto t0 = std::chrono::steady_clock::now();
-  const SummaryParts parts = CriticalityParts(scene, rig, fields, caster, k);
-  InMemoryPercentiles lists(parts.lists);
-  CriticalityTable table =
-      FinishCriticality(rig, k, fields.stats.active_set.region_voxels, parts.counts, lists);
+  const CriticalitySetup setup(scene, rig, fields, caster, k);
+  const std::int64_t region = fields.stats.active_set.region_voxels;
+  const std::size_t leaves = setup.origins.size();
+  // The lists hold about 8 bytes per (triangulable voxel, camera that sees it).
+  const std::vector<std::int64_t> pairs =
+      setup.sigma_grid ? PairsPerLeaf(setup) : std::vector<std::int64_t>();
+  double list_bytes = 0;
+  for (std::int64_t n : pairs) list_bytes += 8.0 * double(n);
+  CriticalityTable table;
+  if (list_bytes <= memory.bytes) {
+    const SummaryParts parts = PartsOfLeaves(setup, 0, leaves);
+    InMemoryPercentiles lists(parts.lists);
+    table = FinishCriticality(rig, k, region, parts.counts, lists);
+  } else {
+    // Part by part, each part's lists written to disk and freed: a part's lists, their threads'
+    // copies and the growth of those take up to about four times the lists' own bytes.
+    const std::string folder =
+        memory.folder.empty() ? std::filesystem::temp_directory_path().string() : memory.folder;
+    SpilledParts spilled(folder, memory.blame.empty() ? folder : memory.blame);
+    AddPartsOfLeaves(setup, pairs, std::max(1.0, memory.bytes / 4.0), spilled);
+    table = FinishCriticality(rig, k, region, spilled.Counts(), spilled);
+    table.spilled_bytes = list_bytes;
+  }
   table.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return table;
 }

@@ -48,6 +48,8 @@ struct CriticalityTable {
   int worst = -1;
   double mean_ge_k = 0;  ///< Mean over the rows of ge_k (the intact ge_k when there are none).
   double seconds = 0;    ///< Wall time of ComputeCriticality.
+  /// Bytes of sigma_max lists ComputeCriticality wrote to temporary files (0: kept in memory).
+  double spilled_bytes = 0;
 
   /// ge_k lost by the worst failure (0 without rows).
   double worst_loss() const { return worst >= 0 ? ge_k - rows[worst].ge_k : 0.0; }
@@ -58,18 +60,34 @@ struct CriticalityTable {
 /// True when `fields` holds the per-camera sets (the "cameras" field was evaluated).
 bool HasCameraSets(const Fields& fields);
 
+/// Where ComputeCriticality keeps the sigma_max lists of its percentiles (about 8 bytes per
+/// triangulable voxel and camera that sees it: 1.3 GB for 11 M voxels seen by 15 cameras each):
+/// in memory when they take at most `bytes`, else computed part by part (each part's lists at
+/// most a quarter of `bytes`) and appended to unnamed temporary files in `folder` (empty: the
+/// system's temporary folder), as a streamed run keeps them (volume/summary_parts.h). The table
+/// is the same either way, bit for bit. `blame`: what a file error names (default: the folder).
+struct ListMemory {
+  double bytes = 64.0 * 1048576.0;
+  std::string folder, blame;
+};
+
 /// The criticality of every enabled camera of `rig` from `fields`, which must be an evaluation of
 /// exactly `rig` over `scene` with the "cameras" field (HasCameraSets; throws std::invalid_argument
 /// otherwise). With the "sigma_max" field the uncertainty columns are filled: the Jacobians at the
 /// voxels each camera sees are recomputed (`caster` is only held by the visibility tester: no ray
 /// is cast). `k` >= 1: the camera count of ge_k. Runs in parallel with TBB.
 CriticalityTable ComputeCriticality(const Scene& scene, const Rig& rig, const Fields& fields,
-                                    const RayCaster& caster, int k);
+                                    const RayCaster& caster, int k, const ListMemory& memory = {});
 
 /// ComputeCriticality in parts (volume/summary_parts.h): the counts and sigma_max lists over the
 /// voxels of `fields` (a streamed run's tile, or the whole region). Throws as ComputeCriticality.
 SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
                               const RayCaster& caster, int k);
+/// CriticalityParts of `fields` in parts of leaves, each part's lists at most about `part_bytes`
+/// (and their working copies about three times that), added to `into` one after the other: a
+/// streamed run's tile without its whole lists in memory.
+void AddCriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
+                         const RayCaster& caster, int k, double part_bytes, SpilledParts& into);
 /// The table from every part's counts added up and their lists; `region_voxels`: the free region
 /// voxels of all the parts. Equal to ComputeCriticality of the whole region (seconds left 0).
 CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_voxels,

@@ -8,6 +8,7 @@
 #include "analysis/geometry/inside_mesh.h"
 #include "analysis/util/text.h"
 #include "volume/fields_vdb.h"
+#include "volume/value_spill.h"
 
 namespace pandora {
 namespace {
@@ -16,7 +17,28 @@ double Fraction(std::int64_t part, std::int64_t whole) {
   return whole > 0 ? static_cast<double>(part) / static_cast<double>(whole) : 0.0;
 }
 
+// Nearest-rank percentiles of the values `for_each_chunk` passes (fn(values, count) per chunk, the
+// same values each time it is called) without a copy of them: by counts of their order-preserving
+// keys (volume/value_spill.h), two passes; equal to NearestRankPercentile.
+template <typename ForEachChunk>
+std::vector<std::optional<double>> CountedPercentiles(ForEachChunk&& for_each_chunk,
+                                                      const std::vector<double>& p) {
+  std::vector<std::int64_t> high(1 << 16, 0), low;
+  for_each_chunk([&](const float* v, std::size_t n) { AddHighCounts(v, n, 1, high); });
+  const PercentileBins selection = SelectPercentileBins(high, p);
+  low.assign(selection.bins.size() << 16, 0);
+  for_each_chunk(
+      [&](const float* v, std::size_t n) { AddLowCounts(v, n, 1, selection.bins, low); });
+  return ResolvePercentiles(selection, low, p.size());
+}
+
 SigmaPercentiles Percentiles(const std::vector<float>& values) {
+  // A large list is not copied (NearestRankPercentile sorts a copy).
+  if (values.size() > (std::size_t{1} << 20)) {
+    const auto p =
+        CountedPercentiles([&](auto&& fn) { fn(values.data(), values.size()); }, {50, 90, 99});
+    return {p[0], p[1], p[2]};
+  }
   return {NearestRankPercentile(values, 50), NearestRankPercentile(values, 90),
           NearestRankPercentile(values, 99)};
 }
@@ -60,10 +82,23 @@ std::vector<float> GridActiveValues(const Fields& fields, const std::string& nam
 std::vector<std::optional<double>> GridPercentileValues(const Fields& fields,
                                                         const std::string& name,
                                                         const std::vector<int>& percentiles) {
-  const std::vector<float> values = GridActiveValues(fields, name);
-  std::vector<std::optional<double>> out;
-  for (int p : percentiles) out.push_back(NearestRankPercentile(values, p));
-  return out;
+  // Counted from the grid in chunks: no list of its values.
+  const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name);
+  if (!grid) return std::vector<std::optional<double>>(percentiles.size());
+  const auto for_each_chunk = [&](auto&& fn) {
+    std::vector<float> chunk;
+    chunk.reserve(4096);
+    for (auto it = grid->cbeginValueOn(); it; ++it) {
+      const openvdb::Index64 n = it.isVoxelValue() ? 1 : it.getVoxelCount();
+      for (openvdb::Index64 k = 0; k < n; ++k) {
+        chunk.push_back(*it);
+        if (chunk.size() == 4096) fn(chunk.data(), chunk.size()), chunk.clear();
+      }
+    }
+    if (!chunk.empty()) fn(chunk.data(), chunk.size());
+  };
+  return CountedPercentiles(for_each_chunk,
+                            std::vector<double>(percentiles.begin(), percentiles.end()));
 }
 
 nlohmann::json GridPercentiles(const Fields& fields, const std::string& name,

@@ -86,6 +86,8 @@ SpilledParts::SpilledParts(std::string folder, std::string blame, CountReducer r
 SpilledParts::~SpilledParts() = default;
 
 void SpilledParts::Add(SummaryParts&& part) {
+  high_.clear();
+  asked_.clear();
   AddInto(counts_, part.counts);
   AddInto(seconds_, part.seconds);
   while (spills_.size() < part.lists.size())
@@ -128,7 +130,13 @@ ListPercentiles SpilledParts::Percentiles(const std::vector<ListTerm>& terms,
         std::vector<std::int64_t> high(1 << 16, 0);
         for (const ListTerm& t : terms)
           if (t.list < spills_.size()) {
-            const std::vector<std::int64_t> h = spills_[t.list]->HighCounts();
+            if (asked_.size() < spills_.size()) asked_.resize(spills_.size(), 0);
+            auto it = high_.find(t.list);
+            std::vector<std::int64_t> once;
+            if (it == high_.end() && asked_[t.list]++ > 0)
+              it = high_.emplace(t.list, spills_[t.list]->HighCounts()).first;
+            if (it == high_.end()) once = spills_[t.list]->HighCounts();
+            const std::vector<std::int64_t>& h = it != high_.end() ? it->second : once;
             for (std::size_t b = 0; b < high.size(); ++b) high[b] += t.sign * h[b];
           }
         return sum(std::move(high));

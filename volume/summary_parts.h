@@ -107,6 +107,10 @@ class SpilledParts : public PercentileSource {
   std::vector<std::int64_t> counts_;
   std::vector<double> seconds_;
   std::vector<std::unique_ptr<ValueSpill>> spills_;
+  // A list's HighCounts once it is asked for a second time (N-1 asks for the intact list with
+  // every camera), and the lists asked for once.
+  std::map<std::size_t, std::vector<std::int64_t>> high_;
+  std::vector<std::uint8_t> asked_;
 };
 
 /// An exact sum of values in [0, 1] in any order: each value's round-toward-zero multiple of 2^-64

@@ -71,7 +71,10 @@ RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const 
   // N-1: what the rig loses when any one camera fails, from the per-voxel camera sets
   // (docs/failures.md).
   if (options.robustness && HasCameraSets(fields)) {
-    s.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras());
+    ListMemory lists;
+    lists.folder = options.spill_folder;
+    lists.blame = options.spill_blame;
+    s.robustness = ComputeCriticality(scene, rig, fields, caster, scene.TimeMinCameras(), lists);
     if (grids) AddCoverageN1Grid(grids);
   }
   // PTZ cameras: reach times, reachable shares, tours (docs/ptz.md).

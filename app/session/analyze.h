@@ -40,6 +40,9 @@ struct AnalyzeOptions {
   /// The steps a front end may leave out: the report has no section for pixel targets, DORI and
   /// PTZ yet; the viewer's Compare shows the headline numbers only.
   bool pixel_targets = true, dori = true, ptz = true, calibration = true, robustness = true;
+  /// Where N-1 writes its sigma_max lists when they outgrow memory (ListMemory,
+  /// volume/robustness.h; empty: the system's temporary folder) and what a file error there names.
+  std::string spill_folder, spill_blame;
 };
 
 /// What CompleteAnalysis adds: the full typed summary and its warnings (also in summary.warnings).
