@@ -146,6 +146,8 @@ session::SessionOptions AnalyzeSessionOptions(const AnalyzeArgs& args, const Sce
   so.disable = args.disable;
   so.incremental = false;  // one evaluation: no per-pair state
   so.fields = AnalyzeFieldOptions(args, scene);
+  // The summary reads sigma_max's percentiles from its grid: no second copy of the values.
+  so.fields.value_lists = false;
   so.fields.partition_count = mpi.size();
   so.fields.partition_rank = mpi.rank();
   return so;

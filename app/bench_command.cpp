@@ -332,6 +332,7 @@ int RunBench(const BenchArgs& args) {
                      {"field_rays_per_second", stats.rays / best_fields},
                      {"raw_rays_per_second", double(t.rays) / best_raw},
                      {"tiles", t.tiles},
+                     {"recorded_rays", t.rays},
                      {"largest_tile_rays", t.largest_tile_rays},
                      {"memory_budget_mib", options.memory_budget_bytes / 1048576.0},
                      {"raw_packet_seconds", best_packet},

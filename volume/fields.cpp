@@ -650,6 +650,7 @@ struct FieldEvaluator::State {
   bool want_coverage = false, want_cameras = false, want_resolution = false;
   bool want_static = false, want_steady = false, want_angle = false;
   bool want_information = false, want_jacobian = false;
+  bool list_sigma = true, list_steady = true;  // FieldStats' sigma lists made
   std::array<bool, kFloatFieldCount> want_float{};
   MotionModel motion;
   double frame_period = 0;
@@ -1401,8 +1402,8 @@ void FieldEvaluator::State::SummariseBlock(const Block& block, BlockState* next)
   {
     int triangulable = 0;
     for (int o = 0; o < 512; ++o) triangulable += next->status[o] == kTriangulable ? 1 : 0;
-    next->sigma_list.reserve(triangulable);
-    if (want_steady) next->steady_list.reserve(triangulable);
+    if (list_sigma) next->sigma_list.reserve(triangulable);
+    if (want_steady && list_steady) next->steady_list.reserve(triangulable);
   }
   for (int x = 0; x < block.extent.x(); ++x)
     for (int y = 0; y < block.extent.y(); ++y)
@@ -1416,8 +1417,8 @@ void FieldEvaluator::State::SummariseBlock(const Block& block, BlockState* next)
         if (next->status[o] == kUnobservable) ++next->unobservable;
         if (next->status[o] != kTriangulable) continue;
         ++next->triangulable;
-        next->sigma_list.push_back(next->sigma_max[o]);
-        if (want_steady) next->steady_list.push_back(next->sigma_steady[o]);
+        if (list_sigma) next->sigma_list.push_back(next->sigma_max[o]);
+        if (want_steady && list_steady) next->steady_list.push_back(next->sigma_steady[o]);
       }
 }
 
@@ -1686,6 +1687,10 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   // Any uncertainty field needs the triangulability decision, so J is built for all of them.
   S.want_information = S.want_static || S.want_steady || S.want_angle;
   S.want_jacobian = S.want_resolution || S.want_information;
+  // One evaluation whose sigma_max (steady) grid holds the very values of its list can leave
+  // the list out (FieldOptions::value_lists).
+  S.list_sigma = opt.value_lists || keep_state || !S.want_float[kSigmaMax];
+  S.list_steady = opt.value_lists || keep_state || !S.want_float[kSigmaMaxSteady];
   S.motion = study.motion.value_or(MotionModel{});
   S.frame_period = 1.0 / S.motion.rate_hz;
   S.scene_scale = scene.ContentBounds().diagonal();

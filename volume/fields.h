@@ -43,6 +43,11 @@ struct FieldOptions {
   std::function<void(double)> progress;
   /// Keep every occlusion segment cast, in evaluation order (benchmarks replay them).
   bool record_rays = false;
+  /// Fill FieldStats::sigma_max_mm (sigma_max_steady_mm) also where the evaluation's sigma_max
+  /// (sigma_max_steady) grid holds the very same values. false: one evaluation (EvaluateFields)
+  /// leaves such a list empty, and Summarize reads the grid instead (8 bytes per triangulable
+  /// voxel less with both; `pandora analyze`). An evaluator that keeps state always fills them.
+  bool value_lists = true;
   /// Try every camera pair for triangulation_angle instead of only those whose angle bound can
   /// still win (the same values, more work): for tests and benchmarks.
   bool exhaustive_angle_pairs = false;
@@ -96,7 +101,8 @@ struct FieldStats {
   std::int64_t triangulable_voxels = 0;  ///< >= 2 cameras and observable (when computed).
   std::int64_t unobservable_voxels = 0;  ///< >= 2 cameras but a direction unobservable.
   /// sigma_max (mm) of every triangulable voxel, unsorted; filled when an uncertainty field is
-  /// computed (for percentiles). Likewise sigma_max_steady when a motion model is set.
+  /// computed (for percentiles). Likewise sigma_max_steady when a motion model is set. Left empty
+  /// where the grid of that field holds the values and FieldOptions::value_lists is false.
   std::vector<float> sigma_max_mm, sigma_max_steady_mm;
   std::vector<std::int64_t> coverage_histogram;  ///< [k] = voxels seen by exactly k cameras.
   std::vector<std::int64_t> per_camera_seen;     ///< [c] = voxels camera c sees.

@@ -47,6 +47,30 @@ std::int64_t CountAtMost(const std::vector<float>& values, double limit) {
   return std::count_if(values.begin(), values.end(), [&](float v) { return v <= limit; });
 }
 
+// The percentiles of a sigma list and, with `limit`, how many values are <= it: from the list, or
+// from the field's grid where the evaluation left the list out (FieldOptions::value_lists: the
+// grid is active exactly at the triangulable voxels, with the list's values).
+SigmaPercentiles SigmaValues(const Fields& fields, const std::vector<float>& list,
+                             const std::string& grid_name, const std::optional<double>& limit,
+                             std::int64_t* at_most) {
+  const bool from_grid = list.empty() && fields.stats.triangulable_voxels > 0 &&
+                         fields.impl().Float(grid_name) != nullptr;
+  if (!from_grid) {
+    if (limit) *at_most = CountAtMost(list, *limit);
+    return Percentiles(list);
+  }
+  const openvdb::FloatGrid::Ptr grid = fields.impl().Float(grid_name);
+  if (limit) {
+    *at_most = 0;
+    for (auto it = grid->cbeginValueOn(); it; ++it)
+      if (double(*it) <= *limit)
+        *at_most += it.isVoxelValue() ? 1 : static_cast<std::int64_t>(it.getVoxelCount());
+  }
+  const std::vector<std::optional<double>> p =
+      GridPercentileValues(fields, grid_name, {50, 90, 99});
+  return {p[0], p[1], p[2]};
+}
+
 nlohmann::json Value(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
@@ -223,18 +247,19 @@ Summary Summarize(const Scene& scene, const Rig& rig, const Fields& fields,
     u.triangulable_voxels = st.triangulable_voxels;
     u.unobservable_voxels = st.unobservable_voxels;
     u.pixel_sigma = scene.study.pixel_sigma;
-    u.sigma_max_mm = Percentiles(st.sigma_max_mm);
-    if (scene.study.max_sigma_mm) {
-      u.max_sigma_mm = *scene.study.max_sigma_mm;
-      u.meets_max_sigma = Fraction(CountAtMost(st.sigma_max_mm, *scene.study.max_sigma_mm), region);
+    const std::optional<double> limit = scene.study.max_sigma_mm;
+    std::int64_t meets = 0;
+    u.sigma_max_mm = SigmaValues(fields, st.sigma_max_mm, "sigma_max", limit, &meets);
+    if (limit) {
+      u.max_sigma_mm = *limit;
+      u.meets_max_sigma = Fraction(meets, region);
     }
     if (scene.study.motion) {
       u.motion = *scene.study.motion;
       u.steady_prior = scene.study.steady_prior;
-      u.sigma_max_steady_mm = Percentiles(st.sigma_max_steady_mm);
-      if (scene.study.max_sigma_mm)
-        u.meets_max_sigma_steady =
-            Fraction(CountAtMost(st.sigma_max_steady_mm, *scene.study.max_sigma_mm), region);
+      u.sigma_max_steady_mm =
+          SigmaValues(fields, st.sigma_max_steady_mm, "sigma_max_steady", limit, &meets);
+      if (limit) u.meets_max_sigma_steady = Fraction(meets, region);
     }
     s.uncertainty = u;
   }

@@ -323,6 +323,35 @@ TEST(Summarize, JsonIsTheTypedValue) {
 namespace pandora {
 namespace {
 
+// An evaluation that leaves the sigma lists out (FieldOptions::value_lists false, as `pandora
+// analyze` runs) has the same summary: its percentiles and max_sigma shares come from the grids.
+TEST(Summarize, FromTheGridsWithoutTheLists) {
+  RoomSetup s;
+  s.scene.study.motion = MotionModel{1.0, 60.0};
+  const std::vector<std::string> names{"coverage", "sigma_max", "sigma_max_steady"};
+  FieldOptions options;
+  options.fields = names;
+  const Fields with = EvaluateFields(s.scene, s.rig, *s.caster, options);
+  options.value_lists = false;
+  const Fields without = EvaluateFields(s.scene, s.rig, *s.caster, options);
+  ASSERT_GT(with.stats.triangulable_voxels, 100);
+  EXPECT_EQ(with.stats.sigma_max_mm.size(), std::size_t(with.stats.triangulable_voxels));
+  EXPECT_TRUE(without.stats.sigma_max_mm.empty());
+  EXPECT_TRUE(without.stats.sigma_max_steady_mm.empty());
+  s.scene.study.max_sigma_mm = *NearestRankPercentile(with.stats.sigma_max_mm, 50);  // half meet
+  const nlohmann::json a = MakeSummary(s.scene, s.rig, with, names, 2, {});
+  nlohmann::json b = MakeSummary(s.scene, s.rig, without, names, 2, {});
+  b["timing"] = a["timing"];
+  EXPECT_EQ(a, b);
+  // Some voxels meet the limit and some do not: the shares are counted, not trivially 0 or 1.
+  const double meets = a["uncertainty"]["meets_max_sigma"].get<double>();
+  EXPECT_GT(meets, 0.0);
+  EXPECT_LT(meets, a["uncertainty"]["triangulable"].get<double>());
+  // Without the grid (sigma_mean only) the list is kept whatever the option says.
+  options.fields = {"coverage", "sigma_mean"};
+  EXPECT_FALSE(EvaluateFields(s.scene, s.rig, *s.caster, options).stats.sigma_max_mm.empty());
+}
+
 TEST(FormatSummary, TheTableAnalyzePrints) {
   Summary s;
   s.rig = "ring";
