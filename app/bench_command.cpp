@@ -118,8 +118,6 @@ void TimeTile(const Scene& scene, const Rig& rig, const RayCaster& caster, Field
   all_stats.sigma_max_mm.clear(), all_stats.sigma_max_steady_mm.clear();
   AddFieldStats(&t.stats, stats);
   AddFieldStats(&t.all_stats, all_stats);
-  t.all_stats.angle_pairs_tried += all_stats.angle_pairs_tried;
-  t.all_stats.angle_pairs_all += all_stats.angle_pairs_all;
   t.uncertainty_fields = with_uncertainty.fields;
   t.all_fields = all_fields.fields;
 }
@@ -136,11 +134,9 @@ BenchTimes TimeTiles(const Scene& scene, const Rig& rig, const RayCaster& caster
   const std::vector<BlockColumns> tiles =
       BenchTiles(scene, rig, options, all_fields.fields, lattice);
   BenchTimes t;
-  if (tiles.size() == 1) {
-    TimeTile(scene, rig, caster, options, std::nullopt, repeat, t);
-    return t;
-  }
-  for (const BlockColumns& tile : tiles) TimeTile(scene, rig, caster, options, tile, repeat, t);
+  for (const BlockColumns& tile : tiles)  // one tile: the whole region, evaluated as before
+    TimeTile(scene, rig, caster, options,
+             tiles.size() > 1 ? std::optional<BlockColumns>(tile) : std::nullopt, repeat, t);
   return t;
 }
 

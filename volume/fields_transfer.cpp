@@ -86,6 +86,8 @@ void AddFieldStats(FieldStats* into, const FieldStats& part) {
   into->unobservable_voxels += part.unobservable_voxels;
   into->point_camera_tests += part.point_camera_tests;
   into->rays += part.rays;
+  into->angle_pairs_tried += part.angle_pairs_tried;
+  into->angle_pairs_all += part.angle_pairs_all;
   add(&into->coverage_histogram, part.coverage_histogram);
   add(&into->per_camera_seen, part.per_camera_seen);
   into->sigma_max_mm.insert(into->sigma_max_mm.end(), part.sigma_max_mm.begin(),

@@ -24,8 +24,9 @@ void MergePartialFields(const std::string& bytes, Fields* fields);
 
 /// Adds the statistics of an evaluation of disjoint voxels (another partition, a streamed run's
 /// tile) to `into`: the active set's counts, the seen, triangulable and unobservable voxels, the
-/// tests and rays, the histogram and per-camera counts (the longer length kept), the sigma lists
-/// joined, the times summed (the parts ran one after another), the largest estimate kept.
+/// tests, rays and triangulation_angle's pairs, the histogram and per-camera counts (the longer
+/// length kept), the sigma lists joined, the times summed (the parts ran one after another), the
+/// largest estimate kept.
 void AddFieldStats(FieldStats* into, const FieldStats& part);
 
 }  // namespace pandora

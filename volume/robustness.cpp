@@ -85,28 +85,20 @@ std::vector<openvdb::Coord> SeenLeafOrigins(const Rig& rig, const Fields::Impl& 
   return origins;
 }
 
-// Sizes `base` and `intact` for the triangulable voxels' sigma_max (the leaves fill the values).
-void SizeIntactSigmas(const openvdb::FloatGrid& sigma_grid,
-                      const std::vector<openvdb::Coord>& origins, std::vector<std::int64_t>* base,
-                      std::vector<float>* intact) {
+// Where each leaf's triangulable voxels start among all of `origins`' (base[i], leaf by leaf, base
+// of size origins + 1); refuses a sigma_max field outside the camera sets.
+std::vector<std::int64_t> IntactSigmaBase(const openvdb::FloatGrid& sigma_grid,
+                                          const std::vector<openvdb::Coord>& origins) {
+  std::vector<std::int64_t> base(origins.size() + 1, 0);
   for (std::size_t i = 0; i < origins.size(); ++i) {
     const auto* leaf = sigma_grid.tree().probeConstLeaf(origins[i]);
-    (*base)[i + 1] = (*base)[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
+    base[i + 1] = base[i] + (leaf ? static_cast<std::int64_t>(leaf->onVoxelCount()) : 0);
   }
-  intact->resize(static_cast<std::size_t>(base->back()));
-}
-
-// Refuses a sigma_max field outside the camera sets: sigma_max is active only where >= 2 cameras
-// see a voxel, so inside the leaves at `origins`.
-void CheckSigmasInside(const openvdb::FloatGrid& sigma_grid,
-                       const std::vector<openvdb::Coord>& origins) {
-  std::int64_t inside = 0;
-  for (const openvdb::Coord& origin : origins)
-    if (const auto* leaf = sigma_grid.tree().probeConstLeaf(origin))
-      inside += static_cast<std::int64_t>(leaf->onVoxelCount());
-  if (inside != static_cast<std::int64_t>(sigma_grid.activeVoxelCount()))
+  // sigma_max is active only where >= 2 cameras see a voxel, so inside these leaves.
+  if (base.back() != static_cast<std::int64_t>(sigma_grid.activeVoxelCount()))
     throw std::invalid_argument(
         "ComputeCriticality: the sigma_max field does not match the camera sets");
+  return base;
 }
 
 // What every leaf's work reads (the rig, its fields, the thresholds, the prepared cameras) and
@@ -376,9 +368,9 @@ constexpr std::size_t kCountsBefore = 5, kPerCamera = 5;
 namespace {
 
 // What every part of one criticality computation shares: the checked inputs, the leaves seen by
-// some enabled camera, and (with sigma_max) the cameras prepared as the field evaluation prepares
-// its rig (FieldEvaluator::State::Prepare): the Jacobian in the camera frame and the whitened
-// rotation.
+// some enabled camera, and (with sigma_max) where each leaf's triangulable voxels start and the
+// cameras prepared as the field evaluation prepares its rig (FieldEvaluator::State::Prepare): the
+// Jacobian in the camera frame and the whitened rotation.
 struct CriticalitySetup {
   const Rig& rig;
   const Fields& fields;
@@ -386,6 +378,7 @@ struct CriticalitySetup {
   Thresholds th;
   openvdb::FloatGrid::Ptr sigma_grid;
   std::vector<openvdb::Coord> origins;
+  std::vector<std::int64_t> base;  // IntactSigmaBase (with sigma_max)
   std::unique_ptr<VisibilityTester> tester;
   std::vector<std::array<double, 9>> whitened;
 
@@ -402,7 +395,7 @@ struct CriticalitySetup {
     const std::size_t camera_count = rig.cameras.size();
     whitened.resize(camera_count);
     if (!sigma_grid) return;
-    CheckSigmasInside(*sigma_grid, origins);
+    base = IntactSigmaBase(*sigma_grid, origins);
     tester =
         std::make_unique<VisibilityTester>(rig.cameras, caster, scene.ContentBounds().diagonal());
     for (std::size_t c = 0; c < camera_count; ++c) {
@@ -425,7 +418,11 @@ SummaryParts PartsOfLeaves(const CriticalitySetup& setup, std::size_t begin, std
   // a leaf): base[i] is where leaf i's values start.
   std::vector<std::int64_t> base(origins.size() + 1, 0);
   std::vector<float> intact;
-  if (uncertainty) SizeIntactSigmas(*setup.sigma_grid, origins, &base, &intact);
+  if (uncertainty) {
+    for (std::size_t i = 0; i < base.size(); ++i)
+      base[i] = setup.base[begin + i] - setup.base[begin];
+    intact.resize(static_cast<std::size_t>(base.back()));
+  }
 
   const CriticalityInputs in{rig,
                              setup.fields,

@@ -32,42 +32,44 @@ std::vector<std::optional<double>> CountedPercentiles(ForEachChunk&& for_each_ch
   return ResolvePercentiles(selection, low, p.size());
 }
 
-SigmaPercentiles Percentiles(const std::vector<float>& values) {
-  // A large list is not copied (NearestRankPercentile sorts a copy).
-  if (values.size() > (std::size_t{1} << 20)) {
-    const auto p =
-        CountedPercentiles([&](auto&& fn) { fn(values.data(), values.size()); }, {50, 90, 99});
-    return {p[0], p[1], p[2]};
+// Passes a grid's active values to fn(values, count) in chunks of up to 4096 (a tile's value once
+// per voxel it covers).
+template <typename Fn>
+void ForEachActiveChunk(const openvdb::FloatGrid& grid, Fn&& fn) {
+  std::vector<float> chunk;
+  chunk.reserve(4096);
+  for (auto it = grid.cbeginValueOn(); it; ++it) {
+    const openvdb::Index64 n = it.isVoxelValue() ? 1 : it.getVoxelCount();
+    for (openvdb::Index64 k = 0; k < n; ++k) {
+      chunk.push_back(*it);
+      if (chunk.size() == 4096) fn(chunk.data(), chunk.size()), chunk.clear();
+    }
   }
-  return {NearestRankPercentile(values, 50), NearestRankPercentile(values, 90),
-          NearestRankPercentile(values, 99)};
-}
-
-std::int64_t CountAtMost(const std::vector<float>& values, double limit) {
-  return std::count_if(values.begin(), values.end(), [&](float v) { return v <= limit; });
+  if (!chunk.empty()) fn(chunk.data(), chunk.size());
 }
 
 // The percentiles of a sigma list and, with `limit`, how many values are <= it: from the list, or
 // from the field's grid where the evaluation left the list out (FieldOptions::value_lists: the
-// grid is active exactly at the triangulable voxels, with the list's values).
+// grid is active exactly at the triangulable voxels, with the list's values). Counted, so neither
+// is copied.
 SigmaPercentiles SigmaValues(const Fields& fields, const std::vector<float>& list,
                              const std::string& grid_name, const std::optional<double>& limit,
                              std::int64_t* at_most) {
-  const bool from_grid = list.empty() && fields.stats.triangulable_voxels > 0 &&
-                         fields.impl().Float(grid_name) != nullptr;
-  if (!from_grid) {
-    if (limit) *at_most = CountAtMost(list, *limit);
-    return Percentiles(list);
-  }
   const openvdb::FloatGrid::Ptr grid = fields.impl().Float(grid_name);
+  const bool from_grid = list.empty() && fields.stats.triangulable_voxels > 0 && grid;
+  const auto for_each_chunk = [&](auto&& fn) {
+    if (from_grid)
+      ForEachActiveChunk(*grid, fn);
+    else
+      fn(list.data(), list.size());
+  };
   if (limit) {
     *at_most = 0;
-    for (auto it = grid->cbeginValueOn(); it; ++it)
-      if (double(*it) <= *limit)
-        *at_most += it.isVoxelValue() ? 1 : static_cast<std::int64_t>(it.getVoxelCount());
+    for_each_chunk([&](const float* v, std::size_t n) {
+      *at_most += std::count_if(v, v + n, [&](float x) { return x <= *limit; });
+    });
   }
-  const std::vector<std::optional<double>> p =
-      GridPercentileValues(fields, grid_name, {50, 90, 99});
+  const std::vector<std::optional<double>> p = CountedPercentiles(for_each_chunk, {50, 90, 99});
   return {p[0], p[1], p[2]};
 }
 
@@ -109,19 +111,7 @@ std::vector<std::optional<double>> GridPercentileValues(const Fields& fields,
   // Counted from the grid in chunks: no list of its values.
   const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name);
   if (!grid) return std::vector<std::optional<double>>(percentiles.size());
-  const auto for_each_chunk = [&](auto&& fn) {
-    std::vector<float> chunk;
-    chunk.reserve(4096);
-    for (auto it = grid->cbeginValueOn(); it; ++it) {
-      const openvdb::Index64 n = it.isVoxelValue() ? 1 : it.getVoxelCount();
-      for (openvdb::Index64 k = 0; k < n; ++k) {
-        chunk.push_back(*it);
-        if (chunk.size() == 4096) fn(chunk.data(), chunk.size()), chunk.clear();
-      }
-    }
-    if (!chunk.empty()) fn(chunk.data(), chunk.size());
-  };
-  return CountedPercentiles(for_each_chunk,
+  return CountedPercentiles([&](auto&& fn) { ForEachActiveChunk(*grid, fn); },
                             std::vector<double>(percentiles.begin(), percentiles.end()));
 }
 

@@ -131,13 +131,15 @@ ListPercentiles SpilledParts::Percentiles(const std::vector<ListTerm>& terms,
         for (const ListTerm& t : terms)
           if (t.list < spills_.size()) {
             if (asked_.size() < spills_.size()) asked_.resize(spills_.size(), 0);
-            auto it = high_.find(t.list);
             std::vector<std::int64_t> once;
-            if (it == high_.end() && asked_[t.list]++ > 0)
-              it = high_.emplace(t.list, spills_[t.list]->HighCounts()).first;
-            if (it == high_.end()) once = spills_[t.list]->HighCounts();
-            const std::vector<std::int64_t>& h = it != high_.end() ? it->second : once;
-            for (std::size_t b = 0; b < high.size(); ++b) high[b] += t.sign * h[b];
+            const std::vector<std::int64_t>* h = nullptr;
+            if (const auto it = high_.find(t.list); it != high_.end())
+              h = &it->second;
+            else if (asked_[t.list]++ > 0)
+              h = &(high_[t.list] = spills_[t.list]->HighCounts());
+            else
+              h = &(once = spills_[t.list]->HighCounts());
+            for (std::size_t b = 0; b < high.size(); ++b) high[b] += t.sign * (*h)[b];
           }
         return sum(std::move(high));
       },
