@@ -226,8 +226,17 @@ int RunAnalyze(const AnalyzeArgs& args) {
                     (mpi.active() ? " (rank 0 of " + std::to_string(mpi.size()) + ")" : ""),
                 !quiet);
     so.fields.progress = [&bar](double f) { bar->Update(f); };
-    session_holder.emplace(study, so);
     if (root) StageAnalyzeOutputs(output, study->scene(), out, vdb_path, summary_path);
+    if (!mpi.active()) {
+      // The fields nothing reads before fields.vdb is written (CompleteAnalysis reads coverage,
+      // the camera sets, resolution, sigma_max and sigma_max_steady) are not held as they are
+      // evaluated: their leaves wait beside the staged outputs (docs/performance.md).
+      so.fields.spilled_fields = {"sigma_mean", "triangulation_angle", "condition",
+                                  "sigma_mean_steady"};
+      so.fields.spill_folder = std::filesystem::path(vdb_path).parent_path().string();
+      so.fields.spill_blame = "--out";
+    }
+    session_holder.emplace(study, so);
   } catch (...) {
     failure = std::current_exception();
   }

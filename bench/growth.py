@@ -2,10 +2,11 @@
 """The growth table of docs/performance.md (issue 15): time and peak memory of `pandora analyze` on
 generated large stages (bench/large_stage.py) against region voxels, cameras, triangles and
 threads, one quantity varied at a time around a base case, with the exponent of a least-squares
-power law fitted to each series (time ~ N^b).
+power law fitted to each series (time ~ N^b); and the field list at the base case (coverage alone,
+the base four, all nine), with each run's peak against coverage alone's (issue 33).
 
     python3 bench/growth.py [--pandora build/pandora] [--work /tmp/pandora-growth] [--quick]
-                            [--json growth.json]
+                            [--series voxels,cameras,triangles,threads,fields] [--json growth.json]
 
 Each run is `pandora analyze` under /usr/bin/time (wall seconds, peak resident memory); the field
 evaluation's own seconds, rays and region voxels come from its summary.json. Prints a Markdown
@@ -22,10 +23,15 @@ import sys
 HERE = pathlib.Path(__file__).resolve().parent
 
 
+ALL_NINE = ("coverage,cameras,resolution,sigma_max,sigma_mean,triangulation_angle,condition,"
+            "sigma_max_steady,sigma_mean_steady")
+
+
 def run(pandora, work, name, triangles, cameras, voxel, threads, fields):
     scene = work / f"{name}.json"
+    motion = ["--motion"] if "steady" in fields else []  # the steady fields need a motion model
     subprocess.run([sys.executable, str(HERE / "large_stage.py"), str(scene), "--triangles", str(triangles),
-                    "--cameras", str(cameras), "--voxel", str(voxel)], check=True, capture_output=True)
+                    "--cameras", str(cameras), "--voxel", str(voxel)] + motion, check=True, capture_output=True)
     out = work / f"{name}.out"
     timed = subprocess.run(["/usr/bin/time", "-f", "%e %M", pandora, "analyze", str(scene), "--out", str(out),
                             "--threads", str(threads), "--fields", fields, "--quiet"],
@@ -38,7 +44,7 @@ def run(pandora, work, name, triangles, cameras, voxel, threads, fields):
         "name": name, "triangles": triangles, "cameras": cameras, "voxel_m": voxel, "threads": threads,
         "region_voxels": summary["region_voxels"], "rays": summary["timing"]["rays"],
         "field_s": summary["timing"]["seconds"], "wall_s": float(wall), "peak_mb": int(rss_kb) / 1024,
-        "vdb_mb": (out / "fields.vdb").stat().st_size / 2**20,
+        "vdb_mb": (out / "fields.vdb").stat().st_size / 2**20, "fields": fields,
     }
     print(f"  {name}: {row['region_voxels']} voxels, {cameras} cameras, ~{triangles} triangles, {threads} threads: "
           f"fields {row['field_s']:.2f} s, wall {row['wall_s']:.2f} s, peak {row['peak_mb']:.0f} MB", flush=True)
@@ -60,6 +66,8 @@ def main():
     ap.add_argument("--work", default="/tmp/pandora-growth")
     ap.add_argument("--fields", default="coverage,cameras,resolution,sigma_max")
     ap.add_argument("--quick", action="store_true", help="smaller series (a smoke run)")
+    ap.add_argument("--series", default="voxels,cameras,triangles,threads,fields",
+                    help="comma-separated series to run")
     ap.add_argument("--json", help="also write the rows and exponents here")
     a = ap.parse_args()
     work = pathlib.Path(a.work)
@@ -70,15 +78,24 @@ def main():
         "cameras": ("cameras", [dict(base, cameras=c) for c in ((6, 12) if a.quick else (6, 12, 24, 48))]),
         "triangles": ("triangles", [dict(base, triangles=t) for t in ((10000, 100000) if a.quick else (10000, 100000, 300000, 1000000))]),
         "threads": ("threads", [dict(base, threads=t) for t in sorted({1, base["threads"]})]),
+        "fields": (None, [dict(base, fields=f) for f in ("coverage", a.fields, ALL_NINE)]),
     }
     rows, exponents = [], {}
+    wanted = a.series.split(",")
     for label, (key, cases) in series.items():
+        if label not in wanted:
+            continue
         print(f"{label}:", flush=True)
-        got = [run(a.pandora, work, f"{label}_{i}", c["triangles"], c["cameras"], c["voxel"], c["threads"], a.fields)
+        got = [run(a.pandora, work, f"{label}_{i}", c["triangles"], c["cameras"], c["voxel"], c["threads"],
+                   c.get("fields", a.fields))
                for i, c in enumerate(cases)]
         for r in got:
             r["series"] = label
         rows += got
+        if key is None:  # the field list: each peak against coverage alone's
+            for r in got:
+                r["peak_vs_coverage"] = r["peak_mb"] / got[0]["peak_mb"]
+            continue
         xs = [r[key] for r in got]
         exponents[label] = {"field_s": fit(xs, [r["field_s"] for r in got]),
                             "wall_s": fit(xs, [r["wall_s"] for r in got]),
@@ -86,8 +103,12 @@ def main():
     print()
     print("| Series | Region voxels | Cameras | Triangles (asked) | Threads | Rays | Fields (s) | Wall (s) | Peak (MB) | fields.vdb (MB) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
+    names = {"coverage": "coverage", a.fields: "base four", ALL_NINE: "all nine"}
     for r in rows:
-        print(f"| {r['series']} | {r['region_voxels']:,} | {r['cameras']} | {r['triangles']:,} | {r['threads']} | {r['rays']:,} | "
+        series = r["series"]
+        if "peak_vs_coverage" in r:
+            series = f"fields: {names.get(r['fields'], r['fields'])} ({r['peak_vs_coverage']:.2f}x coverage's peak)"
+        print(f"| {series} | {r['region_voxels']:,} | {r['cameras']} | {r['triangles']:,} | {r['threads']} | {r['rays']:,} | "
               f"{r['field_s']:.2f} | {r['wall_s']:.2f} | {r['peak_mb']:.0f} | {r['vdb_mb']:.1f} |")
     print()
     print("| Against | Field time exponent | Wall time exponent | Peak memory exponent |")

@@ -139,6 +139,18 @@ double BytesPerVoxel(const std::string& field) {
   return 4 + overhead;  // float fields
 }
 
+// The fields an evaluation holds in memory, for its estimate: without kept state the float fields
+// of FieldOptions::spilled_fields go to disk as their blocks finish.
+std::vector<std::string> HeldFields(const FieldOptions& opt, bool keep) {
+  std::vector<std::string> held;
+  for (const std::string& f : opt.fields)
+    if (keep || f == "coverage" || f == "cameras" ||
+        std::find(opt.spilled_fields.begin(), opt.spilled_fields.end(), f) ==
+            opt.spilled_fields.end())
+      held.push_back(f);
+  return held;
+}
+
 // Steady-state statistics from the steady position variances in rows kVar0..kVar2.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -644,6 +656,8 @@ struct FieldEvaluator::State {
   double active_set_seconds = 0;
   Rig rig;                                                          // as of the last update
   std::array<openvdb::FloatGrid*, kFloatFieldCount> float_grids{};  // in fields, by FloatField
+  // FieldOptions::spilled_fields of a one-shot evaluation: where their leaves go, by FloatField.
+  std::array<std::shared_ptr<LeafSpill>, kFloatFieldCount> spills{};
   bool evaluated = false;
   Fields fields;
 
@@ -740,6 +754,14 @@ void FieldEvaluator::State::ResetGrids(int camera_count) {
     g.floats[kFloatFieldNames[f]] = grid;
     float_grids[f] = grid.get();
   }
+  g.spilled.clear();
+  const std::vector<std::string>& spilled = options.spilled_fields;
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    spills[f] =
+        want_float[f] && !keep &&
+                std::find(spilled.begin(), spilled.end(), kFloatFieldNames[f]) != spilled.end()
+            ? std::make_shared<LeafSpill>(options.spill_folder, options.spill_blame)
+            : nullptr;
   if (want_cameras) {
     g.visible.resize(camera_count);
     for (auto& v : g.visible) MakeGrid(v, "visible", g.transform);
@@ -1591,7 +1613,8 @@ void BuildBlocks(FieldEvaluator::State& S, const Scene& scene,
   S.blocks = BuildActiveSet(S.fields.lattice, study.region, solids, region_mesh, no_cameras, 0,
                             &S.active_stats, opt.tile ? &*opt.tile : nullptr);
   if (check_budget)
-    check_budget(EstimateBytesForVoxels(512.0 * double(S.blocks.size()), opt.fields, 0));
+    check_budget(
+        EstimateBytesForVoxels(512.0 * double(S.blocks.size()), HeldFields(opt, S.keep), 0));
   if (opt.voxel_filter) {
     // Only the voxels the filter keeps: cleared from the blocks' masks, empty blocks dropped.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 4),
@@ -1674,7 +1697,7 @@ FieldEvaluator::FieldEvaluator(const Scene& scene, const RayCaster& caster, Fiel
   // floor peaked at 1.4 GB under a 700 MiB budget when voxels were counted).
   const double box_blocks = LatticeBlocks(estimated);
   check_budget(sparse ? box_blocks * (sizeof(Block) + 513.0)
-                      : EstimateBytesForVoxels(512.0 * box_blocks, opt.fields, 0));
+                      : EstimateBytesForVoxels(512.0 * box_blocks, HeldFields(opt, S.keep), 0));
 
   S.want_coverage = Wants(opt.fields, "coverage");
   S.want_cameras = Wants(opt.fields, "cameras");
@@ -2006,6 +2029,15 @@ void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
   if (count > 0 || old.coverage.empty())
     S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
              in_place ? &old : &next[i], &leaves[i], in_place);
+  // Spilled fields: the block's leaf to its file, out of memory (FieldOptions::spilled_fields).
+  BlockLeaves& l = leaves[i];
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    if (S.spills[f] && l.floats[f]) {
+      S.spills[f]->Append(*l.floats[f]);
+      if (l.float_owned[f]) delete l.floats[f];
+      l.floats[f] = nullptr;
+      l.float_owned[f] = false;
+    }
   // Camera grids: a leaf per re-cast camera that sees part of the block.
   if (S.want_cameras) CameraLeaves(block, cast[i], &leaves[i]);
   if (!S.keep) DropPairData(old, u, i);
@@ -2195,6 +2227,13 @@ void FinishUpdate(State& S, const Rig& rig, const RigData& rd, UpdatePass* u, Fi
   InsertLeaves(S, new_count, u);
   StoreStates(S, u);
   Fields::Impl& g = S.fields.impl();
+  for (int f = 0; f < kFloatFieldCount; ++f)
+    if (S.spills[f]) {  // the (empty) grid moves beside its leaves' file
+      const std::string name = kFloatFieldNames[f];
+      g.spilled[name] = SpilledGrid{g.floats.at(name), std::move(S.spills[f])};
+      g.floats.erase(name);
+      S.float_grids[f] = nullptr;
+    }
   if (S.want_cameras && new_count < static_cast<int>(g.visible.size())) g.visible.resize(new_count);
   if (S.evaluated) {
     if (u->per_block && g.coverage) openvdb::tools::pruneInactive(g.coverage->tree());

@@ -48,6 +48,15 @@ struct FieldOptions {
   /// leaves such a list empty, and Summarize reads the grid instead (8 bytes per triangulable
   /// voxel less with both; `pandora analyze`). An evaluator that keeps state always fills them.
   bool value_lists = true;
+  /// One evaluation only (EvaluateFields, or an evaluator without kept state; an evaluator that
+  /// keeps state holds every grid): the float fields listed here are not held as they are
+  /// evaluated. Each block's leaf goes to an unnamed temporary file in `spill_folder` as the block
+  /// finishes (volume/leaf_spill.h); the fields then hold them in Fields::Impl::spilled, not in
+  /// Fields::Impl::floats, until WriteFieldsVdb reads them back one at a time. For fields nothing
+  /// reads before they are written (`pandora analyze`: 50 MB per field at 11 M voxels). Errors
+  /// creating or writing the file blame `spill_blame`.
+  std::vector<std::string> spilled_fields;
+  std::string spill_folder, spill_blame;
   /// Try every camera pair for triangulation_angle instead of only those whose angle bound can
   /// still win (the same values, more work): for tests and benchmarks.
   bool exhaustive_angle_pairs = false;

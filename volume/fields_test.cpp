@@ -4,6 +4,8 @@
 #include <openvdb/io/File.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include "analysis/geometry/inside_mesh.h"
@@ -14,6 +16,7 @@
 #include "analysis/util/units.h"
 #include "tests/fixtures.h"
 #include "tests/random_scene.h"
+#include "volume/fields_test_util.h"
 #include "volume/fields_vdb.h"
 #include "volume/summary.h"
 #include "volume/vdb_io.h"
@@ -493,6 +496,64 @@ TEST(Fields, VdbRoundTrip) {
   // An unwritable destination is an InputError naming the file, and leaves nothing behind.
   EXPECT_THROW(WriteFieldsVdb(fields, "/proc/pandora/nope.vdb", {}), InputError);
   std::filesystem::remove_all(dir);
+}
+
+// The bytes of a .vdb file, the header's random UUID (36 characters after the magic number,
+// the file and library versions and the grid-offsets flag) blanked.
+std::string BytesButTheUuid(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() > 57) bytes.replace(21, 36, 36, '-');
+  return bytes;
+}
+
+// `pandora analyze` keeps the fields nothing reads before they are written out of memory: their
+// leaves go to a temporary file block by block and come back when fields.vdb is written. The file
+// is the one the evaluation holding every grid writes, byte for byte; the spilled grids are not
+// among the fields' floats meanwhile, and the statistics are the same.
+TEST(Fields, SpilledFieldsWriteTheSameFile) {
+  const Scene scene = TestScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions held;
+  held.fields = {"coverage",  "cameras",    "resolution",
+                 "sigma_max", "sigma_mean", "triangulation_angle",
+                 "condition"};
+  const auto dir = std::filesystem::temp_directory_path() / "pandora_spill_test";
+  std::filesystem::create_directories(dir);
+  FieldOptions spilled = held;
+  spilled.spilled_fields = {"sigma_max", "triangulation_angle", "condition", "sigma_mean"};
+  spilled.spill_folder = dir.string();
+  spilled.spill_blame = "--out";
+  const Fields a = EvaluateFields(scene, scene.rigs[0], *caster, held);
+  Fields b = EvaluateFields(scene, scene.rigs[0], *caster, spilled);
+  EXPECT_EQ(b.impl().floats.size(), 1u);  // resolution
+  ASSERT_EQ(b.impl().spilled.size(), 4u);
+  EXPECT_FALSE(b.impl().Float("sigma_max"));
+  const SpilledGrid& sigma = b.impl().spilled.at("sigma_max");
+  EXPECT_EQ(sigma.grid->tree().leafCount(), 0u);
+  EXPECT_EQ(sigma.leaves->leaves(), std::int64_t(a.impl().Float("sigma_max")->tree().leafCount()));
+  EXPECT_GT(sigma.leaves->leaves(), 10);
+  testing::ExpectSameGrid(*a.impl().Float("sigma_max"), *sigma.Read(), "sigma_max read back");
+  EXPECT_EQ(a.stats.triangulable_voxels, b.stats.triangulable_voxels);
+  EXPECT_EQ(a.stats.coverage_histogram, b.stats.coverage_histogram);
+  EXPECT_EQ(a.stats.sigma_max_mm, b.stats.sigma_max_mm);
+  const std::map<std::string, std::string> meta{{"units", "m"}, {"scene_sha256", "abc"}};
+  const std::string path_a = (dir / "held.vdb").string(), path_b = (dir / "spilled.vdb").string();
+  WriteFieldsVdb(a, path_a, meta);
+  WriteFieldsVdb(std::move(b), path_b, meta);
+  EXPECT_TRUE(b.impl().spilled.empty());  // NOLINT(bugprone-use-after-move): consumed
+  const std::string bytes_a = BytesButTheUuid(path_a);
+  EXPECT_GT(bytes_a.size(), 10000u);
+  EXPECT_TRUE(bytes_a == BytesButTheUuid(path_b));
+  // A spill folder that cannot hold a file: one InputError naming what to change.
+  spilled.spill_folder = (dir / "missing" / "folder").string();
+  try {
+    EvaluateFields(scene, scene.rigs[0], *caster, spilled);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "--out");
+    EXPECT_NE(std::string(e.what()).find("temporary file"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

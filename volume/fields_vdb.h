@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "volume/fields.h"
+#include "volume/leaf_spill.h"
 
 namespace pandora {
 
@@ -30,6 +31,9 @@ struct Fields::Impl {
   /// grids). Read back as they are (float grids with the fields' transform) for slices and
   /// isosurfaces.
   std::map<std::string, openvdb::FloatGrid::Ptr> extra;
+  /// The float fields of FieldOptions::spilled_fields, by name: their leaves are in temporary
+  /// files until WriteFieldsVdb reads them back (not in `floats`: Float() does not find them).
+  std::map<std::string, SpilledGrid> spilled;
 
   /// The float grid `name`, or null when it was not requested.
   openvdb::FloatGrid::Ptr Float(const std::string& name) const {

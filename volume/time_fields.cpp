@@ -76,7 +76,8 @@ void EvaluateSamples(
 FieldOptions OverTimeOptions(FieldOptions options) {
   options.partition_count = 1;
   options.partition_rank = 0;
-  options.value_lists = true;  // the samples' lists are the time summary's parts
+  options.value_lists = true;      // the samples' lists are the time summary's parts
+  options.spilled_fields.clear();  // the samples' grids are read as they are made
   bool uncertainty = false;
   for (const std::string& f : options.fields)
     uncertainty |= f != "coverage" && f != "cameras" && f != "resolution";

@@ -33,20 +33,24 @@ float FromKey(std::uint32_t key) {
 
 }  // namespace
 
-ValueSpill::ValueSpill(const std::string& folder, const std::string& blame) : blame_(blame) {
+std::FILE* OpenTemporaryFile(const std::string& folder, const std::string& blame) {
   int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
   if (fd < 0) {  // file systems without O_TMPFILE: a named file, unlinked at once
     std::string name = folder + "/.pandora-values-XXXXXX";
     fd = ::mkstemp(name.data());
     if (fd >= 0) ::unlink(name.c_str());
   }
-  if (fd >= 0) file_ = ::fdopen(fd, "w+b");
-  if (!file_) {
+  std::FILE* file = fd >= 0 ? ::fdopen(fd, "w+b") : nullptr;
+  if (!file) {
     const std::string why = std::strerror(errno);
     if (fd >= 0) ::close(fd);
-    throw InputError(blame_, "", "cannot create a temporary file in " + folder + ": " + why);
+    throw InputError(blame, "", "cannot create a temporary file in " + folder + ": " + why);
   }
+  return file;
 }
+
+ValueSpill::ValueSpill(const std::string& folder, const std::string& blame)
+    : file_(OpenTemporaryFile(folder, blame)), blame_(blame) {}
 
 ValueSpill::~ValueSpill() {
   if (file_) std::fclose(file_);

@@ -13,6 +13,11 @@
 
 namespace pandora {
 
+/// Opens an unnamed temporary file in `folder` for reading and writing (removed by the system when
+/// it is closed, even when the process is killed; on file systems without O_TMPFILE a named file
+/// unlinked at once). Throws InputError(blame, "", ...) when it cannot be created.
+std::FILE* OpenTemporaryFile(const std::string& folder, const std::string& blame);
+
 class ValueSpill {
  public:
   /// Opens an unnamed temporary file in `folder` (removed by the system when it is closed, even

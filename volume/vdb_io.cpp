@@ -18,6 +18,7 @@
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
+#include "volume/vdb_writer.h"
 
 namespace pandora {
 
@@ -63,27 +64,6 @@ void Describe(openvdb::GridBase& grid) {
   grid.insertMeta("value_units", openvdb::StringMetadata(it->second.first));
   grid.insertMeta("description", openvdb::StringMetadata(it->second.second));
 }
-
-// io::File::write does not check its stream: on a full disk it returns normally over a cut-short
-// file. This writes the same archive (seekable, with grid offsets) through a stream it checks.
-class CheckedVdbWriter : public openvdb::io::Archive {
- public:
-  void Write(const std::string& path, const openvdb::GridPtrVec& grids,
-             const openvdb::MetaMap& meta) {
-    std::ofstream os(path, std::ios::binary | std::ios::trunc);
-    if (!os) throw InputError(path, "", "cannot create the VDB file", "check the output folder");
-    openvdb::io::Archive::write(os, grids, /*seekable=*/true, meta);
-    os.flush();
-    const bool ok = static_cast<bool>(os);
-    os.close();
-    if (!ok || os.fail())
-      throw InputError(path, "", "cannot write the VDB file: the disk is full or the write failed",
-                       "free some space, then run again");
-  }
-  openvdb::io::Archive::Ptr copy() const override {
-    return openvdb::io::Archive::Ptr(new CheckedVdbWriter(*this));
-  }
-};
 
 // Camera ids in rig order from the "rig" metadata (RigToJson); empty when absent or unusable.
 std::vector<std::string> CameraIds(const std::map<std::string, std::string>& metadata) {
@@ -233,83 +213,90 @@ openvdb::FloatGrid::Ptr TakeCoverageAsFloat(openvdb::Int32Grid& grid) {
   return out;
 }
 
-void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage,
-                        const std::string& path,
-                        const std::map<std::string, std::string>& metadata);
-
-}  // namespace
-
-void WriteFieldsVdb(Fields&& fields, const std::string& path,
-                    const std::map<std::string, std::string>& metadata) {
-  InitializeOpenVdb();
-  Fields::Impl& g = fields.impl();
-  openvdb::FloatGrid::Ptr coverage;
-  if (g.coverage) {
-    openvdb::math::Transform::Ptr transform = ExactCopy(g.coverage->transform());
-    coverage = TakeCoverageAsFloat(*g.coverage);
-    coverage->setTransform(transform);
-    g.coverage.reset();
-  }
-  WriteFieldsVdbWith(fields, coverage, path, metadata);
-}
-
-void WriteFieldsVdb(const Fields& fields, const std::string& path,
-                    const std::map<std::string, std::string>& metadata) {
-  InitializeOpenVdb();
-  const Fields::Impl& g = fields.impl();
-  openvdb::FloatGrid::Ptr coverage;
-  if (g.coverage) {
-    coverage = openvdb::FloatGrid::create(std::make_shared<openvdb::FloatTree>(g.coverage->tree()));
-    coverage->setTransform(ExactCopy(g.coverage->transform()));
-  }
-  WriteFieldsVdbWith(fields, coverage, path, metadata);
-}
-
-namespace {
-
-void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage,
-                        const std::string& path,
-                        const std::map<std::string, std::string>& metadata) {
-  const Fields::Impl& g = fields.impl();
-  openvdb::GridPtrVec grids;
-  if (coverage) {
-    coverage->setName(kCoverageGrid);
-    grids.push_back(coverage);
-  }
-  for (const std::string& name : FieldNames())
-    if (auto f = g.Float(name)) {
-      // Shares the tree and the transform (copyGrid() would re-derive the transform, see
-      // ExactCopy).
-      auto copy = openvdb::FloatGrid::create(f->treePtr());
-      copy->setTransform(f->transformPtr());
-      copy->insertMeta(static_cast<const openvdb::MetaMap&>(*f));
-      grids.push_back(copy);
-    }
-  for (const auto& [name, f] : g.extra) {
-    auto copy = openvdb::FloatGrid::create(f->treePtr());
-    copy->setTransform(f->transformPtr());
-    copy->setName(name);
-    grids.push_back(copy);
-  }
-  for (openvdb::GridBase::Ptr& grid : grids) {
+// fields.vdb's grids in order, each made when its turn comes: coverage (as floats), the float
+// fields in FieldNames() order (a spilled one read back from its file), the extra grids, then the
+// per-camera grids. With `owned` (the fields being consumed, `g` itself), each grid leaves the
+// fields as it is made, so that it is freed once written: one grid at a time is held beyond those
+// not yet written.
+std::vector<GridToWrite> FieldGridsToWrite(const Fields::Impl& g, Fields::Impl* owned,
+                                           const std::map<std::string, std::string>& metadata) {
+  const auto described = [&metadata](openvdb::GridBase::Ptr grid) {
     for (const auto& [key, value] : metadata) grid->insertMeta(key, openvdb::StringMetadata(value));
     Describe(*grid);
-  }
-  if (!g.visible.empty()) {
-    for (openvdb::GridBase::Ptr grid : CameraGrids(g.visible, CameraIds(metadata))) {
-      for (const auto& [key, value] : metadata)
-        if (key != "rig") grid->insertMeta(key, openvdb::StringMetadata(value));
-      grids.push_back(grid);
+    return grid;
+  };
+  std::vector<GridToWrite> grids;
+  if (g.coverage)
+    grids.push_back({kCoverageGrid, [&g, owned, described] {
+                       openvdb::math::Transform::Ptr transform = ExactCopy(g.coverage->transform());
+                       openvdb::FloatGrid::Ptr coverage;
+                       if (owned) {
+                         coverage = TakeCoverageAsFloat(*owned->coverage);
+                         owned->coverage.reset();
+                       } else {
+                         coverage = openvdb::FloatGrid::create(
+                             std::make_shared<openvdb::FloatTree>(g.coverage->tree()));
+                       }
+                       coverage->setTransform(transform);
+                       coverage->setName(kCoverageGrid);
+                       return described(coverage);
+                     }});
+  for (const std::string& name : FieldNames()) {
+    if (g.Float(name)) {
+      grids.push_back({name, [&g, owned, described, name] {
+                         const openvdb::FloatGrid::Ptr f = g.Float(name);
+                         // Shares the tree and the transform (copyGrid() would re-derive the
+                         // transform, see ExactCopy).
+                         auto copy = openvdb::FloatGrid::create(f->treePtr());
+                         copy->setTransform(f->transformPtr());
+                         copy->insertMeta(static_cast<const openvdb::MetaMap&>(*f));
+                         if (owned) owned->floats.erase(name);
+                         return described(copy);
+                       }});
+    } else if (g.spilled.count(name)) {
+      grids.push_back({name, [&g, owned, described, name] {
+                         openvdb::FloatGrid::Ptr grid = g.spilled.at(name).Read();
+                         if (owned) owned->spilled.erase(name);  // its file closed
+                         return described(grid);
+                       }});
     }
   }
+  for (const auto& [name, f] : g.extra)
+    grids.push_back({name, [&g, owned, described, name = name] {
+                       const openvdb::FloatGrid::Ptr& f = g.extra.at(name);
+                       auto copy = openvdb::FloatGrid::create(f->treePtr());
+                       copy->setTransform(f->transformPtr());
+                       copy->setName(name);
+                       if (owned) owned->extra.erase(name);
+                       return described(copy);
+                     }});
+  if (!g.visible.empty()) {
+    // Shares the trees: cheap to make at once, each dropped (with the fields' own) once written.
+    auto cameras =
+        std::make_shared<openvdb::GridPtrVec>(CameraGrids(g.visible, CameraIds(metadata)));
+    for (std::size_t c = 0; c < cameras->size(); ++c)
+      grids.push_back({(*cameras)[c]->getName(), [cameras, c, owned, &metadata] {
+                         openvdb::GridBase::Ptr grid = std::move((*cameras)[c]);
+                         if (owned) owned->visible[c].reset();
+                         for (const auto& [key, value] : metadata)
+                           if (key != "rig") grid->insertMeta(key, openvdb::StringMetadata(value));
+                         return grid;
+                       }});
+  }
+  return grids;
+}
+
+// Writes the grids to a temporary name, then renames it to `path`.
+void WriteFieldsVdbWith(const Fields::Impl& g, Fields::Impl* owned, const std::string& path,
+                        const std::map<std::string, std::string>& metadata) {
+  InitializeOpenVdb();
+  const std::vector<GridToWrite> grids = FieldGridsToWrite(g, owned, metadata);
   openvdb::MetaMap file_meta;
   for (const auto& [key, value] : metadata)
     file_meta.insertMeta(key, openvdb::StringMetadata(value));
   const std::string tmp = TemporaryPath(path);
   try {
-    CheckedVdbWriter writer;
-    writer.setCompression(kCompression);
-    writer.Write(tmp, grids, file_meta);
+    WriteGridsOneAtATime(tmp, grids, file_meta, kCompression);
   } catch (const openvdb::Exception& e) {
     std::remove(tmp.c_str());
     throw InputError(path, "", std::string("cannot write the VDB file: ") + e.what(),
@@ -322,6 +309,16 @@ void WriteFieldsVdbWith(const Fields& fields, openvdb::FloatGrid::Ptr coverage,
 }
 
 }  // namespace
+
+void WriteFieldsVdb(Fields&& fields, const std::string& path,
+                    const std::map<std::string, std::string>& metadata) {
+  WriteFieldsVdbWith(fields.impl(), &fields.impl(), path, metadata);
+}
+
+void WriteFieldsVdb(const Fields& fields, const std::string& path,
+                    const std::map<std::string, std::string>& metadata) {
+  WriteFieldsVdbWith(fields.impl(), nullptr, path, metadata);
+}
 
 Fields ReadFieldsVdb(const std::string& path, FieldsProvenance* provenance) {
   return ReadFieldsVdbBytes(ReadVdbFileBytes(path), path, provenance);

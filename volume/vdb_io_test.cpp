@@ -21,6 +21,7 @@
 #include "analysis/util/error.h"
 #include "volume/fields_vdb.h"
 #include "volume/vdb_check.h"
+#include "volume/vdb_writer.h"
 
 namespace pandora {
 namespace {
@@ -190,6 +191,49 @@ TEST(VdbIo, ConsumingWriterWritesTheSameFile) {
   ExpectSameFields(f, ReadFieldsVdb(b.string()));
   EXPECT_FALSE(
       g.impl().coverage);  // NOLINT(bugprone-use-after-move): the writer's documented effect
+}
+
+// WriteGridsOneAtATime writes the file openvdb::io::File::write writes from the same grids (names
+// used twice and an empty name included), but for the header's random UUID, making each grid only
+// when its turn comes.
+TEST(VdbIo, OneAtATimeWriterWritesWhatOpenVdbWrites) {
+  const Fields f = MakeFields(5);
+  const Fields::Impl& g = f.impl();
+  auto twin = openvdb::gridPtrCast<openvdb::FloatGrid>(g.Float("sigma_max")->deepCopyGrid());
+  twin->setName("resolution");
+  const openvdb::GridPtrVec grids{g.Float("resolution"), g.Float("sigma_max"), twin, g.visible[0],
+                                  g.visible[3]->deepCopyGrid()};
+  openvdb::MetaMap meta;
+  meta.insertMeta("units", openvdb::StringMetadata("m"));
+  const std::uint32_t compression = openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK;
+  const fs::path a = TempDir() / "openvdb.vdb", b = TempDir() / "one_at_a_time.vdb";
+  openvdb::io::File file(a.string());
+  file.setCompression(compression);
+  file.write(grids, meta);
+  file.close();
+  std::vector<GridToWrite> list;
+  std::vector<std::size_t> made;
+  for (std::size_t i = 0; i < grids.size(); ++i)
+    list.push_back({grids[i]->getName(), [&, i] {
+                      made.push_back(i);
+                      return grids[i];
+                    }});
+  WriteGridsOneAtATime(b.string(), list, meta, compression);
+  EXPECT_EQ(made, (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+  std::string bytes_a = ReadBytes(a), bytes_b = ReadBytes(b);
+  ASSERT_GT(bytes_a.size(), 1000u);
+  ASSERT_EQ(bytes_a.size(), bytes_b.size());
+  EXPECT_NE(bytes_a.substr(21, 36), bytes_b.substr(21, 36));  // the UUIDs, and nothing else
+  bytes_a.replace(21, 36, 36, '-');
+  bytes_b.replace(21, 36, 36, '-');
+  EXPECT_TRUE(bytes_a == bytes_b);
+  // A folder that does not exist: the path named.
+  try {
+    WriteGridsOneAtATime((TempDir() / "no" / "such.vdb").string(), list, meta, compression);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(e.file().find("such.vdb"), std::string::npos);
+  }
 }
 
 TEST(VdbIo, OneBoolGridPerCameraNamedByItsEncodedId) {
