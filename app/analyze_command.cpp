@@ -228,11 +228,12 @@ int RunAnalyze(const AnalyzeArgs& args) {
     so.fields.progress = [&bar](double f) { bar->Update(f); };
     if (root) StageAnalyzeOutputs(output, study->scene(), out, vdb_path, summary_path);
     if (!mpi.active()) {
-      // The fields nothing reads before fields.vdb is written (CompleteAnalysis reads coverage,
-      // the camera sets, resolution, sigma_max and sigma_max_steady) are not held as they are
-      // evaluated: their leaves wait beside the staged outputs (docs/performance.md).
-      so.fields.spilled_fields = {"sigma_mean", "triangulation_angle", "condition",
-                                  "sigma_mean_steady"};
+      // Every float field goes to disk leaf by leaf as its blocks finish, beside the staged
+      // outputs: the analyses after the evaluation read each one back when they need it, one at a
+      // time (Fields::Impl::Load), and fields.vdb is written a grid at a time
+      // (docs/performance.md, "All nine fields against coverage alone").
+      for (const std::string& f : so.fields.fields)
+        if (f != "coverage" && f != "cameras") so.fields.spilled_fields.push_back(f);
       so.fields.spill_folder = std::filesystem::path(vdb_path).parent_path().string();
       so.fields.spill_blame = "--out";
     }
@@ -264,6 +265,7 @@ int RunAnalyze(const AnalyzeArgs& args) {
   // samples and surface targets, pixel targets and DORI, warnings, calibration, N-1, PTZ.
   session::AnalyzeOptions analysis;
   analysis.fields = options;
+  analysis.fields.solid_trees = &study->solid_trees();  // the plausibility checks use them too
   analysis.spill_folder = out.string();
   analysis.spill_blame = "--out";
   analysis.threads = static_cast<int>(
@@ -842,6 +844,7 @@ int RunStreamedAnalyze(const AnalyzeArgs& args) {
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   RigCheckOptions check;
   check.visible_voxels = merged.stats.per_camera_seen;
+  study->solid_trees().LendTo(scene, &check);  // built by the tiles already
   const std::vector<Warning> warnings = CheckRig(scene, rig, study->caster(), check);
   Summary typed = Summarize(scene, rig, merged, options.fields, threads, warnings);
   ApplyStreamPercentiles(p, want_resolution, merged, typed);

@@ -18,6 +18,7 @@
 #include "tests/random_scene.h"
 #include "volume/fields_test_util.h"
 #include "volume/fields_vdb.h"
+#include "volume/robustness.h"
 #include "volume/summary.h"
 #include "volume/vdb_io.h"
 
@@ -507,10 +508,11 @@ std::string BytesButTheUuid(const std::string& path) {
   return bytes;
 }
 
-// `pandora analyze` keeps the fields nothing reads before they are written out of memory: their
-// leaves go to a temporary file block by block and come back when fields.vdb is written. The file
-// is the one the evaluation holding every grid writes, byte for byte; the spilled grids are not
-// among the fields' floats meanwhile, and the statistics are the same.
+// `pandora analyze` keeps the float fields out of memory: their leaves go to a temporary file block
+// by block, the analyses read each grid back when they need it (Load), and fields.vdb is written a
+// grid at a time. The file is the one the evaluation holding every grid writes, byte for byte; the
+// spilled grids are not among the fields' floats meanwhile, and the statistics, the summary and
+// the N-1 table are the same.
 TEST(Fields, SpilledFieldsWriteTheSameFile) {
   const Scene scene = TestScene();
   const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
@@ -521,14 +523,17 @@ TEST(Fields, SpilledFieldsWriteTheSameFile) {
   const auto dir = std::filesystem::temp_directory_path() / "pandora_spill_test";
   std::filesystem::create_directories(dir);
   FieldOptions spilled = held;
-  spilled.spilled_fields = {"sigma_max", "triangulation_angle", "condition", "sigma_mean"};
+  spilled.spilled_fields = {"sigma_max", "triangulation_angle", "condition", "sigma_mean",
+                            "resolution"};
   spilled.spill_folder = dir.string();
   spilled.spill_blame = "--out";
   const Fields a = EvaluateFields(scene, scene.rigs[0], *caster, held);
   Fields b = EvaluateFields(scene, scene.rigs[0], *caster, spilled);
-  EXPECT_EQ(b.impl().floats.size(), 1u);  // resolution
-  ASSERT_EQ(b.impl().spilled.size(), 4u);
+  EXPECT_TRUE(b.impl().floats.empty());
+  ASSERT_EQ(b.impl().spilled.size(), 5u);
   EXPECT_FALSE(b.impl().Float("sigma_max"));
+  EXPECT_TRUE(b.impl().Has("sigma_max"));
+  EXPECT_FALSE(b.impl().Has("sigma_max_steady"));
   const SpilledGrid& sigma = b.impl().spilled.at("sigma_max");
   EXPECT_EQ(sigma.grid->tree().leafCount(), 0u);
   EXPECT_EQ(sigma.leaves->leaves(), std::int64_t(a.impl().Float("sigma_max")->tree().leafCount()));
@@ -537,6 +542,18 @@ TEST(Fields, SpilledFieldsWriteTheSameFile) {
   EXPECT_EQ(a.stats.triangulable_voxels, b.stats.triangulable_voxels);
   EXPECT_EQ(a.stats.coverage_histogram, b.stats.coverage_histogram);
   EXPECT_EQ(a.stats.sigma_max_mm, b.stats.sigma_max_mm);
+  const auto without_timing = [](nlohmann::json j) {
+    j.erase("timing");
+    return j;
+  };
+  EXPECT_EQ(without_timing(Summarize(scene, scene.rigs[0], a, held.fields, 1, {})),
+            without_timing(Summarize(scene, scene.rigs[0], b, held.fields, 1, {})));
+  nlohmann::json n1_a = ComputeCriticality(scene, scene.rigs[0], a, *caster, 2),
+                 n1_b = ComputeCriticality(scene, scene.rigs[0], b, *caster, 2);
+  n1_a.erase("seconds");
+  n1_b.erase("seconds");
+  EXPECT_EQ(n1_a, n1_b);
+  EXPECT_FALSE(n1_a["per_camera"][0]["sigma_max_p50_mm"].is_null());
   const std::map<std::string, std::string> meta{{"units", "m"}, {"scene_sha256", "abc"}};
   const std::string path_a = (dir / "held.vdb").string(), path_b = (dir / "spilled.vdb").string();
   WriteFieldsVdb(a, path_a, meta);

@@ -41,6 +41,18 @@ struct Fields::Impl {
     return it == floats.end() ? nullptr : it->second;
   }
 
+  /// Whether float field `name` was evaluated: held in `floats` or spilled.
+  bool Has(const std::string& name) const { return floats.count(name) || spilled.count(name); }
+  /// The float grid `name` for reading: the held one, or a spilled one read back from its file (a
+  /// new grid at each call: hold it only while it is read); null when it was not evaluated. The
+  /// analyses `pandora analyze` runs after the evaluation read their grids through this, one at a
+  /// time.
+  openvdb::FloatGrid::Ptr Load(const std::string& name) const {
+    if (openvdb::FloatGrid::Ptr grid = Float(name)) return grid;
+    auto it = spilled.find(name);
+    return it == spilled.end() ? nullptr : it->second.Read();
+  }
+
   /// The non-null field grids (not the per-camera ones), in FieldNames() order.
   openvdb::GridPtrVec Grids() const {
     openvdb::GridPtrVec grids;

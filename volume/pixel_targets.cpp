@@ -107,7 +107,7 @@ std::vector<PixelTargetSummary> EvaluatePixelTargets(const Scene& scene, const R
 
 DoriSummary EvaluateDori(const Scene& scene, const Fields& fields, Fields* grids) {
   const Fields::Impl& g = fields.impl();
-  const openvdb::FloatGrid::Ptr resolution = g.Float("resolution");
+  const openvdb::FloatGrid::Ptr resolution = g.Load("resolution");
   if (!resolution || !g.coverage)
     throw InputError(scene.path, "$.study.dori",
                      "DORI classes need the coverage and resolution fields",

@@ -390,7 +390,7 @@ struct CriticalitySetup {
     if (g.visible.size() != rig.cameras.size())
       throw std::invalid_argument("ComputeCriticality: the fields were evaluated for another rig");
     if (k < 1) throw std::invalid_argument("ComputeCriticality: k must be at least 1");
-    sigma_grid = g.Float("sigma_max");
+    sigma_grid = g.Load("sigma_max");
     origins = SeenLeafOrigins(rig, g);
     const std::size_t camera_count = rig.cameras.size();
     whitened.resize(camera_count);

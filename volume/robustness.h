@@ -67,7 +67,7 @@ bool HasCameraSets(const Fields& fields);
 /// system's temporary folder), as a streamed run keeps them (volume/summary_parts.h). The table
 /// is the same either way, bit for bit. `blame`: what a file error names (default: the folder).
 struct ListMemory {
-  double bytes = 64.0 * 1048576.0;
+  double bytes = 16.0 * 1048576.0;
   std::string folder, blame;
 };
 

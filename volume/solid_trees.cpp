@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "analysis/rig/rig_check.h"
+
 namespace pandora {
 namespace {
 
@@ -53,6 +55,11 @@ int SolidTrees::built() const {
 double SolidTrees::build_seconds() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return seconds_;
+}
+
+void SolidTrees::LendTo(const Scene& scene, RigCheckOptions* check) const {
+  check->object_tree = [this, &scene](std::size_t o) { return Object(scene, o); };
+  check->region_tree = [this, &scene] { return RegionMesh(scene); };
 }
 
 }  // namespace pandora

@@ -16,6 +16,8 @@
 
 namespace pandora {
 
+struct RigCheckOptions;
+
 class SolidTrees {
  public:
   /// Builds nothing. `scene` must outlive this object (the study owns both).
@@ -28,6 +30,9 @@ class SolidTrees {
   const InsideMesh* Object(const Scene& scene, std::size_t index) const;
   /// The tree of the region's mesh, under the same condition.
   const InsideMesh* RegionMesh(const Scene& scene) const;
+  /// Lends these trees to the plausibility checks (RigCheckOptions::object_tree and region_tree,
+  /// analysis/rig/rig_check.h) over `scene`, which must outlive `check` as this object must.
+  void LendTo(const Scene& scene, RigCheckOptions* check) const;
   /// Trees built so far and the seconds spent building them (all threads' wall time summed).
   int built() const;
   double build_seconds() const;

@@ -55,7 +55,7 @@ void ForEachActiveChunk(const openvdb::FloatGrid& grid, Fn&& fn) {
 SigmaPercentiles SigmaValues(const Fields& fields, const std::vector<float>& list,
                              const std::string& grid_name, const std::optional<double>& limit,
                              std::int64_t* at_most) {
-  const openvdb::FloatGrid::Ptr grid = fields.impl().Float(grid_name);
+  const openvdb::FloatGrid::Ptr grid = fields.impl().Load(grid_name);
   const bool from_grid = list.empty() && fields.stats.triangulable_voxels > 0 && grid;
   const auto for_each_chunk = [&](auto&& fn) {
     if (from_grid)
@@ -93,7 +93,7 @@ std::optional<double> NearestRankPercentile(std::vector<float> values, double p)
 
 std::vector<float> GridActiveValues(const Fields& fields, const std::string& name) {
   std::vector<float> values;
-  if (const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name)) {
+  if (const openvdb::FloatGrid::Ptr grid = fields.impl().Load(name)) {
     values.reserve(grid->activeVoxelCount());
     for (auto it = grid->cbeginValueOn(); it; ++it) {
       if (it.isVoxelValue())
@@ -109,7 +109,7 @@ std::vector<std::optional<double>> GridPercentileValues(const Fields& fields,
                                                         const std::string& name,
                                                         const std::vector<int>& percentiles) {
   // Counted from the grid in chunks: no list of its values.
-  const openvdb::FloatGrid::Ptr grid = fields.impl().Float(name);
+  const openvdb::FloatGrid::Ptr grid = fields.impl().Load(name);
   if (!grid) return std::vector<std::optional<double>>(percentiles.size());
   return CountedPercentiles([&](auto&& fn) { ForEachActiveChunk(*grid, fn); },
                             std::vector<double>(percentiles.begin(), percentiles.end()));
@@ -128,7 +128,7 @@ std::vector<RegionCounts> CountRegions(const Scene& scene, const Fields& fields)
   std::vector<RegionCounts> out;
   const Fields::Impl& g = fields.impl();
   if (scene.study.regions.empty() || !g.coverage) return out;
-  const openvdb::FloatGrid::Ptr sigma = g.Float("sigma_max"), resolution = g.Float("resolution");
+  const openvdb::FloatGrid::Ptr sigma = g.Load("sigma_max"), resolution = g.Load("resolution");
   for (const auto& [name, region] : scene.study.regions) {
     std::unique_ptr<InsideMesh> inside;
     if (region.kind == Region::Kind::kMesh && !region.mesh.triangles.empty())
@@ -174,8 +174,7 @@ std::vector<RegionSummary> SummarizeRegions(const Scene& scene, const Fields& fi
   std::vector<RegionSummary> out;
   const std::vector<RegionCounts> counts = CountRegions(scene, fields);
   const Fields::Impl& g = fields.impl();
-  const bool has_resolution = g.Float("resolution") != nullptr,
-             has_sigma = g.Float("sigma_max") != nullptr;
+  const bool has_resolution = g.Has("resolution"), has_sigma = g.Has("sigma_max");
   for (std::size_t i = 0; i < counts.size(); ++i) {
     const RegionCounts& r = counts[i];
     out.push_back(FinishRegion(

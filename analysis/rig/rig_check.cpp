@@ -40,29 +40,31 @@ std::string Percent(double fraction) {
 // Angle (radians) between the optical axis (+z) and a unit ray.
 double AxisAngle(const Vec3& ray) { return std::atan2(ray.head<2>().norm(), ray.z()); }
 
-// Point-in-solid tests, built on first use per object (CGAL AABB trees are not free).
+// Point-in-solid tests: the given trees (RigCheckOptions::object_tree), or built on first use per
+// object (CGAL AABB trees are not free).
 class Solids {
  public:
-  explicit Solids(const Scene& scene) : scene_(scene) {
+  Solids(const Scene& scene, const RigCheckOptions& options) : scene_(scene), given_(options) {
     for (std::size_t o = 0; o < scene.objects.size(); ++o)
       if (scene.objects[o].solid && !scene.objects[o].mesh.triangles.empty()) {
         objects_.push_back(static_cast<int>(o));
         bounds_.push_back(scene.objects[o].mesh.Bounds());
       }
-    tests_.resize(objects_.size());
+    tests_.resize(objects_.size(), nullptr);
+    own_.resize(objects_.size());
   }
   /// The object index of a solid containing p, or -1. With `strict`, a point within `tolerance` of
   /// the surface (some axis offset by it is outside) does not count.
   int Containing(const Vec3& p, bool strict = false, double tolerance = 0) {
     for (std::size_t i = 0; i < objects_.size(); ++i) {
       if (!bounds_[i].Contains(p)) continue;
-      if (!tests_[i]) tests_[i] = std::make_unique<InsideMesh>(scene_.objects[objects_[i]].mesh);
-      if (!tests_[i]->Inside(p)) continue;
+      const InsideMesh& test = Test(i);
+      if (!test.Inside(p)) continue;
       bool on_surface = false;
       for (int a = 0; strict && a < 6 && !on_surface; ++a) {
         Vec3 q = p;
         q[a / 2] += (a % 2 ? tolerance : -tolerance);
-        on_surface = !tests_[i]->Inside(q);
+        on_surface = !test.Inside(q);
       }
       if (!on_surface) return objects_[i];
     }
@@ -70,20 +72,37 @@ class Solids {
   }
 
  private:
+  const InsideMesh& Test(std::size_t i) {
+    if (!tests_[i] && given_.object_tree) tests_[i] = given_.object_tree(objects_[i]);
+    if (!tests_[i]) {
+      own_[i] = std::make_unique<InsideMesh>(scene_.objects[objects_[i]].mesh);
+      tests_[i] = own_[i].get();
+    }
+    return *tests_[i];
+  }
   const Scene& scene_;
+  const RigCheckOptions& given_;
   std::vector<int> objects_;
   std::vector<Aabb> bounds_;
-  std::vector<std::unique_ptr<InsideMesh>> tests_;
+  std::vector<const InsideMesh*> tests_;
+  std::vector<std::unique_ptr<InsideMesh>> own_;
 };
 
 // Cell centres of an n^3 lattice over the region box, inside the region and outside every solid.
-std::vector<Vec3> RegionSamples(const Scene& scene, int n, Solids* solids) {
+std::vector<Vec3> RegionSamples(const Scene& scene, int n, const RigCheckOptions& options,
+                                Solids* solids) {
   const Region& region = scene.study.region;
   std::vector<Vec3> out;
   if (region.box.empty() || n < 1) return out;
-  std::unique_ptr<InsideMesh> inside;
-  if (region.kind == Region::Kind::kMesh && !region.mesh.triangles.empty())
-    inside = std::make_unique<InsideMesh>(region.mesh);
+  const InsideMesh* inside = nullptr;
+  std::unique_ptr<InsideMesh> own;
+  if (region.kind == Region::Kind::kMesh && !region.mesh.triangles.empty()) {
+    if (options.region_tree) inside = options.region_tree();
+    if (!inside) {
+      own = std::make_unique<InsideMesh>(region.mesh);
+      inside = own.get();
+    }
+  }
   const Vec3 size = region.box.size();
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
@@ -481,13 +500,19 @@ std::vector<Warning> CheckRig(const Scene& scene, const Rig& rig, const RayCaste
     return "$.rigs[" + std::to_string(rig_index) + "].cameras[" + std::to_string(c) + "]";
   };
   CheckPlausibleValues(scene, rig, camera_path, &out);
+  // The object of each triangle in scene.AllTriangles() order (the caster's), and the bounds of
+  // all of them, without a copy of the triangles.
   std::vector<int> triangle_object;
-  const TriangleMesh all = scene.AllTriangles(&triangle_object);
-  const Aabb geometry = all.Bounds();
+  Aabb geometry;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const TriangleMesh& mesh = scene.objects[o].mesh;
+    for (const Vec3& v : mesh.vertices) geometry.Extend(v);
+    triangle_object.insert(triangle_object.end(), mesh.triangles.size(), static_cast<int>(o));
+  }
   const double pad = 1e-9 * std::max(1.0, geometry.diagonal());
-  Solids solids(scene);
+  Solids solids(scene, options);
   const std::vector<Vec3> samples =
-      RegionSamples(scene, std::max(1, options.region_samples_per_axis), &solids);
+      RegionSamples(scene, std::max(1, options.region_samples_per_axis), options, &solids);
   const double scale = std::max(scene.Bounds().diagonal(), 1e-9);
   const VisibilityTester tester(rig.cameras, caster, scale);
   const double eps = tester.epsilon();

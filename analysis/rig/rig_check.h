@@ -8,11 +8,14 @@
 ///
 /// Also the lens's effective field of view with distortion, beside the nominal one.
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "analysis/geometry/camera.h"
+#include "analysis/geometry/inside_mesh.h"
 #include "analysis/geometry/ray_caster.h"
 #include "analysis/scene/scene.h"
 
@@ -72,6 +75,11 @@ struct RigCheckOptions {
   /// Sample points of the region per axis (a lattice of cell centres; mesh regions keep the points
   /// inside, and points inside solids are dropped).
   int region_samples_per_axis = 16;
+  /// Point-in-solid trees built already (a study's, volume/solid_trees.h): the tree of
+  /// scene.objects[object], and of the region's mesh; nullptr (or no function): CheckRig builds
+  /// its own where it needs one (a CGAL AABB tree of the object's triangles).
+  std::function<const InsideMesh*(std::size_t object)> object_tree;
+  std::function<const InsideMesh*()> region_tree;
 };
 
 /// Checks every enabled camera of `rig` (which must be one of scene.rigs, for the JSON paths) and

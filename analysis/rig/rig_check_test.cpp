@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "analysis/geometry/ray_caster.h"
@@ -166,6 +167,31 @@ TEST(CheckRig, EachNonsenseCameraGetsItsOneWarning) {
     }
   }
   EXPECT_EQ(FormatWarning("lab.json", ws[0]), "lab.json: " + ws[0].json_path + ": " + ws[0].reason);
+}
+
+// A study's point-in-solid trees (RigCheckOptions::object_tree) are used instead of trees of its
+// own, with the same warnings word for word.
+TEST(CheckRig, GivenSolidTreesGiveTheSameWarnings) {
+  const Scene scene = ParseScene(Lab(), "lab.json");
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  const std::vector<Warning> own = CheckRig(scene, scene.rigs[0], *caster);
+  std::vector<std::unique_ptr<InsideMesh>> trees(scene.objects.size());
+  int asked = 0;
+  RigCheckOptions o;
+  o.object_tree = [&](std::size_t object) -> const InsideMesh* {
+    ++asked;
+    if (!trees.at(object)) trees[object] = std::make_unique<InsideMesh>(scene.objects[object].mesh);
+    return trees[object].get();
+  };
+  const std::vector<Warning> given = CheckRig(scene, scene.rigs[0], *caster, o);
+  EXPECT_GT(asked, 0);
+  ASSERT_EQ(given.size(), own.size());
+  for (std::size_t i = 0; i < own.size(); ++i) {
+    EXPECT_EQ(given[i].kind, own[i].kind);
+    EXPECT_EQ(given[i].camera, own[i].camera);
+    EXPECT_EQ(given[i].json_path, own[i].json_path);
+    EXPECT_EQ(given[i].reason, own[i].reason);
+  }
 }
 
 TEST(CheckRig, VoxelCountsDecideWhatACameraSees) {

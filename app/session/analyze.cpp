@@ -9,6 +9,7 @@
 #include "volume/pixel_targets.h"
 #include "volume/ptz_fields.h"
 #include "volume/robustness.h"
+#include "volume/solid_trees.h"
 #include "volume/time_fields.h"
 
 namespace pandora::session {
@@ -58,6 +59,8 @@ RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const 
   RigAnalysis out;
   RigCheckOptions check;
   check.visible_voxels = fields.stats.per_camera_seen;
+  if (const SolidTrees* trees = options.fields.solid_trees)
+    trees->LendTo(scene, &check);  // the study's, not built again
   out.warnings = CheckRig(scene, rig, caster, check);
   Summary& s = out.summary;
   s = Summarize(scene, rig, fields, options.fields.fields, options.threads, out.warnings);
@@ -83,11 +86,11 @@ RigAnalysis CompleteAnalysis(const Scene& scene, const RayCaster& caster, const 
 }
 
 RigFieldsAnalysis AnalyzeRig(const Study& study, const Rig& rig, const AnalyzeOptions& options) {
-  FieldOptions field_options = options.fields;
-  if (!field_options.solid_trees) field_options.solid_trees = &study.solid_trees();
-  RigFieldsAnalysis out{EvaluateFields(study.scene(), rig, study.caster(), field_options), {}};
+  AnalyzeOptions with_trees = options;
+  if (!with_trees.fields.solid_trees) with_trees.fields.solid_trees = &study.solid_trees();
+  RigFieldsAnalysis out{EvaluateFields(study.scene(), rig, study.caster(), with_trees.fields), {}};
   out.analysis =
-      CompleteAnalysis(study.scene(), study.caster(), rig, out.fields, &out.fields, options);
+      CompleteAnalysis(study.scene(), study.caster(), rig, out.fields, &out.fields, with_trees);
   return out;
 }
 
