@@ -144,9 +144,7 @@ double BytesPerVoxel(const std::string& field) {
 std::vector<std::string> HeldFields(const FieldOptions& opt, bool keep) {
   std::vector<std::string> held;
   for (const std::string& f : opt.fields)
-    if (keep || f == "coverage" || f == "cameras" ||
-        std::find(opt.spilled_fields.begin(), opt.spilled_fields.end(), f) ==
-            opt.spilled_fields.end())
+    if (keep || f == "coverage" || f == "cameras" || !Wants(opt.spilled_fields, f))
       held.push_back(f);
   return held;
 }
@@ -755,13 +753,10 @@ void FieldEvaluator::State::ResetGrids(int camera_count) {
     float_grids[f] = grid.get();
   }
   g.spilled.clear();
-  const std::vector<std::string>& spilled = options.spilled_fields;
   for (int f = 0; f < kFloatFieldCount; ++f)
-    spills[f] =
-        want_float[f] && !keep &&
-                std::find(spilled.begin(), spilled.end(), kFloatFieldNames[f]) != spilled.end()
-            ? std::make_shared<LeafSpill>(options.spill_folder, options.spill_blame)
-            : nullptr;
+    spills[f] = want_float[f] && !keep && Wants(options.spilled_fields, kFloatFieldNames[f])
+                    ? std::make_shared<LeafSpill>(options.spill_folder, options.spill_blame)
+                    : nullptr;
   if (want_cameras) {
     g.visible.resize(camera_count);
     for (auto& v : g.visible) MakeGrid(v, "visible", g.transform);

@@ -67,8 +67,7 @@ void LeafSpill::AddTo(openvdb::FloatTree& tree) const {
 openvdb::FloatGrid::Ptr SpilledGrid::Read() const {
   openvdb::FloatGrid::Ptr out = openvdb::FloatGrid::create(grid->background());
   out->setTransform(grid->transformPtr());
-  out->insertMeta(static_cast<const openvdb::MetaMap&>(*grid));
-  out->setName(grid->getName());
+  out->insertMeta(static_cast<const openvdb::MetaMap&>(*grid));  // its name too
   if (leaves) leaves->AddTo(out->tree());
   return out;
 }

@@ -213,6 +213,14 @@ openvdb::FloatGrid::Ptr TakeCoverageAsFloat(openvdb::Int32Grid& grid) {
   return out;
 }
 
+// A grid sharing `f`'s tree and transform (copyGrid() would re-derive the transform, see
+// ExactCopy).
+openvdb::FloatGrid::Ptr SharingTree(const openvdb::FloatGrid::Ptr& f) {
+  auto copy = openvdb::FloatGrid::create(f->treePtr());
+  copy->setTransform(f->transformPtr());
+  return copy;
+}
+
 // fields.vdb's grids in order, each made when its turn comes: coverage (as floats), the float
 // fields in FieldNames() order (a spilled one read back from its file), the extra grids, then the
 // per-camera grids. With `owned` (the fields being consumed, `g` itself), each grid leaves the
@@ -245,10 +253,7 @@ std::vector<GridToWrite> FieldGridsToWrite(const Fields::Impl& g, Fields::Impl* 
     if (g.Float(name)) {
       grids.push_back({name, [&g, owned, described, name] {
                          const openvdb::FloatGrid::Ptr f = g.Float(name);
-                         // Shares the tree and the transform (copyGrid() would re-derive the
-                         // transform, see ExactCopy).
-                         auto copy = openvdb::FloatGrid::create(f->treePtr());
-                         copy->setTransform(f->transformPtr());
+                         auto copy = SharingTree(f);
                          copy->insertMeta(static_cast<const openvdb::MetaMap&>(*f));
                          if (owned) owned->floats.erase(name);
                          return described(copy);
@@ -263,9 +268,7 @@ std::vector<GridToWrite> FieldGridsToWrite(const Fields::Impl& g, Fields::Impl* 
   }
   for (const auto& [name, f] : g.extra)
     grids.push_back({name, [&g, owned, described, name = name] {
-                       const openvdb::FloatGrid::Ptr& f = g.extra.at(name);
-                       auto copy = openvdb::FloatGrid::create(f->treePtr());
-                       copy->setTransform(f->transformPtr());
+                       auto copy = SharingTree(g.extra.at(name));
                        copy->setName(name);
                        if (owned) owned->extra.erase(name);
                        return described(copy);
