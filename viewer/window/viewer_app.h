@@ -30,7 +30,7 @@ struct AppOptions {
   /// fraction of the window's resolution and with shadow maps of at most 1024 texels, then again
   /// in full once idle: interaction stays responsive on software GL (docs/viewer.md, "Frame rate").
   /// 1: always full. With target_hz, where moving frames start: each moving frame's scale is then
-  /// adapted (0.2 .. 1) so that frames take about 1 / target_hz.
+  /// adapted (0.2 .. 1) so that frames take about 1 / (1.15 target_hz): a margin above the target.
   double motion_scale = 0.5;
   /// The frame rate the reduced frames aim at while moving (0: keep motion_scale).
   double target_hz = 30;

@@ -159,6 +159,7 @@ struct ViewerApp::Impl {
   double overhead_seconds = 0;  // the frame's time besides the main picture (running mean)
   double frame_gl_seconds = 0;  // this frame's main picture, 0 when it was kept
   static constexpr double kMinMotionScale = 0.2;
+  static constexpr double kTargetHeadroom = 1.15;  // moving frames aim at 1.15 x target_hz
   int shadow_map_size = 2048;
   InputState input;
   ImGuiContext* imgui = nullptr;
