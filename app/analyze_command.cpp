@@ -515,10 +515,9 @@ void AnalyzeStreamTile(const StreamSetup& setup, const FieldOptions& tile_option
   }
   totals.pixel_targets.Add(PixelTargetParts(scene, rig, f, k, &f));
   if (HasCameraSets(f)) {
-    // A part's lists (8 bytes per triangulable voxel and camera that sees it) at a time, with
-    // their working copies about a tenth of the budget (the tile itself may take half).
-    AddCriticalityParts(scene, rig, f, setup.study->caster(), k,
-                        std::max(1.0, tile_options.memory_budget_bytes / 32.0), totals.criticality);
+    // A part's lists (8 bytes per triangulable voxel and camera that sees it) at a time, as
+    // small as the in-memory run's spilled parts (faster than large ones, and within any budget).
+    AddCriticalityParts(scene, rig, f, setup.study->caster(), k, totals.criticality);
     AddCoverageN1Grid(&f);
   }
   if (RigHasPtz(rig)) totals.ptz.Add(PtzFieldsParts(scene, rig, setup.study->caster(), f, &f));
@@ -738,9 +737,15 @@ StreamAnalyses FinishStreamAnalyses(const StreamSetup& setup, StreamTotals& tota
   pixel.counts = totals.pixel_targets.Counts();
   pixel.seconds = totals.pixel_targets.Seconds();
   out.pixel_targets = FinishPixelTargets(scene, k, pixel);
-  if (!totals.criticality.Counts().empty())  // (the region's size is rank 0's sum: its result)
+  if (!totals.criticality.Counts().empty()) {  // (the region's size is rank 0's sum: its result)
+    const auto t0 = std::chrono::steady_clock::now();
     out.criticality = FinishCriticality(rig, k, totals.total.active_set.region_voxels,
                                         totals.criticality.Counts(), totals.criticality);
+    // The tiles' parts (summed over tiles and processes) and the percentiles over all of them.
+    out.criticality->seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (double s : totals.criticality.Seconds()) out.criticality->seconds += s;
+  }
   if (RigHasPtz(rig))
     out.ptz = FinishPtzFields(scene, rig, totals.ptz.Counts(), totals.ptz.Seconds(), totals.ptz);
   return out;

@@ -489,11 +489,16 @@ void AddPartsOfLeaves(const CriticalitySetup& setup, const std::vector<std::int6
 }  // namespace
 
 void AddCriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
-                         const RayCaster& caster, int k, double part_bytes, SpilledParts& into) {
+                         const RayCaster& caster, int k, SpilledParts& into, double part_bytes) {
+  const auto t0 = std::chrono::steady_clock::now();
   const CriticalitySetup setup(scene, rig, fields, caster, k);
   const std::vector<std::int64_t> pairs =
       setup.sigma_grid ? PairsPerLeaf(setup) : std::vector<std::int64_t>(setup.origins.size(), 0);
   AddPartsOfLeaves(setup, pairs, part_bytes, into);
+  // The time it took, as a part of its own (timings add up over tiles and processes).
+  SummaryParts timing;
+  timing.seconds = {std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+  into.Add(std::move(timing));
 }
 
 SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,

@@ -47,7 +47,7 @@ struct CriticalityTable {
   /// share, then the highest sigma_max p90, then rig order); -1 when there are no rows.
   int worst = -1;
   double mean_ge_k = 0;  ///< Mean over the rows of ge_k (the intact ge_k when there are none).
-  double seconds = 0;    ///< Wall time of ComputeCriticality.
+  double seconds = 0;    ///< Wall time of ComputeCriticality (streamed: summed over tiles).
   /// Bytes of sigma_max lists ComputeCriticality wrote to temporary files (0: kept in memory).
   double spilled_bytes = 0;
 
@@ -85,9 +85,13 @@ SummaryParts CriticalityParts(const Scene& scene, const Rig& rig, const Fields& 
                               const RayCaster& caster, int k);
 /// CriticalityParts of `fields` in parts of leaves, each part's lists at most about `part_bytes`
 /// (and their working copies about three times that), added to `into` one after the other: a
-/// streamed run's tile without its whole lists in memory.
+/// streamed run's tile without its whole lists in memory. Its time is added as a part with only
+/// `seconds` (one value). Parts as small as ComputeCriticality's spilled ones (the default) are
+/// the fastest: on the 2 cm capture stage 1-16 MiB parts took 15-17 s of N-1 over 16 tiles, 64
+/// MiB 21 s, 128 MiB 29 s (the threads' working copies then come from fresh pages each part).
 void AddCriticalityParts(const Scene& scene, const Rig& rig, const Fields& fields,
-                         const RayCaster& caster, int k, double part_bytes, SpilledParts& into);
+                         const RayCaster& caster, int k, SpilledParts& into,
+                         double part_bytes = ListMemory().bytes / 4.0);
 /// The table from every part's counts added up and their lists; `region_voxels`: the free region
 /// voxels of all the parts. Equal to ComputeCriticality of the whole region (seconds left 0).
 CriticalityTable FinishCriticality(const Rig& rig, int k, std::int64_t region_voxels,

@@ -34,7 +34,8 @@ for rig in $rigs; do
   jq -e --slurpfile scene "$scene" '
     ($scene[0].study) as $study
     | .stream.tile_count > 1
-      and ((($study.fields // []) | index("cameras")) == null or (.robustness.per_camera | length) > 0)
+      and ((($study.fields // []) | index("cameras")) == null
+           or ((.robustness.per_camera | length) > 0 and .robustness.seconds > 0))
       and (($study.pixel_targets // []) | length) == (.pixel_targets | length)
       and (($scene[0].motions // null) == null or (.time.samples | length) > 1)
       and ((.per_camera | map(select(.enabled)) | length) > 0)' "$out/stream/summary.json" > /dev/null \
