@@ -18,6 +18,7 @@
 #include "analysis/scene/motion.h"
 #include "analysis/scene/scene.h"
 #include "analysis/scene/surface_targets.h"
+#include "analysis/util/allocation_budget.h"
 #include "analysis/util/error.h"
 #include "app/cli.h"
 #include "app/commands.h"
@@ -554,6 +555,7 @@ void EvaluateStreamTiles(const StreamSetup& setup, const MpiSession& mpi,
     o.tile = tiles[t];
     o.progress = [&bar, i, n = mine.size()](double f) { bar.Update((double(i) + f) / double(n)); };
     Fields f = EvaluateFields(scene, rig, study->caster(), o);
+    ReleaseFreedMemory();  // the tile's freed blocks, before its analyses
     FieldStats& st = f.stats;
     AnalyzeStreamTile(setup, o, f, totals);
     // DORI classes: the tile's grid, and its counts added up (the shares at the end).

@@ -1,6 +1,5 @@
 #include "volume/fields.h"
 
-#include <malloc.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
@@ -2244,14 +2243,12 @@ void FinishUpdate(State& S, const Rig& rig, const RigData& rd, UpdatePass* u, Fi
   const double estimated = st.estimated_bytes;
   S.Totals(&st, new_count, rd.enabled);
   if (!S.keep) {
-    // One evaluation: the blocks' lists are in the totals now. Freed, and the freed pages of the
-    // heap handed back (the blocks' small allocations would otherwise stay resident: 8 bytes per
-    // triangulable voxel with the steady fields).
+    // One evaluation: the blocks' lists are in the totals now, so freed. (A one-shot command hands
+    // the freed pages back after the evaluation: ReleaseFreedMemory.)
     for (BlockState& s : S.states) {
       std::vector<float>().swap(s.sigma_list);
       std::vector<float>().swap(s.steady_list);
     }
-    malloc_trim(0);
   }
   st.estimated_bytes = estimated;
   st.angle_pairs_tried = S.angle_pairs_tried;

@@ -43,4 +43,12 @@ class AllocationBudget {
 /// Bytes of physical memory on this machine (sysconf); 0 when unknown.
 std::uint64_t PhysicalMemoryBytes();
 
+/// Hands the heap's free pages back to the system (glibc's malloc_trim; nothing elsewhere). For a
+/// one-shot command between stages (after an import, after a field evaluation), where freed small
+/// allocations would otherwise stay resident beside what the next stage allocates. Not inside
+/// loops: the pages handed back are faulted in again by the next allocation that needs them (on
+/// this project's VM a 4 KiB page fault costs about 12 us; one trim per evaluation cost the
+/// trauma room's repeated evaluations a fifth of their time, docs/performance.md).
+void ReleaseFreedMemory();
+
 }  // namespace pandora

@@ -17,6 +17,7 @@
 #include "analysis/rig/rig_formats.h"
 #include "analysis/scene/motion.h"
 #include "analysis/scene/surface_targets.h"
+#include "analysis/util/allocation_budget.h"
 #include "analysis/util/atomic_file.h"
 #include "analysis/util/color.h"
 #include "analysis/util/error.h"
@@ -286,6 +287,7 @@ ReportData ComputeReport(const Scene& scene_in, const RayCaster& caster,
     RigReport r;
     r.rig = *rig;
     r.fields = EvaluateFields(scene, *rig, caster, field_options);
+    ReleaseFreedMemory();  // the evaluation's freed blocks, before the analyses
     session::RigAnalysis result =
         session::CompleteAnalysis(scene, caster, *rig, r.fields, nullptr, analysis);
     r.summary = std::move(result.summary);

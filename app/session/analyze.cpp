@@ -6,6 +6,7 @@
 
 #include "analysis/rig/calibration.h"
 #include "analysis/scene/surface_targets.h"
+#include "analysis/util/allocation_budget.h"
 #include "volume/pixel_targets.h"
 #include "volume/ptz_fields.h"
 #include "volume/robustness.h"
@@ -89,6 +90,9 @@ RigFieldsAnalysis AnalyzeRig(const Study& study, const Rig& rig, const AnalyzeOp
   AnalyzeOptions with_trees = options;
   if (!with_trees.fields.solid_trees) with_trees.fields.solid_trees = &study.solid_trees();
   RigFieldsAnalysis out{EvaluateFields(study.scene(), rig, study.caster(), with_trees.fields), {}};
+  // The evaluation's freed blocks (8 bytes per triangulable voxel with the steady fields, and
+  // more) would stay resident beside what the analyses below allocate.
+  ReleaseFreedMemory();
   out.analysis =
       CompleteAnalysis(study.scene(), study.caster(), rig, out.fields, &out.fields, with_trees);
   return out;

@@ -1,9 +1,6 @@
 #include "app/session/study.h"
 
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
-
+#include "analysis/util/allocation_budget.h"
 #include "analysis/util/error.h"
 #include "analysis/util/input_file.h"
 #include "validation/print.h"
@@ -17,12 +14,10 @@ std::shared_ptr<const Study> Study::Load(const std::string& path,
   study->text_ = ReadInputFile(path, InputLimits::kJsonBytes, "scene file");
   study->scene_ = ParseScene(study->text_, path);
   PrintFiducials(&study->scene_);  // the markers' and boards' pixels, OpenCV's own
-#if defined(__GLIBC__)
   // The mesh importers (assimp) free most of what they allocated; glibc keeps it resident unless
   // asked. A 1,002,252-triangle OBJ: 434 MiB resident after its import, 71 MiB after this, for the
   // rest of the run (docs/robustness.md).
-  malloc_trim(0);
-#endif
+  ReleaseFreedMemory();
   if (adjust) adjust(study->scene_);
   study->caster_ = MakeEmbreeRayCaster(study->scene_.AllTriangles());
   study->solid_trees_ = std::make_unique<SolidTrees>(study->scene_);
