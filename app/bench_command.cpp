@@ -164,9 +164,9 @@ TimeSampleTimes TimeSamples(const Scene& scene, const Rig& rig, const RayCaster&
   const auto parts = MakeSceneParts(scene);
   FieldOptions all = options;
   all.fields = fields;
-  // Not the study's search trees: the moved solids differ from them, and every sample's
-  // evaluation builds what it needs alike.
-  all.solid_trees = nullptr;
+  // The study's search trees, as `pandora analyze` lends them: the static evaluation and each
+  // sample use the kept tree of every solid whose mesh is the scene's (SolidTrees::Object) and
+  // build their own for the moved ones.
   all.fields.erase(std::remove(all.fields.begin(), all.fields.end(), "cameras"), all.fields.end());
   t.fields = all.fields.size();
   // What the time summary is made of (coverage and sigma_max per sample): as `pandora analyze`.

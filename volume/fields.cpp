@@ -461,21 +461,6 @@ inline int PopcountInline(std::uint64_t x) {
 // What one camera sees of one block: the voxels (bits) and, per seen voxel in ascending offset,
 // its information contribution A^T A (six doubles, AddCameraInformation on zeros) and pixel
 // density.
-struct CameraEntry {
-  std::int32_t camera = 0;
-  std::int32_t rays = 0;  // occlusion segments cast
-  std::int32_t seen = 0;  // bits set
-  Bits bits{};
-  std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
-  std::vector<double> information;            // with an information field
-  std::vector<std::uint8_t> band;  // with an information field: Band() of each contribution
-  std::vector<float> density;      // with resolution
-  double Bytes() const {
-    return sizeof(CameraEntry) + information.capacity() * sizeof(double) + band.capacity() +
-           density.capacity() * sizeof(float);
-  }
-};
-
 // An allocator whose value-initialisation leaves trivial types uninitialised: resize() without
 // zeroing, for caches that are written before they are read.
 template <class T>
@@ -494,6 +479,23 @@ struct DefaultInit : std::allocator<T> {
   template <class U, class... Args>
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+struct CameraEntry {
+  std::int32_t camera = 0;
+  std::int32_t rays = 0;  // occlusion segments cast
+  std::int32_t seen = 0;  // bits set
+  Bits bits{};
+  std::array<std::int16_t, kWords> before{};  // seen voxels in the words before
+  // Per seen voxel (ascending offset), each written in full where it is made (Cast, CastAgain):
+  // not zero-filled first.
+  std::vector<double, DefaultInit<double>> information;       // with an information field
+  std::vector<std::uint8_t, DefaultInit<std::uint8_t>> band;  // with one: Band() of each
+  std::vector<float, DefaultInit<float>> density;             // with resolution
+  double Bytes() const {
+    return sizeof(CameraEntry) + information.capacity() * sizeof(double) + band.capacity() +
+           density.capacity() * sizeof(float);
   }
 };
 
@@ -941,6 +943,20 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   int index = 0, f = 0;
   for (int w = 0; w < kWords; ++w) {
     entry->before[w] = static_cast<std::int16_t>(index);
+    if (entry->bits[w] == was.bits[w]) {
+      // A word seen as before (most of them): its contributions are the previous view's run.
+      const int n = PopcountInline(was.bits[w]), old = was.before[w];
+      if (want_information && n > 0) {
+        std::memcpy(&entry->information[6 * std::size_t(index)],
+                    &was.information[6 * std::size_t(old)], 6 * sizeof(double) * std::size_t(n));
+        std::memcpy(&entry->band[std::size_t(index)], &was.band[std::size_t(old)], std::size_t(n));
+      }
+      if (want_resolution && n > 0)
+        std::memcpy(&entry->density[std::size_t(index)], &was.density[std::size_t(old)],
+                    sizeof(float) * std::size_t(n));
+      index += n;
+      continue;
+    }
     for (std::uint64_t bits = entry->bits[w]; bits; bits &= bits - 1, ++index) {
       const int bit = __builtin_ctzll(bits);
       if (was.bits[w] >> bit & 1) {
