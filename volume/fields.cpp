@@ -940,34 +940,33 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
     entry->band.resize(std::size_t(seen));
   }
   if (want_resolution) entry->density.resize(std::size_t(seen));
+  // The previous view's contributions [old, old + n) kept at [index, index + n).
+  const auto keep = [&](int index, int old, int n) {
+    if (n == 0) return;
+    if (want_information) {
+      std::memcpy(&entry->information[6 * std::size_t(index)],
+                  &was.information[6 * std::size_t(old)], 6 * sizeof(double) * std::size_t(n));
+      std::memcpy(&entry->band[std::size_t(index)], &was.band[std::size_t(old)], std::size_t(n));
+    }
+    if (want_resolution)
+      std::memcpy(&entry->density[std::size_t(index)], &was.density[std::size_t(old)],
+                  sizeof(float) * std::size_t(n));
+  };
   int index = 0, f = 0;
   for (int w = 0; w < kWords; ++w) {
     entry->before[w] = static_cast<std::int16_t>(index);
     if (entry->bits[w] == was.bits[w]) {
       // A word seen as before (most of them): its contributions are the previous view's run.
-      const int n = PopcountInline(was.bits[w]), old = was.before[w];
-      if (want_information && n > 0) {
-        std::memcpy(&entry->information[6 * std::size_t(index)],
-                    &was.information[6 * std::size_t(old)], 6 * sizeof(double) * std::size_t(n));
-        std::memcpy(&entry->band[std::size_t(index)], &was.band[std::size_t(old)], std::size_t(n));
-      }
-      if (want_resolution && n > 0)
-        std::memcpy(&entry->density[std::size_t(index)], &was.density[std::size_t(old)],
-                    sizeof(float) * std::size_t(n));
+      const int n = PopcountInline(was.bits[w]);
+      keep(index, was.before[w], n);
       index += n;
       continue;
     }
     for (std::uint64_t bits = entry->bits[w]; bits; bits &= bits - 1, ++index) {
       const int bit = __builtin_ctzll(bits);
       if (was.bits[w] >> bit & 1) {
-        const int old =
-            was.before[w] + PopcountInline(was.bits[w] & ((std::uint64_t{1} << bit) - 1));
-        if (want_information) {
-          std::memcpy(&entry->information[6 * index], &was.information[6 * old],
-                      6 * sizeof(double));
-          entry->band[index] = was.band[old];
-        }
-        if (want_resolution) entry->density[index] = was.density[old];
+        keep(index, was.before[w] + PopcountInline(was.bits[w] & ((std::uint64_t{1} << bit) - 1)),
+             1);
       } else {
         if (want_information) {
           for (int r = 0; r < 6; ++r) entry->information[6 * index + r] = scratch.info[r][f];

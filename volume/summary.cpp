@@ -55,8 +55,11 @@ void ForEachActiveChunk(const openvdb::FloatGrid& grid, Fn&& fn) {
 SigmaPercentiles SigmaValues(const Fields& fields, const std::vector<float>& list,
                              const std::string& grid_name, const std::optional<double>& limit,
                              std::int64_t* at_most) {
-  const openvdb::FloatGrid::Ptr grid = fields.impl().Load(grid_name);
-  const bool from_grid = list.empty() && fields.stats.triangulable_voxels > 0 && grid;
+  // Read (back from its file when spilled) only when the list was left out.
+  const openvdb::FloatGrid::Ptr grid = list.empty() && fields.stats.triangulable_voxels > 0
+                                           ? fields.impl().Load(grid_name)
+                                           : nullptr;
+  const bool from_grid = grid != nullptr;
   const auto for_each_chunk = [&](auto&& fn) {
     if (from_grid)
       ForEachActiveChunk(*grid, fn);
