@@ -580,36 +580,69 @@ struct DeriveScratch {
   std::array<std::int16_t, 512> double_index;
 };
 
-// Whether a segment from `eye` to a point of `box` can meet `moved` (conservative): the convex hull
-// of the eye and the box against the moved box, along the world axes, and the cone from the eye
-// around the box's bounding ball against the moved box's bounding ball.
-bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
-  for (int k = 0; k < 3; ++k) {
-    const double lo = std::min(eye[k], box.min[k]), hi = std::max(eye[k], box.max[k]);
-    if (hi < moved.min[k] || lo > moved.max[k]) return false;
+// The cone from an eye around a box's bounding ball: the box, the ball's centre less the eye, its
+// length and radius, the sine and cosine of the half-angle (the eye inside the ball: `inside`).
+// Made once per (eye, box) and compared many times (ConesMayMeet).
+struct EyeCone {
+  Vec3 eye, lo, hi;
+  Vec3 axis;
+  double length = 0, radius = 0, sine = 0, cosine = 0;
+  bool inside = false;
+};
+
+EyeCone ConeOf(const Vec3& eye, const Aabb& box) {
+  EyeCone c;
+  c.eye = eye;
+  c.lo = box.min;
+  c.hi = box.max;
+  c.axis = 0.5 * (box.min + box.max) - eye;
+  c.radius = 0.5 * (box.max - box.min).norm();
+  c.length = c.axis.norm();
+  c.inside = c.length <= c.radius;
+  if (!c.inside) {
+    c.sine = c.radius / c.length;
+    c.cosine = std::sqrt(std::max(0.0, 1 - c.sine * c.sine));
   }
-  const Vec3 d = 0.5 * (box.min + box.max) - eye, e = 0.5 * (moved.min + moved.max) - eye;
-  const double rb = 0.5 * (box.max - box.min).norm(), rm = 0.5 * (moved.max - moved.min).norm();
-  const double nd = d.norm(), ne = e.norm();
-  if (nd <= rb || ne <= rm) return true;  // the eye inside a ball
-  if (ne - rm > nd + rb) return false;    // the moved box beyond the segments' ends
-  const double alpha = std::asin(std::min(1.0, rb / nd)), beta = std::asin(std::min(1.0, rm / ne));
-  if (alpha + beta >= kPi) return true;
-  const double cos_between = std::clamp(d.dot(e) / (nd * ne), -1.0, 1.0);
-  return std::acos(cos_between) <= alpha + beta + 1e-12;
+  return c;
 }
 
-// Per point p < count of `batch`: whether its segment (origin, unit direction, [t_near, t_far])
-// meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all points,
-// vectorised.
-void SegmentsMeetBoxes(const VisibilityTester::GeometryBatch& batch, int count,
-                       const std::vector<Aabb>& boxes, std::uint8_t* meets) {
+// Whether a segment from the eye to a point of `segments`' box can meet `moved`'s box (the same
+// eye; conservative): the convex hull of the eye and the box against the moved box, along the
+// world axes, and the cones around the two bounding balls. The cones' half-angles a and b (both
+// in [0, pi/2)) and the angle t between their axes: they meet when t <= a + b, that is cos t >=
+// cos(a + b) = cos a cos b - sin a sin b (cos falls over [0, pi]), with a margin far above the
+// round-off.
+inline bool ConesMayMeet(const EyeCone& segments, const EyeCone& moved) {
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min(segments.eye[k], segments.lo[k]),
+                 hi = std::max(segments.eye[k], segments.hi[k]);
+    if (hi < moved.lo[k] || lo > moved.hi[k]) return false;
+  }
+  if (segments.inside || moved.inside) return true;  // the eye inside a ball
+  if (moved.length - moved.radius > segments.length + segments.radius)
+    return false;  // the moved box beyond the segments' ends
+  return segments.axis.dot(moved.axis) >=
+         (segments.cosine * moved.cosine - segments.sine * moved.sine - 1e-9) *
+             (segments.length * moved.length);
+}
+
+bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
+  return ConesMayMeet(ConeOf(eye, box), ConeOf(eye, moved));
+}
+
+// Per point p in [begin, end) of `batch`: whether its segment (origin, unit direction, [t_near,
+// t_far]) meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all
+// points, vectorised.
+__attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBoxes(
+    const VisibilityTester::GeometryBatch& batch, int begin, int end,
+    const std::vector<Aabb>& boxes, std::uint8_t* meets) {
+  std::fill(meets + begin, meets + end, std::uint8_t{0});
+  if (boxes.empty()) return;
   alignas(64) double inv[3][512];
   const double* d[3] = {batch.dx, batch.dy, batch.dz};
   for (int k = 0; k < 3; ++k)
 #pragma omp simd
-    for (int p = 0; p < count; ++p) inv[k][p] = 1.0 / d[k][p];  // +-inf along an axis
-  std::fill(meets, meets + count, std::uint8_t{0});
+    for (int p = begin; p < end; ++p) inv[k][p] = 1.0 / d[k][p];  // +-inf along an axis
   for (const Aabb& box : boxes) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
@@ -622,7 +655,7 @@ void SegmentsMeetBoxes(const VisibilityTester::GeometryBatch& batch, int count,
       if (hi[k] == 0.0) hi[k] = tiny;
     }
 #pragma omp simd
-    for (int p = 0; p < count; ++p) {
+    for (int p = begin; p < end; ++p) {
       double t0 = batch.t_near[p], t1 = batch.t_far[p];
       for (int k = 0; k < 3; ++k) {
         // A direction of 0 along k: the slab's times are -inf..inf when the origin is inside it,
@@ -680,6 +713,7 @@ struct FieldEvaluator::State {
     int count = 0;
     alignas(64) std::array<double, 512> x, y, z;
     std::array<std::int16_t, 512> offset;
+    std::array<Aabb, 8> octant;  // of the points in each octant (4^3 voxels) of the block
   };
   void Points(const Block& block, BlockPoints* points) const;
   // A scene update's view of a block cast again: the camera's previous view of it and the moved
@@ -697,16 +731,18 @@ struct FieldEvaluator::State {
   // holds only the bits when nothing is seen differently.
   int CastAgain(const BlockPoints& points, int camera, const RigData& rd, const CameraEntry& was,
                 const Again& again, CameraEntry* entry) const;
+  // `occlusion_only`: a scene update, whose changed cameras see the voxels they saw before and
+  // still see with the same contributions (CastAgain copies them).
   void Derive(const Block& block, const BlockState& old, std::vector<const CameraEntry*> view,
               const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
               const std::vector<Vec3>& centres, BlockState* next, BlockLeaves* leaves,
-              bool in_place);
+              bool in_place, bool occlusion_only);
   // Derive's steps, in its order.
   void PrepareCaches(const BlockState& old, bool fresh, bool in_place, BlockState* next) const;
   void PrepareLeaves(const openvdb::Coord& origin, bool in_place, BlockLeaves* leaves);
   void SumChangedCameras(const BlockState& old, const std::vector<const CameraEntry*>& view,
                          const Bits& dirty, const std::vector<std::uint8_t>& is_changed,
-                         BlockState* next, DeriveScratch* scratch) const;
+                         bool occlusion_only, BlockState* next, DeriveScratch* scratch) const;
   void Rescan(const std::vector<const CameraEntry*>& view, const Bits& dirty, bool fresh,
               BlockState* next, DeriveScratch* scratch) const;
   void WriteDirtyVoxels(const Block& block, const Bits& dirty, BlockState* next,
@@ -779,6 +815,32 @@ RigData FieldEvaluator::State::Prepare(const Rig& r) const {
   return rd;
 }
 
+// Per octant of a block (its box; empty: no free voxel), the moved boxes of `again` (where they
+// are, where they were) that the segments from `eye` to it may meet (ConesMayMeet).
+static void NearOctantBoxes(const std::array<Aabb, 8>& octants, const Vec3& eye,
+                            const FieldEvaluator::State::Again& again,
+                            std::array<std::vector<Aabb>, 8>* near_after,
+                            std::array<std::vector<Aabb>, 8>* near_before) {
+  thread_local std::vector<EyeCone> cones_after, cones_before;
+  cones_after.clear();
+  cones_before.clear();
+  for (const Aabb& box : *again.after) cones_after.push_back(ConeOf(eye, box));
+  for (const Aabb& box : *again.before) cones_before.push_back(ConeOf(eye, box));
+  for (int k = 0; k < 8; ++k) {
+    (*near_after)[k].clear();
+    (*near_before)[k].clear();
+    if (octants[k].empty()) continue;
+    const EyeCone octant = ConeOf(eye, octants[k]);
+    for (std::size_t j = 0; j < cones_after.size(); ++j)
+      if (ConesMayMeet(octant, cones_after[j])) (*near_after)[k].push_back((*again.after)[j]);
+    for (std::size_t j = 0; j < cones_before.size(); ++j)
+      if (ConesMayMeet(octant, cones_before[j])) (*near_before)[k].push_back((*again.before)[j]);
+  }
+}
+
+// The octant (4^3 voxels) of a block offset.
+inline int OctantOf(int o) { return ((o >> 8) << 2) | (((o >> 5) & 1) << 1) | ((o >> 2) & 1); }
+
 void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) const {
   const VoxelLattice& lattice = fields.lattice;
   int n = 0;
@@ -795,6 +857,25 @@ void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) cons
         ++n;
       }
   points->count = n;
+  // Each octant's box: its free voxels' lowest and highest centres, one extent per axis (the
+  // x, y, z loops visit the octants' voxels in runs).
+  std::array<std::array<int, 6>, 8> range;
+  for (auto& r : range) r = {8, 8, 8, -1, -1, -1};
+  for (int p = 0; p < n; ++p) {
+    const int o = points->offset[p], x = o >> 6, y = (o >> 3) & 7, z = o & 7;
+    std::array<int, 6>& r = range[OctantOf(o)];
+    r = {std::min(r[0], x), std::min(r[1], y), std::min(r[2], z),
+         std::max(r[3], x), std::max(r[4], y), std::max(r[5], z)};
+  }
+  for (int k = 0; k < 8; ++k) {
+    points->octant[k] = Aabb();
+    if (range[k][3] < 0) continue;
+    const Eigen::Vector3i& b = block.origin;
+    points->octant[k].Extend(
+        lattice.Center(b.x() + range[k][0], b.y() + range[k][1], b.z() + range[k][2]));
+    points->octant[k].Extend(
+        lattice.Center(b.x() + range[k][3], b.y() + range[k][4], b.z() + range[k][5]));
+  }
 }
 
 // Camera `camera`'s view of a block: the geometric tests first (vectorised over the block's free
@@ -847,9 +928,6 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
   }
 }
 
-// The octant (4^3 voxels) of a block offset.
-inline int OctantOf(int o) { return ((o >> 8) << 2) | (((o >> 5) & 1) << 1) | ((o >> 2) & 1); }
-
 int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, const RigData& rd,
                                      const CameraEntry& was, const Again& again,
                                      CameraEntry* entry) const {
@@ -857,25 +935,28 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   entry->rays = was.rays;  // the segments in view: geometry, unchanged
   entry->bits = was.bits;
   // The octants whose segments can meet a moved box; only their points are looked at again.
-  std::array<Aabb, 8> octant;
-  for (int p = 0; p < points.count; ++p)
-    octant[OctantOf(points.offset[p])].Extend(Vec3(points.x[p], points.y[p], points.z[p]));
-  std::array<bool, 8> flagged{};
-  const Vec3& eye = rd.centres[camera];
+  // Per octant, the moved boxes (where they are, where they were) its segments may meet; the
+  // points of the octants with any, octant by octant (ascending offset within each).
+  thread_local std::array<std::vector<Aabb>, 8> near_after, near_before;
+  NearOctantBoxes(points.octant, rd.centres[camera], again, &near_after, &near_before);
+  std::array<int, 9> start{};
+  std::array<int, 8> fill{};
+  for (int p = 0; p < points.count; ++p) ++fill[OctantOf(points.offset[p])];
   for (int k = 0; k < 8; ++k) {
-    if (octant[k].empty()) continue;
-    for (const std::vector<Aabb>* boxes : {again.after, again.before})
-      for (const Aabb& box : *boxes)
-        flagged[k] = flagged[k] || SegmentsMayMeet(eye, octant[k], box);
+    const bool flagged = !near_after[k].empty() || !near_before[k].empty();
+    start[k + 1] = start[k] + (flagged ? fill[k] : 0);
+    fill[k] = flagged ? start[k] : -1;
   }
   thread_local BlockPoints sub;
-  int m = 0;
+  const int m = start[8];
   for (int p = 0; p < points.count; ++p) {
-    if (!flagged[OctantOf(points.offset[p])]) continue;
-    sub.x[m] = points.x[p];
-    sub.y[m] = points.y[p];
-    sub.z[m] = points.z[p];
-    sub.offset[m++] = points.offset[p];
+    const int at = fill[OctantOf(points.offset[p])];
+    if (at < 0) continue;
+    sub.x[at] = points.x[p];
+    sub.y[at] = points.y[p];
+    sub.z[at] = points.z[p];
+    sub.offset[at] = points.offset[p];
+    ++fill[OctantOf(points.offset[p])];
   }
   sub.count = m;
   if (m == 0) return 0;
@@ -885,8 +966,11 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   // Cast only the segments whose answer can have changed: those that meet a moved box where it
   // is now, and the occluded ones that meet one where it was; the others keep their answer.
   std::array<std::uint8_t, 512> meets_after, meets_before, occluded;
-  SegmentsMeetBoxes(batch, m, *again.after, meets_after.data());
-  SegmentsMeetBoxes(batch, m, *again.before, meets_before.data());
+  for (int k = 0; k < 8; ++k) {
+    if (start[k + 1] == start[k]) continue;
+    SegmentsMeetBoxes(batch, start[k], start[k + 1], near_after[k], meets_after.data());
+    SegmentsMeetBoxes(batch, start[k], start[k + 1], near_before[k], meets_before.data());
+  }
   std::array<std::int16_t, 512> subset, where;
   int cast = 0;
   for (int i = 0; i < n; ++i) {
@@ -914,17 +998,18 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
       SetBit(entry->bits, o);
   }
   if (entry->bits == was.bits) return cast;  // nothing seen differently: the view is kept
-  // The newly seen voxels' contributions (ascending offset, as the batch keeps the points' order);
-  // the others' are the previous view's, the same bits.
+  // The newly seen voxels' contributions (in the batch's order, octant by octant: fresh_at maps
+  // an offset to its place); the others' are the previous view's, the same bits.
   thread_local InformationScratch scratch;
   std::array<float, 512> density;
+  std::array<std::int16_t, 512> fresh_at;
   int fresh = 0;
   for (int i = 0; i < n; ++i) {
     const int q = batch.index[i];
     if (occluded[i] || TestBit(was.bits, sub.offset[q])) continue;
     if (want_information || want_resolution)
       for (int r = 0; r < 6; ++r) scratch.jac[r][fresh] = batch.jac[r][q];
-    ++fresh;
+    fresh_at[sub.offset[q]] = static_cast<std::int16_t>(fresh++);
   }
   if (want_resolution && fresh > 0) {
     const double* const jac[6] = {scratch.jac[0], scratch.jac[1], scratch.jac[2],
@@ -952,7 +1037,7 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
       std::memcpy(&entry->density[std::size_t(index)], &was.density[std::size_t(old)],
                   sizeof(float) * std::size_t(n));
   };
-  int index = 0, f = 0;
+  int index = 0;
   for (int w = 0; w < kWords; ++w) {
     entry->before[w] = static_cast<std::int16_t>(index);
     if (entry->bits[w] == was.bits[w]) {
@@ -968,12 +1053,12 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
         keep(index, was.before[w] + PopcountInline(was.bits[w] & ((std::uint64_t{1} << bit) - 1)),
              1);
       } else {
+        const int f = fresh_at[64 * w + bit];
         if (want_information) {
           for (int r = 0; r < 6; ++r) entry->information[6 * index + r] = scratch.info[r][f];
           entry->band[index] = scratch.band[f];
         }
         if (want_resolution) entry->density[index] = density[f];
-        ++f;
       }
     }
   }
@@ -1082,22 +1167,44 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
                                               const std::vector<const CameraEntry*>& view,
                                               const Bits& dirty,
                                               const std::vector<std::uint8_t>& is_changed,
-                                              BlockState* next, DeriveScratch* scratch) const {
+                                              bool occlusion_only, BlockState* next,
+                                              DeriveScratch* scratch) const {
   std::array<std::int32_t, 512>& cover = scratch->cover;
   Bits& rescan_density = scratch->rescan_density;
   Bits& rescan_info = scratch->rescan_info;
   const std::array<BandScale, 64>& scales = BandScales();
   // Only the dirty voxels: elsewhere a changed camera's old and new contributions are the same
   // bits (a scene update: its view there did not change), and adding one while taking out the
-  // other would change nothing.
-  const auto walk = [&dirty](const CameraEntry& e, auto&& f) __attribute__((always_inline)) {
-    WalkMasked(e, dirty, f);
+  // other would change nothing. With `occlusion_only` the same holds voxel by voxel: of a
+  // changed camera only the voxels it sees now and did not (new view), or saw and does not (old
+  // view), are walked. The result is the same (counts, maxima and exact sums; a best density's
+  // camera that still sees its voxel keeps it).
+  const auto bits_of = [](const CameraEntry* e) { return e ? e->bits : Bits{}; };
+  // Both ascend by camera.
+  const auto old_entry = [&old](int camera) -> const CameraEntry* {
+    const auto it = std::lower_bound(old.entries.begin(), old.entries.end(), camera,
+                                     [](const CameraEntry& e, int c) { return e.camera < c; });
+    return it != old.entries.end() && it->camera == camera ? &*it : nullptr;
+  };
+  const auto new_entry = [&view](int camera) -> const CameraEntry* {
+    const auto it = std::lower_bound(view.begin(), view.end(), camera,
+                                     [](const CameraEntry* e, int c) { return e->camera < c; });
+    return it != view.end() && (*it)->camera == camera ? *it : nullptr;
+  };
+  const auto walk = [&](const CameraEntry& e, const CameraEntry* other, auto&& f)
+      __attribute__((always_inline)) {
+    if (!occlusion_only) return WalkMasked(e, dirty, f);
+    const Bits o = bits_of(other);
+    Bits mask;
+    for (int w = 0; w < kWords; ++w) mask[w] = dirty[w] & ~o[w];
+    WalkMasked(e, mask, f);
   };
   for (int o = 0; o < 512; ++o) cover[o] = next->coverage[o];
   for (const CameraEntry* e : view) {
     if (!is_changed[e->camera]) continue;
     walk(
-        *e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
+        *e, occlusion_only ? old_entry(e->camera) : nullptr,
+        [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
           ++cover[o];
           if (want_resolution && e->density[index] > next->best_density[o]) {
             next->best_density[o] = e->density[index];
@@ -1117,7 +1224,8 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   for (const CameraEntry& e : old.entries) {
     if (!is_changed[e.camera] || e.seen == 0) continue;
     walk(
-        e, [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
+        e, occlusion_only ? new_entry(e.camera) : nullptr,
+        [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
           --cover[o];
           if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
           if (want_information && !TestBit(rescan_info, o)) {
@@ -1463,7 +1571,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
                                    std::vector<const CameraEntry*> view, const Bits& dirty,
                                    const std::vector<std::uint8_t>& is_changed,
                                    const std::vector<Vec3>& centres, BlockState* next,
-                                   BlockLeaves* leaves, bool in_place) {
+                                   BlockLeaves* leaves, bool in_place, bool occlusion_only) {
   // Entries that see nothing take no part.
   view.erase(
       std::remove_if(view.begin(), view.end(), [](const CameraEntry* e) { return e->seen == 0; }),
@@ -1488,7 +1596,7 @@ void FieldEvaluator::State::Derive(const Block& block, const BlockState& old,
     if (want_resolution) scratch.rescan_density = dirty;
     if (want_information) scratch.rescan_info = dirty;
   } else {
-    SumChangedCameras(old, view, dirty, is_changed, next, &scratch);
+    SumChangedCameras(old, view, dirty, is_changed, occlusion_only, next, &scratch);
   }
   Rescan(view, dirty, fresh, next, &scratch);
   WriteDirtyVoxels(block, dirty, next, leaves, &scratch);
@@ -2037,7 +2145,7 @@ void DeriveBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
             [](const CameraEntry* a, const CameraEntry* b) { return a->camera < b->camera; });
   if (count > 0 || old.coverage.empty())
     S.Derive(block, old, std::move(view), voxels, is_changed, rd.centres,
-             in_place ? &old : &next[i], &leaves[i], in_place);
+             in_place ? &old : &next[i], &leaves[i], in_place, u->per_block);
   // Spilled fields: the block's leaf to its file, out of memory (FieldOptions::spilled_fields).
   BlockLeaves& l = leaves[i];
   for (int f = 0; f < kFloatFieldCount; ++f)
@@ -2443,6 +2551,10 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
   std::vector<std::vector<int>> recast(S.blocks.size());
   std::vector<std::uint8_t> dirty_block(S.blocks.size(), 0), old_kept(old_blocks.size(), 0);
   const int count = static_cast<int>(rig.cameras.size());
+  std::vector<std::vector<EyeCone>> box_cones(
+      static_cast<std::size_t>(count));  // per camera, per moved box
+  for (int c = 0; c < count; ++c)
+    for (const Aabb& m : boxes) box_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
       const Block& block = S.blocks[b];
@@ -2453,12 +2565,14 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
         old_kept[it->second] = 1;
         S.states[b] = std::move(old_states[it->second]);
         u.candidates[b] = S.states[b].candidates;
-        for (int c : u.candidates[b])
-          for (const Aabb& m : boxes)
-            if (SegmentsMayMeet(rd.centres[c], box, m)) {
+        for (int c : u.candidates[b]) {
+          const EyeCone segments = ConeOf(rd.centres[c], box);
+          for (const EyeCone& m : box_cones[std::size_t(c)])
+            if (ConesMayMeet(segments, m)) {
               recast[b].push_back(c);
               break;
             }
+        }
         dirty_block[b] = !recast[b].empty();
       } else {
         // New or other voxels (a moved solid came or went): evaluated anew.

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -54,14 +55,23 @@ struct ColumnGrid {
     return {CellX(x_lo), CellX(x_hi), CellY(y_lo), CellY(y_hi)};
   }
 
-  void Build(const Mesh& mesh, const Aabb& bounds) {
+  // Per face, its corners as given (the mesh's triangles, in order) and its bounding box.
+  std::vector<Aabb> boxes;
+
+  void Build(const TriangleMesh& mesh, const Aabb& bounds) {
     corners.clear();
-    for (const auto f : CGAL::faces(mesh)) {
+    corners.reserve(mesh.triangles.size());
+    boxes.reserve(mesh.triangles.size());
+    for (const Eigen::Vector3i& t : mesh.triangles) {
       std::array<Point, 3> v;
-      int k = 0;
-      for (const auto vertex : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
-        if (k < 3) v[k++] = mesh.point(vertex);
+      Aabb box;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& p = mesh.vertices[std::size_t(t[k])];
+        v[k] = Point(p.x(), p.y(), p.z());
+        box.Extend(p);
+      }
       corners.push_back(v);
+      boxes.push_back(box);
     }
     const double n = static_cast<double>(corners.size());
     const double wx = bounds.max.x() - bounds.min.x(), wy = bounds.max.y() - bounds.min.y();
@@ -102,7 +112,13 @@ struct ColumnGrid {
   }
 };
 
+// CGAL's mesh and AABB tree are built only when a query needs them (a point query, a column
+// through an edge or a vertex, a box over many grid cells): a moving solid re-made at every time
+// sample is usually classified by its column grid alone.
 struct InsideMesh::Impl {
+  std::vector<Point> points;
+  std::vector<std::array<std::size_t, 3>> polygons;
+  std::once_flag built;
   Mesh mesh;
   Tree tree;
   ColumnGrid columns;
@@ -110,28 +126,31 @@ struct InsideMesh::Impl {
   // thread uses its own, all sharing the one tree.
   mutable tbb::enumerable_thread_specific<std::unique_ptr<Side>> sides;
 
-  const Side& side() const {
+  const Tree& Built() {
+    std::call_once(built, [this] {
+      CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+      tree.insert(CGAL::faces(mesh).first, CGAL::faces(mesh).second, mesh);
+      tree.build();
+    });
+    return tree;
+  }
+  const Side& side() {
     std::unique_ptr<Side>& s = sides.local();
-    if (!s) s = std::make_unique<Side>(tree);
+    if (!s) s = std::make_unique<Side>(Built());
     return *s;
   }
 };
 
 InsideMesh::InsideMesh(const TriangleMesh& closed_mesh) : impl_(std::make_unique<Impl>()) {
-  std::vector<Point> points;
-  points.reserve(closed_mesh.vertices.size());
-  for (const Vec3& v : closed_mesh.vertices) points.emplace_back(v.x(), v.y(), v.z());
-  std::vector<std::array<std::size_t, 3>> polygons;
-  polygons.reserve(closed_mesh.triangles.size());
-  for (const Eigen::Vector3i& t : closed_mesh.triangles)
-    polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, polygons, impl_->mesh);
-  if (impl_->mesh.number_of_faces() == 0)
+  if (closed_mesh.triangles.empty())
     throw std::invalid_argument("InsideMesh: the mesh has no faces");
-  impl_->tree.insert(CGAL::faces(impl_->mesh).first, CGAL::faces(impl_->mesh).second, impl_->mesh);
-  impl_->tree.build();
+  impl_->points.reserve(closed_mesh.vertices.size());
+  for (const Vec3& v : closed_mesh.vertices) impl_->points.emplace_back(v.x(), v.y(), v.z());
+  impl_->polygons.reserve(closed_mesh.triangles.size());
+  for (const Eigen::Vector3i& t : closed_mesh.triangles)
+    impl_->polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
   bounds_ = closed_mesh.Bounds();
-  impl_->columns.Build(impl_->mesh, bounds_);
+  impl_->columns.Build(closed_mesh, bounds_);
 }
 
 InsideMesh::~InsideMesh() = default;
@@ -229,11 +248,35 @@ InsideMesh::BoxClass InsideMesh::Classify(const Aabb& box) const {
   const bool disjoint = (box.max.array() < bounds_.min.array()).any() ||
                         (box.min.array() > bounds_.max.array()).any();
   if (disjoint) return BoxClass::kOutside;
-  const CGAL::Bbox_3 b(box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(),
-                       box.max.z());
-  if (impl_->tree.do_intersect(b)) return BoxClass::kCrossing;
-  // No triangle meets the box: it is all inside or all outside; its centre decides.
-  return Inside(box.center()) ? BoxClass::kInside : BoxClass::kOutside;
+  // The faces whose bounding box meets the box are in the grid cells of the box's (x, y) range
+  // (rounding to cells is monotone). One meeting it: kCrossing (conservative, as documented).
+  const ColumnGrid& grid = impl_->columns;
+  const int i0 = grid.CellX(box.min.x()), i1 = grid.CellX(box.max.x());
+  const int j0 = grid.CellY(box.min.y()), j1 = grid.CellY(box.max.y());
+  const std::size_t span = std::size_t(grid.start[std::size_t(i1) * grid.ny + j1 + 1]) -
+                           grid.start[std::size_t(i0) * grid.ny + j0];
+  if (span > 8 * grid.corners.size() + 4096) {
+    // A box over most of a large mesh: the tree's exact triangle test.
+    const CGAL::Bbox_3 b(box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(),
+                         box.max.z());
+    if (impl_->Built().do_intersect(b)) return BoxClass::kCrossing;
+  } else {
+    for (int i = i0; i <= i1; ++i)
+      for (int j = j0; j <= j1; ++j) {
+        const std::size_t cell = std::size_t(i) * grid.ny + j;
+        for (std::uint32_t k = grid.start[cell]; k < grid.start[cell + 1]; ++k) {
+          const Aabb& f = grid.boxes[grid.faces[k]];
+          if ((f.max.array() >= box.min.array()).all() && (f.min.array() <= box.max.array()).all())
+            return BoxClass::kCrossing;
+        }
+      }
+  }
+  // No face meets the box: it is all inside or all outside; its centre decides (the column's
+  // parity, equal to Inside()).
+  const Vec3 c = box.center();
+  unsigned char in = 0;
+  InsideOnColumn(ColumnAt(c.x(), c.y()), &c.z(), 1, &in);
+  return in ? BoxClass::kInside : BoxClass::kOutside;
 }
 
 }  // namespace pandora

@@ -1,6 +1,7 @@
 #pragma once
 /// \file inside_mesh.h
-/// Point-in-closed-mesh tests (CGAL's Side_of_triangle_mesh over an AABB tree), used for solid
+/// Point-in-closed-mesh tests (vertical columns' crossing parity with CGAL's exact predicates, and
+/// CGAL's Side_of_triangle_mesh over an AABB tree where a column is degenerate), used for solid
 /// objects and mesh regions. The only translation unit that includes CGAL is inside_mesh.cpp.
 
 #include <memory>
@@ -14,7 +15,9 @@ namespace pandora {
 /// after construction; safe for concurrent const use (each thread gets its own CGAL query object).
 class InsideMesh {
  public:
-  /// The mesh must be closed (the scene loader checks it). Builds the AABB tree eagerly.
+  /// The mesh must be closed (the scene loader checks it). Builds the column grid (the faces
+  /// bucketed by their (x, y) bounds); CGAL's mesh and AABB tree only when a query needs them
+  /// (Inside(), a column through an edge or a vertex, Classify() over most of a large mesh).
   explicit InsideMesh(const TriangleMesh& closed_mesh);
   ~InsideMesh();
   InsideMesh(const InsideMesh&) = delete;
@@ -47,7 +50,8 @@ class InsideMesh {
 
   enum class BoxClass { kOutside, kInside, kCrossing };
   /// Whether the closed box lies entirely outside, entirely inside, or may cross the surface.
-  /// Conservative: kCrossing whenever a triangle's bounding box meets the box.
+  /// Conservative: kCrossing whenever a triangle's bounding box meets the box; otherwise the
+  /// centre's column parity (as InsideOnColumn) decides.
   BoxClass Classify(const Aabb& box) const;
 
   const Aabb& bounds() const { return bounds_; }

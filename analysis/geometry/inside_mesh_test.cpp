@@ -77,5 +77,42 @@ TEST(InsideMesh, ColumnsAgreeWithPointsOnLatticeAlignedBoxes) {
   CompareOnLattice(b, h, Vec3(-0.5, -0.5, -0.5), &degenerate);
 }
 
+// Classify (the column grid's face boxes, the centre's column parity) against Inside() at the
+// corners and centre and random points of random boxes: a box called inside or outside is so at
+// every point tested; boxes of every class occur, and boxes reaching beyond the mesh's bounds.
+TEST(InsideMesh, ClassifiedBoxesAgreeWithPoints) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), w(0.005, 0.15);
+  const Mat3 rotation = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  std::array<int, 3> classes{};
+  for (int shape = 0; shape < 3; ++shape) {
+    const TriangleMesh mesh = shape == 0   ? MakeSphere(0.6, 24)
+                              : shape == 1 ? MakeCapsule(0.3, 0.8, 16)
+                                           : MakeBox(Vec3(0.9, 0.5, 0.7));
+    const InsideMesh inside(Moved(mesh, rotation, Vec3(0.1, -0.2, 0.05)));
+    for (int trial = 0; trial < 3000; ++trial) {
+      const Vec3 centre(u(rng), u(rng), u(rng)), half(w(rng), w(rng), w(rng));
+      Aabb box;
+      box.Extend(centre - half);
+      box.Extend(centre + half);
+      const InsideMesh::BoxClass c = inside.Classify(box);
+      ++classes[int(c)];
+      if (c == InsideMesh::BoxClass::kCrossing) continue;
+      const bool expected = c == InsideMesh::BoxClass::kInside;
+      std::uniform_real_distribution<double> t(0.0, 1.0);
+      for (int k = 0; k < 12; ++k) {
+        Vec3 p;
+        for (int a = 0; a < 3; ++a)
+          p[a] = k < 8 ? ((k >> a & 1) ? box.max[a] : box.min[a])
+                       : box.min[a] + t(rng) * (box.max[a] - box.min[a]);
+        ASSERT_EQ(inside.Inside(p), expected) << "shape " << shape << " trial " << trial;
+      }
+    }
+  }
+  EXPECT_GT(classes[int(InsideMesh::BoxClass::kInside)], 100);
+  EXPECT_GT(classes[int(InsideMesh::BoxClass::kOutside)], 100);
+  EXPECT_GT(classes[int(InsideMesh::BoxClass::kCrossing)], 100);
+}
+
 }  // namespace
 }  // namespace pandora
