@@ -626,16 +626,18 @@ inline bool ConesMayMeet(const EyeCone& segments, const EyeCone& moved) {
              (segments.length * moved.length);
 }
 
-bool SegmentsMayMeet(const Vec3& eye, const Aabb& box, const Aabb& moved) {
-  return ConesMayMeet(ConeOf(eye, box), ConeOf(eye, moved));
-}
-
 // Per point p in [begin, end) of `batch`: whether its segment (origin, unit direction, [t_near,
 // t_far]) meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all
 // points, vectorised.
+// Segments from one origin: unit directions and their [t_near, t_far], by point.
+struct SegmentArrays {
+  const double *dx, *dy, *dz, *t_near, *t_far;
+  Vec3 origin;
+};
+
 __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBoxes(
-    const VisibilityTester::GeometryBatch& batch, int begin, int end,
-    const std::vector<Aabb>& boxes, std::uint8_t* meets) {
+    const SegmentArrays& batch, int begin, int end, const std::vector<Aabb>& boxes,
+    std::uint8_t* meets) {
   std::fill(meets + begin, meets + end, std::uint8_t{0});
   if (boxes.empty()) return;
   alignas(64) double inv[3][512];
@@ -667,6 +669,42 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBo
       }
       meets[p] |= t0 <= t1 ? 1 : 0;
     }
+  }
+}
+
+// Per point in view of `batch` (at `offset` in the block; octant k's points in [start[k],
+// start[k + 1])): whether its segment meets one of its octant's moved boxes where they are now
+// (`meets_after`), and, only for the points `seen` did not see that none meets now, where they
+// were (`meets_before`, gathered; unset for the others, whose answers do not depend on it).
+void MeetMovedBoxes(const VisibilityTester::GeometryBatch& batch, const std::int16_t* offset,
+                    const std::array<int, 9>& start,
+                    const std::array<std::vector<Aabb>, 8>& near_after,
+                    const std::array<std::vector<Aabb>, 8>& near_before, const Bits& seen,
+                    std::uint8_t* meets_after, std::uint8_t* meets_before) {
+  std::array<std::uint8_t, 512> in_view{};
+  for (int i = 0; i < batch.count; ++i) in_view[batch.index[i]] = 1;
+  const SegmentArrays all{batch.dx, batch.dy, batch.dz, batch.t_near, batch.t_far, batch.origin};
+  for (int k = 0; k < 8; ++k) {
+    if (start[k + 1] == start[k]) continue;
+    SegmentsMeetBoxes(all, start[k], start[k + 1], near_after[k], meets_after);
+    if (near_before[k].empty()) continue;
+    thread_local std::array<double, 512> gx, gy, gz, gn, gf;
+    std::array<std::int16_t, 512> picked;
+    int g = 0;
+    for (int q = start[k]; q < start[k + 1]; ++q) {
+      if (!in_view[q] || meets_after[q] || TestBit(seen, offset[q])) continue;
+      gx[g] = batch.dx[q];
+      gy[g] = batch.dy[q];
+      gz[g] = batch.dz[q];
+      gn[g] = batch.t_near[q];
+      gf[g] = batch.t_far[q];
+      picked[g++] = static_cast<std::int16_t>(q);
+    }
+    std::array<std::uint8_t, 512> meets;
+    SegmentsMeetBoxes(
+        SegmentArrays{gx.data(), gy.data(), gz.data(), gn.data(), gf.data(), batch.origin}, 0, g,
+        near_before[k], meets.data());
+    for (int j = 0; j < g; ++j) meets_before[picked[j]] = meets[j];
   }
 }
 
@@ -721,6 +759,9 @@ struct FieldEvaluator::State {
   struct Again {
     const std::vector<Aabb>* before = nullptr;  // what moved, where it was
     const std::vector<Aabb>* after = nullptr;   // and where it is
+    // Their cones from the camera (ConeOf), in the same order.
+    const std::vector<EyeCone>* before_cones = nullptr;
+    const std::vector<EyeCone>* after_cones = nullptr;
   };
   void Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
             std::vector<Ray>* rays) const;
@@ -821,11 +862,8 @@ static void NearOctantBoxes(const std::array<Aabb, 8>& octants, const Vec3& eye,
                             const FieldEvaluator::State::Again& again,
                             std::array<std::vector<Aabb>, 8>* near_after,
                             std::array<std::vector<Aabb>, 8>* near_before) {
-  thread_local std::vector<EyeCone> cones_after, cones_before;
-  cones_after.clear();
-  cones_before.clear();
-  for (const Aabb& box : *again.after) cones_after.push_back(ConeOf(eye, box));
-  for (const Aabb& box : *again.before) cones_before.push_back(ConeOf(eye, box));
+  const std::vector<EyeCone>& cones_after = *again.after_cones;
+  const std::vector<EyeCone>& cones_before = *again.before_cones;
   for (int k = 0; k < 8; ++k) {
     (*near_after)[k].clear();
     (*near_before)[k].clear();
@@ -966,17 +1004,14 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   // Cast only the segments whose answer can have changed: those that meet a moved box where it
   // is now, and the occluded ones that meet one where it was; the others keep their answer.
   std::array<std::uint8_t, 512> meets_after, meets_before, occluded;
-  for (int k = 0; k < 8; ++k) {
-    if (start[k + 1] == start[k]) continue;
-    SegmentsMeetBoxes(batch, start[k], start[k + 1], near_after[k], meets_after.data());
-    SegmentsMeetBoxes(batch, start[k], start[k + 1], near_before[k], meets_before.data());
-  }
+  MeetMovedBoxes(batch, sub.offset.data(), start, near_after, near_before, was.bits,
+                 meets_after.data(), meets_before.data());
   std::array<std::int16_t, 512> subset, where;
   int cast = 0;
   for (int i = 0; i < n; ++i) {
     const int q = batch.index[i];
     const bool seen = TestBit(was.bits, sub.offset[q]);
-    if (meets_after[q] || (meets_before[q] && !seen)) {
+    if (meets_after[q] || (!seen && meets_before[q])) {
       subset[cast] = batch.index[i];
       where[cast++] = static_cast<std::int16_t>(i);
     } else {
@@ -1905,6 +1940,8 @@ struct UpdatePass {
   bool per_block = false;
   std::vector<std::vector<int>> block_changed;
   SceneChange moved;  // padded
+  // Per camera, the cones (ConeOf) from it around each box of moved.before and moved.after.
+  std::vector<std::vector<EyeCone>> before_cones, after_cones;
   bool Changed(std::size_t i, int camera) const {
     if (!per_block) return is_changed[camera] != 0;
     return std::binary_search(block_changed[i].begin(), block_changed[i].end(), camera);
@@ -2185,14 +2222,23 @@ void CastBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
     }
     // The moved boxes this camera's segments to the block may meet.
     thread_local std::vector<Aabb> before, after;
-    const auto near = [&](const std::vector<Aabb>& all, std::vector<Aabb>* out) {
+    thread_local std::vector<EyeCone> before_cones, after_cones;
+    const EyeCone segments = ConeOf(rd.centres[c], box);
+    const auto near = [&](const std::vector<Aabb>& all, const std::vector<EyeCone>& cones,
+                          std::vector<Aabb>* out, std::vector<EyeCone>* out_cones) {
       out->clear();
-      for (const Aabb& m : all)
-        if (SegmentsMayMeet(rd.centres[c], box, m)) out->push_back(m);
+      out_cones->clear();
+      for (std::size_t m = 0; m < all.size(); ++m)
+        if (ConesMayMeet(segments, cones[m])) {
+          out->push_back(all[m]);
+          out_cones->push_back(cones[m]);
+        }
     };
-    near(u->moved.before, &before);
-    near(u->moved.after, &after);
-    u->rays += S.CastAgain(points, c, rd, *was, State::Again{&before, &after}, &cast.back());
+    near(u->moved.before, u->before_cones[std::size_t(c)], &before, &before_cones);
+    near(u->moved.after, u->after_cones[std::size_t(c)], &after, &after_cones);
+    u->rays +=
+        S.CastAgain(points, c, rd, *was, State::Again{&before, &after, &before_cones, &after_cones},
+                    &cast.back());
   }
   if (again) DropUnchangedViews(S.states[b], u, i);
 }
@@ -2543,18 +2589,20 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
   };
   UpdatePass u;
   u.moved = {padded(moved.before), padded(moved.after)};
-  std::vector<Aabb> boxes = u.moved.before;  // both
-  boxes.insert(boxes.end(), u.moved.after.begin(), u.moved.after.end());
   u.per_block = true;
   u.candidates.resize(S.blocks.size());
   S.states.resize(S.blocks.size());
   std::vector<std::vector<int>> recast(S.blocks.size());
   std::vector<std::uint8_t> dirty_block(S.blocks.size(), 0), old_kept(old_blocks.size(), 0);
   const int count = static_cast<int>(rig.cameras.size());
-  std::vector<std::vector<EyeCone>> box_cones(
-      static_cast<std::size_t>(count));  // per camera, per moved box
-  for (int c = 0; c < count; ++c)
-    for (const Aabb& m : boxes) box_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
+  u.before_cones.resize(static_cast<std::size_t>(count));
+  u.after_cones.resize(static_cast<std::size_t>(count));
+  for (int c = 0; c < count; ++c) {
+    for (const Aabb& m : u.moved.before)
+      u.before_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
+    for (const Aabb& m : u.moved.after)
+      u.after_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
+  }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
       const Block& block = S.blocks[b];
@@ -2567,11 +2615,13 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
         u.candidates[b] = S.states[b].candidates;
         for (int c : u.candidates[b]) {
           const EyeCone segments = ConeOf(rd.centres[c], box);
-          for (const EyeCone& m : box_cones[std::size_t(c)])
-            if (ConesMayMeet(segments, m)) {
-              recast[b].push_back(c);
-              break;
-            }
+          const auto meets = [&segments](const std::vector<EyeCone>& cones) {
+            for (const EyeCone& m : cones)
+              if (ConesMayMeet(segments, m)) return true;
+            return false;
+          };
+          if (meets(u.before_cones[std::size_t(c)]) || meets(u.after_cones[std::size_t(c)]))
+            recast[b].push_back(c);
         }
         dirty_block[b] = !recast[b].empty();
       } else {

@@ -48,15 +48,10 @@ struct ColumnGrid {
   }
   int CellX(double x) const { return Cell(x, x0, cw, nx); }
   int CellY(double y) const { return Cell(y, y0, ch, ny); }
-  // The cells a face's (x, y) bounding box meets: columns i0..i1, rows j0..j1.
-  std::array<int, 4> CellRange(const std::array<Point, 3>& v) const {
-    const auto [x_lo, x_hi] = std::minmax({v[0].x(), v[1].x(), v[2].x()});
-    const auto [y_lo, y_hi] = std::minmax({v[0].y(), v[1].y(), v[2].y()});
-    return {CellX(x_lo), CellX(x_hi), CellY(y_lo), CellY(y_hi)};
-  }
-
   // Per face, its corners as given (the mesh's triangles, in order) and its bounding box.
   std::vector<Aabb> boxes;
+  // While building: the cells each face's (x, y) box meets, columns i0..i1 and rows j0..j1.
+  std::vector<std::array<int, 4>> ranges;
 
   void Build(const TriangleMesh& mesh, const Aabb& bounds) {
     corners.clear();
@@ -88,27 +83,33 @@ struct ColumnGrid {
                   : 1;
       cw = wx > 0 ? wx / nx : 1.0;
       ch = wy > 0 ? wy / ny : 1.0;
+      // Each face's cells (from its box: the corners' own minima and maxima), kept for the
+      // passes below.
       std::size_t entries = 0;
-      for (const auto& v : corners) {
-        const auto [i0, i1, j0, j1] = CellRange(v);
+      ranges.resize(boxes.size());
+      for (std::size_t f = 0; f < boxes.size(); ++f) {
+        const Aabb& b = boxes[f];
+        ranges[f] = {CellX(b.min.x()), CellX(b.max.x()), CellY(b.min.y()), CellY(b.max.y())};
+        const auto [i0, i1, j0, j1] = ranges[f];
         entries += std::size_t(i1 - i0 + 1) * std::size_t(j1 - j0 + 1);
       }
       if (entries <= 16 * corners.size() + 4096 || (nx == 1 && ny == 1)) break;
       cells /= 4;
     }
     start.assign(std::size_t(nx) * ny + 1, 0);
-    const auto each_cell = [&](const std::array<Point, 3>& v, auto&& fn) {
-      const auto [i0, i1, j0, j1] = CellRange(v);
+    const auto each_cell = [&](std::size_t f, auto&& fn) {
+      const auto [i0, i1, j0, j1] = ranges[f];
       for (int i = i0; i <= i1; ++i)
         for (int j = j0; j <= j1; ++j) fn(std::size_t(i) * ny + j);
     };
-    for (const auto& v : corners) each_cell(v, [&](std::size_t c) { ++start[c + 1]; });
+    for (std::size_t f = 0; f < corners.size(); ++f)
+      each_cell(f, [&](std::size_t c) { ++start[c + 1]; });
     for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
     faces.assign(start.back(), 0);
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
     for (std::size_t f = 0; f < corners.size(); ++f)
-      each_cell(corners[f],
-                [&](std::size_t c) { faces[fill[c]++] = static_cast<std::uint32_t>(f); });
+      each_cell(f, [&](std::size_t c) { faces[fill[c]++] = static_cast<std::uint32_t>(f); });
+    std::vector<std::array<int, 4>>().swap(ranges);
   }
 };
 
