@@ -78,7 +78,7 @@ TEST(InsideMesh, ColumnsAgreeWithPointsOnLatticeAlignedBoxes) {
 }
 
 // Classify (the column grid's face boxes, the centre's column parity) against Inside() at the
-// corners and centre and random points of random boxes: a box called inside or outside is so at
+// eight corners and four random points of random boxes: a box called inside or outside is so at
 // every point tested; boxes of every class occur, and boxes reaching beyond the mesh's bounds.
 TEST(InsideMesh, ClassifiedBoxesAgreeWithPoints) {
   std::mt19937 rng(11);
