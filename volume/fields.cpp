@@ -499,6 +499,13 @@ struct CameraEntry {
   }
 };
 
+// The entry of `camera` among `entries` (ascending camera), or nullptr.
+const CameraEntry* FindEntry(const std::vector<CameraEntry>& entries, int camera) {
+  const auto it = std::lower_bound(entries.begin(), entries.end(), camera,
+                                   [](const CameraEntry& e, int c) { return e.camera < c; });
+  return it != entries.end() && it->camera == camera ? &*it : nullptr;
+}
+
 enum VoxelStatus : std::uint8_t { kUnseen, kSeenOnly, kTriangulable, kUnobservable };
 
 struct BlockState {
@@ -584,7 +591,8 @@ struct DeriveScratch {
 // length and radius, the sine and cosine of the half-angle (the eye inside the ball: `inside`).
 // Made once per (eye, box) and compared many times (ConesMayMeet).
 struct EyeCone {
-  Vec3 eye, lo, hi;
+  Vec3 eye;
+  Aabb box;
   Vec3 axis;
   double length = 0, radius = 0, sine = 0, cosine = 0;
   bool inside = false;
@@ -593,8 +601,7 @@ struct EyeCone {
 EyeCone ConeOf(const Vec3& eye, const Aabb& box) {
   EyeCone c;
   c.eye = eye;
-  c.lo = box.min;
-  c.hi = box.max;
+  c.box = box;
   c.axis = 0.5 * (box.min + box.max) - eye;
   c.radius = 0.5 * (box.max - box.min).norm();
   c.length = c.axis.norm();
@@ -614,9 +621,9 @@ EyeCone ConeOf(const Vec3& eye, const Aabb& box) {
 // round-off.
 inline bool ConesMayMeet(const EyeCone& segments, const EyeCone& moved) {
   for (int k = 0; k < 3; ++k) {
-    const double lo = std::min(segments.eye[k], segments.lo[k]),
-                 hi = std::max(segments.eye[k], segments.hi[k]);
-    if (hi < moved.lo[k] || lo > moved.hi[k]) return false;
+    const double lo = std::min(segments.eye[k], segments.box.min[k]),
+                 hi = std::max(segments.eye[k], segments.box.max[k]);
+    if (hi < moved.box.min[k] || lo > moved.box.max[k]) return false;
   }
   if (segments.inside || moved.inside) return true;  // the eye inside a ball
   if (moved.length - moved.radius > segments.length + segments.radius)
@@ -626,14 +633,15 @@ inline bool ConesMayMeet(const EyeCone& segments, const EyeCone& moved) {
              (segments.length * moved.length);
 }
 
-// Per point p in [begin, end) of `batch`: whether its segment (origin, unit direction, [t_near,
-// t_far]) meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all
-// points, vectorised.
 // Segments from one origin: unit directions and their [t_near, t_far], by point.
 struct SegmentArrays {
   const double *dx, *dy, *dz, *t_near, *t_far;
   Vec3 origin;
 };
+
+// Per point p in [begin, end) of `batch`: whether its segment (origin, unit direction, [t_near,
+// t_far]) meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all
+// points, vectorised.
 
 __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBoxes(
     const SegmentArrays& batch, int begin, int end, const std::vector<Aabb>& boxes,
@@ -757,11 +765,9 @@ struct FieldEvaluator::State {
   // A scene update's view of a block cast again: the camera's previous view of it and the moved
   // boxes its segments may meet.
   struct Again {
-    const std::vector<Aabb>* before = nullptr;  // what moved, where it was
-    const std::vector<Aabb>* after = nullptr;   // and where it is
-    // Their cones from the camera (ConeOf), in the same order.
-    const std::vector<EyeCone>* before_cones = nullptr;
-    const std::vector<EyeCone>* after_cones = nullptr;
+    // What moved, where it was and where it is: the boxes' cones from the camera (ConeOf).
+    const std::vector<EyeCone>* before = nullptr;
+    const std::vector<EyeCone>* after = nullptr;
   };
   void Cast(const BlockPoints& points, int camera, const RigData& rd, CameraEntry* entry,
             std::vector<Ray>* rays) const;
@@ -862,17 +868,15 @@ static void NearOctantBoxes(const std::array<Aabb, 8>& octants, const Vec3& eye,
                             const FieldEvaluator::State::Again& again,
                             std::array<std::vector<Aabb>, 8>* near_after,
                             std::array<std::vector<Aabb>, 8>* near_before) {
-  const std::vector<EyeCone>& cones_after = *again.after_cones;
-  const std::vector<EyeCone>& cones_before = *again.before_cones;
   for (int k = 0; k < 8; ++k) {
     (*near_after)[k].clear();
     (*near_before)[k].clear();
     if (octants[k].empty()) continue;
     const EyeCone octant = ConeOf(eye, octants[k]);
-    for (std::size_t j = 0; j < cones_after.size(); ++j)
-      if (ConesMayMeet(octant, cones_after[j])) (*near_after)[k].push_back((*again.after)[j]);
-    for (std::size_t j = 0; j < cones_before.size(); ++j)
-      if (ConesMayMeet(octant, cones_before[j])) (*near_before)[k].push_back((*again.before)[j]);
+    for (const EyeCone& moved : *again.after)
+      if (ConesMayMeet(octant, moved)) (*near_after)[k].push_back(moved.box);
+    for (const EyeCone& moved : *again.before)
+      if (ConesMayMeet(octant, moved)) (*near_before)[k].push_back(moved.box);
   }
 }
 
@@ -1215,13 +1219,7 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   // view), are walked. The result is the same (counts, maxima and exact sums; a best density's
   // camera that still sees its voxel keeps it).
   const auto bits_of = [](const CameraEntry* e) { return e ? e->bits : Bits{}; };
-  // Both ascend by camera.
-  const auto old_entry = [&old](int camera) -> const CameraEntry* {
-    const auto it = std::lower_bound(old.entries.begin(), old.entries.end(), camera,
-                                     [](const CameraEntry& e, int c) { return e.camera < c; });
-    return it != old.entries.end() && it->camera == camera ? &*it : nullptr;
-  };
-  const auto new_entry = [&view](int camera) -> const CameraEntry* {
+  const auto new_entry = [&view](int camera) -> const CameraEntry* {  // view ascends by camera
     const auto it = std::lower_bound(view.begin(), view.end(), camera,
                                      [](const CameraEntry* e, int c) { return e->camera < c; });
     return it != view.end() && (*it)->camera == camera ? *it : nullptr;
@@ -1238,7 +1236,7 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   for (const CameraEntry* e : view) {
     if (!is_changed[e->camera]) continue;
     walk(
-        *e, occlusion_only ? old_entry(e->camera) : nullptr,
+        *e, occlusion_only ? FindEntry(old.entries, e->camera) : nullptr,
         [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's new view
           ++cover[o];
           if (want_resolution && e->density[index] > next->best_density[o]) {
@@ -1939,8 +1937,8 @@ struct UpdatePass {
   // view of it changed.
   bool per_block = false;
   std::vector<std::vector<int>> block_changed;
-  SceneChange moved;  // padded
-  // Per camera, the cones (ConeOf) from it around each box of moved.before and moved.after.
+  // A scene update, per camera: the cones (ConeOf) from it around each moved box (padded),
+  // where it was and where it is.
   std::vector<std::vector<EyeCone>> before_cones, after_cones;
   bool Changed(std::size_t i, int camera) const {
     if (!per_block) return is_changed[camera] != 0;
@@ -2107,13 +2105,6 @@ void DropPairData(BlockState& old, UpdatePass* u, std::size_t i) {
   std::vector<std::int32_t>().swap(next[i].band_count);
 }
 
-// The entry of `camera` among `entries` (ascending camera), or nullptr.
-const CameraEntry* FindEntry(const std::vector<CameraEntry>& entries, int camera) {
-  const auto it = std::lower_bound(entries.begin(), entries.end(), camera,
-                                   [](const CameraEntry& e, int c) { return e.camera < c; });
-  return it != entries.end() && it->camera == camera ? &*it : nullptr;
-}
-
 // A scene update: drops block i's re-cast views that equal the kept ones (nothing changed for
 // that camera there), from the cast and from the block's changed cameras.
 void DropUnchangedViews(const BlockState& old, UpdatePass* u, std::size_t i) {
@@ -2221,24 +2212,16 @@ void CastBlock(State& S, const RigData& rd, UpdatePass* u, std::size_t i) {
       continue;
     }
     // The moved boxes this camera's segments to the block may meet.
-    thread_local std::vector<Aabb> before, after;
-    thread_local std::vector<EyeCone> before_cones, after_cones;
+    thread_local std::vector<EyeCone> before, after;
     const EyeCone segments = ConeOf(rd.centres[c], box);
-    const auto near = [&](const std::vector<Aabb>& all, const std::vector<EyeCone>& cones,
-                          std::vector<Aabb>* out, std::vector<EyeCone>* out_cones) {
+    const auto near = [&](const std::vector<EyeCone>& all, std::vector<EyeCone>* out) {
       out->clear();
-      out_cones->clear();
-      for (std::size_t m = 0; m < all.size(); ++m)
-        if (ConesMayMeet(segments, cones[m])) {
-          out->push_back(all[m]);
-          out_cones->push_back(cones[m]);
-        }
+      for (const EyeCone& moved : all)
+        if (ConesMayMeet(segments, moved)) out->push_back(moved);
     };
-    near(u->moved.before, u->before_cones[std::size_t(c)], &before, &before_cones);
-    near(u->moved.after, u->after_cones[std::size_t(c)], &after, &after_cones);
-    u->rays +=
-        S.CastAgain(points, c, rd, *was, State::Again{&before, &after, &before_cones, &after_cones},
-                    &cast.back());
+    near(u->before_cones[std::size_t(c)], &before);
+    near(u->after_cones[std::size_t(c)], &after);
+    u->rays += S.CastAgain(points, c, rd, *was, State::Again{&before, &after}, &cast.back());
   }
   if (again) DropUnchangedViews(S.states[b], u, i);
 }
@@ -2588,7 +2571,7 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
     return out;
   };
   UpdatePass u;
-  u.moved = {padded(moved.before), padded(moved.after)};
+  const std::vector<Aabb> moved_before = padded(moved.before), moved_after = padded(moved.after);
   u.per_block = true;
   u.candidates.resize(S.blocks.size());
   S.states.resize(S.blocks.size());
@@ -2598,9 +2581,9 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
   u.before_cones.resize(static_cast<std::size_t>(count));
   u.after_cones.resize(static_cast<std::size_t>(count));
   for (int c = 0; c < count; ++c) {
-    for (const Aabb& m : u.moved.before)
+    for (const Aabb& m : moved_before)
       u.before_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
-    for (const Aabb& m : u.moved.after)
+    for (const Aabb& m : moved_after)
       u.after_cones[std::size_t(c)].push_back(ConeOf(rd.centres[c], m));
   }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, S.blocks.size(), 16), [&](const auto& r) {

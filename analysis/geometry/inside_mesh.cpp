@@ -41,17 +41,14 @@ struct ColumnGrid {
   int nx = 1, ny = 1;
   std::vector<std::uint32_t> start;  // per cell, into faces; nx * ny + 1
   std::vector<std::uint32_t> faces;
-  std::vector<std::array<Point, 3>> corners;  // per face
+  std::vector<std::array<Point, 3>> corners;  // per face, as given (the mesh's triangles, in order)
+  std::vector<Aabb> boxes;                    // per face, its bounding box
 
   int Cell(double v, double v0, double w, int n) const {
     return static_cast<int>(std::clamp(std::floor((v - v0) / w), 0.0, double(n - 1)));
   }
   int CellX(double x) const { return Cell(x, x0, cw, nx); }
   int CellY(double y) const { return Cell(y, y0, ch, ny); }
-  // Per face, its corners as given (the mesh's triangles, in order) and its bounding box.
-  std::vector<Aabb> boxes;
-  // While building: the cells each face's (x, y) box meets, columns i0..i1 and rows j0..j1.
-  std::vector<std::array<int, 4>> ranges;
 
   void Build(const TriangleMesh& mesh, const Aabb& bounds) {
     corners.clear();
@@ -75,6 +72,8 @@ struct ColumnGrid {
     // About one face per cell (a closed surface projects onto its footprint twice), at most 1024
     // cells a side; coarser while large faces would fill too many cells.
     double cells = std::max(1.0, n);
+    // The cells each face's (x, y) box meets (columns i0..i1, rows j0..j1), for the passes below.
+    std::vector<std::array<int, 4>> ranges(boxes.size());
     for (;;) {
       const double aspect = wy > 0 && wx > 0 ? wx / wy : 1.0;
       nx = wx > 0 ? static_cast<int>(std::clamp(std::round(std::sqrt(cells * aspect)), 1.0, 1024.0))
@@ -83,10 +82,7 @@ struct ColumnGrid {
                   : 1;
       cw = wx > 0 ? wx / nx : 1.0;
       ch = wy > 0 ? wy / ny : 1.0;
-      // Each face's cells (from its box: the corners' own minima and maxima), kept for the
-      // passes below.
       std::size_t entries = 0;
-      ranges.resize(boxes.size());
       for (std::size_t f = 0; f < boxes.size(); ++f) {
         const Aabb& b = boxes[f];
         ranges[f] = {CellX(b.min.x()), CellX(b.max.x()), CellY(b.min.y()), CellY(b.max.y())};
@@ -109,7 +105,6 @@ struct ColumnGrid {
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
     for (std::size_t f = 0; f < corners.size(); ++f)
       each_cell(f, [&](std::size_t c) { faces[fill[c]++] = static_cast<std::uint32_t>(f); });
-    std::vector<std::array<int, 4>>().swap(ranges);
   }
 };
 
