@@ -1405,9 +1405,9 @@ void FieldEvaluator::State::WriteDirtyVoxels(const Block& block, const Bits& dir
       if (TestBit(in_double, o)) {
         for (int k = 0; k < 6; ++k) upper[k][candidate_count] = double_sum[double_index[o]][k];
       } else {
-        const BandScale& scale = scales[next->sum_band[o]];
-        for (int k = 0; k < 6; ++k)
-          upper[k][candidate_count] = SumLimbsToDouble(next->sums[o], k, scale.up);
+        double entry[6];
+        SumLimbsToDoubles(next->sums[o], scales[next->sum_band[o]].up, entry);
+        for (int k = 0; k < 6; ++k) upper[k][candidate_count] = entry[k];
       }
       if (want_angle) {
         const int x = o >> 6, y = (o >> 3) & 7, z = o & 7;
@@ -1662,6 +1662,15 @@ void FieldEvaluator::State::Totals(FieldStats* st, int camera_count, int enabled
   st->active_set.culled_blocks = 0;
   st->coverage_histogram.assign(camera_count + 1, 0);
   st->per_camera_seen.assign(camera_count, 0);
+  // The lists' sizes first: one allocation each, not a doubling per block (an update's Totals
+  // gathers every block's list, 81,000 values on the trauma room).
+  std::size_t sigma_count = 0, steady_count = 0;
+  for (const BlockState& s : states) {
+    sigma_count += s.sigma_list.size();
+    steady_count += s.steady_list.size();
+  }
+  st->sigma_max_mm.reserve(sigma_count);
+  st->sigma_max_steady_mm.reserve(steady_count);
   for (std::size_t b = 0; b < states.size(); ++b) {
     const BlockState& s = states[b];
     if (s.candidates.empty()) ++st->active_set.culled_blocks;

@@ -234,4 +234,56 @@ inline double SumLimbsToDouble(const SumLimbs& s, int k, const double* up) {
   return ToDouble(SumLimbsUnits(s, k)) * up[0] * up[1];
 }
 
+// The same six doubles without integers, two entries at a time in SSE2 (the field evaluation's
+// route; SumLimbsToDouble is its reference). The limbs are integers (in units of 2^q) below 2^123
+// in magnitude whose sum is SumLimbsUnits' int128, so ToDouble of it is the sum of three doubles
+// rounded once to nearest, ties to even: Boldo and Melquiond's correctly rounded sum of any three
+// doubles ("Emulation of a FMA and correctly rounded sums: proved algorithms using rounding to
+// odd", IEEE Trans. Computers 57(4), 2008, proved in Coq) gives it with two exact 2Sums (Knuth),
+// their two errors added rounded to odd, and that added to the larger part rounded to nearest.
+// Round-to-odd is emulated: the nearest sum, and when that is inexact and its last significand
+// bit is 0, its neighbour on the side of the error. Valid for finite values whose sum does not
+// overflow, without underflow (all of them integers here). information_sum_test checks the bits
+// against the int128 route, ties and near-ties included.
+typedef std::uint64_t U2 __attribute__((vector_size(16)));
+
+// a + b = s + TwoSumError(a, b, s) exactly, for s = a + b rounded to nearest (Knuth's 2Sum).
+__attribute__((always_inline)) inline V2 TwoSumError(V2 a, V2 b, V2 s) {
+  const V2 bb = s - a;
+  return (a - (s - bb)) + (b - bb);
+}
+
+// x + y rounded to odd: x + y if it is a double, else of the two doubles around it the one whose
+// last significand bit is 1 (one unit more in the magnitude when x + y's error has s's sign, one
+// less when not).
+__attribute__((always_inline)) inline V2 AddRoundToOdd(V2 x, V2 y) {
+  const V2 s = x + y;
+  const V2 e = TwoSumError(x, y, s);
+  U2 sb, eb;
+  std::memcpy(&sb, &s, sizeof(sb));
+  std::memcpy(&eb, &e, sizeof(eb));
+  const U2 inexact = (U2)(e != 0.0) & 1;
+  const U2 to_other = inexact & ~sb;  // bit 0: inexact and even
+  const U2 outward = ~((sb ^ eb) >> 63);
+  const U2 r = sb + (to_other & outward & 1) - (to_other & ~outward & 1);
+  V2 out;
+  std::memcpy(&out, &r, sizeof(out));
+  return out;
+}
+
+__attribute__((always_inline)) inline void SumLimbsToDoubles(const SumLimbs& s, const double* up,
+                                                             double out[6]) {
+  const V2 u0 = {up[0], up[0]}, u1 = {up[1], up[1]};
+  for (int k = 0; k < 6; k += 2) {
+    V2 a, b, c;
+    std::memcpy(&a, s.hi + k, sizeof(a));
+    std::memcpy(&b, s.mid + k, sizeof(b));
+    std::memcpy(&c, s.lo + k, sizeof(c));
+    const V2 uh = b + c, ul = TwoSumError(b, c, uh);
+    const V2 th = a + uh, tl = TwoSumError(a, uh, th);
+    const V2 v = (th + AddRoundToOdd(tl, ul)) * u0 * u1;
+    std::memcpy(out + k, &v, sizeof(v));
+  }
+}
+
 }  // namespace pandora::information

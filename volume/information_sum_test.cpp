@@ -96,5 +96,78 @@ TEST(InformationSum, LimbSumsAreExactInAnyOrderUpToTwoToTheSeventeen) {
   }
 }
 
+// Entry j of limbs `s` set to hold the integer v, split at random as sums of limbs can be: hi a
+// multiple of 2^70, mid of 2^35 (beyond 2^70 and of either sign), lo an integer up to about 2^52.
+void Split(std::mt19937_64& rng, Int128 v, SumLimbs* s, int j) {
+  const Int128 two35 = Int128{1} << 35, two70 = Int128{1} << 70;
+  const Int128 hi = v / two70 + Int128(int(rng() % 3) - 1);
+  const Int128 rest = v - hi * two70;
+  const Int128 mid = rest / two35 + Int128(int(rng() % 5) - 2) * Int128(rng() % (1u << 16));
+  const Int128 lo = rest - mid * two35;
+  s->hi[j] = static_cast<double>(static_cast<std::int64_t>(hi)) * 0x1p70;
+  s->mid[j] = static_cast<double>(static_cast<std::int64_t>(mid)) * 0x1p35;
+  s->lo[j] = static_cast<double>(static_cast<std::int64_t>(lo));
+  ASSERT_TRUE(SumLimbsUnits(*s, j) == v);
+}
+
+// A random integer of exactly `bits` bits (at most 122), either sign; 0 for none.
+Int128 RandomInteger(std::mt19937_64& rng, int bits) {
+  if (bits == 0) return 0;
+  const unsigned __int128 r = (static_cast<unsigned __int128>(rng()) << 64) | rng();
+  const unsigned __int128 top = static_cast<unsigned __int128>(1) << (bits - 1);
+  const Int128 v = static_cast<Int128>((r >> (128 - bits)) | top);
+  return (rng() & 1) ? -v : v;
+}
+
+// Every entry of SumLimbsToDoubles has SumLimbsToDouble's bits.
+void ExpectIntegerRoutesBits(const SumLimbs& s, int band) {
+  const auto& scales = BandScales();
+  double got[6];
+  SumLimbsToDoubles(s, scales[band].up, got);
+  for (int j = 0; j < 6; ++j)
+    ASSERT_EQ(DoubleBits(got[j]), DoubleBits(SumLimbsToDouble(s, j, scales[band].up)))
+        << "band " << band << " entry " << j << ": hi " << std::hexfloat << s.hi[j] << " mid "
+        << s.mid[j] << " lo " << s.lo[j];
+}
+
+// The integer-free conversion gives the int128 route's bits: for limb sums of random
+// contributions of every band (some taken out again), and for integers split into limbs at
+// random, three quarters of them at or next to a tie of rounding to 53 bits (a midpoint between
+// two doubles, plus -2..2) or at a power of two.
+TEST(InformationSum, SumLimbsToDoublesGivesTheIntegerRoutesBits) {
+  std::mt19937_64 rng(53);
+  const auto& scales = BandScales();
+  for (int k = 0; k < 63; ++k)
+    for (int trial = 0; trial < 300; ++trial) {
+      SumLimbs s{};
+      const int terms = 1 + int(rng() % 40);
+      for (int t = 0; t < terms; ++t) {
+        const std::vector<double> c = Contribution(rng, int(rng() % std::uint64_t(k + 1)));
+        AccumulateLimbs(s, c.data(), scales[k].down, (rng() % 4) != 0);
+      }
+      ExpectIntegerRoutesBits(s, k);
+    }
+  int ties = 0;
+  for (int trial = 0; trial < 100000; ++trial) {
+    SumLimbs s{};
+    for (int j = 0; j < 6; ++j) {
+      const int kind = int(rng() % 4);
+      const int bits = kind == 0 ? int(rng() % 123) : 55 + int(rng() % 68);
+      Int128 v = RandomInteger(rng, kind == 0 ? bits : 53);
+      if (kind != 0) {
+        // A midpoint between two doubles of `bits` bits, or a power of two, nudged by -2..2.
+        const Int128 unit = Int128{1} << (bits - 53), sign = v < 0 ? -1 : 1;
+        v = kind == 3 ? sign * (Int128{1} << (bits - 1)) : v * unit + sign * (unit / 2);
+        const Int128 nudge = Int128(int(rng() % 5) - 2);
+        ties += kind != 3 && nudge == 0 ? 1 : 0;
+        v += nudge;
+      }
+      Split(rng, v, &s, j);
+    }
+    ExpectIntegerRoutesBits(s, int(rng() % 63));
+  }
+  EXPECT_GT(ties, 50000);
+}
+
 }  // namespace
 }  // namespace pandora::information
