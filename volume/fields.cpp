@@ -885,38 +885,45 @@ inline int OctantOf(int o) { return ((o >> 8) << 2) | (((o >> 5) & 1) << 1) | ((
 
 void FieldEvaluator::State::Points(const Block& block, BlockPoints* points) const {
   const VoxelLattice& lattice = fields.lattice;
+  const Eigen::Vector3i& origin = block.origin;
+  const Eigen::Vector3i& extent = block.extent;
+  // Centres per axis (Center is per component: the same doubles), then the free voxels'.
+  std::array<double, 8> cx{}, cy{}, cz{};
+  for (int a = 0; a < 8; ++a) {
+    const Vec3 c = lattice.Center(origin.x() + a, origin.y() + a, origin.z() + a);
+    cx[a] = c.x();
+    cy[a] = c.y();
+    cz[a] = c.z();
+  }
   int n = 0;
-  for (int x = 0; x < block.extent.x(); ++x)
-    for (int y = 0; y < block.extent.y(); ++y)
-      for (int z = 0; z < block.extent.z(); ++z) {
+  for (int x = 0; x < extent.x(); ++x)
+    for (int y = 0; y < extent.y(); ++y)
+      for (int z = 0; z < extent.z(); ++z) {
         if (!block.IsFree(x, y, z)) continue;
-        const Vec3 p =
-            lattice.Center(block.origin.x() + x, block.origin.y() + y, block.origin.z() + z);
-        points->x[n] = p.x();
-        points->y[n] = p.y();
-        points->z[n] = p.z();
+        points->x[n] = cx[x];
+        points->y[n] = cy[y];
+        points->z[n] = cz[z];
         points->offset[n] = static_cast<std::int16_t>(Block::Offset(x, y, z));
         ++n;
       }
   points->count = n;
-  // Each octant's box: its free voxels' lowest and highest centres, one extent per axis (the
-  // x, y, z loops visit the octants' voxels in runs).
-  std::array<std::array<int, 6>, 8> range;
-  for (auto& r : range) r = {8, 8, 8, -1, -1, -1};
-  for (int p = 0; p < n; ++p) {
-    const int o = points->offset[p], x = o >> 6, y = (o >> 3) & 7, z = o & 7;
-    std::array<int, 6>& r = range[OctantOf(o)];
-    r = {std::min(r[0], x), std::min(r[1], y), std::min(r[2], z),
-         std::max(r[3], x), std::max(r[4], y), std::max(r[5], z)};
-  }
+  // Each octant's box: its free voxels' lowest and highest centres, one extent per axis, in
+  // locals octant by octant (updating a per-octant array point by point was a store-forwarding
+  // chain).
   for (int k = 0; k < 8; ++k) {
     points->octant[k] = Aabb();
-    if (range[k][3] < 0) continue;
-    const Eigen::Vector3i& b = block.origin;
-    points->octant[k].Extend(
-        lattice.Center(b.x() + range[k][0], b.y() + range[k][1], b.z() + range[k][2]));
-    points->octant[k].Extend(
-        lattice.Center(b.x() + range[k][3], b.y() + range[k][4], b.z() + range[k][5]));
+    const int x0 = 4 * (k >> 2), y0 = 4 * ((k >> 1) & 1), z0 = 4 * (k & 1);
+    int lo[3] = {8, 8, 8}, hi[3] = {-1, -1, -1};
+    for (int x = x0; x < std::min(x0 + 4, extent.x()); ++x)
+      for (int y = y0; y < std::min(y0 + 4, extent.y()); ++y)
+        for (int z = z0; z < std::min(z0 + 4, extent.z()); ++z) {
+          if (!block.IsFree(x, y, z)) continue;
+          lo[0] = std::min(lo[0], x), lo[1] = std::min(lo[1], y), lo[2] = std::min(lo[2], z);
+          hi[0] = std::max(hi[0], x), hi[1] = std::max(hi[1], y), hi[2] = std::max(hi[2], z);
+        }
+    if (hi[0] < 0) continue;
+    points->octant[k].Extend(Vec3(cx[lo[0]], cy[lo[1]], cz[lo[2]]));
+    points->octant[k].Extend(Vec3(cx[hi[0]], cy[hi[1]], cz[hi[2]]));
   }
 }
 
