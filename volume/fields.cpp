@@ -505,6 +505,12 @@ const CameraEntry* FindEntry(const std::vector<CameraEntry>& entries, int camera
                                    [](const CameraEntry& e, int c) { return e.camera < c; });
   return it != entries.end() && it->camera == camera ? &*it : nullptr;
 }
+// The same among pointers to entries (a block's view).
+const CameraEntry* FindEntry(const std::vector<const CameraEntry*>& entries, int camera) {
+  const auto it = std::lower_bound(entries.begin(), entries.end(), camera,
+                                   [](const CameraEntry* e, int c) { return e->camera < c; });
+  return it != entries.end() && (*it)->camera == camera ? *it : nullptr;
+}
 
 enum VoxelStatus : std::uint8_t { kUnseen, kSeenOnly, kTriangulable, kUnobservable };
 
@@ -642,7 +648,6 @@ struct SegmentArrays {
 // Per point p in [begin, end) of `batch`: whether its segment (origin, unit direction, [t_near,
 // t_far]) meets one of `boxes` (the slab test; points out of view get garbage). Box by box over all
 // points, vectorised.
-
 __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBoxes(
     const SegmentArrays& batch, int begin, int end, const std::vector<Aabb>& boxes,
     std::uint8_t* meets) {
@@ -999,13 +1004,12 @@ int FieldEvaluator::State::CastAgain(const BlockPoints& points, int camera, cons
   thread_local BlockPoints sub;
   const int m = start[8];
   for (int p = 0; p < points.count; ++p) {
-    const int at = fill[OctantOf(points.offset[p])];
+    int& at = fill[OctantOf(points.offset[p])];
     if (at < 0) continue;
     sub.x[at] = points.x[p];
     sub.y[at] = points.y[p];
     sub.z[at] = points.z[p];
-    sub.offset[at] = points.offset[p];
-    ++fill[OctantOf(points.offset[p])];
+    sub.offset[at++] = points.offset[p];
   }
   sub.count = m;
   if (m == 0) return 0;
@@ -1226,11 +1230,6 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   // view), are walked. The result is the same (counts, maxima and exact sums; a best density's
   // camera that still sees its voxel keeps it).
   const auto bits_of = [](const CameraEntry* e) { return e ? e->bits : Bits{}; };
-  const auto new_entry = [&view](int camera) -> const CameraEntry* {  // view ascends by camera
-    const auto it = std::lower_bound(view.begin(), view.end(), camera,
-                                     [](const CameraEntry* e, int c) { return e->camera < c; });
-    return it != view.end() && (*it)->camera == camera ? *it : nullptr;
-  };
   const auto walk = [&](const CameraEntry& e, const CameraEntry* other, auto&& f)
       __attribute__((always_inline)) {
     if (!occlusion_only) return WalkMasked(e, dirty, f);
@@ -1264,7 +1263,7 @@ void FieldEvaluator::State::SumChangedCameras(const BlockState& old,
   for (const CameraEntry& e : old.entries) {
     if (!is_changed[e.camera] || e.seen == 0) continue;
     walk(
-        e, occlusion_only ? new_entry(e.camera) : nullptr,
+        e, occlusion_only ? FindEntry(view, e.camera) : nullptr,
         [&](int o, int index) __attribute__((always_inline)) {  // a changed camera's old view
           --cover[o];
           if (want_resolution && next->best_camera[o] == e.camera) SetBit(rescan_density, o);
