@@ -166,15 +166,30 @@ void SteadyStatistics(int n, double* const* rows) {
   }
 }
 
+// a where mask is all ones, b where it is 0: on the bits. A select of doubles whose arms GCC
+// computes only where taken (a division, a subtraction: traps it may not make unconditional under
+// -ftrapping-math) stays a branch, and the loop around it is not vectorised.
+inline double SelectBits(std::uint64_t mask, double a, double b) {
+  std::uint64_t x, y;
+  std::memcpy(&x, &a, sizeof(x));
+  std::memcpy(&y, &b, sizeof(y));
+  const std::uint64_t r = (x & mask) | (y & ~mask);
+  double out;
+  std::memcpy(&out, &r, sizeof(out));
+  return out;
+}
+inline std::uint64_t MaskOf(bool b) { return -std::uint64_t(b); }
+
 // atan(t) for t >= 0 (+inf allowed) to 2.1e-8 relative (measured against std::atan over
-// 1e-12..1e12), branch-free so that it vectorises:
+// 1e-12..1e12), branch-free so that it vectorises (both divisions made, SelectBits):
 // Cephes' single-precision reduction (t > tan(3 pi/8): pi/2 - atan(1/t); t > tan(pi/8):
 // pi/4 + atan((t-1)/(t+1))) and its degree-9 odd minimax polynomial. The angle grid is float.
 inline double AtanNonNegative(double t) {
-  const bool big = t > 2.414213562373095;
-  const bool mid = t > 0.4142135623730950;
-  const double x = big ? -1.0 / t : (mid ? (t - 1.0) / (t + 1.0) : t);
-  const double base = big ? (0.5 * kPi) : (mid ? (0.25 * kPi) : 0.0);
+  const std::uint64_t big = MaskOf(t > 2.414213562373095);
+  const std::uint64_t mid = MaskOf(t > 0.4142135623730950);
+  const double inverse = -1.0 / t, ratio = (t - 1.0) / (t + 1.0);
+  const double x = SelectBits(big, inverse, SelectBits(mid, ratio, t));
+  const double base = SelectBits(big, 0.5 * kPi, SelectBits(mid, 0.25 * kPi, 0.0));
   const double z = x * x;
   return base +
          (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z -
@@ -368,16 +383,27 @@ TriangulationAngles(int count, const double* x, const double* y, const double* z
       if (!have[best_a[m]]) directions(int(best_a[m]));
       if (!have[best_b[m]]) directions(int(best_b[m]));
     }
-#pragma omp simd
+    // The best pairs' directions gathered first (GCC does not vectorise the indexed loads), then
+    // the angles in SIMD.
+    double pair_dirs[6][kTile];
     for (int m = 0; m < n; ++m) {
       const double* ad = dirs + 3 * kTile * best_a[m] + m;
       const double* bd = dirs + 3 * kTile * best_b[m] + m;
-      const double ax = ad[0], ay = ad[kTile], az = ad[2 * kTile];
-      const double bx = bd[0], by = bd[kTile], bz = bd[2 * kTile];
+      for (int k = 0; k < 3; ++k) {
+        pair_dirs[k][m] = ad[k * kTile];
+        pair_dirs[3 + k][m] = bd[k * kTile];
+      }
+    }
+#pragma omp simd
+    for (int m = 0; m < n; ++m) {
+      const double ax = pair_dirs[0][m], ay = pair_dirs[1][m], az = pair_dirs[2][m];
+      const double bx = pair_dirs[3][m], by = pair_dirs[4][m], bz = pair_dirs[5][m];
       const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
       const double dot = best_dot[m];
       const double angle = AtanNonNegative(std::sqrt(cx * cx + cy * cy + cz * cz) / std::abs(dot));
-      degrees[start + m] = static_cast<float>((dot < 0 ? kPi - angle : angle) * (180.0 / kPi));
+      const double obtuse = kPi - angle;
+      degrees[start + m] =
+          static_cast<float>(SelectBits(MaskOf(dot < 0), obtuse, angle) * (180.0 / kPi));
     }
     for (int m = 0; m < n; ++m) {
       best_dot_io[start + m] = best_dot[m];
@@ -438,8 +464,11 @@ void InformationLanes(int n, const double* rw, InformationScratch* s) {
     i3[m] = c3;
     i4[m] = c4;
     i5[m] = c5;
-    band[m] = Band(c0, c1, c2, c3, c4, c5);
   }
+  // The bands in a loop of their own: with their byte stores in the loop above GCC chose vectors
+  // by the bytes' width and gave the doubles half of AVX-512's lanes.
+#pragma omp simd
+  for (int m = 0; m < n; ++m) band[m] = Band(i0[m], i1[m], i2[m], i3[m], i4[m], i5[m]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -591,6 +620,8 @@ struct DeriveScratch {
   Bits in_double{};
   std::vector<std::array<double, 6>> double_sum;
   std::array<std::int16_t, 512> double_index;
+  // One camera's (voxel, contribution index) pairs for AccumulateLimbList.
+  std::array<std::int16_t, 512> list_voxel, list_index;
 };
 
 // The cone from an eye around a box's bounding ball: the box, the ball's centre less the eye, its
@@ -654,7 +685,14 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBo
   std::fill(meets + begin, meets + end, std::uint8_t{0});
   if (boxes.empty()) return;
   alignas(64) double inv[3][512];
+  alignas(64) std::int64_t hit[512];  // lanes as wide as the doubles'
+  std::fill(hit + begin, hit + end, std::int64_t{0});
   const double* d[3] = {batch.dx, batch.dy, batch.dz};
+  // Through restrict locals: a store to `meets` (bytes) could change `batch`'s pointers, so GCC
+  // would reload them per point and not vectorise.
+  const double* __restrict t_near = batch.t_near;
+  const double* __restrict t_far = batch.t_far;
+  std::uint8_t* __restrict out = meets;
   for (int k = 0; k < 3; ++k)
 #pragma omp simd
     for (int p = begin; p < end; ++p) inv[k][p] = 1.0 / d[k][p];  // +-inf along an axis
@@ -671,7 +709,8 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBo
     }
 #pragma omp simd
     for (int p = begin; p < end; ++p) {
-      double t0 = batch.t_near[p], t1 = batch.t_far[p];
+      double t0 = t_near[p], t1 = t_far[p];
+#pragma GCC unroll 3
       for (int k = 0; k < 3; ++k) {
         // A direction of 0 along k: the slab's times are -inf..inf when the origin is inside it,
         // else both +inf or both -inf (a miss).
@@ -680,9 +719,10 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void SegmentsMeetBo
         t0 = near > t0 ? near : t0;
         t1 = far < t1 ? far : t1;
       }
-      meets[p] |= t0 <= t1 ? 1 : 0;
+      hit[p] |= std::int64_t(t0 <= t1);
     }
   }
+  for (int p = begin; p < end; ++p) out[p] = static_cast<std::uint8_t>(hit[p]);
 }
 
 // Per point in view of `batch` (at `offset` in the block; octant k's points in [start[k],
@@ -1295,7 +1335,6 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
   Bits& in_double = scratch->in_double;
   std::vector<std::array<double, 6>>& double_sum = scratch->double_sum;
   std::array<std::int16_t, 512>& double_index = scratch->double_index;
-  const std::array<BandScale, 64>& scales = BandScales();
   // Rescans, camera by camera in rig order: coverage (a full evaluation), best density, the band
   // of the information sum and its count.
   Bits rescan = rescan_density;
@@ -1356,17 +1395,25 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
       }
     }
     if (any_info)
-      for (const CameraEntry* e : view)
+      for (const CameraEntry* e : view) {
+        // The camera's pairs to sum exactly listed first, then summed in one call (SIMD).
+        std::array<std::int16_t, 512>& voxels = scratch->list_voxel;
+        std::array<std::int16_t, 512>& indices = scratch->list_index;
+        int listed = 0;
         walk_masked(
             *e, rescan_info, [&](int o, int index) __attribute__((always_inline)) {
-              const double* c = &e->information[6 * index];
               if (TestBit(in_double, o)) {
+                const double* c = &e->information[6 * index];
                 std::array<double, 6>& d = double_sum[double_index[o]];
                 for (int k = 0; k < 6; ++k) d[k] += c[k];
               } else {
-                AccumulateLimbs(next->sums[o], c, scales[next->sum_band[o]].down, true);
+                voxels[listed] = static_cast<std::int16_t>(o);
+                indices[listed++] = static_cast<std::int16_t>(index);
               }
             });
+        AccumulateLimbList(listed, voxels.data(), indices.data(), e->information.data(),
+                           next->sum_band.data(), next->sums.data(), true);
+      }
   }
 }
 

@@ -11,6 +11,10 @@
 #include <cstdint>
 #include <cstring>
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#include <immintrin.h>
+#endif
+
 namespace pandora::information {
 
 // Rows of the per-candidate statistics arrays.
@@ -209,6 +213,67 @@ __attribute__((always_inline)) inline void AccumulateLimbs(SumLimbs& s, const do
     std::memcpy(s.mid + k, &b, sizeof(b));
     std::memcpy(s.lo + k, &e, sizeof(e));
   }
+}
+
+// AccumulateLimbs for a list of (voxel, contribution) pairs, j < n: contribution
+// information[6 index[j]] (one camera's, ascending seen voxel) added (`add`) to or subtracted from
+// sums[voxel[j]] on that voxel's band, band[voxel[j]] (< kNotExact). Where the CPU has AVX2 a
+// pair's six entries go as four and two (AccumulateEntries), with the same operations per entry
+// as AccumulateLimbs, so the same bits (information_sum_test); elsewhere AccumulateLimbs pair by
+// pair. (All six in one AVX-512 vector with masked loads and stores was slower on the capture
+// stage, 0.161 s against 0.152 s for all nine fields.)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+typedef double V4 __attribute__((vector_size(32)));
+// Entries k..k+W-1 of one pair (W = 2 or 4 doubles of vector type V).
+template <typename V>
+__attribute__((always_inline)) inline void AccumulateEntries(SumLimbs& s, const double* c, int k,
+                                                             double down0, double down1, bool add) {
+  const V d0 = V{} + down0, d1 = V{} + down1;
+  const V m_hi = V{} + 0x1.8p122, m_mid = V{} + 0x1.8p87, m_lo = V{} + 0x1.8p52;
+  V y;
+  std::memcpy(&y, c + k, sizeof(y));
+  y = (y * d0) * d1;
+  const V hi = (y + m_hi) - m_hi;
+  const V r1 = y - hi;
+  const V mid = (r1 + m_mid) - m_mid;
+  const V r2 = r1 - mid;
+  const V lo = (r2 + m_lo) - m_lo;
+  V a, b, e;
+  std::memcpy(&a, s.hi + k, sizeof(a));
+  std::memcpy(&b, s.mid + k, sizeof(b));
+  std::memcpy(&e, s.lo + k, sizeof(e));
+  if (add) {
+    a += hi, b += mid, e += lo;
+  } else {
+    a -= hi, b -= mid, e -= lo;
+  }
+  std::memcpy(s.hi + k, &a, sizeof(a));
+  std::memcpy(s.mid + k, &b, sizeof(b));
+  std::memcpy(s.lo + k, &e, sizeof(e));
+}
+__attribute__((target("avx2"))) inline void AccumulateLimbListAvx2(
+    int n, const std::int16_t* voxel, const std::int16_t* index, const double* information,
+    const std::uint8_t* band, const BandScale* scales, SumLimbs* sums, bool add) {
+  for (int j = 0; j < n; ++j) {
+    const int o = voxel[j];
+    const double* down = scales[band[o]].down;
+    const double* c = information + 6 * index[j];
+    AccumulateEntries<V4>(sums[o], c, 0, down[0], down[1], add);
+    AccumulateEntries<V2>(sums[o], c, 4, down[0], down[1], add);
+  }
+}
+#endif
+
+inline void AccumulateLimbList(int n, const std::int16_t* voxel, const std::int16_t* index,
+                               const double* information, const std::uint8_t* band, SumLimbs* sums,
+                               bool add) {
+  const BandScale* scales = BandScales().data();
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return AccumulateLimbListAvx2(n, voxel, index, information, band, scales, sums, add);
+#endif
+  for (int j = 0; j < n; ++j)
+    AccumulateLimbs(sums[voxel[j]], information + 6 * index[j], scales[band[voxel[j]]].down, add);
 }
 
 // s = 0 as nine 16-byte stores (a value-initialisation compiles to `rep stos`, whose start-up

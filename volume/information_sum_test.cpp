@@ -169,5 +169,41 @@ TEST(InformationSum, SumLimbsToDoublesGivesTheIntegerRoutesBits) {
   EXPECT_GT(ties, 50000);
 }
 
+// AccumulateLimbList (AVX-512 where the CPU has it) leaves the bits of AccumulateLimbs pair by
+// pair: 512 voxels on random bands, twelve cameras' contributions of every band up to the voxel's
+// (subnormal, zero and band-top entries among them) added, then half of them taken out.
+TEST(InformationSum, LimbListGivesThePairByPairBits) {
+  std::mt19937_64 rng(53);
+  const auto& scales = BandScales();
+  std::vector<std::uint8_t> band(512);
+  for (auto& b : band) b = static_cast<std::uint8_t>(rng() % 63);
+  std::vector<SumLimbs> list_sums(512), pair_sums(512);
+  for (int v = 0; v < 512; ++v)
+    for (int j = 0; j < 6; ++j) Split(rng, RandomInteger(rng, 60), &list_sums[v], j);
+  pair_sums = list_sums;
+  for (int camera = 0; camera < 12; ++camera) {
+    std::vector<std::int16_t> voxel, index;
+    std::vector<double> information;
+    for (int v = 0; v < 512; ++v) {
+      if (rng() % 3 == 0) continue;  // not seen by this camera
+      const std::vector<double> c = Contribution(rng, int(rng() % std::uint64_t(band[v] + 1)));
+      voxel.push_back(static_cast<std::int16_t>(v));
+      index.push_back(static_cast<std::int16_t>(index.size()));
+      information.insert(information.end(), c.begin(), c.end());
+    }
+    const bool add = camera % 4 != 3;
+    AccumulateLimbList(int(voxel.size()), voxel.data(), index.data(), information.data(),
+                       band.data(), list_sums.data(), add);
+    for (std::size_t j = 0; j < voxel.size(); ++j)
+      AccumulateLimbs(pair_sums[voxel[j]], &information[6 * j], scales[band[voxel[j]]].down, add);
+  }
+  for (int v = 0; v < 512; ++v)
+    for (int j = 0; j < 6; ++j) {
+      ASSERT_EQ(DoubleBits(list_sums[v].hi[j]), DoubleBits(pair_sums[v].hi[j])) << v << " " << j;
+      ASSERT_EQ(DoubleBits(list_sums[v].mid[j]), DoubleBits(pair_sums[v].mid[j])) << v << " " << j;
+      ASSERT_EQ(DoubleBits(list_sums[v].lo[j]), DoubleBits(pair_sums[v].lo[j])) << v << " " << j;
+    }
+}
+
 }  // namespace
 }  // namespace pandora::information

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -200,7 +202,8 @@ bool HaveAvx2() {
 // PixelDensity's expressions lane by lane: Eigen sums a 3-vector's squared norm and dot product
 // as x0 + (x1 + x2); a degenerate or non-finite determinant gives 0 (the select keeps the square
 // roots of the other lanes exact; both are correctly rounded in scalar and vector code).
-inline void DensityLanes(int n, const double* const jac[6], float* out) {
+__attribute__((always_inline)) inline void DensityLanes(int n, const double* const jac[6],
+                                                        float* out) {
   const double* __restrict j0 = jac[0];
   const double* __restrict j1 = jac[1];
   const double* __restrict j2 = jac[2];
@@ -214,9 +217,20 @@ inline void DensityLanes(int n, const double* const jac[6], float* out) {
     const double b = j0[m] * j3[m] + (j1[m] * j4[m] + j2[m] * j5[m]);
     const double c = j3[m] * j3[m] + (j4[m] * j4[m] + j5[m] * j5[m]);
     const double det = a * c - b * b;
-    const bool good = det > 0.0 && det <= std::numeric_limits<double>::max();
-    const double root = std::sqrt(std::sqrt(good ? det : 1.0));
-    o[m] = good ? static_cast<float>(root) : 0.0f;
+    // det > 0 and det <= DBL_MAX (not NaN, not infinite), and the selects, on the bits: with
+    // floating-point comparisons and selects GCC keeps branches (it may not make a comparison that
+    // can trap unconditional) and does not vectorise the loop.
+    std::uint64_t bits;
+    std::memcpy(&bits, &det, sizeof(bits));
+    const std::uint64_t good = -std::uint64_t(bits - 1 < 0x7fefffffffffffffULL);      // all ones
+    const std::uint64_t safe_bits = (bits & good) | (0x3ff0000000000000ULL & ~good);  // else 1.0
+    double safe;
+    std::memcpy(&safe, &safe_bits, sizeof(safe));
+    const float root = static_cast<float>(std::sqrt(std::sqrt(safe)));
+    std::uint32_t root_bits;
+    std::memcpy(&root_bits, &root, sizeof(root_bits));
+    root_bits &= static_cast<std::uint32_t>(good);  // +0.0f where not good
+    std::memcpy(o + m, &root_bits, sizeof(root_bits));
   }
 }
 __attribute__((target("avx2"))) void DensityLanesAvx2(int n, const double* const jac[6],
