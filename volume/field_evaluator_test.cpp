@@ -4,6 +4,7 @@
 // tree topology), and so do the summary statistics. Also: cancellation keeps the previous fields,
 // and the evaluator takes rigs of any size.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <atomic>
@@ -378,6 +379,31 @@ TEST(FieldEvaluator, PrunedAnglePairsEqualTheExhaustiveSearch) {
                      "step " + std::to_string(step) + " (" + edit + ")");
     if (::testing::Test::HasFatalFailure()) return;
   }
+}
+
+// FieldOptions::time_phases (pandora bench's floor) times the uncertainty fields' own steps and
+// changes nothing: the same fields bit for bit; each step timed, within the evaluation's wall
+// time on one thread; nothing timed without it or without uncertainty fields.
+TEST(FieldEvaluator, TimedPhasesChangeNothing) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const Scene scene = SyntheticScene();
+  const auto caster = MakeEmbreeRayCaster(scene.AllTriangles());
+  FieldOptions plain;
+  plain.fields = FieldNames();
+  FieldOptions timed = plain;
+  timed.time_phases = true;
+  const Fields a = EvaluateFields(scene, scene.rigs[0], *caster, plain);
+  const Fields b = EvaluateFields(scene, scene.rigs[0], *caster, timed);
+  ExpectSameFields(a, b, "timed");
+  const FieldStats::Phases& p = b.stats.phases;
+  EXPECT_GT(p.contributions, 0);
+  EXPECT_GT(p.sums, 0);
+  EXPECT_GT(p.eigenvalues, 0);
+  EXPECT_GT(p.angles, 0);
+  EXPECT_LT(p.Total(), b.stats.seconds);
+  EXPECT_EQ(a.stats.phases.Total(), 0.0);
+  timed.fields = {"coverage", "cameras", "resolution"};
+  EXPECT_EQ(EvaluateFields(scene, scene.rigs[0], *caster, timed).stats.phases.Total(), 0.0);
 }
 
 // A session keeps every camera's per-block entries for incremental updates: that state is bounded

@@ -794,6 +794,29 @@ struct FieldEvaluator::State {
   // (voxel, camera pair) dot products of triangulation_angle in the current update, and all the
   // pairs there were to try.
   mutable std::atomic<std::int64_t> angle_pairs_tried{0}, angle_pairs_all{0};
+  // With options.time_phases: nanoseconds in each of FieldStats::Phases' steps, in its order.
+  enum Phase { kContributions, kSums, kEigenvalues, kAngles, kPhaseCount };
+  mutable std::array<std::atomic<std::int64_t>, kPhaseCount> phase_ns{};
+  // Adds the time from its construction to its destruction to phase_ns[phase] (when timed).
+  class PhaseTimer {
+   public:
+    PhaseTimer(const State& s, Phase phase)
+        : s_(s), phase_(phase), on_(s.options.time_phases), start_(on_ ? Now() : 0) {}
+    ~PhaseTimer() {
+      if (on_) s_.phase_ns[phase_] += Now() - start_;
+    }
+
+   private:
+    static std::int64_t Now() {
+      return std::chrono::duration_cast<std::chrono::nanoseconds>(
+                 std::chrono::steady_clock::now().time_since_epoch())
+          .count();
+    }
+    const State& s_;
+    Phase phase_;
+    bool on_;
+    std::int64_t start_;
+  };
 
   State(const Scene& s, const RayCaster& c) : scene(&s), caster(&c) {}
 
@@ -1007,6 +1030,7 @@ void FieldEvaluator::State::Cast(const BlockPoints& points, int camera, const Ri
     PixelDensityLanes(visible, jac, entry->density.data());
   }
   if (want_information && visible > 0) {
+    const PhaseTimer timer(*this, kContributions);
     InformationLanes(visible, rd.whitened[camera].data(), &scratch);
     entry->information.resize(6 * std::size_t(visible));
     entry->band.resize(std::size_t(visible));
@@ -1394,7 +1418,8 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
         }
       }
     }
-    if (any_info)
+    if (any_info) {
+      const PhaseTimer timer(*this, kSums);
       for (const CameraEntry* e : view) {
         // The camera's pairs to sum exactly listed first, then summed in one call (SIMD).
         std::array<std::int16_t, 512>& voxels = scratch->list_voxel;
@@ -1414,6 +1439,7 @@ void FieldEvaluator::State::Rescan(const std::vector<const CameraEntry*>& view, 
         AccumulateLimbList(listed, voxels.data(), indices.data(), e->information.data(),
                            next->sum_band.data(), next->sums.data(), true);
       }
+    }
   }
 }
 
@@ -1489,9 +1515,15 @@ void FieldEvaluator::State::CandidateStatistics(const std::vector<const CameraEn
   for (int k = 0; k < 6; ++k) upper_ptr[k] = scratch->upper[k].data();
   double* eigen_ptr[3] = {scratch->eigenvalue[0].data(), scratch->eigenvalue[1].data(),
                           scratch->eigenvalue[2].data()};
-  SymmetricEigenvalues3(upper_ptr, eigen_ptr, scratch->converged.data(), candidate_count);
+  {
+    const PhaseTimer timer(*this, kEigenvalues);
+    SymmetricEigenvalues3(upper_ptr, eigen_ptr, scratch->converged.data(), candidate_count);
+  }
   StaticStatistics(candidate_count, eigen_ptr, stats_ptr);
-  if (want_angle) CandidateAngles(view, is_changed, centres, fresh, next, scratch);
+  if (want_angle) {
+    const PhaseTimer timer(*this, kAngles);
+    CandidateAngles(view, is_changed, centres, fresh, next, scratch);
+  }
   if (want_steady) {
     const double frame = frame_period;
     for (int k = 0; k < 3; ++k)
@@ -2467,6 +2499,10 @@ void FinishUpdate(State& S, const Rig& rig, const RigData& rd, UpdatePass* u, Fi
   st.estimated_bytes = estimated;
   st.angle_pairs_tried = S.angle_pairs_tried;
   st.angle_pairs_all = S.angle_pairs_all;
+  st.phases.contributions = 1e-9 * double(S.phase_ns[State::kContributions]);
+  st.phases.sums = 1e-9 * double(S.phase_ns[State::kSums]);
+  st.phases.eigenvalues = 1e-9 * double(S.phase_ns[State::kEigenvalues]);
+  st.phases.angles = 1e-9 * double(S.phase_ns[State::kAngles]);
   st.active_set_seconds = update->full || u->per_block ? S.active_set_seconds : 0.0;
   if (opt.record_rays && update->full) {
     // Joined in block order; without kept state each block's own copy goes as it is joined.
@@ -2513,6 +2549,7 @@ FieldUpdate FieldEvaluator::Update(const Rig& rig) {
   const RigData rd = S.Prepare(rig);
   S.angle_pairs_tried = 0;
   S.angle_pairs_all = 0;
+  for (auto& ns : S.phase_ns) ns = 0;
 
   // New candidate lists; the blocks to visit are those a changed camera's old or new frustum
   // meets (all of them the first time).
@@ -2620,6 +2657,7 @@ FieldUpdate FieldEvaluator::UpdateScene(const Scene& scene, const RayCaster& cas
   const RigData rd = S.Prepare(rig);
   S.angle_pairs_tried = 0;
   S.angle_pairs_all = 0;
+  for (auto& ns : S.phase_ns) ns = 0;
   // Boxes padded for round-off: a segment that misses one cannot meet what moved inside it.
   const double pad = 1e-6 * scale + 1e-9;
   const auto padded = [pad](const std::vector<Aabb>& in) {

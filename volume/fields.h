@@ -60,6 +60,9 @@ struct FieldOptions {
   /// Try every camera pair for triangulation_angle instead of only those whose angle bound can
   /// still win (the same values, more work): for tests and benchmarks.
   bool exhaustive_angle_pairs = false;
+  /// Time the uncertainty fields' own steps (FieldStats::phases), two clock reads per step and
+  /// block or camera: for `pandora bench`, which reports them from an evaluation of their own.
+  bool time_phases = false;
   /// Set from another thread to stop FieldEvaluator::Update early; the evaluator then keeps the
   /// fields of the previous update (nothing half updated). Checked once per block.
   const std::atomic<bool>* cancel = nullptr;
@@ -126,6 +129,14 @@ struct FieldStats {
   /// triangulation_angle's work in this evaluation or update: (voxel, camera pair) dot products
   /// computed, and those an all-pairs search would compute (docs/performance.md).
   std::int64_t angle_pairs_tried = 0, angle_pairs_all = 0;
+  /// With FieldOptions::time_phases: seconds (summed over the threads) in the steps that only the
+  /// uncertainty fields take, each already vectorised over a block's voxels: the contributions
+  /// J^T J of seen voxels (with their bands), the exact sums (limbs), the 3x3 eigenvalues and the
+  /// exact best camera pair and its angle. Zero otherwise.
+  struct Phases {
+    double contributions = 0, sums = 0, eigenvalues = 0, angles = 0;
+    double Total() const { return contributions + sums + eigenvalues + angles; }
+  } phases;
 };
 
 /// Opaque holder of the evaluated grids (OpenVDB inside).
