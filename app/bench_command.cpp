@@ -205,6 +205,31 @@ TimeSampleTimes TimeSamples(const Scene& scene, const Rig& rig, const RayCaster&
   return t;
 }
 
+// The uncertainty fields' own steps and the floor they set for all fields / coverage alone (each
+// step is vectorised, and the eigenvalues and the best pair are fixed bit for bit:
+// docs/performance.md), and the share of camera pairs triangulation_angle tried.
+void PrintUncertaintySteps(const BenchTimes& t) {
+  const FieldStats::Phases& ph = t.phases;
+  std::printf(
+      "  uncertainty's own steps (timed in one more all-fields evaluation): contributions %.4f s, "
+      "exact sums %.4f s, eigenvalues %.4f s, best pairs %.4f s\n",
+      ph.contributions, ph.sums, ph.eigenvalues, ph.angles);
+  std::printf(
+      "  ratio (coverage alone + those steps) / coverage alone = %.3f (a floor for all fields / "
+      "coverage alone; eigenvalues and best pairs alone %.3f)\n",
+      1.0 + ph.Total() / t.coverage, 1.0 + (ph.eigenvalues + ph.angles) / t.coverage);
+  const FieldStats& all_stats = t.all_stats;
+  const std::int64_t two_or_more =
+      all_stats.seen_voxels -
+      (all_stats.coverage_histogram.size() > 1 ? all_stats.coverage_histogram[1] : 0);
+  if (all_stats.angle_pairs_all > 0)
+    std::printf(
+        "  triangulation_angle: %.1f%% of the (voxel, camera pair) dot products of an all-pairs "
+        "search, %.1f pairs per voxel seen twice or more\n",
+        100.0 * double(all_stats.angle_pairs_tried) / double(all_stats.angle_pairs_all),
+        double(all_stats.angle_pairs_tried) / double(std::max<std::int64_t>(1, two_or_more)));
+}
+
 // Prints TimeSamples' measurement (nothing for a static scene).
 void PrintTimeSamples(const TimeSampleTimes& times) {
   if (times.samples == 0) return;
@@ -314,26 +339,7 @@ int RunBench(const BenchArgs& args) {
   std::printf(
       "  all %zu fields %.4f s: ratio all fields / coverage alone = %.3f (target <= 1.15)\n",
       all_field_names.size(), t.all, t.all / best_coverage);
-  // What the ratio cannot go below while these steps stay as they are: each is vectorised, and
-  // the eigenvalues and the best pair are fixed bit for bit (docs/performance.md).
-  const FieldStats::Phases& ph = t.phases;
-  std::printf(
-      "  uncertainty's own steps (timed in one more all-fields evaluation): contributions %.4f s, "
-      "exact sums %.4f s, eigenvalues %.4f s, best pairs %.4f s\n",
-      ph.contributions, ph.sums, ph.eigenvalues, ph.angles);
-  std::printf(
-      "  ratio (coverage alone + those steps) / coverage alone = %.3f (a floor for all fields / "
-      "coverage alone; eigenvalues and best pairs alone %.3f)\n",
-      1.0 + ph.Total() / best_coverage, 1.0 + (ph.eigenvalues + ph.angles) / best_coverage);
-  const std::int64_t two_or_more =
-      all_stats.seen_voxels -
-      (all_stats.coverage_histogram.size() > 1 ? all_stats.coverage_histogram[1] : 0);
-  if (all_stats.angle_pairs_all > 0)
-    std::printf(
-        "  triangulation_angle: %.1f%% of the (voxel, camera pair) dot products of an all-pairs "
-        "search, %.1f pairs per voxel seen twice or more\n",
-        100.0 * double(all_stats.angle_pairs_tried) / double(all_stats.angle_pairs_all),
-        double(all_stats.angle_pairs_tried) / double(std::max<std::int64_t>(1, two_or_more)));
+  PrintUncertaintySteps(t);
   PrintTimeSamples(times);
 
   if (!args.json_out.empty()) {
@@ -367,10 +373,10 @@ int RunBench(const BenchArgs& args) {
                      {"uncertainty_overhead", uncertainty_overhead},
                      {"coverage_only_cpu_seconds", cpu_coverage},
                      {"with_uncertainty_cpu_seconds", cpu_uncertainty},
-                     {"contribution_seconds", ph.contributions},
-                     {"exact_sum_seconds", ph.sums},
-                     {"eigenvalue_seconds", ph.eigenvalues},
-                     {"best_pair_seconds", ph.angles},
+                     {"contribution_seconds", t.phases.contributions},
+                     {"exact_sum_seconds", t.phases.sums},
+                     {"eigenvalue_seconds", t.phases.eigenvalues},
+                     {"best_pair_seconds", t.phases.angles},
                      {"uncertainty_overhead_cpu", cpu_overhead},
                      {"all_fields", all_field_names},
                      {"all_fields_seconds", t.all},
