@@ -185,46 +185,8 @@ struct SumLimbs {
 
 typedef double V2 __attribute__((vector_size(16)));
 
-// Adds (`add`) or subtracts contribution c (six doubles) on band scale `down` (2^-q as two
-// factors) to s: six entries as three pairs, so SSE2 adds two at a time.
-__attribute__((always_inline)) inline void AccumulateLimbs(SumLimbs& s, const double* c,
-                                                           const double* down, bool add) {
-  const V2 d0 = {down[0], down[0]}, d1 = {down[1], down[1]};
-  const V2 m_hi = {0x1.8p122, 0x1.8p122}, m_mid = {0x1.8p87, 0x1.8p87}, m_lo = {0x1.8p52, 0x1.8p52};
-  for (int k = 0; k < 6; k += 2) {
-    V2 y;
-    std::memcpy(&y, c + k, sizeof(y));
-    y = (y * d0) * d1;
-    const V2 hi = (y + m_hi) - m_hi;
-    const V2 r1 = y - hi;
-    const V2 mid = (r1 + m_mid) - m_mid;
-    const V2 r2 = r1 - mid;
-    const V2 lo = (r2 + m_lo) - m_lo;
-    V2 a, b, e;
-    std::memcpy(&a, s.hi + k, sizeof(a));
-    std::memcpy(&b, s.mid + k, sizeof(b));
-    std::memcpy(&e, s.lo + k, sizeof(e));
-    if (add) {
-      a += hi, b += mid, e += lo;
-    } else {
-      a -= hi, b -= mid, e -= lo;
-    }
-    std::memcpy(s.hi + k, &a, sizeof(a));
-    std::memcpy(s.mid + k, &b, sizeof(b));
-    std::memcpy(s.lo + k, &e, sizeof(e));
-  }
-}
-
-// AccumulateLimbs for a list of (voxel, contribution) pairs, j < n: contribution
-// information[6 index[j]] (one camera's, ascending seen voxel) added (`add`) to or subtracted from
-// sums[voxel[j]] on that voxel's band, band[voxel[j]] (< kNotExact). Where the CPU has AVX2 a
-// pair's six entries go as four and two (AccumulateEntries), with the same operations per entry
-// as AccumulateLimbs, so the same bits (information_sum_test); elsewhere AccumulateLimbs pair by
-// pair. (All six in one AVX-512 vector with masked loads and stores was slower on the capture
-// stage, 0.161 s against 0.152 s for all nine fields.)
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-typedef double V4 __attribute__((vector_size(32)));
-// Entries k..k+W-1 of one pair (W = 2 or 4 doubles of vector type V).
+// Entries k..k+W-1 of contribution c added (`add`) to or subtracted from s on band scale
+// (down0, down1) = 2^-q as two factors: W = 2 or 4 doubles of vector type V.
 template <typename V>
 __attribute__((always_inline)) inline void AccumulateEntries(SumLimbs& s, const double* c, int k,
                                                              double down0, double down1, bool add) {
@@ -251,6 +213,23 @@ __attribute__((always_inline)) inline void AccumulateEntries(SumLimbs& s, const 
   std::memcpy(s.mid + k, &b, sizeof(b));
   std::memcpy(s.lo + k, &e, sizeof(e));
 }
+
+// Adds (`add`) or subtracts contribution c (six doubles) on band scale `down` (2^-q as two
+// factors) to s: six entries as three pairs, so SSE2 adds two at a time.
+__attribute__((always_inline)) inline void AccumulateLimbs(SumLimbs& s, const double* c,
+                                                           const double* down, bool add) {
+  for (int k = 0; k < 6; k += 2) AccumulateEntries<V2>(s, c, k, down[0], down[1], add);
+}
+
+// AccumulateLimbs for a list of (voxel, contribution) pairs, j < n: contribution
+// information[6 index[j]] (one camera's, ascending seen voxel) added (`add`) to or subtracted from
+// sums[voxel[j]] on that voxel's band, band[voxel[j]] (< kNotExact). Where the CPU has AVX2 a
+// pair's six entries go as four and two (AccumulateEntries), with the same operations per entry
+// as AccumulateLimbs, so the same bits (information_sum_test); elsewhere AccumulateLimbs pair by
+// pair. (All six in one AVX-512 vector with masked loads and stores was slower on the capture
+// stage, 0.161 s against 0.152 s for all nine fields.)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+typedef double V4 __attribute__((vector_size(32)));
 __attribute__((target("avx2"))) inline void AccumulateLimbListAvx2(
     int n, const std::int16_t* voxel, const std::int16_t* index, const double* information,
     const std::uint8_t* band, const BandScale* scales, SumLimbs* sums, bool add) {
