@@ -11,6 +11,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include "analysis/geometry/ray_caster.h"
@@ -29,6 +30,39 @@ double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Each camera of `rig` in turn moved sideways by `move` in its own frame (its x axis), then back:
+// `update(edited)` after every move.
+template <typename F>
+void MoveEachCamera(const Rig& rig, double move, F&& update) {
+  Rig edited = rig;
+  for (Camera& camera : edited.cameras) {
+    const Vec3 side = camera.world_from_camera.linear().col(0);
+    for (const double step : {move, -move}) {
+      camera.world_from_camera.translation() += step * side;
+      update(edited);
+    }
+  }
+}
+
+// The same edits on an evaluator of their own that times the uncertainty fields' own steps (not
+// the timed one: its clock reads would weigh on the updates measured): the mean time per update
+// in its dirty voxels' eigenvalues and best pairs, computed as a full evaluation computes them.
+double FixedStepsPerUpdate(const Scene& scene, const RayCaster& caster, FieldOptions options,
+                           const Rig& rig, double move) {
+  options.time_phases = true;
+  FieldEvaluator evaluator(scene, caster, options);
+  evaluator.Update(rig);
+  double seconds = 0;
+  int count = 0;
+  MoveEachCamera(rig, move, [&](const Rig& edited) {
+    evaluator.Update(edited);
+    const FieldStats::Phases& p = evaluator.fields().stats.phases;
+    seconds += p.eigenvalues + p.angles;
+    ++count;
+  });
+  return count > 0 ? seconds / count : 0.0;
 }
 
 }  // namespace
@@ -52,19 +86,14 @@ int RunIncrementalBench(const BenchArgs& args) {
   options.fields = scene.study.fields;  // the study's own workload
   options.memory_budget_bytes = scene.study.memory_budget_bytes;
 
-  // The evaluator also times the uncertainty fields' own steps (a few clock reads per block):
-  // what an update spends in its dirty voxels' eigenvalues and best pairs, which it computes as a
-  // full evaluation does (bit for bit).
-  FieldOptions timed = options;
-  timed.time_phases = true;
-  FieldEvaluator evaluator(scene, *caster, timed);
-  const FieldUpdate first = evaluator.Update(rig);
+  // Held optionally so that it goes before FixedStepsPerUpdate builds another (kept state twice).
+  std::optional<FieldEvaluator> evaluator(std::in_place, scene, *caster, options);
+  const FieldUpdate first = evaluator->Update(rig);
   const int n = static_cast<int>(rig.cameras.size());
 
   double best_full = std::numeric_limits<double>::infinity();
   double best_full_cpu = std::numeric_limits<double>::infinity();
   std::vector<double> updates, updates_cpu;
-  double fixed_steps = 0;  // eigenvalues and best pairs, all updates
   std::int64_t dirty_voxels = 0, update_rays = 0, region_voxels = 0, full_rays = 0;
   for (int r = 0; r < args.repeat; ++r) {
     const std::clock_t cpu0 = std::clock();
@@ -73,22 +102,14 @@ int RunIncrementalBench(const BenchArgs& args) {
     best_full = std::min(best_full, full.stats.seconds);
     region_voxels = full.stats.active_set.region_voxels;
     full_rays = full.stats.rays;
-    Rig edited = rig;
-    for (int c = 0; c < n; ++c) {
-      // Sideways in the camera's own frame (its x axis), then back.
-      const Vec3 side = edited.cameras[c].world_from_camera.linear().col(0);
-      for (const double step : {args.move, -args.move}) {
-        edited.cameras[c].world_from_camera.translation() += step * side;
-        const std::clock_t u0 = std::clock();
-        const FieldUpdate u = evaluator.Update(edited);
-        updates_cpu.push_back(double(std::clock() - u0) / CLOCKS_PER_SEC);
-        updates.push_back(u.seconds);
-        const FieldStats::Phases& p = evaluator.fields().stats.phases;
-        fixed_steps += p.eigenvalues + p.angles;
-        dirty_voxels += u.dirty_voxels;
-        update_rays += u.rays;
-      }
-    }
+    MoveEachCamera(rig, args.move, [&](const Rig& edited) {
+      const std::clock_t u0 = std::clock();
+      const FieldUpdate u = evaluator->Update(edited);
+      updates_cpu.push_back(double(std::clock() - u0) / CLOCKS_PER_SEC);
+      updates.push_back(u.seconds);
+      dirty_voxels += u.dirty_voxels;
+      update_rays += u.rays;
+    });
   }
   const double mean = std::accumulate(updates.begin(), updates.end(), 0.0) / updates.size();
   const double median = Median(updates);
@@ -99,7 +120,9 @@ int RunIncrementalBench(const BenchArgs& args) {
   const double ray_share = double(update_rays) / double(updates.size()) / double(full_rays);
   const double ratio = mean / best_full;
   const double ratio_cpu = mean_cpu / best_full_cpu;
-  const double state_mib = evaluator.state_bytes() / 1048576.0;
+  const double state_mib = evaluator->state_bytes() / 1048576.0;
+  evaluator.reset();
+  const double fixed_mean = FixedStepsPerUpdate(scene, *caster, options, rig, args.move);
 
   std::printf(
       "pandora bench --incremental: %s, rig %s (%d cameras), voxel %.4g m, %zu fields, %d "
@@ -121,7 +144,6 @@ int RunIncrementalBench(const BenchArgs& args) {
               ratio_cpu, n, 1.0 / n);
   std::printf("  edit-to-updated-fields latency: median %.1f ms, worst %.1f ms\n", 1e3 * median,
               1e3 * worst);
-  const double fixed_mean = fixed_steps / double(updates.size());
   if (fixed_mean > 0)
     std::printf(
         "  of an update, its dirty voxels' eigenvalues and best pairs: mean %.4f s = %.3f of a "
