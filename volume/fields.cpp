@@ -1475,12 +1475,14 @@ void FieldEvaluator::State::WriteDirtyVoxels(const Block& block, const Bits& dir
         else
           resolution->setValueOff(o, 0.0f);
       }
-      for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
-        if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
       if (!want_information || coverage < 2) {  // not triangulable: no uncertainty work
+        for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
+          if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
         if (want_angle) next->pair_a[o] = next->pair_b[o] = -1;
         continue;
       }
+      // A candidate's uncertainty fields are written by PutStatistics: on where it is
+      // triangulable (every one of them), off where it is not.
       if (TestBit(in_double, o)) {
         for (int k = 0; k < 6; ++k) upper[k][candidate_count] = double_sum[double_index[o]][k];
       } else {
@@ -1634,6 +1636,8 @@ void FieldEvaluator::State::PutStatistics(BlockState* next, BlockLeaves* leaves,
     const int o = candidate[m];
     if (stats[kObservable][m] == 0.0) {
       next->status[o] = kUnobservable;
+      for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
+        if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
       continue;
     }
     next->status[o] = kTriangulable;
