@@ -594,6 +594,11 @@ struct BlockLeaves {
   std::array<bool, kFloatFieldCount> float_owned{};
   std::array<bool, kFloatFieldCount> remove_float{};
   std::vector<std::pair<int, openvdb::BoolTree::LeafNodeType*>> visible;  // changed cameras
+  // Voxel o of every uncertainty field (those after resolution): inactive, 0.
+  void ClearUncertainty(int o) {
+    for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
+      if (floats[f]) floats[f]->setValueOff(o, 0.0f);
+  }
   void Free() {
     if (coverage_owned) delete coverage;
     for (int f = 0; f < kFloatFieldCount; ++f)
@@ -1476,8 +1481,7 @@ void FieldEvaluator::State::WriteDirtyVoxels(const Block& block, const Bits& dir
           resolution->setValueOff(o, 0.0f);
       }
       if (!want_information || coverage < 2) {  // not triangulable: no uncertainty work
-        for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
-          if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
+        leaves->ClearUncertainty(o);
         if (want_angle) next->pair_a[o] = next->pair_b[o] = -1;
         continue;
       }
@@ -1636,8 +1640,7 @@ void FieldEvaluator::State::PutStatistics(BlockState* next, BlockLeaves* leaves,
     const int o = candidate[m];
     if (stats[kObservable][m] == 0.0) {
       next->status[o] = kUnobservable;
-      for (int f = kResolution + 1; f < kFloatFieldCount; ++f)
-        if (leaves->floats[f]) leaves->floats[f]->setValueOff(o, 0.0f);
+      leaves->ClearUncertainty(o);
       continue;
     }
     next->status[o] = kTriangulable;
